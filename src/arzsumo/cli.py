@@ -1,0 +1,124 @@
+"""Command-line interface: one thin command per stage.
+
+Each command loads and validates its input, calls one library function and prints or
+saves. User mistakes (:class:`arzsumo.errors.ArzsumoError`) end as one line on stderr
+with exit code 2; logging is configured here and nowhere else.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import sys
+from collections.abc import Callable, Sequence
+
+from arzsumo import __version__
+from arzsumo.errors import ArzsumoError
+from arzsumo.model import linearize
+from arzsumo.scenarios import Scenario, load_scenario, scenario_from_preset
+from arzsumo.units import ms_to_kmh
+
+log = logging.getLogger("arzsumo")
+
+Command = Callable[[argparse.Namespace], int]
+
+
+def _scenario(args: argparse.Namespace) -> Scenario:
+    if getattr(args, "scenario", None):
+        return load_scenario(args.scenario)
+    return scenario_from_preset(args.preset)
+
+
+def _add_model_source(p: argparse.ArgumentParser) -> None:
+    src = p.add_mutually_exclusive_group()
+    src.add_argument("--preset", default="paper_base",
+                     help="named model preset (paper_base, paper_s12, paper_aggressive)")
+    src.add_argument("--scenario", metavar="FILE.toml", help="scenario file instead of a preset")
+
+
+def model_summary(sc: Scenario) -> dict:
+    """The equilibrium, eigenvalues, regime and t_f of a scenario, SI units."""
+    lin = linearize(sc.equilibrium)
+    return {
+        "scenario": sc.name,
+        "units": "SI (m, s, veh/m, m/s, veh/s)",
+        "params": {k: getattr(sc.params, k) for k in sc.params.__dataclass_fields__},
+        "equilibrium": sc.equilibrium.as_dict(),
+        "eigenvalues": [float(v) for v in lin.eigenvalues],
+        "regime": lin.regime,
+        "t_f": lin.t_f,
+    }
+
+
+def _print_model(summary: dict, description: str) -> None:
+    eq = summary["equilibrium"]
+    lam = [float(ms_to_kmh(v)) for v in summary["eigenvalues"]]
+    print(f"model {summary['scenario']}: {description}")
+    print("equilibrium")
+    print(f"  HV  rho = {eq['rho_h'] * 1000:7.2f} veh/km   v = {eq['v_h'] * 3.6:6.2f} km/h"
+          f"   q = {eq['q_h'] * 3600:6.0f} veh/h")
+    print(f"  AV  rho = {eq['rho_a'] * 1000:7.2f} veh/km   v = {eq['v_a'] * 3.6:6.2f} km/h"
+          f"   q = {eq['q_a'] * 3600:6.0f} veh/h")
+    print(f"  AO = {eq['ao']:.4f}   AV penetration = {eq['penetration']:.1%}")
+    print("characteristic speeds (km/h)")
+    print(f"  lambda_1 = {lam[0]:8.3f}  (= v_h)\n  lambda_2 = {lam[1]:8.3f}\n"
+          f"  lambda_3 = {lam[2]:8.3f}  (= v_a)\n  lambda_4 = {lam[3]:8.3f}")
+    sign = "< 0" if summary["regime"] == "congested" else ">= 0"
+    print(f"regime: {summary['regime']} (lambda_4 {sign})")
+    print(f"t_f = L/min(lambda_1, lambda_3) + L/(-lambda_4) = {summary['t_f']:.1f} s")
+
+
+def cmd_model(args: argparse.Namespace) -> int:
+    sc = _scenario(args)
+    if args.regime_map:
+        from arzsumo.model.regime import regime_map
+        from arzsumo.plots.regime import write_regime_map
+
+        path = write_regime_map(args.regime_map, regime_map(sc.params),
+                                (sc.equilibrium.rho_h, sc.equilibrium.rho_a),
+                                f"Regime map, {sc.name}")
+        log.info("regime map written to %s", path)
+    summary = model_summary(sc)
+    if args.json:
+        print(json.dumps(summary, indent=2))
+    else:
+        _print_model(summary, sc.description)
+        if args.regime_map:
+            print(f"regime map: {args.regime_map}")
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="arzsumo",
+        description="PDE boundary control of mixed-autonomy traffic, from the ARZ model "
+                    "into SUMO.")
+    parser.add_argument("--version", action="version", version=f"arzsumo {__version__}")
+    parser.add_argument("-v", "--verbose", action="store_true", help="debug logging")
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    p = sub.add_parser("model", help="equilibrium, eigenvalues, regime and t_f of a model")
+    _add_model_source(p)
+    p.add_argument("--json", action="store_true", help="print JSON with SI values")
+    p.add_argument("--regime-map", metavar="FILE.png", help="draw the free/congested map")
+    p.set_defaults(func=cmd_model)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    logging.basicConfig(level=logging.DEBUG if args.verbose else logging.INFO,
+                        format="%(levelname)s %(name)s: %(message)s")
+    logging.getLogger("matplotlib").setLevel(logging.WARNING)
+    func: Command = args.func
+    try:
+        return func(args)
+    except ArzsumoError as exc:
+        print(f"arzsumo: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

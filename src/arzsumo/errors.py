@@ -1,0 +1,31 @@
+"""Exceptions for user mistakes.
+
+Every error a user can cause by a bad argument, preset or scenario value derives from
+:class:`ArzsumoError`. The CLI prints such an error as one line and exits with code 2;
+anything else is a bug and keeps its traceback.
+"""
+
+from __future__ import annotations
+
+
+class ArzsumoError(Exception):
+    """A user-facing error: the message names the field, the value and what is allowed."""
+
+
+class ModelError(ArzsumoError, ValueError):
+    """Invalid model parameters or states (e.g. negative density, AO at or above its maximum)."""
+
+
+class ScenarioError(ArzsumoError, ValueError):
+    """An invalid scenario file, key or value."""
+
+
+class DemandError(ModelError):
+    """A traffic demand the fundamental diagram cannot carry."""
+
+
+def require(condition: bool, field: str, value: object, allowed: str,
+            error: type[ArzsumoError] = ModelError) -> None:
+    """Raise ``error`` with a message naming ``field``, ``value`` and what is ``allowed``."""
+    if not condition:
+        raise error(f"{field} = {value!r} is not allowed: {allowed}")

@@ -1,0 +1,62 @@
+import json
+import subprocess
+import sys
+
+import pytest
+
+from arzsumo.cli import main
+
+
+def run_cli(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "arzsumo.cli", *args], capture_output=True,
+                          text=True, timeout=120)
+
+
+def test_model_json_has_the_documented_keys(capsys):
+    assert main(["model", "--preset", "paper_base", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert set(out["equilibrium"]) >= {"rho_h", "rho_a", "v_h", "v_a"}
+    assert len(out["eigenvalues"]) == 4 and out["eigenvalues"][3] < 0
+    assert out["regime"] == "congested"
+    assert out["t_f"] == pytest.approx(250.15, abs=0.05)
+    assert out["equilibrium"]["rho_h"] == pytest.approx(0.110)
+
+
+def test_model_human_output_in_human_units(capsys):
+    assert main(["model", "--preset", "paper_s12"]) == 0
+    out = capsys.readouterr().out
+    assert "110.00 veh/km" in out and "48.29 km/h" in out and "congested" in out
+
+
+def test_regime_map_png(tmp_path, capsys):
+    target = tmp_path / "map.png"
+    assert main(["model", "--regime-map", str(target)]) == 0
+    assert target.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert target.stat().st_size > 20_000
+    assert not list(tmp_path.glob(".*"))        # no temporary file left behind
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    (["model", "--preset", "nope"], "preset = 'nope' is unknown"),
+    (["model", "--scenario", "missing.toml"], "does not exist"),
+])
+def test_user_errors_are_one_line_exit_2(args, message):
+    proc = run_cli(*args)
+    assert proc.returncode == 2
+    assert message in proc.stderr
+    assert "Traceback" not in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1
+
+
+def test_bad_scenario_values_from_file(tmp_path):
+    cases = {
+        "rho_h_veh_km = -3": "rho_h = -0.003",
+        "rho_h_veh_km = 260\nrho_a_veh_km = 100": "AO = ",
+        "demand_h_veh_h = 9000\ndemand_a_veh_h = 5000": "exceeds what",
+    }
+    for body, message in cases.items():
+        f = tmp_path / "s.toml"
+        f.write_text(f"[equilibrium]\n{body}\n")
+        proc = run_cli("model", "--scenario", str(f))
+        assert proc.returncode == 2, proc.stderr
+        assert message in proc.stderr and "Traceback" not in proc.stderr

@@ -1,0 +1,50 @@
+import pytest
+
+from arzsumo.errors import DemandError, ModelError, ScenarioError
+from arzsumo.scenarios import load_scenario, scenario_from_dict
+
+
+def test_scenario_units_are_converted_to_si():
+    sc = scenario_from_dict({"model": {"preset": "paper_base", "v_free_h_kmh": 72,
+                                       "vehicle_width_m": 2.07},
+                             "equilibrium": {"rho_h_veh_km": 110, "rho_a_veh_km": 95}})
+    assert sc.params.v_free_h == pytest.approx(20.0)
+    assert sc.equilibrium.rho_h == pytest.approx(0.110)
+
+
+def test_scenario_from_demand():
+    sc = scenario_from_dict({"equilibrium": {"demand_h_veh_h": 4104, "demand_a_veh_h": 1560}})
+    assert sc.equilibrium.q_h * 3600 == pytest.approx(4104)
+
+
+@pytest.mark.parametrize(("data", "error", "match"), [
+    ({"modle": {}}, ScenarioError, r"unknown key 'modle'; allowed: description, equilibrium"),
+    ({"model": {"spacing_x_m": 3}}, ScenarioError, r"\[model\]: unknown key 'spacing_x_m'"),
+    ({"model": {"tau_h_s": "fast"}}, ScenarioError, r"tau_h_s = 'fast' is not allowed"),
+    ({"model": {"preset": "paper"}}, ModelError, r"preset = 'paper' is unknown"),
+    ({"equilibrium": {"rho_h_veh_km": -5}}, ModelError, r"rho_h = -0.005"),
+    ({"equilibrium": {"rho_h_veh_km": 200, "rho_a_veh_km": 120}}, ModelError,
+     r"AO = .* below its maximum"),
+    ({"equilibrium": {"demand_h_veh_h": 9000, "demand_a_veh_h": 4000}}, DemandError,
+     r"exceeds what the fundamental diagram can carry"),
+    ({"equilibrium": {"rho_h_veh_km": 110, "demand_h_veh_h": 100}}, ScenarioError,
+     r"not both"),
+    ({"equilibrium": {"v_h_kmh": 32}}, ModelError, r"v_h = 32.00 km/h disagrees"),
+])
+def test_bad_scenarios_name_field_and_value(data, error, match):
+    with pytest.raises(error, match=match):
+        scenario_from_dict(data)
+
+
+def test_missing_and_broken_files(tmp_path):
+    with pytest.raises(ScenarioError, match="does not exist"):
+        load_scenario(tmp_path / "nope.toml")
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[model\n")
+    with pytest.raises(ScenarioError, match="not valid TOML"):
+        load_scenario(bad)
+
+
+def test_shipped_scenarios_load(scenario_files):
+    for path in scenario_files:
+        load_scenario(path)
