@@ -1,0 +1,119 @@
+"""The controller interface shared by the linear plant, the PDE twin and the SUMO bridge.
+
+Every controller (open loop, continuous backstepping, full-state ETC, observer-based ETC,
+ALINEA) is checked once per control period: it receives the macroscopic state available
+to it and returns the physical control U (veh/s), the deviation of the outlet flow from
+q* (paper, section 2), to hold until the next check. Controllers form deviations from
+their equilibrium themselves, so callers hand over the nonlinear fields.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class MacroState:
+    """Macroscopic fields at time ``t`` (s) on cell centres ``x`` (m, increasing, in [0, L]).
+
+    Densities in veh/m, speeds in m/s. A controller that needs only the inlet reads
+    ``v_h[0]``, ``v_a[0]`` (the observer's measurement y(t) = w-(0, t)).
+    """
+
+    t: float
+    x: np.ndarray
+    rho_h: np.ndarray
+    v_h: np.ndarray
+    rho_a: np.ndarray
+    v_a: np.ndarray
+
+
+@dataclass
+class ControlLog:
+    """What a controller did at each check: times, applied and continuous control, events.
+
+    ``u_applied[k]`` is the U (veh/s) held after check k; ``u_continuous[k]`` the value the
+    continuous law would apply at that check; ``triggered[k]`` marks an update of the
+    applied control (an event). ``extra`` holds per-check diagnostics (V, d, m, ...).
+    """
+
+    t: list[float] = field(default_factory=list)
+    u_applied: list[float] = field(default_factory=list)
+    u_continuous: list[float] = field(default_factory=list)
+    triggered: list[bool] = field(default_factory=list)
+    extra: dict[str, list[float]] = field(default_factory=dict)
+
+    def record(self, t: float, u_applied: float, u_continuous: float, triggered: bool,
+               **extra: float) -> None:
+        self.t.append(float(t))
+        self.u_applied.append(float(u_applied))
+        self.u_continuous.append(float(u_continuous))
+        self.triggered.append(bool(triggered))
+        for key, value in extra.items():
+            self.extra.setdefault(key, []).append(float(value))
+
+    @property
+    def triggers(self) -> int:
+        """Number of events (updates of the applied control)."""
+        return int(np.sum(self.triggered))
+
+    @property
+    def event_times(self) -> np.ndarray:
+        """Times (s) of the events."""
+        return np.asarray(self.t)[np.asarray(self.triggered, bool)]
+
+
+class Controller(ABC):
+    """A ramp-metering controller checked once per control period.
+
+    Subclasses implement :meth:`decide`; :meth:`check` records it in :attr:`log`.
+    """
+
+    #: short name used in outputs ("open", "backstepping", "etc", "observer-etc", "alinea")
+    name: str = "controller"
+    #: "full" (needs every cell) or "inlet" (needs only the inlet speeds)
+    measurement: str = "full"
+
+    def __init__(self) -> None:
+        self.log = ControlLog()
+
+    def reset(self) -> None:
+        """Forget all history (new run)."""
+        self.log = ControlLog()
+
+    def check(self, state: MacroState) -> float:
+        """Evaluate the controller at a check instant and return U (veh/s) to hold."""
+        return self.decide(state)
+
+    @abstractmethod
+    def decide(self, state: MacroState) -> float:
+        """Return U (veh/s); implementations append one record to :attr:`log`."""
+
+
+class OpenLoop(Controller):
+    """U = 0: the outlet flow stays at q* (the paper's open-loop case)."""
+
+    name = "open"
+    measurement = "none"
+
+    def decide(self, state: MacroState) -> float:
+        self.log.record(state.t, 0.0, 0.0, False)
+        return 0.0
+
+
+class ConstantControl(Controller):
+    """U held at a constant value (veh/s); useful for tests and for replaying a plan."""
+
+    name = "constant"
+    measurement = "none"
+
+    def __init__(self, u: float) -> None:
+        super().__init__()
+        self.u = float(u)
+
+    def decide(self, state: MacroState) -> float:
+        self.log.record(state.t, self.u, self.u, not self.log.t)
+        return self.u
