@@ -60,3 +60,23 @@ def test_bad_scenario_values_from_file(tmp_path):
         proc = run_cli("model", "--scenario", str(f))
         assert proc.returncode == 2, proc.stderr
         assert message in proc.stderr and "Traceback" not in proc.stderr
+
+
+def test_verify_json_reports_the_theory_checks(tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv("ARZSUMO_CACHE", str(tmp_path))
+    assert main(["verify", "--preset", "paper_base", "--cells", "100", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert set(out) >= {"t_f", "closed_loop_ratio", "no_kernel_ratio", "open_loop_ratio",
+                        "inverse_error", "grid"}
+    assert out["grid"] == 100
+    assert out["closed_loop_ratio"] < 1e-3 < out["no_kernel_ratio"] * 10
+    assert out["open_loop_ratio"] > 1
+
+
+def test_kernels_command_plots(tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv("ARZSUMO_CACHE", str(tmp_path))
+    target = tmp_path / "k.png"
+    assert main(["kernels", "--cells", "40", "--plot", str(target)]) == 0
+    assert target.read_bytes()[:4] == b"\x89PNG"
+    assert "M(L, 0)" in capsys.readouterr().out
+    assert main(["kernels", "--cells", "2"]) == 2

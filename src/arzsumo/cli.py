@@ -24,13 +24,13 @@ log = logging.getLogger("arzsumo")
 Command = Callable[[argparse.Namespace], int]
 
 
-def _scenario(args: argparse.Namespace) -> Scenario:
+def scenario_of(args: argparse.Namespace) -> Scenario:
     if getattr(args, "scenario", None):
         return load_scenario(args.scenario)
     return scenario_from_preset(args.preset)
 
 
-def _add_model_source(p: argparse.ArgumentParser) -> None:
+def add_model_source(p: argparse.ArgumentParser) -> None:
     src = p.add_mutually_exclusive_group()
     src.add_argument("--preset", default="paper_base",
                      help="named model preset (paper_base, paper_s12, paper_aggressive)")
@@ -70,7 +70,7 @@ def _print_model(summary: dict, description: str) -> None:
 
 
 def cmd_model(args: argparse.Namespace) -> int:
-    sc = _scenario(args)
+    sc = scenario_of(args)
     if args.regime_map:
         from arzsumo.model.regime import regime_map
         from arzsumo.plots.regime import write_regime_map
@@ -99,10 +99,14 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
 
     p = sub.add_parser("model", help="equilibrium, eigenvalues, regime and t_f of a model")
-    _add_model_source(p)
+    add_model_source(p)
     p.add_argument("--json", action="store_true", help="print JSON with SI values")
     p.add_argument("--regime-map", metavar="FILE.png", help="draw the free/congested map")
     p.set_defaults(func=cmd_model)
+
+    from arzsumo import cli_control
+
+    cli_control.register(sub)
     return parser
 
 

@@ -1,0 +1,131 @@
+"""Kernel equations (back4), their numerical order, the 2x2 case and the inverse kernels."""
+
+import numpy as np
+import pytest
+
+from arzsumo.control.kernels import solve_kernels
+from arzsumo.model.single_class import single_class_arz
+
+
+@pytest.fixture(scope="module")
+def base_system():
+    from arzsumo.model import PRESETS, equilibrium_from_densities, linearize
+
+    p = PRESETS["paper_base"]
+    return linearize(equilibrium_from_densities(p.params, p.rho_h, p.rho_a)).system
+
+
+def test_boundary_conditions_hold_exactly(base_system):
+    s = base_system
+    k = solve_kernels(s, 100)
+    sig = s.sigma(k.x)
+    n = s.n
+    diag = np.einsum("ijj->ij", k.K)
+    np.testing.assert_allclose(diag, (-sig[:, n, :n] / (s.lam_plus + s.lam_minus)).T)
+    np.testing.assert_allclose(k.M[:, 0], (k.K[:, :, 0].T * s.lam_plus) @ s.Q / s.lam_minus,
+                               rtol=1e-12, atol=1e-20)
+
+
+def test_kernel_pdes_are_satisfied(base_system):
+    """Finite-difference residual of mu K_x - K_xi Lambda+ - K Sigma++ - M Sigma-+ = 0."""
+    s = base_system
+    n_cells = 200
+    k = solve_kernels(s, n_cells)
+    h, mu, n = k.h, s.lam_minus, s.n
+    sig = s.sigma(k.x)
+    j, l = np.meshgrid(np.arange(2, n_cells - 1), np.arange(2, n_cells - 1), indexing="ij")
+    inside = l < j - 2
+    j, l = j[inside], l[inside]
+    kx = (k.K[:, j + 1, l] - k.K[:, j - 1, l]) / (2 * h)
+    kxi = (k.K[:, j, l + 1] - k.K[:, j, l - 1]) / (2 * h)
+    source = np.einsum("mp,pmi->ip", k.K[:, j, l], sig[l][:, :n, :n]) \
+        + k.M[j, l] * sig[l][:, n, :n].T
+    residual = mu * kx - s.lam_plus[:, None] * kxi - source
+    scale = np.abs(mu * kx).max() + np.abs(source).max()
+    assert np.abs(residual).max() < 1e-3 * scale
+    mx = (k.M[j + 1, l] - k.M[j - 1, l]) / (2 * h)
+    mxi = (k.M[j, l + 1] - k.M[j, l - 1]) / (2 * h)
+    m_source = np.einsum("ip,pi->p", k.K[:, j, l], sig[l][:, :n, n]) / mu
+    assert np.abs(mx + mxi - m_source).max() < 1e-3 * (np.abs(mx).max() + 1e-30)
+
+
+def test_grid_convergence_is_second_order(base_system):
+    values = []
+    for n_cells in (50, 100, 200, 400):
+        k = solve_kernels(base_system, n_cells)
+        values.append(np.array([k.K[0, -1, 0], k.K[2, -1, 0], k.M[-1, 0]]))
+    values = np.array(values)
+    diffs = np.abs(np.diff(values, axis=0))            # successive differences
+    orders = np.log2(diffs[:-1] / diffs[1:])
+    assert np.all(orders > 1.6), orders        # second order (k_3 converges even faster)
+
+
+def test_single_class_closed_form_without_inlet_reflection():
+    """Q = 0: M = 0 and k is constant along (mu, -lambda) from the diagonal, so
+    k(x, xi) = -Sigma-+((lambda x + mu xi) / (lambda + mu)) / (lambda + mu)."""
+    s = single_class_arz(80 / 3.6, 0.2, 2.0, 30.0, 0.13, 1000.0, inlet="reflecting-free")
+    k = solve_kernels(s, 100)
+    lam, mu = s.lam_plus[0], s.lam_minus
+    xx, xi = np.meshgrid(k.x, k.x, indexing="ij")
+    foot = (lam * xx + mu * xi) / (lam + mu)
+    exact = -s.sigma(foot.ravel())[:, 1, 0].reshape(xx.shape) / (lam + mu)
+    lower = xi <= xx
+    np.testing.assert_allclose(k.K[0][lower], exact[lower], rtol=1e-7, atol=1e-15)
+    assert np.abs(k.M).max() == 0.0
+
+
+def _first_order_reference(s, n_cells):
+    """Independent donor-cell discretisation of the n = 1 kernel equations."""
+    lam, mu, q = s.lam_plus[0], s.lam_minus, s.Q[0]
+    x = np.linspace(0, s.length, n_cells + 1)
+    h = x[1] - x[0]
+    sig_mp = s.sigma(x)[:, 1, 0]
+    k = np.zeros((n_cells + 1, n_cells + 1))
+    m = np.zeros_like(k)
+    k[0, 0] = -sig_mp[0] / (lam + mu)
+    m[0, 0] = lam * q * k[0, 0] / mu
+    for j in range(1, n_cells + 1):
+        k[j, j] = -sig_mp[j] / (lam + mu)
+        m[j, 1:j + 1] = m[j - 1, :j]                  # M_x + M_xi = 0 (Sigma+- = 0)
+        for ll in range(j - 1, -1, -1):
+            rhs = mu * k[j - 1, ll] + lam * k[j, ll + 1]
+            if ll == 0:   # M(x_j, 0) = lam q k(x_j, 0) / mu, solved together with k
+                k[j, 0] = rhs / (mu + lam - h * sig_mp[0] * lam * q / mu)
+                m[j, 0] = lam * q * k[j, 0] / mu
+            else:
+                k[j, ll] = (rhs + h * m[j, ll] * sig_mp[ll]) / (mu + lam)
+    return x, k, m
+
+
+def test_single_class_agrees_with_an_independent_discretisation():
+    s = single_class_arz(80 / 3.6, 0.2, 2.0, 30.0, 0.13, 1000.0, inlet="flow")
+    ours = solve_kernels(s, 50)
+    _, k_ref, m_ref = _first_order_reference(s, 800)
+    sub = np.s_[::16, ::16]
+    lower = np.tril(np.ones((51, 51), bool))
+    scale = np.abs(ours.K[0]).max()
+    err = np.abs(ours.K[0][lower] - k_ref[sub][lower]).max() / scale
+    assert err < 5e-3                                  # first-order reference at h = 1.25 m
+    assert np.abs(ours.M[lower] - m_ref[sub][lower]).max() < 5e-3 * np.abs(m_ref).max()
+
+
+def test_inverse_kernels_solve_the_resolvent_equations(base_system):
+    """L(x, xi) = K(x, xi) + int_xi^x N(x, s) K(s, xi) ds and the same for N with M,
+    to the trapezoid rule's O(h^2)."""
+    k = solve_kernels(base_system, 200)
+    j = 200
+    for l_idx in (0, 50, 150):
+        s_idx = np.arange(l_idx, j + 1)
+        integral_n = np.trapezoid(k.N[j, s_idx] * k.M[s_idx, l_idx], k.x[s_idx])
+        assert k.N[j, l_idx] == pytest.approx(k.M[j, l_idx] + integral_n, rel=1e-3, abs=1e-12)
+        for i in range(3):
+            integral_l = np.trapezoid(k.N[j, s_idx] * k.K[i, s_idx, l_idx], k.x[s_idx])
+            assert k.L[i, j, l_idx] == pytest.approx(k.K[i, j, l_idx] + integral_l,
+                                                     rel=1e-3, abs=1e-12)
+
+
+def test_too_few_cells_is_refused(base_system):
+    from arzsumo.errors import ModelError
+
+    with pytest.raises(ModelError, match="n_cells = 2 "):
+        solve_kernels(base_system, 2)
