@@ -80,3 +80,26 @@ def test_kernels_command_plots(tmp_path, monkeypatch, capsys):
     assert target.read_bytes()[:4] == b"\x89PNG"
     assert "M(L, 0)" in capsys.readouterr().out
     assert main(["kernels", "--cells", "2"]) == 2
+
+
+def test_verify_etc_json(tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv("ARZSUMO_CACHE", str(tmp_path))
+    assert main(["verify", "--controller", "etc", "--cells", "100", "--horizon", "200",
+                 "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert set(out) >= {"triggers", "release_time", "V_ratio", "m_min", "m_max"}
+    assert 0 < out["triggers"] < 200
+    assert out["release_time"] == pytest.approx(200 - out["triggers"])
+
+
+def test_design_check_reports_every_condition(tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv("ARZSUMO_CACHE", str(tmp_path))
+    assert main(["design-check", "--cells", "40", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    labels = [c["label"] for c in out["conditions"]]
+    assert labels.count("select1") == 3 and labels.count("select3") == 3
+    assert {"select2", "select4"} <= set(labels)
+    assert out["tau_star"] > 0
+    # the paper's own values fail select4 (sum A_i q_i^2 exceeds B): reported, not hidden
+    select4 = next(c for c in out["conditions"] if c["label"] == "select4")
+    assert select4["holds"] is False

@@ -42,11 +42,33 @@ def cmd_kernels(args: argparse.Namespace) -> int:
     return 0
 
 
+def _design(args: argparse.Namespace):
+    from arzsumo.control.etc import PAPER_DESIGN
+
+    changes = {k: getattr(args, k) for k in ("mu", "sigma", "zeta") if getattr(args, k)}
+    return PAPER_DESIGN.with_(**changes)
+
+
 def cmd_verify(args: argparse.Namespace) -> int:
-    from arzsumo.control.verify import verify_backstepping
+    from arzsumo.control.verify import run_closed_loop, verify_backstepping
 
     lin = _linearization(args)
-    report = verify_backstepping(lin, args.cells, cached_kernels(lin.system, args.cells))
+    kernels = cached_kernels(lin.system, args.cells)
+    if args.controller != "theory":
+        require(args.period > 0, "--period", args.period, "a check period > 0 s")
+        run = run_closed_loop(lin, kernels, args.controller, args.period, args.horizon,
+                              _design(args))
+        summary = run.summary()
+        summary["grid"] = args.cells
+        if args.json:
+            print(json.dumps(summary, indent=2))
+        else:
+            print(f"{args.controller} on the linear plant, {args.cells} cells, checks every "
+                  f"{args.period:g} s over {args.horizon:g} s")
+            for key, value in summary.items():
+                print(f"  {key:28s} {value}")
+        return 0
+    report = verify_backstepping(lin, args.cells, kernels)
     if args.json:
         print(json.dumps(report.as_dict(), indent=2))
         return 0
@@ -69,7 +91,50 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=cmd_kernels)
 
     p = sub.add_parser("verify", help="finite-time convergence and transform checks on the "
-                                      "linear plant")
+                                      "linear plant, or a controller run on it")
     _add_common(p)
+    p.add_argument("--controller", default="theory",
+                   choices=["theory", "backstepping", "etc", "observer-etc"],
+                   help="'theory': the backstepping checks (default); else run that "
+                        "controller with periodic checks")
+    p.add_argument("--period", type=float, default=1.0, help="check period, s (default 1)")
+    p.add_argument("--horizon", type=float, default=450.0, help="run length, s (default 450)")
+    _add_design(p)
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(func=cmd_verify)
+
+    p = sub.add_parser("design-check", help="ETC design conditions select1-select4 and tau*")
+    _add_common(p)
+    _add_design(p)
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.set_defaults(func=cmd_design_check)
+
+
+def _add_design(p: argparse.ArgumentParser) -> None:
+    for name in ("mu", "sigma", "zeta"):
+        p.add_argument(f"--{name}", type=float, help=f"ETC design {name} (default: paper)")
+
+
+def cmd_design_check(args: argparse.Namespace) -> int:
+    from dataclasses import asdict
+
+    from arzsumo.control.design_check import check_design
+    from arzsumo.control.verify import sinusoidal_deviation
+
+    lin = _linearization(args)
+    kernels = cached_kernels(lin.system, args.cells)
+    w0 = lin.to_riemann(sinusoidal_deviation(lin, kernels.x), kernels.x)
+    alpha_x = (w0[:-1, -1] - w0[:-1, -2]) / kernels.h
+    report = check_design(lin.system, kernels, _design(args), alpha_x)
+    if args.json:
+        print(json.dumps({"conditions": [asdict(c) for c in report.conditions],
+                          "tau_star": report.tau_star, "constants": report.constants},
+                         indent=2))
+        return 0
+    print(f"{'condition':9s} {'holds':5s} {'lhs':>12s} {'rhs':>12s}  statement")
+    for c in report.conditions:
+        print(f"{c.label:9s} {'yes' if c.holds else 'NO':5s} {c.lhs:12.4e} {c.rhs:12.4e}  "
+              f"{c.statement}")
+    print(f"minimum dwell time tau* = {report.tau_star:.4g} s (Theorem minimalthm; c_4 from "
+          "the sinusoidal initial state)")
+    return 0

@@ -99,6 +99,13 @@ class Backstepping(Controller):
         """U (veh/s) from deviations on the kernel grid, shape (4, n_cells+1)."""
         return float(np.sum(self.gain_z * z))
 
+    def check_riemann(self, t: float, w_bar: np.ndarray) -> float:
+        """Check on a scaled Riemann state at the kernel nodes; returns U-bar (updated)."""
+        u_bar = self.law.u_bar(w_bar)
+        u = u_bar / self.lin.u_bar_per_u
+        self.log.record(t, u, u, True)
+        return u_bar
+
     def decide(self, state: MacroState) -> float:
         u = self.u_of_z(self.state_map.deviations(state))
         self.log.record(state.t, u, u, True)

@@ -12,11 +12,12 @@ Scheme: Strang splitting of transport and in-domain coupling.
   w-(L) = R w+(L) + U-bar (clpsys4), with U-bar from the controller evaluated on the
   updated state (so a continuous law sets beta(L) = 0 at every step).
 
-The time step is CFL-bounded: dt = cfl h / max |lambda|.
+The time step is CFL-bounded: dt <= cfl h / max |lambda|.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -63,17 +64,22 @@ class LinearPlant:
     cfl : float, optional
         Courant number of the fastest wave, in (0, 1]. Default 1.
     scheme : {"cubic", "upwind"}
+    dt : float, optional
+        Time step (s), at most the CFL step; default the CFL step.
     """
 
     def __init__(self, system: CharacteristicSystem, n_cells: int, cfl: float = 1.0,
-                 scheme: str = "cubic") -> None:
+                 scheme: str = "cubic", dt: float | None = None) -> None:
         require(0 < cfl <= 1, "cfl", cfl, "a Courant number in (0, 1]", ModelError)
         require(scheme in ("cubic", "upwind"), "scheme", scheme, "'cubic' or 'upwind'",
                 ModelError)
         self.system = system
         self.x = np.linspace(0.0, system.length, n_cells + 1)
         h = self.x[1] - self.x[0]
-        self.dt = cfl * h / float(np.abs(system.lam).max())
+        dt_max = cfl * h / float(np.abs(system.lam).max())
+        require(dt is None or 0 < dt <= dt_max * (1 + 1e-12), "dt", dt,
+                f"a time step in (0, {dt_max:.4g}] s (CFL)", ModelError)
+        self.dt = dt_max if dt is None else float(dt)
         order = 4 if scheme == "cubic" else 2
         feet = np.clip(self.x[None, :] - system.lam[:, None] * self.dt, 0.0, system.length)
         stencils = [_stencil(self.x, f, order) for f in feet]
@@ -100,15 +106,23 @@ class LinearPlant:
         self.t = 0.0
         self.u_bar_applied = 0.0
 
-    def step(self, u_bar_fn: UBarFunction) -> None:
-        """Advance one time step; the outlet boundary uses ``u_bar_fn(t + dt, state)``."""
+    def step(self, u_bar_fn: UBarFunction, inlet: float | None = None,
+             injection: np.ndarray | None = None) -> None:
+        """Advance one time step; the outlet boundary uses ``u_bar_fn(t + dt, state)``.
+
+        For an observer copy of the plant: ``inlet`` replaces w-(0) in the inlet condition
+        w+(0) = Q w-(0) (the measurement y), and ``injection`` (n+1, N+1) is added times
+        dt as an output-injection source.
+        """
         n = self.system.n
         w = np.einsum("jab,bj->aj", self._half_source, self.state)
         rows = np.arange(n + 1)[:, None, None]
         w = np.sum(self._w * w[rows, self._idx], axis=-1)
         w = np.einsum("jab,bj->aj", self._half_source, w)
+        if injection is not None:
+            w += self.dt * injection
         self.t += self.dt
-        w[:n, 0] = self.system.Q * w[n, 0]
+        w[:n, 0] = self.system.Q * (w[n, 0] if inlet is None else inlet)
         w[n, -1] = self.system.R @ w[:n, -1] + self.u_bar_applied
         self.u_bar_applied = u_bar_fn(self.t, w)
         w[n, -1] = self.system.R @ w[:n, -1] + self.u_bar_applied
@@ -131,3 +145,8 @@ class LinearPlant:
                 us.append(self.u_bar_applied)
                 next_sample += sample_every
         return PlantHistory(np.array(ts), np.array(norms), np.array(us))
+
+
+def step_dividing(period: float, dt_max: float) -> float:
+    """The largest time step <= dt_max that divides ``period`` (s) into whole steps."""
+    return period / math.ceil(period / dt_max - 1e-9)

@@ -101,3 +101,130 @@ def verify_backstepping(lin: Linearization, n_cells: int = 200,
         no_kernel_ratio=float(nk[-1] / nk[0]), open_loop_ratio=float(at_horizon / ol[0]),
         open_loop_growth_rate=growth, open_loop_min_ratio=float(ol.min() / ol[0]),
         inverse_error=inverse_error, law_forms_error=float(forms), grid=n_cells)
+
+
+@dataclass(frozen=True)
+class ClosedLoopRun:
+    """A controller on the linear plant: the controller's log and per-check series.
+
+    ``V`` is the Lyapunov functional (label lyapunov) of the *true* state at each check,
+    ``norm`` its L2 norm of z, ``estimation_error`` the relative L2 error of the
+    observer's estimate (NaN for full-state controllers).
+    """
+
+    controller: str
+    period: float
+    horizon: float
+    t: np.ndarray
+    V: np.ndarray
+    norm: np.ndarray
+    estimation_error: np.ndarray
+    log: object
+
+    def summary(self) -> dict[str, float | int | str]:
+        from arzsumo.control.events import event_summary, lyapunov_convergence_time
+
+        ev = event_summary(self.log, self.horizon)
+        m = np.asarray(self.log.extra.get("m", [np.nan]))
+        m_stats = (float(m.min()), float(m.max())) if np.isfinite(m).all() else (np.nan, np.nan)
+        return {
+            "controller": self.controller, "period": self.period, "horizon": self.horizon,
+            "triggers": ev.triggers, "release_time": ev.release_time,
+            "min_interval": ev.min_interval, "mean_interval": ev.mean_interval,
+            "V_ratio": float(self.V[-1] / self.V[0]),
+            "final_norm_ratio": float(self.norm[-1] / self.norm[0]),
+            "lyapunov_convergence_time": lyapunov_convergence_time(self.t, self.V),
+            "m_min": m_stats[0], "m_max": m_stats[1],
+            "m_nonnegative_checks": int(np.sum(np.asarray(m) >= 0)),
+        }
+
+
+def run_closed_loop(lin: Linearization, kernels: Kernels, controller: str = "etc",
+                    period: float = 1.0, horizon: float = 450.0, design=None,
+                    amplitude: float = 0.1) -> ClosedLoopRun:
+    """Run ``controller`` ("backstepping", "etc", "observer-etc") on the linear plant.
+
+    The controller is checked every ``period`` s (the plant step divides it) and its
+    output held in between; the plant starts from the sinusoidal stop-and-go deviation.
+    """
+    from arzsumo.control.backstepping import Backstepping
+    from arzsumo.control.etc import PAPER_DESIGN, EventTriggered, Lyapunov
+    from arzsumo.control.observer import ObserverEtc
+    from arzsumo.control.plant import step_dividing
+    from arzsumo.errors import ModelError
+
+    design = design or PAPER_DESIGN
+    system, n = lin.system, kernels.n_cells
+    dt = step_dividing(period, LinearPlant(system, n).dt)
+    plant = LinearPlant(system, n, dt=dt)
+    w0 = lin.to_riemann(sinusoidal_deviation(lin, kernels.x, amplitude), kernels.x)
+    plant.reset(w0)
+    if controller == "backstepping":
+        ctrl = Backstepping(lin, kernels)
+        check = ctrl.check_riemann
+    elif controller == "etc":
+        ctrl = EventTriggered(lin, kernels, design)
+        check = ctrl.check_riemann
+    elif controller == "observer-etc":
+        ctrl = ObserverEtc(lin, kernels, design)
+        check = lambda t, w: ctrl.check_measurement(t, float(w[-1, 0]))  # noqa: E731
+    else:
+        raise ModelError(f"controller = {controller!r} is not allowed: 'backstepping', 'etc' "
+                         "or 'observer-etc'")
+    transform = BacksteppingTransform(kernels)
+    lyap = Lyapunov(system, kernels.x, design)
+    ts, vs, norms, errs = [], [], [], []
+
+    def observe(t: float, w: np.ndarray) -> None:
+        ts.append(t)
+        vs.append(lyap(*transform.forward(w)))
+        norms.append(z_norm(lin, w, kernels.x))
+        if controller == "observer-etc":
+            errs.append(np.linalg.norm(w - ctrl.observer.estimate) / np.linalg.norm(w0))
+        else:
+            errs.append(np.nan)
+
+    held = check(0.0, w0)
+    observe(0.0, w0)
+    plant.u_bar_applied = held
+    steps_per_check = round(period / dt)
+    count = 0
+
+    def u_bar_fn(t: float, w: np.ndarray) -> float:
+        nonlocal held, count
+        count += 1
+        if count % steps_per_check == 0:
+            if t < horizon - 0.5 * dt:       # checks at 0, Delta, ..., T - Delta
+                held = check(t, w)
+            observe(t, w)
+        return held
+
+    while plant.t < horizon - 0.5 * dt:
+        plant.step(u_bar_fn)
+    return ClosedLoopRun(controller, period, horizon, np.array(ts), np.array(vs),
+                         np.array(norms), np.array(errs), ctrl.log)
+
+
+def sensitivity(lin: Linearization, kernels: Kernels, parameter: str,
+                values: list[float], period: float = 1.0, horizon: float = 450.0,
+                design=None, fraction: float = 0.01) -> list[dict[str, float]]:
+    """ETC release time and Lyapunov convergence time per value of one design parameter.
+
+    ``parameter`` is a field of :class:`~arzsumo.control.etc.EtcDesign` (mu, sigma, zeta,
+    ...). The convergence time is the first time after which V stays below ``fraction``
+    V(0) (sensitivity subsection of section 5).
+    """
+    from arzsumo.control.etc import PAPER_DESIGN
+    from arzsumo.control.events import lyapunov_convergence_time
+
+    base = design or PAPER_DESIGN
+    rows = []
+    for value in values:
+        run = run_closed_loop(lin, kernels, "etc", period, horizon,
+                              base.with_(**{parameter: value}))
+        summary = run.summary()
+        rows.append({"parameter": parameter, "value": float(value),
+                     "triggers": summary["triggers"], "release_time": summary["release_time"],
+                     "lyapunov_convergence_time": lyapunov_convergence_time(run.t, run.V,
+                                                                            fraction)})
+    return rows

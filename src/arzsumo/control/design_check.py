@@ -1,0 +1,139 @@
+"""Design conditions select1-select4 and the minimum dwell time tau* of minimalthm.
+
+Interpretations where the paper is ambiguous (stated so the numbers can be checked):
+
+* q_i are the entries of Q (clpsys3); j_i is the norm of column i of Sigma++(L) (the
+  "element in coefficient matrix Sigma++" multiplying alpha_i(L) in G(L, t)).
+* epsilon_i = 8 l_i(L, L)^2 lambda_i^2 + 8 j_i ||R||^2 (Lemma bounddt, as printed).
+* p_1 = 1 / ||inverse transform||^2 and p_3 = the smallest weight of V (norm equivalences),
+  gamma as printed in the proof of Theorem minimalthm with A = max A_i.
+* phi_1 (bounddt) = (8 N(L,L)^2 Lambda-^2 + 2 (R Sigma+-(L))^2) ||R||^2,
+  phi_2 (bounddt) = 8/p_3 (c_1 + c_2/p_1) + 8 c_3 ||R||^2 / p_3 with c_1..c_3 as printed.
+* c_4 bounds 2 ||R Lambda+||^2 ||alpha_x(L, t)||^2 and depends on the trajectory; we take
+  it from a given state's alpha_x(L) (the sinusoidal initial condition by default).
+* varphi_1 = 1/(2 zeta) - mu sigma, varphi_2 = 1 + phi_1 + (1 - sigma) mu / (2 zeta)
+  - gamma + eta, varphi_3 = B e^{mu L/Lambda-} (phi_2 + c_4)/(mu sigma) + 1 + eta + phi_1,
+  and tau* = int_0^1 ds / (varphi_1 s^2 + varphi_2 s + varphi_3) (Psi runs from 0 to 1;
+  the paper's upper limit L is a typo).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.integrate import quad
+
+from arzsumo.control.etc import EtcDesign
+from arzsumo.control.kernels import Kernels, trapezoid_weights
+from arzsumo.control.transform import BacksteppingTransform
+from arzsumo.model.characteristic import CharacteristicSystem
+
+
+@dataclass(frozen=True)
+class Condition:
+    """One design condition: its label, whether it holds, and the two sides compared."""
+
+    label: str
+    statement: str
+    lhs: float
+    rhs: float
+    holds: bool
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "lhs", float(self.lhs))
+        object.__setattr__(self, "rhs", float(self.rhs))
+        object.__setattr__(self, "holds", bool(self.holds))
+
+
+@dataclass(frozen=True)
+class DesignReport:
+    conditions: tuple[Condition, ...]
+    tau_star: float
+    constants: dict[str, float]
+
+
+def _inverse_norm(kernels: Kernels) -> float:
+    """Spectral norm of the discrete inverse transform in the trapezoid L2 inner product."""
+    n, nodes = kernels.K.shape[0], kernels.n_cells + 1
+    tr = BacksteppingTransform(kernels)
+    eye = np.eye((n + 1) * nodes)
+    cols = [np.concatenate(tr.inverse(e.reshape(n + 1, nodes)[:n],
+                                      e.reshape(n + 1, nodes)[n]).reshape(1, -1))
+            for e in eye]
+    return float(np.linalg.norm(np.array(cols).T, 2))
+
+
+def check_design(system: CharacteristicSystem, kernels: Kernels, design: EtcDesign,
+                 alpha_x_at_l: np.ndarray | None = None) -> DesignReport:
+    """Evaluate select1-select4, the decay condition of esthm, and tau* (module docstring)."""
+    n, lam, lm = system.n, system.lam_plus, system.lam_minus
+    length, mu_d = system.length, design.mu
+    A = np.array(design.A)
+    vs = np.array(design.varsigma)
+    q, r = system.Q, system.R
+    sig = system.sigma(kernels.x)
+    w = trapezoid_weights(kernels.n_cells, kernels.h)[-1]
+    r_norm = float(np.linalg.norm(r))
+    b_exp = design.B * math.exp(mu_d * length / lm)
+    l_ll = kernels.L[:, -1, -1]
+    j = np.linalg.norm(sig[-1, :n, :n], axis=0)
+    eps = 8 * l_ll**2 * lam**2 + 8 * j * r_norm**2
+    p3 = float(min((A / lam * np.exp(-mu_d * length / lam)).min(), design.B / lm))
+    p1 = 1.0 / _inverse_norm(kernels) ** 2 if kernels.n_cells <= 60 else 1.0 / _inverse_norm(
+        _coarsen(kernels)) ** 2
+    l_row, n_row = kernels.L[:, -1, :], kernels.N[-1, :]
+    l_xi = np.gradient(l_row, kernels.x, axis=1)
+    n_xi = np.gradient(n_row, kernels.x)
+    c1 = max(float(w @ np.sum((l_xi * lam[:, None]) ** 2, axis=0)), float(w @ (n_xi * lm) ** 2))
+    c2 = max(float(w @ np.linalg.norm(np.einsum("il,lij->lj", l_row, sig[:, :n, :n]),
+                                       axis=1) ** 2),
+             float(w @ (np.einsum("il,li->l", l_row, sig[:, :n, n])) ** 2))
+    s_pm_l = sig[-1, :n, n]
+    c3 = max(float(w @ (np.linalg.norm(s_pm_l) * np.linalg.norm(l_row, axis=0)) ** 2),
+             float(w @ (np.linalg.norm(s_pm_l) * n_row) ** 2))
+    phi1 = (8 * kernels.N[-1, -1] ** 2 * lm**2 + 2 * float(r @ s_pm_l) ** 2) * r_norm**2
+    phi2 = 8 / p3 * (c1 + c2 / p1) + 8 * c3 * r_norm**2 / p3
+    sig_pp_max = float(np.linalg.norm(sig[:, :n, :n], axis=(1, 2)).max())
+    sig_pm_max = float(np.linalg.norm(sig[:, :n, n], axis=1).max())
+    gamma = 2 * A.max() / (p3 * lam.min()) * (sig_pp_max + (1 + 1 / p1) * sig_pm_max)
+    ax = np.zeros(n) if alpha_x_at_l is None else np.asarray(alpha_x_at_l)
+    c4 = 2 * float(np.linalg.norm(r * lam)) ** 2 * float(ax @ ax)
+    zeta, sigma, eta = design.zeta, design.sigma, design.eta
+    aq = float(A @ q**2)
+    conds = []
+    for i in range(n):
+        need = max(zeta * b_exp * eps[i], zeta * mu_d * eps[i])
+        conds.append(Condition("select1", f"varsigma_{i + 1} >= max(zeta B e^(mu L/Lambda-) "
+                               f"eps_{i + 1}, zeta mu eps_{i + 1})", vs[i], need, vs[i] >= need))
+    need4 = max(0.0, -2 * zeta * mu_d * (aq - design.B))
+    conds.append(Condition("select2", "varsigma_4 >= max(0, -2 zeta mu (sum A_i q_i^2 - B))",
+                           vs[n], need4, vs[n] >= need4))
+    for i in range(n):
+        bound = A[i] * math.exp(-mu_d * length / lam[i])
+        conds.append(Condition("select3", f"varsigma_{i + 1} <= A_{i + 1} e^(-mu L/lambda_"
+                               f"{i + 1})", vs[i], bound, vs[i] <= bound))
+    conds.append(Condition("select4", "varsigma_4 + sum A_i q_i^2 - B <= 0",
+                           vs[n] + aq - design.B, 0.0, vs[n] + aq - design.B <= 0))
+    rate = mu_d * (1 - sigma) - gamma
+    conds.append(Condition("esthm", "mu (1 - sigma) - gamma > 0 (decay rate of V_d)",
+                           rate, 0.0, rate > 0))
+    conds.append(Condition("esthm", "eta >= mu (1 - sigma) - gamma", eta, rate, eta >= rate))
+    vphi1 = 1 / (2 * zeta) - mu_d * sigma
+    vphi2 = 1 + phi1 + (1 - sigma) * mu_d / (2 * zeta) - gamma + eta
+    vphi3 = b_exp * (phi2 + c4) / (mu_d * sigma) + 1 + eta + phi1
+    tau, _ = quad(lambda s: 1.0 / (vphi1 * s * s + vphi2 * s + vphi3), 0.0, 1.0)
+    constants = {"p1": float(p1), "p3": p3, "gamma": gamma, "c1": c1, "c2": c2, "c3": c3, "c4": c4,
+                 "phi1": phi1, "phi2": phi2, "varphi1": vphi1, "varphi2": vphi2,
+                 "varphi3": vphi3, "B_exp": b_exp}
+    constants.update({f"eps_{i + 1}": float(eps[i]) for i in range(n)})
+    return DesignReport(tuple(conds), float(tau), {k: float(v) for k, v in constants.items()})
+
+
+def _coarsen(kernels: Kernels, target: int = 50) -> Kernels:
+    """Kernels sampled on about ``target`` cells (for the dense norm computation)."""
+    step = max(1, kernels.n_cells // target)
+    sub = np.s_[..., ::step, ::step]
+    return Kernels(kernels.x[::step], kernels.K[sub], kernels.M[sub], kernels.L[sub],
+                   kernels.N[sub])
