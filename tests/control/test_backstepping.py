@@ -95,3 +95,18 @@ def test_controller_applies_the_law_in_physical_units(lin, kernels):
     coarse = _state(lin, xc, sinusoidal_deviation(lin, xc))
     assert ctrl.check(coarse) == pytest.approx(u, rel=0.05)
     assert ctrl.check(_state(lin, kernels.x, 0 * z)) == 0.0
+
+
+def test_registry_builds_every_controller(lin, kernels):
+    from arzsumo.control import CONTROLLERS, make_controller
+    from arzsumo.errors import ModelError
+
+    eq = lin.equilibrium
+    x = kernels.x
+    z = sinusoidal_deviation(lin, x)
+    state = MacroState(0.0, x, eq.rho_h + z[0], eq.v_h + z[1], eq.rho_a + z[2], eq.v_a + z[3])
+    us = {name: make_controller(name, lin, kernels).check(state) for name in CONTROLLERS}
+    assert us["open"] == 0.0
+    assert us["backstepping"] == pytest.approx(us["etc"])        # first ETC check is an event
+    with pytest.raises(ModelError, match="controller = 'pid' is not allowed"):
+        make_controller("pid", lin, kernels)

@@ -4,5 +4,15 @@ Pure math: no SUMO, no files, no plotting.
 """
 
 from arzsumo.control.base import ConstantControl, Controller, ControlLog, MacroState, OpenLoop
+from arzsumo.control.registry import CONTROLLERS, PDE_CONTROLLERS, make_controller
 
-__all__ = ["ConstantControl", "ControlLog", "Controller", "MacroState", "OpenLoop"]
+__all__ = [
+    "CONTROLLERS",
+    "PDE_CONTROLLERS",
+    "ConstantControl",
+    "ControlLog",
+    "Controller",
+    "MacroState",
+    "OpenLoop",
+    "make_controller",
+]
