@@ -8,21 +8,8 @@ from arzsumo.control.backstepping import Backstepping
 from arzsumo.control.kernels import Kernels, solve_kernels
 from arzsumo.control.transform import BacksteppingLaw, BacksteppingTransform
 from arzsumo.control.verify import _run, sinusoidal_deviation, verify_backstepping
-from arzsumo.model import PRESETS, equilibrium_from_densities, linearize
 from arzsumo.model.characteristic import CharacteristicSystem
-
-N_CELLS = 200
-
-
-@pytest.fixture(scope="module")
-def lin():
-    p = PRESETS["paper_base"]
-    return linearize(equilibrium_from_densities(p.params, p.rho_h, p.rho_a))
-
-
-@pytest.fixture(scope="module")
-def kernels(lin):
-    return solve_kernels(lin.system, N_CELLS)
+from tests.control.conftest import N_CELLS
 
 
 @pytest.fixture(scope="module")

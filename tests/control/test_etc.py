@@ -6,25 +6,11 @@ import pytest
 from arzsumo.control.base import ControlLog
 from arzsumo.control.etc import PAPER_DESIGN, EtcDesign, EventTrigger, integrate_m
 from arzsumo.control.events import lyapunov_convergence_time, release_time
-from arzsumo.control.kernels import solve_kernels
 from arzsumo.control.observer import BoundaryObserver, dual_system, observer_gains
 from arzsumo.control.verify import run_closed_loop
 from arzsumo.errors import ModelError
-from arzsumo.model import PRESETS, equilibrium_from_densities, linearize
 from arzsumo.model.characteristic import CharacteristicSystem
-
-N_CELLS = 200
-
-
-@pytest.fixture(scope="module")
-def lin():
-    p = PRESETS["paper_base"]
-    return linearize(equilibrium_from_densities(p.params, p.rho_h, p.rho_a))
-
-
-@pytest.fixture(scope="module")
-def kernels(lin):
-    return solve_kernels(lin.system, N_CELLS)
+from tests.control.conftest import N_CELLS
 
 
 @pytest.fixture(scope="module")
