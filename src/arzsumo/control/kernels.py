@@ -53,6 +53,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import solve_triangular
 
+from arzsumo.control.interp import interpolate
 from arzsumo.errors import ModelError, require
 from arzsumo.model.characteristic import CharacteristicSystem
 
@@ -88,32 +89,6 @@ class Kernels:
     @property
     def h(self) -> float:
         return float(self.x[1] - self.x[0])
-
-
-def _lagrange(nodes_x: np.ndarray, values: np.ndarray, x_eval: np.ndarray,
-              order: int = 4) -> np.ndarray:
-    """Piecewise Lagrange interpolation (``order`` points) on a uniform grid.
-
-    ``values`` has shape (C, m) on the m uniform ``nodes_x``; ``x_eval`` any shape E.
-    Returns shape (C, *E). Near the ends the stencil is shifted, never extrapolated beyond
-    one cell.
-    """
-    m = nodes_x.size
-    p = min(order, m)
-    if p == 1:
-        return np.broadcast_to(values[:, :1].reshape(-1, *([1] * x_eval.ndim)),
-                               (values.shape[0], *x_eval.shape)).copy()
-    h = nodes_x[1] - nodes_x[0]
-    base = np.floor((x_eval - nodes_x[0]) / h).astype(int)
-    start = np.clip(base - (p // 2 - 1), 0, m - p)
-    idx = start[..., None] + np.arange(p)                      # (*E, p)
-    xs = nodes_x[idx]
-    weights = np.ones_like(xs)
-    for a in range(p):
-        for b in range(p):
-            if a != b:
-                weights[..., a] *= (x_eval - xs[..., b]) / (xs[..., a] - xs[..., b])
-    return np.sum(weights * values[:, idx], axis=-1)
 
 
 def solve_kernels(system: CharacteristicSystem, n_cells: int) -> Kernels:
@@ -172,8 +147,8 @@ def solve_kernels(system: CharacteristicSystem, n_cells: int) -> Kernels:
         xf = np.where(on_row, x[j - 1], x[j] - mu * s_diag)
         xif = np.where(on_row, xi_row, xf)                         # diagonal: xi = x
         row_vals = np.concatenate([K[:, j - 1, :j], M[None, j - 1, :j]])
-        foot_row = _lagrange(x[:j], row_vals, xif)                 # (n+1, n, j)
-        m_on_diag = _lagrange(x[: j + 1], np.diag(M)[None, : j + 1], xf)[0]
+        foot_row = interpolate(x[:j], row_vals, xif)                 # (n+1, n, j)
+        m_on_diag = interpolate(x[: j + 1], np.diag(M)[None, : j + 1], xf)[0]
         k_on_diag = k_diag(xf.ravel()).reshape(n, n, j)
         foot_k = np.where(on_row[None], foot_row[:n], k_on_diag)   # [m, i, l]: k_m at foot i
         foot_m = np.where(on_row, foot_row[n], m_on_diag)          # [i, l]

@@ -23,26 +23,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from arzsumo.control.interp import lagrange_stencil
 from arzsumo.errors import ModelError, require
 from arzsumo.model.characteristic import CharacteristicSystem
 
 #: maps (t, state) -> U-bar to apply on the outlet at time t
 UBarFunction = Callable[[float, np.ndarray], float]
-
-
-def _stencil(x: np.ndarray, x_eval: np.ndarray, order: int) -> tuple[np.ndarray, np.ndarray]:
-    """Indices (len(x_eval), order) and Lagrange weights for interpolation at x_eval."""
-    m, h = x.size, x[1] - x[0]
-    base = np.floor((x_eval - x[0]) / h + 1e-9).astype(int)
-    start = np.clip(base - (order // 2 - 1), 0, m - order)
-    idx = start[:, None] + np.arange(order)
-    xs = x[idx]
-    w = np.ones_like(xs)
-    for a in range(order):
-        for b in range(order):
-            if a != b:
-                w[:, a] *= (x_eval - xs[:, b]) / (xs[:, a] - xs[:, b])
-    return idx, w
 
 
 @dataclass
@@ -82,7 +68,7 @@ class LinearPlant:
         self.dt = dt_max if dt is None else float(dt)
         order = 4 if scheme == "cubic" else 2
         feet = np.clip(self.x[None, :] - system.lam[:, None] * self.dt, 0.0, system.length)
-        stencils = [_stencil(self.x, f, order) for f in feet]
+        stencils = [lagrange_stencil(self.x, f, order) for f in feet]
         self._idx = np.stack([s[0] for s in stencils])        # (n+1, N+1, order)
         self._w = np.stack([s[1] for s in stencils])
         a = system.sigma(self.x) * (0.5 * self.dt)            # (N+1, n+1, n+1)
