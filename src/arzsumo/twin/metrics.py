@@ -76,7 +76,7 @@ def performance(params: ModelParameters, t: np.ndarray, x: np.ndarray,
     params : ModelParameters
         Supplies the free-flow speeds V_h, V_a (m/s) for the delay.
     t : ndarray (n_t,)
-        Output times, s (at least three for the derivatives).
+        Output times, s; with fewer than two every index is NaN.
     x : ndarray (n_x,)
         Uniform cell centres, m.
     fields : ndarray (n_t, 4, n_x)
@@ -84,6 +84,9 @@ def performance(params: ModelParameters, t: np.ndarray, x: np.ndarray,
     """
     b0, b1, b2, b3 = B_FUEL
     dx = float(x[1] - x[0])
+    if t.size < 2:                        # a run stopped at once: nothing to integrate
+        nan = ClassIndices(*(float("nan"),) * 5)
+        return Performance(nan, nan, nan)
     per_class = {}
     for k, (cls, v_free) in enumerate(zip(CLASSES, (params.v_free_h, params.v_free_a),
                                           strict=True)):
