@@ -137,3 +137,18 @@ def test_options_validate_themselves():
         SolverOptions(scheme="weno")
     with pytest.raises(ModelError, match=r"cfl = 1\.5 is not allowed"):
         SolverOptions(cfl=1.5)
+
+
+def test_inlet_demand_series_sets_the_inflow(base_lin):
+    """A class-demand ramp at the inlet: the vehicles entering are its integral."""
+    from arzsumo.twin import Inlet
+
+    eq = base_lin.equilibrium
+    inlet = Inlet.from_demands(base_lin, np.array([0.0, 30.0, 60.0]),
+                               np.array([eq.q_h, 0.95 * eq.q_h, 0.95 * eq.q_h]),
+                               np.array([eq.q_a, eq.q_a, eq.q_a]))
+    res = simulate(eq, _init(eq, kind="equilibrium"), inlet=inlet,
+                   options=SolverOptions(horizon=60.0))
+    expected = eq.q * 60.0 - 0.05 * eq.q_h * (15.0 + 30.0)     # trapezoid of the ramp
+    assert res.complete
+    assert res.inflow == pytest.approx(expected, rel=2e-3)     # flow interpolated per step

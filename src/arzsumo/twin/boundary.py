@@ -78,6 +78,7 @@ class Inlet:
             raise ModelError(f"l4 = {self.l4!r} is not allowed: 4 finite numbers")
         l4.setflags(write=False)
         object.__setattr__(self, "l4", l4)
+        object.__setattr__(self, "_l4", tuple(float(v) for v in l4))   # hot path
 
     @classmethod
     def at_equilibrium(cls, lin: Linearization) -> Inlet:
@@ -116,14 +117,15 @@ class Inlet:
     def boundary_primitive(self, t: float, z0: np.ndarray) -> np.ndarray:
         """Boundary state (rho_h, v_h, rho_a, v_a) at x = 0 given the first cell's ``z0``."""
         rho_h, rho_a, flow = _value(self.rho_h, t), _value(self.rho_a, t), _value(self.flow, t)
-        lv = self.l4
-        c = float(lv @ z0) - lv[0] * rho_h - lv[2] * rho_a
-        det = lv[1] * rho_a - lv[3] * rho_h
-        if abs(det) < 1e-12 * (abs(lv[1]) + abs(lv[3])) * (rho_h + rho_a):
+        l0, l1, l2, l3 = self._l4
+        z = [float(v) for v in z0]
+        c = l0 * (z[0] - rho_h) + l1 * z[1] + l2 * (z[2] - rho_a) + l3 * z[3]
+        det = l1 * rho_a - l3 * rho_h
+        if abs(det) < 1e-12 * (abs(l1) + abs(l3)) * (rho_h + rho_a):
             raise ModelError(f"inlet densities ({rho_h:.4g}, {rho_a:.4g}) veh/m make the inlet "
                              "condition singular for the outgoing family lambda_4")
-        v_h = (c * rho_a - lv[3] * flow) / det
-        v_a = (lv[1] * flow - rho_h * c) / det
+        v_h = (c * rho_a - l3 * flow) / det
+        v_a = (l1 * flow - rho_h * c) / det
         return np.array([rho_h, v_h, rho_a, v_a])
 
     def boundary_state(self, p: ModelParameters, t: float, z0: np.ndarray) -> np.ndarray:

@@ -32,20 +32,21 @@ import numpy as np
 from arzsumo.control.base import Controller, OpenLoop
 from arzsumo.errors import ArzsumoError, require
 from arzsumo.model.equilibrium import Equilibrium
+from arzsumo.model.fd import speed_of_ao
 from arzsumo.model.params import ModelParameters
 from arzsumo.twin.boundary import Inlet, outlet_flux
 from arzsumo.twin.flux import (
     FLUXES,
     LIMITERS,
     from_reconstruction,
-    muscl_faces,
-    to_reconstruction,
     waves,
 )
 from arzsumo.twin.source import relax
 from arzsumo.twin.state import (
     RHO_A,
     RHO_H,
+    Y_A,
+    Y_H,
     cell_centres,
     domain_violation,
     macro_state,
@@ -188,22 +189,41 @@ class _Transport:
         self.second = opts.scheme == "muscl"
         self.inlet = inlet
         self.limited = False        # outlet demand-limited at the last evaluation
+        n = opts.cells
+        self._pad = np.empty((4, n + 2))
+        self._faces = np.empty((4, 2 * n))
+        self._full = np.empty((4, n + 1))
+
+    def _primitive_at(self, r: np.ndarray, j: int) -> np.ndarray:
+        """(rho_h, v_h, rho_a, v_a) of cell ``j`` from reconstruction variables ``r``."""
+        p = self.p
+        rho_h, rho_a = float(r[0, j]), float(r[2, j])
+        ve_h, ve_a = speed_of_ao(p, (p.area_h * rho_h + p.area_a * rho_a) / p.road_width)
+        return np.array([rho_h, float(r[1, j]) + float(ve_h), rho_a, float(r[3, j]) + float(ve_a)])
 
     def rhs(self, q: np.ndarray, t: float, outflow: float) -> tuple[np.ndarray, float,
                                                                       float, float]:
         """dq/dt, the largest wave speed (m/s) and the density fluxes in and out (veh/s)."""
         p = self.p
         if self.second:
-            # second-order value at x = 0 for the outgoing family: linear extrapolation
-            z01 = to_primitive(p, q[:, :2])
-            f_in, qb = self.inlet.boundary_flux(p, t, 1.5 * z01[:, 0] - 0.5 * z01[:, 1])
-            r = to_reconstruction(p, q)
-            rb = to_reconstruction(p, qb[:, None])[:, 0]
-            padded = np.concatenate([(2.0 * rb - r[:, 0])[:, None], r,
-                                     (2.0 * r[:, -1] - r[:, -2])[:, None]], axis=1)
-            east, west = muscl_faces(padded, self.limiter)
             n = q.shape[1]
-            faces = waves(p, from_reconstruction(np.concatenate([east, west], axis=1)))
+            pad = self._pad                          # (rho_h, w_h, rho_a, w_a) + 2 ghosts
+            r = pad[:, 1:-1]
+            r[...] = q
+            r[Y_H] /= q[RHO_H]
+            r[Y_A] /= q[RHO_A]
+            # second-order value at x = 0 for the outgoing family: linear extrapolation
+            z_b = 1.5 * self._primitive_at(r, 0) - 0.5 * self._primitive_at(r, 1)
+            f_in, qb = self.inlet.boundary_flux(p, t, z_b)
+            rb = np.array([qb[0], qb[1] / qb[0], qb[2], qb[3] / qb[2]])
+            pad[:, 0] = 2.0 * rb - r[:, 0]
+            pad[:, -1] = 2.0 * r[:, -1] - r[:, -2]
+            d = np.diff(pad, axis=1)
+            half = 0.5 * self.limiter(d[:, :-1], d[:, 1:])
+            rec = self._faces                        # east faces, then west faces
+            np.add(r, half, out=rec[:, :n])
+            np.subtract(r, half, out=rec[:, n:])
+            faces = waves(p, from_reconstruction(rec))
             flux, smax = self.riemann(faces.sel(slice(0, n - 1)), faces.sel(slice(n + 1, None)))
             out = faces.sel(slice(n - 1, n))
             s = max(float(smax.max()), float(-faces.lo[n]), float(faces.hi[n - 1]))
@@ -216,7 +236,10 @@ class _Transport:
             s = max(float(smax.max()), float(-cells.lo[0]), float(cells.hi[-1]))
         f_out, self.limited = outlet_flux(out.q[:, 0], float(out.v_h[0]), float(out.v_a[0]),
                                           outflow, congested=bool(out.lo[0] < 0.0))
-        full = np.concatenate([f_in[:, None], flux, f_out[:, None]], axis=1)
+        full = self._full
+        full[:, 0] = f_in
+        full[:, 1:-1] = flux
+        full[:, -1] = f_out
         dq = (full[:, :-1] - full[:, 1:]) / self.dx
         return dq, s, float(f_in[RHO_H] + f_in[RHO_A]), float(f_out[RHO_H] + f_out[RHO_A])
 
