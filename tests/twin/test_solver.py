@@ -152,3 +152,26 @@ def test_inlet_demand_series_sets_the_inflow(base_lin):
     expected = eq.q * 60.0 - 0.05 * eq.q_h * (15.0 + 30.0)     # trapezoid of the ramp
     assert res.complete
     assert res.inflow == pytest.approx(expected, rel=2e-3)     # flow interpolated per step
+
+
+def test_stepper_advances_and_can_be_reset_from_fields(base_eq):
+    """The bridge's building block: advance with a held U, read and replace the state."""
+    from arzsumo.twin import TwinStepper, TwinStoppedError
+
+    eq = base_eq
+    st = TwinStepper(eq, _init(eq, cells=100, amplitude=0.02), SolverOptions(cells=100))
+    n0 = st.total_vehicles()
+    st.advance(10.0, -0.05)
+    assert st.t == 10.0 and st.steps > 10
+    assert st.total_vehicles() == pytest.approx(n0 + 0.05 * 10.0, rel=1e-12)
+    state = st.macro_state()
+    assert state.t == 10.0 and state.x.shape == (100,)
+    st.set_state(state)                              # e.g. aggregated SUMO fields
+    assert st.total_vehicles() == pytest.approx(n0 + 0.5, rel=1e-12)
+    st.advance(12.5, 0.0)
+    assert st.t == 12.5
+    with pytest.raises(TwinStoppedError, match=r"stopped at t = .* AO = .* x = 995.0 m"):
+        st.advance(20.0, -eq.q)                      # meter closed: the outlet jams
+    assert st.t < 20.0 and np.all(np.isfinite(st.q))  # last valid state kept
+    with pytest.raises(ModelError, match=r"initial = \(4, 3\) is not allowed"):
+        st.set_state(np.ones((4, 3)))

@@ -1,22 +1,17 @@
-"""The time loop of the nonlinear twin: finite volumes, CFL-adaptive step, controller hook.
+"""The time loop of the nonlinear twin: CFL-adaptive stepping, controller hook, guard.
 
-One function, :func:`simulate`, owns the loop (as PyClaw's controller does): it picks the
-time step from the CFL condition, lands exactly on control checks and output instants,
-calls the controller once per control period through :meth:`Controller.check` and holds
-its U in between, saturates U to a feasible range (and counts the time spent saturated),
-and stops with a message when the state leaves the physical domain, keeping the results
-so far (``complete=False``).
+:class:`TwinStepper` owns the one time loop (as PyClaw's controller does): it advances
+the state to a requested time with a held outflow q* + U, choosing each step from the CFL
+condition, redoing a step whose waves turned out faster than Courant 1, and stopping with
+:class:`TwinStoppedError` (time, position, variable) when the state leaves the physical domain,
+keeping the last valid state. The SUMO bridge can drive it directly
+(``advance(t, u)`` / ``macro_state()`` / ``set_state(...)``).
 
-Each step is Strang-split: exact relaxation over dt/2 (:mod:`arzsumo.twin.source`), one
-transport step, relaxation over dt/2. Transport is either
-
-* ``first``: forward Euler with the numerical flux of :mod:`arzsumo.twin.flux` between
-  cell averages (first order, the paper's Algorithm 1 with a proper upwind flux), or
-* ``muscl``: limited linear reconstruction of (rho, v - Ve) with SSP-RK2 (Heun) in time
-  (second order on smooth solutions).
-
-Boundary fluxes come from :mod:`arzsumo.twin.boundary`. Everything is vectorised over
-cells; the only Python loop is over time steps.
+:func:`simulate` runs a whole experiment on top of it: it calls the controller once per
+control period through :meth:`Controller.check` and holds U in between, saturates U to a
+feasible range (and counts the time spent saturated), stores fields at output instants and
+returns a :class:`TwinResult`, marked ``complete=False`` with the stop message if the run
+ended early. The numerics of one step are in :mod:`arzsumo.twin.scheme`.
 """
 
 from __future__ import annotations
@@ -29,24 +24,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from arzsumo.control.base import Controller, OpenLoop
+from arzsumo.control.base import Controller, MacroState, OpenLoop
 from arzsumo.errors import ArzsumoError, require
 from arzsumo.model.equilibrium import Equilibrium
-from arzsumo.model.fd import speed_of_ao
-from arzsumo.model.params import ModelParameters
-from arzsumo.twin.boundary import Inlet, outlet_flux
-from arzsumo.twin.flux import (
-    FLUXES,
-    LIMITERS,
-    from_reconstruction,
-    waves,
-)
-from arzsumo.twin.source import relax
+from arzsumo.twin.boundary import Inlet
+from arzsumo.twin.flux import FLUXES, LIMITERS
+from arzsumo.twin.scheme import SCHEMES, Transport, max_cell_speed
 from arzsumo.twin.state import (
-    RHO_A,
-    RHO_H,
-    Y_A,
-    Y_H,
     cell_centres,
     domain_violation,
     macro_state,
@@ -57,9 +41,19 @@ from arzsumo.twin.state import (
 
 log = logging.getLogger(__name__)
 
-SCHEMES = ("first", "muscl")
 #: Largest Courant number accepted after a step before it is redone with a smaller dt.
 CFL_MAX = 1.0
+
+StepCallback = Callable[[float, np.ndarray, float, float], None]
+
+
+class TwinStoppedError(ArzsumoError):
+    """The state left the physical domain (or max_steps was reached) at time ``t``."""
+
+    def __init__(self, t: float, reason: str) -> None:
+        super().__init__(f"stopped at t = {t:.3f} s: {reason}")
+        self.t = t
+        self.reason = reason
 
 
 @dataclass(frozen=True)
@@ -174,97 +168,126 @@ class TwinResult:
         return float(self.t[-1] / self.wall_time) if self.wall_time > 0 else math.inf
 
 
-StepCallback = Callable[[float, np.ndarray, float, float], None]
+class TwinStepper:
+    """The twin's state and its time loop; advance it with a held U.
 
+    Parameters
+    ----------
+    eq : Equilibrium
+        Reference equilibrium: q* for the outlet, rho_i* and q* for the default inlet.
+    initial : ndarray, shape (4, cells)
+        Primitive fields (rho_h veh/m, v_h m/s, rho_a veh/m, v_a m/s) on the cell centres.
+    options : SolverOptions, optional
+        ``cells``, ``scheme``, ``flux``, ``limiter``, ``cfl``, ``max_steps`` are used here.
+    inlet : Inlet, optional
+        Default :meth:`Inlet.at_equilibrium` of the linearisation at ``eq``.
+    t0 : float
+        Initial time, s.
 
-class _Transport:
-    """Right-hand side -(F_{j+1/2} - F_{j-1/2}) / dx with the boundary fluxes."""
+    Attributes
+    ----------
+    t : float
+        Current time, s.
+    q : ndarray (4, cells)
+        Conserved state (rho_h, y_h, rho_a, y_a); always inside the physical domain.
+    inflow, outflow : float
+        Vehicles that have entered at x = 0 and left at x = L so far.
+    steps, rejected_steps : int
+    outlet_limited_time : float
+        Seconds during which the arriving demand, not q* + U, set the outflow.
+    """
 
-    def __init__(self, eq: Equilibrium, opts: SolverOptions, inlet: Inlet) -> None:
-        self.p = eq.params
+    def __init__(self, eq: Equilibrium, initial: np.ndarray, options: SolverOptions | None = None,
+                 inlet: Inlet | None = None, t0: float = 0.0) -> None:
+        from arzsumo.model.characteristic import linearize
+
         self.eq = eq
-        self.dx = self.p.length / opts.cells
-        self.riemann = FLUXES[opts.flux]
-        self.limiter = LIMITERS[opts.limiter]
-        self.second = opts.scheme == "muscl"
-        self.inlet = inlet
-        self.limited = False        # outlet demand-limited at the last evaluation
-        n = opts.cells
-        self._pad = np.empty((4, n + 2))
-        self._faces = np.empty((4, 2 * n))
-        self._full = np.empty((4, n + 1))
+        self.options = opts = options or SolverOptions()
+        self.params = eq.params
+        self.x = cell_centres(eq.params.length, opts.cells)
+        self.transport = Transport(eq.params, opts.cells, opts.scheme, opts.flux, opts.limiter,
+                                   inlet or Inlet.at_equilibrium(linearize(eq)))
+        self.q_star = eq.q
+        self.t = float(t0)
+        self.inflow = self.outflow = self.outlet_limited_time = 0.0
+        self.steps = self.rejected_steps = 0
+        self.set_state(initial)
 
-    def _primitive_at(self, r: np.ndarray, j: int) -> np.ndarray:
-        """(rho_h, v_h, rho_a, v_a) of cell ``j`` from reconstruction variables ``r``."""
-        p = self.p
-        rho_h, rho_a = float(r[0, j]), float(r[2, j])
-        ve_h, ve_a = speed_of_ao(p, (p.area_h * rho_h + p.area_a * rho_a) / p.road_width)
-        return np.array([rho_h, float(r[1, j]) + float(ve_h), rho_a, float(r[3, j]) + float(ve_a)])
+    @property
+    def dx(self) -> float:
+        """Cell width, m."""
+        return self.transport.dx
 
-    def rhs(self, q: np.ndarray, t: float, outflow: float) -> tuple[np.ndarray, float,
-                                                                      float, float]:
-        """dq/dt, the largest wave speed (m/s) and the density fluxes in and out (veh/s)."""
-        p = self.p
-        if self.second:
-            n = q.shape[1]
-            pad = self._pad                          # (rho_h, w_h, rho_a, w_a) + 2 ghosts
-            r = pad[:, 1:-1]
-            r[...] = q
-            r[Y_H] /= q[RHO_H]
-            r[Y_A] /= q[RHO_A]
-            # second-order value at x = 0 for the outgoing family: linear extrapolation
-            z_b = 1.5 * self._primitive_at(r, 0) - 0.5 * self._primitive_at(r, 1)
-            f_in, qb = self.inlet.boundary_flux(p, t, z_b)
-            rb = np.array([qb[0], qb[1] / qb[0], qb[2], qb[3] / qb[2]])
-            pad[:, 0] = 2.0 * rb - r[:, 0]
-            pad[:, -1] = 2.0 * r[:, -1] - r[:, -2]
-            d = np.diff(pad, axis=1)
-            half = 0.5 * self.limiter(d[:, :-1], d[:, 1:])
-            rec = self._faces                        # east faces, then west faces
-            np.add(r, half, out=rec[:, :n])
-            np.subtract(r, half, out=rec[:, n:])
-            faces = waves(p, from_reconstruction(rec))
-            flux, smax = self.riemann(faces.sel(slice(0, n - 1)), faces.sel(slice(n + 1, None)))
-            out = faces.sel(slice(n - 1, n))
-            s = max(float(smax.max()), float(-faces.lo[n]), float(faces.hi[n - 1]))
-        else:
-            cells = waves(p, q)
-            z0 = np.array([q[RHO_H, 0], cells.v_h[0], q[RHO_A, 0], cells.v_a[0]])
-            f_in, _ = self.inlet.boundary_flux(p, t, z0)
-            flux, smax = self.riemann(cells.sel(slice(None, -1)), cells.sel(slice(1, None)))
-            out = cells.sel(slice(-1, None))
-            s = max(float(smax.max()), float(-cells.lo[0]), float(cells.hi[-1]))
-        f_out, self.limited = outlet_flux(out.q[:, 0], float(out.v_h[0]), float(out.v_a[0]),
-                                          outflow, congested=bool(out.lo[0] < 0.0))
-        full = self._full
-        full[:, 0] = f_in
-        full[:, 1:-1] = flux
-        full[:, -1] = f_out
-        dq = (full[:, :-1] - full[:, 1:]) / self.dx
-        return dq, s, float(f_in[RHO_H] + f_in[RHO_A]), float(f_out[RHO_H] + f_out[RHO_A])
+    def set_state(self, fields: np.ndarray | MacroState) -> None:
+        """Replace the state by primitive fields (4, cells) or a :class:`MacroState`.
 
-    def step(self, q: np.ndarray, t: float, dt: float, outflow: float) -> tuple[np.ndarray,
-                                                                                float, float,
-                                                                                float]:
-        """One Strang-split step: relaxation dt/2, transport dt, relaxation dt/2.
-
-        Returns the new q, the largest wave speed met (m/s) and the vehicles that entered
-        and left during the step.
+        Raises :class:`ArzsumoError` naming the variable and position if the fields lie
+        outside the physical domain.
         """
-        q = relax(self.p, q, 0.5 * dt)
-        dq, s1, fin1, fout1 = self.rhs(q, t, outflow)
-        q1 = q + dt * dq
-        if not self.second:
-            return relax(self.p, q1, 0.5 * dt), s1, dt * fin1, dt * fout1
-        dq2, s2, fin2, fout2 = self.rhs(q1, t + dt, outflow)
-        q2 = 0.5 * (q + q1 + dt * dq2)
-        return (relax(self.p, q2, 0.5 * dt), max(s1, s2), 0.5 * dt * (fin1 + fin2),
-                0.5 * dt * (fout1 + fout2))
+        if isinstance(fields, MacroState):
+            fields = np.stack([fields.rho_h, fields.v_h, fields.rho_a, fields.v_a])
+        fields = np.asarray(fields, float)
+        n = self.options.cells
+        require(fields.shape == (4, n), "initial", fields.shape,
+                f"shape (4, {n}) of (rho_h, v_h, rho_a, v_a) on the cells")
+        q = to_conserved(self.params, *fields)
+        problem = domain_violation(self.params, q, self.x)
+        if problem is not None:
+            raise ArzsumoError(f"initial state outside the physical domain: {problem}")
+        self.q = q
+        self._smax = max_cell_speed(self.params, q)
 
+    def macro_state(self) -> MacroState:
+        """The current fields as handed to controllers."""
+        return macro_state(self.params, self.t, self.x, self.q)
 
-def _max_cell_speed(p: ModelParameters, q: np.ndarray) -> float:
-    w = waves(p, q)
-    return float(max(-w.lo.min(), w.hi.max()))
+    def primitive(self) -> np.ndarray:
+        """Current (rho_h, v_h, rho_a, v_a), shape (4, cells)."""
+        return to_primitive(self.params, self.q)
+
+    def total_vehicles(self) -> float:
+        """Vehicles on the road now."""
+        return total_vehicles(self.q, self.dx)
+
+    def advance(self, t_end: float, u: float, callback: StepCallback | None = None) -> None:
+        """Advance to ``t_end`` (s) with outlet flow q* + ``u`` (veh/s) held.
+
+        Raises
+        ------
+        TwinStoppedError
+            If a step would leave the physical domain, the inlet condition has no
+            solution, or ``max_steps`` is reached; the state stays the last valid one.
+        """
+        opts, tr, p = self.options, self.transport, self.params
+        eps = 1e-12 * max(1.0, abs(t_end))
+        outflow = self.q_star + float(u)
+        with np.errstate(all="ignore"):
+            while self.t < t_end - eps:
+                if self.steps >= opts.max_steps:
+                    raise TwinStoppedError(self.t, f"max_steps = {opts.max_steps} reached")
+                dt = min(opts.cfl * tr.dx / max(self._smax, 1e-12), t_end - self.t)
+                while True:
+                    try:
+                        q_new, s_step, din, dout = tr.step(self.q, self.t, dt, outflow)
+                    except ArzsumoError as exc:
+                        raise TwinStoppedError(self.t, str(exc)) from None
+                    if s_step * dt <= CFL_MAX * tr.dx * (1 + 1e-12) or dt < 1e-9:
+                        break
+                    self.rejected_steps += 1         # waves sped up during the step: redo
+                    dt = opts.cfl * tr.dx / s_step
+                self._smax = s_step
+                problem = domain_violation(p, q_new, self.x)
+                if problem is not None:
+                    raise TwinStoppedError(self.t + dt, problem)
+                if tr.limited:
+                    self.outlet_limited_time += dt
+                self.q = q_new
+                self.t = t_end if abs(self.t + dt - t_end) <= eps else self.t + dt
+                self.inflow += din
+                self.outflow += dout
+                self.steps += 1
+                if callback is not None:
+                    callback(self.t, self.q, din, dout)
 
 
 def simulate(eq: Equilibrium, initial: np.ndarray, *, controller: Controller | None = None,
@@ -281,7 +304,7 @@ def simulate(eq: Equilibrium, initial: np.ndarray, *, controller: Controller | N
         (see :func:`arzsumo.twin.initial.initial_fields`).
     controller : Controller, optional
         Reset, then checked once per control period via :meth:`Controller.check`
-        (first check at t = 0); default open loop.
+        (first check at t = 0); its U is held until the next check. Default open loop.
     options : SolverOptions, optional
     inlet : Inlet, optional
         Default :meth:`Inlet.at_equilibrium` of the linearisation at ``eq``.
@@ -295,22 +318,11 @@ def simulate(eq: Equilibrium, initial: np.ndarray, *, controller: Controller | N
         ``complete`` is False if the state left the physical domain; ``status`` names the
         time, position and variable.
     """
-    from arzsumo.model.characteristic import linearize
-
     opts = options or SolverOptions()
     ctrl = controller if controller is not None else OpenLoop()
     ctrl.reset()
-    p = eq.params
-    x = cell_centres(p.length, opts.cells)
-    initial = np.asarray(initial, float)
-    require(initial.shape == (4, opts.cells), "initial", initial.shape,
-            f"shape (4, {opts.cells}) of (rho_h, v_h, rho_a, v_a) on the cells")
-    q = to_conserved(p, *initial)
-    problem = domain_violation(p, q, x)
-    if problem is not None:
-        raise ArzsumoError(f"initial state outside the physical domain: {problem}")
-    transport = _Transport(eq, opts, inlet or Inlet.at_equilibrium(linearize(eq)))
-    q_star = eq.q
+    stepper = TwinStepper(eq, initial, opts, inlet)
+    q_star = stepper.q_star
     u_lo = -q_star if opts.u_min is None else opts.u_min
     u_hi = q_star if opts.u_max is None else opts.u_max
 
@@ -320,67 +332,42 @@ def simulate(eq: Equilibrium, initial: np.ndarray, *, controller: Controller | N
     ctl_t: list[float] = []
     ctl_u: list[float] = []
     ctl_req: list[float] = []
-    k_ctl = k_out = steps = rejected = 0
-    t, u, saturated, vin, vout, limited_time = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    k_ctl = k_out = 0
+    u, saturated = 0.0, 0.0
     status, complete = "completed", True
-    smax = _max_cell_speed(p, q)
-    start = _time.perf_counter()
     eps = 1e-9 * max(1.0, opts.horizon)
-    with np.errstate(all="ignore"):
-        while True:
-            if k_out < n_out and t >= k_out * opts.output_period - eps:
-                out_t[k_out], out_f[k_out] = t, to_primitive(p, q)
-                k_out += 1
-            if t >= opts.horizon - eps:
-                break
-            if t >= k_ctl * opts.control_period - eps:
-                requested = float(ctrl.check(macro_state(p, t, x, q)))
-                u = min(max(requested, u_lo), u_hi)
-                if u != requested:
-                    saturated += min(opts.control_period, opts.horizon - t)
-                ctl_t.append(t)
-                ctl_u.append(u)
-                ctl_req.append(requested)
-                k_ctl += 1
-            if steps >= opts.max_steps:
-                status, complete = f"stopped at t = {t:.3f} s: max_steps = {opts.max_steps}", False
-                break
-            t_next = min(k_ctl * opts.control_period, k_out * opts.output_period, opts.horizon)
-            dt = min(opts.cfl * transport.dx / max(smax, 1e-12), t_next - t)
-            while True:
-                try:
-                    q_new, s_step, din, dout = transport.step(q, t, dt, q_star + u)
-                except ArzsumoError as exc:
-                    status, complete = f"stopped at t = {t:.3f} s: {exc}", False
-                    break
-                if s_step * dt <= CFL_MAX * transport.dx * (1 + 1e-12) or dt < 1e-9:
-                    break
-                rejected += 1                    # waves sped up during the step: redo it
-                dt = opts.cfl * transport.dx / s_step
-            if not complete:
-                break
-            smax = s_step
-            if transport.limited:
-                limited_time += dt
-            problem = domain_violation(p, q_new, x)
-            if problem is not None:
-                status = f"stopped at t = {t + dt:.3f} s: {problem}"
-                complete = False
-                break
-            q, t = q_new, t + dt
-            if abs(t - t_next) <= eps:
-                t = t_next
-            vin, vout, steps = vin + din, vout + dout, steps + 1
-            if callback is not None:
-                callback(t, q, din, dout)
+    start = _time.perf_counter()
+    while True:
+        t = stepper.t
+        if k_out < n_out and t >= k_out * opts.output_period - eps:
+            out_t[k_out], out_f[k_out] = t, stepper.primitive()
+            k_out += 1
+        if t >= opts.horizon - eps:
+            break
+        if t >= k_ctl * opts.control_period - eps:
+            requested = float(ctrl.check(stepper.macro_state()))
+            u = min(max(requested, u_lo), u_hi)
+            if u != requested:
+                saturated += min(opts.control_period, opts.horizon - t)
+            ctl_t.append(t)
+            ctl_u.append(u)
+            ctl_req.append(requested)
+            k_ctl += 1
+        t_next = min(k_ctl * opts.control_period, k_out * opts.output_period, opts.horizon)
+        try:
+            stepper.advance(t_next, u, callback)
+        except TwinStoppedError as exc:
+            status, complete = str(exc), False
+            break
     wall = _time.perf_counter() - start
     if not complete:
         log.warning("twin run incomplete: %s", status)
-        if k_out == 0 or out_t[k_out - 1] < t:
-            out_t[k_out], out_f[k_out] = t, to_primitive(p, q)    # last valid state
+        if k_out == 0 or out_t[k_out - 1] < stepper.t:
+            out_t[k_out], out_f[k_out] = stepper.t, stepper.primitive()   # last valid state
             k_out += 1
-    return TwinResult(eq, opts, ctrl, out_t[:k_out].copy(), x, out_f[:k_out].copy(),
+    return TwinResult(eq, opts, ctrl, out_t[:k_out].copy(), stepper.x, out_f[:k_out].copy(),
                       np.asarray(ctl_t), np.asarray(ctl_u), np.asarray(ctl_req), saturated,
-                      (u_lo, u_hi), vin, vout, steps, rejected, wall, complete, status,
-                      {"final_state": q, "total_vehicles": total_vehicles(q, transport.dx),
-                       "outlet_limited_time": limited_time})
+                      (u_lo, u_hi), stepper.inflow, stepper.outflow, stepper.steps,
+                      stepper.rejected_steps, wall, complete, status,
+                      {"final_state": stepper.q, "total_vehicles": stepper.total_vehicles(),
+                       "outlet_limited_time": stepper.outlet_limited_time})
