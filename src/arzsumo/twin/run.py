@@ -41,6 +41,7 @@ class TwinRun:
     norm: np.ndarray
     events: np.ndarray
     baseline: Performance | None
+    baseline_status: str = "not run"
 
     @property
     def triggers(self) -> int:
@@ -81,6 +82,7 @@ class TwinRun:
             "total_delay": {k: v["total_delay"] for k, v in perf.items()},
             "relative_to_open_loop_percent": (relative_change(self.performance, self.baseline)
                                               if self.baseline is not None else None),
+            "open_loop_baseline": self.baseline_status,
             "initial_norm": float(self.norm[0]),
             "final_norm": float(self.norm[-1]),
             "final_norm_ratio": ratio,
@@ -119,11 +121,17 @@ def run_twin(scenario: Scenario, config: TwinConfig | None = None, *,
     init = initial_fields(cfg.initial, eq, x)
     res = simulate(eq, init, controller=ctrl, options=cfg.solver)
     perf = performance(eq.params, res.t, res.x, res.fields)
-    base = None
-    if baseline and ctrl.name != "open":
+    base, base_status = None, "not run"
+    if ctrl.name == "open":
+        base_status = "this run is the open loop"
+    elif baseline:
         open_res = simulate(eq, init, options=cfg.solver)
+        base_status = open_res.status
         if open_res.complete and res.complete:
             base = performance(eq.params, open_res.t, open_res.x, open_res.fields)
+        else:                 # indices over different horizons are not comparable
+            base_status = f"no comparison: open loop {open_res.status}; run {res.status}"
     log = ctrl.log
     mask = events(res.control_t, res.control_u, log.triggered if log.t else None)
-    return TwinRun(scenario, cfg, res, perf, deviation_norm(eq, res.x, res.fields), mask, base)
+    return TwinRun(scenario, cfg, res, perf, deviation_norm(eq, res.x, res.fields), mask, base,
+                   base_status)
