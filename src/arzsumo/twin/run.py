@@ -88,6 +88,7 @@ class TwinRun:
             "final_norm_ratio": ratio,
             "final_time": float(r.t[-1]),
             "equilibrium": self.scenario.equilibrium.as_dict(),
+            "regime": linearize(self.scenario.equilibrium).regime,
             "config": self.config.as_dict(),
             "numerics": {"steps": r.steps, "rejected_steps": r.rejected_steps,
                          "wall_time_s": r.wall_time, "speed_up": r.speed_up},

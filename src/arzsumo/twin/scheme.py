@@ -23,7 +23,21 @@ SCHEMES = ("first", "muscl")
 
 
 class Transport:
-    """Right-hand side -(F_{j+1/2} - F_{j-1/2}) / dx with the boundary fluxes."""
+    """Right-hand side -(F_{j+1/2} - F_{j-1/2}) / dx with the boundary fluxes, and one step.
+
+    Parameters
+    ----------
+    params : ModelParameters
+    cells : int
+        Number of cells on [0, L].
+    scheme : {"first", "muscl"}
+    flux : str
+        Key of :data:`arzsumo.twin.flux.FLUXES`.
+    limiter : str
+        Key of :data:`arzsumo.twin.flux.LIMITERS` (``muscl`` only).
+    inlet : Inlet
+        Inlet data (:mod:`arzsumo.twin.boundary`).
+    """
 
     def __init__(self, params: ModelParameters, cells: int, scheme: str, flux: str,
                  limiter: str, inlet: Inlet) -> None:

@@ -184,6 +184,11 @@ class TwinStepper:
     t0 : float
         Initial time, s.
 
+    Notes
+    -----
+    The boundary conditions are those of section 2, posed for a congested equilibrium
+    (lambda_4 < 0); a free-flow equilibrium is accepted with a logged warning.
+
     Attributes
     ----------
     t : float
@@ -205,8 +210,14 @@ class TwinStepper:
         self.options = opts = options or SolverOptions()
         self.params = eq.params
         self.x = cell_centres(eq.params.length, opts.cells)
+        lin = linearize(eq)
+        if lin.regime != "congested":
+            log.warning("the equilibrium is in free flow (lambda_4 = %.3g m/s >= 0): the "
+                        "boundary conditions of section 2 are posed for congestion; in free "
+                        "flow the inlet under-determines and the results are not reliable",
+                        lin.eigenvalues[3])
         self.transport = Transport(eq.params, opts.cells, opts.scheme, opts.flux, opts.limiter,
-                                   inlet or Inlet.at_equilibrium(linearize(eq)))
+                                   inlet or Inlet.at_equilibrium(lin))
         self.q_star = eq.q
         self.t = float(t0)
         self.inflow = self.outflow = self.outlet_limited_time = 0.0
