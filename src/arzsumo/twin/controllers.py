@@ -4,14 +4,20 @@ A factory takes the linearisation at the scenario's equilibrium and the twin
 configuration and returns a fresh :class:`arzsumo.control.base.Controller`. The twin
 calls controllers only through :meth:`Controller.check`, once per control period.
 
-To plug in a controller (e.g. backstepping, ETC, observer-ETC from
-:mod:`arzsumo.control`)::
+Scenario files name controllers in ``[twin] controller``, and names are validated when
+the file is parsed, so entries must exist at import time: add them to :data:`CONTROLLERS`
+below (imports inside the factory keep ``import arzsumo.twin`` light), or call
+:func:`register_controller` before loading scenarios. For the PDE controllers of
+:mod:`arzsumo.control.registry` (kernels from :mod:`arzsumo.kernel_cache`)::
 
-    from arzsumo.twin.controllers import register_controller
-    register_controller("backstepping", lambda lin, cfg: Backstepping(lin, dt=cfg.solver
-                                                                      .control_period))
+    def _pde(name):
+        def factory(lin, cfg):
+            from arzsumo.control.registry import make_controller as make_pde
+            from arzsumo.kernel_cache import cached_kernels
+            return make_pde(name, lin, cached_kernels(lin.system, 200))
+        return factory
 
-or add an entry to :data:`CONTROLLERS` below.
+    CONTROLLERS.update({n: _pde(n) for n in ("backstepping", "etc", "observer-etc")})
 """
 
 from __future__ import annotations
