@@ -22,7 +22,7 @@ EXIT_INCOMPLETE = 3
 
 
 def cmd_twin(args: argparse.Namespace) -> int:
-    from arzsumo.twin.output import _json_safe, write_run
+    from arzsumo.twin.output import json_safe, write_run
     from arzsumo.twin.run import run_twin
 
     sc = load_scenario(args.scenario)
@@ -31,7 +31,7 @@ def cmd_twin(args: argparse.Namespace) -> int:
     write_run(run, out, plots=not args.no_plots)
     summary = run.summary()
     if args.json:
-        print(json.dumps(_json_safe(summary), indent=2))
+        print(json.dumps(json_safe(summary), indent=2))
     else:
         _print(summary, out)
     return 0 if run.result.complete else EXIT_INCOMPLETE

@@ -45,15 +45,16 @@ def control_table(run: TwinRun) -> pa.Table:
                      "triggered": run.events.astype(bool)})
 
 
-def _json_safe(obj: Any) -> Any:
+def json_safe(obj: Any) -> Any:
+    """``obj`` with numpy scalars as Python numbers and non-finite floats as None."""
     if isinstance(obj, dict):
-        return {k: _json_safe(v) for k, v in obj.items()}
+        return {k: json_safe(v) for k, v in obj.items()}
     if isinstance(obj, list | tuple):
-        return [_json_safe(v) for v in obj]
+        return [json_safe(v) for v in obj]
     if isinstance(obj, float) and not math.isfinite(obj):
         return None
     if isinstance(obj, np.generic):
-        return _json_safe(obj.item())
+        return json_safe(obj.item())
     return obj
 
 
@@ -64,7 +65,7 @@ def write_run(run: TwinRun, out: str | Path, plots: bool = True) -> Path:
     with atomic_dir(out) as tmp:
         pq.write_table(fields_table(run), tmp / "fields.parquet")
         pq.write_table(control_table(run), tmp / "control.parquet")
-        (tmp / "summary.json").write_text(json.dumps(_json_safe(run.summary()), indent=2)
+        (tmp / "summary.json").write_text(json.dumps(json_safe(run.summary()), indent=2)
                                           + "\n", encoding="utf-8")
         if plots:
             write_twin_plots(run, tmp)
