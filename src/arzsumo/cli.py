@@ -13,7 +13,7 @@ import logging
 import sys
 from collections.abc import Callable, Sequence
 
-from arzsumo import __version__
+from arzsumo import __version__, cli_control, cli_twin
 from arzsumo.errors import ArzsumoError
 from arzsumo.model import linearize
 from arzsumo.scenarios import Scenario, load_scenario, scenario_from_preset
@@ -104,9 +104,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--regime-map", metavar="FILE.png", help="draw the free/congested map")
     p.set_defaults(func=cmd_model)
 
-    from arzsumo import cli_control
-
     cli_control.register(sub)
+    cli_twin.register(sub)
     return parser
 
 

@@ -66,7 +66,8 @@ EQUILIBRIUM_KEYS: dict[str, Callable[[float], Any]] = {
     "demand_a_veh_h": veh_h_to_veh_s,
 }
 
-TOP_KEYS = {"name", "description", "model", "equilibrium"}
+#: [twin] and [initial] are parsed by arzsumo.twin.config (the PDE twin's own settings).
+TOP_KEYS = {"name", "description", "model", "equilibrium", "twin", "initial"}
 
 
 @dataclass(frozen=True)

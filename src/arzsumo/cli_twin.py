@@ -1,0 +1,77 @@
+"""``arzsumo twin SCENARIO [--out DIR] [--json]``: run the nonlinear PDE twin.
+
+Registered into the main parser by :func:`register`; the work is done by
+:func:`arzsumo.twin.run.run_twin` and :func:`arzsumo.twin.output.write_run`.
+Exit codes: 0 completed, 3 stopped early (state left the physical domain; the partial
+results are written and marked ``"complete": false``), 2 user error.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+from pathlib import Path
+
+from arzsumo.scenarios import load_scenario
+from arzsumo.units import veh_s_to_veh_h
+
+log = logging.getLogger(__name__)
+
+EXIT_INCOMPLETE = 3
+
+
+def cmd_twin(args: argparse.Namespace) -> int:
+    from arzsumo.twin.output import json_safe, write_run
+    from arzsumo.twin.run import run_twin
+
+    sc = load_scenario(args.scenario)
+    run = run_twin(sc, baseline=not args.no_baseline)
+    out = Path(args.out) if args.out else Path("results") / "twin" / sc.name
+    write_run(run, out, plots=not args.no_plots)
+    summary = run.summary()
+    if args.json:
+        print(json.dumps(json_safe(summary), indent=2))
+    else:
+        _print(summary, out)
+    return 0 if run.result.complete else EXIT_INCOMPLETE
+
+
+def _print(s: dict, out: Path) -> None:
+    num = s["numerics"]
+    print(f"twin {s['scenario']}: controller {s['controller']}, "
+          f"{s['config']['cells']} cells, {s['config']['scheme']}")
+    print(f"  status: {s['status']}")
+    print(f"  simulated {s['final_time']:.1f} s in {num['wall_time_s']:.2f} s "
+          f"({num['speed_up']:.0f}x real time, {num['steps']} steps)")
+    print(f"  deviation norm: {s['initial_norm']:.4g} -> {s['final_norm']:.4g} "
+          f"(ratio {s['final_norm_ratio']:.3g})")
+    print(f"  triggers {s['triggers']}, release time {s['release_time']:.0f} s, "
+          f"saturated {s['saturation_time']:.0f} s "
+          f"(U in [{veh_s_to_veh_h(s['u_range'][0]):.0f}, "
+          f"{veh_s_to_veh_h(s['u_range'][1]):.0f}] veh/h)")
+    for key in ("J_fuel", "J_discom", "J_TTT", "total_delay"):
+        v = s[key]
+        line = f"  {key:<12} HV {v['h']:12.5g}  AV {v['a']:12.5g}  total {v['total']:12.5g}"
+        rel = s["relative_to_open_loop_percent"]
+        if rel is not None:
+            line += f"   ({rel['total'][key]:+.2f} % vs open loop)"
+        print(line)
+    c = s["conservation"]
+    print(f"  vehicles {c['vehicles_initial']:.3f} -> {c['vehicles_final']:.3f}, in "
+          f"{c['inflow']:.3f}, out {c['outflow']:.3f}, balance error {c['balance_error']:.2e}")
+    print(f"  written to {out}/")
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``twin`` subcommand to the main parser's subparsers."""
+    p = subparsers.add_parser("twin", help="run the nonlinear PDE twin on a scenario")
+    p.add_argument("scenario", metavar="SCENARIO.toml",
+                   help="scenario file with optional [twin] and [initial] tables")
+    p.add_argument("--out", metavar="DIR",
+                   help="output directory (default results/twin/<scenario name>)")
+    p.add_argument("--json", action="store_true", help="print the summary as JSON (SI)")
+    p.add_argument("--no-plots", action="store_true", help="skip the PNG figures")
+    p.add_argument("--no-baseline", action="store_true",
+                   help="do not run the open loop for relative changes")
+    p.set_defaults(func=cmd_twin)

@@ -1,0 +1,177 @@
+"""Boundary conditions of section 2 for the finite-volume twin.
+
+Inlet (x = 0), three conditions for the three incoming families (lambda_1..3 > 0)::
+
+    rho_h(0, t) = rho_h^in(t),  rho_a(0, t) = rho_a^in(t),
+    rho_h v_h + rho_a v_a = q^in(t)                       (defaults: rho_i*, q_h* + q_a*)
+
+The fourth relation comes from the outgoing family lambda_4 < 0: the boundary state z_b
+keeps the lambda_4 Riemann variable of the first cell, l_4 . z_b = l_4 . z_0, with l_4
+the left eigenvector of the linearisation at the reference equilibrium (row 4 of T,
+docs/characteristic_form.md; z = (rho_h, v_h, rho_a, v_a)). This is a 2x2 linear system
+for (v_h, v_a) at the boundary; the inlet flux is the physical flux of z_b, so the total
+density flux through x = 0 is exactly q^in(t). At an equilibrium it returns the
+equilibrium state.
+
+Outlet (x = L), one condition for the one incoming family::
+
+    rho_h v_h + rho_a v_a = q* + U(t)
+
+Splitting rule (documented choice): the metered flow q* + U is shared between the classes
+in proportion to the class flows arriving in the last cell, F_rho_i = (q* + U) q_i / (q_h
++ q_a), and each vehicle leaves with its own Lagrangian marker: F_y_i = w_i F_rho_i with
+w_i = v_i - Ve_i = y_i / rho_i of the last cell. At an equilibrium with U = 0 this is the
+equilibrium flux, and the class mix of the outflow equals that of the arriving traffic.
+
+A ramp meter limits the flow; it cannot pull vehicles that are not there. Where the last
+cell is congested (its smallest characteristic speed lambda_min < 0, so one family enters
+through x = L) the condition above is imposed as stated, with q* + U floored at 0. Where it
+is in free flow (lambda_min >= 0) every family leaves the domain and no condition can be
+imposed: the outflow is then the smaller of the meter rate and the arriving flow q_h + q_a
+(supply and demand, as in a cell transmission model). :func:`outlet_flux` reports when
+the arriving flow, not q* + U, set the outflow.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from arzsumo.errors import ModelError, require
+from arzsumo.model.characteristic import Linearization
+from arzsumo.model.equilibrium import equilibrium_from_demand
+from arzsumo.model.params import ModelParameters
+from arzsumo.twin.state import to_conserved
+
+Signal = float | Callable[[float], float]
+
+
+def _value(signal: Signal, t: float) -> float:
+    return float(signal(t)) if callable(signal) else float(signal)
+
+
+@dataclass(frozen=True)
+class Inlet:
+    """Inlet data: class densities (veh/m) and total inflow (veh/s), constants or f(t).
+
+    Parameters
+    ----------
+    rho_h, rho_a : float or callable
+        Inlet class densities rho_i(0, t), veh/m.
+    flow : float or callable
+        Total inflow rho_h v_h + rho_a v_a at x = 0, veh/s.
+    l4 : ndarray, shape (4,)
+        Left eigenvector of lambda_4 in z = (rho_h, v_h, rho_a, v_a) (row 4 of T).
+    """
+
+    rho_h: Signal
+    rho_a: Signal
+    flow: Signal
+    l4: np.ndarray
+
+    def __post_init__(self) -> None:
+        l4 = np.array(self.l4, dtype=float)
+        if l4.shape != (4,) or not np.all(np.isfinite(l4)):
+            raise ModelError(f"l4 = {self.l4!r} is not allowed: 4 finite numbers")
+        l4.setflags(write=False)
+        object.__setattr__(self, "l4", l4)
+        object.__setattr__(self, "_l4", tuple(float(v) for v in l4))   # hot path
+
+    @classmethod
+    def at_equilibrium(cls, lin: Linearization) -> Inlet:
+        """The paper's inlet: rho_i(0) = rho_i*, inflow q_h* + q_a*."""
+        eq = lin.equilibrium
+        return cls(eq.rho_h, eq.rho_a, eq.q, lin.T[3])
+
+    @classmethod
+    def from_demands(cls, lin: Linearization, times: np.ndarray, demand_h: np.ndarray,
+                     demand_a: np.ndarray) -> Inlet:
+        """An inlet driven by class demand time series (veh/s at ``times`` s).
+
+        At each sample the inlet densities are those of the congested equilibrium that
+        carries the demands (:func:`equilibrium_from_demand`); densities and total flow
+        are interpolated linearly between samples and held beyond them.
+        """
+        times = np.asarray(times, float)
+        demand_h = np.asarray(demand_h, float)
+        demand_a = np.asarray(demand_a, float)
+        require(times.ndim == 1 and times.size >= 1 and times.shape == demand_h.shape
+                == demand_a.shape, "demand series", (times.shape, demand_h.shape,
+                                                     demand_a.shape),
+                "1-D arrays of equal length")
+        require(bool(np.all(np.diff(times) > 0)), "times", times.tolist()[:5],
+                "strictly increasing")
+        p = lin.equilibrium.params
+        eqs = [equilibrium_from_demand(p, float(qh), float(qa)) for qh, qa in
+               zip(demand_h, demand_a, strict=True)]
+        rho_h = np.array([e.rho_h for e in eqs])
+        rho_a = np.array([e.rho_a for e in eqs])
+        flow = demand_h + demand_a
+        return cls(lambda t: float(np.interp(t, times, rho_h)),
+                   lambda t: float(np.interp(t, times, rho_a)),
+                   lambda t: float(np.interp(t, times, flow)), lin.T[3])
+
+    def boundary_primitive(self, t: float, z0: np.ndarray) -> np.ndarray:
+        """Boundary state (rho_h, v_h, rho_a, v_a) at x = 0 given the first cell's ``z0``."""
+        rho_h, rho_a, flow = _value(self.rho_h, t), _value(self.rho_a, t), _value(self.flow, t)
+        l0, l1, l2, l3 = self._l4
+        z = [float(v) for v in z0]
+        c = l0 * (z[0] - rho_h) + l1 * z[1] + l2 * (z[2] - rho_a) + l3 * z[3]
+        det = l1 * rho_a - l3 * rho_h
+        if abs(det) < 1e-12 * (abs(l1) + abs(l3)) * (rho_h + rho_a):
+            raise ModelError(f"inlet densities ({rho_h:.4g}, {rho_a:.4g}) veh/m make the inlet "
+                             "condition singular for the outgoing family lambda_4")
+        v_h = (c * rho_a - l3 * flow) / det
+        v_a = (l1 * flow - rho_h * c) / det
+        return np.array([rho_h, v_h, rho_a, v_a])
+
+    def boundary_state(self, p: ModelParameters, t: float, z0: np.ndarray) -> np.ndarray:
+        """Conserved boundary state at x = 0, shape (4,)."""
+        return to_conserved(p, *self.boundary_primitive(t, z0))
+
+    def boundary_flux(self, p: ModelParameters, t: float,
+                      z0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Physical flux (4,) of the boundary state at x = 0, and that state (conserved)."""
+        rho_h, v_h, rho_a, v_a = self.boundary_primitive(t, z0)
+        rho_h, v_h, rho_a, v_a = float(rho_h), float(v_h), float(rho_a), float(v_a)
+        ao = (p.area_h * rho_h + p.area_a * rho_a) / p.road_width
+        ve_h = p.v_free_h * (1.0 - (ao / p.ao_max_h) ** p.gamma_h)    # fd.speed_of_ao
+        ve_a = p.v_free_a * (1.0 - (ao / p.ao_max_a) ** p.gamma_a)
+        y_h, y_a = rho_h * (v_h - ve_h), rho_a * (v_a - ve_a)
+        return (np.array([rho_h * v_h, y_h * v_h, rho_a * v_a, y_a * v_a]),
+                np.array([rho_h, y_h, rho_a, y_a]))
+
+
+def outlet_flux(q_last: np.ndarray, v_h: float, v_a: float, total: float,
+                congested: bool = True) -> tuple[np.ndarray, bool]:
+    """Flux (4,) through x = L carrying ``total`` veh/s, split by the rule above.
+
+    Parameters
+    ----------
+    q_last : ndarray, shape (4,)
+        Conserved state at the outlet face (last cell, or its reconstructed east value).
+    v_h, v_a : float
+        Speeds there, m/s.
+    total : float
+        Metered outflow q* + U, veh/s.
+    congested : bool
+        Whether the smallest characteristic speed at the outlet is negative.
+
+    Returns
+    -------
+    flux : ndarray, shape (4,)
+    limited : bool
+        True when the arriving demand (or 0) and not ``total`` set the outflow.
+    """
+    rho_h, y_h, rho_a, y_a = (float(c) for c in q_last)
+    q_h, q_a = rho_h * v_h, rho_a * v_a
+    arriving = q_h + q_a
+    share_h = q_h / arriving if arriving > 0 and math.isfinite(arriving) else 0.5
+    flow = max(total, 0.0)
+    if not congested:
+        flow = min(flow, max(arriving, 0.0))
+    f_h, f_a = flow * share_h, flow * (1.0 - share_h)
+    return np.array([f_h, y_h / rho_h * f_h, f_a, y_a / rho_a * f_a]), flow != total

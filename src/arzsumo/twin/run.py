@@ -1,0 +1,138 @@
+"""One twin run of a scenario: initial fields, controller, solver, indices, summary.
+
+This is the library function behind ``arzsumo twin``; it writes nothing.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from arzsumo import __version__
+from arzsumo.control.base import Controller
+from arzsumo.model.characteristic import linearize
+from arzsumo.scenarios import Scenario
+from arzsumo.twin.config import TwinConfig, twin_config_from_dict
+from arzsumo.twin.controllers import make_controller
+from arzsumo.twin.initial import initial_fields
+from arzsumo.twin.metrics import (
+    Performance,
+    deviation_norm,
+    events,
+    performance,
+    relative_change,
+    release_time,
+)
+from arzsumo.twin.solver import TwinResult, simulate
+from arzsumo.twin.state import cell_centres
+
+
+@dataclass(frozen=True)
+class TwinRun:
+    """A finished (possibly incomplete) twin run with everything outputs and plots need."""
+
+    scenario: Scenario
+    config: TwinConfig
+    result: TwinResult
+    performance: Performance
+    norm: np.ndarray
+    events: np.ndarray
+    baseline: Performance | None
+    baseline_status: str = "not run"
+
+    @property
+    def triggers(self) -> int:
+        """Number of updates of the applied control."""
+        return int(self.events.sum())
+
+    @property
+    def release_time(self) -> float:
+        """Total release time, s (:func:`arzsumo.twin.metrics.release_time`)."""
+        return release_time(self.result.control_t, self.events, float(self.result.t[-1]))
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-ready summary; SI units (veh, s, m)."""
+        r = self.result
+        dx = r.dx
+        n0 = float(r.fields[0, [0, 2]].sum() * dx)
+        n1 = float(r.extra["total_vehicles"])
+        perf = self.performance.as_dict()
+        ratio = float(self.norm[-1] / self.norm[0]) if self.norm[0] > 0 else math.nan
+        return {
+            "scenario": self.scenario.name,
+            "source": self.scenario.source,
+            "version": __version__,
+            "seed": self.config.seed,
+            "controller": r.controller.name,
+            "complete": r.complete,
+            "status": r.status,
+            "units": "SI: veh, s, m; U in veh/s",
+            "triggers": self.triggers,
+            "release_time": self.release_time,
+            "saturation_time": r.saturated_time,
+            "outlet_limited_time": r.extra["outlet_limited_time"],
+            "u_range": list(r.u_range),
+            "J_fuel": {k: v["J_fuel"] for k, v in perf.items()},
+            "J_discom": {k: v["J_discom"] for k, v in perf.items()},
+            "J_TTT": {k: v["J_TTT"] for k, v in perf.items()},
+            "TMT": {k: v["TMT"] for k, v in perf.items()},
+            "total_delay": {k: v["total_delay"] for k, v in perf.items()},
+            "relative_to_open_loop_percent": (relative_change(self.performance, self.baseline)
+                                              if self.baseline is not None else None),
+            "open_loop_baseline": self.baseline_status,
+            "initial_norm": float(self.norm[0]),
+            "final_norm": float(self.norm[-1]),
+            "final_norm_ratio": ratio,
+            "final_time": float(r.t[-1]),
+            "equilibrium": self.scenario.equilibrium.as_dict(),
+            "regime": linearize(self.scenario.equilibrium).regime,
+            "config": self.config.as_dict(),
+            "numerics": {"steps": r.steps, "rejected_steps": r.rejected_steps,
+                         "wall_time_s": r.wall_time, "speed_up": r.speed_up},
+            "conservation": {"vehicles_initial": n0, "vehicles_final": n1,
+                             "inflow": r.inflow, "outflow": r.outflow,
+                             "balance_error": n1 - n0 - (r.inflow - r.outflow)},
+        }
+
+
+def run_twin(scenario: Scenario, config: TwinConfig | None = None, *,
+             controller: Controller | None = None, baseline: bool = True) -> TwinRun:
+    """Run the twin on ``scenario``.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Model and equilibrium; its ``[twin]``/``[initial]`` tables give the configuration
+        unless ``config`` is passed.
+    config : TwinConfig, optional
+    controller : Controller, optional
+        Overrides the configured controller name (for callers holding an instance).
+    baseline : bool
+        Also run the open loop of the same scenario to report relative changes (skipped
+        when the controller is the open loop).
+    """
+    cfg = config or twin_config_from_dict(scenario.raw, scenario.source)
+    eq = scenario.equilibrium
+    lin = linearize(eq)
+    ctrl = controller or make_controller(cfg.controller, lin, cfg)
+    x = cell_centres(eq.params.length, cfg.solver.cells)
+    init = initial_fields(cfg.initial, eq, x)
+    res = simulate(eq, init, controller=ctrl, options=cfg.solver)
+    perf = performance(eq.params, res.t, res.x, res.fields)
+    base, base_status = None, "not run"
+    if ctrl.name == "open":
+        base_status = "this run is the open loop"
+    elif baseline:
+        open_res = simulate(eq, init, options=cfg.solver)
+        base_status = open_res.status
+        if open_res.complete and res.complete:
+            base = performance(eq.params, open_res.t, open_res.x, open_res.fields)
+        else:                 # indices over different horizons are not comparable
+            base_status = f"no comparison: open loop {open_res.status}; run {res.status}"
+    log = ctrl.log
+    mask = events(res.control_t, res.control_u, log.triggered if log.t else None)
+    return TwinRun(scenario, cfg, res, perf, deviation_norm(eq, res.x, res.fields), mask, base,
+                   base_status)
