@@ -26,7 +26,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from arzsumo.errors import ScenarioError
+from arzsumo.control.etc import PAPER_DESIGN, EtcDesign
+from arzsumo.errors import ArzsumoError, ScenarioError
 from arzsumo.model.equilibrium import (
     Equilibrium,
     equilibrium_from_demand,
@@ -67,7 +68,10 @@ EQUILIBRIUM_KEYS: dict[str, Callable[[float], Any]] = {
 }
 
 #: [twin] and [initial] are parsed by arzsumo.twin.config (the PDE twin's own settings).
-TOP_KEYS = {"name", "description", "model", "equilibrium", "twin", "initial"}
+TOP_KEYS = {"name", "description", "model", "equilibrium", "twin", "initial", "design"}
+
+#: ETC design keys of the [design] table (dimensionless or SI as in the paper, section 5)
+DESIGN_KEYS = {"zeta", "sigma", "eta", "A", "B", "varsigma", "mu", "m0"}
 
 
 @dataclass(frozen=True)
@@ -141,6 +145,26 @@ def scenario_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scena
     name = str(data.get("name", Path(source).stem if source != "<dict>" else preset.name))
     return Scenario(name, str(data.get("description", preset.description)), params, eq,
                     source, dict(data))
+
+
+def design_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> EtcDesign:
+    """The ETC design of the ``[design]`` table (paper values for missing keys)."""
+    table = _section(data, "design", source)
+    where = f"{source} [design]"
+    _check_keys(table, DESIGN_KEYS, where)
+    changes: dict[str, Any] = {}
+    for key, value in table.items():
+        if key in ("A", "varsigma"):
+            if not isinstance(value, list) or not value:
+                raise ScenarioError(f"{where}: {key} = {value!r} is not allowed: a list of "
+                                    "numbers")
+            changes[key] = tuple(_number({key: v}, key, where) for v in value)
+        else:
+            changes[key] = _number(table, key, where)
+    try:
+        return PAPER_DESIGN.with_(**changes)
+    except ArzsumoError as exc:
+        raise ScenarioError(f"{where}: {exc}") from None
 
 
 def load_scenario(path: str | Path) -> Scenario:

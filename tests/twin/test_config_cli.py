@@ -120,3 +120,39 @@ def test_cli_twin_bad_scenario_is_one_line(tmp_path):
     assert proc.returncode == 2
     assert "scheme = 'weno' is not allowed" in proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1
+
+
+def test_pde_controllers_run_in_the_twin_with_a_design_table(tmp_path, monkeypatch):
+    """backstepping updates at every check; ETC far less often; [design] reaches the ETC."""
+    from arzsumo.scenarios import scenario_from_dict
+    from arzsumo.twin.config import twin_config_from_dict
+    from arzsumo.twin.run import run_twin
+
+    monkeypatch.setenv("ARZSUMO_CACHE", str(tmp_path))
+    base = {"model": {"preset": "paper_base"},
+            "twin": {"cells": 100, "horizon_s": 120, "kernel_cells": 100},
+            "initial": {"kind": "sinusoid", "amplitude": [0.02, -0.02, 0.02, -0.02],
+                        "wavenumber": 2},
+            "design": {"mu": 1e-3, "A": [0.02, 0.003, 0.004]}}
+    sc = scenario_from_dict({k: v for k, v in base.items() if k in ("model",)})
+    counts = {}
+    for name in ("backstepping", "etc"):
+        data = {**base, "twin": {**base["twin"], "controller": name}}
+        cfg = twin_config_from_dict(data)
+        assert cfg.design.mu == 1e-3
+        run = run_twin(sc, cfg, baseline=False)
+        counts[name] = run.triggers
+    assert counts["backstepping"] == 120
+    assert counts["etc"] < 0.7 * counts["backstepping"]
+
+
+def test_bad_design_table_is_named():
+    import pytest
+
+    from arzsumo.errors import ScenarioError
+    from arzsumo.twin.config import twin_config_from_dict
+
+    with pytest.raises(ScenarioError, match=r"\[design\]: unknown key 'nu'"):
+        twin_config_from_dict({"design": {"nu": 1.0}})
+    with pytest.raises(ScenarioError, match=r"m0 = 0.5 is not allowed"):
+        twin_config_from_dict({"design": {"m0": 0.5}})

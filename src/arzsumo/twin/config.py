@@ -16,6 +16,12 @@ Example::
     controller = "open"         # a name registered in arzsumo.twin.controllers
     constant_u_veh_h = 0        # for controller = "constant"
     seed = 0                    # recorded in outputs; the twin itself is deterministic
+    kernel_cells = 200          # grid of the backstepping kernels (PDE controllers)
+
+    [design]                    # ETC design (defaults: the paper's section 5 values)
+    mu = 5e-4
+    sigma = 1e-4
+    zeta = 8e-3
 
     [initial]
     kind = "sinusoid"           # equilibrium, sinusoid, nonrecurrent, linear
@@ -32,9 +38,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from typing import Any
 
+from arzsumo.control.etc import PAPER_DESIGN, EtcDesign
 from arzsumo.errors import ArzsumoError, ScenarioError
 from arzsumo.twin.controllers import CONTROLLERS
 from arzsumo.twin.initial import KINDS, InitialCondition
@@ -46,7 +53,7 @@ DEFAULT_AMPLITUDE = (0.05, -0.05, 0.05, -0.05)
 
 TWIN_KEYS = {"cells", "scheme", "flux", "limiter", "cfl", "horizon_s", "control_period_s",
              "output_period_s", "u_min_veh_h", "u_max_veh_h", "controller",
-             "constant_u_veh_h", "seed", "max_steps"}
+             "constant_u_veh_h", "seed", "max_steps", "kernel_cells"}
 INITIAL_KEYS = {"kind", "amplitude", "wavenumber", "phase_rad", "fraction"}
 
 
@@ -60,11 +67,17 @@ class TwinConfig:
     controller: str = "open"
     constant_u: float = 0.0
     seed: int = 0
+    kernel_cells: int = 200
+    design: EtcDesign = PAPER_DESIGN
 
     def __post_init__(self) -> None:
         if self.controller not in CONTROLLERS:
             raise ScenarioError(f"controller = {self.controller!r} is not allowed: one of "
                                 f"{', '.join(sorted(CONTROLLERS))}")
+        if isinstance(self.kernel_cells, bool) or not isinstance(self.kernel_cells, int) \
+                or self.kernel_cells < 4:
+            raise ScenarioError(f"kernel_cells = {self.kernel_cells!r} is not allowed: an "
+                                "integer >= 4")
         if not math.isfinite(self.constant_u):
             raise ScenarioError(f"constant_u = {self.constant_u!r} is not allowed: finite")
 
@@ -75,7 +88,8 @@ class TwinConfig:
                 "cfl": s.cfl, "horizon": s.horizon, "control_period": s.control_period,
                 "output_period": s.output_period, "u_min": s.u_min, "u_max": s.u_max,
                 "controller": self.controller, "constant_u": self.constant_u,
-                "seed": self.seed, "initial": {"kind": self.initial.kind,
+                "seed": self.seed, "kernel_cells": self.kernel_cells,
+                "design": asdict(self.design), "initial": {"kind": self.initial.kind,
                                                "amplitude": list(self.initial.amplitude),
                                                "wavenumber": list(self.initial.wavenumber),
                                                "phase": list(self.initial.phase)}}
@@ -148,6 +162,10 @@ def twin_config_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Tw
     constant_u = (float(veh_h_to_veh_s(_num(tw, "constant_u_veh_h", where)))
                   if "constant_u_veh_h" in tw else 0.0)
     seed = _int(tw, "seed", where) if "seed" in tw else 0
+    kernel_cells = _int(tw, "kernel_cells", where) if "kernel_cells" in tw else 200
+    from arzsumo.scenarios import design_from_dict
+
+    design = design_from_dict(data, source)
 
     ini = _table(data, "initial", INITIAL_KEYS, source)
     where_i = f"{source} [initial]"
@@ -173,7 +191,7 @@ def twin_config_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Tw
                             f"kind = {kind!r}")
     try:
         return TwinConfig(SolverOptions(**opts), InitialCondition(**ic_args), controller,
-                          constant_u, seed)
+                          constant_u, seed, kernel_cells, design)
     except ScenarioError:
         raise
     except ArzsumoError as exc:

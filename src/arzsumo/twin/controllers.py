@@ -38,8 +38,22 @@ ControllerFactory = Callable[[Linearization, "TwinConfig"], Controller]
 CONTROLLERS: dict[str, ControllerFactory] = {
     "open": lambda lin, cfg: OpenLoop(),
     "constant": lambda lin, cfg: ConstantControl(cfg.constant_u),
-    # "backstepping": ..., "etc": ..., "observer-etc": ...   (issues 3 and 4)
 }
+
+
+def _pde_factory(name: str) -> ControllerFactory:
+    """Backstepping, ETC or observer-ETC with cached kernels on ``cfg.kernel_cells`` cells."""
+
+    def factory(lin: Linearization, cfg: TwinConfig) -> Controller:
+        from arzsumo.control.registry import make_controller as make_pde
+        from arzsumo.kernel_cache import cached_kernels
+
+        return make_pde(name, lin, cached_kernels(lin.system, cfg.kernel_cells), cfg.design)
+
+    return factory
+
+
+CONTROLLERS.update({n: _pde_factory(n) for n in ("backstepping", "etc", "observer-etc")})
 
 
 def register_controller(name: str, factory: ControllerFactory, *,
