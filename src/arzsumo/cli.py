@@ -13,7 +13,7 @@ import logging
 import sys
 from collections.abc import Callable, Sequence
 
-from arzsumo import __version__
+from arzsumo import __version__, cli_sumo
 from arzsumo.errors import ArzsumoError
 from arzsumo.model import linearize
 from arzsumo.scenarios import Scenario, load_scenario, scenario_from_preset
@@ -103,6 +103,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print JSON with SI values")
     p.add_argument("--regime-map", metavar="FILE.png", help="draw the free/congested map")
     p.set_defaults(func=cmd_model)
+    cli_sumo.register(sub)
     return parser
 
 

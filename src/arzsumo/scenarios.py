@@ -66,7 +66,7 @@ EQUILIBRIUM_KEYS: dict[str, Callable[[float], Any]] = {
     "demand_a_veh_h": veh_h_to_veh_s,
 }
 
-TOP_KEYS = {"name", "description", "model", "equilibrium"}
+TOP_KEYS = {"name", "description", "model", "equilibrium", "sumo"}
 
 
 @dataclass(frozen=True)
@@ -137,6 +137,9 @@ def scenario_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scena
         rho_a = si.get("rho_a_veh_km", preset.rho_a)
         eq = equilibrium_from_densities(params, rho_h, rho_a, v_h=si.get("v_h_kmh"),
                                         v_a=si.get("v_a_kmh"))
+    if "sumo" in data:  # validated by the SUMO side; stays in Scenario.raw
+        from arzsumo.sumo.config import sumo_config_from_table
+        sumo_config_from_table(data["sumo"], f"{source} [sumo]")
     name = str(data.get("name", Path(source).stem if source != "<dict>" else preset.name))
     return Scenario(name, str(data.get("description", preset.description)), params, eq,
                     source, dict(data))

@@ -22,6 +22,8 @@ from arzsumo.errors import ScenarioError, require
 from arzsumo.units import veh_h_to_veh_s
 
 HV_MODELS = ("Krauss", "IDM")
+#: Width of the mainline lane, m (the network's).
+LANE_WIDTH = 6.5
 AV_MODELS = ("ACC", "CACC")
 
 
@@ -108,6 +110,10 @@ class SumoConfig:
             unit(name)
         require(self.step_length <= 1.0, "step_length", self.step_length, "at most 1 s",
                 ScenarioError)
+        subl = LANE_WIDTH / self.lateral_resolution
+        require(abs(subl - round(subl)) < 1e-6, "lateral_resolution", self.lateral_resolution,
+                f"a width dividing the {LANE_WIDTH} m lane, e.g. 0.5 or 0.25",
+                ScenarioError)
         ratio = self.control_period / self.step_length
         require(abs(ratio - round(ratio)) < 1e-9, "control_period", self.control_period,
                 f"a multiple of step_length = {self.step_length} s", ScenarioError)
@@ -192,3 +198,9 @@ def sumo_config_from_table(table: Mapping[str, Any], where: str = "[sumo]") -> S
         return SumoConfig(**changes)
     except ScenarioError as exc:
         raise ScenarioError(f"{where}: {exc}") from None
+
+
+def sumo_config_of(scenario: Any) -> SumoConfig:
+    """The SumoConfig of a loaded scenario (its ``[sumo]`` table; defaults without one)."""
+    raw = getattr(scenario, "raw", {}) or {}
+    return sumo_config_from_table(raw.get("sumo", {}), f"{scenario.source} [sumo]")

@@ -18,6 +18,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+from arzsumo.errors import ScenarioError
 from arzsumo.io import atomic_file
 from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.config import SumoConfig
@@ -110,9 +111,32 @@ def demand_flows(cfg: SumoConfig, road_width: float = 6.5,
     return [f for f in flows if f.rate > 1e-12]
 
 
+def check_columns(road_width: float, vehicle_width: float, resolution: float,
+                  offsets: Sequence[float]) -> None:
+    """Raise unless vehicles in the lateral ``offsets`` (m) occupy disjoint sublanes.
+
+    SUMO's sublane model blocks an insertion whenever another vehicle occupies one of the
+    sublanes the new vehicle covers; columns sharing a sublane starve each other.
+    """
+    used: list[tuple[int, int]] = []
+    for c in sorted(offsets):
+        left = c - vehicle_width / 2 + road_width / 2
+        lo = math.floor(left / resolution + 1e-9)
+        hi = math.ceil((left + vehicle_width) / resolution - 1e-9) - 1
+        if used and lo <= used[-1][1]:
+            raise ScenarioError(
+                f"lateral_resolution = {resolution} is not allowed: with vehicles "
+                f"{vehicle_width} m wide in columns at {list(offsets)} m on a {road_width} m "
+                "lane, neighbouring columns share a sublane; use a resolution such as 0.5 "
+                "or 0.25 m")
+        used.append((lo, hi))
+
+
 def route_file_text(params: ModelParameters, cfg: SumoConfig,
                     initial: Sequence[InitialVehicle] = ()) -> str:
     """The route file: vTypes, the two routes, initial vehicles, then the flows."""
+    check_columns(params.road_width, params.vehicle_width, cfg.lateral_resolution,
+                  insertion_columns(params.road_width, params.vehicle_width, 3))
     hv, av = vehicle_types(params, cfg)
     lines = [hv.to_xml(), av.to_xml(),
              f'<route id="{ROUTE_MAIN}" edges="{MAIN} {MERGE} {DOWN}"/>',
@@ -131,3 +155,32 @@ def write_route_file(path: Path, params: ModelParameters, cfg: SumoConfig,
     with atomic_file(path) as tmp:
         tmp.write_text(route_file_text(params, cfg, initial), encoding="utf-8")
     return path
+
+
+def sumocfg_text(net_file: str, route_file: str, cfg: SumoConfig) -> str:
+    """A ``.sumocfg`` a user can open in sumo-gui (same options as arzsumo's runs)."""
+    opts = {
+        "input": {"net-file": net_file, "route-files": route_file},
+        "time": {"begin": "0", "end": f"{cfg.horizon:.6g}",
+                 "step-length": f"{cfg.step_length:.6g}"},
+        "processing": {"lateral-resolution": f"{cfg.lateral_resolution:.6g}",
+                       "time-to-teleport": f"{cfg.time_to_teleport:.6g}",
+                       "eager-insert": "true", "collision.action": "warn"},
+        "random_number": {"seed": str(cfg.seed)},
+    }
+    lines = ['<?xml version="1.0" encoding="UTF-8"?>', "<configuration>"]
+    for section, values in opts.items():
+        lines.append(f"    <{section}>")
+        lines += [f"        <{k} value={quoteattr(v)}/>" for k, v in values.items()]
+        lines.append(f"    </{section}>")
+    lines.append("</configuration>")
+    return "\n".join(lines) + "\n"
+
+
+def write_gui_files(out_dir: Path, params: ModelParameters, cfg: SumoConfig,
+                    net_name: str, route_name: str, cfg_name: str) -> list[Path]:
+    """Write a route file and a ``.sumocfg`` beside the network (for sumo-gui)."""
+    route = write_route_file(out_dir / route_name, params, cfg)
+    with atomic_file(out_dir / cfg_name) as tmp:
+        tmp.write_text(sumocfg_text(net_name, route_name, cfg), encoding="utf-8")
+    return [route, out_dir / cfg_name]

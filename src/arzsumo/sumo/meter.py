@@ -69,6 +69,23 @@ DEFAULT_CURVE = GreenShareCurve((0.0, 0.33, 0.5, 0.67, 1.0),
                                  4383 / 3600))
 
 
+def plan_green_steps(g: float, cycle: int, min_green: int, min_red: int) -> int:
+    """Green steps per cycle of ``cycle`` steps for green share ``g`` in [0, 1].
+
+    A green shorter than ``min_green`` steps becomes 0 (all red) or ``min_green``,
+    whichever is nearer; a red shorter than ``min_red`` becomes 0 (all green) or
+    ``min_red``. So g = 0 is always red and g = 1 always green.
+    """
+    require(math.isfinite(g) and 0.0 <= g <= 1.0, "green_share", g, "a number in [0, 1]",
+            ArzsumoError)
+    green = round(g * cycle)
+    if 0 < green < min_green:
+        green = 0 if green < min_green / 2 else min_green
+    if 0 < cycle - green < min_red:
+        green = cycle if cycle - green < min_red / 2 else cycle - min_red
+    return green
+
+
 class RampMeter:
     """Drives the ramp traffic light of an open libsumo run.
 
@@ -97,17 +114,8 @@ class RampMeter:
 
     # -- timing --------------------------------------------------------------------------
     def _timing(self, g: float) -> int:
-        """Green steps per cycle for green share ``g`` under the minimum green and red."""
-        require(math.isfinite(g), "green_share", g, "a finite number in [0, 1]", ArzsumoError)
-        g = min(1.0, max(0.0, g))
-        c = self.cycle_steps
-        green = round(g * c)
-        ming, minr = round(self.cfg.min_green / self.dt), round(self.cfg.min_red / self.dt)
-        if 0 < green < ming:
-            green = 0 if green < ming / 2 else ming
-        if 0 < c - green < minr:
-            green = c if c - green < minr / 2 else c - minr
-        return green
+        return plan_green_steps(g, self.cycle_steps, round(self.cfg.min_green / self.dt),
+                           round(self.cfg.min_red / self.dt))
 
     @property
     def green_share(self) -> float:

@@ -16,6 +16,7 @@ mainline capacity and the meter sets the mainline outflow q(L, t). The traffic l
 from __future__ import annotations
 
 import logging
+import os
 import subprocess
 from dataclasses import dataclass, fields
 from pathlib import Path
@@ -148,14 +149,13 @@ def run_netconvert(src_dir: Path, out_dir: Path) -> Path:
                         "with the files written by `arzsumo build-net`")
     out_dir.mkdir(parents=True, exist_ok=True)
     with atomic_file(out_dir / NET_FILE) as tmp:
+        # relative names from the source directory keep absolute paths out of the net's header
         cmd = [str(sumo_binary("netconvert")),
-               "--node-files", str(src_dir / "ramp.nod.xml"),
-               "--edge-files", str(src_dir / "ramp.edg.xml"),
-               "--connection-files", str(src_dir / "ramp.con.xml"),
-               "--tllogic-files", str(src_dir / "ramp.tll.xml"),
+               "--node-files", "ramp.nod.xml", "--edge-files", "ramp.edg.xml",
+               "--connection-files", "ramp.con.xml", "--tllogic-files", "ramp.tll.xml",
                "--no-turnarounds", "true", "--no-internal-links", "false",
-               "--output-file", str(tmp), "--no-warnings", "true"]
-        proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
+               "--output-file", os.path.relpath(tmp, src_dir), "--no-warnings", "true"]
+        proc = subprocess.run(cmd, capture_output=True, text=True, check=False, cwd=src_dir)
         if proc.returncode != 0:
             lines = [ln for ln in (proc.stderr or proc.stdout).splitlines() if ln.strip()]
             raise SumoError(f"netconvert failed: {lines[-1] if lines else proc.returncode}")
@@ -178,9 +178,13 @@ def build_network(out_dir: Path, spec: NetworkSpec | None = None, *,
     Checks that the mainline is exactly ``spec.length`` long in the built network.
     """
     spec = spec or NetworkSpec()
-    if write:
-        write_sources(spec, out_dir)
-    net = run_netconvert(out_dir, out_dir)
+    try:
+        if write:
+            write_sources(spec, out_dir)
+        net = run_netconvert(out_dir, out_dir)
+    except OSError as exc:
+        raise SumoError(f"out = {str(out_dir)!r} cannot be written: {exc.strerror}; allowed: "
+                        "a writable directory") from None
     main_length = edge_lengths(net)[MAIN]
     if abs(main_length - spec.length) > 1e-6:
         raise SumoError(f"main edge length = {main_length} m differs from the requested "
