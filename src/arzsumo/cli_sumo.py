@@ -67,7 +67,8 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     print(f"medium demand, green share {eq['green_share']:.2f}: "
           f"HV {veh_m_to_veh_km(eq['rho_h']):.1f} veh/km at {ms_to_kmh(eq['v_h']):.1f} km/h, "
           f"AV {veh_m_to_veh_km(eq['rho_a']):.1f} veh/km at {ms_to_kmh(eq['v_a']):.1f} km/h, "
-          f"AO {eq['ao']:.3f}, outflow {veh_s_to_veh_h(eq['outflow']):.0f} veh/h")
+          f"AO {eq['ao']:.3f}; mainline inflow {veh_s_to_veh_h(eq['inflow']):.0f} veh/h, "
+          f"outflow {veh_s_to_veh_h(eq['outflow']):.0f} veh/h")
     if "eigenvalues" in eq:
         lam = [ms_to_kmh(v) for v in eq["eigenvalues"]]
         print(f"calibrated model there: v_h {ms_to_kmh(eq['model_v_h']):.1f} km/h, v_a "

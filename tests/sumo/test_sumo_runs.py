@@ -137,3 +137,22 @@ def test_teleports_counted_when_enabled():
     assert res.report.teleports > 0
     # vehicles in a teleport still count as on the network
     assert res.report.inserted == res.report.arrived + res.report.on_network
+
+
+def test_e2_chain_counts_each_vehicle_once_like_the_position_sensor():
+    from arzsumo.sumo.detectors import E2Sensor
+
+    cfg = FAST.with_(horizon=80.0, cell_length=50.0)
+    with open_simulation(PARAMS, cfg, e2_chain=True) as sim:
+        sim.run_until(70.0)                  # traffic over the whole 1000 m
+        e2 = E2Sensor(sim.lib, PARAMS.length, cfg.cell_length, cfg.step_length, 1)
+        pos = MainlineSensor(sim.lib, PARAMS.length, cfg.cell_length, cfg.step_length, 1)
+        t = sim.step()
+        a, b = e2.collect(t), pos.collect(t)
+        naive = sum(len(sim.lib.lanearea.getLastStepVehicleIDs(d)) for d in e2.ids)
+    assert a is not None and b is not None
+    np.testing.assert_array_equal(a.rho_h, b.rho_h)
+    np.testing.assert_array_equal(a.rho_a, b.rho_a)
+    np.testing.assert_allclose(a.q_h, b.q_h, rtol=1e-12)
+    assert e2.double_counted > 0 and naive == round((a.rho_h + a.rho_a).sum() * 50) + \
+        e2.double_counted

@@ -145,12 +145,18 @@ def _scores(y: np.ndarray, f: np.ndarray) -> tuple[float, float]:
 
 
 def fit_class(ao: np.ndarray, v: np.ndarray, paper: tuple[float, float, float]) -> ClassFit:
-    """Least-squares fit of one class's FD to (AO, speed m/s) points."""
+    """Least-squares fit of one class's FD to (AO, speed m/s) points.
+
+    The free-flow speed is bounded by 1.02 times the paper's V_i, which is the vehicle
+    type's maximum speed in SUMO: no SUMO speed can exceed it.
+    """
     if ao.size < 5:
         raise ArzsumoError(f"calibration points = {ao.size} are too few; allowed: at least 5 "
                            "(longer runs or more demand levels)")
-    p0 = (max(float(v.max()), 1.0), min(0.99, max(0.3, float(ao.max()) * 1.05)), 1.5)
-    popt, _ = curve_fit(fd_speed, ao, v, p0=p0, bounds=([0.5, 0.05, 0.1], [60.0, 1.0, 8.0]),
+    v_cap = 1.02 * paper[0]
+    p0 = (min(max(float(v.max()), 1.0), v_cap), min(0.99, max(0.3, float(ao.max()) * 1.05)),
+          1.5)
+    popt, _ = curve_fit(fd_speed, ao, v, p0=p0, bounds=([0.5, 0.05, 0.1], [v_cap, 1.0, 8.0]),
                         maxfev=20000)
     r2, rmse = _scores(v, fd_speed(ao, *popt))
     r2p, rmsep = _scores(v, np.maximum(fd_speed(ao, *paper), 0.0))
@@ -201,7 +207,8 @@ def measured_equilibrium(runs: list[RunData], calibrated: ModelParameters,
     eq: dict[str, Any] = {"green_share": run.green_share, "rho_h": mh, "rho_a": ma,
                           "v_h": q_h / mh if mh else float("nan"),
                           "v_a": q_a / ma if ma else float("nan"),
-                          "outflow": run.outflow, "delivered": run.delivered}
+                          "outflow": run.outflow, "inflow": run.inflow,
+                          "delivered": run.delivered}
     ao = (calibrated.area_h * mh + calibrated.area_a * ma) / calibrated.road_width
     eq["ao"] = ao
     try:

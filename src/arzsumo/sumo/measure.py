@@ -106,8 +106,13 @@ class EdieGrid:
     def add(self, pos: np.ndarray, speed: np.ndarray, av: np.ndarray) -> None:
         """Add one step's samples: positions (m), speeds (m/s), AV mask."""
         idx = np.minimum((pos / self.dx).astype(np.intp), self.n - 1) + self.n * av
-        self._cnt += np.bincount(idx, minlength=2 * self.n).reshape(2, self.n)
-        self._dist += np.bincount(idx, weights=speed, minlength=2 * self.n).reshape(2, self.n)
+        self.add_binned(np.bincount(idx, minlength=2 * self.n).reshape(2, self.n),
+                        np.bincount(idx, weights=speed, minlength=2 * self.n).reshape(2, self.n))
+
+    def add_binned(self, counts: np.ndarray, speed_sums: np.ndarray) -> None:
+        """Add one step's per-cell vehicle counts and speed sums (m/s), shape (2, cells)."""
+        self._cnt += counts
+        self._dist += speed_sums
         self.steps += 1
 
     def flush(self, t: float) -> CellData:

@@ -253,14 +253,21 @@ class SumoSimulation:
 
 def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
                     initial: Sequence[InitialVehicle] = (), net_dir: Path | None = None,
-                    extra_args: Sequence[str] = ()) -> SumoSimulation:
+                    extra_args: Sequence[str] = (), e2_chain: bool = False) -> SumoSimulation:
     """A started simulation of the default network with the demand of ``cfg``.
 
-    The route file goes to a temporary directory removed when the run closes.
+    The route file (and, with ``e2_chain``, an E2 detector per measurement cell, see
+    :mod:`arzsumo.sumo.detectors`) goes to a temporary directory removed when the run
+    closes.
     """
     net = nets_dir(net_dir) / NET_FILE
     workdir = Path(tempfile.mkdtemp(prefix="arzsumo-"))
     route = write_route_file(workdir / "run.rou.xml", params, cfg, initial)
+    if e2_chain:
+        from arzsumo.sumo.detectors import write_e2_chain
+
+        add = write_e2_chain(workdir / "e2.add.xml", params.length, cfg.cell_length)
+        extra_args = ("--additional-files", str(add), *extra_args)
     sim = SumoSimulation(net, route, cfg, requested_initial=len(initial), workdir=workdir,
                          extra_args=extra_args, cleanup=(workdir,))
     return sim.start()
