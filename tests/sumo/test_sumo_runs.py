@@ -156,3 +156,10 @@ def test_e2_chain_counts_each_vehicle_once_like_the_position_sensor():
     np.testing.assert_allclose(a.q_h, b.q_h, rtol=1e-12)
     assert e2.double_counted > 0 and naive == round((a.rho_h + a.rho_a).sum() * 50) + \
         e2.double_counted
+
+
+def test_spillback_override_releases_a_long_queue():
+    cfg = FAST.with_(horizon=50.0, ramp_demand=1200 / 3600, spillback_queue=4)
+    res = run_fixed_meter(PARAMS, cfg, 0.0, measure=False)
+    assert res.meter["override_steps"] > 0 and res.ramp_passed > 0
+    assert res.meter["max_queue"] >= 4
