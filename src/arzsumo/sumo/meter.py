@@ -63,10 +63,12 @@ class GreenShareCurve:
 
 
 #: Mainline outflow against green share on the default network, 6 s cycle, medium demand
-#: (4104 HV/h + 1560 AV/h, ramp 1200 veh/h); written by ``arzsumo calibrate``.
-DEFAULT_CURVE = GreenShareCurve((0.0, 0.33, 0.5, 0.67, 1.0),
-                                (5598 / 3600, 5391 / 3600, 5100 / 3600, 4851 / 3600,
-                                 4383 / 3600))
+#: (4104 HV/h + 1560 AV/h, ramp 1200 veh/h, seed 42, 450 s, mean after 150 s), as written
+#: by ``arzsumo calibrate`` to ``meter_curve.toml`` (load others with
+#: :func:`arzsumo.sumo.calibration_io.load_green_share_curve`).
+DEFAULT_CURVE = GreenShareCurve((0.0, 0.25, 0.5, 0.75, 1.0),
+                                (5664 / 3600, 4512 / 3600, 4464 / 3600, 3300 / 3600,
+                                 3240 / 3600))
 
 
 def plan_green_steps(g: float, cycle: int, min_green: int, min_red: int) -> int:
