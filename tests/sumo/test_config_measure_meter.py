@@ -150,3 +150,16 @@ def test_placement_rejects_bad_profiles():
         place_vehicles(PARAMS, SumoConfig(), x, [-0.1, 0.1], [1, 1], [0, 0], [1, 1])
     with pytest.raises(ModelError, match="do not fit"):
         place_vehicles(PARAMS, SumoConfig(), x, [0.5, 0.5], [1, 1], [0.2, 0.2], [1, 1])
+
+
+def test_fd_fit_recovers_parameters_and_scores_paper_curve():
+    from arzsumo.sumo.calibrate import fd_speed, fit_class
+
+    ao = np.linspace(0.02, 0.6, 200)
+    v = fd_speed(ao, 20.0, 0.7, 2.0)
+    fit = fit_class(ao, v, (22.0, 0.9, 2.5))
+    assert fit.v_free == pytest.approx(20.0, rel=1e-4)
+    assert fit.ao_max == pytest.approx(0.7, rel=1e-4) and fit.gamma == pytest.approx(2.0, rel=1e-3)
+    assert fit.r2 == pytest.approx(1.0) and fit.rmse < 1e-4 and fit.r2_paper < 0.9
+    with pytest.raises(ArzsumoError, match="too few"):
+        fit_class(ao[:3], v[:3], (22.0, 0.9, 2.5))

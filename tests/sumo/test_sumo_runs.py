@@ -31,12 +31,16 @@ def test_vehicles_are_conserved():
                 r = sim.take_report()
                 assert r.requested == r.inserted + r.waiting
                 assert r.inserted == r.arrived + r.on_network
+                ramp_waiting = sum(1 for v in sim.lib.simulation.getPendingVehicles()
+                                   if v.startswith("ramp"))
+                assert r.requested_ramp == r.inserted_ramp + ramp_waiting
                 checked += 1
     r = sim.report
     assert checked >= 9 and r.requested > 190 and r.arrived > 10
     assert r.requested == r.inserted + r.waiting
     assert r.inserted == r.arrived + r.on_network
     assert r.teleports == 0 and r.collisions == 0 and r.emergency_braking >= 0
+    assert r.requested_ramp > 30 and r.delivered_main == 1.0
 
 
 def test_edie_density_of_single_step_is_count_over_length():

@@ -97,7 +97,7 @@ def _run_one(params: ModelParameters, cfg: SumoConfig, level: str, g: float,
     return RunData(level, g, m.array("rho_h")[keep], m.array("rho_a")[keep],
                    m.array("v_h")[keep], m.array("v_a")[keep], m.array("samples_h")[keep],
                    m.array("samples_a")[keep], float(out.mean()), float(inflow.mean()),
-                   res.report.delivered, res.report.collisions, res.meter)
+                   res.report.delivered_main, res.report.collisions, res.meter)
 
 
 def run_calibration_runs(params: ModelParameters, base: SumoConfig, plan: CalibrationPlan,
@@ -111,7 +111,7 @@ def run_calibration_runs(params: ModelParameters, base: SumoConfig, plan: Calibr
         results = []
         for (lv, g, _), fut in zip(runs, futures, strict=True):
             data = fut.result()
-            log.info("run %-6s g = %.2f: outflow %.0f veh/h, delivered %.1f %%", lv, g,
+            log.info("run %-6s g = %.2f: outflow %.0f veh/h, mainline delivered %.1f %%", lv, g,
                      data.outflow * 3600, 100 * data.delivered)
             results.append(data)
     return results

@@ -69,6 +69,11 @@ class CellData:
         with np.errstate(invalid="ignore", divide="ignore"):
             return np.where(self.samples_a > 0, self.q_a / self.rho_a, np.nan)
 
+    @property
+    def inlet_speeds(self) -> tuple[float, float]:
+        """(v_h, v_a) in the first cell, m/s: the observer's measurement (NaN if empty)."""
+        return float(self.v_h[0]), float(self.v_a[0])
+
     def macro_state(self, v_empty_h: float, v_empty_a: float) -> MacroState:
         """The :class:`MacroState` of this window; empty cells get the given speeds (m/s)."""
         return MacroState(self.t, self.x, self.rho_h, np.nan_to_num(self.v_h, nan=v_empty_h),

@@ -58,16 +58,13 @@ def run_fixed_meter(params: ModelParameters, cfg: SumoConfig, green_share: float
         meter = RampMeter(sim.lib, cfg, curve)
         sensor = MainlineSensor(sim.lib, params.length, cfg.cell_length, cfg.step_length,
                                 cfg.steps_per_period)
-        ramp_departed = 0
         while sim.time < cfg.horizon - 1e-9:
             t = sim.step()
             meter.step()
             if measure:
                 sensor.collect(t)
-            ramp_departed += sum(1 for v in sim.lib.simulation.getDepartedIDList()
-                                 if v.startswith("ramp"))
         # ramp vehicles past the meter: inserted minus those still upstream of it
-        ramp_passed = ramp_departed - int(sim.lib.edge.getLastStepVehicleNumber(RAMP_UP))
+        ramp_passed = sim.inserted_ramp - int(sim.lib.edge.getLastStepVehicleNumber(RAMP_UP))
     assert sim.report is not None
     log.info("%s", sim.report.summary())
     return RunResult(cfg, g, sensor.log, sim.report, meter.summary(), ramp_passed)
