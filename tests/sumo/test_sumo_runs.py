@@ -83,6 +83,12 @@ def test_meter_counts_plan_and_light_changes():
         assert meter.light_changes == 4               # two cycles: G->r, r->G, G->r, r->G
         assert meter.command_outflow(1e6) == 0.0      # more outflow than possible: all red
         assert meter.plan_changes == 1
+    sat = cfg.with_(green_share_min=0.2, green_share_max=0.8)
+    with open_simulation(PARAMS, sat) as sim:
+        meter = RampMeter(sim.lib, sat)
+        assert meter.command_outflow(1e6) == pytest.approx(0.2, abs=0.02)
+        assert meter.command_outflow(0.0) == pytest.approx(0.8, abs=0.02)
+        assert meter.plan_changes == 2
         sim.run_until(30.0)
 
 

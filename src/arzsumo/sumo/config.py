@@ -55,6 +55,8 @@ class SumoConfig:
         Meter signal cycle and its minimum green and red times, s.
     green_share : float
         Nominal green share of the meter cycle, in [0, 1].
+    green_share_min, green_share_max : float
+        Saturation limits of commanded green shares, 0 <= min <= max <= 1.
     spillback_queue : int
         Ramp queue (veh) that forces green; 0 disables the override.
     time_to_teleport : float
@@ -81,6 +83,8 @@ class SumoConfig:
     min_green: float = 1.0
     min_red: float = 1.0
     green_share: float = 0.5
+    green_share_min: float = 0.0
+    green_share_max: float = 1.0
     spillback_queue: int = 0
     time_to_teleport: float = -1.0
     hv_model: str = "Krauss"
@@ -106,8 +110,12 @@ class SumoConfig:
             v = getattr(self, name)
             require(isinstance(v, int | float) and math.isfinite(v) and v >= 0, name, v,
                     "a finite number of at least 0", ScenarioError)
-        for name in ("ramp_av_share", "green_share", "hv_sigma"):
+        for name in ("ramp_av_share", "green_share", "hv_sigma", "green_share_min",
+                     "green_share_max"):
             unit(name)
+        require(self.green_share_min <= self.green_share_max, "green_share_min",
+                self.green_share_min, f"at most green_share_max = {self.green_share_max}",
+                ScenarioError)
         require(self.step_length <= 1.0, "step_length", self.step_length, "at most 1 s",
                 ScenarioError)
         subl = LANE_WIDTH / self.lateral_resolution
@@ -167,6 +175,8 @@ SUMO_KEYS: dict[str, tuple[str, Callable[[Any], Any], type]] = {
     "min_green_s": ("min_green", _same, float),
     "min_red_s": ("min_red", _same, float),
     "green_share": ("green_share", _same, float),
+    "green_share_min": ("green_share_min", _same, float),
+    "green_share_max": ("green_share_max", _same, float),
     "spillback_queue_veh": ("spillback_queue", int, int),
     "time_to_teleport_s": ("time_to_teleport", _same, float),
     "hv_model": ("hv_model", str, str),

@@ -134,9 +134,13 @@ class RampMeter:
         return True
 
     def command_outflow(self, q: float) -> float:
-        """Request mainline outflow ``q`` (veh/s) = q* + U; return the green share chosen."""
+        """Request mainline outflow ``q`` (veh/s) = q* + U; return the green share chosen.
+
+        The green share is saturated to [cfg.green_share_min, cfg.green_share_max].
+        """
         require(math.isfinite(q), "outflow", q, "a finite flow in veh/s", ArzsumoError)
-        g = self.curve.green_share_for(q)
+        g = min(self.cfg.green_share_max,
+                max(self.cfg.green_share_min, self.curve.green_share_for(q)))
         self.set_green_share(g)
         return self._pending / self.cycle_steps
 
