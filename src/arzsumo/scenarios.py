@@ -68,7 +68,7 @@ EQUILIBRIUM_KEYS: dict[str, Callable[[float], Any]] = {
 }
 
 #: [twin] and [initial] are parsed by arzsumo.twin.config (the PDE twin's own settings).
-TOP_KEYS = {"name", "description", "model", "equilibrium", "twin", "initial", "design"}
+TOP_KEYS = {"name", "description", "model", "equilibrium", "twin", "initial", "design", "sumo"}
 
 #: ETC design keys of the [design] table (dimensionless or SI as in the paper, section 5)
 DESIGN_KEYS = {"zeta", "sigma", "eta", "A", "B", "varsigma", "mu", "m0"}
@@ -142,6 +142,9 @@ def scenario_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scena
         rho_a = si.get("rho_a_veh_km", preset.rho_a)
         eq = equilibrium_from_densities(params, rho_h, rho_a, v_h=si.get("v_h_kmh"),
                                         v_a=si.get("v_a_kmh"))
+    if "sumo" in data:  # validated by the SUMO side; stays in Scenario.raw
+        from arzsumo.sumo.config import sumo_config_from_table
+        sumo_config_from_table(data["sumo"], f"{source} [sumo]")
     name = str(data.get("name", Path(source).stem if source != "<dict>" else preset.name))
     return Scenario(name, str(data.get("description", preset.description)), params, eq,
                     source, dict(data))

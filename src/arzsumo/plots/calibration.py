@@ -1,0 +1,63 @@
+"""Calibration figure: SUMO speeds against area occupancy with the fitted and paper curves,
+and the mainline outflow against the meter's green share."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.figure import Figure
+
+from arzsumo.io import atomic_file
+from arzsumo.units import ms_to_kmh, veh_s_to_veh_h
+
+
+def _fd(ao: np.ndarray, v: float, ao_max: float, gamma: float) -> np.ndarray:
+    return np.maximum(v * (1.0 - (ao / ao_max) ** gamma), 0.0)
+
+
+def calibration_figure(points: dict[str, tuple[np.ndarray, np.ndarray]],
+                       fitted: dict[str, tuple[float, float, float]],
+                       paper: dict[str, tuple[float, float, float]],
+                       r2: dict[str, float], curve: tuple[np.ndarray, np.ndarray],
+                       equilibrium: tuple[float, float, float] | None = None) -> Figure:
+    """Three panels: HV and AV speed (km/h) vs AO, and outflow (veh/h) vs green share.
+
+    ``fitted`` and ``paper`` map class ("h", "a") to (V m/s, AO_max, gamma); ``curve`` is
+    (green shares, outflows veh/s); ``equilibrium`` (AO, v_h, v_a m/s) marks SUMO's state.
+    """
+    fig, axes = plt.subplots(1, 3, figsize=(14, 4.4), layout="constrained")
+    names = {"h": "HV", "a": "AV"}
+    for ax, cls in zip(axes[:2], ("h", "a"), strict=True):
+        ao, v = points[cls]
+        ax.plot(ao, ms_to_kmh(v), ".", ms=3, alpha=0.35, color="0.4", label="SUMO cells")
+        grid = np.linspace(0.0, max(1.0, float(ao.max()) if ao.size else 1.0), 200)
+        ax.plot(grid, ms_to_kmh(_fd(grid, *fitted[cls])), "C0", lw=2,
+                label=f"fit (R² = {r2[cls]:.2f})")
+        ax.plot(grid, ms_to_kmh(_fd(grid, *paper[cls])), "C3--", lw=1.5, label="paper")
+        if equilibrium is not None:
+            ax.plot(equilibrium[0], ms_to_kmh(equilibrium[1 if cls == "h" else 2]), "k*",
+                    ms=12, label="medium demand, nominal meter")
+        ax.set_xlabel("area occupancy AO")
+        ax.set_ylabel(f"{names[cls]} speed (km/h)")
+        ax.set_title(f"{names[cls]} speed against AO")
+        ax.set_xlim(0, grid[-1])
+        ax.set_ylim(0, None)
+        ax.legend(fontsize=8)
+    g, q = curve
+    axes[2].plot(g, veh_s_to_veh_h(np.asarray(q)), "o-", color="C2")
+    axes[2].set_xlabel("meter green share")
+    axes[2].set_ylabel("mainline outflow q(L) (veh/h)")
+    axes[2].set_title("Outflow against green share (medium demand)")
+    axes[2].grid(alpha=0.3)
+    return fig
+
+
+def write_calibration_figure(path: str | Path, *args: object, **kwargs: object) -> Path:
+    """Draw :func:`calibration_figure` and save it as PNG at ``path`` (atomically)."""
+    fig = calibration_figure(*args, **kwargs)  # type: ignore[arg-type]
+    with atomic_file(path) as tmp:
+        fig.savefig(tmp, dpi=110, format="png")
+    plt.close(fig)
+    return Path(path)

@@ -1,0 +1,16 @@
+"""The SUMO side: network, vehicle types, demand, run lifecycle, measurement, ramp meter,
+placement and calibration (see docs/sumo.md).
+
+Modules by concern; importing this package imports neither libsumo nor sumolib (they load
+when a run starts), so the math packages and the CLI stay light.
+
+* :mod:`~arzsumo.sumo.paths`: binaries and the network directory
+* :mod:`~arzsumo.sumo.network`: plain-XML sources and netconvert
+* :mod:`~arzsumo.sumo.config`: :class:`SumoConfig` and the ``[sumo]`` scenario table
+* :mod:`~arzsumo.sumo.vtypes`, :mod:`~arzsumo.sumo.demand`: vehicle types, route files
+* :mod:`~arzsumo.sumo.simulation`: the run lifecycle
+* :mod:`~arzsumo.sumo.measure`, :mod:`~arzsumo.sumo.detectors`: micro to macro
+* :mod:`~arzsumo.sumo.placement`: macro to micro
+* :mod:`~arzsumo.sumo.meter`: the ramp-meter actuator
+* :mod:`~arzsumo.sumo.runner`, :mod:`~arzsumo.sumo.calibrate`: open-loop runs, calibration
+"""

@@ -1,0 +1,157 @@
+"""Writing and reading calibration results.
+
+``arzsumo calibrate --out DIR`` writes, atomically as one directory:
+
+* ``calibrated_model.toml``: a scenario file (``arzsumo model --scenario ...``) whose
+  ``[model]`` holds the fitted FD and whose ``[equilibrium]`` is the state SUMO held;
+* ``meter_curve.toml``: the outflow against green share curve the actuator inverts
+  (:func:`load_green_share_curve`);
+* ``calibration.json``: every number (SI), ``calibration_points.npz``: the fitted points;
+* ``calibration.png``: data against fit and the paper's curves, and the outflow curve.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import tomllib
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from arzsumo.errors import ArzsumoError
+from arzsumo.io import atomic_dir
+from arzsumo.sumo.calibrate import Calibration
+from arzsumo.sumo.config import SumoConfig
+from arzsumo.sumo.meter import GreenShareCurve
+from arzsumo.units import ms_to_kmh, veh_h_to_veh_s, veh_m_to_veh_km, veh_s_to_veh_h
+
+
+def _toml_value(v: Any) -> str:
+    if isinstance(v, str):
+        return json.dumps(v)
+    if isinstance(v, list | tuple):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    return f"{v:.6g}" if isinstance(v, float) else str(v)
+
+
+def scenario_text(cal: Calibration, cfg: SumoConfig) -> str:
+    """The calibrated model as a scenario file (human units in key names)."""
+    p, eq = cal.calibrated, cal.equilibrium
+    fh, fa = cal.fits["h"], cal.fits["a"]
+    lines = [
+        "# Written by `arzsumo calibrate`: the AO fundamental diagram fitted to SUMO.",
+        f"# HV fit R^2 = {fh.r2:.3f}, RMSE = {ms_to_kmh(fh.rmse):.2f} km/h, {fh.n} points; "
+        f"paper curve R^2 = {fh.r2_paper:.3f}",
+        f"# AV fit R^2 = {fa.r2:.3f}, RMSE = {ms_to_kmh(fa.rmse):.2f} km/h, {fa.n} points; "
+        f"paper curve R^2 = {fa.r2_paper:.3f}",
+        'name = "sumo_calibrated"',
+        'description = "AO fundamental diagram fitted to SUMO; equilibrium measured at '
+        'medium demand with the meter at its nominal green share"',
+        "", "[model]", 'preset = "paper_base"',
+        f"length_m = {p.length:.6g}", f"road_width_m = {p.road_width:.6g}",
+        f"vehicle_width_m = {p.vehicle_width:.6g}",
+        f"spacing_h_m = {p.spacing_h:.6g}", f"spacing_a_m = {p.spacing_a:.6g}",
+        f"tau_h_s = {p.tau_h:.6g}", f"tau_a_s = {p.tau_a:.6g}",
+        f"gamma_h = {p.gamma_h:.6g}", f"gamma_a = {p.gamma_a:.6g}",
+        f"ao_max_h = {p.ao_max_h:.6g}", f"ao_max_a = {p.ao_max_a:.6g}",
+        f"v_free_h_kmh = {ms_to_kmh(p.v_free_h):.6g}",
+        f"v_free_a_kmh = {ms_to_kmh(p.v_free_a):.6g}",
+    ]
+    if eq.get("regime") in ("congested", "free"):
+        lines += ["", f"# measured in SUMO; regime under this model: {eq['regime']}",
+                  "[equilibrium]",
+                  f"rho_h_veh_km = {veh_m_to_veh_km(eq['rho_h']):.4f}",
+                  f"rho_a_veh_km = {veh_m_to_veh_km(eq['rho_a']):.4f}"]
+    lines += ["", "[sumo]", f"step_length_s = {cfg.step_length:.6g}",
+              f"lateral_resolution_m = {cfg.lateral_resolution:.6g}", f"seed = {cfg.seed}",
+              f"demand_h_veh_h = {veh_s_to_veh_h(cfg.demand_h):.6g}",
+              f"demand_a_veh_h = {veh_s_to_veh_h(cfg.demand_a):.6g}",
+              f"ramp_demand_veh_h = {veh_s_to_veh_h(cfg.ramp_demand):.6g}",
+              f"meter_cycle_s = {cfg.meter_cycle:.6g}",
+              f"green_share = {cfg.green_share:.6g}"]
+    return "\n".join(lines) + "\n"
+
+
+def curve_text(curve: GreenShareCurve, cfg: SumoConfig) -> str:
+    """The outflow curve as TOML."""
+    return "\n".join([
+        "# Mainline outflow q(L) against the ramp meter's green share, medium demand,",
+        f"# ramp demand {veh_s_to_veh_h(cfg.ramp_demand):.0f} veh/h, cycle "
+        f"{cfg.meter_cycle:g} s. Written by `arzsumo calibrate`.",
+        f"green_share = {_toml_value([round(g, 6) for g in curve.green_share])}",
+        "outflow_veh_h = "
+        f"{_toml_value([round(float(veh_s_to_veh_h(q)), 2) for q in curve.outflow])}",
+    ]) + "\n"
+
+
+def load_green_share_curve(path: str | Path) -> GreenShareCurve:
+    """Read a ``meter_curve.toml`` written by ``arzsumo calibrate``."""
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ArzsumoError(f"meter_curve = {str(path)!r} does not exist") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ArzsumoError(f"{path}: not valid TOML: {exc}") from None
+    for key in ("green_share", "outflow_veh_h"):
+        if not isinstance(data.get(key), list):
+            raise ArzsumoError(f"{path}: {key} = {data.get(key)!r} is not allowed: a list "
+                               "of numbers")
+    return GreenShareCurve(tuple(float(g) for g in data["green_share"]),
+                           tuple(float(veh_h_to_veh_s(q)) for q in data["outflow_veh_h"]))
+
+
+def _jsonable(obj: Any) -> Any:
+    if isinstance(obj, dict):
+        return {k: _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, float | np.floating):
+        return float(obj) if math.isfinite(obj) else None
+    if isinstance(obj, np.integer):
+        return int(obj)
+    return obj
+
+
+def calibration_json(cal: Calibration, cfg: SumoConfig) -> dict[str, Any]:
+    """All calibration numbers, SI."""
+    return _jsonable({
+        "units": "SI (m, s, veh/m, m/s, veh/s)",
+        "fits": {c: f.__dict__ for c, f in cal.fits.items()},
+        "calibrated_params": {k: getattr(cal.calibrated, k)
+                              for k in cal.calibrated.__dataclass_fields__},
+        "paper_params": {k: getattr(cal.params, k) for k in cal.params.__dataclass_fields__},
+        "green_share_curve": {"green_share": list(cal.curve.green_share),
+                              "outflow": list(cal.curve.outflow)},
+        "equilibrium": cal.equilibrium,
+        "runs": cal.runs,
+        "config": cfg.__dict__,
+    })
+
+
+def write_calibration(out: str | Path, cal: Calibration, cfg: SumoConfig) -> Path:
+    """Write all calibration outputs into directory ``out`` (atomically)."""
+    from arzsumo.plots.calibration import write_calibration_figure
+
+    out = Path(out)
+    with atomic_dir(out) as tmp:
+        (tmp / "calibrated_model.toml").write_text(scenario_text(cal, cfg), encoding="utf-8")
+        (tmp / "meter_curve.toml").write_text(curve_text(cal.curve, cfg), encoding="utf-8")
+        (tmp / "calibration.json").write_text(json.dumps(calibration_json(cal, cfg), indent=2),
+                                              encoding="utf-8")
+        np.savez_compressed(tmp / "calibration_points.npz",
+                            **{f"{k}_{c}": arr for c, (ao, v) in cal.points.items()
+                               for k, arr in (("ao", ao), ("v", v))})
+        p, c = cal.params, cal.calibrated
+        eq = cal.equilibrium
+        mark = (eq["ao"], eq["v_h"], eq["v_a"]) if math.isfinite(eq.get("v_h", math.nan)) \
+            else None
+        write_calibration_figure(
+            tmp / "calibration.png", cal.points,
+            {"h": (c.v_free_h, c.ao_max_h, c.gamma_h), "a": (c.v_free_a, c.ao_max_a, c.gamma_a)},
+            {"h": (p.v_free_h, p.ao_max_h, p.gamma_h), "a": (p.v_free_a, p.ao_max_a, p.gamma_a)},
+            {k: f.r2 for k, f in cal.fits.items()},
+            (np.asarray(cal.curve.green_share), np.asarray(cal.curve.outflow)), mark)
+    return out

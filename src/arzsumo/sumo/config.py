@@ -1,0 +1,216 @@
+"""Settings of a SUMO run and the ``[sumo]`` table of scenario files.
+
+Everything inside :class:`SumoConfig` is SI (s, m, veh/s). Scenario files write the unit in
+the key name; :func:`sumo_config_from_table` converts through :mod:`arzsumo.units`::
+
+    [sumo]
+    step_length_s = 0.1
+    demand_h_veh_h = 4104
+    demand_a_veh_h = 1560
+    ramp_demand_veh_h = 1200
+    meter_cycle_s = 6
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, fields, replace
+from typing import Any
+
+from arzsumo.errors import ScenarioError, require
+from arzsumo.units import veh_h_to_veh_s
+
+HV_MODELS = ("Krauss", "IDM")
+#: Width of the mainline lane, m (the network's).
+LANE_WIDTH = 6.5
+AV_MODELS = ("ACC", "CACC")
+
+
+@dataclass(frozen=True)
+class SumoConfig:
+    """One SUMO run: numerics, demand, measurement grid and ramp meter (SI units).
+
+    Parameters
+    ----------
+    step_length : float
+        SUMO step, s (ACC/CACC need small steps; default 0.1 s).
+    lateral_resolution : float
+        Sublane width, m; must divide the 6.5 m lane (0.65 or 1.3).
+    seed : int
+        SUMO random seed.
+    horizon : float
+        End time of the run, s.
+    demand_h, demand_a : float
+        Class flows requested at x = 0, veh/s.
+    ramp_demand : float
+        Ramp flow requested, veh/s (HVs, or AVs with probability ``ramp_av_share``).
+    ramp_av_share : float
+        Share of AVs in the ramp demand, in [0, 1].
+    cell_length : float
+        Measurement cell length, m (must divide the mainline length).
+    control_period : float
+        Measurement window and meter update period, s (a multiple of the step).
+    meter_cycle, min_green, min_red : float
+        Meter signal cycle and its minimum green and red times, s.
+    green_share : float
+        Nominal green share of the meter cycle, in [0, 1].
+    green_share_min, green_share_max : float
+        Saturation limits of commanded green shares, 0 <= min <= max <= 1.
+    spillback_queue : int
+        Ramp queue (veh) that forces green; 0 disables the override.
+    time_to_teleport : float
+        SUMO's --time-to-teleport, s; -1 disables teleports (default).
+    hv_model, hv_sigma : str, float
+        HV car-following model ("Krauss" or "IDM") and its driver imperfection in [0, 1].
+    av_model : str
+        AV car-following model ("ACC" or "CACC").
+    min_gap_lat : float
+        Lateral gap kept by both classes, m.
+    """
+
+    step_length: float = 0.1
+    lateral_resolution: float = 0.5
+    seed: int = 42
+    horizon: float = 450.0
+    demand_h: float = 4104.0 / 3600.0
+    demand_a: float = 1560.0 / 3600.0
+    ramp_demand: float = 1200.0 / 3600.0
+    ramp_av_share: float = 0.0
+    cell_length: float = 50.0
+    control_period: float = 1.0
+    meter_cycle: float = 6.0
+    min_green: float = 1.0
+    min_red: float = 1.0
+    green_share: float = 0.5
+    green_share_min: float = 0.0
+    green_share_max: float = 1.0
+    spillback_queue: int = 0
+    time_to_teleport: float = -1.0
+    hv_model: str = "Krauss"
+    hv_sigma: float = 0.5
+    av_model: str = "ACC"
+    min_gap_lat: float = 0.15
+
+    def __post_init__(self) -> None:
+        def pos(name: str) -> None:
+            v = getattr(self, name)
+            require(isinstance(v, int | float) and math.isfinite(v) and v > 0, name, v,
+                    "a finite number greater than 0", ScenarioError)
+
+        def unit(name: str) -> None:
+            v = getattr(self, name)
+            require(isinstance(v, int | float) and 0.0 <= v <= 1.0, name, v,
+                    "a number in [0, 1]", ScenarioError)
+
+        for name in ("step_length", "lateral_resolution", "horizon", "cell_length",
+                     "control_period", "meter_cycle", "min_gap_lat"):
+            pos(name)
+        for name in ("demand_h", "demand_a", "ramp_demand", "min_green", "min_red"):
+            v = getattr(self, name)
+            require(isinstance(v, int | float) and math.isfinite(v) and v >= 0, name, v,
+                    "a finite number of at least 0", ScenarioError)
+        for name in ("ramp_av_share", "green_share", "hv_sigma", "green_share_min",
+                     "green_share_max"):
+            unit(name)
+        require(self.green_share_min <= self.green_share_max, "green_share_min",
+                self.green_share_min, f"at most green_share_max = {self.green_share_max}",
+                ScenarioError)
+        require(self.step_length <= 1.0, "step_length", self.step_length, "at most 1 s",
+                ScenarioError)
+        subl = LANE_WIDTH / self.lateral_resolution
+        require(abs(subl - round(subl)) < 1e-6, "lateral_resolution", self.lateral_resolution,
+                f"a width dividing the {LANE_WIDTH} m lane, e.g. 0.5 or 0.25",
+                ScenarioError)
+        ratio = self.control_period / self.step_length
+        require(abs(ratio - round(ratio)) < 1e-9, "control_period", self.control_period,
+                f"a multiple of step_length = {self.step_length} s", ScenarioError)
+        require(self.min_green + self.min_red <= self.meter_cycle, "min_green + min_red",
+                self.min_green + self.min_red, f"at most meter_cycle = {self.meter_cycle} s",
+                ScenarioError)
+        require(isinstance(self.seed, int) and not isinstance(self.seed, bool)
+                and 0 <= self.seed < 2**31, "seed", self.seed, "an integer in [0, 2^31)",
+                ScenarioError)
+        require(isinstance(self.spillback_queue, int) and self.spillback_queue >= 0,
+                "spillback_queue", self.spillback_queue, "an integer >= 0 (0 = off)",
+                ScenarioError)
+        require(self.time_to_teleport == -1 or self.time_to_teleport > 0, "time_to_teleport",
+                self.time_to_teleport, "-1 (off) or a time > 0 s", ScenarioError)
+        require(self.hv_model in HV_MODELS, "hv_model", self.hv_model,
+                " or ".join(HV_MODELS), ScenarioError)
+        require(self.av_model in AV_MODELS, "av_model", self.av_model,
+                " or ".join(AV_MODELS), ScenarioError)
+
+    @property
+    def steps_per_period(self) -> int:
+        """SUMO steps per control period."""
+        return round(self.control_period / self.step_length)
+
+    def with_(self, **changes: Any) -> SumoConfig:
+        """A copy with some fields changed (validated again)."""
+        unknown = set(changes) - {f.name for f in fields(self)}
+        if unknown:
+            raise ScenarioError(f"unknown SUMO setting(s) {sorted(unknown)}; allowed: "
+                                f"{', '.join(f.name for f in fields(self))}")
+        return replace(self, **changes)
+
+
+def _same(x: float) -> float:
+    return float(x)
+
+
+# TOML key -> (SumoConfig field, conversion to SI, kind)
+SUMO_KEYS: dict[str, tuple[str, Callable[[Any], Any], type]] = {
+    "step_length_s": ("step_length", _same, float),
+    "lateral_resolution_m": ("lateral_resolution", _same, float),
+    "seed": ("seed", int, int),
+    "horizon_s": ("horizon", _same, float),
+    "demand_h_veh_h": ("demand_h", veh_h_to_veh_s, float),
+    "demand_a_veh_h": ("demand_a", veh_h_to_veh_s, float),
+    "ramp_demand_veh_h": ("ramp_demand", veh_h_to_veh_s, float),
+    "ramp_av_share": ("ramp_av_share", _same, float),
+    "cell_length_m": ("cell_length", _same, float),
+    "control_period_s": ("control_period", _same, float),
+    "meter_cycle_s": ("meter_cycle", _same, float),
+    "min_green_s": ("min_green", _same, float),
+    "min_red_s": ("min_red", _same, float),
+    "green_share": ("green_share", _same, float),
+    "green_share_min": ("green_share_min", _same, float),
+    "green_share_max": ("green_share_max", _same, float),
+    "spillback_queue_veh": ("spillback_queue", int, int),
+    "time_to_teleport_s": ("time_to_teleport", _same, float),
+    "hv_model": ("hv_model", str, str),
+    "hv_sigma": ("hv_sigma", _same, float),
+    "av_model": ("av_model", str, str),
+    "min_gap_lat_m": ("min_gap_lat", _same, float),
+}
+
+
+def sumo_config_from_table(table: Mapping[str, Any], where: str = "[sumo]") -> SumoConfig:
+    """Validate a ``[sumo]`` scenario table (human units in key names) into a SumoConfig."""
+    if not isinstance(table, Mapping):
+        raise ScenarioError(f"{where} must be a table, got {table!r}")
+    changes: dict[str, Any] = {}
+    for key, value in table.items():
+        if key not in SUMO_KEYS:
+            raise ScenarioError(f"{where}: unknown key {key!r}; allowed: "
+                                f"{', '.join(sorted(SUMO_KEYS))}")
+        name, conv, kind = SUMO_KEYS[key]
+        ok = (isinstance(value, str) if kind is str else
+              isinstance(value, int) and not isinstance(value, bool) if kind is int else
+              isinstance(value, int | float) and not isinstance(value, bool)
+              and math.isfinite(value))
+        if not ok:
+            allowed = {str: "a string", int: "an integer", float: "a finite number"}[kind]
+            raise ScenarioError(f"{where}: {key} = {value!r} is not allowed: {allowed}")
+        changes[name] = conv(value)
+    try:
+        return SumoConfig(**changes)
+    except ScenarioError as exc:
+        raise ScenarioError(f"{where}: {exc}") from None
+
+
+def sumo_config_of(scenario: Any) -> SumoConfig:
+    """The SumoConfig of a loaded scenario (its ``[sumo]`` table; defaults without one)."""
+    raw = getattr(scenario, "raw", {}) or {}
+    return sumo_config_from_table(raw.get("sumo", {}), f"{scenario.source} [sumo]")

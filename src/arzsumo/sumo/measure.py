@@ -1,0 +1,195 @@
+"""Micro to macro: Edie's space-time density, flow and speed per class on a cell grid.
+
+Every SUMO step the positions and speeds of the vehicles on ``main`` are collected with
+libsumo getters (measured fastest under libsumo: about 0.3 ms per step for 130 vehicles,
+against 0.5 ms for ``vehicle.getAllSubscriptionResults``; edge context subscriptions
+missed vehicles) and binned with ``numpy.bincount``. Over a window of n steps of length
+dt on a cell of length dx, Edie's definitions are
+
+    rho = sum(dt) / (dx n dt),   q = sum(v dt) / (dx n dt),   v = q / rho,
+
+the sums running over the vehicle samples in the cell. For a single-step window rho is
+the vehicle count over dx. Classes come from vehicle ids: the route files written by
+:mod:`arzsumo.sumo.demand` and :mod:`arzsumo.sumo.placement` start AV ids with ``av``.
+
+Class flows at x = 0 count vehicles that appeared on ``main`` (initial vehicles, whose ids
+contain ``_init``, excepted); at x = L vehicles that left ``main`` (set difference of
+consecutive id lists).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from types import ModuleType
+
+import numpy as np
+
+from arzsumo.control.base import MacroState
+from arzsumo.errors import require
+from arzsumo.sumo.network import MAIN
+
+
+def is_av(ids: tuple[str, ...] | list[str]) -> np.ndarray:
+    """Boolean array: which vehicle ids are AVs (ids starting with ``av``)."""
+    return np.fromiter((v.startswith("av") for v in ids), bool, len(ids))
+
+
+@dataclass(frozen=True)
+class CellData:
+    """Edie aggregates over one window ending at ``t`` (SI).
+
+    ``rho_*`` veh/m, ``q_*`` veh/s, ``v_*`` m/s (NaN in cells no vehicle of the class
+    visited), ``samples_*`` vehicle-steps per cell, ``inflow_*``/``outflow_*`` class
+    flows at x = 0 and x = L over the window, veh/s.
+    """
+
+    t: float
+    window: float
+    x: np.ndarray
+    rho_h: np.ndarray
+    rho_a: np.ndarray
+    q_h: np.ndarray
+    q_a: np.ndarray
+    samples_h: np.ndarray
+    samples_a: np.ndarray
+    inflow_h: float
+    inflow_a: float
+    outflow_h: float
+    outflow_a: float
+
+    @property
+    def v_h(self) -> np.ndarray:
+        """HV space-mean speed per cell, m/s (NaN where empty)."""
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(self.samples_h > 0, self.q_h / self.rho_h, np.nan)
+
+    @property
+    def v_a(self) -> np.ndarray:
+        """AV space-mean speed per cell, m/s (NaN where empty)."""
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(self.samples_a > 0, self.q_a / self.rho_a, np.nan)
+
+    @property
+    def inlet_speeds(self) -> tuple[float, float]:
+        """(v_h, v_a) in the first cell, m/s: the observer's measurement (NaN if empty)."""
+        return float(self.v_h[0]), float(self.v_a[0])
+
+    def macro_state(self, v_empty_h: float, v_empty_a: float) -> MacroState:
+        """The :class:`MacroState` of this window; empty cells get the given speeds (m/s)."""
+        return MacroState(self.t, self.x, self.rho_h, np.nan_to_num(self.v_h, nan=v_empty_h),
+                          self.rho_a, np.nan_to_num(self.v_a, nan=v_empty_a))
+
+
+class EdieGrid:
+    """Accumulates per-step vehicle samples on a uniform grid over [0, length].
+
+    Parameters
+    ----------
+    length : float
+        Road length L, m.
+    cell_length : float
+        Cell length dx, m; must divide L.
+    dt : float
+        Sampling step, s.
+    """
+
+    def __init__(self, length: float, cell_length: float, dt: float) -> None:
+        n = length / cell_length
+        require(abs(n - round(n)) < 1e-9 and n >= 1, "cell_length", cell_length,
+                f"a length dividing the road length {length} m")
+        self.length, self.dx, self.dt, self.n = length, cell_length, dt, round(n)
+        self.x = (np.arange(self.n) + 0.5) * cell_length
+        self.reset()
+
+    def reset(self) -> None:
+        """Start a new window."""
+        self._cnt = np.zeros((2, self.n))
+        self._dist = np.zeros((2, self.n))
+        self.steps = 0
+        self.flows = np.zeros(4)          # in_h, in_a, out_h, out_a (vehicles)
+
+    def add(self, pos: np.ndarray, speed: np.ndarray, av: np.ndarray) -> None:
+        """Add one step's samples: positions (m), speeds (m/s), AV mask."""
+        idx = np.minimum((pos / self.dx).astype(np.intp), self.n - 1) + self.n * av
+        self.add_binned(np.bincount(idx, minlength=2 * self.n).reshape(2, self.n),
+                        np.bincount(idx, weights=speed, minlength=2 * self.n).reshape(2, self.n))
+
+    def add_binned(self, counts: np.ndarray, speed_sums: np.ndarray) -> None:
+        """Add one step's per-cell vehicle counts and speed sums (m/s), shape (2, cells)."""
+        self._cnt += counts
+        self._dist += speed_sums
+        self.steps += 1
+
+    def flush(self, t: float) -> CellData:
+        """Aggregates of the window ending at ``t`` (s); starts a new window."""
+        require(self.steps > 0, "window", 0, "at least one step before flush")
+        span = self.steps * self.dt
+        rho = self._cnt * self.dt / (self.dx * span)
+        q = self._dist * self.dt / (self.dx * span)
+        f = self.flows / span
+        data = CellData(float(t), span, self.x.copy(), rho[0], rho[1], q[0], q[1],
+                        self._cnt[0].copy(), self._cnt[1].copy(), *map(float, f))
+        self.reset()
+        return data
+
+
+@dataclass
+class MeasurementLog:
+    """Stacked :class:`CellData` of a run (arrays of shape (windows, cells))."""
+
+    records: list[CellData] = field(default_factory=list)
+
+    def append(self, data: CellData) -> None:
+        self.records.append(data)
+
+    def array(self, name: str) -> np.ndarray:
+        """One field over all windows, e.g. ``log.array("rho_h")``."""
+        return np.array([getattr(r, name) for r in self.records])
+
+
+class MainlineSensor:
+    """Collects ``main`` every step from an open libsumo run and yields windows.
+
+    Call :meth:`collect` after every SUMO step; when :attr:`steps_per_window` steps have
+    been collected it returns the window's :class:`CellData` (otherwise None).
+    """
+
+    def __init__(self, lib: ModuleType, length: float, cell_length: float, dt: float,
+                 steps_per_window: int) -> None:
+        require(steps_per_window >= 1, "steps_per_window", steps_per_window, "at least 1")
+        self.lib, self.grid = lib, EdieGrid(length, cell_length, dt)
+        self.steps_per_window = steps_per_window
+        self._prev: set[str] = set()
+        self.log = MeasurementLog()
+
+    def sample(self) -> tuple[tuple[str, ...], np.ndarray, np.ndarray, np.ndarray]:
+        """(ids, positions m, speeds m/s, AV mask) of the vehicles on ``main`` now."""
+        v = self.lib.vehicle
+        ids = self.lib.edge.getLastStepVehicleIDs(MAIN)
+        n = len(ids)
+        pos = np.fromiter(map(v.getLanePosition, ids), float, n)
+        speed = np.fromiter(map(v.getSpeed, ids), float, n)
+        return ids, pos, speed, is_av(ids)
+
+    def collect(self, t: float) -> CellData | None:
+        """Sample the current step (time ``t``, s); return a finished window or None."""
+        ids, pos, speed, av = self.sample()
+        self.grid.add(pos, speed, av)
+        cur = set(ids)
+        entered = cur - self._prev
+        left = self._prev - cur
+        entered = {i for i in entered if "_init" not in i}   # placed at t = 0: not inflow
+        if entered:
+            na = sum(1 for i in entered if i.startswith("av"))
+            self.grid.flows[0] += len(entered) - na
+            self.grid.flows[1] += na
+        if left:
+            na = sum(1 for i in left if i.startswith("av"))
+            self.grid.flows[2] += len(left) - na
+            self.grid.flows[3] += na
+        self._prev = cur
+        if self.grid.steps >= self.steps_per_window:
+            data = self.grid.flush(t)
+            self.log.append(data)
+            return data
+        return None

@@ -1,0 +1,192 @@
+"""The ramp-metering network: plain XML sources and the netconvert build.
+
+Layout (x along the mainline, metres)::
+
+    A(0) --main, 1 lane 6.5 m, 1000 m--> B(L) --merge, 2 lanes--> C --down (bottleneck)--> D
+                                          ^
+    R --ramp_up (queue storage)--> M(meter, traffic light) --ramp_dn--/
+
+``main`` is the controlled road [0, L]. The ramp joins the right lane (acceleration lane)
+of ``merge`` at x = L; that lane ends, so ramp vehicles must merge into the 6.5 m lane
+before C. ``down`` is slower than ``main``: a capacity bottleneck, so ramp inflow takes
+mainline capacity and the meter sets the mainline outflow q(L, t). The traffic light
+``meter`` at node M has one signal (link index 0) on the ramp.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import subprocess
+from dataclasses import dataclass, fields
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+from arzsumo.errors import require
+from arzsumo.io import atomic_file
+from arzsumo.sumo.paths import NET_FILE, SumoError, sumo_binary
+
+log = logging.getLogger(__name__)
+
+MAIN, MERGE, DOWN, RAMP_UP, RAMP_DN = "main", "merge", "down", "ramp_up", "ramp_dn"
+METER_TL = "meter"
+SOURCE_FILES = ("ramp.nod.xml", "ramp.edg.xml", "ramp.con.xml", "ramp.tll.xml")
+
+
+@dataclass(frozen=True)
+class NetworkSpec:
+    """Geometry and speed limits of the ramp network (SI: m, m/s).
+
+    Parameters
+    ----------
+    length : float
+        Mainline length L, m (exactly the ``main`` edge length).
+    lane_width : float
+        Mainline lane width W, m.
+    main_speed : float
+        Mainline speed limit, m/s (vehicle types cap themselves below it).
+    merge_length, acc_lane_width : float
+        Length of the merge section and width of its acceleration lane, m.
+    down_length, down_speed : float
+        Length (m) and speed limit (m/s) of the downstream bottleneck.
+    ramp_length, ramp_dn_length, ramp_speed : float
+        Queue storage upstream of the meter (m), ramp length from meter to merge (m),
+        ramp speed limit (m/s).
+    """
+
+    length: float = 1000.0
+    lane_width: float = 6.5
+    main_speed: float = 80.0 / 3.6
+    merge_length: float = 150.0
+    acc_lane_width: float = 3.5
+    down_length: float = 500.0
+    down_speed: float = 50.0 / 3.6
+    ramp_length: float = 300.0
+    ramp_dn_length: float = 120.0
+    ramp_speed: float = 50.0 / 3.6
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            require(isinstance(value, int | float) and value > 0, f.name, value,
+                    "a number greater than 0")
+        require(self.lane_width <= 20.0, "lane_width", self.lane_width, "at most 20 m")
+
+
+def _xml(root: str, lines: list[str]) -> str:
+    body = "\n".join(f"    {line}" for line in lines)
+    return f'<?xml version="1.0" encoding="UTF-8"?>\n<{root}>\n{body}\n</{root}>\n'
+
+
+def _attrs(**kw: object) -> str:
+    return " ".join(f"{k}={quoteattr(_fmt(v))}" for k, v in kw.items())
+
+
+def _fmt(v: object) -> str:
+    return f"{v:.6g}" if isinstance(v, float) else str(v)
+
+
+def network_sources(spec: NetworkSpec) -> dict[str, str]:
+    """The four plain-XML sources (file name -> text) of the network ``spec``."""
+    L = spec.length
+    mx, my = L - 0.6 * spec.ramp_dn_length, -0.8 * spec.ramp_dn_length
+    nodes = [
+        f'<node {_attrs(id="A", x=0.0, y=0.0, type="priority")}/>',
+        f'<node {_attrs(id="B", x=L, y=0.0, type="priority")}/>',
+        f'<node {_attrs(id="C", x=L + spec.merge_length, y=0.0, type="priority")}/>',
+        f'<node {_attrs(id="D", x=L + spec.merge_length + spec.down_length, y=0.0)}/>',
+        f'<node {_attrs(id="M", x=mx, y=my, type="traffic_light", tl=METER_TL)}/>',
+        f'<node {_attrs(id="R", x=mx - 0.6 * spec.ramp_length, y=my - 0.8 * spec.ramp_length)}/>',
+    ]
+    edges = [
+        f'<edge {_attrs(id=MAIN, **{"from": "A"}, to="B", numLanes=1, speed=spec.main_speed, priority=3, length=L, width=spec.lane_width)}/>',  # noqa: E501
+        f'<edge {_attrs(id=MERGE, **{"from": "B"}, to="C", numLanes=2, speed=spec.main_speed, priority=3, length=spec.merge_length)}>',  # noqa: E501
+        f'    <lane {_attrs(index=0, width=spec.acc_lane_width)}/>',
+        f'    <lane {_attrs(index=1, width=spec.lane_width)}/>',
+        "</edge>",
+        f'<edge {_attrs(id=DOWN, **{"from": "C"}, to="D", numLanes=1, speed=spec.down_speed, priority=3, length=spec.down_length, width=spec.lane_width)}/>',  # noqa: E501
+        f'<edge {_attrs(id=RAMP_UP, **{"from": "R"}, to="M", numLanes=1, speed=spec.ramp_speed, priority=1, length=spec.ramp_length, width=spec.acc_lane_width)}/>',  # noqa: E501
+        f'<edge {_attrs(id=RAMP_DN, **{"from": "M"}, to="B", numLanes=1, speed=spec.ramp_speed, priority=1, length=spec.ramp_dn_length, width=spec.acc_lane_width)}/>',  # noqa: E501
+    ]
+    cons = [
+        f'<connection {_attrs(**{"from": MAIN}, to=MERGE, fromLane=0, toLane=1)}/>',
+        f'<connection {_attrs(**{"from": RAMP_DN}, to=MERGE, fromLane=0, toLane=0)}/>',
+        f'<connection {_attrs(**{"from": MERGE}, to=DOWN, fromLane=1, toLane=0)}/>',
+        f'<connection {_attrs(**{"from": RAMP_UP}, to=RAMP_DN, fromLane=0, toLane=0)}/>',
+    ]
+    tll = [
+        f'<tlLogic {_attrs(id=METER_TL, type="static", programID="0", offset=0)}>',
+        f'    <phase {_attrs(duration=3, state="G")}/>',
+        f'    <phase {_attrs(duration=1, state="y")}/>',
+        f'    <phase {_attrs(duration=2, state="r")}/>',
+        "</tlLogic>",
+        f'<connection {_attrs(**{"from": RAMP_UP}, to=RAMP_DN, fromLane=0, toLane=0, tl=METER_TL, linkIndex=0)}/>',  # noqa: E501
+    ]
+    return {
+        "ramp.nod.xml": _xml("nodes", nodes),
+        "ramp.edg.xml": _xml("edges", edges),
+        "ramp.con.xml": _xml("connections", cons),
+        "ramp.tll.xml": _xml("tlLogics", tll),
+    }
+
+
+def write_sources(spec: NetworkSpec, out_dir: Path) -> list[Path]:
+    """Write the plain-XML sources of ``spec`` into ``out_dir`` (atomically per file)."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for name, text in network_sources(spec).items():
+        with atomic_file(out_dir / name) as tmp:
+            tmp.write_text(text, encoding="utf-8")
+        paths.append(out_dir / name)
+    return paths
+
+
+def run_netconvert(src_dir: Path, out_dir: Path) -> Path:
+    """Build ``ramp.net.xml`` in ``out_dir`` from the sources in ``src_dir``; return its path."""
+    missing = [n for n in SOURCE_FILES if not (src_dir / n).is_file()]
+    if missing:
+        raise SumoError(f"sources = {missing} are missing in {src_dir}; allowed: a directory "
+                        "with the files written by `arzsumo build-net`")
+    out_dir.mkdir(parents=True, exist_ok=True)
+    with atomic_file(out_dir / NET_FILE) as tmp:
+        # relative names from the source directory keep absolute paths out of the net's header
+        cmd = [str(sumo_binary("netconvert")),
+               "--node-files", "ramp.nod.xml", "--edge-files", "ramp.edg.xml",
+               "--connection-files", "ramp.con.xml", "--tllogic-files", "ramp.tll.xml",
+               "--no-turnarounds", "true", "--no-internal-links", "false",
+               "--output-file", os.path.relpath(tmp, src_dir), "--no-warnings", "true"]
+        proc = subprocess.run(cmd, capture_output=True, text=True, check=False, cwd=src_dir)
+        if proc.returncode != 0:
+            lines = [ln for ln in (proc.stderr or proc.stdout).splitlines() if ln.strip()]
+            raise SumoError(f"netconvert failed: {lines[-1] if lines else proc.returncode}")
+    log.info("network written to %s", out_dir / NET_FILE)
+    return out_dir / NET_FILE
+
+
+def edge_lengths(net_file: Path) -> dict[str, float]:
+    """Lengths (m) of the non-internal edges of a built network, read with sumolib."""
+    import sumolib
+
+    net = sumolib.net.readNet(str(net_file))
+    return {e.getID(): float(e.getLength()) for e in net.getEdges()}
+
+
+def build_network(out_dir: Path, spec: NetworkSpec | None = None, *,
+                  write: bool = True) -> Path:
+    """Write the sources of ``spec`` (unless ``write`` is False) and build the network.
+
+    Checks that the mainline is exactly ``spec.length`` long in the built network.
+    """
+    spec = spec or NetworkSpec()
+    try:
+        if write:
+            write_sources(spec, out_dir)
+        net = run_netconvert(out_dir, out_dir)
+    except OSError as exc:
+        raise SumoError(f"out = {str(out_dir)!r} cannot be written: {exc.strerror}; allowed: "
+                        "a writable directory") from None
+    main_length = edge_lengths(net)[MAIN]
+    if abs(main_length - spec.length) > 1e-6:
+        raise SumoError(f"main edge length = {main_length} m differs from the requested "
+                        f"{spec.length} m")
+    return net

@@ -1,0 +1,290 @@
+"""The SUMO run lifecycle: start with a fixed seed, step, count, close on every exit path.
+
+libsumo holds one simulation per process; :class:`SumoSimulation` refuses a second one
+while the first is open and can be started again after :meth:`SumoSimulation.close`.
+A SUMO error ends the run as a :class:`~arzsumo.sumo.paths.SumoError` whose message is
+SUMO's cause in one line. Use it as a context manager::
+
+    with open_simulation(params, cfg) as sim:
+        while sim.time < cfg.horizon:
+            sim.step()
+    print(sim.report)
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import logging
+import shutil
+import tempfile
+import xml.etree.ElementTree as ET
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from types import ModuleType, TracebackType
+
+from arzsumo.model.params import ModelParameters
+from arzsumo.sumo.config import SumoConfig
+from arzsumo.sumo.demand import InitialVehicle, demand_flows, write_route_file
+from arzsumo.sumo.paths import NET_FILE, SumoError, nets_dir, sumo_binary
+
+log = logging.getLogger(__name__)
+
+_ACTIVE: SumoSimulation | None = None
+
+
+def libsumo_module() -> ModuleType:
+    """Import libsumo, keeping its import-time version chatter off stdout."""
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        import libsumo
+    if buf.getvalue().strip():
+        log.debug("libsumo import: %s", buf.getvalue().strip())
+    return libsumo
+
+
+def _one_line(exc: BaseException) -> str:
+    text = str(exc).strip() or type(exc).__name__
+    return text.splitlines()[0]
+
+
+@dataclass(frozen=True)
+class RunReport:
+    """Vehicle accounting and safety counts of a run (at the time it was taken).
+
+    ``requested`` vehicles were due by then; ``inserted + waiting == requested`` and
+    ``inserted == arrived + on_network`` hold when no vehicle was removed
+    (teleports off, no collision removal).
+    """
+
+    time: float
+    requested: int
+    loaded: int
+    inserted: int
+    waiting: int
+    arrived: int
+    on_network: int
+    collisions: int
+    teleports: int
+    emergency_stops: int
+    emergency_braking: int = -1
+    requested_ramp: int = 0
+    inserted_ramp: int = 0
+
+    @property
+    def delivered(self) -> float:
+        """Inserted over requested vehicles (1.0 when nothing was requested)."""
+        return self.inserted / self.requested if self.requested else 1.0
+
+    @property
+    def delivered_main(self) -> float:
+        """Inserted over requested mainline vehicles (ramp vehicles held by the meter
+        are waiting by design)."""
+        req = self.requested - self.requested_ramp
+        return (self.inserted - self.inserted_ramp) / req if req else 1.0
+
+    def summary(self) -> str:
+        return (f"t = {self.time:.1f} s: requested {self.requested}, inserted {self.inserted} "
+                f"({self.delivered:.1%}; mainline {self.delivered_main:.1%}), waiting "
+                f"{self.waiting}, arrived {self.arrived}, "
+                f"on network {self.on_network}; collisions {self.collisions}, teleports "
+                f"{self.teleports}, emergency braking {self.emergency_braking}, "
+                f"emergency stops {self.emergency_stops}")
+
+
+class SumoSimulation:
+    """One libsumo run of ``net_file`` with ``route_file`` under ``cfg``.
+
+    Parameters
+    ----------
+    net_file, route_file : Path
+        Network and route files.
+    cfg : SumoConfig
+        Step length, seed, lateral resolution, teleport setting, horizon.
+    requested_initial : int
+        Vehicles placed at t = 0 by the route file (added to the requested count).
+    workdir : Path, optional
+        Directory for SUMO's statistics output; a temporary one by default.
+    extra_args : sequence of str
+        Further SUMO options.
+    """
+
+    def __init__(self, net_file: Path, route_file: Path, cfg: SumoConfig, *,
+                 requested_initial: int = 0, workdir: Path | None = None,
+                 extra_args: Sequence[str] = (), cleanup: Sequence[Path] = ()) -> None:
+        self.net_file, self.route_file, self.cfg = Path(net_file), Path(route_file), cfg
+        self.requested_initial = requested_initial
+        self._own_workdir = workdir is None
+        self.workdir = Path(workdir) if workdir else Path(tempfile.mkdtemp(prefix="arzsumo-"))
+        self.extra_args = tuple(extra_args)
+        self._cleanup = tuple(cleanup)
+        self._flows = demand_flows(cfg)
+        self._lib: ModuleType | None = None
+        self.started = self.closed = False
+        self.loaded = self.inserted = self.inserted_ramp = self.arrived = 0
+        self.collisions = self.teleports = self.emergency_stops = 0
+        self.emergency_braking = -1
+        self.time = 0.0
+        self.report: RunReport | None = None
+
+    # -- command line --------------------------------------------------------------------
+    @property
+    def stats_file(self) -> Path:
+        return self.workdir / "statistics.xml"
+
+    def command(self) -> list[str]:
+        """The SUMO command line (the one place it is built)."""
+        c = self.cfg
+        return [str(sumo_binary("sumo")), "--net-file", str(self.net_file),
+                "--route-files", str(self.route_file),
+                "--step-length", f"{c.step_length:.6g}", "--seed", str(c.seed),
+                "--lateral-resolution", f"{c.lateral_resolution:.6g}",
+                "--time-to-teleport", f"{c.time_to_teleport:.6g}",
+                "--eager-insert", "true", "--collision.action", "warn",
+                "--collision.check-junctions", "true",
+                "--statistic-output", str(self.stats_file),
+                "--no-step-log", "true", "--no-warnings", "true",
+                "--duration-log.disable", "true", *self.extra_args]
+
+    # -- lifecycle -----------------------------------------------------------------------
+    def start(self) -> SumoSimulation:
+        """Start SUMO; a second open simulation in this process is refused."""
+        global _ACTIVE
+        if self.started:
+            raise SumoError("this simulation was already started; allowed: start once")
+        if _ACTIVE is not None:
+            raise SumoError("another SUMO simulation is open in this process; allowed: one "
+                            "at a time (close it first)")
+        lib = libsumo_module()
+        try:
+            lib.start(self.command())
+        except Exception as exc:
+            self._remove_files()
+            raise SumoError(f"SUMO did not start: {_one_line(exc)}") from None
+        self._lib, self.started, _ACTIVE = lib, True, self
+        self.time = float(lib.simulation.getTime())
+        log.debug("SUMO started: seed %d, step %.3g s", self.cfg.seed, self.cfg.step_length)
+        return self
+
+    @property
+    def lib(self) -> ModuleType:
+        """The libsumo module of the open run."""
+        if self._lib is None or self.closed:
+            raise SumoError("the simulation is not running; allowed: use it between start() "
+                            "and close()")
+        return self._lib
+
+    def step(self) -> float:
+        """Advance one SUMO step and update the counters; return the new time (s)."""
+        lib = self.lib
+        sim = lib.simulation
+        try:
+            lib.simulationStep()
+        except Exception as exc:
+            self.close()
+            raise SumoError(f"SUMO stopped at t = {self.time:.2f} s: {_one_line(exc)}") from None
+        self.loaded += sim.getLoadedNumber()
+        departed = sim.getDepartedIDList()
+        self.inserted += len(departed)
+        if departed:
+            self.inserted_ramp += sum(1 for v in departed if v.startswith("ramp"))
+        self.arrived += sim.getArrivedNumber()
+        self.collisions += sim.getCollidingVehiclesNumber()
+        self.emergency_stops += sim.getEmergencyStoppingVehiclesNumber()
+        if self.cfg.time_to_teleport > 0:
+            self.teleports += sim.getStartingTeleportNumber()
+        self.time = float(sim.getTime())
+        return self.time
+
+    def run_until(self, t_end: float) -> float:
+        """Step until the time reaches ``t_end`` (s)."""
+        while self.time < t_end - 1e-9:
+            self.step()
+        return self.time
+
+    def requested(self, ramp_only: bool = False) -> int:
+        """Vehicles due by the current time (initial vehicles plus flows; or ramp flows)."""
+        t = self.time - self.cfg.step_length  # vehicles due in the step just executed
+        ramp = sum(f.requested(t) for f in self._flows if f.id.startswith("ramp"))
+        if ramp_only:
+            return ramp
+        return self.requested_initial + sum(f.requested(t) for f in self._flows)
+
+    def take_report(self) -> RunReport:
+        """Accounting at the current time (run must be open)."""
+        sim = self.lib.simulation
+        return RunReport(self.time, self.requested(), self.loaded, self.inserted,
+                         len(sim.getPendingVehicles()), self.arrived,
+                         int(self.lib.vehicle.getIDCount()), self.collisions, self.teleports,
+                         self.emergency_stops, self.emergency_braking,
+                         self.requested(ramp_only=True), self.inserted_ramp)
+
+    def close(self) -> RunReport | None:
+        """Close SUMO (safe to call twice); keep the final :attr:`report`."""
+        global _ACTIVE
+        if self.closed or not self.started:
+            self.closed = True
+            self._remove_files()
+            return self.report
+        try:
+            self.report = self.take_report()
+        except Exception:  # SUMO already broken: keep counts without the live figures
+            self.report = None
+        try:
+            assert self._lib is not None
+            self._lib.close()
+        except Exception as exc:  # pragma: no cover - SUMO failing to close
+            log.warning("SUMO close: %s", _one_line(exc))
+        finally:
+            self.closed, _ACTIVE = True, None
+        self.emergency_braking = self._read_braking()
+        if self.report is not None:
+            self.report = RunReport(**{**self.report.__dict__,
+                                       "emergency_braking": self.emergency_braking})
+            if self.report.delivered_main < 0.98:
+                log.warning("mainline demand not delivered: %s", self.report.summary())
+        self._remove_files()
+        return self.report
+
+    def _read_braking(self) -> int:
+        try:
+            safety = ET.parse(self.stats_file).getroot().find("safety")
+        except (OSError, ET.ParseError):
+            return -1
+        return int(safety.get("emergencyBraking", -1)) if safety is not None else -1
+
+    def _remove_files(self) -> None:
+        if self._own_workdir:
+            shutil.rmtree(self.workdir, ignore_errors=True)
+        for path in self._cleanup:
+            shutil.rmtree(path, ignore_errors=True)
+
+    def __enter__(self) -> SumoSimulation:
+        return self if self.started else self.start()
+
+    def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
+                 tb: TracebackType | None) -> None:
+        self.close()
+
+
+def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
+                    initial: Sequence[InitialVehicle] = (), net_dir: Path | None = None,
+                    extra_args: Sequence[str] = (), e2_chain: bool = False) -> SumoSimulation:
+    """A started simulation of the default network with the demand of ``cfg``.
+
+    The route file (and, with ``e2_chain``, an E2 detector per measurement cell, see
+    :mod:`arzsumo.sumo.detectors`) goes to a temporary directory removed when the run
+    closes.
+    """
+    net = nets_dir(net_dir) / NET_FILE
+    workdir = Path(tempfile.mkdtemp(prefix="arzsumo-"))
+    route = write_route_file(workdir / "run.rou.xml", params, cfg, initial)
+    if e2_chain:
+        from arzsumo.sumo.detectors import write_e2_chain
+
+        add = write_e2_chain(workdir / "e2.add.xml", params.length, cfg.cell_length)
+        extra_args = ("--additional-files", str(add), *extra_args)
+    sim = SumoSimulation(net, route, cfg, requested_initial=len(initial), workdir=workdir,
+                         extra_args=extra_args, cleanup=(workdir,))
+    return sim.start()

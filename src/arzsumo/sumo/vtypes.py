@@ -1,0 +1,77 @@
+"""HV and AV vehicle types from the model parameters.
+
+The spacing policy becomes ``length + minGap = s_i``, the width is the model's ``d``, the
+free-flow speed ``V_i`` caps the vehicle's speed. HVs drive a human car-following model
+with noise (Krauss with ``sigma`` or IDM with speed noise); AVs drive SUMO's ACC or CACC.
+Both use the sublane model (``latAlignment="arbitrary"``) so they spread over the whole
+6.5 m lane.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from xml.sax.saxutils import quoteattr
+
+from arzsumo.model.params import ModelParameters
+from arzsumo.sumo.config import SumoConfig
+
+HV_TYPE, AV_TYPE = "hv", "av"
+
+#: Longest vehicle body, m; shorter spacing policies shrink it to 60 % of the spacing.
+MAX_LENGTH = 5.0
+
+
+@dataclass(frozen=True)
+class VehicleType:
+    """A SUMO vType: id, geometry (m), speed (m/s) and model attributes."""
+
+    id: str
+    length: float
+    min_gap: float
+    width: float
+    max_speed: float
+    car_follow_model: str
+    attrs: tuple[tuple[str, str], ...]
+
+    @property
+    def spacing(self) -> float:
+        """length + minGap, m (the model's spacing policy s_i)."""
+        return self.length + self.min_gap
+
+    def to_xml(self) -> str:
+        """The ``<vType .../>`` element."""
+        base = {"id": self.id, "length": f"{self.length:.4f}", "minGap": f"{self.min_gap:.4f}",
+                "width": f"{self.width:.4f}", "maxSpeed": f"{self.max_speed:.6f}",
+                "desiredMaxSpeed": f"{self.max_speed:.6f}",
+                "carFollowModel": self.car_follow_model}
+        base.update(dict(self.attrs))
+        return "<vType " + " ".join(f"{k}={quoteattr(v)}" for k, v in base.items()) + "/>"
+
+
+def _geometry(spacing: float) -> tuple[float, float]:
+    length = min(MAX_LENGTH, 0.6 * spacing)
+    return length, spacing - length
+
+
+def vehicle_types(params: ModelParameters, cfg: SumoConfig) -> tuple[VehicleType, VehicleType]:
+    """(HV, AV) vehicle types for ``params`` under the run settings ``cfg``."""
+    sub = (("latAlignment", "arbitrary"), ("minGapLat", f"{cfg.min_gap_lat:.3f}"),
+           ("maxSpeedLat", "1.0"), ("lcSublane", "1.0"), ("lcPushy", "0.2"),
+           ("lcStrategic", "1.0"), ("lcKeepRight", "0"), ("lcSpeedGain", "0.5"))
+    length, gap = _geometry(params.spacing_h)
+    if cfg.hv_model == "Krauss":
+        hv_model: tuple[tuple[str, str], ...] = (("sigma", f"{cfg.hv_sigma:.3f}"),)
+    else:
+        hv_model = (("speedDev", "0.1"),)
+    hv = VehicleType(HV_TYPE, length, gap, params.vehicle_width, params.v_free_h,
+                     cfg.hv_model,
+                     (("vClass", "passenger"), ("accel", "2.6"), ("decel", "4.5"),
+                      ("emergencyDecel", "9.0"), ("tau", "1.0"), ("speedFactor", "1"),
+                      ("speedDev", "0.05"), *hv_model, ("color", "0.2,0.4,1"), *sub))
+    length, gap = _geometry(params.spacing_a)
+    av = VehicleType(AV_TYPE, length, gap, params.vehicle_width, params.v_free_a,
+                     cfg.av_model,
+                     (("vClass", "passenger"), ("accel", "2.0"), ("decel", "4.5"),
+                      ("emergencyDecel", "9.0"), ("tau", "1.0"), ("speedFactor", "1"),
+                      ("speedDev", "0"), ("color", "1,0.3,0.1"), *sub))
+    return hv, av

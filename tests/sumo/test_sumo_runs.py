@@ -1,0 +1,175 @@
+"""Integration tests with the real SUMO (libsumo), short horizons, one run at a time."""
+
+import numpy as np
+import pytest
+
+from arzsumo.model import get_preset
+from arzsumo.sumo.config import SumoConfig
+from arzsumo.sumo.measure import MainlineSensor
+from arzsumo.sumo.meter import RampMeter
+from arzsumo.sumo.network import MAIN, RAMP_UP
+from arzsumo.sumo.paths import SumoError
+from arzsumo.sumo.placement import place_vehicles
+from arzsumo.sumo.runner import run_fixed_meter
+from arzsumo.sumo.simulation import open_simulation
+
+pytestmark = pytest.mark.sumo
+
+PARAMS = get_preset("paper_base").params
+FAST = SumoConfig(horizon=40.0, step_length=0.2, control_period=1.0)
+
+
+def test_vehicles_are_conserved():
+    cfg = FAST.with_(horizon=100.0, ramp_demand=1500 / 3600)
+    checked = 0
+    with open_simulation(PARAMS, cfg) as sim:
+        meter = RampMeter(sim.lib, cfg)
+        while sim.time < cfg.horizon:
+            sim.step()
+            meter.step()
+            if round(sim.time / cfg.step_length) % 50 == 0:
+                r = sim.take_report()
+                assert r.requested == r.inserted + r.waiting
+                assert r.inserted == r.arrived + r.on_network
+                ramp_waiting = sum(1 for v in sim.lib.simulation.getPendingVehicles()
+                                   if v.startswith("ramp"))
+                assert r.requested_ramp == r.inserted_ramp + ramp_waiting
+                checked += 1
+    r = sim.report
+    assert checked >= 9 and r.requested > 190 and r.arrived > 10
+    assert r.requested == r.inserted + r.waiting
+    assert r.inserted == r.arrived + r.on_network
+    assert r.teleports == 0 and r.collisions == 0 and r.emergency_braking >= 0
+    assert r.requested_ramp > 30 and r.delivered_main == 1.0
+
+
+def test_edie_density_of_single_step_is_count_over_length():
+    cfg = FAST.with_(horizon=30.0)
+    with open_simulation(PARAMS, cfg) as sim:
+        sim.run_until(25.0)
+        sensor = MainlineSensor(sim.lib, PARAMS.length, 50.0, cfg.step_length, 1)
+        data = sensor.collect(sim.step())
+        ids = sim.lib.edge.getLastStepVehicleIDs(MAIN)
+        pos = np.array([sim.lib.vehicle.getLanePosition(v) for v in ids])
+        av = np.array([sim.lib.vehicle.getTypeID(v) == "av" for v in ids])
+    assert data is not None and len(ids) >= 30
+    bins = np.arange(0.0, 1000.1, 50.0)
+    count_h = np.histogram(np.minimum(pos[~av], 999.9), bins)[0]
+    count_a = np.histogram(np.minimum(pos[av], 999.9), bins)[0]
+    np.testing.assert_allclose(data.rho_h, count_h / 50.0, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(data.rho_a, count_a / 50.0, rtol=0, atol=1e-12)
+
+
+def test_always_red_holds_ramp_and_always_green_releases_it():
+    cfg = FAST.with_(horizon=50.0, ramp_demand=1200 / 3600)
+    red = run_fixed_meter(PARAMS, cfg, 0.0, measure=False)
+    green = run_fixed_meter(PARAMS, cfg, 1.0, measure=False)
+    assert red.ramp_passed == 0 and red.meter["light_changes"] == 0
+    assert red.meter["max_queue"] >= 5
+    assert green.ramp_passed >= 5 and green.meter["light_changes"] == 0
+    assert green.meter["max_queue"] < red.meter["max_queue"]
+
+
+def test_meter_counts_plan_and_light_changes():
+    cfg = FAST.with_(horizon=30.0, meter_cycle=6.0, min_green=1.0, min_red=1.0)
+    with open_simulation(PARAMS, cfg) as sim:
+        meter = RampMeter(sim.lib, cfg)               # nominal green share 0.5
+        assert meter.set_green_share(0.5) is False    # same timing: no plan change
+        for _ in range(round(12.0 / cfg.step_length)):
+            sim.step()
+            meter.step()
+            states = sim.lib.trafficlight.getRedYellowGreenState("meter")
+            assert states == meter.light
+        assert meter.light_changes == 4               # two cycles: G->r, r->G, G->r, r->G
+        assert meter.command_outflow(1e6) == 0.0      # more outflow than possible: all red
+        assert meter.plan_changes == 1
+    sat = cfg.with_(green_share_min=0.2, green_share_max=0.8)
+    with open_simulation(PARAMS, sat) as sim:
+        meter = RampMeter(sim.lib, sat)
+        assert meter.command_outflow(1e6) == pytest.approx(0.2, abs=0.02)
+        assert meter.command_outflow(0.0) == pytest.approx(0.8, abs=0.02)
+        assert meter.plan_changes == 2
+        sim.run_until(30.0)
+
+
+def test_same_seed_gives_identical_cells_and_another_seed_differs():
+    cfg = FAST.with_(horizon=30.0, seed=11)
+    a = run_fixed_meter(PARAMS, cfg).measurements
+    b = run_fixed_meter(PARAMS, cfg).measurements
+    c = run_fixed_meter(PARAMS, cfg.with_(seed=12)).measurements
+    for name in ("rho_h", "rho_a", "q_h", "q_a", "outflow_h", "inflow_a"):
+        np.testing.assert_array_equal(a.array(name), b.array(name))
+    assert len(a.records) == 30
+    assert not np.array_equal(a.array("q_h"), c.array("q_h"))
+
+
+def test_placement_reproduces_target_density_within_5_percent_per_100m():
+    x = np.arange(25.0, 1000.0, 50.0)
+    rho_h = np.where(x < 500, 0.110, 0.080)
+    rho_a = np.where(x < 300, 0.100, 0.060)
+    v_h, v_a = np.full_like(x, 10.0), np.full_like(x, 8.0)
+    cfg = FAST.with_(demand_h=0.0, demand_a=0.0, ramp_demand=0.0, horizon=1.0)
+    veh, rep = place_vehicles(PARAMS, cfg, x, rho_h, v_h, rho_a, v_a)
+    with open_simulation(PARAMS, cfg, initial=veh) as sim:
+        sensor = MainlineSensor(sim.lib, PARAMS.length, 100.0, cfg.step_length, 1)
+        data = sensor.collect(sim.step())
+        r = sim.take_report()
+    assert r.inserted == len(veh) == rep.n_h + rep.n_a
+    target_h = rho_h.reshape(10, 2).mean(axis=1)
+    target_a = rho_a.reshape(10, 2).mean(axis=1)
+    np.testing.assert_allclose(data.rho_h, target_h, rtol=0.05)
+    np.testing.assert_allclose(data.rho_a, target_a, rtol=0.05)
+
+
+def test_lifecycle_close_twice_one_at_a_time_and_errors_in_one_line():
+    sim = open_simulation(PARAMS, FAST)
+    try:
+        with pytest.raises(SumoError, match="another SUMO simulation is open"):
+            open_simulation(PARAMS, FAST)
+        sim.step()
+    finally:
+        sim.close()
+    sim.close()                                        # safe twice
+    with pytest.raises(SumoError, match="not running"):
+        sim.step()
+    with pytest.raises(SumoError) as info:
+        open_simulation(PARAMS, FAST, extra_args=["--no-such-option", "1"])
+    assert "SUMO did not start" in str(info.value) and "\n" not in str(info.value)
+    with open_simulation(PARAMS, FAST) as again:       # libsumo restarts in one process
+        again.run_until(2.0)
+        assert again.lib.edge.getLastStepVehicleNumber(RAMP_UP) >= 0
+    assert again.closed
+
+
+def test_teleports_counted_when_enabled():
+    cfg = FAST.with_(horizon=40.0, time_to_teleport=5.0, ramp_demand=1800 / 3600)
+    res = run_fixed_meter(PARAMS, cfg, 0.0, measure=False)   # red: ramp queue stands
+    assert res.report.teleports > 0
+    # vehicles in a teleport still count as on the network
+    assert res.report.inserted == res.report.arrived + res.report.on_network
+
+
+def test_e2_chain_counts_each_vehicle_once_like_the_position_sensor():
+    from arzsumo.sumo.detectors import E2Sensor
+
+    cfg = FAST.with_(horizon=80.0, cell_length=50.0)
+    with open_simulation(PARAMS, cfg, e2_chain=True) as sim:
+        sim.run_until(70.0)                  # traffic over the whole 1000 m
+        e2 = E2Sensor(sim.lib, PARAMS.length, cfg.cell_length, cfg.step_length, 1)
+        pos = MainlineSensor(sim.lib, PARAMS.length, cfg.cell_length, cfg.step_length, 1)
+        t = sim.step()
+        a, b = e2.collect(t), pos.collect(t)
+        naive = sum(len(sim.lib.lanearea.getLastStepVehicleIDs(d)) for d in e2.ids)
+    assert a is not None and b is not None
+    np.testing.assert_array_equal(a.rho_h, b.rho_h)
+    np.testing.assert_array_equal(a.rho_a, b.rho_a)
+    np.testing.assert_allclose(a.q_h, b.q_h, rtol=1e-12)
+    assert e2.double_counted > 0 and naive == round((a.rho_h + a.rho_a).sum() * 50) + \
+        e2.double_counted
+
+
+def test_spillback_override_releases_a_long_queue():
+    cfg = FAST.with_(horizon=50.0, ramp_demand=1200 / 3600, spillback_queue=4)
+    res = run_fixed_meter(PARAMS, cfg, 0.0, measure=False)
+    assert res.meter["override_steps"] > 0 and res.ramp_passed > 0
+    assert res.meter["max_queue"] >= 4
