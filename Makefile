@@ -13,7 +13,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 run: $(STAMP)
-	$(BIN)/arzsumo model --preset paper_base
+	$(BIN)/arzsumo run
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q

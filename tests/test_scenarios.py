@@ -18,7 +18,8 @@ def test_scenario_from_demand():
 
 
 @pytest.mark.parametrize(("data", "error", "match"), [
-    ({"modle": {}}, ScenarioError, r"unknown key 'modle'; allowed: description, design, equilibrium"),
+    ({"modle": {}}, ScenarioError,
+     r"unknown key 'modle'; allowed: description, design, equilibrium"),
     ({"model": {"spacing_x_m": 3}}, ScenarioError, r"\[model\]: unknown key 'spacing_x_m'"),
     ({"model": {"tau_h_s": "fast"}}, ScenarioError, r"tau_h_s = 'fast' is not allowed"),
     ({"model": {"preset": "paper"}}, ModelError, r"preset = 'paper' is unknown"),

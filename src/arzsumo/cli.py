@@ -13,7 +13,7 @@ import logging
 import sys
 from collections.abc import Callable, Sequence
 
-from arzsumo import __version__, cli_control, cli_sumo, cli_twin
+from arzsumo import __version__, cli_bridge, cli_control, cli_sumo, cli_twin
 from arzsumo.errors import ArzsumoError
 from arzsumo.model import linearize
 from arzsumo.scenarios import Scenario, load_scenario, scenario_from_preset
@@ -107,6 +107,7 @@ def build_parser() -> argparse.ArgumentParser:
     cli_control.register(sub)
     cli_twin.register(sub)
     cli_sumo.register(sub)
+    cli_bridge.register(sub)
     return parser
 
 

@@ -67,8 +67,10 @@ EQUILIBRIUM_KEYS: dict[str, Callable[[float], Any]] = {
     "demand_a_veh_h": veh_h_to_veh_s,
 }
 
-#: [twin] and [initial] are parsed by arzsumo.twin.config (the PDE twin's own settings).
-TOP_KEYS = {"name", "description", "model", "equilibrium", "twin", "initial", "design", "sumo"}
+#: Tables parsed elsewhere: [twin] and [initial] by arzsumo.twin.config, [sumo] by
+#: arzsumo.sumo.config, [run] by arzsumo.bridge.config; [design] below.
+TOP_KEYS = {"name", "description", "model", "equilibrium", "twin", "initial", "design", "sumo",
+            "run"}
 
 #: ETC design keys of the [design] table (dimensionless or SI as in the paper, section 5)
 DESIGN_KEYS = {"zeta", "sigma", "eta", "A", "B", "varsigma", "mu", "m0"}

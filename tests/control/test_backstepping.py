@@ -97,3 +97,23 @@ def test_registry_builds_every_controller(lin, kernels):
     assert us["backstepping"] == pytest.approx(us["etc"])        # first ETC check is an event
     with pytest.raises(ModelError, match="controller = 'pid' is not allowed"):
         make_controller("pid", lin, kernels)
+
+
+def test_alinea_integrates_occupancy_error():
+    from arzsumo.control.alinea import Alinea
+
+    def curve(g):                   # more ramp green, less mainline outflow (veh/s)
+        return 1.5 - 0.6 * g
+
+    ctrl = Alinea(curve, nominal_green=0.5, target=0.2)
+    x = np.array([25.0])
+    one = np.ones(1)
+    state = MacroState(0.0, x, one, one, one, one, occupancy_out=0.3)   # too dense
+    u1 = ctrl.check(state)
+    assert ctrl.green == pytest.approx(0.5 - 7000 / 1800 * 0.1)        # K_R / r_sat * error
+    assert u1 == pytest.approx(curve(ctrl.green) - curve(0.5)) and u1 > 0
+    for _ in range(20):
+        ctrl.check(state)
+    assert ctrl.green == 0.0                                              # saturated
+    ctrl.check(MacroState(1.0, x, one, one, one, one))                    # no measurement
+    assert ctrl.green == 0.0

@@ -21,6 +21,8 @@ class MacroState:
 
     Densities in veh/m, speeds in m/s. A controller that needs only the inlet reads
     ``v_h[0]``, ``v_a[0]`` (the observer's measurement y(t) = w-(0, t)).
+    ``occupancy_out`` is the occupancy (fraction, SUMO's lane occupancy) measured
+    downstream of the merge over the last period, for ALINEA; NaN where not measured.
     """
 
     t: float
@@ -29,6 +31,7 @@ class MacroState:
     v_h: np.ndarray
     rho_a: np.ndarray
     v_a: np.ndarray
+    occupancy_out: float = float("nan")
 
 
 @dataclass

@@ -1,0 +1,143 @@
+"""Results of a co-simulation: tables, ``summary.json`` and plots, written atomically.
+
+Layout of ``DIR``::
+
+    periods.parquet   per control period: t_s (check time), U commanded and continuous (veh/s),
+                      event flag, green share commanded and running, light and plan changes
+                      so far, ramp queue, class in/outflows (veh/s), downstream occupancy
+    cells.parquet     per period and cell: source (micro, replay, reference), t_s, x_m,
+                      rho_h, v_h, rho_a, v_a (SI; micro speeds NaN in empty cells)
+    summary.json      see :func:`summary`
+    scenario.toml     the resolved scenario (as loaded) and settings
+    fields_h.png, fields_a.png   micro | replay twin | reference twin, per class
+    control.png       U, green share, light, queue, release instants
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from arzsumo import __version__
+from arzsumo.bridge.cosim import CoSimResult, fill_speeds
+from arzsumo.control.base import ControlLog
+from arzsumo.control.events import release_time
+from arzsumo.io import atomic_dir
+from arzsumo.model.characteristic import linearize
+from arzsumo.twin.metrics import performance
+from arzsumo.twin.output import json_safe
+
+VARIABLES = ("rho_h", "v_h", "rho_a", "v_a")
+
+
+def _indices(res: CoSimResult, fields: np.ndarray) -> dict[str, Any]:
+    """TTT, total delay, J_fuel, J_discom of fields (periods, 4, cells) up to their first NaN."""
+    p = res.scenario.params
+    ok = np.all(np.isfinite(fields[:, [0, 2]]), axis=(1, 2))
+    n = int(np.argmin(ok)) if not ok.all() else ok.size
+    if n < 2:
+        return {"TTT": None, "total_delay": None, "J_fuel": None, "J_discom": None,
+                "until_s": float(res.t[n - 1]) if n else 0.0}
+    f = fields[:n].copy()
+    f[:, 1], f[:, 3] = fill_speeds(p, f[:, 0], f[:, 1], f[:, 2], f[:, 3])
+    perf = performance(p, res.t[:n], res.x, f)
+    out: dict[str, Any] = {}
+    for key, attr in (("TTT", "J_TTT"), ("total_delay", "total_delay"), ("J_fuel", "J_fuel"),
+                      ("J_discom", "J_discom")):
+        out[key] = {c: getattr(getattr(perf, c), attr) for c in ("h", "a", "total")}
+    out["until_s"] = float(res.t[n - 1])
+    return out
+
+
+def rmse(res: CoSimResult, twin: np.ndarray) -> dict[str, dict[str, float]]:
+    """RMSE of a twin against the micro fields per variable: absolute (SI) and relative to
+    the equilibrium value; cells where either is NaN (empty, stopped) are skipped."""
+    eq = res.equilibrium
+    ref = {"rho_h": eq.rho_h, "v_h": eq.v_h, "rho_a": eq.rho_a, "v_a": eq.v_a}
+    out: dict[str, dict[str, float]] = {}
+    for k, name in enumerate(VARIABLES):
+        a, b = res.micro[:, k], twin[:, k]
+        ok = np.isfinite(a) & np.isfinite(b)
+        value = float(np.sqrt(np.mean((a[ok] - b[ok]) ** 2))) if ok.any() else float("nan")
+        out[name] = {"absolute": value, "relative": value / ref[name], "samples": int(ok.sum())}
+    return out
+
+
+def summary(res: CoSimResult) -> dict[str, Any]:
+    """The run's summary: meter counts, events, indices (micro and twins), fidelity, accounting."""
+    per = res.periods
+    rep = res.report
+    triggered = per["triggered"].astype(bool)
+    horizon = float(res.sumo.horizon)
+    log = res.controller_log
+    n = triggered.size
+    clipped = ControlLog(list(log.t[:n]), list(log.u_applied[:n]),
+                         list(log.u_continuous[:n]), list(log.triggered[:n]))
+    v = res.micro[:, [1, 3]]
+    eq = res.equilibrium
+    return {
+        "scenario": res.scenario.name, "source": res.scenario.source, "version": __version__,
+        "seed": res.sumo.seed, "controller": res.settings.controller, "complete": True,
+        "units": "SI: veh, s, m; U and flows in veh/s",
+        "equilibrium": eq.as_dict(), "lambda_4": float(linearize(eq).eigenvalues[3]),
+        "q_nominal": res.q_nominal, "horizon": horizon, "warmup": res.settings.warmup,
+        "plan_changes": int(res.meter["plan_changes"]),
+        "light_changes": int(res.meter["light_changes"]),
+        "triggers": int(triggered.sum()), "release_time": release_time(clipped, horizon),
+        "max_ramp_queue": int(res.meter["max_queue"]),
+        "speed_variance": {"h": float(np.nanvar(v[:, 0])), "a": float(np.nanvar(v[:, 1]))},
+        **{k: v for k, v in _indices(res, res.micro).items()},
+        "twin_replay": _indices(res, res.replay), "twin_reference": _indices(res, res.reference),
+        "rmse": {"replay": rmse(res, res.replay), "reference": rmse(res, res.reference)},
+        "twin_status": res.twin_status,
+        "inserted": rep.inserted if rep else None, "requested": rep.requested if rep else None,
+        "waiting": rep.waiting if rep else None, "arrived": rep.arrived if rep else None,
+        "teleports": rep.teleports if rep else None,
+        "collisions": rep.collisions if rep else None,
+        "emergency_braking": rep.emergency_braking if rep else None,
+        "placement": res.placement,
+        "wall_time": res.wall_time, "timings": res.timings,
+        "controller_time_per_period": float(np.mean(per["controller_s"])) if n else None,
+        "settings": res.settings.as_dict(),
+    }
+
+
+def periods_table(res: CoSimResult) -> pa.Table:
+    cols = {"t_s": res.periods["t"]}
+    cols.update({k: v for k, v in res.periods.items() if k not in ("t", "controller_s")})
+    cols["triggered"] = res.periods["triggered"].astype(bool)
+    return pa.table(cols)
+
+
+def cells_table(res: CoSimResult) -> pa.Table:
+    parts = []
+    n_t, _, n_x = res.micro.shape
+    for source, arr in (("micro", res.micro), ("replay", res.replay),
+                        ("reference", res.reference)):
+        cols: dict[str, Any] = {"source": np.full(n_t * n_x, source),
+                                "t_s": np.repeat(res.t, n_x), "x_m": np.tile(res.x, n_t)}
+        cols.update({name: arr[:, k, :].ravel() for k, name in enumerate(VARIABLES)})
+        parts.append(pa.table(cols))
+    return pa.concat_tables(parts)
+
+
+def write_results(res: CoSimResult, out: str | Path, scenario_text: str,
+                  plots: bool = True) -> tuple[Path, dict[str, Any]]:
+    """Write everything into ``out`` (replaced atomically); return the path and summary."""
+    from arzsumo.plots.bridge import write_bridge_plots
+
+    summ = summary(res)
+    with atomic_dir(out) as tmp:
+        pq.write_table(periods_table(res), tmp / "periods.parquet")
+        pq.write_table(cells_table(res), tmp / "cells.parquet")
+        (tmp / "scenario.toml").write_text(scenario_text, encoding="utf-8")
+        (tmp / "summary.json").write_text(json.dumps(json_safe(summ), indent=2) + "\n",
+                                          encoding="utf-8")
+        if plots:
+            write_bridge_plots(res, tmp)
+    return Path(out), summ
