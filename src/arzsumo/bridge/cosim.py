@@ -53,8 +53,10 @@ from arzsumo.twin.solver import SolverOptions, TwinStepper, TwinStoppedError
 
 log = logging.getLogger(__name__)
 
-#: seconds of warm-up averaged for a measured equilibrium
+#: seconds of warm-up averaged for a measured equilibrium (and ALINEA's target occupancy)
 MEASURE_WINDOW = 60.0
+#: ALINEA target when the warm-up measured no downstream occupancy (fraction)
+DEFAULT_OCCUPANCY_TARGET = 0.2
 
 
 def check_before_start(settings: RunSettings, eq: Equilibrium) -> Linearization:
@@ -278,7 +280,12 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
                    if settings.controller in PDE_CONTROLLERS else None)
         k_occ = max(1, round(MEASURE_WINDOW / cfg.control_period))
         occ_target = settings.alinea_target or (float(np.mean(occ_warm[-k_occ:]))
-                                                if occ_warm else 0.1)
+                                                if occ_warm else 0.0)
+        if occ_target <= 0.01:     # nothing reached the detector during a short warm-up
+            occ_target = DEFAULT_OCCUPANCY_TARGET
+            if settings.controller == "alinea":
+                log.warning("no downstream occupancy measured in the warm-up; ALINEA target "
+                            "%.2f", occ_target)
         ctrl = _controller(settings.controller, lin, kernels, design, settings, curve, cfg,
                            occ_target)
         ref_name = settings.controller if settings.controller in PDE_CONTROLLERS else "open"

@@ -1,0 +1,123 @@
+"""The closed loop with real SUMO: every controller, outputs, refusals, interruption."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+
+from arzsumo.bridge.config import RunSettings, run_settings_from_dict
+from arzsumo.bridge.cosim import run_cosimulation
+from arzsumo.bridge.outputs import write_results
+from arzsumo.cli import main
+from arzsumo.control.etc import PAPER_DESIGN
+from arzsumo.errors import ScenarioError
+from arzsumo.scenarios import load_scenario
+from arzsumo.sumo.config import sumo_config_of
+
+DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "default.toml"
+pytestmark = pytest.mark.sumo
+
+
+@pytest.fixture(scope="module")
+def scenario():
+    return load_scenario(DEFAULT)
+
+
+def _short(scenario, controller, seed=42, horizon=60.0, warmup=40.0):
+    settings = run_settings_from_dict(scenario.raw, scenario.source, controller=controller,
+                                      warmup=warmup, kernel_cells=50, twin_cells=50)
+    cfg = sumo_config_of(scenario).with_(horizon=horizon, seed=seed)
+    return run_cosimulation(scenario, settings, cfg, PAPER_DESIGN)
+
+
+@pytest.fixture(scope="module")
+def runs(scenario, tmp_path_factory, monkeypatch_module):
+    monkeypatch_module.setenv("ARZSUMO_CACHE", str(tmp_path_factory.mktemp("cache")))
+    out = {}
+    for name in ("open", "backstepping", "etc", "observer-etc", "alinea"):
+        res = _short(scenario, name)
+        path, summ = write_results(res, tmp_path_factory.mktemp(name) / "run", "# test\n",
+                                   plots=name in ("etc", "alinea"))
+        out[name] = (res, path, summ)
+    return out
+
+
+@pytest.fixture(scope="module")
+def monkeypatch_module():
+    with pytest.MonkeyPatch.context() as mp:
+        yield mp
+
+
+def test_every_controller_completes_and_writes_its_outputs(runs):
+    for name, (res, path, summ) in runs.items():
+        assert summ["controller"] == name and summ["complete"]
+        for f in ("periods.parquet", "cells.parquet", "summary.json", "scenario.toml"):
+            assert (path / f).is_file(), (name, f)
+        assert res.t.size == 60 and res.micro.shape == (60, 4, 20)
+        assert {"plan_changes", "light_changes", "triggers", "release_time", "TTT",
+                "total_delay", "J_fuel", "J_discom", "rmse", "max_ramp_queue", "inserted",
+                "requested", "teleports", "collisions", "wall_time", "seed", "scenario",
+                "version"} <= set(summ)
+        assert summ["inserted"] + summ["waiting"] == summ["requested"]
+    for name in ("etc", "alinea"):
+        assert all((runs[name][1] / f).is_file() for f in ("fields_h.png", "control.png"))
+
+
+def test_trigger_count_from_the_period_table_equals_the_summary(runs):
+    for _name, (_res, path, summ) in runs.items():
+        table = pq.read_table(path / "periods.parquet").to_pandas()
+        assert int(table["triggered"].sum()) == summ["triggers"]
+        assert summ["release_time"] == pytest.approx(60.0 - summ["triggers"])
+
+
+def test_open_loop_never_touches_the_meter_and_backstepping_updates_every_period(runs):
+    assert runs["open"][2]["plan_changes"] == 0
+    assert np.all(runs["open"][0].periods["u"] == 0)
+    assert runs["backstepping"][2]["triggers"] == 60
+    assert runs["etc"][2]["triggers"] < 60
+    assert runs["etc"][2]["plan_changes"] <= runs["backstepping"][2]["plan_changes"]
+
+
+def test_same_seed_same_numbers(scenario, runs):
+    again = _short(scenario, "etc")
+    first = runs["etc"][0]
+    np.testing.assert_array_equal(again.micro, first.micro)
+    np.testing.assert_array_equal(again.periods["u"], first.periods["u"])
+
+
+def test_free_flow_with_a_pde_controller_is_refused_before_sumo_starts(tmp_path, capsys):
+    text = DEFAULT.read_text().replace(
+        "[equilibrium]\nrho_h_veh_km = 80.8154\nrho_a_veh_km = 41.2363",
+        "[equilibrium]\nrho_h_veh_km = 20\nrho_a_veh_km = 10")
+    path = tmp_path / "free.toml"
+    path.write_text(text)
+    sc = load_scenario(path)
+    with pytest.raises(ScenarioError, match=r"lambda_4 = .* >= 0 \(free flow\)"):
+        run_cosimulation(sc, RunSettings(controller="etc"), sumo_config_of(sc), PAPER_DESIGN)
+    t0 = time.perf_counter()
+    assert main(["run", str(path), "--quiet", "--out", str(tmp_path / "out")]) == 2
+    assert time.perf_counter() - t0 < 5                  # no SUMO run happened
+    assert "free flow" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_run_killed_halfway_leaves_no_complete_results(tmp_path):
+    out = tmp_path / "killed"
+    proc = subprocess.Popen([sys.executable, "-m", "arzsumo.cli", "run", str(DEFAULT),
+                             "--out", str(out), "--horizon", "300"],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                            start_new_session=True)
+    deadline = time.time() + 60
+    seen = b""
+    while time.time() < deadline and b"20.0%" not in seen:   # well inside the SUMO run
+        seen += proc.stderr.read1(256) if proc.stderr else b""
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait(timeout=30)
+    assert not out.exists()
+    assert not any((p / "summary.json").exists() for p in tmp_path.iterdir() if p.is_dir())
