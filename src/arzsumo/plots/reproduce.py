@@ -71,12 +71,13 @@ def penetration_figure(pen: Sequence[float], ours_trig: Sequence[float],
     return fig
 
 
-def sensitivity_figure(sweeps: Mapping[str, tuple[np.ndarray, np.ndarray, np.ndarray]]
-                       ) -> Figure:
+def sensitivity_figure(sweeps: Mapping[str, tuple[np.ndarray, np.ndarray, np.ndarray]],
+                       paper_values: Mapping[str, float] | None = None) -> Figure:
     """Release time and Lyapunov convergence time (s) per design parameter value.
 
     ``sweeps`` maps a parameter name to (values, release times, Lyapunov times); an
-    infinite Lyapunov time (never converged) is drawn at the top edge.
+    infinite Lyapunov time (never converged) is left out. ``paper_values`` marks the
+    paper's value of each parameter with a dotted line.
     """
     fig, axes = plt.subplots(1, max(1, len(sweeps)), figsize=(4 * max(1, len(sweeps)), 3.6),
                              squeeze=False)
@@ -91,6 +92,9 @@ def sensitivity_figure(sweeps: Mapping[str, tuple[np.ndarray, np.ndarray, np.nda
         top = max([v for v in lyap if math.isfinite(v)] + [1.0])
         ax2.set_ylim(0, 1.3 * top)
         ax.set_ylim(0, 1.15 * max(max(rel), 1.0))
+        if paper_values and par in paper_values:
+            ax.axvline(paper_values[par], color="0.5", ls=":", lw=1)
+            ax.text(paper_values[par], 5, " paper", color="0.4", fontsize=8)
         ax.grid(alpha=0.3)
     fig.suptitle("Sensitivity of the ETC to its design parameters")
     fig.tight_layout()
@@ -134,5 +138,9 @@ def write_reproduce_plots(rep, out: str | Path) -> list[Path]:
             if rows:
                 sweeps[par] = tuple(np.array([r[k] for r in rows], float)
                                     for k in ("value", "release_time_s", "lyapunov_time_s"))
-        written.append(_save(sensitivity_figure(sweeps), out / "sensitivity.png"))
+        from arzsumo.control.etc import PAPER_DESIGN
+
+        written.append(_save(sensitivity_figure(
+            sweeps, {p: float(getattr(PAPER_DESIGN, p)) for p in sweeps}),
+            out / "sensitivity.png"))
     return written

@@ -72,7 +72,9 @@ def _cell(v: Any) -> str:
             return "-"
         if math.isinf(v):
             return "never"
-        return f"{v:.2f}" if abs(v) < 1000 else f"{v:.0f}"
+        if v.is_integer():
+            return str(int(v))
+        return f"{v:.3g}" if abs(v) < 0.1 else f"{v:.2f}"
     if v == REPRODUCED:
         return "yes"
     if v == NOT_REPRODUCED:
