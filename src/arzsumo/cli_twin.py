@@ -72,7 +72,8 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     from arzsumo.twin.reproduce_output import write_reproduction
 
     rep = reproduce(args.scenarios, quick=args.quick, only=args.only or None,
-                    workers=args.workers)
+                    workers=args.workers,
+                    twin={"scheme": args.scheme} if args.scheme else None)
     out = Path(args.out) if args.out else Path("results") / "reproduce"
     write_reproduction(rep, out, plots=not args.no_plots)
     cl = claims(rep)
@@ -112,6 +113,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="directory of the section 5 scenario files (default scenarios/paper)")
     r.add_argument("--only", metavar="NAME", nargs="*",
                    help="run only these scenario names")
+    r.add_argument("--scheme", choices=("first", "muscl"),
+                   help="override every scenario's [twin] scheme (files: first order)")
     r.add_argument("--workers", type=int, default=1,
                    help="processes (default 1; results do not depend on it)")
     r.add_argument("--no-plots", action="store_true", help="skip the PNG figures")

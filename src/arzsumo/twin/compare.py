@@ -360,14 +360,18 @@ def claims(rep: Reproduction) -> list[Claim]:
             _verdict(ok), "" if ok else "the gains stay below 1 %"))
     pairs = [(g(f"{c}_backstepping"), g(f"{c}_etc")) for c in ("base", "s12", "aggressive")]
     pairs = [(b, e) for b, e in pairs if b and e]
-    if pairs:
-        ok = all(e.relative("total", "J_discom") > b.relative("total", "J_discom")
-                 for b, e in pairs)  # type: ignore[union-attr]
+    values = [(e.relative("total", "J_discom"), b.relative("total", "J_discom"))  # type: ignore
+              for b, e in pairs]
+    finite = [(e, b) for e, b in values if math.isfinite(e) and math.isfinite(b)]
+    if finite:
+        ok = all(e > b for e, b in finite)
+        why = "" if ok else "in one spacing case ETC is the more comfortable"
+        if len(finite) < len(values):
+            why = (why + "; " if why else "") + (
+                f"{len(values) - len(finite)} case(s) without a baseline (open loop stopped "
+                "early) left out")
         out.append(Claim(
             "ETC brings more discomfort than backstepping (piecewise-constant input)",
             "J_discom -41.07 vs -48.86 % (15), -71.17 vs -74.27 % (12), -26.46 vs -73.63 % (8)",
-            ", ".join(f"{e.relative('total', 'J_discom'):.1f} vs "  # type: ignore[union-attr]
-                      f"{b.relative('total', 'J_discom'):.1f} %"  # type: ignore[union-attr]
-                      for b, e in pairs), _verdict(ok),
-            "" if ok else "in one spacing case ETC is the more comfortable"))
+            ", ".join(f"{e:.1f} vs {b:.1f} %" for e, b in values), _verdict(ok), why))
     return out + sensitivity_claims(rep)

@@ -104,6 +104,7 @@ class Reproduction:
     source: str
     workers: int = 1
     scenarios: tuple[str, ...] = field(default_factory=tuple)
+    overrides: dict[str, Any] = field(default_factory=dict)
 
     def get(self, name: str) -> RunRecord | None:
         """The record called ``name`` (a scenario name, or ``name[parameter=value]``)."""
@@ -170,8 +171,9 @@ def load_experiments(directory: str | Path = DEFAULT_DIR) -> list[Scenario]:
 
 
 def plan(scenarios: Sequence[Scenario], *, quick: bool = False,
-         only: Sequence[str] | None = None) -> list[_Task]:
-    """Expand sweeps, apply ``quick`` and group tasks that share an open loop."""
+         only: Sequence[str] | None = None,
+         twin: Mapping[str, Any] | None = None) -> list[_Task]:
+    """Expand sweeps, apply ``quick`` and ``twin`` overrides, group tasks by open loop."""
     if only is not None:
         names = {sc.name for sc in scenarios}
         missing = sorted(set(only) - names)
@@ -182,8 +184,9 @@ def plan(scenarios: Sequence[Scenario], *, quick: bool = False,
     tasks: list[_Task] = []
     groups: dict[str, int] = {}
     for sc in scenarios:
-        if quick:
-            sc = _with(sc, twin=QUICK_TWIN)
+        changes = {**(QUICK_TWIN if quick else {}), **(twin or {})}
+        if changes:
+            sc = _with(sc, twin=changes)
         sweep = _sweep_of(sc)
         items = ([(sc, None)] if sweep is None else
                  [(_with(sc, design={sweep[0]: v}), (sweep[0], v)) for v in sweep[1]])
@@ -229,7 +232,8 @@ def _map(fn: Any, args: list[tuple], workers: int) -> list[Any]:
 
 
 def reproduce(directory: str | Path = DEFAULT_DIR, *, quick: bool = False,
-              only: Sequence[str] | None = None, workers: int | None = None) -> Reproduction:
+              only: Sequence[str] | None = None, workers: int | None = None,
+              twin: Mapping[str, Any] | None = None) -> Reproduction:
     """Run every experiment of ``directory`` (one open loop per group of controllers).
 
     Parameters
@@ -241,13 +245,16 @@ def reproduce(directory: str | Path = DEFAULT_DIR, *, quick: bool = False,
         meaningful).
     only : sequence of str, optional
         Scenario names to run (all by default).
+    twin : mapping, optional
+        ``[twin]`` keys (scenario-file names and units, e.g. ``{"scheme": "muscl"}``)
+        set in every scenario; validated like the files.
     workers : int, optional
         Processes (default: at most 2, the cores of the reference machine). Results do
         not depend on it.
     """
     start = time.perf_counter()
     scenarios = load_experiments(directory)
-    tasks = plan(scenarios, quick=quick, only=only)
+    tasks = plan(scenarios, quick=quick, only=only, twin=twin)
     workers = min(2, os.cpu_count() or 1) if workers is None else max(1, int(workers))
     first: dict[int, int] = {}                 # group -> index of its first task
     for i, task in enumerate(tasks):
@@ -266,4 +273,4 @@ def reproduce(directory: str | Path = DEFAULT_DIR, *, quick: bool = False,
             records[i] = opens[g][3]
     return Reproduction(tuple(r for r in records if r is not None), len(opens), quick,
                         time.perf_counter() - start, str(directory), workers,
-                        tuple(sc.name for sc in scenarios))
+                        tuple(sc.name for sc in scenarios), dict(twin or {}))

@@ -116,6 +116,9 @@ def report_markdown(rep: Reproduction) -> str:
     pen, ev, sens = penetration_table(rep), events_table(rep), sensitivity_table(rep)
     cl = claims(rep)
     n_ok = sum(c.verdict == REPRODUCED for c in cl)
+    stopped = [f"{r.name}: {r.summary['open_loop_baseline']}" for r in rep.records
+               if not r.summary["complete"]
+               or str(r.summary["open_loop_baseline"]).startswith("no comparison")]
     parts = [
         "# Reproduction of section 5 on the nonlinear PDE twin",
         "",
@@ -123,14 +126,20 @@ def report_markdown(rep: Reproduction) -> str:
         f"each scenario) from `{rep.source}`, {rep.wall_time:.0f} s wall time on "
         f"{rep.workers} process(es)."
         + (f" **Quick mode** ({QUICK_TWIN}): the numbers are not meaningful." if rep.quick
-           else ""),
+           else "")
+        + (f" Overrides of every `[twin]`: {rep.overrides}." if rep.overrides else ""),
         "",
         "Relative changes are against the open loop of the same scenario, in percent "
         "(negative = better). *yes* = reproduced in direction (same sign, at least "
         "0.05 % in size), **no** = not reproduced. Magnitudes are not expected to match: "
         "the paper does not give the vehicle width d (2.0 m here), the initial amplitude "
         "(2 % stop-and-go here), the aggressive case's speeds and maximum AOs; its 1/4 "
-        "profile fraction is infeasible (0.15 here); the grid is 200 first-order cells.",
+        "profile fraction is infeasible (0.15 here); the grid is 200 cells (first order "
+        "unless overridden).",
+        "",
+        ("Runs without a baseline because they or their open loop left the physical "
+         "domain (kept, marked incomplete): " + "; ".join(stopped) + "." if stopped else
+         "All runs and their open loops completed."),
         "",
         f"## Claims ({n_ok} of {len(cl)} reproduced in direction)",
         "",
