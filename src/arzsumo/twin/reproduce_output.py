@@ -95,7 +95,8 @@ def _claims_md(items: Sequence[Claim]) -> str:
     out = []
     for c in items:
         out.append(f"- **{c.verdict}** - {c.claim}. Paper: {c.paper}. Twin: {c.ours}."
-                   + (f" *Why:* {c.why}." if c.why else ""))
+                   + (f" *{'Why' if c.verdict != REPRODUCED else 'Note'}:* {c.why}."
+                      if c.why else ""))
     return "\n".join(out)
 
 
