@@ -19,7 +19,8 @@ from matplotlib.figure import Figure
 
 
 def release_instants_figure(names: Sequence[str], event_times: Sequence[np.ndarray],
-                            horizon: float, paper: Mapping[str, str] | None = None) -> Figure:
+                            release: Sequence[float], horizon: float,
+                            paper: Mapping[str, str] | None = None) -> Figure:
     """One row per run: a tick at each control update (s); the label gives the counts.
 
     Parameters
@@ -28,8 +29,10 @@ def release_instants_figure(names: Sequence[str], event_times: Sequence[np.ndarr
         Row labels (top to bottom).
     event_times : sequence of ndarray
         Update times of each run, s.
+    release : sequence of float
+        Total release time of each run, s (time without an update).
     horizon : float
-        Simulated time, s (release time = time without an update).
+        Simulated time, s.
     paper : mapping, optional
         Row label -> the paper's numbers, appended to the label.
     """
@@ -38,8 +41,8 @@ def release_instants_figure(names: Sequence[str], event_times: Sequence[np.ndarr
         y = len(names) - 1 - k
         ax.vlines(times, y - 0.35, y + 0.35, lw=0.6, color="C0")
     labels = []
-    for name, times in zip(names, event_times, strict=True):
-        text = f"{name}: {times.size} / {horizon - times.size:.0f} s"
+    for name, times, rel in zip(names, event_times, release, strict=True):
+        text = f"{name}: {times.size} / {rel:.0f} s"
         if paper and name in paper:
             text += f"  (paper {paper[name]})"
         labels.append(text)
@@ -122,7 +125,8 @@ def write_reproduce_plots(rep, out: str | Path) -> list[Path]:
                  if e.release_time is not None}
         horizon = float(runs[0].summary["final_time"])
         written.append(_save(release_instants_figure(
-            [r.name for r in runs], [r.event_times for r in runs], horizon, paper),
+            [r.name for r in runs], [r.event_times for r in runs],
+            [r.release_time for r in runs], horizon, paper),
             out / "release_instants.png"))
     pen = penetration_table(rep)
     if pen:
