@@ -297,9 +297,10 @@ def claims(rep: Reproduction) -> list[Claim]:
             "" if ok else "on the nonlinear twin the observer estimate does not converge "
             "(relative estimation error about 1 over the whole run, measured beside the run), "
             "although the same observer-ETC converges on the linear plant (final norm ratio "
-            "0.08, 189 against 148 triggers, arzsumo.control.verify); the twin's inlet "
-            "satisfies w+(0) = Q w-(0) to about 10 %, the outlet relation w-(L) = R w+(L) + "
-            "U-bar under the twin's class split is the open suspect"))
+            "0.08, 189 against 148 triggers, arzsumo.control.verify); on the twin the "
+            "boundary relations the observer assumes hold (inlet w+(0) = Q w-(0) to about "
+            "10 %, outlet w-(L) = R w+(L) + U-bar at the sampled checks), so the cause is "
+            "still open"))
     pens = _penetration_records(rep)
     if len(pens) >= 2:
         keys = sorted(pens)
