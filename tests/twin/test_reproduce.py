@@ -206,3 +206,14 @@ def test_cli_reproduce_quick(tmp_path, monkeypatch, capsys):
     assert code == 0
     assert (out / "report.md").exists() and not (out / "sensitivity.png").exists()
     assert "claims reproduced in direction" in capsys.readouterr().out
+
+
+def test_twin_overrides_reach_every_scenario_and_are_validated():
+    from arzsumo.twin.config import twin_config_from_dict
+
+    tasks = plan(load_experiments(PAPER_DIR), only=["base_etc", "linear_etc"],
+                 twin={"scheme": "muscl"})
+    for t in tasks:
+        assert twin_config_from_dict(t.scenario.raw).solver.scheme == "muscl"
+    with pytest.raises(ScenarioError, match=r"scheme = 'third' is not allowed"):
+        plan(load_experiments(PAPER_DIR), only=["base_etc"], twin={"scheme": "third"})

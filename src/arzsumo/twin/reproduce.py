@@ -186,6 +186,7 @@ def plan(scenarios: Sequence[Scenario], *, quick: bool = False,
         changes = {**(QUICK_TWIN if quick else {}), **(twin or {})}
         if changes:
             sc = _with(sc, twin=changes)
+        twin_config_from_dict(sc.raw, sc.source)          # fail before any run starts
         sweep = _sweep_of(sc)
         items = ([(sc, None)] if sweep is None else
                  [(_with(sc, design={sweep[0]: v}), (sweep[0], v)) for v in sweep[1]])
