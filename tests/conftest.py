@@ -24,6 +24,6 @@ def base_lin():
 def scenario_files():
     from pathlib import Path
 
-    files = sorted((Path(__file__).parent.parent / "scenarios").glob("*.toml"))
+    files = sorted((Path(__file__).parent.parent / "scenarios").rglob("*.toml"))
     assert files, "no scenario files shipped"
     return files

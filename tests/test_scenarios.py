@@ -29,7 +29,12 @@ def test_scenario_from_demand():
     ({"equilibrium": {"demand_h_veh_h": 9000, "demand_a_veh_h": 4000}}, DemandError,
      r"exceeds what the fundamental diagram can carry"),
     ({"equilibrium": {"rho_h_veh_km": 110, "demand_h_veh_h": 100}}, ScenarioError,
-     r"not both"),
+     r"not several"),
+    ({"equilibrium": {"penetration": 0.5}}, ScenarioError, r"total_flow_veh_h is missing"),
+    ({"equilibrium": {"total_flow_veh_h": 5000, "penetration": 1.2}}, ModelError,
+     r"penetration = 1.2 is not allowed"),
+    ({"equilibrium": {"total_flow_veh_h": 20000, "penetration": 0.5}}, DemandError,
+     r"flow = 20000 veh/h is not allowed at penetration 0.500: at most \d+ veh/h"),
     ({"equilibrium": {"v_h_kmh": 32}}, ModelError, r"v_h = 32.00 km/h disagrees"),
 ])
 def test_bad_scenarios_name_field_and_value(data, error, match):
@@ -44,6 +49,13 @@ def test_missing_and_broken_files(tmp_path):
     bad.write_text("[model\n")
     with pytest.raises(ScenarioError, match="not valid TOML"):
         load_scenario(bad)
+
+
+def test_scenario_from_flow_and_penetration():
+    sc = scenario_from_dict({"equilibrium": {"total_flow_veh_h": 5680.4733,
+                                             "penetration": 0.5}})
+    assert sc.equilibrium.q * 3600 == pytest.approx(5680.4733, rel=1e-9)
+    assert sc.equilibrium.penetration == pytest.approx(0.5)
 
 
 def test_shipped_scenarios_load(scenario_files):

@@ -1,7 +1,10 @@
-"""``arzsumo twin SCENARIO [--out DIR] [--json]``: run the nonlinear PDE twin.
+"""``arzsumo twin SCENARIO [--out DIR] [--json]``: run the nonlinear PDE twin;
+``arzsumo reproduce [--out DIR] [--quick]``: run every experiment of section 5.
 
 Registered into the main parser by :func:`register`; the work is done by
-:func:`arzsumo.twin.run.run_twin` and :func:`arzsumo.twin.output.write_run`.
+:func:`arzsumo.twin.run.run_twin` and :func:`arzsumo.twin.output.write_run`, and by
+:func:`arzsumo.twin.reproduce.reproduce` and
+:func:`arzsumo.twin.reproduce_output.write_reproduction`.
 Exit codes: 0 completed, 3 stopped early (state left the physical domain; the partial
 results are written and marked ``"complete": false``), 2 user error.
 """
@@ -63,6 +66,30 @@ def _print(s: dict, out: Path) -> None:
     print(f"  written to {out}/")
 
 
+def cmd_reproduce(args: argparse.Namespace) -> int:
+    from arzsumo.twin.compare import REPRODUCED, claims
+    from arzsumo.twin.reproduce import reproduce
+    from arzsumo.twin.reproduce_output import write_reproduction
+
+    rep = reproduce(args.scenarios, quick=args.quick, only=args.only or None,
+                    workers=args.workers,
+                    twin={"scheme": args.scheme} if args.scheme else None)
+    out = Path(args.out) if args.out else Path("results") / "reproduce"
+    write_reproduction(rep, out, plots=not args.no_plots)
+    cl = claims(rep)
+    print(f"reproduce: {len(rep.records)} runs, {rep.open_loops} open loops, "
+          f"{rep.wall_time:.1f} s{' (quick)' if rep.quick else ''}")
+    for c in cl:
+        mark = "yes" if c.verdict == REPRODUCED else "NO "
+        print(f"  [{mark}] {c.claim}: {c.ours}")
+    print(f"  {sum(c.verdict == REPRODUCED for c in cl)} of {len(cl)} claims reproduced in "
+          f"direction; report in {out}/report.md")
+    incomplete = [r.name for r in rep.records if not r.summary["complete"]]
+    if incomplete:
+        print(f"  incomplete runs: {', '.join(incomplete)}")
+    return 0 if not incomplete else EXIT_INCOMPLETE
+
+
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``twin`` subcommand to the main parser's subparsers."""
     p = subparsers.add_parser("twin", help="run the nonlinear PDE twin on a scenario")
@@ -75,3 +102,20 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--no-baseline", action="store_true",
                    help="do not run the open loop for relative changes")
     p.set_defaults(func=cmd_twin)
+
+    r = subparsers.add_parser("reproduce",
+                              help="run every experiment of section 5 and compare with the paper")
+    r.add_argument("--out", metavar="DIR",
+                   help="output directory (default results/reproduce)")
+    r.add_argument("--quick", action="store_true",
+                   help="tiny grid and horizon: a smoke test, numbers not meaningful")
+    r.add_argument("--scenarios", metavar="DIR", default="scenarios/paper",
+                   help="directory of the section 5 scenario files (default scenarios/paper)")
+    r.add_argument("--only", metavar="NAME", nargs="*",
+                   help="run only these scenario names")
+    r.add_argument("--scheme", choices=("first", "muscl"),
+                   help="override every scenario's [twin] scheme (files: first order)")
+    r.add_argument("--workers", type=int, default=1,
+                   help="processes (default 1; results do not depend on it)")
+    r.add_argument("--no-plots", action="store_true", help="skip the PNG figures")
+    r.set_defaults(func=cmd_reproduce)

@@ -30,6 +30,7 @@ from arzsumo.control.etc import PAPER_DESIGN, EtcDesign
 from arzsumo.errors import ArzsumoError, ScenarioError
 from arzsumo.model.equilibrium import (
     Equilibrium,
+    equilibrium_at_penetration,
     equilibrium_from_demand,
     equilibrium_from_densities,
 )
@@ -65,12 +66,15 @@ EQUILIBRIUM_KEYS: dict[str, Callable[[float], Any]] = {
     "v_a_kmh": kmh_to_ms,
     "demand_h_veh_h": veh_h_to_veh_s,
     "demand_a_veh_h": veh_h_to_veh_s,
+    "total_flow_veh_h": veh_h_to_veh_s,
+    "penetration": _si,
 }
 
 #: Tables parsed elsewhere: [twin] and [initial] by arzsumo.twin.config, [sumo] by
-#: arzsumo.sumo.config, [run] by arzsumo.bridge.config; [design] below.
-TOP_KEYS = {"name", "description", "model", "equilibrium", "twin", "initial", "design", "sumo",
-            "run"}
+#: arzsumo.sumo.config, [run] by arzsumo.bridge.config, [sweep] (parameter, values) by
+#: arzsumo.twin.reproduce (design sensitivity); [design] below.
+TOP_KEYS = {"name", "description", "model", "equilibrium", "twin", "initial", "design",
+            "sumo", "run", "sweep"}
 
 #: ETC design keys of the [design] table (dimensionless or SI as in the paper, section 5)
 DESIGN_KEYS = {"zeta", "sigma", "eta", "A", "B", "varsigma", "mu", "m0"}
@@ -126,10 +130,21 @@ def scenario_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scena
     si = {k: EQUILIBRIUM_KEYS[k](_number(eqt, k, where)) for k in eqt if k != "branch"}
     has_demand = "demand_h_veh_h" in si or "demand_a_veh_h" in si
     has_density = "rho_h_veh_km" in si or "rho_a_veh_km" in si
-    if has_demand and has_density:
-        raise ScenarioError(f"{where}: give either densities (rho_*_veh_km) or demands "
-                            "(demand_*_veh_h), not both")
-    if has_demand:
+    has_mix = "total_flow_veh_h" in si or "penetration" in si
+    if has_demand + has_density + has_mix > 1:
+        raise ScenarioError(f"{where}: give either densities (rho_*_veh_km), demands "
+                            "(demand_*_veh_h) or total_flow_veh_h and penetration, not "
+                            "several")
+    if has_mix:
+        for key in ("total_flow_veh_h", "penetration"):
+            if key not in si:
+                raise ScenarioError(f"{where}: {key} is missing (total_flow_veh_h and "
+                                    "penetration go together)")
+        if "v_h_kmh" in si or "v_a_kmh" in si:
+            raise ScenarioError(f"{where}: speeds follow from the flow; remove v_*_kmh")
+        eq = equilibrium_at_penetration(params, si["total_flow_veh_h"], si["penetration"],
+                                        branch=str(eqt.get("branch", "congested")))
+    elif has_demand:
         if "v_h_kmh" in si or "v_a_kmh" in si:
             raise ScenarioError(f"{where}: speeds follow from demands; remove v_*_kmh")
         for key in ("demand_h_veh_h", "demand_a_veh_h"):
@@ -139,7 +154,7 @@ def scenario_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scena
                                      branch=str(eqt.get("branch", "congested")))
     else:
         if "branch" in eqt:
-            raise ScenarioError(f"{where}: branch applies to demands only")
+            raise ScenarioError(f"{where}: branch applies to demands and flows only")
         rho_h = si.get("rho_h_veh_km", preset.rho_h)
         rho_a = si.get("rho_a_veh_km", preset.rho_a)
         eq = equilibrium_from_densities(params, rho_h, rho_a, v_h=si.get("v_h_kmh"),

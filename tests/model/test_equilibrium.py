@@ -4,6 +4,7 @@ import pytest
 from arzsumo.errors import DemandError, ModelError
 from arzsumo.model import (
     ModelParameters,
+    equilibrium_at_penetration,
     equilibrium_from_demand,
     equilibrium_from_densities,
     linearize,
@@ -66,3 +67,33 @@ def test_stated_speeds_must_match_the_fundamental_diagram():
 def test_bad_densities_are_named(rho_h, rho_a, match):
     with pytest.raises(ModelError, match=match):
         equilibrium_from_densities(P, rho_h, rho_a)
+
+
+@pytest.mark.parametrize("penetration", [0.44, 0.47, 0.50, 0.53])
+@pytest.mark.parametrize("branch", ["congested", "free"])
+def test_penetration_helper_keeps_the_inflow_and_hits_the_share(penetration, branch):
+    base = equilibrium_from_densities(P, 0.110, 0.095)
+    eq = equilibrium_at_penetration(P, base.q, penetration, branch)
+    assert eq.q == pytest.approx(base.q, rel=1e-10)
+    assert eq.penetration == pytest.approx(penetration, rel=1e-12)
+    assert linearize(eq).regime == ("congested" if branch == "congested" else "free")
+    again = equilibrium_from_demand(P, eq.q_h, eq.q_a, branch)
+    assert (again.rho_h, again.rho_a) == pytest.approx((eq.rho_h, eq.rho_a), rel=1e-8)
+
+
+def test_penetration_helper_recovers_the_base_case():
+    base = equilibrium_from_densities(P, 0.110, 0.095)
+    eq = equilibrium_at_penetration(P, base.q, base.penetration)
+    assert (eq.rho_h, eq.rho_a) == pytest.approx((0.110, 0.095), rel=1e-9)
+
+
+@pytest.mark.parametrize(("q", "pen", "error", "match"), [
+    (veh_h_to_veh_s(20000), 0.5, DemandError, r"flow = 20000 veh/h .* at most \d+ veh/h"),
+    (-1.0, 0.5, DemandError, r"flow = -1.0 is not allowed"),
+    (1.0, 0.0, ModelError, r"penetration = 0.0 is not allowed: a fraction strictly"),
+    (1.0, 0.5, ModelError, r"branch = 'jam' is not allowed"),
+])
+def test_penetration_helper_errors(q, pen, error, match):
+    branch = "jam" if "branch" in match else "congested"
+    with pytest.raises(error, match=match):
+        equilibrium_at_penetration(P, q, pen, branch)

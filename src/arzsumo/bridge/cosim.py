@@ -78,7 +78,7 @@ def fill_speeds(params: ModelParameters, rho_h: np.ndarray, v_h: np.ndarray,
 
 
 def to_twin_grid(params: ModelParameters, data: CellData, x_twin: np.ndarray,
-                 ao_limit: float = 0.95) -> tuple[np.ndarray, float]:
+                 ao_limit: float = 0.9) -> tuple[np.ndarray, float]:
     """Micro cell data interpolated to the twin's cells, made admissible for the model.
 
     Densities are scaled down where the calibrated model could not hold them (AO above
@@ -303,7 +303,7 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
                              horizon=cfg.horizon, control_period=cfg.control_period)
         inlet = MeasuredInlet(eq, lin, settings.smoothing)
         inlet.start(data)
-        q_out = data.outflow_h + data.outflow_a       # smoothed outflow replayed at x = L
+        q_out = q_nom         # smoothed outflow replayed at x = L, from the nominal plan's
         x_twin = (np.arange(settings.twin_cells) + 0.5) * params.length / settings.twin_cells
         start_fields, removed = to_twin_grid(params, data, x_twin)
         if removed > 0.5:
@@ -329,11 +329,12 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
             t_rel = data.t - t0
             c0 = time.perf_counter()
             u = ctrl.check(state)
+            c1 = time.perf_counter()
+            timings["controller"] += c1 - c0
             ref_state = twins["reference"].stepper.macro_state() \
                 if twins["reference"].stopped_at is None else None
             u_ref = ref_ctrl.check(ref_state) if ref_state is not None else 0.0
-            c1 = time.perf_counter()
-            timings["controller"] += c1 - c0
+            timings["twins"] += time.perf_counter() - c1
             green = (meter.command_outflow(q_nom + u) if settings.controller != "open"
                      else meter.green_share)
             last = ctrl.log

@@ -11,6 +11,7 @@ from arzsumo.model.characteristic import (
 )
 from arzsumo.model.equilibrium import (
     Equilibrium,
+    equilibrium_at_penetration,
     equilibrium_from_demand,
     equilibrium_from_densities,
 )
@@ -26,6 +27,7 @@ __all__ = [
     "Preset",
     "area_occupancy",
     "characteristic_speeds",
+    "equilibrium_at_penetration",
     "equilibrium_from_demand",
     "equilibrium_from_densities",
     "equilibrium_speeds",

@@ -183,6 +183,60 @@ def _max_total_flow(params: ModelParameters, hv_share: float) -> float:
     return lo
 
 
+def _mix_flow(params: ModelParameters, rho: float, penetration: float) -> float:
+    """Total equilibrium flow (veh/s) at total density ``rho`` (veh/m) and AV share."""
+    rho_h, rho_a = (1.0 - penetration) * rho, penetration * rho
+    ve_h, ve_a = equilibrium_speeds(params, rho_h, rho_a)
+    return float(rho_h * ve_h + rho_a * ve_a)
+
+
+def equilibrium_at_penetration(params: ModelParameters, q: float, penetration: float,
+                               branch: Branch = "congested") -> Equilibrium:
+    """The equilibrium carrying total flow ``q`` (veh/s) with AV density share ``penetration``.
+
+    The penetration rate of section 5 ("Experiments with different AV penetration rates",
+    table diffpene) is rho_a* / (rho_h* + rho_a*); the paper keeps "the equilibrium inflow
+    the same" while it varies. With rho_h = (1 - p) rho and rho_a = p rho the total flow
+    Q(rho) = rho_h Ve_h(AO) + rho_a Ve_a(AO) is zero at rho = 0 and at AO = AO_max and
+    has one maximum in between (the capacity at this mix); the congested branch is the
+    root of Q(rho) = q above the maximiser, the free branch the one below.
+
+    Parameters
+    ----------
+    params : ModelParameters
+    q : float
+        Total equilibrium flow q_h* + q_a*, veh/s (> 0).
+    penetration : float
+        AV share of the density, in (0, 1).
+    branch : {"congested", "free"}
+
+    Raises
+    ------
+    DemandError
+        ``q`` exceeds the capacity at this mix (the message gives the capacity in veh/h).
+    """
+    require(math.isfinite(q) and q > 0, "flow", q, "a flow greater than 0 veh/s",
+            DemandError)
+    require(math.isfinite(penetration) and 0.0 < penetration < 1.0, "penetration",
+            penetration, "a fraction strictly between 0 and 1")
+    require(branch in ("congested", "free"), "branch", branch, "'congested' or 'free'")
+    per_veh_area = ((1.0 - penetration) * params.area_h + penetration * params.area_a) \
+        / params.road_width                                    # AO per unit total density
+    rho_max = params.ao_max / per_veh_area * (1.0 - 1e-12)
+    res = minimize_scalar(lambda r: -_mix_flow(params, r, penetration), bounds=(0.0, rho_max),
+                          method="bounded", options={"xatol": 1e-12})
+    rho_cap, q_cap = float(res.x), float(-res.fun)
+    if q > q_cap:
+        raise DemandError(
+            f"flow = {veh_s_to_veh_h(q):.0f} veh/h is not allowed at penetration "
+            f"{penetration:.3f}: at most {veh_s_to_veh_h(q_cap):.0f} veh/h (the capacity "
+            "at this mix)")
+    lo, hi = (rho_cap, rho_max) if branch == "congested" else (1e-12, rho_cap)
+    rho = rho_cap if q == q_cap else brentq(
+        lambda r: _mix_flow(params, r, penetration) - q, lo, hi, xtol=1e-15, rtol=1e-14)
+    return Equilibrium(params, (1.0 - penetration) * rho, penetration * rho)
+
+
 def flows(params: ModelParameters, rho_h: np.ndarray, rho_a: np.ndarray) -> tuple[np.ndarray, ...]:
     """Equilibrium class flows (veh/s) at the given densities (veh/m)."""
     ve_h, ve_a = equilibrium_speeds(params, rho_h, rho_a)

@@ -6,7 +6,7 @@ This is the library function behind ``arzsumo twin``; it writes nothing.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -122,17 +122,37 @@ def run_twin(scenario: Scenario, config: TwinConfig | None = None, *,
     init = initial_fields(cfg.initial, eq, x)
     res = simulate(eq, init, controller=ctrl, options=cfg.solver)
     perf = performance(eq.params, res.t, res.x, res.fields)
-    base, base_status = None, "not run"
-    if ctrl.name == "open":
-        base_status = "this run is the open loop"
-    elif baseline:
-        open_res = simulate(eq, init, options=cfg.solver)
-        base_status = open_res.status
-        if open_res.complete and res.complete:
-            base = performance(eq.params, open_res.t, open_res.x, open_res.fields)
-        else:                 # indices over different horizons are not comparable
-            base_status = f"no comparison: open loop {open_res.status}; run {res.status}"
     log = ctrl.log
     mask = events(res.control_t, res.control_u, log.triggered if log.t else None)
-    return TwinRun(scenario, cfg, res, perf, deviation_norm(eq, res.x, res.fields), mask, base,
-                   base_status)
+    run = TwinRun(scenario, cfg, res, perf, deviation_norm(eq, res.x, res.fields), mask, None)
+    if ctrl.name == "open":
+        return replace(run, baseline_status="this run is the open loop")
+    if not baseline:
+        return run
+    open_res = simulate(eq, init, options=cfg.solver)
+    open_perf = performance(eq.params, open_res.t, open_res.x, open_res.fields)
+    return compare_to_open_loop(run, open_perf, open_res.complete, open_res.status)
+
+
+def compare_to_open_loop(run: TwinRun, open_loop: Performance, complete: bool,
+                         status: str) -> TwinRun:
+    """``run`` with the indices of the open loop of the same scenario as its baseline.
+
+    Parameters
+    ----------
+    run : TwinRun
+        A controlled run.
+    open_loop : Performance
+        Indices of the open-loop simulation from the same initial fields and solver
+        options (the caller guarantees it; :func:`arzsumo.twin.reproduce.reproduce`
+        shares one open loop among the controllers of a scenario).
+    complete, status
+        Whether that open loop completed, and its status message. Indices over
+        different horizons are not comparable, so an incomplete run on either side
+        gives no baseline.
+    """
+    res = run.result
+    if complete and res.complete:
+        return replace(run, baseline=open_loop, baseline_status=status)
+    return replace(run, baseline=None,
+                   baseline_status=f"no comparison: open loop {status}; run {res.status}")
