@@ -149,29 +149,36 @@ class MeasuredInlet:
 
 @dataclass
 class Twin:
-    """One twin run alongside SUMO, and whether (and when) it stopped."""
+    """One twin run alongside SUMO.
+
+    When a step would leave the model's physical domain (SUMO can hold area occupancies the
+    calibrated fundamental diagram cannot), the twin is re-synchronised to the aggregated
+    micro state of that period and goes on; every re-synchronisation is counted, and the
+    period it happens in is excluded from the fidelity measures (NaN fields).
+    """
 
     mode: str
     stepper: TwinStepper
     controller: Controller | None = None
-    u: float = 0.0
-    stopped_at: float | None = None
-    reason: str = ""
-    control_t: list[float] = field(default_factory=list)
-    control_u: list[float] = field(default_factory=list)
+    resyncs: list[float] = field(default_factory=list)
+    reasons: list[str] = field(default_factory=list)
+    _fresh: bool = False
 
-    def advance(self, t: float, u: float) -> None:
-        if self.stopped_at is not None:
-            return
+    def advance(self, t: float, u: float, resync: np.ndarray) -> None:
+        self._fresh = False
         try:
             self.stepper.advance(t, u)
         except TwinStoppedError as exc:
-            self.stopped_at, self.reason = t, str(exc)
-            log.warning("%s twin stopped at t = %.1f s: %s", self.mode, t, exc)
+            self.resyncs.append(t)
+            self.reasons.append(str(exc))
+            log.debug("%s twin re-synchronised at t = %.1f s: %s", self.mode, t, exc)
+            self.stepper.set_state(resync)
+            self.stepper.t = t
+            self._fresh = True
 
     def sample(self, x: np.ndarray) -> np.ndarray:
-        """Fields at positions x (4, len(x)); NaN once stopped."""
-        if self.stopped_at is not None:
+        """Fields at positions x (4, len(x)); NaN in a period that ended in a re-sync."""
+        if self._fresh:
             return np.full((4, x.size), np.nan)
         f = self.stepper.primitive()
         return np.vstack([np.interp(x, self.stepper.x, row) for row in f])
@@ -196,7 +203,7 @@ class CoSimResult:
     reference_log: Any
     meter: dict[str, float]
     report: RunReport | None
-    twin_status: dict[str, str]
+    twin_status: dict[str, Any]
     placement: str
     wall_time: float
     timings: dict[str, float]
@@ -331,9 +338,7 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
             u = ctrl.check(state)
             c1 = time.perf_counter()
             timings["controller"] += c1 - c0
-            ref_state = twins["reference"].stepper.macro_state() \
-                if twins["reference"].stopped_at is None else None
-            u_ref = ref_ctrl.check(ref_state) if ref_state is not None else 0.0
+            u_ref = ref_ctrl.check(twins["reference"].stepper.macro_state())
             timings["twins"] += time.perf_counter() - c1
             green = (meter.command_outflow(q_nom + u) if settings.controller != "open"
                      else meter.green_share)
@@ -369,8 +374,9 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
             t_next = data.t - t0
             q_out += (1.0 - math.exp(-cfg.control_period / settings.smoothing)) * (
                 data.outflow_h + data.outflow_a - q_out)
-            twins["replay"].advance(t_next, q_out - eq.q)
-            twins["reference"].advance(t_next, u_ref)
+            resync, _ = to_twin_grid(params, data, x_twin)
+            twins["replay"].advance(t_next, q_out - eq.q, resync)
+            twins["reference"].advance(t_next, u_ref, resync)
             timings["twins"] += time.perf_counter() - tw0
             for key, value in (("green_running", meter.green_share),
                                ("light_changes", meter.light_changes),
@@ -391,8 +397,9 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
     bar.close()
     # the row of the last check has no following period: drop it from per-period columns
     periods = {k: np.asarray(v[:len(times)], float) for k, v in rows.items()}
-    status = {mode: ("complete" if tw.stopped_at is None else
-                     f"stopped at t = {tw.stopped_at:.0f} s: {tw.reason}")
+    status = {mode: {"resyncs": len(tw.resyncs), "first_resync_s": (tw.resyncs[0] if tw.resyncs
+                                                                  else None),
+                     "first_reason": tw.reasons[0] if tw.reasons else ""}
               for mode, tw in twins.items()}
     timings["sumo_step"] -= timings["measure_actuate"]
     return CoSimResult(scenario, settings, cfg, eq, q_nom, np.asarray(times), xm,
