@@ -13,7 +13,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 
-from arzsumo.io import atomic_file
+from arzsumo.plots import save_png
 from arzsumo.units import ms_to_kmh, veh_m_to_veh_km, veh_s_to_veh_h
 
 _LABEL = {"h": ("HVs", 0), "a": ("AVs", 2)}
@@ -86,10 +86,7 @@ def signals_figure(t: np.ndarray, u: np.ndarray, u_cont: np.ndarray, events: np.
 
 
 def _save(fig: Figure, path: Path) -> Path:
-    with atomic_file(path) as tmp:
-        fig.savefig(tmp, dpi=100, format="png")
-    plt.close(fig)
-    return path
+    return save_png(fig, path, dpi=100)
 
 
 def write_bridge_plots(res, out: str | Path) -> list[Path]:

@@ -17,6 +17,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 
+from arzsumo.plots import save_png
+
 
 def release_instants_figure(names: Sequence[str], event_times: Sequence[np.ndarray],
                             release: Sequence[float], horizon: float,
@@ -105,9 +107,7 @@ def sensitivity_figure(sweeps: Mapping[str, tuple[np.ndarray, np.ndarray, np.nda
 
 
 def _save(fig: Figure, path: Path) -> Path:
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_png(fig, path, dpi=120)
 
 
 def write_reproduce_plots(rep, out: str | Path) -> list[Path]:

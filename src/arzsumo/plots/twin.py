@@ -13,7 +13,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 
-from arzsumo.io import atomic_file
+from arzsumo.plots import save_png
 from arzsumo.units import ms_to_kmh, veh_m_to_veh_km, veh_s_to_veh_h
 
 _CLASS = {"h": ("HVs", 0), "a": ("AVs", 2)}
@@ -99,10 +99,7 @@ def control_figure(control_t: np.ndarray, u_applied: np.ndarray, events: np.ndar
 
 
 def _save(fig: Figure, path: Path) -> Path:
-    with atomic_file(path) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
-    plt.close(fig)
-    return path
+    return save_png(fig, path, dpi=110)
 
 
 def write_twin_plots(run, out: str | Path) -> list[Path]:
