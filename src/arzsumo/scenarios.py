@@ -106,6 +106,15 @@ def _check_keys(table: Mapping[str, Any], allowed: set[str], where: str) -> None
                                 f"{', '.join(sorted(allowed))}")
 
 
+def scenario_table(data: Mapping[str, Any], name: str, allowed: set[str],
+                   source: str) -> dict[str, Any]:
+    """The ``[name]`` table of a parsed scenario (empty if absent), keys checked against
+    ``allowed``; the error names the file, the table and the key."""
+    table = _section(data, name, source)
+    _check_keys(table, allowed, f"{source} [{name}]")
+    return table
+
+
 def _number(table: Mapping[str, Any], key: str, where: str) -> float:
     value = table[key]
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):

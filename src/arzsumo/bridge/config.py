@@ -26,6 +26,7 @@ from dataclasses import asdict, dataclass
 from typing import Any
 
 from arzsumo.errors import ScenarioError, require
+from arzsumo.units import veh_h_to_veh_s
 
 CONTROLLERS = ("open", "backstepping", "etc", "observer-etc", "alinea")
 RUN_KEYS = {"controller", "warmup_s", "start", "equilibrium", "kernel_cells", "twin_cells",
@@ -77,25 +78,22 @@ class RunSettings:
 def run_settings_from_dict(data: Mapping[str, Any], source: str = "<dict>",
                            **overrides: Any) -> RunSettings:
     """Parse the ``[run]`` table of a parsed scenario mapping; ``overrides`` win."""
-    table = data.get("run", {})
+    from arzsumo.scenarios import scenario_table
+
+    table = scenario_table(data, "run", RUN_KEYS, source)
     where = f"{source} [run]"
-    if not isinstance(table, Mapping):
-        raise ScenarioError(f"{where} must be a table, got {table!r}")
-    for key in table:
-        if key not in RUN_KEYS:
-            raise ScenarioError(f"{where}: unknown key {key!r}; allowed: "
-                                f"{', '.join(sorted(RUN_KEYS))}")
-    conv = {"warmup_s": ("warmup", 1.0), "smoothing_s": ("smoothing", 1.0),
-            "alinea_target": ("alinea_target", 1.0),
-            "alinea_gain_veh_h_per_pct": ("alinea_gain", 100.0 / 3600.0),
-            "alinea_saturation_veh_h": ("alinea_saturation", 1.0 / 3600.0)}
+    # per % of occupancy -> per unit occupancy is the factor 100
+    conv = {"warmup_s": ("warmup", float), "smoothing_s": ("smoothing", float),
+            "alinea_target": ("alinea_target", float),
+            "alinea_gain_veh_h_per_pct": ("alinea_gain", lambda v: veh_h_to_veh_s(100 * v)),
+            "alinea_saturation_veh_h": ("alinea_saturation", veh_h_to_veh_s)}
     values: dict[str, Any] = {}
     for key, value in table.items():
         if key in conv:
             if isinstance(value, bool) or not isinstance(value, int | float):
                 raise ScenarioError(f"{where}: {key} = {value!r} is not allowed: a number")
-            name, factor = conv[key]
-            values[name] = float(value) * factor
+            name, to_si = conv[key]
+            values[name] = float(to_si(value))
         elif key in ("kernel_cells", "twin_cells"):
             if isinstance(value, bool) or not isinstance(value, int):
                 raise ScenarioError(f"{where}: {key} = {value!r} is not allowed: an integer")

@@ -26,6 +26,7 @@ from __future__ import annotations
 import logging
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -164,7 +165,7 @@ class Twin:
     reasons: list[str] = field(default_factory=list)
     _fresh: bool = False
 
-    def advance(self, t: float, u: float, resync: np.ndarray) -> None:
+    def advance(self, t: float, u: float, resync: Callable[[], np.ndarray]) -> None:
         self._fresh = False
         try:
             self.stepper.advance(t, u)
@@ -172,7 +173,7 @@ class Twin:
             self.resyncs.append(t)
             self.reasons.append(str(exc))
             log.debug("%s twin re-synchronised at t = %.1f s: %s", self.mode, t, exc)
-            self.stepper.set_state(resync)
+            self.stepper.set_state(resync())
             self.stepper.t = t
             self._fresh = True
 
@@ -374,7 +375,9 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
             t_next = data.t - t0
             q_out += (1.0 - math.exp(-cfg.control_period / settings.smoothing)) * (
                 data.outflow_h + data.outflow_a - q_out)
-            resync, _ = to_twin_grid(params, data, x_twin)
+            def resync(d: CellData = data) -> np.ndarray:
+                return to_twin_grid(params, d, x_twin)[0]
+
             twins["replay"].advance(t_next, q_out - eq.q, resync)
             twins["reference"].advance(t_next, u_ref, resync)
             timings["twins"] += time.perf_counter() - tw0

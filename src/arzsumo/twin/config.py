@@ -96,14 +96,9 @@ class TwinConfig:
 
 
 def _table(data: Mapping[str, Any], name: str, allowed: set[str], where: str) -> dict:
-    value = data.get(name, {})
-    if not isinstance(value, dict):
-        raise ScenarioError(f"{where}: [{name}] must be a table, got {value!r}")
-    for key in value:
-        if key not in allowed:
-            raise ScenarioError(f"{where} [{name}]: unknown key {key!r}; allowed: "
-                                f"{', '.join(sorted(allowed))}")
-    return dict(value)
+    from arzsumo.scenarios import scenario_table
+
+    return scenario_table(data, name, allowed, where)
 
 
 def _num(table: Mapping[str, Any], key: str, where: str) -> float:
