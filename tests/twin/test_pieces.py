@@ -163,6 +163,31 @@ def test_initial_profiles(base_eq):
         initial_fields(InitialCondition("array", fields=(x[:50],) * 4), eq, x)
 
 
+def test_random_wave_is_seeded_smooth_and_keeps_stop_and_go_signs(base_eq):
+    eq = base_eq
+    x = cell_centres(1000.0, 200)
+    amp = (0.02, -0.03, 0.02, -0.03)
+    star = np.array([eq.rho_h, eq.v_h, eq.rho_a, eq.v_a])[:, None]
+
+    def rel(seed: int) -> np.ndarray:
+        ic = InitialCondition("random", amplitude=amp, modes=3, seed=seed)
+        return initial_fields(ic, eq, x) / star - 1.0
+
+    a, b, c = rel(1), rel(1), rel(2)
+    np.testing.assert_array_equal(a, b)                         # same seed, same wave
+    assert np.max(np.abs(a[0] - c[0])) > 1e-3                   # another seed, another wave
+    np.testing.assert_allclose(np.max(np.abs(a), axis=1), np.abs(amp), rtol=1e-12)
+    np.testing.assert_allclose(a[1], -1.5 * a[0], atol=1e-15)   # dense where slow
+    # at most 3 periods over the road: the shape lies in the span of modes 1..3 to 1e-12
+    s = x / 1000.0
+    basis = np.concatenate([np.sin(2 * np.pi * m * s)[None] for m in (1, 2, 3)]
+                           + [np.cos(2 * np.pi * m * s)[None] for m in (1, 2, 3)])
+    coef, *_ = np.linalg.lstsq(basis.T, a[0], rcond=None)
+    assert np.max(np.abs(basis.T @ coef - a[0])) < 1e-12
+    with pytest.raises(ModelError, match="modes = 0 is not allowed"):
+        InitialCondition("random", modes=0)
+
+
 def test_domain_violation_names_variable_position(base_eq):
     p = base_eq.params
     x = cell_centres(1000.0, 4)

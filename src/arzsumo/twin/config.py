@@ -15,7 +15,7 @@ Example::
     u_max_veh_h = 2000
     controller = "open"         # a name registered in arzsumo.twin.controllers
     constant_u_veh_h = 0        # for controller = "constant"
-    seed = 0                    # recorded in outputs; the twin itself is deterministic
+    seed = 0                    # draws the [initial] kind = "random" wave; else recorded only
     kernel_cells = 200          # grid of the backstepping kernels (PDE controllers)
 
     [design]                    # ETC design (defaults: the paper's section 5 values)
@@ -29,6 +29,7 @@ Example::
     wavenumber = 2              # periods over the road (one number or four)
     phase_rad = 0
     fraction = 0.25             # nonrecurrent / linear: the paper's 1/4
+    modes = 3                   # random: highest mode of the seeded wave
 
 Loading checks the shape (known keys, types) and then the meaning (the dataclasses
 validate themselves); errors name the key, the value and what is allowed.
@@ -54,7 +55,7 @@ DEFAULT_AMPLITUDE = (0.05, -0.05, 0.05, -0.05)
 TWIN_KEYS = {"cells", "scheme", "flux", "limiter", "cfl", "horizon_s", "control_period_s",
              "output_period_s", "u_min_veh_h", "u_max_veh_h", "controller",
              "constant_u_veh_h", "seed", "max_steps", "kernel_cells"}
-INITIAL_KEYS = {"kind", "amplitude", "wavenumber", "phase_rad", "fraction"}
+INITIAL_KEYS = {"kind", "amplitude", "wavenumber", "phase_rad", "fraction", "modes"}
 
 
 @dataclass(frozen=True)
@@ -92,7 +93,9 @@ class TwinConfig:
                 "design": asdict(self.design), "initial": {"kind": self.initial.kind,
                                                "amplitude": list(self.initial.amplitude),
                                                "wavenumber": list(self.initial.wavenumber),
-                                               "phase": list(self.initial.phase)}}
+                                               "phase": list(self.initial.phase),
+                                               "modes": self.initial.modes,
+                                               "seed": self.initial.seed}}
 
 
 def _table(data: Mapping[str, Any], name: str, allowed: set[str], where: str) -> dict:
@@ -174,11 +177,18 @@ def twin_config_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Tw
             ic_args["wavenumber"] = _four(ini, "wavenumber", where_i)
         if "phase_rad" in ini:
             ic_args["phase"] = _four(ini, "phase_rad", where_i)
-        extra = {"fraction"} & set(ini)
+        extra = {"fraction", "modes"} & set(ini)
+    elif kind == "random":
+        ic_args["amplitude"] = (_four(ini, "amplitude", where_i) if "amplitude" in ini
+                                else DEFAULT_AMPLITUDE)
+        ic_args["seed"] = seed
+        if "modes" in ini:
+            ic_args["modes"] = _int(ini, "modes", where_i)
+        extra = {"fraction", "wavenumber", "phase_rad"} & set(ini)
     else:
         if kind in ("nonrecurrent", "linear"):
             ic_args["amplitude"] = _num(ini, "fraction", where_i) if "fraction" in ini else 0.25
-        extra = {"amplitude", "wavenumber", "phase_rad"} & set(ini)
+        extra = {"amplitude", "wavenumber", "phase_rad", "modes"} & set(ini)
         if kind == "equilibrium":
             extra |= {"fraction"} & set(ini)
     if extra:

@@ -20,6 +20,12 @@ Kinds
     density at the inlet, against the inlet condition). We implement the evident intent,
     a perturbation growing linearly from zero at x = 0 to a fraction f of the equilibrium
     at x = L: rho_i* (1 + f x / L), v_i* (1 - f x / L), f = 1/4 by default.
+``random``
+    A seeded stop-and-go wave: one random smooth shape g(x) = sum_m c_m sin(2 pi m x / L +
+    phi_m) over modes m = 1..M, normalised to max |g| = 1, then z_k* (1 + A_k g(x)). The
+    amplitudes keep the sinusoid's sign structure (dense where slow); the seed draws the
+    coefficients c_m ~ N(0, 1/m) and phases phi_m ~ U(0, 2 pi). Gives sweeps over seeds a
+    spread of initial waves where the paper's profiles are deterministic.
 ``array``
     Arbitrary fields (e.g. aggregated SUMO data) given as arrays on the cell centres.
 
@@ -40,7 +46,7 @@ from arzsumo.errors import ModelError, require
 from arzsumo.model.equilibrium import Equilibrium
 from arzsumo.twin.state import domain_violation, to_conserved
 
-KINDS = ("equilibrium", "sinusoid", "nonrecurrent", "linear", "array")
+KINDS = ("equilibrium", "sinusoid", "nonrecurrent", "linear", "random", "array")
 
 
 def _four(name: str, value: object) -> tuple[float, ...]:
@@ -64,6 +70,10 @@ class InitialCondition:
         ``sinusoid``: periods over the road n_k, dimensionless.
     phase : float or 4 floats
         ``sinusoid``: phases phi_k, rad.
+    modes : int
+        ``random``: highest mode M (periods over the road).
+    seed : int
+        ``random``: seed of the random shape.
     fields : tuple of 4 arrays, optional
         ``array``: (rho_h veh/m, v_h m/s, rho_a veh/m, v_a m/s) on the cell centres.
     """
@@ -72,6 +82,8 @@ class InitialCondition:
     amplitude: tuple[float, ...] = (0.1, -0.1, 0.1, -0.1)
     wavenumber: tuple[float, ...] = (2.0, 2.0, 2.0, 2.0)
     phase: tuple[float, ...] = (0.0, 0.0, 0.0, 0.0)
+    modes: int = 3
+    seed: int = 0
     fields: tuple[np.ndarray, ...] | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
@@ -83,6 +95,10 @@ class InitialCondition:
             require(self.fields is not None and len(self.fields) == 4, "fields",
                     None if self.fields is None else len(self.fields),
                     "4 arrays (rho_h, v_h, rho_a, v_a) for kind 'array'")
+        require(isinstance(self.modes, int) and not isinstance(self.modes, bool)
+                and 1 <= self.modes <= 64, "modes", self.modes, "an integer in 1..64")
+        require(isinstance(self.seed, int) and not isinstance(self.seed, bool)
+                and self.seed >= 0, "seed", self.seed, "an integer >= 0")
         if self.kind in ("nonrecurrent", "linear"):
             require(-1.0 < self.amplitude[0] < 1.0, "amplitude", self.amplitude[0],
                     "a fraction f in (-1, 1)")
@@ -101,6 +117,13 @@ def _profile(ic: InitialCondition, x: np.ndarray, length: float) -> np.ndarray:
     if ic.kind == "sinusoid":
         a, n, ph = (np.asarray(v)[:, None] for v in (ic.amplitude, ic.wavenumber, ic.phase))
         return a * np.sin(2.0 * math.pi * n * s[None, :] + ph)
+    if ic.kind == "random":
+        rng = np.random.default_rng(ic.seed)
+        m = np.arange(1, ic.modes + 1, dtype=float)
+        coef = rng.normal(0.0, 1.0 / m)
+        phase = rng.uniform(0.0, 2.0 * math.pi, size=m.size)
+        g = coef @ np.sin(2.0 * math.pi * m[:, None] * s[None, :] + phase[:, None])
+        return np.asarray(ic.amplitude)[:, None] * (g / np.max(np.abs(g)))[None, :]
     f = ic.amplitude[0]
     base = np.sin(math.pi * s) if ic.kind == "nonrecurrent" else s
     return np.stack([f * base, -f * base, f * base, -f * base])
