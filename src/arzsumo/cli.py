@@ -13,7 +13,7 @@ import logging
 import sys
 from collections.abc import Callable, Sequence
 
-from arzsumo import __version__, cli_bridge, cli_control, cli_sumo, cli_twin
+from arzsumo import __version__, cli_bridge, cli_control, cli_sumo, cli_sweep, cli_twin
 from arzsumo.errors import ArzsumoError
 from arzsumo.model import linearize
 from arzsumo.scenarios import Scenario, load_scenario, scenario_from_preset
@@ -108,6 +108,7 @@ def build_parser() -> argparse.ArgumentParser:
     cli_twin.register(sub)
     cli_sumo.register(sub)
     cli_bridge.register(sub)
+    cli_sweep.register(sub)
     return parser
 
 

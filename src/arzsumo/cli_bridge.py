@@ -7,10 +7,6 @@ import json
 import logging
 from pathlib import Path
 
-import numpy as np
-
-from arzsumo.errors import ScenarioError
-
 log = logging.getLogger("arzsumo")
 
 #: the default scenario of ``arzsumo run`` (and ``make run``)
@@ -18,41 +14,18 @@ DEFAULT_SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "default.
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from arzsumo.bridge.config import run_settings_from_dict
-    from arzsumo.bridge.cosim import run_cosimulation
     from arzsumo.bridge.outputs import write_results
-    from arzsumo.scenarios import design_from_dict, load_scenario
-    from arzsumo.sumo.config import sumo_config_of
+    from arzsumo.bridge.session import run_in_sumo
+    from arzsumo.scenarios import load_scenario
 
     path = Path(args.scenario) if args.scenario else DEFAULT_SCENARIO
     sc = load_scenario(path)
-    raw = sc.raw
-    settings = run_settings_from_dict(raw, sc.source, controller=args.controller)
-    cfg = sumo_config_of(sc)
-    if args.seed is not None:
-        if args.seed < 0:
-            raise ScenarioError(f"--seed = {args.seed} is not allowed: an integer >= 0")
-        cfg = cfg.with_(seed=args.seed)
-    if args.horizon is not None:
-        cfg = cfg.with_(horizon=args.horizon)
-    design = design_from_dict(raw, sc.source)
-    initial = None
-    if settings.start == "placement":
-        from arzsumo.twin.config import twin_config_from_dict
-        from arzsumo.twin.initial import initial_fields
-
-        n = round(sc.params.length / cfg.cell_length)
-        xc = (np.arange(n) + 0.5) * cfg.cell_length
-        initial = initial_fields(twin_config_from_dict(raw, sc.source).initial,
-                                 sc.equilibrium, xc)
+    session = run_in_sumo(sc, controller=args.controller, seed=args.seed,
+                          horizon=args.horizon, progress=not args.quiet)
     out = Path(args.out) if args.out else Path("results") / (
-        f"{sc.name}-{settings.controller}-seed{cfg.seed}")
-    res = run_cosimulation(sc, settings, cfg, design, initial_fields=initial,
-                           progress=not args.quiet)
-    text = path.read_text(encoding="utf-8") + "\n# resolved settings of this run\n" + \
-        "\n".join(f"# {k} = {v!r}" for k, v in settings.as_dict().items()) + \
-        f"\n# sumo = {cfg!r}\n"
-    out, summ = write_results(res, out, text, plots=not args.no_plots)
+        f"{sc.name}-{session.settings.controller}-seed{session.sumo.seed}")
+    text = path.read_text(encoding="utf-8") + session.resolved_comment()
+    out, summ = write_results(session.result, out, text, plots=not args.no_plots)
     if args.json:
         from arzsumo.twin.output import json_safe
 

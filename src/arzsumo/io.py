@@ -1,13 +1,17 @@
-"""Atomic file and directory writes: results appear complete or not at all."""
+"""Atomic file and directory writes (results appear complete or not at all), and TOML out."""
 
 from __future__ import annotations
 
 import contextlib
+import json
+import math
 import os
+import re
 import shutil
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from pathlib import Path
+from typing import Any
 
 
 @contextlib.contextmanager
@@ -48,3 +52,46 @@ def atomic_dir(path: str | os.PathLike[str]) -> Iterator[Path]:
     finally:
         if tmp.exists():
             shutil.rmtree(tmp, ignore_errors=True)
+
+
+_BARE_KEY = re.compile(r"^[A-Za-z0-9_-]+$")
+
+
+def _toml_key(key: str) -> str:
+    return key if _BARE_KEY.match(key) else json.dumps(key)
+
+
+def _toml_value(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if math.isnan(value):
+            return "nan"
+        if math.isinf(value):
+            return "inf" if value > 0 else "-inf"
+        return repr(value)
+    if isinstance(value, str):
+        return json.dumps(value)  # JSON string escapes are valid TOML basic-string escapes
+    if isinstance(value, list | tuple):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    if isinstance(value, Mapping):
+        return "{" + ", ".join(f"{_toml_key(k)} = {_toml_value(v)}"
+                               for k, v in value.items()) + "}"
+    raise TypeError(f"cannot write {type(value).__name__} {value!r} as TOML")
+
+
+def dump_toml(data: Mapping[str, Any]) -> str:
+    """TOML text of ``data`` (scalars, lists and nested tables), read back by ``tomllib``
+    to the same mapping; used for the resolved scenario of every result."""
+    def table(prefix: str, body: Mapping[str, Any]) -> list[str]:
+        lines = [f"{_toml_key(k)} = {_toml_value(v)}" for k, v in body.items()
+                 if not isinstance(v, Mapping)]
+        for k, v in body.items():
+            if isinstance(v, Mapping):
+                name = f"{prefix}.{_toml_key(k)}" if prefix else _toml_key(k)
+                lines += ["", f"[{name}]", *table(name, v)]
+        return lines
+
+    return "\n".join(table("", data)).lstrip("\n") + "\n"

@@ -170,7 +170,7 @@ def test_random_wave_is_seeded_smooth_and_keeps_stop_and_go_signs(base_eq):
     star = np.array([eq.rho_h, eq.v_h, eq.rho_a, eq.v_a])[:, None]
 
     def rel(seed: int) -> np.ndarray:
-        ic = InitialCondition("random", amplitude=amp, modes=3, seed=seed)
+        ic = InitialCondition("random", amplitude=amp, wavenumber=3, seed=seed)
         return initial_fields(ic, eq, x) / star - 1.0
 
     a, b, c = rel(1), rel(1), rel(2)
@@ -184,8 +184,8 @@ def test_random_wave_is_seeded_smooth_and_keeps_stop_and_go_signs(base_eq):
                            + [np.cos(2 * np.pi * m * s)[None] for m in (1, 2, 3)])
     coef, *_ = np.linalg.lstsq(basis.T, a[0], rcond=None)
     assert np.max(np.abs(basis.T @ coef - a[0])) < 1e-12
-    with pytest.raises(ModelError, match="modes = 0 is not allowed"):
-        InitialCondition("random", modes=0)
+    with pytest.raises(ModelError, match=r"wavenumber = 2\.5 is not allowed: an integer"):
+        InitialCondition("random", wavenumber=2.5)
 
 
 def test_domain_violation_names_variable_position(base_eq):

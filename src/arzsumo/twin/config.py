@@ -26,10 +26,9 @@ Example::
     [initial]
     kind = "sinusoid"           # equilibrium, sinusoid, nonrecurrent, linear
     amplitude = [0.05, -0.05, 0.05, -0.05]   # fractions of (rho_h*, v_h*, rho_a*, v_a*)
-    wavenumber = 2              # periods over the road (one number or four)
+    wavenumber = 2              # periods over the road (one number or four); random: highest mode
     phase_rad = 0
     fraction = 0.25             # nonrecurrent / linear: the paper's 1/4
-    modes = 3                   # random: highest mode of the seeded wave
 
 Loading checks the shape (known keys, types) and then the meaning (the dataclasses
 validate themselves); errors name the key, the value and what is allowed.
@@ -55,7 +54,7 @@ DEFAULT_AMPLITUDE = (0.05, -0.05, 0.05, -0.05)
 TWIN_KEYS = {"cells", "scheme", "flux", "limiter", "cfl", "horizon_s", "control_period_s",
              "output_period_s", "u_min_veh_h", "u_max_veh_h", "controller",
              "constant_u_veh_h", "seed", "max_steps", "kernel_cells"}
-INITIAL_KEYS = {"kind", "amplitude", "wavenumber", "phase_rad", "fraction", "modes"}
+INITIAL_KEYS = {"kind", "amplitude", "wavenumber", "phase_rad", "fraction"}
 
 
 @dataclass(frozen=True)
@@ -94,7 +93,6 @@ class TwinConfig:
                                                "amplitude": list(self.initial.amplitude),
                                                "wavenumber": list(self.initial.wavenumber),
                                                "phase": list(self.initial.phase),
-                                               "modes": self.initial.modes,
                                                "seed": self.initial.seed}}
 
 
@@ -177,18 +175,18 @@ def twin_config_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Tw
             ic_args["wavenumber"] = _four(ini, "wavenumber", where_i)
         if "phase_rad" in ini:
             ic_args["phase"] = _four(ini, "phase_rad", where_i)
-        extra = {"fraction", "modes"} & set(ini)
+        extra = {"fraction"} & set(ini)
     elif kind == "random":
         ic_args["amplitude"] = (_four(ini, "amplitude", where_i) if "amplitude" in ini
                                 else DEFAULT_AMPLITUDE)
         ic_args["seed"] = seed
-        if "modes" in ini:
-            ic_args["modes"] = _int(ini, "modes", where_i)
-        extra = {"fraction", "wavenumber", "phase_rad"} & set(ini)
+        if "wavenumber" in ini:
+            ic_args["wavenumber"] = _four(ini, "wavenumber", where_i)
+        extra = {"fraction", "phase_rad"} & set(ini)
     else:
         if kind in ("nonrecurrent", "linear"):
             ic_args["amplitude"] = _num(ini, "fraction", where_i) if "fraction" in ini else 0.25
-        extra = {"amplitude", "wavenumber", "phase_rad", "modes"} & set(ini)
+        extra = {"amplitude", "wavenumber", "phase_rad"} & set(ini)
         if kind == "equilibrium":
             extra |= {"fraction"} & set(ini)
     if extra:

@@ -22,10 +22,11 @@ Kinds
     at x = L: rho_i* (1 + f x / L), v_i* (1 - f x / L), f = 1/4 by default.
 ``random``
     A seeded stop-and-go wave: one random smooth shape g(x) = sum_m c_m sin(2 pi m x / L +
-    phi_m) over modes m = 1..M, normalised to max |g| = 1, then z_k* (1 + A_k g(x)). The
-    amplitudes keep the sinusoid's sign structure (dense where slow); the seed draws the
-    coefficients c_m ~ N(0, 1/m) and phases phi_m ~ U(0, 2 pi). Gives sweeps over seeds a
-    spread of initial waves where the paper's profiles are deterministic.
+    phi_m) over modes m = 1..M (M the wavenumber: at most M periods over the road),
+    normalised to max |g| = 1, then z_k* (1 + A_k g(x)). The amplitudes keep the
+    sinusoid's sign structure (dense where slow); the seed draws the coefficients
+    c_m ~ N(0, 1/m) and phases phi_m ~ U(0, 2 pi). Gives sweeps over seeds a spread of
+    initial waves where the paper's profiles are deterministic.
 ``array``
     Arbitrary fields (e.g. aggregated SUMO data) given as arrays on the cell centres.
 
@@ -67,11 +68,10 @@ class InitialCondition:
         ``sinusoid``: relative amplitudes of (rho_h, v_h, rho_a, v_a) (fractions of the
         equilibrium values). ``nonrecurrent`` / ``linear``: the fraction f (first entry).
     wavenumber : float or 4 floats
-        ``sinusoid``: periods over the road n_k, dimensionless.
+        ``sinusoid``: periods over the road n_k, dimensionless. ``random``: the highest
+        mode M (first entry, an integer).
     phase : float or 4 floats
         ``sinusoid``: phases phi_k, rad.
-    modes : int
-        ``random``: highest mode M (periods over the road).
     seed : int
         ``random``: seed of the random shape.
     fields : tuple of 4 arrays, optional
@@ -82,7 +82,6 @@ class InitialCondition:
     amplitude: tuple[float, ...] = (0.1, -0.1, 0.1, -0.1)
     wavenumber: tuple[float, ...] = (2.0, 2.0, 2.0, 2.0)
     phase: tuple[float, ...] = (0.0, 0.0, 0.0, 0.0)
-    modes: int = 3
     seed: int = 0
     fields: tuple[np.ndarray, ...] | None = field(default=None, repr=False)
 
@@ -95,8 +94,10 @@ class InitialCondition:
             require(self.fields is not None and len(self.fields) == 4, "fields",
                     None if self.fields is None else len(self.fields),
                     "4 arrays (rho_h, v_h, rho_a, v_a) for kind 'array'")
-        require(isinstance(self.modes, int) and not isinstance(self.modes, bool)
-                and 1 <= self.modes <= 64, "modes", self.modes, "an integer in 1..64")
+        if self.kind == "random":
+            n = self.wavenumber[0]
+            require(n == int(n) and 1 <= n <= 64, "wavenumber", n,
+                    "an integer in 1..64 (the highest mode of the random wave)")
         require(isinstance(self.seed, int) and not isinstance(self.seed, bool)
                 and self.seed >= 0, "seed", self.seed, "an integer >= 0")
         if self.kind in ("nonrecurrent", "linear"):
@@ -119,7 +120,7 @@ def _profile(ic: InitialCondition, x: np.ndarray, length: float) -> np.ndarray:
         return a * np.sin(2.0 * math.pi * n * s[None, :] + ph)
     if ic.kind == "random":
         rng = np.random.default_rng(ic.seed)
-        m = np.arange(1, ic.modes + 1, dtype=float)
+        m = np.arange(1, int(ic.wavenumber[0]) + 1, dtype=float)
         coef = rng.normal(0.0, 1.0 / m)
         phase = rng.uniform(0.0, 2.0 * math.pi, size=m.size)
         g = coef @ np.sin(2.0 * math.pi * m[:, None] * s[None, :] + phase[:, None])

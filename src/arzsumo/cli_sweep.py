@@ -1,0 +1,55 @@
+"""``arzsumo sweep SWEEP.toml [--workers N] [--scheduler ADDRESS] [--out DIR]``.
+
+Loads and validates the sweep file, calls :func:`arzsumo.sweep.run_sweep`, prints the
+counts and where the table is. Exit codes: 0 every run finished, 4 some runs were
+invalid, failed or crashed (recorded; the others completed), 2 a user error.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+EXIT_SOME_FAILED = 4
+
+
+def cmd_sweep(args: argparse.Namespace) -> int:
+    from arzsumo.sweep import load_sweep, run_sweep
+
+    spec = load_sweep(args.sweep)
+    if args.list:
+        for run in spec.runs():
+            print(run.run_id)
+        return 0
+    out = Path(args.out) if args.out else Path("results") / "sweeps" / spec.name
+    rep = run_sweep(spec, out, workers=args.workers, scheduler=args.scheduler,
+                    progress=not args.quiet, plots=not args.no_plots)
+    import pandas as pd
+
+    df = pd.read_parquet(out / "summaries.parquet")
+    bad = df[~df["status"].isin(("ok", "incomplete"))]
+    print(f"sweep {spec.name} ({spec.engine}): {rep.total} runs, {rep.skipped} already "
+          f"finished, {rep.executed} executed on {rep.backend} in {rep.wall_time:.1f} s")
+    print("  status: " + ", ".join(f"{k} {v}" for k, v in
+                                   df["status"].value_counts().sort_index().items()))
+    for _, row in bad.iterrows():
+        print(f"  {row['run_id']}: {row['status']}: {str(row['error']).splitlines()[0]}")
+    print(f"  table: {out / 'summaries.parquet'}")
+    return 0 if bad.empty else EXIT_SOME_FAILED
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add ``sweep`` to the top-level parser."""
+    p = sub.add_parser("sweep", help="run a sweep file on a process pool or a Dask cluster")
+    p.add_argument("sweep", metavar="SWEEP.toml", help="sweep file (base, engine, axes)")
+    p.add_argument("--workers", type=int,
+                   help="local processes (default: one per core); ignored with --scheduler")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="Dask scheduler address, e.g. tcp://10.0.0.5:8786")
+    p.add_argument("--out", metavar="DIR",
+                   help="output directory (default results/sweeps/<name>); a restart with "
+                        "the same directory runs only what is missing")
+    p.add_argument("--list", action="store_true", help="print the run IDs and exit")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--no-plots", action="store_true", help="skip the PNG figures")
+    p.set_defaults(func=cmd_sweep)

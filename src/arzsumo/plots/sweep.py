@@ -1,0 +1,153 @@
+"""Figures of a sweep: triggers, release time (and, in SUMO, meter plan changes) against
+each study axis, mean over seeds with one standard deviation as error bars, the paper's
+values beside them where the paper gives numbers (tables diffpene and diffdemands).
+
+Two layers: :func:`study_figure` and :func:`sensitivity_figure` take a table and return a
+Figure; :func:`write_sweep_plots` picks the figures a sweep calls for and saves them.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from matplotlib.figure import Figure
+
+from arzsumo.plots import plt, save_png
+
+LABELS = {"triggers": "triggers (control updates)", "release_time": "release time (s)",
+          "plan_changes": "meter plan changes", "penetration": "AV penetration",
+          "demand_veh_h": "total demand (veh/h)"}
+
+
+def paper_points(table: str | None) -> dict[str, dict[float, float]]:
+    """The paper's numbers for a study: metric -> {axis value: value}."""
+    from arzsumo.twin.paper_values import DIFFPENE, EVENTS
+
+    if table == "diffpene":
+        return {"release_time": {p / 100: r for p, (r, _) in DIFFPENE.items()},
+                "triggers": {p / 100: float(n) for p, (_, n) in DIFFPENE.items()}}
+    if table == "diffdemands":
+        # total demand (veh/h) of the scenario files demand_{low,medium,high}_etc
+        totals = {"demand_low_etc": 4966.0, "demand_medium_etc": 5664.0,
+                  "demand_high_etc": 6510.0}
+        rel = {totals[e.scenario]: float(e.release_time) for e in EVENTS
+               if e.scenario in totals and e.release_time is not None}
+        trg = {totals[e.scenario]: float(e.triggers) for e in EVENTS
+               if e.scenario in totals and e.triggers is not None}
+        return {"release_time": rel, "triggers": trg}
+    return {}
+
+
+def _stats(df: pd.DataFrame, x: str, metric: str) -> tuple[np.ndarray, ...]:
+    g = df.groupby(x, sort=True)[metric]
+    mean, sd, n = g.mean(), g.std(ddof=1).fillna(0.0), g.count()
+    return mean.index.to_numpy(), mean.to_numpy(float), sd.to_numpy(float), n.to_numpy()
+
+
+def _logscale(values: np.ndarray) -> bool:
+    v = np.asarray(values, float)
+    return bool(v.size > 1 and np.all(v > 0) and v.max() / v.min() > 20)
+
+
+def study_figure(df: pd.DataFrame, x: str, metrics: Sequence[str],
+                 lines: Sequence[str] = (), paper: Mapping[str, Mapping[float, float]]
+                 | None = None, title: str = "", label: str = "this sweep") -> Figure:
+    """One panel per metric against axis ``x``; one line per combination of ``lines``
+    columns (else one line called ``label``); error bars one standard deviation over the
+    remaining rows (the seeds)."""
+    fig, axes = plt.subplots(1, len(metrics), figsize=(4.2 * len(metrics), 3.6),
+                             squeeze=False)
+    groups = list(df.groupby(list(lines), sort=True)) if lines else [((), df)]
+    for ax, metric in zip(axes[0], metrics, strict=True):
+        for k, (key, part) in enumerate(groups):
+            xs, mean, sd, _ = _stats(part, x, metric)
+            label = ", ".join(f"{c}={v}" for c, v in zip(lines, np.atleast_1d(key),
+                                                         strict=False)) or label
+            ax.errorbar(xs, mean, yerr=sd, fmt="o-", capsize=3, color=f"C{k}", label=label)
+        if paper and metric in paper and paper[metric]:
+            px = np.array(sorted(paper[metric]))
+            ax.plot(px, [paper[metric][v] for v in px], "k*--", ms=9, lw=1, label="paper")
+        if _logscale(df[x].to_numpy()):
+            ax.set_xscale("log")
+        ax.set_xlabel(LABELS.get(x, x))
+        ax.set_ylabel(LABELS.get(metric, metric))
+        ax.set_ylim(bottom=0)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
+def sensitivity_figure(df: pd.DataFrame, group: str, parameters: Sequence[str],
+                       metrics: Sequence[str], marks: Mapping[str, float] | None = None,
+                       title: str = "") -> Figure:
+    """One-at-a-time study: rows are metrics, columns the varied parameters (the rows of
+    ``df`` whose ``group`` column names that parameter); ``marks`` draws a reference value
+    of each parameter (the paper's design) as a dotted line."""
+    fig, axes = plt.subplots(len(metrics), len(parameters),
+                             figsize=(4 * len(parameters), 3.0 * len(metrics)), squeeze=False)
+    for j, par in enumerate(parameters):
+        part = df[df[group] == par]
+        for i, metric in enumerate(metrics):
+            ax = axes[i, j]
+            if part.empty:
+                continue
+            xs, mean, sd, _ = _stats(part, par, metric)
+            ax.errorbar(xs.astype(float), mean, yerr=sd, fmt="o-", capsize=3)
+            if _logscale(xs):
+                ax.set_xscale("log")
+            if marks and par in marks and math.isfinite(marks[par]):
+                ax.axvline(marks[par], color="0.5", ls=":", lw=1)
+            ax.set_xlabel(par)
+            ax.set_ylabel(LABELS.get(metric, metric))
+            ax.set_ylim(bottom=0)
+            ax.grid(alpha=0.3)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
+def write_sweep_plots(df: pd.DataFrame, spec, out: str | Path) -> list[Path]:
+    """Write the figures of sweep ``spec`` from its table ``df`` into ``out``.
+
+    Finished runs only. A one-at-a-time group gives ``sensitivity.png``; otherwise the
+    first axis that is not the seed is the abscissa of ``study.png`` and the other axes
+    give one line each.
+    """
+    from arzsumo.control.etc import PAPER_DESIGN
+    from arzsumo.sweep.worker import FINISHED
+
+    out = Path(out)
+    ok = df[df["status"].isin(FINISHED)]
+    metrics = [m for m in ("triggers", "release_time", "plan_changes") if m in ok.columns
+               and ok[m].notna().any()]
+    if ok.empty or not metrics:
+        return []
+    engine = "SUMO" if spec.engine == "sumo" else "PDE twin"
+    seeds = f", mean and sd over {ok['seed'].nunique()} seeds" if "seed" in ok.columns else ""
+    written = []
+    groups = [a.group for a in spec.axes if a.group]
+    if groups:
+        group = groups[0]
+        pars = [a.name for a in spec.axes if a.group == group]
+        marks = {p: float(getattr(PAPER_DESIGN, p)) for p in pars
+                 if isinstance(getattr(PAPER_DESIGN, p, None), int | float)}
+        fig = sensitivity_figure(ok, group, pars, metrics, marks,
+                                 f"{spec.name}: {engine}{seeds}; dotted: paper's design")
+        written.append(save_png(fig, out / "sensitivity.png", dpi=120))
+        return written
+    study = [a.name for a in spec.axes if a.name != "seed"]
+    if not study:
+        return written
+    fig = study_figure(ok, study[0], metrics, lines=study[1:],
+                       paper=paper_points(spec.paper), title=f"{spec.name}: {engine}{seeds}",
+                       label=engine)
+    written.append(save_png(fig, out / "study.png", dpi=120))
+    return written

@@ -1,0 +1,15 @@
+"""Sweeps: a base scenario, an engine (twin or SUMO) and axes, run on a process pool or
+a Dask cluster, resumable and failure-isolated, summarised in one tidy table.
+
+``spec`` reads sweep files, ``worker`` runs one run anywhere, ``driver`` schedules and
+stores, ``table`` builds the table.
+"""
+
+from arzsumo.sweep.driver import SweepReport, run_sweep
+from arzsumo.sweep.spec import RunSpec, SweepError, SweepSpec, load_sweep, sweep_from_dict
+from arzsumo.sweep.table import comparable, sweep_table
+from arzsumo.sweep.worker import RunOutcome, RunTask, execute
+
+__all__ = ["RunOutcome", "RunSpec", "RunTask", "SweepError", "SweepReport", "SweepSpec",
+           "comparable", "execute", "load_sweep", "run_sweep", "sweep_from_dict",
+           "sweep_table"]

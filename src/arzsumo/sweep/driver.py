@@ -1,0 +1,268 @@
+"""Run a sweep: skip finished runs, execute the rest on a process pool or a Dask cluster,
+write each outcome as it arrives, then the tidy table, the plots and a manifest.
+
+Layout of the output directory::
+
+    sweep.toml            the sweep file as given
+    sweep.json            manifest: version, engine, counts, one entry per invocation
+    summaries.parquet     one row per run (:mod:`arzsumo.sweep.table`)
+    executions.jsonl      one line per finished execution (run ID, execution ID, status)
+    runs/<run_id>/        scenario.toml (resolved), summary.json and tables, or error.json
+    plots/*.png
+
+Each run directory is written atomically, so a sweep killed at any moment leaves only
+whole runs; a restart executes exactly the runs without a current result. Both backends
+call the same :func:`arzsumo.sweep.worker.execute`.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import json
+import logging
+import multiprocessing
+import os
+import time
+import uuid
+from collections import Counter, deque
+from collections.abc import Callable, Iterable
+from concurrent.futures.process import BrokenProcessPool
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from arzsumo import __version__
+from arzsumo.io import atomic_dir, atomic_file
+from arzsumo.progress import Progress
+from arzsumo.sweep.spec import RunSpec, SweepError, SweepSpec
+from arzsumo.sweep.table import read_record, run_dir, sweep_table
+from arzsumo.sweep.worker import FINISHED, RunOutcome, RunTask, crashed, execute
+
+log = logging.getLogger(__name__)
+
+OnDone = Callable[[RunOutcome], None]
+
+
+@dataclass
+class SweepReport:
+    """What one invocation of a sweep did."""
+
+    name: str
+    out: Path
+    backend: str
+    total: int
+    skipped: int
+    executed: int
+    statuses: dict[str, int] = field(default_factory=dict)
+    wall_time: float = 0.0
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"name": self.name, "backend": self.backend, "total": self.total,
+                "skipped": self.skipped, "executed": self.executed,
+                "statuses": self.statuses, "wall_time": self.wall_time,
+                "version": __version__, "finished": time.time()}
+
+
+def task_of(spec: SweepSpec, run: RunSpec) -> RunTask:
+    """The picklable task of one run."""
+    return RunTask(run.run_id, spec.engine, dict(run.scenario), f"{spec.source} run "
+                   f"{run.run_id}", spec.baseline, run.sha256)
+
+
+def write_outcome(out: Path, run: RunSpec, outcome: RunOutcome) -> None:
+    """Store one outcome atomically under ``runs/<run_id>`` and log its execution."""
+    record = {"run_id": run.run_id, "index": run.index, "columns": dict(run.columns),
+              "overrides": dict(run.overrides), "sha256": run.sha256, "engine": run.engine,
+              "status": outcome.status, "execution": outcome.execution}
+    with atomic_dir(run_dir(out, run)) as tmp:
+        (tmp / "scenario.toml").write_text(
+            f"# run {run.run_id} of a sweep: the resolved scenario\n"
+            + outcome.scenario_toml, encoding="utf-8")
+        if outcome.status in FINISHED and outcome.summary is not None:
+            doc = {**outcome.summary, "sweep": record}
+            (tmp / "summary.json").write_text(json.dumps(doc, indent=2) + "\n",
+                                              encoding="utf-8")
+            for name, blob in outcome.tables.items():
+                (tmp / name).write_bytes(blob)
+        else:
+            doc = {"error": outcome.error, "sweep": record}
+            (tmp / "error.json").write_text(json.dumps(doc, indent=2) + "\n",
+                                            encoding="utf-8")
+    line = json.dumps({"run_id": run.run_id, "execution": outcome.execution.get("id"),
+                       "status": outcome.status})
+    with open(out / "executions.jsonl", "a", encoding="utf-8") as fh:
+        fh.write(line + "\n")
+
+
+# -- backends ------------------------------------------------------------------------------
+def run_local(tasks: Iterable[RunTask], workers: int, on_done: OnDone) -> None:
+    """Execute ``tasks`` on ``workers`` fresh processes (spawned: libsumo holds one
+    simulation per process and must not inherit a parent's state).
+
+    At most ``workers`` tasks are in flight, so when a process dies (a crash in SUMO, the
+    OOM killer) the suspects are known: each is run again alone, and the one that kills
+    its process again is recorded as ``crashed``; the sweep goes on.
+    """
+    ctx = multiprocessing.get_context("spawn")
+    queue = deque(tasks)
+    while queue:
+        suspects: list[RunTask] = []
+        with cf.ProcessPoolExecutor(max_workers=max(1, min(workers, len(queue))),
+                                    mp_context=ctx) as pool:
+            running: dict[cf.Future[RunOutcome], RunTask] = {}
+            while (queue or running) and not suspects:
+                while queue and len(running) < workers:
+                    task = queue.popleft()
+                    running[pool.submit(execute, task)] = task
+                done, _ = cf.wait(running, return_when=cf.FIRST_COMPLETED)
+                for fut in done:
+                    task = running.pop(fut)
+                    try:
+                        on_done(fut.result())
+                    except BrokenProcessPool:
+                        suspects.append(task)
+            suspects += list(running.values())
+        for task in suspects:
+            log.warning("run %s: a worker process died; running it again alone", task.run_id)
+            with cf.ProcessPoolExecutor(max_workers=1, mp_context=ctx) as alone:
+                try:
+                    on_done(alone.submit(execute, task).result())
+                except BrokenProcessPool:
+                    on_done(crashed(task, "the worker process died (twice, the second time "
+                                          "running this run alone)"))
+
+
+def run_dask(tasks: list[RunTask], address: str, on_done: OnDone, one_thread: bool) -> None:
+    """Execute ``tasks`` on the Dask cluster whose scheduler is at ``address``.
+
+    A run whose worker dies is retried by Dask on another worker; after Dask gives up
+    (``KilledWorker``) it is recorded as ``crashed``. ``one_thread`` refuses workers with
+    more than one thread (libsumo: one simulation per process).
+    """
+    from distributed import Client, as_completed
+    from distributed.scheduler import KilledWorker
+
+    try:
+        client = Client(address, timeout="15s")
+    except (OSError, TimeoutError) as exc:
+        raise SweepError(f"--scheduler = {address!r}: cannot reach a Dask scheduler there "
+                         f"({exc})") from None
+    with client:
+        if one_thread:
+            wide = {w: n for w, n in client.nthreads().items() if n > 1}
+            if wide:
+                raise SweepError(f"--scheduler = {address!r}: workers {', '.join(wide)} run "
+                                 f"{max(wide.values())} threads; SUMO runs need one "
+                                 "simulation per process: start them with --nthreads 1")
+        futures = {}
+        for task in tasks:
+            fut = client.submit(execute, task, pure=False,
+                                key=f"arzsumo-{task.run_id}-{uuid.uuid4().hex[:8]}")
+            futures[fut.key] = (fut, task)
+        for fut in as_completed([f for f, _ in futures.values()]):
+            task = futures[fut.key][1]
+            try:
+                outcome = fut.result()
+            except KilledWorker as exc:
+                outcome = crashed(task, f"Dask gave up after its workers died: {exc}")
+            except Exception as exc:  # a worker that cannot import or unpickle arzsumo
+                outcome = crashed(task, f"{type(exc).__name__} on the worker: {exc}")
+            on_done(outcome)
+
+
+# -- the sweep -----------------------------------------------------------------------------
+def _finished(out: Path, run: RunSpec) -> bool:
+    found = read_record(out, run)
+    return found is not None and found[0] in FINISHED
+
+
+def default_workers() -> int:
+    """One process per core (libsumo: one simulation per process)."""
+    return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
+               else (os.cpu_count() or 1))
+
+
+def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
+              scheduler: str | None = None, progress: bool = True,
+              plots: bool = True) -> SweepReport:
+    """Execute the runs of ``spec`` that have no current result under ``out``; then write
+    the table, plots and manifest.
+
+    Parameters
+    ----------
+    spec : SweepSpec
+    out : path
+        Output directory (created; reused by a restart).
+    workers : int, optional
+        Processes of the local pool (default: one per core). Ignored with ``scheduler``.
+    scheduler : str, optional
+        Address of a Dask scheduler (``tcp://host:8786``) to run on instead.
+    """
+    t0 = time.perf_counter()
+    out = Path(out)
+    runs = spec.runs()
+    if workers is not None and workers < 1:
+        raise SweepError(f"--workers = {workers} is not allowed: an integer >= 1")
+    out.mkdir(parents=True, exist_ok=True)
+    with atomic_file(out / "sweep.toml") as tmp:
+        tmp.write_text(spec.text or f"# sweep {spec.name} (built in code)\n", encoding="utf-8")
+    todo = [r for r in runs if not _finished(out, r)]
+    by_id = {r.run_id: r for r in runs}
+    backend = f"dask {scheduler}" if scheduler else \
+        f"local pool, {workers or default_workers()} processes"
+    log.info("sweep %s: %d runs, %d finished before, %d to run (%s)", spec.name, len(runs),
+             len(runs) - len(todo), len(todo), backend)
+    bar = Progress(len(todo), f"sweep {spec.name}", enabled=progress and bool(todo))
+    counts: Counter[str] = Counter()
+
+    def on_done(outcome: RunOutcome) -> None:
+        write_outcome(out, by_id[outcome.run_id], outcome)
+        counts[outcome.status] += 1
+        if outcome.status not in FINISHED:
+            first = (outcome.error or "").splitlines()[0] if outcome.error else ""
+            log.warning("run %s: %s: %s", outcome.run_id, outcome.status, first)
+        bar.update(sum(counts.values()))
+
+    tasks = [task_of(spec, r) for r in todo]
+    try:
+        if tasks and scheduler:
+            run_dask(tasks, scheduler, on_done, one_thread=spec.engine == "sumo")
+        elif tasks:
+            run_local(tasks, workers or default_workers(), on_done)
+    finally:
+        bar.close()
+    report = SweepReport(spec.name, out, backend, len(runs), len(runs) - len(todo),
+                         sum(counts.values()), dict(counts), time.perf_counter() - t0)
+    finish(spec, out, runs, report, plots)
+    return report
+
+
+def finish(spec: SweepSpec, out: Path, runs: list[RunSpec], report: SweepReport,
+           plots: bool) -> None:
+    """Write the table, the plots and the manifest of a sweep whose runs are done."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    df = sweep_table(runs, out)
+    with atomic_file(out / "summaries.parquet") as tmp:
+        pq.write_table(pa.Table.from_pandas(df, preserve_index=False), tmp)
+    if plots:
+        from arzsumo.plots.sweep import write_sweep_plots
+
+        write_sweep_plots(df, spec, out / "plots")
+    manifest_path = out / "sweep.json"
+    history: list[dict[str, Any]] = []
+    if manifest_path.is_file():
+        try:
+            history = json.loads(manifest_path.read_text(encoding="utf-8")).get(
+                "invocations", [])
+        except (OSError, json.JSONDecodeError):
+            history = []
+    manifest = {"name": spec.name, "description": spec.description, "engine": spec.engine,
+                "base": str(spec.base), "version": __version__, "runs": len(runs),
+                "statuses": {str(k): int(v) for k, v in df["status"].value_counts().items()},
+                "axes": [{"name": a.name, "field": a.field, "group": a.group,
+                          "values": list(a.values)} for a in spec.axes],
+                "invocations": [*history, report.as_dict()]}
+    with atomic_file(manifest_path) as tmp:
+        tmp.write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")

@@ -1,0 +1,354 @@
+"""Sweep files: a base scenario, an engine and axes, expanded into runs with stable IDs.
+
+Example (``scenarios/sweeps/penetration_twin.toml``)::
+
+    name = "penetration_twin"
+    base = "../paper/penetration_44_etc.toml"   # relative to the sweep file
+    engine = "twin"                              # or "sumo"
+    seeds = [1, 2, 3]                            # the engine's seed: [twin] or [sumo] seed
+    paper = "diffpene"                           # paper values drawn on the plots
+
+    [set]                                        # changed in every run
+    initial.kind = "random"
+
+    [[axis]]                                     # one field per value
+    field = "equilibrium.penetration"
+    values = [0.44, 0.47, 0.50, 0.53]
+
+    [[axis]]                                     # several fields per value
+    name = "demand_veh_h"
+    values = [4966, 5664]
+    set = [{ "sumo.demand_h_veh_h" = 3461, "sumo.demand_a_veh_h" = 1505 },
+           { "sumo.demand_h_veh_h" = 4104, "sumo.demand_a_veh_h" = 1560 }]
+
+Axes multiply, in file order, seeds last. Axes that share a ``group`` are varied one at
+a time instead (a sensitivity study: the group's column names the varied axis, the other
+axes of the group keep their base value). A field is ``table.key`` of a scenario file
+(``model``, ``equilibrium``, ``twin``, ``initial``, ``design``, ``sumo``, ``run``), in the
+units its key names. Each run's ID is built from its axis values
+(``penetration=0.44,seed=1``), so it does not depend on the order of the runs or on the
+machine; the SHA-256 of the resolved scenario tells a finished run from a stale one.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import itertools
+import json
+import math
+import re
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from arzsumo.errors import ScenarioError
+
+ENGINES = ("twin", "sumo")
+#: the engine's seed field, set by the ``seeds`` key
+SEED_FIELD = {"twin": "twin.seed", "sumo": "sumo.seed"}
+#: paper tables that the plots can draw beside a sweep
+PAPER_TABLES = ("diffpene", "diffdemands", "sensitivity")
+SWEEP_KEYS = {"name", "description", "base", "engine", "seeds", "paper", "baseline", "set",
+              "axis"}
+AXIS_KEYS = {"field", "name", "values", "set", "group"}
+Scalar = bool | int | float | str
+
+
+class SweepError(ScenarioError):
+    """An invalid sweep file, key or value."""
+
+
+def scenario_fields() -> dict[str, set[str]]:
+    """The keys each scenario table accepts (what a sweep may change)."""
+    from arzsumo.bridge.config import RUN_KEYS
+    from arzsumo.scenarios import DESIGN_KEYS, EQUILIBRIUM_KEYS, MODEL_KEYS
+    from arzsumo.sumo.config import SUMO_KEYS
+    from arzsumo.twin.config import INITIAL_KEYS, TWIN_KEYS
+
+    return {"model": set(MODEL_KEYS) | {"preset"},
+            "equilibrium": set(EQUILIBRIUM_KEYS) | {"branch"},
+            "twin": set(TWIN_KEYS), "initial": set(INITIAL_KEYS), "design": set(DESIGN_KEYS),
+            "sumo": set(SUMO_KEYS), "run": set(RUN_KEYS)}
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One axis: a column ``name`` and, per value, the fields it sets."""
+
+    name: str
+    values: tuple[Scalar, ...]
+    sets: tuple[Mapping[str, Any], ...]
+    field: str | None = None
+    group: str | None = None
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """One run of a sweep: its ID, axis values (table columns) and resolved scenario."""
+
+    run_id: str
+    index: int
+    columns: Mapping[str, Scalar | None]
+    overrides: Mapping[str, Any]
+    scenario: Mapping[str, Any]
+    engine: str
+    baseline: bool
+
+    @property
+    def sha256(self) -> str:
+        """Fingerprint of everything that decides the run's numbers."""
+        blob = json.dumps({"engine": self.engine, "baseline": self.baseline,
+                           "scenario": self.scenario}, sort_keys=True, default=str)
+        return hashlib.sha256(blob.encode()).hexdigest()
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """A validated sweep file."""
+
+    name: str
+    description: str
+    engine: str
+    base: Path
+    base_data: Mapping[str, Any] = field(repr=False)
+    fixed: Mapping[str, Any]
+    axes: tuple[Axis, ...]
+    paper: str | None = None
+    baseline: bool = False
+    source: str = "<dict>"
+    text: str = field(default="", repr=False)
+
+    @property
+    def replicate(self) -> str | None:
+        """The column of seeds (error bars in the plots), if the sweep has one."""
+        return "seed" if any(a.name == "seed" for a in self.axes) else None
+
+    def runs(self) -> list[RunSpec]:
+        """Every run of the sweep, in a stable order (axes in file order, seeds last)."""
+        base = _apply(self.base_data, self.fixed)
+        factors = [_levels(group, base) for group in _factors(self.axes)]
+        runs: list[RunSpec] = []
+        for index, combo in enumerate(itertools.product(*factors)):
+            columns: dict[str, Scalar | None] = {}
+            overrides: dict[str, Any] = {}
+            label: list[str] = []
+            for cols, sets, tag in combo:
+                columns.update(cols)
+                overrides.update(sets)
+                label.append(tag)
+            run_id = ",".join(label) or "base"
+            runs.append(RunSpec(run_id, index, columns, overrides, _apply(base, overrides),
+                                self.engine, self.baseline))
+        seen: dict[str, int] = {}
+        for r in runs:
+            if r.run_id in seen:
+                raise SweepError(f"{self.source}: runs {seen[r.run_id]} and {r.index} get the "
+                                 f"same ID {r.run_id!r}; make the axis values distinct")
+            seen[r.run_id] = r.index
+        return runs
+
+
+def _format(value: Scalar) -> str:
+    if isinstance(value, bool):
+        text = "true" if value else "false"
+    elif isinstance(value, float) and float(f"{value:g}") == value:
+        text = f"{value:g}"
+    else:
+        text = str(value)
+    return re.sub(r"[^A-Za-z0-9._+-]", "_", text)
+
+
+def _factors(axes: tuple[Axis, ...]) -> list[list[Axis]]:
+    """Axes grouped into factors of the product: a group is one factor, at its first axis."""
+    factors: list[list[Axis]] = []
+    by_group: dict[str, list[Axis]] = {}
+    for ax in axes:
+        if ax.group is None:
+            factors.append([ax])
+        elif ax.group in by_group:
+            by_group[ax.group].append(ax)
+        else:
+            by_group[ax.group] = [ax]
+            factors.append(by_group[ax.group])
+    return factors
+
+
+def _levels(group: list[Axis], base: Mapping[str, Any]
+            ) -> list[tuple[dict[str, Scalar | None], dict[str, Any], str]]:
+    """(columns, field overrides, ID part) of each level of one factor."""
+    levels = []
+    for ax in group:
+        for value, sets in zip(ax.values, ax.sets, strict=True):
+            cols: dict[str, Scalar | None] = {}
+            if ax.group is not None:
+                cols[ax.group] = ax.name
+                for other in group:
+                    if other is not ax:
+                        cols[other.name] = _get(base, other.field) if other.field else None
+            cols[ax.name] = value
+            levels.append((cols, dict(sets), f"{_format(ax.name)}={_format(value)}"))
+    return levels
+
+
+def _get(data: Mapping[str, Any], dotted: str) -> Any:
+    table, key = dotted.split(".", 1)
+    value = data.get(table, {}).get(key)
+    return value if isinstance(value, bool | int | float | str) else None
+
+
+def _apply(data: Mapping[str, Any], overrides: Mapping[str, Any]) -> dict[str, Any]:
+    out = copy.deepcopy(dict(data))
+    for dotted, value in overrides.items():
+        table, key = dotted.split(".", 1)
+        out.setdefault(table, {})[key] = copy.deepcopy(value)
+    return out
+
+
+def _flat_fields(table: Any, where: str, allowed: Mapping[str, set[str]]) -> dict[str, Any]:
+    """``{"table.key": value}`` of a mapping written nested or with dotted keys; checked."""
+    if not isinstance(table, Mapping):
+        raise SweepError(f"{where} = {table!r} is not allowed: a table of scenario fields")
+    flat: dict[str, Any] = {}
+
+    def walk(prefix: str, body: Mapping[str, Any]) -> None:
+        for k, v in body.items():
+            name = f"{prefix}.{k}" if prefix else str(k)
+            if isinstance(v, Mapping):
+                walk(name, v)
+            else:
+                flat[name] = v
+
+    walk("", table)
+    for name in flat:
+        _check_field(name, where, allowed)
+    return flat
+
+
+def _check_field(name: str, where: str, allowed: Mapping[str, set[str]]) -> None:
+    parts = name.split(".")
+    if len(parts) != 2 or parts[0] not in allowed:
+        raise SweepError(f"{where}: field {name!r} is not allowed: 'table.key' with table one "
+                         f"of {', '.join(sorted(allowed))}")
+    if parts[1] not in allowed[parts[0]]:
+        raise SweepError(f"{where}: field {name!r} is not allowed: [{parts[0]}] has "
+                         f"{', '.join(sorted(allowed[parts[0]]))}")
+
+
+def _scalar(value: Any, where: str) -> Scalar:
+    if isinstance(value, float) and not math.isfinite(value):
+        raise SweepError(f"{where}: value {value!r} is not allowed: a finite number")
+    if not isinstance(value, bool | int | float | str):
+        raise SweepError(f"{where}: value {value!r} is not allowed: a number, string or "
+                         "boolean (use set = [...] for lists)")
+    return value
+
+
+def _axis(raw: Any, i: int, source: str, allowed: Mapping[str, set[str]]) -> Axis:
+    where = f"{source} [[axis]] {i}"
+    if not isinstance(raw, Mapping):
+        raise SweepError(f"{where} is not allowed: a table")
+    for key in raw:
+        if key not in AXIS_KEYS:
+            raise SweepError(f"{where}: unknown key {key!r}; allowed: "
+                             f"{', '.join(sorted(AXIS_KEYS))}")
+    values = raw.get("values")
+    if not isinstance(values, list) or not values:
+        raise SweepError(f"{where}: values = {values!r} is not allowed: a non-empty list")
+    vals = tuple(_scalar(v, where) for v in values)
+    repeated = sorted({_format(v) for v in vals if [_format(w) for w in vals].count(
+        _format(v)) > 1})
+    if repeated:
+        raise SweepError(f"{where}: values repeat {', '.join(repeated)}")
+    if ("field" in raw) == ("set" in raw):
+        raise SweepError(f"{where}: give either field (one field per value) or set (a table "
+                         "of fields per value)")
+    group = raw.get("group")
+    if group is not None and not isinstance(group, str):
+        raise SweepError(f"{where}: group = {group!r} is not allowed: a string")
+    if "field" in raw:
+        fld = raw["field"]
+        if not isinstance(fld, str):
+            raise SweepError(f"{where}: field = {fld!r} is not allowed: 'table.key'")
+        _check_field(fld, where, allowed)
+        name = str(raw.get("name", fld.split(".", 1)[1]))
+        return Axis(name, vals, tuple({fld: v} for v in vals), fld, group)
+    sets = raw["set"]
+    if not isinstance(sets, list) or len(sets) != len(vals):
+        raise SweepError(f"{where}: set must be a list of {len(vals)} tables (one per value), "
+                         f"got {sets!r}")
+    if "name" not in raw or not isinstance(raw["name"], str):
+        raise SweepError(f"{where}: name (the column of this axis) is missing")
+    flat = tuple(_flat_fields(s, f"{where} set", allowed) for s in sets)
+    return Axis(raw["name"], vals, flat, None, group)
+
+
+def sweep_from_dict(data: Mapping[str, Any], source: str = "<dict>",
+                    root: Path | None = None) -> SweepSpec:
+    """Validate a parsed sweep file; ``base`` is read relative to ``root``."""
+    for key in data:
+        if key not in SWEEP_KEYS:
+            raise SweepError(f"{source}: unknown key {key!r}; allowed: "
+                             f"{', '.join(sorted(SWEEP_KEYS))}")
+    engine = data.get("engine", "twin")
+    if engine not in ENGINES:
+        raise SweepError(f"{source}: engine = {engine!r} is not allowed: one of "
+                         f"{', '.join(ENGINES)}")
+    if "base" not in data or not isinstance(data["base"], str):
+        raise SweepError(f"{source}: base (the scenario file the runs start from) is missing")
+    base = (root or Path.cwd()) / data["base"]
+    try:
+        base_data = tomllib.loads(base.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise SweepError(f"{source}: base = {data['base']!r} does not exist ({base})") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise SweepError(f"{source}: base = {data['base']!r} is not valid TOML: {exc}") from None
+    allowed = scenario_fields()
+    fixed = _flat_fields(data.get("set", {}), f"{source} [set]", allowed)
+    raw_axes = data.get("axis", [])
+    if not isinstance(raw_axes, list):
+        raise SweepError(f"{source}: axis must be an array of tables ([[axis]])")
+    axes = [_axis(a, i + 1, source, allowed) for i, a in enumerate(raw_axes)]
+    if "seeds" in data:
+        seeds = data["seeds"]
+        if not isinstance(seeds, list) or not seeds or any(
+                isinstance(s, bool) or not isinstance(s, int) or s < 0 for s in seeds):
+            raise SweepError(f"{source}: seeds = {seeds!r} is not allowed: a non-empty list "
+                             "of integers >= 0")
+        axes.append(_axis({"field": SEED_FIELD[engine], "name": "seed", "values": seeds},
+                          len(axes) + 1, source, allowed))
+    names = [a.name for a in axes]
+    groups = {a.group for a in axes if a.group}
+    dup = sorted({n for n in names if names.count(n) > 1} | (groups & set(names)))
+    if dup:
+        raise SweepError(f"{source}: axis and group names must differ; repeated: "
+                         f"{', '.join(dup)}")
+    paper = data.get("paper")
+    if paper is not None and paper not in PAPER_TABLES:
+        raise SweepError(f"{source}: paper = {paper!r} is not allowed: one of "
+                         f"{', '.join(PAPER_TABLES)}")
+    baseline = data.get("baseline", False)
+    if not isinstance(baseline, bool):
+        raise SweepError(f"{source}: baseline = {baseline!r} is not allowed: true or false")
+    name = data.get("name", Path(source).stem)
+    if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9._-]+", name):
+        raise SweepError(f"{source}: name = {name!r} is not allowed: letters, digits, . _ -")
+    return SweepSpec(name, str(data.get("description", "")), engine, base, base_data, fixed,
+                     tuple(axes), paper, baseline, source)
+
+
+def load_sweep(path: str | Path) -> SweepSpec:
+    """Read and validate a sweep file."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise SweepError(f"sweep = {str(path)!r} does not exist") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SweepError(f"{path}: not valid TOML: {exc}") from None
+    spec = sweep_from_dict(data, str(path), root=path.parent)
+    return SweepSpec(**{**spec.__dict__, "text": text})

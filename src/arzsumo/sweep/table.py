@@ -1,0 +1,104 @@
+"""The tidy table of a sweep: one row per run, axes as columns, then the summary's numbers.
+
+Nested summary entries become dotted columns (``J_TTT.total``, ``rmse.replay.v_h.relative``);
+lists are left out (they stay in each run's ``summary.json``). Times are s, densities
+veh/m, flows veh/s, as in the summaries.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Iterable, Mapping
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from arzsumo.sweep.spec import RunSpec
+
+#: columns that measure the execution, not the traffic: they differ between two
+#: executions of the same run and are left out when tables are compared
+VOLATILE = ("execution.", "wall_time", "numerics.wall_time_s", "numerics.speed_up",
+            "timings.", "controller_time_per_period")
+#: summary entries that are not table columns
+SKIP = {"sweep", "settings_resolved", "units"}
+
+
+def flatten(summary: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
+    """Scalar leaves of a nested summary with dotted names; lists left out."""
+    out: dict[str, Any] = {}
+    for key, value in summary.items():
+        if not prefix and key in SKIP:
+            continue
+        name = f"{prefix}{key}"
+        if isinstance(value, Mapping):
+            out.update(flatten(value, f"{name}."))
+        elif value is None or isinstance(value, bool | int | float | str):
+            out[name] = value
+    return out
+
+
+def run_dir(out: Path, run: RunSpec) -> Path:
+    """Where a run's outputs live."""
+    return out / "runs" / run.run_id
+
+
+def read_record(out: Path, run: RunSpec) -> tuple[str, dict[str, Any]] | None:
+    """(status, stored document) of the run's current result, or None.
+
+    A result counts only if it was made from the same resolved scenario (same SHA-256):
+    after an edit of the sweep or its base scenario, the old result is stale.
+    """
+    d = run_dir(out, run)
+    for name in ("summary.json", "error.json"):
+        path = d / name
+        if not path.is_file():
+            continue
+        try:
+            doc = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, json.JSONDecodeError):
+            return None
+        record = doc.get("sweep", {})
+        if record.get("sha256") == run.sha256:
+            return str(record.get("status")), doc
+        return None
+    return None
+
+
+def _uniform(col: pd.Series) -> pd.Series:
+    """An object column Parquet can store: mixed Python types become strings."""
+    if col.dtype != object:
+        return col
+    kinds = {type(v) for v in col if v is not None and not (isinstance(v, float)
+                                                            and math.isnan(v))}
+    if len(kinds) <= 1 or kinds <= {int, float}:
+        return col
+    return col.map(lambda v: v if v is None else str(v))
+
+
+def sweep_table(runs: Iterable[RunSpec], out: Path) -> pd.DataFrame:
+    """The table of every run of the sweep as stored under ``out`` (missing runs marked)."""
+    rows = []
+    for run in runs:
+        row: dict[str, Any] = {"run_id": run.run_id, "index": run.index}
+        row.update(run.columns)
+        found = read_record(out, run)
+        if found is None:
+            row.update(status="missing", error=None)
+        else:
+            status, doc = found
+            row.update(status=status, error=doc.get("error"))
+            ex = doc.get("sweep", {}).get("execution", {})
+            row.update({f"execution.{k}": v for k, v in ex.items()})
+            metrics = flatten(doc)
+            row.update({k: v for k, v in metrics.items() if k not in row})
+        rows.append(row)
+    df = pd.DataFrame(rows)
+    return df.apply(_uniform)
+
+
+def comparable(df: pd.DataFrame) -> pd.DataFrame:
+    """``df`` without the columns that measure the execution (:data:`VOLATILE`)."""
+    keep = [c for c in df.columns if not any(c == v or c.startswith(v) for v in VOLATILE)]
+    return df[keep].sort_values("index").reset_index(drop=True)

@@ -1,0 +1,114 @@
+"""The worker function of a sweep: one run, in whatever process or machine it lands on.
+
+:func:`execute` is what the local process pool and the Dask workers both call. It takes a
+plain, picklable :class:`RunTask` (the resolved scenario as a mapping, no paths) and
+returns a :class:`RunOutcome` (the summary, the resolved scenario as TOML and small
+tables as Parquet bytes). It never writes files, so workers need no shared file system:
+the sweep driver writes what comes back. It never raises for a bad run either: a user
+error becomes status ``invalid``, anything else ``failed``, each with its message.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import socket
+import time
+import traceback
+import uuid
+from dataclasses import dataclass, field
+from typing import Any
+
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from arzsumo.errors import ArzsumoError
+from arzsumo.io import dump_toml
+
+#: statuses of a run: finished (``ok``, ``incomplete``: the twin left the physical domain
+#: and stopped early, partial summary kept) or not (the rest: an error is recorded)
+STATUSES = ("ok", "incomplete", "invalid", "failed", "crashed")
+FINISHED = ("ok", "incomplete")
+
+
+@dataclass(frozen=True)
+class RunTask:
+    """Everything a worker needs for one run (picklable, no file paths)."""
+
+    run_id: str
+    engine: str
+    scenario: dict[str, Any]
+    source: str
+    baseline: bool
+    sha256: str
+
+
+@dataclass(frozen=True)
+class RunOutcome:
+    """What a worker returns: summary or error, resolved scenario, tables, execution."""
+
+    run_id: str
+    status: str
+    summary: dict[str, Any] | None
+    error: str | None
+    scenario_toml: str
+    tables: dict[str, bytes] = field(default_factory=dict)
+    execution: dict[str, Any] = field(default_factory=dict)
+
+
+def _parquet(table: pa.Table) -> bytes:
+    sink = io.BytesIO()
+    pq.write_table(table, sink)
+    return sink.getvalue()
+
+
+def _run_twin(task: RunTask) -> tuple[str, dict[str, Any], dict[str, bytes]]:
+    from arzsumo.scenarios import scenario_from_dict
+    from arzsumo.twin.output import control_table, json_safe
+    from arzsumo.twin.run import run_twin
+
+    sc = scenario_from_dict(task.scenario, task.source)
+    run = run_twin(sc, baseline=task.baseline)
+    status = "ok" if run.result.complete else "incomplete"
+    return status, json_safe(run.summary()), {"control.parquet": _parquet(control_table(run))}
+
+
+def _run_sumo(task: RunTask) -> tuple[str, dict[str, Any], dict[str, bytes]]:
+    from arzsumo.bridge.outputs import periods_table, summary
+    from arzsumo.bridge.session import run_in_sumo
+    from arzsumo.scenarios import scenario_from_dict
+    from arzsumo.twin.output import json_safe
+
+    sc = scenario_from_dict(task.scenario, task.source)
+    session = run_in_sumo(sc)
+    summ = json_safe(summary(session.result))
+    summ["settings_resolved"] = session.resolved_comment()
+    return "ok", summ, {"periods.parquet": _parquet(periods_table(session.result))}
+
+
+ENGINES = {"twin": _run_twin, "sumo": _run_sumo}
+
+
+def execute(task: RunTask) -> RunOutcome:
+    """Run ``task`` and report; never raises for a bad run (see the module docstring)."""
+    started = time.time()
+    t0 = time.perf_counter()
+    execution = {"id": uuid.uuid4().hex, "host": socket.gethostname(), "pid": os.getpid(),
+                 "started": started}
+    text = dump_toml(task.scenario)
+    try:
+        status, summ, tables = ENGINES[task.engine](task)
+        error = None
+    except ArzsumoError as exc:
+        status, summ, tables, error = "invalid", None, {}, f"{type(exc).__name__}: {exc}"
+    except Exception as exc:
+        tb = traceback.format_exc(limit=-4)
+        status, summ, tables, error = "failed", None, {}, f"{type(exc).__name__}: {exc}\n{tb}"
+    execution["wall_s"] = time.perf_counter() - t0
+    return RunOutcome(task.run_id, status, summ, error, text, tables, execution)
+
+
+def crashed(task: RunTask, why: str) -> RunOutcome:
+    """The outcome of a run whose worker process died (no summary, no tables)."""
+    return RunOutcome(task.run_id, "crashed", None, why, dump_toml(task.scenario), {},
+                      {"id": uuid.uuid4().hex, "started": time.time(), "wall_s": None})
