@@ -1,4 +1,4 @@
-"""Shared fixtures."""
+"""Shared fixtures (``scenario_files``: the scenario files; sweep files are elsewhere)."""
 
 from __future__ import annotations
 
@@ -24,6 +24,7 @@ def base_lin():
 def scenario_files():
     from pathlib import Path
 
-    files = sorted((Path(__file__).parent.parent / "scenarios").rglob("*.toml"))
+    root = Path(__file__).parent.parent / "scenarios"
+    files = sorted(p for p in root.rglob("*.toml") if "sweeps" not in p.relative_to(root).parts)
     assert files, "no scenario files shipped"
     return files

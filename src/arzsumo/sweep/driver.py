@@ -95,9 +95,11 @@ def write_outcome(out: Path, run: RunSpec, outcome: RunOutcome) -> None:
 
 
 # -- backends ------------------------------------------------------------------------------
-def run_local(tasks: Iterable[RunTask], workers: int, on_done: OnDone) -> None:
-    """Execute ``tasks`` on ``workers`` fresh processes (spawned: libsumo holds one
-    simulation per process and must not inherit a parent's state).
+def run_local(tasks: Iterable[RunTask], workers: int, on_done: OnDone,
+              fn: Callable[[RunTask], RunOutcome] = execute) -> None:
+    """Execute ``fn`` (the worker function) on ``tasks`` in ``workers`` fresh processes
+    (spawned: libsumo holds one simulation per process and must not inherit a parent's
+    state).
 
     At most ``workers`` tasks are in flight, so when a process dies (a crash in SUMO, the
     OOM killer) the suspects are known: each is run again alone, and the one that kills
@@ -113,7 +115,7 @@ def run_local(tasks: Iterable[RunTask], workers: int, on_done: OnDone) -> None:
             while (queue or running) and not suspects:
                 while queue and len(running) < workers:
                     task = queue.popleft()
-                    running[pool.submit(execute, task)] = task
+                    running[pool.submit(fn, task)] = task
                 done, _ = cf.wait(running, return_when=cf.FIRST_COMPLETED)
                 for fut in done:
                     task = running.pop(fut)
@@ -126,7 +128,7 @@ def run_local(tasks: Iterable[RunTask], workers: int, on_done: OnDone) -> None:
             log.warning("run %s: a worker process died; running it again alone", task.run_id)
             with cf.ProcessPoolExecutor(max_workers=1, mp_context=ctx) as alone:
                 try:
-                    on_done(alone.submit(execute, task).result())
+                    on_done(alone.submit(fn, task).result())
                 except BrokenProcessPool:
                     on_done(crashed(task, "the worker process died (twice, the second time "
                                           "running this run alone)"))
