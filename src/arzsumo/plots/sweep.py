@@ -42,13 +42,20 @@ def paper_points(table: str | None) -> dict[str, dict[float, float]]:
     return {}
 
 
+def _numeric(values: np.ndarray) -> bool:
+    return pd.api.types.is_numeric_dtype(pd.Series(values).infer_objects())
+
+
 def _stats(df: pd.DataFrame, x: str, metric: str) -> tuple[np.ndarray, ...]:
-    g = df.groupby(x, sort=True)[metric]
+    # numbers in increasing order; names (controllers, ...) in the sweep file's order
+    g = df.groupby(x, sort=_numeric(df[x].to_numpy()))[metric]
     mean, sd, n = g.mean(), g.std(ddof=1).fillna(0.0), g.count()
     return mean.index.to_numpy(), mean.to_numpy(float), sd.to_numpy(float), n.to_numpy()
 
 
 def _logscale(values: np.ndarray) -> bool:
+    if not _numeric(values):
+        return False
     v = np.asarray(values, float)
     return bool(v.size > 1 and np.all(v > 0) and v.max() / v.min() > 20)
 
