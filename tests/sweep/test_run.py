@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import os
 import signal
+import stat
 import subprocess
 import sys
 import time
@@ -16,6 +17,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from arzsumo.cli import main
+from arzsumo.io import FILE_MODE
 from arzsumo.sweep import comparable, run_sweep, sweep_from_dict
 from arzsumo.sweep.driver import run_local, task_of
 from arzsumo.sweep.worker import RunOutcome
@@ -132,6 +134,9 @@ def test_an_invalid_run_is_recorded_and_the_others_complete(tmp_path, capsys):
     err = json.loads((out / "runs" / "penetration=1.5,seed=1" / "error.json").read_text())
     assert err["sweep"]["status"] == "invalid" and "penetration = 1.5" in err["error"]
     assert (out / "plots" / "study.png").stat().st_size > 10_000  # drawn from the good run
+    for path in (out / "sweep.toml", out / "summaries.parquet", out / "runs"
+                 / "penetration=0.44,seed=1" / "summary.json"):
+        assert stat.S_IMODE(path.stat().st_mode) == FILE_MODE       # not 0600 temp files
     # a restart retries the invalid run only
     assert main(["sweep", str(sweep), "--out", str(out), "--workers", "1", "--quiet",
                  "--no-plots"]) == 4
@@ -182,6 +187,7 @@ def test_a_sumo_sweep_runs_the_closed_loop(tmp_path):
     assert df.loc["open", "plan_changes"] == 0 and df.loc["open", "triggers"] == 0
     assert df.loc["etc", "triggers"] >= 1 and df.loc["etc", "seed"] == 5
     assert (df["horizon"] == 30).all() and (df["collisions"] == 0).all()
+    assert (df["warnings"] >= 0).all()   # SUMO's warnings are kept per run, not printed
     periods = pq.read_table(tmp_path / "out" / "runs" / "controller=etc,seed=5" /
                             "periods.parquet")
     assert int(periods.column("triggered").to_numpy().sum()) == df.loc["etc", "triggers"]

@@ -79,13 +79,13 @@ def write_outcome(out: Path, run: RunSpec, outcome: RunOutcome) -> None:
             f"# run {run.run_id} of a sweep: the resolved scenario\n"
             + outcome.scenario_toml, encoding="utf-8")
         if outcome.status in FINISHED and outcome.summary is not None:
-            doc = {**outcome.summary, "sweep": record}
+            doc = {**outcome.summary, "warnings": outcome.warnings, "sweep": record}
             (tmp / "summary.json").write_text(json.dumps(doc, indent=2) + "\n",
                                               encoding="utf-8")
             for name, blob in outcome.tables.items():
                 (tmp / name).write_bytes(blob)
         else:
-            doc = {"error": outcome.error, "sweep": record}
+            doc = {"error": outcome.error, "warnings": outcome.warnings, "sweep": record}
             (tmp / "error.json").write_text(json.dumps(doc, indent=2) + "\n",
                                             encoding="utf-8")
     line = json.dumps({"run_id": run.run_id, "execution": outcome.execution.get("id"),

@@ -1,7 +1,8 @@
 """The tidy table of a sweep: one row per run, axes as columns, then the summary's numbers.
 
 Nested summary entries become dotted columns (``J_TTT.total``, ``rmse.replay.v_h.relative``);
-lists are left out (they stay in each run's ``summary.json``). Times are s, densities
+lists are left out (they stay in each run's ``summary.json``); ``warnings`` counts the
+warnings the run logged (their text is in ``summary.json``). Times are s, densities
 veh/m, flows veh/s, as in the summaries.
 """
 
@@ -88,7 +89,8 @@ def sweep_table(runs: Iterable[RunSpec], out: Path) -> pd.DataFrame:
             row.update(status="missing", error=None)
         else:
             status, doc = found
-            row.update(status=status, error=doc.get("error"))
+            row.update(status=status, error=doc.get("error"),
+                       warnings=len(doc.get("warnings", [])))
             ex = doc.get("sweep", {}).get("execution", {})
             row.update({f"execution.{k}": v for k, v in ex.items()})
             metrics = flatten(doc)

@@ -10,12 +10,15 @@ error becomes status ``invalid``, anything else ``failed``, each with its messag
 
 from __future__ import annotations
 
+import contextlib
 import io
+import logging
 import os
 import socket
 import time
 import traceback
 import uuid
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -54,6 +57,31 @@ class RunOutcome:
     scenario_toml: str
     tables: dict[str, bytes] = field(default_factory=dict)
     execution: dict[str, Any] = field(default_factory=dict)
+    warnings: list[str] = field(default_factory=list)
+
+
+class _Collect(logging.Handler):
+    def __init__(self) -> None:
+        super().__init__(logging.WARNING)
+        self.messages: list[str] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.messages.append(f"{record.name}: {record.getMessage()}")
+
+
+@contextlib.contextmanager
+def _collected_warnings() -> Iterator[list[str]]:
+    """Warnings logged by arzsumo during a run go into its outcome, not onto the sweep's
+    terminal (a hundred workers would bury the progress bar)."""
+    logger = logging.getLogger("arzsumo")
+    handler, propagate = _Collect(), logger.propagate
+    logger.addHandler(handler)
+    logger.propagate = False
+    try:
+        yield handler.messages
+    finally:
+        logger.removeHandler(handler)
+        logger.propagate = propagate
 
 
 def _parquet(table: pa.Table) -> bytes:
@@ -96,16 +124,19 @@ def execute(task: RunTask) -> RunOutcome:
     execution = {"id": uuid.uuid4().hex, "host": socket.gethostname(), "pid": os.getpid(),
                  "started": started}
     text = dump_toml(task.scenario)
-    try:
-        status, summ, tables = ENGINES[task.engine](task)
-        error = None
-    except ArzsumoError as exc:
-        status, summ, tables, error = "invalid", None, {}, f"{type(exc).__name__}: {exc}"
-    except Exception as exc:
-        tb = traceback.format_exc(limit=-4)
-        status, summ, tables, error = "failed", None, {}, f"{type(exc).__name__}: {exc}\n{tb}"
+    with _collected_warnings() as warnings:
+        try:
+            status, summ, tables = ENGINES[task.engine](task)
+            error = None
+        except ArzsumoError as exc:
+            status, summ, tables, error = "invalid", None, {}, f"{type(exc).__name__}: {exc}"
+        except Exception as exc:
+            tb = traceback.format_exc(limit=-4)
+            status, summ, tables = "failed", None, {}
+            error = f"{type(exc).__name__}: {exc}\n{tb}"
     execution["wall_s"] = time.perf_counter() - t0
-    return RunOutcome(task.run_id, status, summ, error, text, tables, execution)
+    return RunOutcome(task.run_id, status, summ, error, text, tables, execution,
+                      list(warnings))
 
 
 def crashed(task: RunTask, why: str) -> RunOutcome:
