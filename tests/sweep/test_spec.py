@@ -103,3 +103,22 @@ def test_shipped_sweep_files_load_and_expand():
         assert len(runs) >= 6 and spec.replicate == "seed"
         assert tomllib.loads(f.read_text())["engine"] == spec.engine
         scenario_from_dict(runs[0].scenario, f"{f} first run")   # the resolved runs load
+
+
+def test_cli_user_errors_are_one_line_with_exit_2(tmp_path, capsys):
+    from arzsumo.cli import main
+
+    assert main(["sweep", str(tmp_path / "nope.toml")]) == 2
+    assert "sweep = " in capsys.readouterr().err
+    bad = tmp_path / "bad.toml"
+    bad.write_text(f'base = "{ROOT / BASE}"\n[[axis]]\nfield = "design.muu"\nvalues = [1]\n')
+    assert main(["sweep", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "field 'design.muu' is not allowed" in err
+    good = tmp_path / "good.toml"
+    good.write_text(f'base = "{ROOT / BASE}"\nseeds = [1, 2]\n')
+    assert main(["sweep", str(good), "--workers", "0", "--out", str(tmp_path / "o")]) == 2
+    assert "--workers = 0 is not allowed" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()                       # nothing half-written
+    assert main(["sweep", str(good), "--list"]) == 0
+    assert capsys.readouterr().out.split() == ["seed=1", "seed=2"]
