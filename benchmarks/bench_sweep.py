@@ -1,7 +1,7 @@
 """Throughput of a twin sweep on 1 and 2 local processes, and the overhead per run of the
 Dask path (a LocalCluster on loopback) against the local pool.
 
-    .venv/bin/python benchmarks/bench_sweep.py [--runs 16] [--horizon 450]
+    .venv/bin/python benchmarks/bench_sweep.py [--runs 32] [--horizon 450]
 
 Each sweep runs into a fresh directory (nothing skipped) with a warm kernel cache (the
 kernels of every penetration are solved once before timing). Wall times include starting
@@ -49,7 +49,7 @@ def timed(sp, tmp: Path, **kw) -> float:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--runs", type=int, default=16)
+    ap.add_argument("--runs", type=int, default=32)
     ap.add_argument("--horizon", type=float, default=450.0)
     ap.add_argument("--cells", type=int, default=200)
     args = ap.parse_args()
