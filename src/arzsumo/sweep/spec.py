@@ -40,7 +40,7 @@ import math
 import re
 import tomllib
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -351,4 +351,4 @@ def load_sweep(path: str | Path) -> SweepSpec:
     except tomllib.TOMLDecodeError as exc:
         raise SweepError(f"{path}: not valid TOML: {exc}") from None
     spec = sweep_from_dict(data, str(path), root=path.parent)
-    return SweepSpec(**{**spec.__dict__, "text": text})
+    return replace(spec, text=text)
