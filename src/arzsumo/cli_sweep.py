@@ -15,6 +15,7 @@ EXIT_SOME_FAILED = 4
 
 def cmd_sweep(args: argparse.Namespace) -> int:
     from arzsumo.sweep import load_sweep, run_sweep
+    from arzsumo.sweep.worker import FINISHED
 
     spec = load_sweep(args.sweep)
     if args.list:
@@ -24,10 +25,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out else Path("results") / "sweeps" / spec.name
     rep = run_sweep(spec, out, workers=args.workers, scheduler=args.scheduler,
                     progress=not args.quiet, plots=not args.no_plots)
-    import pandas as pd
-
-    df = pd.read_parquet(out / "summaries.parquet")
-    bad = df[~df["status"].isin(("ok", "incomplete"))]
+    df = rep.table
+    bad = df[~df["status"].isin(FINISHED)]
     print(f"sweep {spec.name} ({spec.engine}): {rep.total} runs, {rep.skipped} already "
           f"finished, {rep.executed} executed on {rep.backend} in {rep.wall_time:.1f} s")
     print("  status: " + ", ".join(f"{k} {v}" for k, v in

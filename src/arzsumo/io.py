@@ -1,4 +1,4 @@
-"""Atomic file and directory writes (results appear complete or not at all), and TOML out."""
+"""Atomic file and directory writes (results appear complete or not at all), TOML in and out."""
 
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ import os
 import re
 import shutil
 import tempfile
+import tomllib
 from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import Any
@@ -67,6 +68,23 @@ def atomic_dir(path: str | os.PathLike[str]) -> Iterator[Path]:
             shutil.rmtree(tmp, ignore_errors=True)
 
 
+def read_toml(path: str | os.PathLike[str], field: str,
+              error: type[Exception]) -> tuple[str, dict[str, Any]]:
+    """Text and parsed mapping of the TOML file ``path``; a missing, unreadable or invalid
+    file raises ``error`` with one line naming ``field`` and the path."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise error(f"{field} = {str(path)!r} does not exist") from None
+    except OSError as exc:
+        raise error(f"{field} = {str(path)!r} cannot be read: {exc.strerror}") from None
+    try:
+        return text, tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise error(f"{path}: not valid TOML: {exc}") from None
+
+
 _BARE_KEY = re.compile(r"^[A-Za-z0-9_-]+$")
 
 
@@ -74,7 +92,8 @@ def _toml_key(key: str) -> str:
     return key if _BARE_KEY.match(key) else json.dumps(key)
 
 
-def _toml_value(value: Any) -> str:
+def toml_value(value: Any) -> str:
+    """One TOML value (scalar, array or inline table)."""
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, int):
@@ -88,9 +107,9 @@ def _toml_value(value: Any) -> str:
     if isinstance(value, str):
         return json.dumps(value)  # JSON string escapes are valid TOML basic-string escapes
     if isinstance(value, list | tuple):
-        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+        return "[" + ", ".join(toml_value(v) for v in value) + "]"
     if isinstance(value, Mapping):
-        return "{" + ", ".join(f"{_toml_key(k)} = {_toml_value(v)}"
+        return "{" + ", ".join(f"{_toml_key(k)} = {toml_value(v)}"
                                for k, v in value.items()) + "}"
     raise TypeError(f"cannot write {type(value).__name__} {value!r} as TOML")
 
@@ -99,7 +118,7 @@ def dump_toml(data: Mapping[str, Any]) -> str:
     """TOML text of ``data`` (scalars, lists and nested tables), read back by ``tomllib``
     to the same mapping; used for the resolved scenario of every result."""
     def table(prefix: str, body: Mapping[str, Any]) -> list[str]:
-        lines = [f"{_toml_key(k)} = {_toml_value(v)}" for k, v in body.items()
+        lines = [f"{_toml_key(k)} = {toml_value(v)}" for k, v in body.items()
                  if not isinstance(v, Mapping)]
         for k, v in body.items():
             if isinstance(v, Mapping):

@@ -20,7 +20,6 @@ then the meaning (the model validates itself), and names the bad key and value.
 from __future__ import annotations
 
 import math
-import tomllib
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -28,6 +27,7 @@ from typing import Any
 
 from arzsumo.control.etc import PAPER_DESIGN, EtcDesign
 from arzsumo.errors import ArzsumoError, ScenarioError
+from arzsumo.io import read_toml
 from arzsumo.model.equilibrium import (
     Equilibrium,
     equilibrium_at_penetration,
@@ -198,17 +198,7 @@ def design_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> EtcDesi
 
 def load_scenario(path: str | Path) -> Scenario:
     """Read and validate a scenario TOML file."""
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ScenarioError(f"scenario = {str(path)!r} does not exist") from None
-    except OSError as exc:
-        raise ScenarioError(f"scenario = {str(path)!r} cannot be read: {exc.strerror}") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ScenarioError(f"{path}: not valid TOML: {exc}") from None
+    _, data = read_toml(path, "scenario", ScenarioError)
     return scenario_from_dict(data, str(path))
 
 

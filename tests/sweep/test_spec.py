@@ -83,7 +83,8 @@ def test_one_at_a_time_group_and_multi_field_axis():
     ({"seeds": [1, -1]}, r"seeds = \[1, -1\] is not allowed"),
     ({"sets": {}}, "unknown key 'sets'"),
     ({"paper": "table9"}, "paper = 'table9' is not allowed"),
-    ({"base": "nope.toml"}, "base = 'nope.toml' does not exist"),
+    ({"base": "nope.toml"}, "base = '.*nope.toml' does not exist"),
+    ({"base": "scenarios"}, "base = '.*scenarios' cannot be read"),
     ({"seeds": [1], "axis": [{"field": "twin.seed", "values": [1, 2]}]},
      "repeated: seed"),
 ])

@@ -8,7 +8,7 @@ nothing.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -45,7 +45,9 @@ def run_in_sumo(sc: Scenario, *, controller: str | None = None, seed: int | None
     controller : str, optional
         Overrides ``[run] controller``.
     seed : int, optional
-        Overrides ``[sumo] seed``; an integer >= 0.
+        Overrides ``[sumo] seed``; an integer >= 0. The SUMO seed also draws a
+        ``[initial] kind = "random"`` wave when vehicles are placed (``start =
+        "placement"``).
     horizon : float, optional
         Overrides ``[sumo] horizon_s``, s.
     progress : bool
@@ -68,8 +70,10 @@ def run_in_sumo(sc: Scenario, *, controller: str | None = None, seed: int | None
 
         n = round(sc.params.length / cfg.cell_length)
         xc = (np.arange(n) + 0.5) * cfg.cell_length
-        initial = initial_fields(twin_config_from_dict(raw, sc.source).initial,
-                                 sc.equilibrium, xc)
+        ic = twin_config_from_dict(raw, sc.source).initial
+        if ic.kind == "random":  # one seed draws everything random in a SUMO run
+            ic = replace(ic, seed=cfg.seed)
+        initial = initial_fields(ic, sc.equilibrium, xc)
     res = run_cosimulation(sc, settings, cfg, design, initial_fields=initial,
                            progress=progress)
     return SumoSession(res, settings, cfg)

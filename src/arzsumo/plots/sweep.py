@@ -11,12 +11,17 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from arzsumo.plots import plt, save_png
+
+if TYPE_CHECKING:
+    from arzsumo.sweep.spec import SweepSpec
 
 LABELS = {"triggers": "triggers (control updates)", "release_time": "release time (s)",
           "plan_changes": "meter plan changes", "penetration": "AV penetration",
@@ -53,6 +58,13 @@ def _stats(df: pd.DataFrame, x: str, metric: str) -> tuple[np.ndarray, ...]:
     return mean.index.to_numpy(), mean.to_numpy(float), sd.to_numpy(float), n.to_numpy()
 
 
+def _label_axes(ax: Axes, x: str, metric: str) -> None:
+    ax.set_xlabel(LABELS.get(x, x))
+    ax.set_ylabel(LABELS.get(metric, metric))
+    ax.set_ylim(bottom=0)
+    ax.grid(alpha=0.3)
+
+
 def _logscale(values: np.ndarray) -> bool:
     if not _numeric(values):
         return False
@@ -80,10 +92,7 @@ def study_figure(df: pd.DataFrame, x: str, metrics: Sequence[str],
             ax.plot(px, [paper[metric][v] for v in px], "k*--", ms=9, lw=1, label="paper")
         if _logscale(df[x].to_numpy()):
             ax.set_xscale("log")
-        ax.set_xlabel(LABELS.get(x, x))
-        ax.set_ylabel(LABELS.get(metric, metric))
-        ax.set_ylim(bottom=0)
-        ax.grid(alpha=0.3)
+        _label_axes(ax, x, metric)
         ax.legend(fontsize=8)
     if title:
         fig.suptitle(title)
@@ -111,17 +120,14 @@ def sensitivity_figure(df: pd.DataFrame, group: str, parameters: Sequence[str],
                 ax.set_xscale("log")
             if marks and par in marks and math.isfinite(marks[par]):
                 ax.axvline(marks[par], color="0.5", ls=":", lw=1)
-            ax.set_xlabel(par)
-            ax.set_ylabel(LABELS.get(metric, metric))
-            ax.set_ylim(bottom=0)
-            ax.grid(alpha=0.3)
+            _label_axes(ax, par, metric)
     if title:
         fig.suptitle(title)
     fig.tight_layout()
     return fig
 
 
-def write_sweep_plots(df: pd.DataFrame, spec, out: str | Path) -> list[Path]:
+def write_sweep_plots(df: pd.DataFrame, spec: SweepSpec, out: str | Path) -> list[Path]:
     """Write the figures of sweep ``spec`` from its table ``df`` into ``out``.
 
     Finished runs only. A one-at-a-time group gives ``sensitivity.png``; otherwise the
@@ -138,7 +144,8 @@ def write_sweep_plots(df: pd.DataFrame, spec, out: str | Path) -> list[Path]:
     if ok.empty or not metrics:
         return []
     engine = "SUMO" if spec.engine == "sumo" else "PDE twin"
-    seeds = f", mean and sd over {ok['seed'].nunique()} seeds" if "seed" in ok.columns else ""
+    rep = spec.replicate
+    seeds = f", mean and sd over {ok[rep].nunique()} seeds" if rep else ""
     written = []
     groups = [a.group for a in spec.axes if a.group]
     if groups:
@@ -150,7 +157,7 @@ def write_sweep_plots(df: pd.DataFrame, spec, out: str | Path) -> list[Path]:
                                  f"{spec.name}: {engine}{seeds}; dotted: paper's design")
         written.append(save_png(fig, out / "sensitivity.png", dpi=120))
         return written
-    study = [a.name for a in spec.axes if a.name != "seed"]
+    study = [a.name for a in spec.axes if a.name != rep]
     if not study:
         return written
     fig = study_figure(ok, study[0], metrics, lines=study[1:],

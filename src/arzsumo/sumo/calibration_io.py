@@ -14,26 +14,17 @@ from __future__ import annotations
 
 import json
 import math
-import tomllib
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from arzsumo.errors import ArzsumoError
-from arzsumo.io import atomic_dir
+from arzsumo.io import atomic_dir, read_toml, toml_value
 from arzsumo.sumo.calibrate import Calibration
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.meter import GreenShareCurve
 from arzsumo.units import ms_to_kmh, veh_h_to_veh_s, veh_m_to_veh_km, veh_s_to_veh_h
-
-
-def _toml_value(v: Any) -> str:
-    if isinstance(v, str):
-        return json.dumps(v)
-    if isinstance(v, list | tuple):
-        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
-    return f"{v:.6g}" if isinstance(v, float) else str(v)
 
 
 def scenario_text(cal: Calibration, cfg: SumoConfig) -> str:
@@ -80,21 +71,16 @@ def curve_text(curve: GreenShareCurve, cfg: SumoConfig) -> str:
         "# Mainline outflow q(L) against the ramp meter's green share, medium demand,",
         f"# ramp demand {veh_s_to_veh_h(cfg.ramp_demand):.0f} veh/h, cycle "
         f"{cfg.meter_cycle:g} s. Written by `arzsumo calibrate`.",
-        f"green_share = {_toml_value([round(g, 6) for g in curve.green_share])}",
+        f"green_share = {toml_value([round(g, 6) for g in curve.green_share])}",
         "outflow_veh_h = "
-        f"{_toml_value([round(float(veh_s_to_veh_h(q)), 2) for q in curve.outflow])}",
+        f"{toml_value([round(float(veh_s_to_veh_h(q)), 2) for q in curve.outflow])}",
     ]) + "\n"
 
 
 def load_green_share_curve(path: str | Path) -> GreenShareCurve:
     """Read a ``meter_curve.toml`` written by ``arzsumo calibrate``."""
     path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ArzsumoError(f"meter_curve = {str(path)!r} does not exist") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ArzsumoError(f"{path}: not valid TOML: {exc}") from None
+    _, data = read_toml(path, "meter_curve", ArzsumoError)
     for key in ("green_share", "outflow_veh_h"):
         if not isinstance(data.get(key), list):
             raise ArzsumoError(f"{path}: {key} = {data.get(key)!r} is not allowed: a list "

@@ -31,6 +31,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import pandas as pd
+
 from arzsumo import __version__
 from arzsumo.io import atomic_dir, atomic_file
 from arzsumo.progress import Progress
@@ -55,6 +57,7 @@ class SweepReport:
     executed: int
     statuses: dict[str, int] = field(default_factory=dict)
     wall_time: float = 0.0
+    table: pd.DataFrame | None = field(default=None, repr=False)
 
     def as_dict(self) -> dict[str, Any]:
         return {"name": self.name, "backend": self.backend, "total": self.total,
@@ -235,13 +238,14 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
         bar.close()
     report = SweepReport(spec.name, out, backend, len(runs), len(runs) - len(todo),
                          sum(counts.values()), dict(counts), time.perf_counter() - t0)
-    finish(spec, out, runs, report, plots)
+    report.table = finish(spec, out, runs, report, plots)
     return report
 
 
 def finish(spec: SweepSpec, out: Path, runs: list[RunSpec], report: SweepReport,
-           plots: bool) -> None:
-    """Write the table, the plots and the manifest of a sweep whose runs are done."""
+           plots: bool) -> pd.DataFrame:
+    """Write the table, the plots and the manifest of a sweep whose runs are done; return
+    the table."""
     import pyarrow as pa
     import pyarrow.parquet as pq
 
@@ -268,3 +272,4 @@ def finish(spec: SweepSpec, out: Path, runs: list[RunSpec], report: SweepReport,
                 "invocations": [*history, report.as_dict()]}
     with atomic_file(manifest_path) as tmp:
         tmp.write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")
+    return df

@@ -38,13 +38,13 @@ import itertools
 import json
 import math
 import re
-import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 from arzsumo.errors import ScenarioError
+from arzsumo.io import read_toml
 
 ENGINES = ("twin", "sumo")
 #: the engine's seed field, set by the ``seeds`` key
@@ -299,12 +299,7 @@ def sweep_from_dict(data: Mapping[str, Any], source: str = "<dict>",
     if "base" not in data or not isinstance(data["base"], str):
         raise SweepError(f"{source}: base (the scenario file the runs start from) is missing")
     base = (root or Path.cwd()) / data["base"]
-    try:
-        base_data = tomllib.loads(base.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise SweepError(f"{source}: base = {data['base']!r} does not exist ({base})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise SweepError(f"{source}: base = {data['base']!r} is not valid TOML: {exc}") from None
+    _, base_data = read_toml(base, f"{source}: base", SweepError)
     allowed = scenario_fields()
     fixed = _flat_fields(data.get("set", {}), f"{source} [set]", allowed)
     raw_axes = data.get("axis", [])
@@ -342,13 +337,6 @@ def sweep_from_dict(data: Mapping[str, Any], source: str = "<dict>",
 def load_sweep(path: str | Path) -> SweepSpec:
     """Read and validate a sweep file."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise SweepError(f"sweep = {str(path)!r} does not exist") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise SweepError(f"{path}: not valid TOML: {exc}") from None
+    text, data = read_toml(path, "sweep", SweepError)
     spec = sweep_from_dict(data, str(path), root=path.parent)
     return replace(spec, text=text)

@@ -24,7 +24,7 @@ Example::
     zeta = 8e-3
 
     [initial]
-    kind = "sinusoid"           # equilibrium, sinusoid, nonrecurrent, linear
+    kind = "sinusoid"           # equilibrium, sinusoid, nonrecurrent, linear, random
     amplitude = [0.05, -0.05, 0.05, -0.05]   # fractions of (rho_h*, v_h*, rho_a*, v_a*)
     wavenumber = 2              # periods over the road (one number or four); random: highest mode
     phase_rad = 0
