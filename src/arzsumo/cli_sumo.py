@@ -20,16 +20,16 @@ def cmd_build_net(args: argparse.Namespace) -> int:
     from arzsumo.model.params import get_preset
     from arzsumo.sumo.config import SumoConfig
     from arzsumo.sumo.demand import write_gui_files
-    from arzsumo.sumo.network import NetworkSpec, build_network, edge_lengths
+    from arzsumo.sumo.network import NetworkSpec, edge_lengths, rebuild_network
     from arzsumo.sumo.paths import CONFIG_FILE, NET_FILE, ROUTE_FILE, default_nets_dir
 
     out = Path(args.out) if args.out else default_nets_dir()
     spec = NetworkSpec()
-    net = build_network(out, spec, write=not args.keep_sources)
+    net, changed = rebuild_network(out, spec, write=not args.keep_sources)
     write_gui_files(out, get_preset("paper_base").params, SumoConfig(), NET_FILE, ROUTE_FILE,
                     CONFIG_FILE)
     lengths = edge_lengths(net)
-    print(f"network: {net}")
+    print(f"network: {net} ({'written' if changed else 'unchanged'})")
     print("edges (m): " + ", ".join(f"{k} {v:.2f}" for k, v in sorted(lengths.items())))
     print(f"sumo-gui: {out / CONFIG_FILE}")
     return 0
