@@ -1,6 +1,8 @@
 """Results of a co-simulation: tables, ``summary.json`` and plots, written atomically.
 
-Layout of ``DIR``::
+Every file, column (with units, stored in the Parquet field metadata from
+:mod:`arzsumo.schema`) and summary key is described in ``docs/outputs.md``. Layout of
+``DIR``::
 
     periods.parquet   per control period: t_s (check time), U commanded and continuous (veh/s),
                       event flag, green share commanded and running, light and plan changes
@@ -29,6 +31,7 @@ from arzsumo.control.base import ControlLog
 from arzsumo.control.events import release_time
 from arzsumo.io import atomic_dir
 from arzsumo.model.characteristic import linearize
+from arzsumo.schema import CELLS, PERIODS, RUN_SUMMARY, key_units, with_units
 from arzsumo.twin.metrics import performance
 from arzsumo.twin.output import json_safe
 
@@ -80,7 +83,7 @@ def summary(res: CoSimResult) -> dict[str, Any]:
                          list(log.u_continuous[:n]), list(log.triggered[:n]))
     v = res.micro[:, [1, 3]]
     eq = res.equilibrium
-    return {
+    summ = {
         "scenario": res.scenario.name, "source": res.scenario.source, "version": __version__,
         "seed": res.sumo.seed, "controller": res.settings.controller, "complete": True,
         "units": "SI: veh, s, m; U and flows in veh/s",
@@ -105,13 +108,15 @@ def summary(res: CoSimResult) -> dict[str, Any]:
         "controller_time_per_period": float(np.mean(per["controller_s"])) if n else None,
         "settings": res.settings.as_dict(),
     }
+    summ["units_by_key"] = key_units(summ, RUN_SUMMARY)
+    return summ
 
 
 def periods_table(res: CoSimResult) -> pa.Table:
     cols = {"t_s": res.periods["t"]}
     cols.update({k: v for k, v in res.periods.items() if k not in ("t", "controller_s")})
     cols["triggered"] = res.periods["triggered"].astype(bool)
-    return pa.table(cols)
+    return with_units(pa.table(cols), PERIODS, "periods")
 
 
 def cells_table(res: CoSimResult) -> pa.Table:
@@ -123,7 +128,7 @@ def cells_table(res: CoSimResult) -> pa.Table:
                                 "t_s": np.repeat(res.t, n_x), "x_m": np.tile(res.x, n_t)}
         cols.update({name: arr[:, k, :].ravel() for k, name in enumerate(VARIABLES)})
         parts.append(pa.table(cols))
-    return pa.concat_tables(parts)
+    return with_units(pa.concat_tables(parts), CELLS, "cells")
 
 
 def write_results(res: CoSimResult, out: str | Path, scenario_text: str,

@@ -37,7 +37,7 @@ from arzsumo import __version__
 from arzsumo.io import atomic_dir, atomic_file
 from arzsumo.progress import Progress
 from arzsumo.sweep.spec import RunSpec, SweepError, SweepSpec
-from arzsumo.sweep.table import read_record, run_dir, sweep_table
+from arzsumo.sweep.table import arrow_table, read_record, run_dir, sweep_table
 from arzsumo.sweep.worker import FINISHED, RunOutcome, RunTask, crashed, execute
 
 log = logging.getLogger(__name__)
@@ -246,12 +246,11 @@ def finish(spec: SweepSpec, out: Path, runs: list[RunSpec], report: SweepReport,
            plots: bool) -> pd.DataFrame:
     """Write the table, the plots and the manifest of a sweep whose runs are done; return
     the table."""
-    import pyarrow as pa
     import pyarrow.parquet as pq
 
     df = sweep_table(runs, out)
     with atomic_file(out / "summaries.parquet") as tmp:
-        pq.write_table(pa.Table.from_pandas(df, preserve_index=False), tmp)
+        pq.write_table(arrow_table(df, spec.axes), tmp)
     if plots:
         from arzsumo.plots.sweep import write_sweep_plots
 

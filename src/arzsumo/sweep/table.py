@@ -3,7 +3,8 @@
 Nested summary entries become dotted columns (``J_TTT.total``, ``rmse.replay.v_h.relative``);
 lists are left out (they stay in each run's ``summary.json``); ``warnings`` counts the
 warnings the run logged (their text is in ``summary.json``). Times are s, densities
-veh/m, flows veh/s, as in the summaries.
+veh/m, flows veh/s, as in the summaries; :func:`arrow_table` stores each column's unit in
+the Parquet field metadata (:mod:`arzsumo.schema`; every column in ``docs/outputs.md``).
 """
 
 from __future__ import annotations
@@ -15,15 +16,26 @@ from pathlib import Path
 from typing import Any
 
 import pandas as pd
+import pyarrow as pa
 
-from arzsumo.sweep.spec import RunSpec
+from arzsumo.schema import (
+    RUN_SUMMARY,
+    SWEEP_FIXED,
+    TEXT,
+    TWIN_SUMMARY,
+    Column,
+    scenario_field_unit,
+    summary_unit,
+    with_units,
+)
+from arzsumo.sweep.spec import Axis, RunSpec
 
 #: columns that measure the execution, not the traffic: they differ between two
 #: executions of the same run and are left out when tables are compared
 VOLATILE = ("execution.", "wall_time", "numerics.wall_time_s", "numerics.speed_up",
             "timings.", "controller_time_per_period")
 #: summary entries that are not table columns
-SKIP = {"sweep", "settings_resolved", "units"}
+SKIP = {"sweep", "settings_resolved", "units", "units_by_key"}
 
 
 def flatten(summary: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
@@ -104,3 +116,39 @@ def comparable(df: pd.DataFrame) -> pd.DataFrame:
     """``df`` without the columns that measure the execution (:data:`VOLATILE`)."""
     keep = [c for c in df.columns if not any(c == v or c.startswith(v) for v in VOLATILE)]
     return df[keep].sort_values("index").reset_index(drop=True)
+
+
+def _axis_columns(axes: Iterable[Axis], df: pd.DataFrame) -> dict[str, Column]:
+    """Units of the axis columns: from the scenario field's suffix (``_kmh``: km/h, ...)."""
+    out: dict[str, Column] = {}
+    for ax in axes:
+        if ax.group is not None:
+            out[ax.group] = Column(TEXT, f"which axis of group {ax.group} this run varies")
+        numeric = ax.name in df and pd.api.types.is_numeric_dtype(df[ax.name].dtype) \
+            and not pd.api.types.is_bool_dtype(df[ax.name].dtype)
+        unit = (scenario_field_unit(ax.field) if ax.field else None) or \
+            ("1" if numeric and ax.name != "seed" else TEXT)
+        where = f"scenario field {ax.field}" if ax.field else "values set by the sweep file"
+        out[ax.name] = Column(unit, f"sweep axis {ax.name!r}: {where}, in scenario-file units")
+    return out
+
+
+def table_columns(df: pd.DataFrame, axes: Iterable[Axis] = ()) -> dict[str, Column]:
+    """Unit and meaning of every column of the sweep table ``df``.
+
+    Summary columns take the unit of their summary key (:data:`arzsumo.schema.RUN_SUMMARY`
+    or :data:`~arzsumo.schema.TWIN_SUMMARY`); a key neither describes gets unit ``?``
+    (an old summary; the tests keep current summaries fully described).
+    """
+    cols = {**SWEEP_FIXED, **_axis_columns(axes, df)}
+    for name in df.columns:
+        if name not in cols:
+            unit = summary_unit(name, RUN_SUMMARY) or summary_unit(name, TWIN_SUMMARY) or "?"
+            cols[name] = Column(unit, f"summary.json entry {name}")
+    return cols
+
+
+def arrow_table(df: pd.DataFrame, axes: Iterable[Axis] = ()) -> pa.Table:
+    """The sweep table as Arrow, with per-column units (what ``summaries.parquet`` holds)."""
+    table = pa.Table.from_pandas(df, preserve_index=False)
+    return with_units(table, table_columns(df, axes), "summaries")

@@ -1,5 +1,7 @@
 """Write a twin run to a directory: Parquet fields, control history, summary, plots.
 
+Every file, column (units in the Parquet field metadata, from :mod:`arzsumo.schema`) and
+summary key is described in ``docs/outputs.md``.
 Layout of ``DIR`` (written atomically with :func:`arzsumo.io.atomic_dir`)::
 
     fields.parquet    long table: t_s, x_m, rho_h, v_h, rho_a, v_a (SI: veh/m, m/s)
@@ -20,6 +22,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from arzsumo.io import atomic_dir
+from arzsumo.schema import TWIN_CONTROL, TWIN_FIELDS, with_units
 from arzsumo.twin.run import TwinRun
 
 
@@ -30,7 +33,7 @@ def fields_table(run: TwinRun) -> pa.Table:
     cols: dict[str, Any] = {"t_s": np.repeat(r.t, n_x), "x_m": np.tile(r.x, n_t)}
     for k, name in enumerate(("rho_h", "v_h", "rho_a", "v_a")):
         cols[name] = r.fields[:, k, :].ravel()
-    return pa.table(cols)
+    return with_units(pa.table(cols), TWIN_FIELDS, "fields")
 
 
 def control_table(run: TwinRun) -> pa.Table:
@@ -40,9 +43,10 @@ def control_table(run: TwinRun) -> pa.Table:
     n = r.control_t.size
     cont = np.asarray(log.u_continuous, float) if len(log.u_continuous) == n else \
         np.full(n, np.nan)
-    return pa.table({"t_s": r.control_t, "u_applied": r.control_u,
-                     "u_requested": r.control_u_requested, "u_continuous": cont,
-                     "triggered": run.events.astype(bool)})
+    table = pa.table({"t_s": r.control_t, "u_applied": r.control_u,
+                      "u_requested": r.control_u_requested, "u_continuous": cont,
+                      "triggered": run.events.astype(bool)})
+    return with_units(table, TWIN_CONTROL, "control")
 
 
 def json_safe(obj: Any) -> Any:

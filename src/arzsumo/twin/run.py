@@ -15,6 +15,7 @@ from arzsumo import __version__
 from arzsumo.control.base import Controller
 from arzsumo.model.characteristic import linearize
 from arzsumo.scenarios import Scenario
+from arzsumo.schema import TWIN_SUMMARY, key_units
 from arzsumo.twin.config import TwinConfig, twin_config_from_dict
 from arzsumo.twin.controllers import make_controller
 from arzsumo.twin.initial import initial_fields
@@ -54,14 +55,14 @@ class TwinRun:
         return release_time(self.result.control_t, self.events, float(self.result.t[-1]))
 
     def summary(self) -> dict[str, Any]:
-        """JSON-ready summary; SI units (veh, s, m)."""
+        """JSON-ready summary; SI units (veh, s, m); ``units_by_key`` gives each key's unit."""
         r = self.result
         dx = r.dx
         n0 = float(r.fields[0, [0, 2]].sum() * dx)
         n1 = float(r.extra["total_vehicles"])
         perf = self.performance.as_dict()
         ratio = float(self.norm[-1] / self.norm[0]) if self.norm[0] > 0 else math.nan
-        return {
+        summ = {
             "scenario": self.scenario.name,
             "source": self.scenario.source,
             "version": __version__,
@@ -96,6 +97,8 @@ class TwinRun:
                              "inflow": r.inflow, "outflow": r.outflow,
                              "balance_error": n1 - n0 - (r.inflow - r.outflow)},
         }
+        summ["units_by_key"] = key_units(summ, TWIN_SUMMARY)   # docs/outputs.md
+        return summ
 
 
 def run_twin(scenario: Scenario, config: TwinConfig | None = None, *,

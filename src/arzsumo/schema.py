@@ -1,0 +1,249 @@
+"""Units and meanings of every column arzsumo writes to Parquet and of the summary keys.
+
+One place for the output schema (explained for users in ``docs/outputs.md``): the column
+tables of ``periods.parquet`` and ``cells.parquet`` (``arzsumo run``), ``fields.parquet``
+and ``control.parquet`` (``arzsumo twin``), the fixed columns of a sweep's
+``summaries.parquet``, and the units of the keys of ``summary.json`` (run and twin), whose
+dotted names are also the sweep table's columns.
+
+:func:`with_units` attaches a table's units to an Arrow table as field metadata ``unit``
+and ``description`` plus table metadata (arzsumo version, a note on units). Unit strings:
+SI (``veh/s``, ``veh/m``, ``m/s``, ``m``, ``s``), ``1`` for a dimensionless number
+(fractions, ratios), ``count`` for a number of events or vehicles counted, ``-`` for what
+is not a quantity (text, identifiers, flags).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from fnmatch import fnmatchcase
+from typing import NamedTuple
+
+import pyarrow as pa
+
+from arzsumo import __version__
+
+#: the note stored with every table
+UNITS_NOTE = ("SI units (veh, m, s); per-column unit and description in the field "
+              "metadata; see docs/outputs.md")
+TEXT = "-"
+
+
+class Column(NamedTuple):
+    """Unit and one-line meaning of a column."""
+
+    unit: str
+    description: str
+
+
+_PERIOD = "over the control period [t_s, t_s + control period]"
+#: ``periods.parquet`` of ``arzsumo run``: one row per control period
+PERIODS: dict[str, Column] = {
+    "t_s": Column("s", "time of the controller check that opens the period, from the start "
+                       "of control (end of warm-up)"),
+    "u": Column("veh/s", "U applied: commanded mainline outflow minus q_nominal (0: open loop)"),
+    "u_continuous": Column("veh/s", "the continuous control law at this check (before event "
+                                    "triggering; equal to u for continuous controllers)"),
+    "triggered": Column(TEXT, "true where the controller updated U at this check (an event)"),
+    "green_commanded": Column("1", "green share commanded for the period (fraction of cycle)"),
+    "green_running": Column("1", "green share the meter runs at the end of the period"),
+    "light_changes": Column("count", "ramp-light changes so far, from SUMO start (warm-up "
+                                     "included), cumulative"),
+    "plan_changes": Column("count", "meter plan (green share) changes so far, from SUMO "
+                                    "start, cumulative"),
+    "queue": Column("veh", "ramp queue at the end of the period: halted on ramp_up plus "
+                           "ramp vehicles waiting for insertion"),
+    "max_queue": Column("veh", "largest ramp queue so far (from SUMO start)"),
+    "inflow_h": Column("veh/s", f"HVs entering the mainline at x = 0 {_PERIOD}"),
+    "inflow_a": Column("veh/s", f"AVs entering the mainline at x = 0 {_PERIOD}"),
+    "outflow_h": Column("veh/s", f"HVs leaving the mainline at x = L {_PERIOD}"),
+    "outflow_a": Column("veh/s", f"AVs leaving the mainline at x = L {_PERIOD}"),
+    "occupancy_out": Column("1", "SUMO lane occupancy of down_0 (downstream of the merge), "
+                                 f"mean {_PERIOD}; ALINEA's measurement"),
+    "u_reference": Column("veh/s", "U of the reference twin's own controller at this check"),
+}
+
+_STATE = {
+    "rho_h": Column("veh/m", "HV density"),
+    "v_h": Column("m/s", "HV speed"),
+    "rho_a": Column("veh/m", "AV density"),
+    "v_a": Column("m/s", "AV speed"),
+}
+#: ``cells.parquet`` of ``arzsumo run``: one row per source, period end and micro cell
+CELLS: dict[str, Column] = {
+    "source": Column(TEXT, "micro (SUMO, Edie aggregates), replay or reference (PDE twins)"),
+    "t_s": Column("s", "end of the control period, from the start of control"),
+    "x_m": Column("m", "cell centre on the mainline, 0 at the inlet"),
+    "rho_h": Column("veh/m", "HV density (micro: Edie over the period)"),
+    "v_h": Column("m/s", "HV speed (micro: space-mean, NaN in a cell no HV visited; twins: "
+                         "all four variables NaN at a re-synchronisation)"),
+    "rho_a": Column("veh/m", "AV density"),
+    "v_a": Column("m/s", "AV speed (micro: NaN in a cell no AV visited)"),
+}
+#: ``fields.parquet`` of ``arzsumo twin``: one row per output time and cell
+TWIN_FIELDS: dict[str, Column] = {
+    "t_s": Column("s", "output time from the start of the run"),
+    "x_m": Column("m", "cell centre, 0 at the inlet"),
+    **_STATE,
+}
+#: ``control.parquet`` of ``arzsumo twin``: one row per controller check
+TWIN_CONTROL: dict[str, Column] = {
+    "t_s": Column("s", "time of the controller check"),
+    "u_applied": Column("veh/s", "U applied at the outlet after saturation to [u_min, u_max]"),
+    "u_requested": Column("veh/s", "U the controller asked for (before saturation)"),
+    "u_continuous": Column("veh/s", "continuous control law (NaN when the controller does "
+                                    "not log one per check)"),
+    "triggered": Column(TEXT, "true where the applied U was updated (an event)"),
+}
+#: columns of a sweep's ``summaries.parquet`` that do not come from a summary
+SWEEP_FIXED: dict[str, Column] = {
+    "run_id": Column(TEXT, "run identifier: axis=value pairs"),
+    "index": Column("-", "position of the run in the sweep"),
+    "status": Column(TEXT, "ok, incomplete, invalid, failed, crashed or missing"),
+    "error": Column(TEXT, "error message of a run that did not finish (else empty)"),
+    "warnings": Column("count", "warnings the run logged (text in its summary.json)"),
+    "execution.id": Column(TEXT, "identifier of the execution that produced the result"),
+    "execution.host": Column(TEXT, "host name of the worker"),
+    "execution.pid": Column(TEXT, "process id of the worker"),
+    "execution.started": Column("s", "start, seconds since 1970-01-01 UTC"),
+    "execution.wall_s": Column("s", "wall time of the execution"),
+}
+
+_FUEL = "veh"          # the paper's fuel rate is in 1/s; integrated over veh s
+_DISCOM = "veh m^2/s^3 + veh m^2/s^5"
+#: performance indices (paper, section 5): in the run summary (micro and twins) and twin's
+_RUN_INDICES = {"TTT": "veh*s", "total_delay": "veh*s", "J_fuel": _FUEL, "J_discom": _DISCOM}
+_TWIN_INDICES = {"J_TTT": "veh*s", "TMT": "veh*m", "total_delay": "veh*s", "J_fuel": _FUEL,
+                 "J_discom": _DISCOM}
+_EQUILIBRIUM = {"equilibrium.rho_*": "veh/m", "equilibrium.v_*": "m/s",
+                "equilibrium.q_*": "veh/s", "equilibrium.ao": "1",
+                "equilibrium.penetration": "1"}
+_COMMON = {"scenario": TEXT, "source": TEXT, "version": TEXT, "seed": TEXT,
+           "controller": TEXT, "complete": TEXT, "units": TEXT, "units_by_key": TEXT,
+           "triggers": "count", "release_time": "s", **_EQUILIBRIUM}
+
+#: units of the keys of ``arzsumo run``'s summary.json (dotted; ``*`` within a name)
+RUN_SUMMARY: dict[str, str] = {
+    **_COMMON, "lambda_4": "m/s", "q_nominal": "veh/s", "horizon": "s", "warmup": "s",
+    "plan_changes": "count", "light_changes": "count", "max_ramp_queue": "veh",
+    "speed_variance.*": "m^2/s^2",
+    **{f"{k}.*": u for k, u in _RUN_INDICES.items()}, "until_s": "s",
+    **{f"twin_*.{k}.*": u for k, u in _RUN_INDICES.items()}, "twin_*.until_s": "s",
+    "rmse.*.rho_*.absolute": "veh/m", "rmse.*.v_*.absolute": "m/s",
+    "rmse.*.*.relative": "1", "rmse.*.*.samples": "count",
+    "twin_status.*.resyncs": "count", "twin_status.*.first_resync_s": "s",
+    "twin_status.*.first_reason": TEXT,
+    "inserted": "veh", "requested": "veh", "waiting": "veh", "arrived": "veh",
+    "teleports": "count", "collisions": "count", "emergency_braking": "count",
+    "placement": TEXT, "wall_time": "s", "timings.*": "s",
+    "controller_time_per_period": "s",
+    "settings.warmup": "s", "settings.smoothing": "s", "settings.alinea_target": "1",
+    "settings.alinea_gain": "veh/s", "settings.alinea_saturation": "veh/s",
+    "settings.kernel_cells": "count", "settings.twin_cells": "count", "settings.*": TEXT,
+}
+#: units of the keys of ``arzsumo twin``'s summary.json
+TWIN_SUMMARY: dict[str, str] = {
+    **_COMMON, "status": TEXT, "saturation_time": "s", "outlet_limited_time": "s",
+    "u_range": "veh/s", **{f"{k}.*": u for k, u in _TWIN_INDICES.items()},
+    "relative_to_open_loop_percent.*": "%",
+    "open_loop_baseline": TEXT, "initial_norm": "1", "final_norm": "1",
+    "final_norm_ratio": "1", "final_time": "s", "regime": TEXT,
+    "config.cells": "count", "config.kernel_cells": "count", "config.cfl": "1",
+    "config.horizon": "s", "config.control_period": "s", "config.output_period": "s",
+    "config.u_min": "veh/s", "config.u_max": "veh/s", "config.constant_u": "veh/s",
+    "config.design.*": "paper", "config.initial.amplitude": "1",
+    "config.initial.wavenumber": "1", "config.initial.phase": "rad", "config.*": TEXT,
+    "numerics.steps": "count", "numerics.rejected_steps": "count",
+    "numerics.wall_time_s": "s", "numerics.speed_up": "1", "conservation.*": "veh",
+}
+
+#: scenario-file key suffixes and their units (scenario files name their units)
+_SUFFIXES = (("_veh_h_per_pct", "veh/h per %"), ("_veh_km", "veh/km"), ("_veh_h", "veh/h"),
+             ("_kmh", "km/h"), ("_veh", "veh"), ("_rad", "rad"), ("_m", "m"), ("_s", "s"))
+
+
+def summary_unit(key: str, table: Mapping[str, str]) -> str | None:
+    """Unit of the summary entry ``key`` (dotted) in ``table``: exact name first, then the
+    first matching pattern; a pattern ``a.*`` also covers ``a`` itself (a group written as
+    null when it could not be computed). None if the key is not described."""
+    if key in table:
+        return table[key]
+    return next((u for pattern, u in table.items() if fnmatchcase(key, pattern)
+                 or (pattern.endswith(".*") and fnmatchcase(key, pattern[:-2]))), None)
+
+
+def scenario_field_unit(field: str) -> str | None:
+    """Unit of a scenario field ``table.key`` read from its suffix, or None (no suffix)."""
+    return next((u for suffix, u in _SUFFIXES if field.endswith(suffix)), None)
+
+
+def with_units(table: pa.Table, columns: Mapping[str, Column], name: str) -> pa.Table:
+    """``table`` with each field's ``unit`` and ``description`` and table metadata.
+
+    Raises
+    ------
+    KeyError
+        A column of ``table`` is missing from ``columns``: every written column must
+        state its unit (a programming error, caught by the tests).
+    """
+    missing = [c for c in table.column_names if c not in columns]
+    if missing:
+        raise KeyError(f"{name}: columns {missing} have no unit in arzsumo.schema")
+    fields = [f.with_metadata({b"unit": columns[f.name].unit.encode(),
+                               b"description": columns[f.name].description.encode()})
+              for f in table.schema]
+    meta = dict(table.schema.metadata or {})
+    meta.update({b"arzsumo.table": name.encode(), b"arzsumo.version": __version__.encode(),
+                 b"arzsumo.units": UNITS_NOTE.encode()})
+    return pa.Table.from_arrays(table.columns, schema=pa.schema(fields, metadata=meta))
+
+
+def units_of(table: pa.Table) -> dict[str, str]:
+    """Column -> unit of a table written by arzsumo ("" where none is stored)."""
+    return {f.name: (f.metadata or {}).get(b"unit", b"").decode() for f in table.schema}
+
+
+def markdown(columns: Mapping[str, Column]) -> str:
+    """A Markdown table (column, unit, meaning) of ``columns`` for docs/outputs.md."""
+    rows = ["| column | unit | meaning |", "|---|---|---|"]
+    rows += [f"| `{k}` | {c.unit} | {c.description} |" for k, c in columns.items()]
+    return "\n".join(rows)
+
+
+def _leaves(data: Mapping[str, object], prefix: str = "") -> list[str]:
+    out: list[str] = []
+    for key, value in data.items():
+        name = f"{prefix}{key}"
+        out += _leaves(value, f"{name}.") if isinstance(value, Mapping) else [name]
+    return out
+
+
+def key_units(summary: Mapping[str, object], table: Mapping[str, str]) -> dict[str, str]:
+    """Dotted key -> unit of every quantity in ``summary`` (text entries left out), for the
+    summary's ``units_by_key`` entry; a key ``table`` does not describe maps to "?"."""
+    units = {k: summary_unit(k, table) or "?" for k in _leaves(summary)}
+    return {k: u for k, u in units.items() if u != TEXT}
+
+
+#: the generated tables of docs/outputs.md, by marker name
+DOC_TABLES: dict[str, Mapping[str, Column]] = {
+    "periods": PERIODS, "cells": CELLS, "fields": TWIN_FIELDS, "control": TWIN_CONTROL,
+    "summaries": SWEEP_FIXED}
+
+
+def render_doc(text: str) -> str:
+    """``text`` with each block ``<!-- schema:NAME -->...<!-- /schema -->`` regenerated."""
+    import re
+
+    def block(m: re.Match[str]) -> str:
+        return f"<!-- schema:{m[1]} -->\n{markdown(DOC_TABLES[m[1]])}\n<!-- /schema -->"
+
+    return re.sub(r"<!-- schema:(\w+) -->\n.*?<!-- /schema -->", block, text, flags=re.S)
+
+
+if __name__ == "__main__":      # python -m arzsumo.schema docs/outputs.md: refresh the tables
+    import sys
+    from pathlib import Path
+
+    doc = Path(sys.argv[1])
+    doc.write_text(render_doc(doc.read_text(encoding="utf-8")), encoding="utf-8")
