@@ -17,8 +17,8 @@ import time
 
 from arzsumo.model import get_preset
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.measure import MainlineSensor
 from arzsumo.sumo.meter import RampMeter
+from arzsumo.sumo.sensor import SumoSensor
 from arzsumo.sumo.simulation import open_simulation
 
 
@@ -36,14 +36,13 @@ def run(cfg: SumoConfig, measured: bool) -> tuple[float, float, float, int, floa
         lib = sim.lib
         if measured:
             meter = RampMeter(lib, cfg)
-            sensor = MainlineSensor(lib, params.length, cfg.cell_length, cfg.step_length,
-                                    cfg.steps_per_period)
+            sensor = SumoSensor(lib, params.length, cfg)
             q_star = meter.curve.outflow_at(cfg.green_share)
             while sim.time < cfg.horizon - 1e-9:
                 t = sim.step()
                 a = clock()
-                meter.step()
-                data = sensor.collect(t)
+                data = sensor.observe(t)
+                meter.step(sensor.queue)
                 if data is not None:   # a controller would run here; command a varying U
                     meter.command_outflow(q_star + 0.05 * math.sin(t / 20.0))
                 inside += clock() - a

@@ -11,6 +11,7 @@ from arzsumo.sumo.network import MAIN, RAMP_UP
 from arzsumo.sumo.paths import SumoError
 from arzsumo.sumo.placement import place_vehicles
 from arzsumo.sumo.runner import run_fixed_meter
+from arzsumo.sumo.sensor import ramp_queue
 from arzsumo.sumo.simulation import open_simulation
 
 pytestmark = pytest.mark.sumo
@@ -26,7 +27,7 @@ def test_vehicles_are_conserved():
         meter = RampMeter(sim.lib, cfg)
         while sim.time < cfg.horizon:
             sim.step()
-            meter.step()
+            meter.step(ramp_queue(sim.lib))
             if round(sim.time / cfg.step_length) % 50 == 0:
                 r = sim.take_report()
                 assert r.requested == r.inserted + r.waiting
@@ -77,7 +78,7 @@ def test_meter_counts_plan_and_light_changes():
         assert meter.set_green_share(0.5) is False    # same timing: no plan change
         for _ in range(round(12.0 / cfg.step_length)):
             sim.step()
-            meter.step()
+            meter.step(ramp_queue(sim.lib))
             states = sim.lib.trafficlight.getRedYellowGreenState("meter")
             assert states == meter.light
         assert meter.light_changes == 4               # two cycles: G->r, r->G, G->r, r->G

@@ -26,7 +26,8 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from arzsumo import __version__
-from arzsumo.bridge.cosim import CoSimResult, fill_speeds
+from arzsumo.bridge.cosim import CoSimResult
+from arzsumo.bridge.estimator import fill_speeds
 from arzsumo.control.base import ControlLog
 from arzsumo.control.events import release_time
 from arzsumo.io import atomic_dir

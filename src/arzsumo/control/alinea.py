@@ -40,7 +40,6 @@ class Alinea(Controller):
     """
 
     name = "alinea"
-    measurement = "occupancy"
 
     def __init__(self, outflow_of_green: Callable[[float], float], nominal_green: float,
                  target: float, gain: float = 7000.0 / 3600.0,

@@ -82,7 +82,6 @@ class Backstepping(Controller):
     """
 
     name = "backstepping"
-    measurement = "full"
 
     def __init__(self, lin: Linearization, kernels: Kernels) -> None:
         super().__init__()

@@ -77,8 +77,6 @@ class Controller(ABC):
 
     #: short name used in outputs ("open", "backstepping", "etc", "observer-etc", "alinea")
     name: str = "controller"
-    #: "full" (needs every cell) or "inlet" (needs only the inlet speeds)
-    measurement: str = "full"
 
     def __init__(self) -> None:
         self.log = ControlLog()
@@ -100,7 +98,6 @@ class OpenLoop(Controller):
     """U = 0: the outlet flow stays at q* (the paper's open-loop case)."""
 
     name = "open"
-    measurement = "none"
 
     def decide(self, state: MacroState) -> float:
         self.log.record(state.t, 0.0, 0.0, False)
@@ -111,7 +108,6 @@ class ConstantControl(Controller):
     """U held at a constant value (veh/s); useful for tests and for replaying a plan."""
 
     name = "constant"
-    measurement = "none"
 
     def __init__(self, u: float) -> None:
         super().__init__()

@@ -166,7 +166,6 @@ class EventTriggered(Controller):
     """Full-state dynamic ETC (control law sam with the mechanism of defdynamic)."""
 
     name = "etc"
-    measurement = "full"
 
     def __init__(self, lin: Linearization, kernels: Kernels,
                  design: EtcDesign = PAPER_DESIGN) -> None:

@@ -111,7 +111,6 @@ class ObserverEtc(Controller):
     """Observer-based dynamic ETC: measurement only at the inlet (bs_control_of_etc)."""
 
     name = "observer-etc"
-    measurement = "inlet"
 
     def __init__(self, lin: Linearization, kernels: Kernels,
                  design: EtcDesign = PAPER_DESIGN) -> None:

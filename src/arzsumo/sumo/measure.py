@@ -24,7 +24,6 @@ from types import ModuleType
 
 import numpy as np
 
-from arzsumo.control.base import MacroState
 from arzsumo.errors import require
 from arzsumo.sumo.network import MAIN
 
@@ -68,16 +67,6 @@ class CellData:
         """AV space-mean speed per cell, m/s (NaN where empty)."""
         with np.errstate(invalid="ignore", divide="ignore"):
             return np.where(self.samples_a > 0, self.q_a / self.rho_a, np.nan)
-
-    @property
-    def inlet_speeds(self) -> tuple[float, float]:
-        """(v_h, v_a) in the first cell, m/s: the observer's measurement (NaN if empty)."""
-        return float(self.v_h[0]), float(self.v_a[0])
-
-    def macro_state(self, v_empty_h: float, v_empty_a: float) -> MacroState:
-        """The :class:`MacroState` of this window; empty cells get the given speeds (m/s)."""
-        return MacroState(self.t, self.x, self.rho_h, np.nan_to_num(self.v_h, nan=v_empty_h),
-                          self.rho_a, np.nan_to_num(self.v_a, nan=v_empty_a))
 
 
 class EdieGrid:

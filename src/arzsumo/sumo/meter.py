@@ -7,9 +7,11 @@ becomes a fixed-cycle program: green for g C seconds, then red, with minimum gre
 red times (a shorter green becomes all-red or the minimum green, whichever is nearer; the
 same for red). A new timing is a *plan change* and takes effect at the next cycle start;
 each switch of the light (green to red or red to green) is a *light change*. The ramp
-queue (halted vehicles on ``ramp_up`` plus ramp vehicles waiting to be inserted) and its
-maximum are tracked every step; an optional spillback override forces green while the
-queue is at or above ``spillback_queue``.
+queue (halted vehicles on ``ramp_up`` plus ramp vehicles waiting to be inserted), read by
+the sensor (:mod:`arzsumo.sumo.sensor`) and handed to :meth:`RampMeter.step` every step,
+and its maximum are tracked; an optional spillback override forces green while the queue
+is at or above ``spillback_queue``. The meter reads nothing from SUMO: it only sets the
+light.
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ import numpy as np
 
 from arzsumo.errors import ArzsumoError, require
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.network import METER_TL, RAMP_UP
+from arzsumo.sumo.network import METER_TL
 
 GREEN, RED = "G", "r"
 
@@ -148,15 +150,10 @@ class RampMeter:
     def _set(self, state: str) -> None:
         self.lib.trafficlight.setRedYellowGreenState(self.tl_id, state)
 
-    def measure_queue(self) -> int:
-        """Halted vehicles on the ramp plus ramp vehicles still waiting to be inserted."""
-        waiting = sum(1 for v in self.lib.simulation.getPendingVehicles()
-                      if v.startswith("ramp"))
-        return int(self.lib.edge.getLastStepHaltingNumber(RAMP_UP)) + waiting
-
-    def step(self) -> str:
-        """Call once after every SUMO step: update queue, cycle and light; return the light."""
-        self.queue = self.measure_queue()
+    def step(self, queue: int) -> str:
+        """Call once after every SUMO step with the ramp queue the sensor read (vehicles,
+        :func:`arzsumo.sumo.sensor.ramp_queue`): update cycle and light; return the light."""
+        self.queue = queue
         self.max_queue = max(self.max_queue, self.queue)
         self._k += 1
         if self._k >= self.cycle_steps:

@@ -14,9 +14,11 @@ from pathlib import Path
 from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.demand import InitialVehicle
-from arzsumo.sumo.measure import MainlineSensor, MeasurementLog
+from arzsumo.sumo.measure import MeasurementLog
 from arzsumo.sumo.meter import DEFAULT_CURVE, GreenShareCurve, RampMeter
 from arzsumo.sumo.network import RAMP_UP
+from arzsumo.sumo.paths import SumoError
+from arzsumo.sumo.sensor import SumoSensor, ramp_queue
 from arzsumo.sumo.simulation import RunReport, open_simulation
 
 log = logging.getLogger(__name__)
@@ -56,15 +58,20 @@ def run_fixed_meter(params: ModelParameters, cfg: SumoConfig, green_share: float
     cfg = cfg.with_(green_share=g)
     with open_simulation(params, cfg, initial=initial, net_dir=net_dir) as sim:
         meter = RampMeter(sim.lib, cfg, curve)
-        sensor = MainlineSensor(sim.lib, params.length, cfg.cell_length, cfg.step_length,
-                                cfg.steps_per_period)
+        sensor = SumoSensor(sim.lib, params.length, cfg)
+        measurements = MeasurementLog()
         while sim.time < cfg.horizon - 1e-9:
             t = sim.step()
-            meter.step()
             if measure:
-                sensor.collect(t)
+                got = sensor.observe(t)
+                if got is not None:
+                    measurements.append(got.cells)
+                meter.step(sensor.queue)
+            else:
+                meter.step(ramp_queue(sim.lib))
         # ramp vehicles past the meter: inserted minus those still upstream of it
         ramp_passed = sim.inserted_ramp - int(sim.lib.edge.getLastStepVehicleNumber(RAMP_UP))
-    assert sim.report is not None
+    if sim.report is None:  # pragma: no cover - close() failed to read SUMO's counts
+        raise SumoError("SUMO closed without a final report")
     log.info("%s", sim.report.summary())
-    return RunResult(cfg, g, sensor.log, sim.report, meter.summary(), ramp_passed)
+    return RunResult(cfg, g, measurements, sim.report, meter.summary(), ramp_passed)

@@ -333,52 +333,83 @@ def simulate(eq: Equilibrium, initial: np.ndarray, *, controller: Controller | N
     ctrl = controller if controller is not None else OpenLoop()
     ctrl.reset()
     stepper = TwinStepper(eq, initial, opts, inlet)
-    q_star = stepper.q_star
-    u_lo = -q_star if opts.u_min is None else opts.u_min
-    u_hi = q_star if opts.u_max is None else opts.u_max
-
-    n_out = math.floor(opts.horizon / opts.output_period + 1e-9) + 1
-    out_t = np.empty(n_out)
-    out_f = np.empty((n_out, 4, opts.cells))
-    ctl_t: list[float] = []
-    ctl_u: list[float] = []
-    ctl_req: list[float] = []
-    k_ctl = k_out = 0
-    u, saturated = 0.0, 0.0
-    status, complete = "completed", True
-    eps = 1e-9 * max(1.0, opts.horizon)
+    checks = _Checks(ctrl, opts, stepper.q_star)
+    samples = _Samples(opts)
     start = _time.perf_counter()
-    while True:
-        t = stepper.t
-        if k_out < n_out and t >= k_out * opts.output_period - eps:
-            out_t[k_out], out_f[k_out] = t, stepper.primitive()
-            k_out += 1
-        if t >= opts.horizon - eps:
-            break
-        if t >= k_ctl * opts.control_period - eps:
-            requested = float(ctrl.check(stepper.macro_state()))
-            u = min(max(requested, u_lo), u_hi)
-            if u != requested:
-                saturated += min(opts.control_period, opts.horizon - t)
-            ctl_t.append(t)
-            ctl_u.append(u)
-            ctl_req.append(requested)
-            k_ctl += 1
-        t_next = min(k_ctl * opts.control_period, k_out * opts.output_period, opts.horizon)
-        try:
-            stepper.advance(t_next, u, callback)
-        except TwinStoppedError as exc:
-            status, complete = str(exc), False
-            break
+    status = _time_loop(stepper, checks, samples, opts, callback)
     wall = _time.perf_counter() - start
+    complete = status == "completed"
     if not complete:
         log.warning("twin run incomplete: %s", status)
-        if k_out == 0 or out_t[k_out - 1] < stepper.t:
-            out_t[k_out], out_f[k_out] = stepper.t, stepper.primitive()   # last valid state
-            k_out += 1
-    return TwinResult(eq, opts, ctrl, out_t[:k_out].copy(), stepper.x, out_f[:k_out].copy(),
-                      np.asarray(ctl_t), np.asarray(ctl_u), np.asarray(ctl_req), saturated,
-                      (u_lo, u_hi), stepper.inflow, stepper.outflow, stepper.steps,
+        if samples.k == 0 or samples.t[samples.k - 1] < stepper.t:
+            samples.take(stepper.t, stepper.primitive())   # the last valid state
+    return TwinResult(eq, opts, ctrl, samples.t[:samples.k].copy(), stepper.x,
+                      samples.f[:samples.k].copy(), np.asarray(checks.t),
+                      np.asarray(checks.u), np.asarray(checks.requested), checks.saturated,
+                      checks.bounds, stepper.inflow, stepper.outflow, stepper.steps,
                       stepper.rejected_steps, wall, complete, status,
                       {"final_state": stepper.q, "total_vehicles": stepper.total_vehicles(),
                        "outlet_limited_time": stepper.outlet_limited_time})
+
+
+class _Samples:
+    """Primitive fields sampled every output period (preallocated)."""
+
+    def __init__(self, opts: SolverOptions) -> None:
+        n = math.floor(opts.horizon / opts.output_period + 1e-9) + 1
+        self.t, self.f, self.k = np.empty(n), np.empty((n, 4, opts.cells)), 0
+        self.period = opts.output_period
+
+    def due(self, t: float, eps: float) -> bool:
+        return self.k < self.t.size and t >= self.k * self.period - eps
+
+    def take(self, t: float, fields: np.ndarray) -> None:
+        self.t[self.k], self.f[self.k] = t, fields
+        self.k += 1
+
+
+class _Checks:
+    """The controller's checks, once per control period: U held between them, saturated
+    to [u_min, u_max] (default -q* .. q*), and the time it spent saturated (s)."""
+
+    def __init__(self, ctrl: Controller, opts: SolverOptions, q_star: float) -> None:
+        self.ctrl, self.period, self.horizon = ctrl, opts.control_period, opts.horizon
+        self.bounds = (-q_star if opts.u_min is None else opts.u_min,
+                       q_star if opts.u_max is None else opts.u_max)
+        self.t: list[float] = []
+        self.u: list[float] = []
+        self.requested: list[float] = []
+        self.held, self.saturated, self.k = 0.0, 0.0, 0
+
+    def due(self, t: float, eps: float) -> bool:
+        return t >= self.k * self.period - eps
+
+    def check(self, t: float, state: MacroState) -> None:
+        requested = float(self.ctrl.check(state))
+        self.held = min(max(requested, self.bounds[0]), self.bounds[1])
+        if self.held != requested:
+            self.saturated += min(self.period, self.horizon - t)
+        self.t.append(t)
+        self.u.append(self.held)
+        self.requested.append(requested)
+        self.k += 1
+
+
+def _time_loop(stepper: TwinStepper, checks: _Checks, samples: _Samples,
+               opts: SolverOptions, callback: StepCallback | None) -> str:
+    """Advance to the horizon between output samples and checks; return the status."""
+    eps = 1e-9 * max(1.0, opts.horizon)
+    while True:
+        t = stepper.t
+        if samples.due(t, eps):
+            samples.take(t, stepper.primitive())
+        if t >= opts.horizon - eps:
+            return "completed"
+        if checks.due(t, eps):
+            checks.check(t, stepper.macro_state())
+        t_next = min(checks.k * opts.control_period, samples.k * opts.output_period,
+                     opts.horizon)
+        try:
+            stepper.advance(t_next, checks.held, callback)
+        except TwinStoppedError as exc:
+            return str(exc)

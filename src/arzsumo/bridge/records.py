@@ -1,0 +1,50 @@
+"""What one control period of the closed loop leaves behind: a typed record per period.
+
+Record k pairs the check at ``t`` (s from the start of control) with the SUMO period that
+followed it under that check's command, ending at ``t + control_period``; the fields of
+that period's end are stored beside (see :class:`~arzsumo.bridge.cosim.CoSimResult`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class PeriodRecord:
+    """One control period (SI; flows veh/s, counts since the start of control).
+
+    ``u`` is the U held after the check (veh/s), ``u_continuous`` what the continuous
+    law gave, ``triggered`` an update of the held U (1.0 or 0.0), ``green_commanded`` the
+    green share asked of the meter, ``u_reference`` the reference twin's U,
+    ``controller_s`` the wall time of the check. The rest is the period that followed:
+    the running green share, cumulative light and plan changes, the ramp queue at its end
+    and its maximum so far (veh), class in- and outflows of the section, and the mean
+    occupancy downstream of the merge (fraction).
+    """
+
+    t: float
+    u: float
+    u_continuous: float
+    triggered: float
+    green_commanded: float
+    green_running: float
+    light_changes: float
+    plan_changes: float
+    queue: float
+    max_queue: float
+    inflow_h: float
+    inflow_a: float
+    outflow_h: float
+    outflow_a: float
+    occupancy_out: float
+    u_reference: float
+    controller_s: float
+
+
+def columns(records: list[PeriodRecord]) -> dict[str, np.ndarray]:
+    """The records as one float array per field (the ``periods`` table's columns)."""
+    return {f.name: np.array([getattr(r, f.name) for r in records], float)
+            for f in fields(PeriodRecord)}
