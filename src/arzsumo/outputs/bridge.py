@@ -27,10 +27,9 @@ from arzsumo import __version__
 from arzsumo.bridge.cosim import CoSimResult, fill_speeds
 from arzsumo.control.base import ControlLog
 from arzsumo.control.events import release_time
-from arzsumo.io import atomic_dir
+from arzsumo.io import atomic_dir, json_safe
 from arzsumo.model.characteristic import linearize
 from arzsumo.twin.metrics import performance
-from arzsumo.twin.output import json_safe
 
 VARIABLES = ("rho_h", "v_h", "rho_a", "v_a")
 
@@ -88,7 +87,8 @@ def summary(res: CoSimResult) -> dict[str, Any]:
         "q_nominal": res.q_nominal, "horizon": horizon, "warmup": res.settings.warmup,
         "plan_changes": int(res.meter["plan_changes"]),
         "light_changes": int(res.meter["light_changes"]),
-        "triggers": int(triggered.sum()), "release_time": release_time(clipped, horizon),
+        "triggers": int(triggered.sum()),
+        "release_time": release_time(clipped.t, clipped.triggered, horizon),
         "max_ramp_queue": int(res.meter["max_queue"]),
         "speed_variance": {"h": float(np.nanvar(v[:, 0])), "a": float(np.nanvar(v[:, 1]))},
         **{k: v for k, v in _indices(res, res.micro).items()},
