@@ -1,5 +1,5 @@
 # make run  : create .venv if missing, install arzsumo with its extras, run the default job
-# make test : the same set-up, then the whole test suite
+# make test : the same set-up, then the import contracts (lint-imports) and the whole test suite
 PYTHON ?= python3
 VENV   ?= .venv
 BIN    := $(VENV)/bin
@@ -16,6 +16,7 @@ run: $(STAMP)
 	$(BIN)/arzsumo run
 
 test: $(STAMP)
+	$(BIN)/lint-imports
 	$(BIN)/python -m pytest -q
 
 lint: $(STAMP)

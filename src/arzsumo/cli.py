@@ -14,27 +14,15 @@ import sys
 from collections.abc import Callable, Sequence
 
 from arzsumo import __version__, cli_bridge, cli_control, cli_sumo, cli_sweep, cli_twin
+from arzsumo.cli_common import add_model_source, scenario_of
 from arzsumo.errors import ArzsumoError
 from arzsumo.model import linearize
-from arzsumo.scenarios import Scenario, load_scenario, scenario_from_preset
+from arzsumo.scenarios import Scenario
 from arzsumo.units import ms_to_kmh
 
 log = logging.getLogger("arzsumo")
 
 Command = Callable[[argparse.Namespace], int]
-
-
-def scenario_of(args: argparse.Namespace) -> Scenario:
-    if getattr(args, "scenario", None):
-        return load_scenario(args.scenario)
-    return scenario_from_preset(args.preset)
-
-
-def add_model_source(p: argparse.ArgumentParser) -> None:
-    src = p.add_mutually_exclusive_group()
-    src.add_argument("--preset", default="paper_base",
-                     help="named model preset (paper_base, paper_s12, paper_aggressive)")
-    src.add_argument("--scenario", metavar="FILE.toml", help="scenario file instead of a preset")
 
 
 def model_summary(sc: Scenario) -> dict:
@@ -73,7 +61,7 @@ def cmd_model(args: argparse.Namespace) -> int:
     sc = scenario_of(args)
     if args.regime_map:
         from arzsumo.model.regime import regime_map
-        from arzsumo.plots.regime import write_regime_map
+        from arzsumo.outputs.figures import write_regime_map
 
         path = write_regime_map(args.regime_map, regime_map(sc.params),
                                 (sc.equilibrium.rho_h, sc.equilibrium.rho_a),

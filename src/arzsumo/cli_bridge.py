@@ -14,8 +14,8 @@ DEFAULT_SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "default.
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from arzsumo.bridge.outputs import write_results
     from arzsumo.bridge.session import run_in_sumo
+    from arzsumo.outputs.bridge import write_results
     from arzsumo.scenarios import load_scenario
 
     path = Path(args.scenario) if args.scenario else DEFAULT_SCENARIO
@@ -27,7 +27,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     text = path.read_text(encoding="utf-8") + session.resolved_comment()
     out, summ = write_results(session.result, out, text, plots=not args.no_plots)
     if args.json:
-        from arzsumo.twin.output import json_safe
+        from arzsumo.io import json_safe
 
         print(json.dumps(json_safe(summ), indent=2))
     else:
@@ -39,7 +39,7 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def cmd_compare(args: argparse.Namespace) -> int:
-    from arzsumo.bridge.compare import compare_runs
+    from arzsumo.outputs.compare import compare_runs
 
     table, csv, png = compare_runs([Path(p) for p in args.runs], Path(args.out))
     print(table)

@@ -6,19 +6,17 @@ import argparse
 import json
 import time
 
+from arzsumo.cli_common import add_model_source, scenario_of
 from arzsumo.errors import require
 from arzsumo.kernel_cache import cached_kernels
 
 
 def _add_common(p: argparse.ArgumentParser) -> None:
-    from arzsumo.cli import add_model_source
-
     add_model_source(p)
     p.add_argument("--cells", type=int, default=200, help="kernel grid cells (default 200)")
 
 
 def _linearization(args: argparse.Namespace):
-    from arzsumo.cli import scenario_of
     from arzsumo.model import linearize
 
     require(args.cells >= 4, "--cells", args.cells, "an integer >= 4")
@@ -26,7 +24,7 @@ def _linearization(args: argparse.Namespace):
 
 
 def cmd_kernels(args: argparse.Namespace) -> int:
-    from arzsumo.plots.kernels import write_kernels_plot
+    from arzsumo.outputs.figures import write_kernels_plot
 
     lin = _linearization(args)
     t0 = time.perf_counter()

@@ -36,9 +36,9 @@ def cmd_build_net(args: argparse.Namespace) -> int:
 
 
 def cmd_calibrate(args: argparse.Namespace) -> int:
+    from arzsumo.outputs.calibration import write_calibration
     from arzsumo.scenarios import load_scenario, scenario_from_preset
     from arzsumo.sumo.calibrate import CalibrationPlan, calibrate
-    from arzsumo.sumo.calibration_io import write_calibration
     from arzsumo.sumo.config import sumo_config_of
 
     sc = load_scenario(args.scenario) if args.scenario else scenario_from_preset(args.preset)

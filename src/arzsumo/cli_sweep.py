@@ -14,6 +14,7 @@ EXIT_SOME_FAILED = 4
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
+    from arzsumo.studies.paper.values import paper_points
     from arzsumo.sweep import load_sweep, run_sweep
     from arzsumo.sweep.worker import FINISHED
 
@@ -24,7 +25,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         return 0
     out = Path(args.out) if args.out else Path("results") / "sweeps" / spec.name
     rep = run_sweep(spec, out, workers=args.workers, scheduler=args.scheduler,
-                    progress=not args.quiet, plots=not args.no_plots)
+                    progress=not args.quiet, plots=not args.no_plots,
+                    paper=paper_points(spec.paper))
     df = rep.table
     bad = df[~df["status"].isin(FINISHED)]
     print(f"sweep {spec.name} ({spec.engine}): {rep.total} runs, {rep.skipped} already "

@@ -2,9 +2,9 @@
 ``arzsumo reproduce [--out DIR] [--quick]``: run every experiment of section 5.
 
 Registered into the main parser by :func:`register`; the work is done by
-:func:`arzsumo.twin.run.run_twin` and :func:`arzsumo.twin.output.write_run`, and by
-:func:`arzsumo.twin.reproduce.reproduce` and
-:func:`arzsumo.twin.reproduce_output.write_reproduction`.
+:func:`arzsumo.twin.run.run_twin` and :func:`arzsumo.outputs.twin.write_run`, and by
+:func:`arzsumo.studies.paper.reproduce.reproduce` and
+:func:`arzsumo.studies.paper.report.write_reproduction`.
 Exit codes: 0 completed, 3 stopped early (state left the physical domain; the partial
 results are written and marked ``"complete": false``), 2 user error.
 """
@@ -25,7 +25,8 @@ EXIT_INCOMPLETE = 3
 
 
 def cmd_twin(args: argparse.Namespace) -> int:
-    from arzsumo.twin.output import json_safe, write_run
+    from arzsumo.io import json_safe
+    from arzsumo.outputs.twin import write_run
     from arzsumo.twin.run import run_twin
 
     sc = load_scenario(args.scenario)
@@ -67,9 +68,9 @@ def _print(s: dict, out: Path) -> None:
 
 
 def cmd_reproduce(args: argparse.Namespace) -> int:
-    from arzsumo.twin.compare import REPRODUCED, claims
-    from arzsumo.twin.reproduce import reproduce
-    from arzsumo.twin.reproduce_output import write_reproduction
+    from arzsumo.studies.paper.compare import REPRODUCED, claims
+    from arzsumo.studies.paper.report import write_reproduction
+    from arzsumo.studies.paper.reproduce import reproduce
 
     rep = reproduce(args.scenarios, quick=args.quick, only=args.only or None,
                     workers=args.workers,

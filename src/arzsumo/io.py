@@ -1,4 +1,5 @@
-"""Atomic file and directory writes (results appear complete or not at all), TOML in and out."""
+"""Atomic file and directory writes (results appear complete or not at all), TOML in and out,
+JSON-ready values. A leaf utility: imports nothing of arzsumo."""
 
 from __future__ import annotations
 
@@ -13,6 +14,8 @@ import tomllib
 from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 
 def _umask() -> int:
@@ -127,3 +130,16 @@ def dump_toml(data: Mapping[str, Any]) -> str:
         return lines
 
     return "\n".join(table("", data)).lstrip("\n") + "\n"
+
+
+def json_safe(obj: Any) -> Any:
+    """``obj`` with numpy scalars as Python numbers and non-finite floats as None."""
+    if isinstance(obj, dict):
+        return {k: json_safe(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [json_safe(v) for v in obj]
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    if isinstance(obj, np.generic):
+        return json_safe(obj.item())
+    return obj

@@ -72,7 +72,7 @@ EQUILIBRIUM_KEYS: dict[str, Callable[[float], Any]] = {
 
 #: Tables parsed elsewhere: [twin] and [initial] by arzsumo.twin.config, [sumo] by
 #: arzsumo.sumo.config, [run] by arzsumo.bridge.config, [sweep] (parameter, values) by
-#: arzsumo.twin.reproduce (design sensitivity); [design] below.
+#: arzsumo.studies.paper.reproduce (design sensitivity); [design] below.
 TOP_KEYS = {"name", "description", "model", "equilibrium", "twin", "initial", "design",
             "sumo", "run", "sweep"}
 

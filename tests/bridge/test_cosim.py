@@ -13,10 +13,10 @@ import pytest
 
 from arzsumo.bridge.config import RunSettings, run_settings_from_dict
 from arzsumo.bridge.cosim import run_cosimulation
-from arzsumo.bridge.outputs import write_results
 from arzsumo.cli import main
 from arzsumo.control.etc import PAPER_DESIGN
 from arzsumo.errors import ScenarioError
+from arzsumo.outputs.bridge import write_results
 from arzsumo.scenarios import load_scenario
 from arzsumo.sumo.config import sumo_config_of
 

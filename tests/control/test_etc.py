@@ -5,7 +5,7 @@ import pytest
 
 from arzsumo.control.base import ControlLog
 from arzsumo.control.etc import PAPER_DESIGN, EtcDesign, EventTrigger, integrate_m
-from arzsumo.control.events import lyapunov_convergence_time, release_time
+from arzsumo.control.events import event_summary, lyapunov_convergence_time, release_time
 from arzsumo.control.observer import BoundaryObserver, dual_system, observer_gains
 from arzsumo.control.verify import run_closed_loop
 from arzsumo.errors import ModelError
@@ -115,11 +115,17 @@ def test_m_integration_is_exact_for_linear_forcing():
     assert integrate_m(-0.01, 0.2, 0.7, eta, tau) == pytest.approx(m, rel=1e-7)
 
 
+def test_release_time_of_an_empty_log_is_the_horizon():
+    # no check, no update: the control was held all along (T - N Delta with N = 0)
+    assert release_time([], [], 450.0) == 450.0
+    assert event_summary(ControlLog(), 450.0).release_time == 450.0
+
+
 def test_release_time_and_lyapunov_time_definitions():
     log = ControlLog()
     for t, trig in [(0, True), (1, False), (2, False), (3, True), (4, False)]:
         log.record(t, 0, 0, trig)
-    assert release_time(log, 5.0) == 3.0
+    assert release_time(log.t, log.triggered, 5.0) == 3.0
     t = np.arange(6.0)
     assert lyapunov_convergence_time(t, np.array([1, 0.5, 0.001, 0.02, 0.001, 0.0])) == 4.0
 

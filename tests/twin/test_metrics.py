@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from arzsumo.control.events import release_time
 from arzsumo.twin.metrics import (
     B_FUEL,
     acceleration,
@@ -12,7 +13,6 @@ from arzsumo.twin.metrics import (
     events,
     performance,
     relative_change,
-    release_time,
 )
 
 

@@ -1,4 +1,5 @@
-"""One table across co-simulation runs (``arzsumo compare``), as text, CSV and bar plot."""
+"""One table across co-simulation runs (``arzsumo compare``): rows from run summaries, as
+text; written with its bar plot by :func:`arzsumo.outputs.compare.compare_runs`."""
 
 from __future__ import annotations
 
@@ -9,7 +10,6 @@ from typing import Any
 import pandas as pd
 
 from arzsumo.errors import ScenarioError
-from arzsumo.io import atomic_file
 
 #: (column, header, how to read it from summary.json, unit conversion for humans)
 COLUMNS: tuple[tuple[str, str], ...] = (
@@ -66,33 +66,3 @@ def load_summaries(runs: list[Path]) -> list[dict[str, Any]]:
                                 "(not a complete arzsumo run directory)")
         out.append(json.loads(path.read_text(encoding="utf-8")))
     return out
-
-
-def compare_runs(runs: list[Path], out: Path) -> tuple[str, Path, Path]:
-    """Write ``comparison.csv`` and ``comparison.png`` into ``out``; return the text table."""
-    import matplotlib.pyplot as plt
-
-    import arzsumo.plots  # noqa: F401  (Agg backend)
-
-    summaries = load_summaries(runs)
-    df = pd.DataFrame([row_of(s) for s in summaries])
-    out.mkdir(parents=True, exist_ok=True)
-    csv = out / "comparison.csv"
-    with atomic_file(csv) as tmp:
-        df.to_csv(tmp, index=False)
-    grouped = df.groupby("controller", sort=False)
-    metrics = [("plan_changes", "meter plan changes"), ("TTT_veh_h", "TTT (veh h)"),
-               ("delay_veh_h", "total delay (veh h)"), ("speed_sd_h_kmh", "sd of HV speed (km/h)")]
-    fig, axes = plt.subplots(1, len(metrics), figsize=(4 * len(metrics), 3.6),
-                             layout="constrained")
-    for ax, (col, label) in zip(axes, metrics, strict=True):
-        mean, sd = grouped[col].mean(), grouped[col].std().fillna(0.0)
-        ax.bar(mean.index, mean.values, yerr=sd.values, capsize=3, color="C0")
-        ax.set_title(label, fontsize=10)
-        ax.tick_params(axis="x", rotation=30)
-    fig.suptitle("mean over seeds (error bars: standard deviation)")
-    png = out / "comparison.png"
-    with atomic_file(png) as tmp:
-        fig.savefig(tmp, dpi=100, format="png")
-    plt.close(fig)
-    return summary_table(summaries), csv, png

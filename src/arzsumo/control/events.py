@@ -6,24 +6,39 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from arzsumo.control.base import ControlLog
 
 
-def release_time(log: ControlLog, horizon: float) -> float:
-    """Total time (s) during which the applied control stayed unchanged.
+def release_time(t: ArrayLike, triggered: ArrayLike, horizon: float) -> float:
+    """Total release time (s): the time during which the applied control stayed unchanged.
 
+    Parameters
+    ----------
+    t : array_like
+        Check times, s, increasing (a :class:`ControlLog`'s ``t``).
+    triggered : array_like of bool
+        Whether the check updated the control (a log's ``triggered``, or the twin's
+        :func:`arzsumo.twin.metrics.events`).
+    horizon : float
+        End of the run, s.
+
+    Notes
+    -----
     Every check that does not update the control releases the signal until the next check
     (the last one until ``horizon``). With checks every Delta from t = 0 this is
     T - N Delta for N events (t_0 included), which matches the paper's pairs (160, 291 s),
     (101, 349 s), (245, 206 s), (358, 93 s) over T = 450 s to within one period.
-    Continuous backstepping updates at every check: release time 0.
+    Continuous backstepping updates at every check: release time 0. An empty log (no
+    check, so no update) gives ``horizon``: the control was held all along, T - N Delta
+    with N = 0.
     """
-    t = np.asarray(log.t)
+    t = np.asarray(t, float)
     if t.size == 0:
         return float(horizon)
     spans = np.diff(np.append(t, max(horizon, t[-1])))
-    return float(np.sum(spans[~np.asarray(log.triggered, bool)]))
+    return float(np.sum(spans[~np.asarray(triggered, bool)]))
 
 
 def lyapunov_convergence_time(t: np.ndarray, V: np.ndarray, fraction: float = 0.01) -> float:
@@ -57,7 +72,7 @@ def event_summary(log: ControlLog, horizon: float) -> EventSummary:
     times = log.event_times
     intervals = np.diff(times)
     return EventSummary(
-        triggers=log.triggers, release_time=release_time(log, horizon),
+        triggers=log.triggers, release_time=release_time(log.t, log.triggered, horizon),
         min_interval=float(intervals.min()) if intervals.size else float("inf"),
         mean_interval=float(intervals.mean()) if intervals.size else float("inf"),
         first_event=float(times[0]) if times.size else float("nan"),

@@ -1,6 +1,7 @@
 """The mixed-autonomy ARZ model: parameters, fundamental diagram, equilibria, characteristic form.
 
-Pure math: no SUMO, no files, no plotting.
+Pure math: no SUMO, no files, no plotting. May import only ``units`` and ``errors``
+(contracts in ``pyproject.toml``, checked by ``lint-imports``).
 """
 
 from arzsumo.model.characteristic import (

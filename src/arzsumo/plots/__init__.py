@@ -1,6 +1,9 @@
-"""Plots: functions that take arrays and return Figures, and writers that save them.
+"""Plots: functions that take arrays (and model types) and return Figures, and
+:func:`save_png`.
 
-Matplotlib's Agg backend is selected here: arzsumo runs headless.
+Imported only by :mod:`arzsumo.outputs` (the writers); imports nothing above the model:
+numpy, pandas, matplotlib, and of arzsumo only ``model``, ``io``, ``units`` (contracts in
+``pyproject.toml``). Matplotlib's Agg backend is selected here: arzsumo runs headless.
 """
 
 from __future__ import annotations

@@ -2,26 +2,28 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
-import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 
-from arzsumo.control.kernels import Kernels
-from arzsumo.io import atomic_file
+from arzsumo.plots import plt
 
 
-def kernels_figure(kernels: Kernels, title: str = "") -> Figure:
-    """One panel per kernel component over the triangle 0 <= xi <= x <= L (km), in 1/km."""
-    n = kernels.K.shape[0]
-    panels = [(f"$k_{i + 1}$", kernels.K[i]) for i in range(n)] + [("$M$", kernels.M)]
-    panels += [(f"$\\ell_{i + 1}$", kernels.L[i]) for i in range(n)] + [("$N$", kernels.N)]
+def kernels_figure(x: np.ndarray, K: np.ndarray, M: np.ndarray, L: np.ndarray,
+                   N: np.ndarray, title: str = "") -> Figure:
+    """One panel per kernel component over the triangle 0 <= xi <= x <= L (km), in 1/km.
+
+    ``x`` is the grid (m); ``K`` (n, m, m) and ``M`` (m, m) the kernels of label back4,
+    ``L`` and ``N`` the inverse kernels of label invback (1/m), as in
+    :class:`arzsumo.control.kernels.Kernels`.
+    """
+    n = K.shape[0]
+    panels = [(f"$k_{i + 1}$", K[i]) for i in range(n)] + [("$M$", M)]
+    panels += [(f"$\\ell_{i + 1}$", L[i]) for i in range(n)] + [("$N$", N)]
     cols = n + 1
     fig, axes = plt.subplots(2, cols, figsize=(3.2 * cols, 6.0), layout="constrained",
                              squeeze=False)
-    x_km = kernels.x / 1000.0
-    lower = np.tril(np.ones_like(kernels.M, dtype=bool))
+    x_km = x / 1000.0
+    lower = np.tril(np.ones_like(M, dtype=bool))
     for ax, (label, field) in zip(axes.ravel(), panels, strict=True):
         data = np.where(lower, field * 1000.0, np.nan)       # 1/m -> 1/km
         span = np.nanmax(np.abs(data)) or 1.0
@@ -35,12 +37,3 @@ def kernels_figure(kernels: Kernels, title: str = "") -> Figure:
     if title:
         fig.suptitle(title)
     return fig
-
-
-def write_kernels_plot(path: str | Path, kernels: Kernels, title: str = "") -> Path:
-    """Save :func:`kernels_figure` as PNG (atomically)."""
-    fig = kernels_figure(kernels, title)
-    with atomic_file(path) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
-    plt.close(fig)
-    return Path(path)

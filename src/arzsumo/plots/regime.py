@@ -2,14 +2,11 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.colors import TwoSlopeNorm
 from matplotlib.figure import Figure
 
-from arzsumo.io import atomic_file
 from arzsumo.model.regime import RegimeMap
 from arzsumo.units import ms_to_kmh, veh_m_to_veh_km
 
@@ -43,13 +40,3 @@ def regime_figure(rmap: RegimeMap, point: tuple[float, float] | None = None,
     ax.set_title(title or r"Congested region: $\lambda_4<0$ (red)")
     ax.set_facecolor("0.85")
     return fig
-
-
-def write_regime_map(path: str | Path, rmap: RegimeMap,
-                     point: tuple[float, float] | None = None, title: str = "") -> Path:
-    """Draw :func:`regime_figure` and save it as PNG at ``path`` (atomically)."""
-    fig = regime_figure(rmap, point, title)
-    with atomic_file(path) as tmp:
-        fig.savefig(tmp, dpi=120, format="png")
-    plt.close(fig)
-    return Path(path)

@@ -1,14 +1,13 @@
 """Figures of ``arzsumo reproduce``: release instants, penetration, sensitivity.
 
-Two layers: the ``*_figure`` functions take arrays and return a Figure; the writer
-:func:`write_reproduce_plots` takes a reproduction and writes PNG files.
+The ``*_figure`` functions take arrays and return a Figure; the writer is
+:func:`arzsumo.outputs.reproduce.write_figures`.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from pathlib import Path
 
 import matplotlib
 
@@ -16,8 +15,6 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
-
-from arzsumo.plots import save_png
 
 
 def release_instants_figure(names: Sequence[str], event_times: Sequence[np.ndarray],
@@ -104,47 +101,3 @@ def sensitivity_figure(sweeps: Mapping[str, tuple[np.ndarray, np.ndarray, np.nda
     fig.suptitle("Sensitivity of the ETC to its design parameters")
     fig.tight_layout()
     return fig
-
-
-def _save(fig: Figure, path: Path) -> Path:
-    return save_png(fig, path, dpi=120)
-
-
-def write_reproduce_plots(rep, out: str | Path) -> list[Path]:
-    """Write release_instants.png, penetration.png and sensitivity.png into ``out``."""
-    from arzsumo.twin.compare import penetration_table, sensitivity_table
-    from arzsumo.twin.paper_values import EVENTS, SENSITIVITY
-
-    out = Path(out)
-    written = []
-    runs = [r for r in rep.records if r.sweep is None and r.controller in ("etc",
-                                                                           "observer-etc")]
-    if runs:
-        paper = {e.scenario: f"{e.triggers if e.triggers is not None else '-'} / "
-                             f"{e.release_time:.0f} s" for e in EVENTS
-                 if e.release_time is not None}
-        horizon = float(runs[0].summary["final_time"])
-        written.append(_save(release_instants_figure(
-            [r.name for r in runs], [r.event_times for r in runs],
-            [r.release_time for r in runs], horizon, paper),
-            out / "release_instants.png"))
-    pen = penetration_table(rep)
-    if pen:
-        col = {k: [row[k] for row in pen] for k in pen[0]}
-        written.append(_save(penetration_figure(
-            col["penetration_percent"], col["ours_triggers"], col["ours_release_time_s"],
-            col["paper_triggers"], col["paper_release_time_s"]), out / "penetration.png"))
-    sens = sensitivity_table(rep)
-    if sens:
-        sweeps = {}
-        for par in SENSITIVITY:
-            rows = [r for r in sens if r["parameter"] == par]
-            if rows:
-                sweeps[par] = tuple(np.array([r[k] for r in rows], float)
-                                    for k in ("value", "release_time_s", "lyapunov_time_s"))
-        from arzsumo.control.etc import PAPER_DESIGN
-
-        written.append(_save(sensitivity_figure(
-            sweeps, {p: float(getattr(PAPER_DESIGN, p)) for p in sweeps}),
-            out / "sensitivity.png"))
-    return written

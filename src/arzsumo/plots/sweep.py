@@ -2,49 +2,25 @@
 each study axis, mean over seeds with one standard deviation as error bars, the paper's
 values beside them where the paper gives numbers (tables diffpene and diffdemands).
 
-Two layers: :func:`study_figure` and :func:`sensitivity_figure` take a table and return a
-Figure; :func:`write_sweep_plots` picks the figures a sweep calls for and saves them.
+:func:`study_figure` and :func:`sensitivity_figure` take a table and return a Figure; the
+writer that picks the figures a sweep calls for is :func:`arzsumo.outputs.sweep.write_sweep_plots`.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from arzsumo.plots import plt, save_png
-
-if TYPE_CHECKING:
-    from arzsumo.sweep.spec import SweepSpec
+from arzsumo.plots import plt
 
 LABELS = {"triggers": "triggers (control updates)", "release_time": "release time (s)",
           "plan_changes": "meter plan changes", "penetration": "AV penetration",
           "demand_veh_h": "total demand (veh/h)"}
-
-
-def paper_points(table: str | None) -> dict[str, dict[float, float]]:
-    """The paper's numbers for a study: metric -> {axis value: value}."""
-    from arzsumo.twin.paper_values import DIFFPENE, EVENTS
-
-    if table == "diffpene":
-        return {"release_time": {p / 100: r for p, (r, _) in DIFFPENE.items()},
-                "triggers": {p / 100: float(n) for p, (_, n) in DIFFPENE.items()}}
-    if table == "diffdemands":
-        # total demand (veh/h) of the scenario files demand_{low,medium,high}_etc
-        totals = {"demand_low_etc": 4966.0, "demand_medium_etc": 5664.0,
-                  "demand_high_etc": 6510.0}
-        rel = {totals[e.scenario]: float(e.release_time) for e in EVENTS
-               if e.scenario in totals and e.release_time is not None}
-        trg = {totals[e.scenario]: float(e.triggers) for e in EVENTS
-               if e.scenario in totals and e.triggers is not None}
-        return {"release_time": rel, "triggers": trg}
-    return {}
 
 
 def _numeric(values: np.ndarray) -> bool:
@@ -125,43 +101,3 @@ def sensitivity_figure(df: pd.DataFrame, group: str, parameters: Sequence[str],
         fig.suptitle(title)
     fig.tight_layout()
     return fig
-
-
-def write_sweep_plots(df: pd.DataFrame, spec: SweepSpec, out: str | Path) -> list[Path]:
-    """Write the figures of sweep ``spec`` from its table ``df`` into ``out``.
-
-    Finished runs only. A one-at-a-time group gives ``sensitivity.png``; otherwise the
-    first axis that is not the seed is the abscissa of ``study.png`` and the other axes
-    give one line each.
-    """
-    from arzsumo.control.etc import PAPER_DESIGN
-    from arzsumo.sweep.worker import FINISHED
-
-    out = Path(out)
-    ok = df[df["status"].isin(FINISHED)]
-    metrics = [m for m in ("triggers", "release_time", "plan_changes") if m in ok.columns
-               and ok[m].notna().any()]
-    if ok.empty or not metrics:
-        return []
-    engine = "SUMO" if spec.engine == "sumo" else "PDE twin"
-    rep = spec.replicate
-    seeds = f", mean and sd over {ok[rep].nunique()} seeds" if rep else ""
-    written = []
-    groups = [a.group for a in spec.axes if a.group]
-    if groups:
-        group = groups[0]
-        pars = [a.name for a in spec.axes if a.group == group]
-        marks = {p: float(getattr(PAPER_DESIGN, p)) for p in pars
-                 if isinstance(getattr(PAPER_DESIGN, p, None), int | float)}
-        fig = sensitivity_figure(ok, group, pars, metrics, marks,
-                                 f"{spec.name}: {engine}{seeds}; dotted: paper's design")
-        written.append(save_png(fig, out / "sensitivity.png", dpi=120))
-        return written
-    study = [a.name for a in spec.axes if a.name != rep]
-    if not study:
-        return written
-    fig = study_figure(ok, study[0], metrics, lines=study[1:],
-                       paper=paper_points(spec.paper), title=f"{spec.name}: {engine}{seeds}",
-                       label=engine)
-    written.append(save_png(fig, out / "study.png", dpi=120))
-    return written

@@ -13,4 +13,8 @@ when a run starts), so the math packages and the CLI stay light.
 * :mod:`~arzsumo.sumo.placement`: macro to micro
 * :mod:`~arzsumo.sumo.meter`: the ramp-meter actuator
 * :mod:`~arzsumo.sumo.runner`, :mod:`~arzsumo.sumo.calibrate`: open-loop runs, calibration
+
+May import ``kernel_cache``, ``control``, ``model``, ``io``, ``progress``, ``units``,
+``errors``; never the twin, the bridge, outputs or plots (calibration files are written by
+:mod:`arzsumo.outputs.calibration`).
 """

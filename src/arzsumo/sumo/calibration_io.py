@@ -1,6 +1,7 @@
-"""Writing and reading calibration results.
+"""Calibration results as text and data, and the meter curve read back.
 
-``arzsumo calibrate --out DIR`` writes, atomically as one directory:
+:func:`arzsumo.outputs.calibration.write_calibration` (``arzsumo calibrate --out DIR``)
+writes, atomically as one directory:
 
 * ``calibrated_model.toml``: a scenario file (``arzsumo model --scenario ...``) whose
   ``[model]`` holds the fitted FD and whose ``[equilibrium]`` is the state SUMO held;
@@ -12,7 +13,6 @@
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import Any
@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from arzsumo.errors import ArzsumoError
-from arzsumo.io import atomic_dir, read_toml, toml_value
+from arzsumo.io import read_toml, toml_value
 from arzsumo.sumo.calibrate import Calibration
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.meter import GreenShareCurve
@@ -115,29 +115,3 @@ def calibration_json(cal: Calibration, cfg: SumoConfig) -> dict[str, Any]:
         "runs": cal.runs,
         "config": cfg.__dict__,
     })
-
-
-def write_calibration(out: str | Path, cal: Calibration, cfg: SumoConfig) -> Path:
-    """Write all calibration outputs into directory ``out`` (atomically)."""
-    from arzsumo.plots.calibration import write_calibration_figure
-
-    out = Path(out)
-    with atomic_dir(out) as tmp:
-        (tmp / "calibrated_model.toml").write_text(scenario_text(cal, cfg), encoding="utf-8")
-        (tmp / "meter_curve.toml").write_text(curve_text(cal.curve, cfg), encoding="utf-8")
-        (tmp / "calibration.json").write_text(json.dumps(calibration_json(cal, cfg), indent=2),
-                                              encoding="utf-8")
-        np.savez_compressed(tmp / "calibration_points.npz",
-                            **{f"{k}_{c}": arr for c, (ao, v) in cal.points.items()
-                               for k, arr in (("ao", ao), ("v", v))})
-        p, c = cal.params, cal.calibrated
-        eq = cal.equilibrium
-        mark = (eq["ao"], eq["v_h"], eq["v_a"]) if math.isfinite(eq.get("v_h", math.nan)) \
-            else None
-        write_calibration_figure(
-            tmp / "calibration.png", cal.points,
-            {"h": (c.v_free_h, c.ao_max_h, c.gamma_h), "a": (c.v_free_a, c.ao_max_a, c.gamma_a)},
-            {"h": (p.v_free_h, p.ao_max_h, p.gamma_h), "a": (p.v_free_a, p.ao_max_a, p.gamma_a)},
-            {k: f.r2 for k, f in cal.fits.items()},
-            (np.asarray(cal.curve.green_share), np.asarray(cal.curve.outflow)), mark)
-    return out

@@ -2,7 +2,12 @@
 a Dask cluster, resumable and failure-isolated, summarised in one tidy table.
 
 ``spec`` reads sweep files, ``worker`` runs one run anywhere, ``driver`` schedules and
-stores, ``table`` builds the table.
+stores, ``table`` builds the table. :func:`~arzsumo.sweep.driver.map_runs` is the engine
+for any batch (``arzsumo reproduce`` runs through it).
+
+May import outputs and every room below (bridge, twin, scenarios, sumo, control, model,
+utilities), never studies or the CLI: reference values drawn on its figures come from the
+caller (``run_sweep(..., paper=...)``).
 """
 
 from arzsumo.sweep.driver import SweepReport, run_sweep

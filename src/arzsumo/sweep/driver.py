@@ -18,6 +18,7 @@ call the same :func:`arzsumo.sweep.worker.execute`.
 from __future__ import annotations
 
 import concurrent.futures as cf
+import functools
 import json
 import logging
 import multiprocessing
@@ -25,7 +26,7 @@ import os
 import time
 import uuid
 from collections import Counter, deque
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -98,15 +99,18 @@ def write_outcome(out: Path, run: RunSpec, outcome: RunOutcome) -> None:
 
 
 # -- backends ------------------------------------------------------------------------------
-def run_local(tasks: Iterable[RunTask], workers: int, on_done: OnDone,
-              fn: Callable[[RunTask], RunOutcome] = execute) -> None:
+def run_local(tasks: Iterable[Any], workers: int, on_done: Callable[[Any], None],
+              fn: Callable[[Any], Any] = execute,
+              on_crash: Callable[[Any, str], Any] = crashed) -> None:
     """Execute ``fn`` (the worker function) on ``tasks`` in ``workers`` fresh processes
     (spawned: libsumo holds one simulation per process and must not inherit a parent's
     state).
 
     At most ``workers`` tasks are in flight, so when a process dies (a crash in SUMO, the
     OOM killer) the suspects are known: each is run again alone, and the one that kills
-    its process again is recorded as ``crashed``; the sweep goes on.
+    its process again is recorded as ``crashed``; the sweep goes on. ``fn`` and
+    ``on_crash`` (task, reason -> outcome, or raise) default to the sweep's; any picklable
+    module-level function of a picklable task works (:func:`map_runs`).
     """
     ctx = multiprocessing.get_context("spawn")
     queue = deque(tasks)
@@ -128,21 +132,25 @@ def run_local(tasks: Iterable[RunTask], workers: int, on_done: OnDone,
                         suspects.append(task)
             suspects += list(running.values())
         for task in suspects:
-            log.warning("run %s: a worker process died; running it again alone", task.run_id)
+            log.warning("run %s: a worker process died; running it again alone",
+                        getattr(task, "run_id", task))
             with cf.ProcessPoolExecutor(max_workers=1, mp_context=ctx) as alone:
                 try:
                     on_done(alone.submit(fn, task).result())
                 except BrokenProcessPool:
-                    on_done(crashed(task, "the worker process died (twice, the second time "
-                                          "running this run alone)"))
+                    on_done(on_crash(task, "the worker process died (twice, the second "
+                                           "time running this task alone)"))
 
 
-def run_dask(tasks: list[RunTask], address: str, on_done: OnDone, one_thread: bool) -> None:
+def run_dask(tasks: list[Any], address: str, on_done: Callable[[Any], None], one_thread: bool,
+             fn: Callable[[Any], Any] = execute,
+             on_crash: Callable[[Any, str], Any] = crashed) -> None:
     """Execute ``tasks`` on the Dask cluster whose scheduler is at ``address``.
 
     A run whose worker dies is retried by Dask on another worker; after Dask gives up
     (``KilledWorker``) it is recorded as ``crashed``. ``one_thread`` refuses workers with
-    more than one thread (libsumo: one simulation per process).
+    more than one thread (libsumo: one simulation per process). ``fn`` and ``on_crash``
+    as in :func:`run_local`.
     """
     from distributed import Client, as_completed
     from distributed.scheduler import KilledWorker
@@ -160,19 +168,59 @@ def run_dask(tasks: list[RunTask], address: str, on_done: OnDone, one_thread: bo
                                  f"{max(wide.values())} threads; SUMO runs need one "
                                  "simulation per process: start them with --nthreads 1")
         futures = {}
-        for task in tasks:
-            fut = client.submit(execute, task, pure=False,
-                                key=f"arzsumo-{task.run_id}-{uuid.uuid4().hex[:8]}")
+        for i, task in enumerate(tasks):
+            fut = client.submit(fn, task, pure=False, key=f"arzsumo-"
+                                f"{getattr(task, 'run_id', i)}-{uuid.uuid4().hex[:8]}")
             futures[fut.key] = (fut, task)
         for fut in as_completed([f for f, _ in futures.values()]):
             task = futures[fut.key][1]
             try:
                 outcome = fut.result()
             except KilledWorker as exc:
-                outcome = crashed(task, f"Dask gave up after its workers died: {exc}")
+                outcome = on_crash(task, f"Dask gave up after its workers died: {exc}")
             except Exception as exc:  # a worker that cannot import or unpickle arzsumo
-                outcome = crashed(task, f"{type(exc).__name__} on the worker: {exc}")
+                outcome = on_crash(task, f"{type(exc).__name__} on the worker: {exc}")
             on_done(outcome)
+
+
+def _raise_crash(task: Any, why: str) -> Any:
+    raise RuntimeError(f"task {task!r}: {why}")
+
+
+def map_runs(fn: Callable[[Any], Any], tasks: Sequence[Any], *, workers: int = 1,
+             scheduler: str | None = None, in_process: bool = False) -> list[Any]:
+    """``[fn(t) for t in tasks]`` on the sweep's backends, results in the order of ``tasks``.
+
+    ``fn`` must be a picklable module-level function and the tasks picklable. With
+    ``scheduler`` the tasks run on that Dask cluster, else on ``workers`` fresh local
+    processes (:func:`run_local`); ``in_process`` runs them here, one after the other
+    (for runs shorter than a process start). A task whose process dies twice raises
+    ``RuntimeError``: unlike a sweep, the caller needs every result.
+    """
+    if in_process or not tasks:
+        return [fn(t) for t in tasks]
+    results: dict[int, Any] = {}
+    indexed = [_Indexed(i, t) for i, t in enumerate(tasks)]
+    call = functools.partial(_call_indexed, fn)
+
+    def on_done(pair: tuple[int, Any]) -> None:
+        results[pair[0]] = pair[1]
+
+    if scheduler:
+        run_dask(indexed, scheduler, on_done, one_thread=False, fn=call, on_crash=_raise_crash)
+    else:
+        run_local(indexed, workers, on_done, fn=call, on_crash=_raise_crash)
+    return [results[i] for i in range(len(tasks))]
+
+
+@dataclass(frozen=True)
+class _Indexed:
+    run_id: int
+    task: Any
+
+
+def _call_indexed(fn: Callable[[Any], Any], item: _Indexed) -> tuple[int, Any]:
+    return item.run_id, fn(item.task)
 
 
 # -- the sweep -----------------------------------------------------------------------------
@@ -189,7 +237,8 @@ def default_workers() -> int:
 
 def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
               scheduler: str | None = None, progress: bool = True,
-              plots: bool = True) -> SweepReport:
+              plots: bool = True,
+              paper: Mapping[str, Mapping[float, float]] | None = None) -> SweepReport:
     """Execute the runs of ``spec`` that have no current result under ``out``; then write
     the table, plots and manifest.
 
@@ -202,6 +251,9 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
         Processes of the local pool (default: one per core). Ignored with ``scheduler``.
     scheduler : str, optional
         Address of a Dask scheduler (``tcp://host:8786``) to run on instead.
+    paper : mapping, optional
+        Reference points drawn on ``study.png``: metric -> {axis value: value} (the CLI
+        passes :func:`arzsumo.studies.paper.values.paper_points` of ``spec.paper``).
     """
     t0 = time.perf_counter()
     out = Path(out)
@@ -238,12 +290,13 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
         bar.close()
     report = SweepReport(spec.name, out, backend, len(runs), len(runs) - len(todo),
                          sum(counts.values()), dict(counts), time.perf_counter() - t0)
-    report.table = finish(spec, out, runs, report, plots)
+    report.table = finish(spec, out, runs, report, plots, paper)
     return report
 
 
 def finish(spec: SweepSpec, out: Path, runs: list[RunSpec], report: SweepReport,
-           plots: bool) -> pd.DataFrame:
+           plots: bool, paper: Mapping[str, Mapping[float, float]] | None = None
+           ) -> pd.DataFrame:
     """Write the table, the plots and the manifest of a sweep whose runs are done; return
     the table."""
     import pyarrow.parquet as pq
@@ -252,9 +305,11 @@ def finish(spec: SweepSpec, out: Path, runs: list[RunSpec], report: SweepReport,
     with atomic_file(out / "summaries.parquet") as tmp:
         pq.write_table(arrow_table(df, spec.axes), tmp)
     if plots:
-        from arzsumo.plots.sweep import write_sweep_plots
+        from arzsumo.outputs.sweep import SweepLayout, write_sweep_plots
 
-        write_sweep_plots(df, spec, out / "plots")
+        layout = SweepLayout(spec.name, spec.engine, spec.replicate,
+                             [(a.name, a.group) for a in spec.axes])
+        write_sweep_plots(df[df["status"].isin(FINISHED)], layout, out / "plots", paper)
     manifest_path = out / "sweep.json"
     history: list[dict[str, Any]] = []
     if manifest_path.is_file():

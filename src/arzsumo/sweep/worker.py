@@ -26,7 +26,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from arzsumo.errors import ArzsumoError
-from arzsumo.io import dump_toml
+from arzsumo.io import dump_toml, json_safe
 
 #: statuses of a run: finished (``ok``, ``incomplete``: the twin left the physical domain
 #: and stopped early, partial summary kept) or not (the rest: an error is recorded)
@@ -91,8 +91,8 @@ def _parquet(table: pa.Table) -> bytes:
 
 
 def _run_twin(task: RunTask) -> tuple[str, dict[str, Any], dict[str, bytes]]:
+    from arzsumo.outputs.twin import control_table
     from arzsumo.scenarios import scenario_from_dict
-    from arzsumo.twin.output import control_table, json_safe
     from arzsumo.twin.run import run_twin
 
     sc = scenario_from_dict(task.scenario, task.source)
@@ -102,10 +102,9 @@ def _run_twin(task: RunTask) -> tuple[str, dict[str, Any], dict[str, bytes]]:
 
 
 def _run_sumo(task: RunTask) -> tuple[str, dict[str, Any], dict[str, bytes]]:
-    from arzsumo.bridge.outputs import periods_table, summary
     from arzsumo.bridge.session import run_in_sumo
+    from arzsumo.outputs.bridge import periods_table, summary
     from arzsumo.scenarios import scenario_from_dict
-    from arzsumo.twin.output import json_safe
 
     sc = scenario_from_dict(task.scenario, task.source)
     session = run_in_sumo(sc)

@@ -1,8 +1,12 @@
 """The nonlinear PDE twin: a finite-volume solver of the 4x4 mixed-autonomy ARZ model.
 
-Pure math in :mod:`state`, :mod:`flux`, :mod:`source`, :mod:`boundary`, :mod:`initial`,
-:mod:`scheme`, :mod:`solver` and :mod:`metrics`; :mod:`run` ties a scenario to a run, :mod:`output`
-writes it. Controllers plug in through :mod:`arzsumo.twin.controllers`.
+Numerics in :mod:`state`, :mod:`flux`, :mod:`source`, :mod:`boundary`, :mod:`initial`,
+:mod:`scheme`, :mod:`solver` and :mod:`metrics`: they may import only ``control``,
+``model``, ``units`` and ``errors`` (the "math" contract in ``pyproject.toml``). The
+scenario wiring, :mod:`config` (the ``[twin]`` and ``[initial]`` tables), :mod:`controllers`
+(the registry; kernels from ``kernel_cache``) and :mod:`run` (a scenario to a run), may also
+import ``scenarios`` and ``kernel_cache``. The twin writes no files: runs are written by
+:mod:`arzsumo.outputs.twin`; paper reproduction lives in :mod:`arzsumo.studies.paper`.
 """
 
 from arzsumo.twin.boundary import Inlet, outlet_flux

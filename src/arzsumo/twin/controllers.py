@@ -23,16 +23,25 @@ below (imports inside the factory keep ``import arzsumo.twin`` light), or call
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 from arzsumo.control.base import ConstantControl, Controller, OpenLoop
+from arzsumo.control.etc import EtcDesign
 from arzsumo.errors import ScenarioError
 from arzsumo.model.characteristic import Linearization
 
-if TYPE_CHECKING:
-    from arzsumo.twin.config import TwinConfig
 
-ControllerFactory = Callable[[Linearization, "TwinConfig"], Controller]
+class ControllerSettings(Protocol):
+    """What a factory reads of the twin configuration (:class:`arzsumo.twin.config.TwinConfig`
+    provides it; a protocol, so this module need not import the configuration, which
+    imports the registry)."""
+
+    constant_u: float       # U of the constant controller, veh/s
+    kernel_cells: int       # grid of the backstepping kernels
+    design: EtcDesign       # ETC design parameters
+
+
+ControllerFactory = Callable[[Linearization, ControllerSettings], Controller]
 
 #: name -> factory(linearization, config). Names are those of scenario files' ``controller``.
 CONTROLLERS: dict[str, ControllerFactory] = {
@@ -44,7 +53,7 @@ CONTROLLERS: dict[str, ControllerFactory] = {
 def _pde_factory(name: str) -> ControllerFactory:
     """Backstepping, ETC or observer-ETC with cached kernels on ``cfg.kernel_cells`` cells."""
 
-    def factory(lin: Linearization, cfg: TwinConfig) -> Controller:
+    def factory(lin: Linearization, cfg: ControllerSettings) -> Controller:
         from arzsumo.control.registry import make_controller as make_pde
         from arzsumo.kernel_cache import cached_kernels
 
@@ -64,7 +73,7 @@ def register_controller(name: str, factory: ControllerFactory, *,
     CONTROLLERS[name] = factory
 
 
-def make_controller(name: str, lin: Linearization, config: TwinConfig) -> Controller:
+def make_controller(name: str, lin: Linearization, config: ControllerSettings) -> Controller:
     """A new controller called ``name``; the error lists the registered names."""
     try:
         factory = CONTROLLERS[name]

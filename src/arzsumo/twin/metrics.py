@@ -140,15 +140,3 @@ def events(control_t: np.ndarray, control_u: np.ndarray,
         return np.asarray(triggered, bool)
     previous = np.concatenate([[0.0], control_u[:-1]])
     return control_u != previous
-
-
-def release_time(control_t: np.ndarray, mask: np.ndarray, horizon: float) -> float:
-    """Total release time (s): the time covered by checks without an update.
-
-    Each check holds until the next one (the last until ``horizon``). With a 1 s period
-    this is horizon - triggers, as in the paper (160 triggers, 291 s over 450 s).
-    """
-    if control_t.size == 0:
-        return 0.0
-    ends = np.append(control_t[1:], horizon)
-    return float(np.sum((ends - control_t)[~mask]))

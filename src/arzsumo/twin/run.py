@@ -13,6 +13,7 @@ import numpy as np
 
 from arzsumo import __version__
 from arzsumo.control.base import Controller
+from arzsumo.control.events import release_time
 from arzsumo.model.characteristic import linearize
 from arzsumo.scenarios import Scenario
 from arzsumo.schema import TWIN_SUMMARY, key_units
@@ -25,7 +26,6 @@ from arzsumo.twin.metrics import (
     events,
     performance,
     relative_change,
-    release_time,
 )
 from arzsumo.twin.solver import TwinResult, simulate
 from arzsumo.twin.state import cell_centres
@@ -51,7 +51,7 @@ class TwinRun:
 
     @property
     def release_time(self) -> float:
-        """Total release time, s (:func:`arzsumo.twin.metrics.release_time`)."""
+        """Total release time, s (:func:`arzsumo.control.events.release_time`)."""
         return release_time(self.result.control_t, self.events, float(self.result.t[-1]))
 
     def summary(self) -> dict[str, Any]:
@@ -147,7 +147,7 @@ def compare_to_open_loop(run: TwinRun, open_loop: Performance, complete: bool,
         A controlled run.
     open_loop : Performance
         Indices of the open-loop simulation from the same initial fields and solver
-        options (the caller guarantees it; :func:`arzsumo.twin.reproduce.reproduce`
+        options (the caller guarantees it; :func:`arzsumo.studies.paper.reproduce.reproduce`
         shares one open loop among the controllers of a scenario).
     complete, status
         Whether that open loop completed, and its status message. Indices over

@@ -1,6 +1,6 @@
 """The paper's section 5 numbers beside the twin's, with a verdict on each claim.
 
-Pure functions of a :class:`arzsumo.twin.reproduce.Reproduction`: they return rows
+Pure functions of a :class:`arzsumo.studies.paper.reproduce.Reproduction`: they return rows
 (dicts, CSV-ready) and :class:`Claim` records; nothing is written here. Verdicts:
 
 - a relative change (tables diffperformance, totaldelay) is *reproduced in direction*
@@ -21,14 +21,14 @@ import math
 from dataclasses import asdict, dataclass
 from typing import Any
 
-from arzsumo.twin.paper_values import (
+from arzsumo.studies.paper.reproduce import Reproduction, RunRecord
+from arzsumo.studies.paper.values import (
     DIFFPENE,
     DIFFPERFORMANCE,
     EVENTS,
     SENSITIVITY,
     TOTALDELAY,
 )
-from arzsumo.twin.reproduce import Reproduction, RunRecord
 
 REPRODUCED = "reproduced in direction"
 NOT_REPRODUCED = "not reproduced"

@@ -7,11 +7,12 @@ only in ``[twin] controller``, ``kernel_cells``, ``[design]`` and ``[sweep]`` sh
 open loop: it is simulated once and every controller of the group is compared with it
 (tables diffperformance and totaldelay report changes against the open loop of the same
 scenario). The paper's numbers and the comparison live in
-:mod:`arzsumo.twin.paper_values` and :mod:`arzsumo.twin.compare`; this module writes
-nothing (see :mod:`arzsumo.twin.reproduce_output`).
+:mod:`arzsumo.studies.paper.values` and :mod:`arzsumo.studies.paper.compare`; this module
+writes nothing (see :mod:`arzsumo.studies.paper.report`).
 
-Runs are deterministic; with ``workers > 1`` they are spread over a process pool and
-the results are identical and in the same order.
+Runs are deterministic; with ``workers > 1`` they are spread over the sweep engine's
+process pool (:func:`arzsumo.sweep.driver.map_runs`) and the results are identical and in
+the same order.
 """
 
 from __future__ import annotations
@@ -21,7 +22,6 @@ import logging
 import math
 import time
 from collections.abc import Mapping, Sequence
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -30,10 +30,11 @@ import numpy as np
 
 from arzsumo.control.events import lyapunov_convergence_time
 from arzsumo.errors import ScenarioError
+from arzsumo.io import json_safe
 from arzsumo.scenarios import DESIGN_KEYS, Scenario, load_scenario, scenario_from_dict
+from arzsumo.sweep.driver import map_runs
 from arzsumo.twin.config import twin_config_from_dict
 from arzsumo.twin.metrics import Performance
-from arzsumo.twin.output import json_safe
 from arzsumo.twin.run import TwinRun, compare_to_open_loop, run_twin
 
 log = logging.getLogger(__name__)
@@ -224,16 +225,21 @@ def _controlled(task: _Task, baseline: tuple[Performance, bool, str]) -> RunReco
     return _record(run, task.sweep)
 
 
-def _map(fn: Any, args: list[tuple], workers: int) -> list[Any]:
-    if workers <= 1 or len(args) <= 1:
-        return [fn(*a) for a in args]
-    with ProcessPoolExecutor(max_workers=workers) as pool:
-        return list(pool.map(fn, *zip(*args, strict=True)))
+def _controlled_pair(item: tuple[_Task, tuple[Performance, bool, str]]) -> RunRecord:
+    return _controlled(*item)
+
+
+def _map(fn: Any, items: list[Any], workers: int, scheduler: str | None) -> list[Any]:
+    """``fn`` over ``items`` through the sweep engine (:func:`arzsumo.sweep.driver.map_runs`),
+    in this process when there is one worker or one item (and no scheduler)."""
+    here = scheduler is None and (workers <= 1 or len(items) <= 1)
+    return map_runs(fn, items, workers=workers, scheduler=scheduler, in_process=here)
 
 
 def reproduce(directory: str | Path = DEFAULT_DIR, *, quick: bool = False,
               only: Sequence[str] | None = None, workers: int | None = None,
-              twin: Mapping[str, Any] | None = None) -> Reproduction:
+              twin: Mapping[str, Any] | None = None,
+              scheduler: str | None = None) -> Reproduction:
     """Run every experiment of ``directory`` (one open loop per group of controllers).
 
     Parameters
@@ -252,6 +258,8 @@ def reproduce(directory: str | Path = DEFAULT_DIR, *, quick: bool = False,
         Processes (default 1: on the 2-core reference machine two processes were measured
         slower, runs of about 1 s being shorter than process start and kernel loading).
         Results do not depend on it.
+    scheduler : str, optional
+        Address of a Dask scheduler to run on instead (``tcp://host:8786``).
     """
     start = time.perf_counter()
     scenarios = load_experiments(directory)
@@ -260,12 +268,14 @@ def reproduce(directory: str | Path = DEFAULT_DIR, *, quick: bool = False,
     first: dict[int, int] = {}                 # group -> index of its first task
     for i, task in enumerate(tasks):
         first.setdefault(task.group, i)
-    opens = dict(zip(first, _map(_open_loop, [(tasks[i],) for i in first.values()], workers),
+    opens = dict(zip(first, _map(_open_loop, [tasks[i] for i in first.values()],
+                                  workers, scheduler),
                      strict=True))
     log.info("%d open loops for %d runs", len(opens), len(tasks))
     reused = {i for g, i in first.items() if opens[g][3] is not None}
     todo = [i for i in range(len(tasks)) if i not in reused]
-    done = _map(_controlled, [(tasks[i], opens[tasks[i].group][:3]) for i in todo], workers)
+    done = _map(_controlled_pair, [(tasks[i], opens[tasks[i].group][:3]) for i in todo],
+                workers, scheduler)
     records: list[RunRecord | None] = [None] * len(tasks)
     for i, rec in zip(todo, done, strict=True):
         records[i] = rec

@@ -11,18 +11,18 @@ import pytest
 from arzsumo.cli import main
 from arzsumo.errors import ScenarioError
 from arzsumo.scenarios import load_scenario
-from arzsumo.twin.compare import (
+from arzsumo.studies.paper.compare import (
     NOT_REPRODUCED,
     REPRODUCED,
     claims,
     direction,
     trend,
 )
-from arzsumo.twin.reproduce import DEFAULT_DIR, load_experiments, plan, reproduce
-from arzsumo.twin.reproduce_output import write_reproduction
+from arzsumo.studies.paper.report import write_reproduction
+from arzsumo.studies.paper.reproduce import DEFAULT_DIR, load_experiments, plan, reproduce
 from arzsumo.twin.run import run_twin
 
-PAPER_DIR = Path(__file__).parent.parent.parent / "scenarios" / "paper"
+PAPER_DIR = Path(__file__).resolve().parents[3] / "scenarios" / "paper"
 SUBSET = ["base_open", "base_backstepping", "base_etc", "penetration_44_etc",
           "penetration_53_etc", "sensitivity_zeta"]
 
@@ -131,6 +131,20 @@ def test_shared_open_loop_is_the_baseline_of_each_controller(quick):
         / opn.summary["J_TTT"]["total"]
     assert etc.relative("total", "J_TTT") == pytest.approx(expected, rel=1e-9)
     assert math.isnan(opn.relative("total", "J_TTT"))
+
+
+def test_quick_numbers_are_pinned(quick):
+    # recorded with `arzsumo reproduce --quick` before paper reproduction moved out of twin/
+    # into studies/ and onto the sweep engine: the move must not change a number
+    rep, out = quick
+    etc, back, opn = rep.get("base_etc"), rep.get("base_backstepping"), rep.get("base_open")
+    assert (etc.triggers, etc.release_time) == (3, 37.0)
+    assert etc.summary["final_norm_ratio"] == pytest.approx(1.1636401548102235, rel=1e-12)
+    assert etc.summary["J_fuel"]["total"] == pytest.approx(206.73892605824363, rel=1e-12)
+    assert (back.triggers, back.release_time) == (40, 0.0)
+    assert (opn.triggers, opn.release_time) == (0, 40.0)         # never updated: the horizon
+    rows = {r["name"]: r for r in _csv(out / "runs.csv")}
+    assert (rows["base_etc"]["triggers"], rows["base_etc"]["release_time_s"]) == ("3", "37.0")
 
 
 def test_workers_do_not_change_results(quick, tmp_path, monkeypatch):

@@ -1,4 +1,5 @@
-"""Write a reproduction: ``report.md``, CSV tables and figures, atomically.
+"""The report of a reproduction: ``report.md``, CSV tables and figure data, written through
+:mod:`arzsumo.outputs.reproduce` (atomically).
 
 Layout of ``DIR`` (written with :func:`arzsumo.io.atomic_dir`)::
 
@@ -16,15 +17,16 @@ Layout of ``DIR`` (written with :func:`arzsumo.io.atomic_dir`)::
 
 from __future__ import annotations
 
-import csv
-import json
 import math
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from arzsumo.io import atomic_dir
-from arzsumo.twin.compare import (
+import numpy as np
+
+from arzsumo.control.etc import PAPER_DESIGN
+from arzsumo.outputs.reproduce import ReproduceFigures, write_report
+from arzsumo.studies.paper.compare import (
     NOT_REPRODUCED,
     REPRODUCED,
     Claim,
@@ -35,8 +37,8 @@ from arzsumo.twin.compare import (
     performance_table,
     sensitivity_table,
 )
-from arzsumo.twin.output import json_safe
-from arzsumo.twin.reproduce import LYAPUNOV_FRACTION, QUICK_TWIN, Reproduction, RunRecord
+from arzsumo.studies.paper.reproduce import LYAPUNOV_FRACTION, QUICK_TWIN, Reproduction, RunRecord
+from arzsumo.studies.paper.values import EVENTS, SENSITIVITY
 
 
 def run_row(rec: RunRecord) -> dict[str, Any]:
@@ -54,16 +56,6 @@ def run_row(rec: RunRecord) -> dict[str, Any]:
             row[f"{key}_{part}"] = s[key][part]
             row[f"{key}_{part}_rel_percent"] = rec.relative(part, key)
     return row
-
-
-def _write_csv(path: Path, rows: Sequence[dict[str, Any]]) -> None:
-    if not rows:
-        path.write_text("", encoding="utf-8")
-        return
-    with path.open("w", newline="", encoding="utf-8") as fh:
-        writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        writer.writeheader()
-        writer.writerows(rows)
 
 
 def _cell(v: Any) -> str:
@@ -210,23 +202,41 @@ def report_markdown(rep: Reproduction) -> str:
     return "\n".join(parts)
 
 
+def figure_data(rep: Reproduction) -> ReproduceFigures:
+    """The arrays behind the reproduction's figures (release instants of the ETC runs,
+    penetration table, sensitivity sweeps), with the paper's numbers beside them."""
+    runs = [r for r in rep.records if r.sweep is None and r.controller in ("etc",
+                                                                           "observer-etc")]
+    release = None
+    if runs:
+        paper = {e.scenario: f"{e.triggers if e.triggers is not None else '-'} / "
+                             f"{e.release_time:.0f} s" for e in EVENTS
+                 if e.release_time is not None}
+        release = ([r.name for r in runs], [r.event_times for r in runs],
+                   [r.release_time for r in runs], float(runs[0].summary["final_time"]), paper)
+    pen, penetration = penetration_table(rep), None
+    if pen:
+        col = {k: [row[k] for row in pen] for k in pen[0]}
+        penetration = (col["penetration_percent"], col["ours_triggers"],
+                       col["ours_release_time_s"], col["paper_triggers"],
+                       col["paper_release_time_s"])
+    sens, sweeps = sensitivity_table(rep), {}
+    for par in SENSITIVITY:
+        rows = [r for r in sens if r["parameter"] == par]
+        if rows:
+            sweeps[par] = tuple(np.array([r[k] for r in rows], float)
+                                for k in ("value", "release_time_s", "lyapunov_time_s"))
+    return ReproduceFigures(release, penetration, sweeps,
+                            {p: float(getattr(PAPER_DESIGN, p)) for p in sweeps})
+
+
 def write_reproduction(rep: Reproduction, out: str | Path, plots: bool = True) -> Path:
     """Write ``rep`` into directory ``out`` (replaced atomically); return its path."""
-    from arzsumo.plots.reproduce import write_reproduce_plots
-
-    with atomic_dir(out) as tmp:
-        (tmp / "report.md").write_text(report_markdown(rep), encoding="utf-8")
-        for name, rows in (("diffperformance", performance_table(rep)),
-                           ("totaldelay", delay_table(rep)),
-                           ("diffpene", penetration_table(rep)),
-                           ("events", events_table(rep)),
-                           ("sensitivity", sensitivity_table(rep)),
-                           ("claims", [c.as_dict() for c in claims(rep)]),
-                           ("runs", [run_row(r) for r in rep.records])):
-            _write_csv(tmp / f"{name}.csv", rows)
-        (tmp / "summaries.json").write_text(
-            json.dumps(json_safe({r.name: r.summary for r in rep.records}), indent=1) + "\n",
-            encoding="utf-8")
-        if plots:
-            write_reproduce_plots(rep, tmp)
-    return Path(out)
+    tables = {"diffperformance": performance_table(rep), "totaldelay": delay_table(rep),
+              "diffpene": penetration_table(rep), "events": events_table(rep),
+              "sensitivity": sensitivity_table(rep),
+              "claims": [c.as_dict() for c in claims(rep)],
+              "runs": [run_row(r) for r in rep.records]}
+    return write_report(out, report_markdown(rep), tables,
+                        {r.name: r.summary for r in rep.records},
+                        figure_data(rep) if plots else None)

@@ -13,7 +13,6 @@ Layout of ``DIR`` (written atomically with :func:`arzsumo.io.atomic_dir`)::
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 from typing import Any
 
@@ -21,7 +20,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from arzsumo.io import atomic_dir
+from arzsumo.io import atomic_dir, json_safe
 from arzsumo.schema import TWIN_CONTROL, TWIN_FIELDS, with_units
 from arzsumo.twin.run import TwinRun
 
@@ -47,19 +46,6 @@ def control_table(run: TwinRun) -> pa.Table:
                       "u_requested": r.control_u_requested, "u_continuous": cont,
                       "triggered": run.events.astype(bool)})
     return with_units(table, TWIN_CONTROL, "control")
-
-
-def json_safe(obj: Any) -> Any:
-    """``obj`` with numpy scalars as Python numbers and non-finite floats as None."""
-    if isinstance(obj, dict):
-        return {k: json_safe(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [json_safe(v) for v in obj]
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    if isinstance(obj, np.generic):
-        return json_safe(obj.item())
-    return obj
 
 
 def write_run(run: TwinRun, out: str | Path, plots: bool = True) -> Path:

@@ -107,3 +107,21 @@ SENSITIVITY: dict[str, tuple[str, str]] = {
     "sigma": ("longer", "longer"),
     "zeta": ("same", "same"),
 }
+
+
+def paper_points(table: str | None) -> dict[str, dict[float, float]]:
+    """The paper's numbers for a sweep's study (``paper`` key of a sweep file: diffpene,
+    diffdemands): metric -> {axis value: value}; empty for other names."""
+    if table == "diffpene":
+        return {"release_time": {p / 100: r for p, (r, _) in DIFFPENE.items()},
+                "triggers": {p / 100: float(n) for p, (_, n) in DIFFPENE.items()}}
+    if table == "diffdemands":
+        # total demand (veh/h) of the scenario files demand_{low,medium,high}_etc
+        totals = {"demand_low_etc": 4966.0, "demand_medium_etc": 5664.0,
+                  "demand_high_etc": 6510.0}
+        rel = {totals[e.scenario]: float(e.release_time) for e in EVENTS
+               if e.scenario in totals and e.release_time is not None}
+        trg = {totals[e.scenario]: float(e.triggers) for e in EVENTS
+               if e.scenario in totals and e.triggers is not None}
+        return {"release_time": rel, "triggers": trg}
+    return {}

@@ -30,11 +30,10 @@ from arzsumo.bridge.cosim import CoSimResult
 from arzsumo.bridge.estimator import fill_speeds
 from arzsumo.control.base import ControlLog
 from arzsumo.control.events import release_time
-from arzsumo.io import atomic_dir
+from arzsumo.io import atomic_dir, json_safe
 from arzsumo.model.characteristic import linearize
 from arzsumo.schema import CELLS, PERIODS, RUN_SUMMARY, key_units, with_units
 from arzsumo.twin.metrics import performance
-from arzsumo.twin.output import json_safe
 
 VARIABLES = ("rho_h", "v_h", "rho_a", "v_a")
 
@@ -92,7 +91,8 @@ def summary(res: CoSimResult) -> dict[str, Any]:
         "q_nominal": res.q_nominal, "horizon": horizon, "warmup": res.settings.warmup,
         "plan_changes": int(res.meter["plan_changes"]),
         "light_changes": int(res.meter["light_changes"]),
-        "triggers": int(triggered.sum()), "release_time": release_time(clipped, horizon),
+        "triggers": int(triggered.sum()),
+        "release_time": release_time(clipped.t, clipped.triggered, horizon),
         "max_ramp_queue": int(res.meter["max_queue"]),
         "speed_variance": {"h": float(np.nanvar(v[:, 0])), "a": float(np.nanvar(v[:, 1]))},
         **{k: v for k, v in _indices(res, res.micro).items()},

@@ -1,0 +1,42 @@
+"""Write a calibration (``arzsumo calibrate --out DIR``) atomically as one directory:
+``calibrated_model.toml``, ``meter_curve.toml``, ``calibration.json``,
+``calibration_points.npz`` and ``calibration.png`` (see :mod:`arzsumo.sumo.calibration_io`
+for their content)."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from arzsumo.io import atomic_dir
+from arzsumo.plots.calibration import write_calibration_figure
+from arzsumo.sumo.calibrate import Calibration
+from arzsumo.sumo.calibration_io import calibration_json, curve_text, scenario_text
+from arzsumo.sumo.config import SumoConfig
+
+
+def write_calibration(out: str | Path, cal: Calibration, cfg: SumoConfig) -> Path:
+    """Write all calibration outputs into directory ``out`` (atomically)."""
+    out = Path(out)
+    with atomic_dir(out) as tmp:
+        (tmp / "calibrated_model.toml").write_text(scenario_text(cal, cfg), encoding="utf-8")
+        (tmp / "meter_curve.toml").write_text(curve_text(cal.curve, cfg), encoding="utf-8")
+        (tmp / "calibration.json").write_text(json.dumps(calibration_json(cal, cfg), indent=2),
+                                              encoding="utf-8")
+        np.savez_compressed(tmp / "calibration_points.npz",
+                            **{f"{k}_{c}": arr for c, (ao, v) in cal.points.items()
+                               for k, arr in (("ao", ao), ("v", v))})
+        p, c = cal.params, cal.calibrated
+        eq = cal.equilibrium
+        mark = (eq["ao"], eq["v_h"], eq["v_a"]) if math.isfinite(eq.get("v_h", math.nan)) \
+            else None
+        write_calibration_figure(
+            tmp / "calibration.png", cal.points,
+            {"h": (c.v_free_h, c.ao_max_h, c.gamma_h), "a": (c.v_free_a, c.ao_max_a, c.gamma_a)},
+            {"h": (p.v_free_h, p.ao_max_h, p.gamma_h), "a": (p.v_free_a, p.ao_max_a, p.gamma_a)},
+            {k: f.r2 for k, f in cal.fits.items()},
+            (np.asarray(cal.curve.green_share), np.asarray(cal.curve.outflow)), mark)
+    return out

@@ -1,0 +1,59 @@
+"""The import contracts of ``pyproject.toml`` ([tool.importlinter]) hold, and they bite: a
+copy of the package with one wrong arrow added fails ``lint-imports``."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+CONFIG = ROOT / "pyproject.toml"
+PACKAGE = ROOT / "src" / "arzsumo"
+
+
+def _lint(src: Path, cwd: Path) -> subprocess.CompletedProcess[str]:
+    """Run lint-imports with the project's contracts on the package found under ``src``."""
+    env = {**os.environ, "PYTHONPATH": str(src)}
+    code = "from importlinter.cli import lint_imports_command; lint_imports_command()"
+    return subprocess.run([sys.executable, "-c", code, str(CONFIG), "--no-cache"],
+                          cwd=cwd, env=env, capture_output=True, text=True, timeout=120)
+
+
+def _copy(tmp_path: Path) -> Path:
+    src = tmp_path / "src"
+    shutil.copytree(PACKAGE, src / "arzsumo", ignore=shutil.ignore_patterns("__pycache__"))
+    return src
+
+
+def test_the_package_keeps_every_contract(tmp_path):
+    res = _lint(PACKAGE.parent, tmp_path)
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert "4 kept, 0 broken" in res.stdout
+
+
+@pytest.mark.parametrize(("where", "line", "contract"), [
+    # the math reaching for SUMO, and the twin numerics for a file writer
+    ("model/_wrong.py", "import arzsumo.sumo.simulation\n",
+     "The math (model, control, twin numerics) imports no SUMO"),
+    ("twin/flux.py", "from arzsumo.io import json_safe\n",
+     "The math (model, control, twin numerics) imports no SUMO"),
+    # a library room drawing a figure itself (lazily, as twin/output.py once did)
+    ("bridge/_wrong.py", "def f():\n    import arzsumo.plots.bridge\n",
+     "Only the output layer imports plots"),
+    # plots reaching up into the runs
+    ("plots/_wrong.py", "import arzsumo.sweep.spec\n", "Rooms import only downward"),
+])
+def test_a_wrong_import_breaks_its_contract(tmp_path, where, line, contract):
+    src = _copy(tmp_path)
+    path = src / "arzsumo" / where                 # a new module, or one line appended
+    path.write_text((path.read_text(encoding="utf-8") if path.exists() else "") + line,
+                    encoding="utf-8")
+    res = _lint(src, tmp_path)
+    assert res.returncode != 0
+    assert f"{contract}" in res.stdout and "BROKEN" in res.stdout
+    assert "arzsumo." + where.removesuffix(".py").replace("/", ".") in res.stdout
