@@ -17,6 +17,10 @@ Sequence (``arzsumo run``):
    SUMO's outflow counts whole vehicles per period; the replay uses it smoothed with
    the same time constant as the inlet (``smoothing_s``), which keeps the vehicle count.
 
+The meter's counts (plan and light changes, queue maximum) cover the control window only:
+the meter's window is closed at the start of control and the warm-up's counts are kept
+apart (``CoSimResult.warmup_meter``).
+
 Both twins take the measured state of SUMO's first cell, smoothed exponentially, as their
 boundary state at x = 0 (a ghost cell): their inflow follows the measured inflow.
 """
@@ -208,6 +212,8 @@ class CoSimResult:
     placement: str
     wall_time: float
     timings: dict[str, float]
+    #: meter counts from t = 0 to the start of control, and that time (``duration_s``, s)
+    warmup_meter: dict[str, float] = field(default_factory=dict)
 
 
 def _controller(name: str, lin: Linearization, kernels: Any, design: EtcDesign,
@@ -307,6 +313,7 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
                 meter.step()
                 data = sensor.collect(t)
         t0 = data.t
+        warmup_meter = {**meter.start_window(), "duration_s": float(t0)}
         opts = SolverOptions(cells=settings.twin_cells, scheme=settings.twin_scheme,
                              horizon=cfg.horizon, control_period=cfg.control_period)
         inlet = MeasuredInlet(eq, lin, settings.smoothing)
@@ -341,8 +348,11 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
             timings["controller"] += c1 - c0
             u_ref = ref_ctrl.check(twins["reference"].stepper.macro_state())
             timings["twins"] += time.perf_counter() - c1
-            green = (meter.command_outflow(q_nom + u) if settings.controller != "open"
-                     else meter.green_share)
+            final = t_rel >= cfg.horizon - 1e-9
+            # no period follows the last check: a command there would count a plan change
+            # that never runs
+            green = (meter.command_outflow(q_nom + u)
+                     if settings.controller != "open" and not final else meter.green_share)
             last = ctrl.log
             rows["t"].append(t_rel)
             rows["u"].append(u)
@@ -351,7 +361,7 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
             rows["green_commanded"].append(green)
             rows["u_reference"].append(u_ref)
             rows["controller_s"].append(c1 - c0)
-            if t_rel >= cfg.horizon - 1e-9:
+            if final:
                 for key in ("green_running", "light_changes", "plan_changes", "queue",
                             "max_queue", "inflow_h", "inflow_a", "outflow_h", "outflow_a",
                             "occupancy_out"):
@@ -408,4 +418,4 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
     return CoSimResult(scenario, settings, cfg, eq, q_nom, np.asarray(times), xm,
                        np.asarray(micro), np.asarray(replay), np.asarray(reference), periods,
                        ctrl.log, ref_ctrl.log, meter_summary, sim.report, status, placement,
-                       time.perf_counter() - wall0, timings)
+                       time.perf_counter() - wall0, timings, warmup_meter)
