@@ -56,7 +56,10 @@ def side_by_side_figure(t: np.ndarray, x: np.ndarray, panels: dict[str, np.ndarr
 def signals_figure(t: np.ndarray, u: np.ndarray, u_cont: np.ndarray, events: np.ndarray,
                    green_cmd: np.ndarray, green_run: np.ndarray, queue: np.ndarray,
                    light_changes: float, plan_changes: float, title: str = "") -> Figure:
-    """U commanded and continuous (veh/h), green share, ramp queue, release instants."""
+    """U commanded and continuous (veh/h), green share, ramp queue, release instants.
+
+    ``light_changes`` and ``plan_changes`` are the counts of the control window shown.
+    """
     fig, axes = plt.subplots(4, 1, figsize=(10, 9), sharex=True, layout="constrained",
                              gridspec_kw={"height_ratios": [3, 2, 1, 2]})
     axes[0].step(t, veh_s_to_veh_h(u), where="post", label="U commanded")
@@ -69,8 +72,8 @@ def signals_figure(t: np.ndarray, u: np.ndarray, u_cont: np.ndarray, events: np.
     axes[1].set_ylabel("green share")
     axes[1].set_ylim(-0.05, 1.05)
     axes[1].legend(loc="upper right")
-    axes[1].set_title(f"{int(plan_changes)} plan changes, {int(light_changes)} light changes",
-                      fontsize=9)
+    axes[1].set_title(f"{int(plan_changes)} plan changes, {int(light_changes)} light changes "
+                      "in the control window", fontsize=9)
     axes[2].vlines(t[events], 0, 1, lw=0.8)
     axes[2].set_yticks([])
     axes[2].set_ylabel("events")
@@ -82,6 +85,22 @@ def signals_figure(t: np.ndarray, u: np.ndarray, u_cont: np.ndarray, events: np.
     axes[3].grid(alpha=0.3)
     if title:
         fig.suptitle(title)
+    return fig
+
+
+def comparison_figure(labels: list[str],
+                      bars: dict[str, tuple[np.ndarray, np.ndarray | None]],
+                      title: str) -> Figure:
+    """One bar chart per metric: ``bars`` maps a panel title (with its unit) to the bar
+    heights and their error bars (None: no error bars), one bar per label; ``title``
+    says what the bars are (means over seeds, or single runs)."""
+    fig, axes = plt.subplots(1, len(bars), figsize=(4 * len(bars), 3.8),
+                             layout="constrained", squeeze=False)
+    for ax, (name, (height, err)) in zip(axes[0], bars.items(), strict=True):
+        ax.bar(labels, height, yerr=err, capsize=3, color="C0")
+        ax.set_title(name, fontsize=10)
+        ax.tick_params(axis="x", rotation=30)
+    fig.suptitle(title, fontsize=10)
     return fig
 
 
