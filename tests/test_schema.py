@@ -47,8 +47,8 @@ def run_dir(tmp_path_factory):
     """A short closed loop in SUMO (ETC), written as ``arzsumo run`` writes it."""
     from arzsumo.bridge.config import run_settings_from_dict
     from arzsumo.bridge.cosim import run_cosimulation
-    from arzsumo.outputs.bridge import write_results
     from arzsumo.control.etc import PAPER_DESIGN
+    from arzsumo.outputs.bridge import write_results
     from arzsumo.scenarios import load_scenario
     from arzsumo.sumo.config import sumo_config_of
 

@@ -41,7 +41,8 @@ def cmd_run(args: argparse.Namespace) -> int:
 def cmd_compare(args: argparse.Namespace) -> int:
     from arzsumo.outputs.compare import compare_runs
 
-    table, csv, png = compare_runs([Path(p) for p in args.runs], Path(args.out))
+    table, csv, png = compare_runs([Path(p) for p in args.runs], Path(args.out),
+                                   allow_mixed=args.allow_mixed)
     print(table)
     print(f"written: {csv}, {png}")
     return 0
@@ -64,4 +65,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("compare", help="one table across run directories (CSV and bar plot)")
     p.add_argument("runs", nargs="+", help="results directories of arzsumo run")
     p.add_argument("--out", default="comparison", help="directory for the CSV and plot")
+    p.add_argument("--allow-mixed", action="store_true",
+                   help="tabulate results of different kinds (twin), scenarios, horizons or "
+                        "warm-ups anyway; the table's header states the mix")
     p.set_defaults(func=cmd_compare)

@@ -124,7 +124,9 @@ _COMMON = {"scenario": TEXT, "source": TEXT, "version": TEXT, "seed": TEXT,
 
 #: units of the keys of ``arzsumo run``'s summary.json (dotted; ``*`` within a name)
 RUN_SUMMARY: dict[str, str] = {
-    **_COMMON, "lambda_4": "m/s", "q_nominal": "veh/s", "horizon": "s", "warmup": "s",
+    **_COMMON, "kind": TEXT, "lambda_4": "m/s", "q_nominal": "veh/s", "horizon": "s",
+    "warmup.window": TEXT, "warmup.duration_s": "s", "warmup.plan_changes": "count",
+    "warmup.light_changes": "count", "warmup.max_ramp_queue": "veh",
     "plan_changes": "count", "light_changes": "count", "max_ramp_queue": "veh",
     "speed_variance.*": "m^2/s^2",
     **{f"{k}.*": u for k, u in _RUN_INDICES.items()}, "until_s": "s",

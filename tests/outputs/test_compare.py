@@ -12,7 +12,8 @@ from arzsumo.outputs.compare import compare_runs
 
 def _run(path, controller, seed, plan_changes, ttt_s):
     path.mkdir()
-    summ = {"controller": controller, "seed": seed, "plan_changes": plan_changes,
+    summ = {"kind": "run", "scenario": "s", "horizon": 60.0, "warmup": {"duration_s": 30.0},
+            "controller": controller, "seed": seed, "plan_changes": plan_changes,
             "light_changes": 2 * plan_changes, "triggers": 3, "release_time": 40.0,
             "TTT": {"total": ttt_s}, "total_delay": {"total": 360.0},
             "speed_variance": {"h": 4.0, "a": 1.0}}

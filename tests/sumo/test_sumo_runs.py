@@ -93,6 +93,27 @@ def test_meter_counts_plan_and_light_changes():
         sim.run_until(30.0)
 
 
+def test_meter_window_restarts_the_counts_but_not_the_light():
+    cfg = FAST.with_(horizon=30.0, meter_cycle=6.0, min_green=1.0, min_red=1.0)
+    with open_simulation(PARAMS, cfg) as sim:
+        meter = RampMeter(sim.lib, cfg)
+        meter.command_outflow(1e6)                    # all red from the next cycle on
+        for _ in range(round(12.0 / cfg.step_length)):
+            sim.step()
+            meter.step(ramp_queue(sim.lib))
+        light, plan = meter.light, meter.green_share
+        closed = meter.start_window()
+        assert closed["plan_changes"] == 1 and closed["light_changes"] == 1   # G->r once
+        assert (meter.plan_changes, meter.light_changes, meter.max_queue) == (0, 0, 0)
+        assert (meter.light, meter.green_share) == (light, plan)
+        assert meter.command_outflow(0.0) == 1.0      # all green from the next cycle on
+        for _ in range(round(7.0 / cfg.step_length)):
+            sim.step()
+            meter.step(ramp_queue(sim.lib))
+        assert meter.plan_changes == 1 and meter.light_changes == 1          # r->G once
+        assert meter.max_queue >= meter.queue              # the window's own maximum
+
+
 def test_same_seed_gives_identical_cells_and_another_seed_differs():
     cfg = FAST.with_(horizon=30.0, seed=11)
     a = run_fixed_meter(PARAMS, cfg).measurements

@@ -1,34 +1,85 @@
-"""One table across co-simulation runs (``arzsumo compare``): rows from run summaries, as
-text; written with its bar plot by :func:`arzsumo.outputs.compare.compare_runs`."""
+"""One table across co-simulation runs (``arzsumo compare``), as text, CSV and bar plot.
+
+Rows compare only when they measure the same thing: results of ``arzsumo run``
+(``summary.json["kind"] == "run"``) of one scenario (by name), one control horizon and one
+warm-up. Anything else is refused with one line naming the directories and values: a
+twin result (``arzsumo twin``, another summary layout), an older run result whose meter
+counts start at t = 0 of the warm-up (kind ``run-v0``), runs of other horizons. With
+``allow_mixed`` they are tabulated anyway and the table's header states the mix.
+
+The CSV holds every row with its identity (``scenario``, ``horizon_s``, ``warmup_s``,
+``controller``, ``seed``, ``kind``) and the metrics in human units (veh h, km/h); the bar
+figure shows means per controller with the seeds listed, or one bar per run. The files are
+written by :func:`arzsumo.outputs.compare.compare_runs`.
+"""
 
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 from typing import Any
 
 import pandas as pd
 
-from arzsumo.errors import ScenarioError
+from arzsumo.errors import ArzsumoError
 
-#: (column, header, how to read it from summary.json, unit conversion for humans)
+
+class CompareError(ArzsumoError, ValueError):
+    """Results that are missing, not ``arzsumo run`` results, or not comparable."""
+
+
+#: (column, header in the text table)
 COLUMNS: tuple[tuple[str, str], ...] = (
-    ("controller", "controller"), ("seed", "seed"), ("plan_changes", "plan chg"),
+    ("scenario", "scenario"), ("horizon_s", "horizon s"), ("warmup_s", "warm-up s"),
+    ("controller", "controller"), ("seed", "seed"), ("kind", "kind"),
+    ("plan_changes", "plan chg"),
     ("light_changes", "light chg"), ("triggers", "updates"), ("release_time", "release s"),
     ("TTT_veh_h", "TTT veh.h"), ("delay_veh_h", "delay veh.h"), ("J_fuel", "J_fuel"),
     ("J_discom", "J_discom"), ("speed_sd_h_kmh", "sd v_h km/h"),
     ("speed_sd_a_kmh", "sd v_a km/h"), ("max_ramp_queue", "max queue"),
     ("rmse_rho_rel", "replay RMSE rho"), ("rmse_v_rel", "replay RMSE v"))
+#: identity columns that must agree between compared rows (unless mixing is allowed)
+MUST_AGREE = ("kind", "scenario", "horizon_s", "warmup_s")
+#: what each kind of result is, for messages and headers
+KINDS = {"run": "arzsumo run result (meter counts over the control window)",
+         "run-v0": "older arzsumo run result (meter counts from t = 0, warm-up included)",
+         "twin": "twin result (arzsumo twin: no SUMO, no meter)"}
 
 
-def _total(summ: dict[str, Any], key: str) -> float:
-    value = summ.get(key)
-    return float(value["total"]) if isinstance(value, dict) and value.get("total") is not None \
-        else float("nan")
+def kind_of(summ: dict[str, Any]) -> str | None:
+    """The kind of result a ``summary.json`` belongs to (see :data:`KINDS`), or None."""
+    if summ.get("kind") == "run":
+        return "run"
+    if "twin_replay" in summ and "max_ramp_queue" in summ:
+        return "run-v0"            # written before summaries named their kind
+    if "final_norm" in summ and isinstance(summ.get("config"), dict):
+        return "twin"
+    return None
+
+
+def identity_of(summ: dict[str, Any], kind: str) -> dict[str, Any]:
+    """scenario, horizon_s (s), warmup_s (s; None for a twin), controller, seed, kind."""
+    if kind == "twin":
+        horizon, warmup = summ["config"].get("horizon"), None
+    else:
+        horizon = summ.get("horizon")
+        warm = summ.get("warmup")
+        warmup = warm.get("duration_s") if isinstance(warm, dict) else warm
+    return {"scenario": summ.get("scenario"), "horizon_s": horizon, "warmup_s": warmup,
+            "controller": summ.get("controller"), "seed": summ.get("seed"), "kind": kind}
+
+
+def _total(summ: dict[str, Any], *keys: str) -> float:
+    for key in keys:
+        value = summ.get(key)
+        if isinstance(value, dict) and value.get("total") is not None:
+            return float(value["total"])
+    return float("nan")
 
 
 def row_of(summ: dict[str, Any]) -> dict[str, Any]:
-    """One flat row (human units) from a run's summary."""
+    """One flat row (identity, then metrics in human units) from a result's summary."""
     rm = summ.get("rmse", {}).get("replay", {})
 
     def rel(*names: str) -> float:
@@ -37,10 +88,10 @@ def row_of(summ: dict[str, Any]) -> dict[str, Any]:
 
     var = summ.get("speed_variance", {})
     return {
-        "controller": summ.get("controller"), "seed": summ.get("seed"),
+        **identity_of(summ, kind_of(summ) or "run"),
         "plan_changes": summ.get("plan_changes"), "light_changes": summ.get("light_changes"),
         "triggers": summ.get("triggers"), "release_time": summ.get("release_time"),
-        "TTT_veh_h": _total(summ, "TTT") / 3600.0,
+        "TTT_veh_h": _total(summ, "TTT", "J_TTT") / 3600.0,
         "delay_veh_h": _total(summ, "total_delay") / 3600.0,
         "J_fuel": _total(summ, "J_fuel"), "J_discom": _total(summ, "J_discom"),
         "speed_sd_h_kmh": (var.get("h") or float("nan")) ** 0.5 * 3.6,
@@ -50,19 +101,105 @@ def row_of(summ: dict[str, Any]) -> dict[str, Any]:
     }
 
 
+def as_text(value: Any) -> str:
+    if isinstance(value, float):
+        return "none" if math.isnan(value) else f"{value:g}"
+    return "none" if value is None else str(value)
+
+
+def differing(df: pd.DataFrame) -> dict[str, list[str]]:
+    """Columns of :data:`MUST_AGREE` with more than one value: column -> values (as text)."""
+    out: dict[str, list[str]] = {}
+    for col in MUST_AGREE:
+        values = list(dict.fromkeys(as_text(v) for v in df[col]))
+        if len(values) > 1:
+            out[col] = values
+    return out
+
+
+def mix_text(mix: dict[str, list[str]]) -> str:
+    """``horizon_s 60, 450; kind run, twin`` for the columns that differ."""
+    return "; ".join(f"{col} {', '.join(vals)}" for col, vals in mix.items())
+
+
+def header(df: pd.DataFrame) -> str:
+    """First line of the text table: what the rows share, or the mix when they differ."""
+    mix = differing(df)
+    if mix:
+        return f"MIXED RESULTS (--allow-mixed), not comparable row to row: {mix_text(mix)}"
+    first = df.iloc[0]
+    warm = "" if first["kind"] == "twin" else f", warm-up {as_text(first['warmup_s'])} s"
+    return (f"scenario {as_text(first['scenario'])}, horizon {as_text(first['horizon_s'])} s"
+            f"{warm}: {KINDS[first['kind']]}")
+
+
 def summary_table(summaries: list[dict[str, Any]]) -> str:
-    """Text table of runs (one row each)."""
+    """Text table of results (one row each) under a header line (:func:`header`).
+
+    The identity columns shared by every row are in the header, not the rows.
+    """
     df = pd.DataFrame([row_of(s) for s in summaries])
-    df = df.rename(columns=dict(COLUMNS))
-    return df.to_string(index=False, float_format=lambda v: f"{v:.3g}")
+    mix = differing(df)
+    drop = [c for c in ("scenario", "horizon_s", "warmup_s", "kind") if c not in mix]
+    body = df.drop(columns=drop).rename(columns=dict(COLUMNS))
+    return header(df) + "\n" + body.to_string(index=False, float_format=lambda v: f"{v:.3g}")
 
 
 def load_summaries(runs: list[Path]) -> list[dict[str, Any]]:
+    """The ``summary.json`` of each directory; refuses a missing, unreadable or unknown one."""
     out = []
     for run in runs:
         path = run / "summary.json"
         if not path.is_file():
-            raise ScenarioError(f"run = {str(run)!r} is not allowed: it has no summary.json "
-                                "(not a complete arzsumo run directory)")
-        out.append(json.loads(path.read_text(encoding="utf-8")))
+            raise CompareError(f"run = {str(run)!r} is not allowed: it has no summary.json "
+                               "(not a complete arzsumo run directory)")
+        try:
+            summ = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+            raise CompareError(f"{path}: cannot be read as JSON ({exc}); compare needs the "
+                               "summary.json written by arzsumo run") from None
+        if not isinstance(summ, dict) or kind_of(summ) is None:
+            raise CompareError(f"{path}: not a summary of arzsumo run (no 'kind' = 'run' "
+                               "and not a known result layout); compare reads arzsumo run "
+                               "result directories")
+        out.append(summ)
     return out
+
+
+def check_comparable(runs: list[Path], summaries: list[dict[str, Any]],
+                     allow_mixed: bool) -> None:
+    """Refuse results of another kind, scenario, horizon or warm-up unless ``allow_mixed``."""
+    if allow_mixed:
+        return
+    for run, summ in zip(runs, summaries, strict=True):
+        kind = kind_of(summ)
+        if kind != "run":
+            raise CompareError(f"run = {str(run)!r} is not allowed: its summary.json is a "
+                               f"{KINDS[str(kind)]}, compare needs arzsumo run results; "
+                               "pass --allow-mixed to tabulate it anyway")
+    df = pd.DataFrame([row_of(s) for s in summaries])
+    for col in differing(df):
+        unit = " s" if col.endswith("_s") else ""
+        where = ", ".join(f"{as_text(v)}{unit} ({run})"
+                          for v, run in zip(df[col], runs, strict=True))
+        raise CompareError(f"{col} differs between the runs: {where}; compare needs one "
+                           "scenario, horizon and warm-up; pass --allow-mixed to tabulate "
+                           "them anyway")
+
+
+def bar_title(df: pd.DataFrame) -> tuple[str, bool]:
+    """(title of the bar figure, whether bars are means per controller)."""
+    mix = differing(df)
+    if mix:
+        return f"one bar per run, MIXED results: {mix_text(mix)}", False
+    seeds = {c: [as_text(s) for s in g["seed"]] for c, g in df.groupby("controller", sort=False)}
+    if all(len(s) == 1 for s in seeds.values()):
+        listed = ", ".join(f"{c} seed {s[0]}" for c, s in seeds.items())
+        return f"one run per controller, no averaging ({listed})", False
+    lists = {", ".join(s) for s in seeds.values()}
+    if len(lists) == 1:
+        n = len(next(iter(seeds.values())))
+        return (f"mean over {n} seeds per controller (seeds {lists.pop()}); error bars: "
+                "standard deviation", True)
+    listed = "; ".join(f"{c} {len(s)} ({', '.join(s)})" for c, s in seeds.items())
+    return f"mean per controller over its seeds: {listed}; error bars: standard deviation", True

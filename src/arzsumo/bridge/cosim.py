@@ -15,7 +15,12 @@ Sequence of :func:`run_cosimulation` (``arzsumo run``):
    (:mod:`~arzsumo.bridge.estimator`) and its U goes to the meter
    (:mod:`~arzsumo.bridge.actuator`); SUMO runs one period, read by the sensor
    (:mod:`arzsumo.sumo.sensor`); the twins (:mod:`~arzsumo.bridge.twins`) advance; one
-   :class:`~arzsumo.bridge.records.PeriodRecord` is kept.
+   :class:`~arzsumo.bridge.records.PeriodRecord` is kept. No command follows the last
+   check (no period follows it: a plan change there would never run).
+
+The meter's counts (plan and light changes, queue maximum) cover the control window only:
+the meter's window is closed at the start of control and the warm-up's counts are kept
+apart (``CoSimResult.warmup_meter``).
 
 A detector sample's path: ``SumoSensor.observe`` (libsumo, every step) ->
 ``PeriodMeasurement`` -> ``Estimator.estimate`` -> ``MacroState`` -> ``Controller.check``
@@ -101,6 +106,8 @@ class CoSimResult:
     placement: str
     wall_time: float
     timings: dict[str, float]
+    #: meter counts from t = 0 to the start of control, and that time (``duration_s``, s)
+    warmup_meter: dict[str, float] = field(default_factory=dict)
 
 
 class SumoPlant:
@@ -218,15 +225,16 @@ class ClosedLoop:
         self.actuator, self.twins, self.period = actuator, twins, period
         self.timings = {"controller": 0.0, "twins": 0.0}
 
-    def decide(self, state: MacroState) -> Decision:
-        """Check the controller and the reference twin's; command the meter."""
+    def decide(self, state: MacroState, final: bool) -> Decision:
+        """Check the controller and the reference twin's; command the meter unless this
+        is the ``final`` check."""
         c0 = time.perf_counter()
         u = self.controller.check(state)
         c1 = time.perf_counter()
         u_ref = self.twins.check_reference()
         self.timings["controller"] += c1 - c0
         self.timings["twins"] += time.perf_counter() - c1
-        green = self.actuator.apply(u)
+        green = self.plant.meter.green_share if final else self.actuator.apply(u)
         log_ = self.controller.log
         return Decision(state.t, u, log_.u_continuous[-1] if log_.u_continuous else u,
                         float(log_.triggered[-1]) if log_.triggered else 0.0, green, u_ref,
@@ -245,8 +253,9 @@ class ClosedLoop:
         t0, trace = start.t, Trace(start.cells.x)
         state = self.estimator.estimate(start, 0.0)
         while True:
-            decision = self.decide(state)
-            if state.t >= horizon - 1e-9:
+            final = state.t >= horizon - 1e-9
+            decision = self.decide(state, final)
+            if final:
                 return trace
             m = self.plant.advance()
             t = m.t - t0
@@ -301,6 +310,7 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
         plant = SumoPlant(sim, params.length, run_cfg, curve)
         warm = warm_up(plant, settings.warmup, period, bar)
         plant.timings = dict.fromkeys(plant.timings, 0.0)   # time the control window only
+        warmup_meter = {**plant.meter.start_window(), "duration_s": float(warm[-1].t)}
         eq = operating_point(settings, scenario.equilibrium, warm, period)
         lin = linearize(eq)
         kernels = (cached_kernels(lin.system, settings.kernel_cells)
@@ -325,4 +335,5 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
                        np.asarray(trace.micro), np.asarray(trace.replay),
                        np.asarray(trace.reference), columns(trace.records), ctrl.log,
                        ref_ctrl.log, meter_summary, sim.report, twins.status(), placement,
-                       time.perf_counter() - wall0, {**plant.timings, **loop.timings})
+                       time.perf_counter() - wall0, {**plant.timings, **loop.timings},
+                       warmup_meter)

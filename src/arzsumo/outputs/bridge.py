@@ -5,14 +5,24 @@ Every file, column (with units, stored in the Parquet field metadata from
 ``DIR``::
 
     periods.parquet   per control period: t_s (check time), U commanded and continuous (veh/s),
-                      event flag, green share commanded and running, light and plan changes
-                      so far, ramp queue, class in/outflows (veh/s), downstream occupancy
+                      event flag, green share commanded and running, light and plan changes,
+                      ramp queue and its maximum (veh), class in/outflows (veh/s),
+                      downstream occupancy
     cells.parquet     per period and cell: source (micro, replay, reference), t_s, x_m,
                       rho_h, v_h, rho_a, v_a (SI; micro speeds NaN in empty cells)
     summary.json      see :func:`summary`
     scenario.toml     the resolved scenario (as loaded) and settings
     fields_h.png, fields_a.png   micro | replay twin | reference twin, per class
     control.png       U, green share, light, queue, release instants
+
+Counting windows: the meter's counts cover the *control window* only (from the start of
+control, after the warm-up, to the horizon). In ``periods.parquet``, ``light_changes`` and
+``plan_changes`` are cumulative counts since the start of control (0 before the first
+change) and ``max_queue`` is the maximum since the start of control, all read at the end
+of each period; ``queue`` is the queue at the end of the period. In ``summary.json`` the
+top-level ``plan_changes``, ``light_changes`` and ``max_ramp_queue`` are those of the
+control window; the warm-up's own counts (from t = 0 of SUMO to the start of control) are
+under ``warmup``, apart, and are not included in the top-level ones.
 """
 
 from __future__ import annotations
@@ -71,8 +81,25 @@ def rmse(res: CoSimResult, twin: np.ndarray) -> dict[str, dict[str, float]]:
     return out
 
 
+#: ``summary.json["kind"]`` of a closed-loop run in SUMO (``arzsumo run``)
+KIND = "run"
+
+
+def warmup_summary(res: CoSimResult) -> dict[str, Any]:
+    """The warm-up's meter counts, labelled as such (``summary.json["warmup"]``)."""
+    w = res.warmup_meter
+    return {"window": "warm-up: t = 0 of SUMO to the start of control; these counts are "
+                      "not in the top-level (control window) counts",
+            "duration_s": float(w["duration_s"]), "plan_changes": int(w["plan_changes"]),
+            "light_changes": int(w["light_changes"]), "max_ramp_queue": int(w["max_queue"])}
+
+
 def summary(res: CoSimResult) -> dict[str, Any]:
-    """The run's summary: meter counts, events, indices (micro and twins), fidelity, accounting."""
+    """The run's summary: meter counts, events, indices (micro and twins), fidelity, accounting.
+
+    Meter counts (``plan_changes``, ``light_changes``, ``max_ramp_queue``) cover the
+    control window; the warm-up's are under ``warmup`` (:func:`warmup_summary`).
+    """
     per = res.periods
     rep = res.report
     triggered = per["triggered"].astype(bool)
@@ -84,11 +111,12 @@ def summary(res: CoSimResult) -> dict[str, Any]:
     v = res.micro[:, [1, 3]]
     eq = res.equilibrium
     summ = {
+        "kind": KIND,
         "scenario": res.scenario.name, "source": res.scenario.source, "version": __version__,
         "seed": res.sumo.seed, "controller": res.settings.controller, "complete": True,
         "units": "SI: veh, s, m; U and flows in veh/s",
         "equilibrium": eq.as_dict(), "lambda_4": float(linearize(eq).eigenvalues[3]),
-        "q_nominal": res.q_nominal, "horizon": horizon, "warmup": res.settings.warmup,
+        "q_nominal": res.q_nominal, "horizon": horizon, "warmup": warmup_summary(res),
         "plan_changes": int(res.meter["plan_changes"]),
         "light_changes": int(res.meter["light_changes"]),
         "triggers": int(triggered.sum()),

@@ -7,20 +7,54 @@ from pathlib import Path
 
 import pandas as pd
 
-from arzsumo.bridge.compare import load_summaries, row_of, summary_table
+from arzsumo.bridge.compare import (
+    as_text,
+    bar_title,
+    check_comparable,
+    differing,
+    load_summaries,
+    row_of,
+    summary_table,
+)
 from arzsumo.io import atomic_file
 
+#: (column of the table, panel title with its unit)
+METRICS = (("plan_changes", "meter plan changes"), ("TTT_veh_h", "TTT (veh h)"),
+           ("delay_veh_h", "total delay (veh h)"), ("speed_sd_h_kmh", "sd of HV speed (km/h)"))
 
-def compare_runs(runs: list[Path], out: Path) -> tuple[str, Path, Path]:
-    """Write ``comparison.csv`` and ``comparison.png`` into ``out``; return the text table."""
+
+def _bars(df: pd.DataFrame, means: bool) -> tuple[list[str], dict]:
+    """Bar labels and heights (with sd error bars when ``means``) per metric panel."""
+    if means:
+        grouped = df.groupby("controller", sort=False)
+        return [str(c) for c in grouped.groups], {
+            label: (grouped[col].mean().to_numpy(float),
+                    grouped[col].std().fillna(0.0).to_numpy(float))
+            for col, label in METRICS}
+    labels = [f"{r.controller} s{as_text(r.seed)}"
+              + "".join(f" {c}={as_text(getattr(r, c))}" for c in differing(df))
+              for r in df.itertuples()]
+    return labels, {label: (df[col].to_numpy(float), None) for col, label in METRICS}
+
+
+def compare_runs(runs: list[Path], out: Path,
+                 allow_mixed: bool = False) -> tuple[str, Path, Path]:
+    """Write ``comparison.csv`` and ``comparison.png`` into ``out``; return the text table.
+
+    Refuses (:class:`~arzsumo.bridge.compare.CompareError`, nothing written) results that
+    are not comparable unless ``allow_mixed``.
+    """
     from arzsumo.plots import save_png
     from arzsumo.plots.compare import comparison_figure
 
     summaries = load_summaries(runs)
+    check_comparable(runs, summaries, allow_mixed)
     df = pd.DataFrame([row_of(s) for s in summaries])
     out.mkdir(parents=True, exist_ok=True)
     csv = out / "comparison.csv"
     with atomic_file(csv) as tmp:
         df.to_csv(tmp, index=False)
-    png = save_png(comparison_figure(df), out / "comparison.png", dpi=100)
+    title, means = bar_title(df)
+    labels, bars = _bars(df, means)
+    png = save_png(comparison_figure(labels, bars, title), out / "comparison.png", dpi=100)
     return summary_table(summaries), csv, png

@@ -56,7 +56,10 @@ def side_by_side_figure(t: np.ndarray, x: np.ndarray, panels: dict[str, np.ndarr
 def signals_figure(t: np.ndarray, u: np.ndarray, u_cont: np.ndarray, events: np.ndarray,
                    green_cmd: np.ndarray, green_run: np.ndarray, queue: np.ndarray,
                    light_changes: float, plan_changes: float, title: str = "") -> Figure:
-    """U commanded and continuous (veh/h), green share, ramp queue, release instants."""
+    """U commanded and continuous (veh/h), green share, ramp queue, release instants.
+
+    ``light_changes`` and ``plan_changes`` are the counts of the control window shown.
+    """
     fig, axes = plt.subplots(4, 1, figsize=(10, 9), sharex=True, layout="constrained",
                              gridspec_kw={"height_ratios": [3, 2, 1, 2]})
     axes[0].step(t, veh_s_to_veh_h(u), where="post", label="U commanded")
@@ -69,8 +72,8 @@ def signals_figure(t: np.ndarray, u: np.ndarray, u_cont: np.ndarray, events: np.
     axes[1].set_ylabel("green share")
     axes[1].set_ylim(-0.05, 1.05)
     axes[1].legend(loc="upper right")
-    axes[1].set_title(f"{int(plan_changes)} plan changes, {int(light_changes)} light changes",
-                      fontsize=9)
+    axes[1].set_title(f"{int(plan_changes)} plan changes, {int(light_changes)} light changes "
+                      "in the control window", fontsize=9)
     axes[2].vlines(t[events], 0, 1, lw=0.8)
     axes[2].set_yticks([])
     axes[2].set_ylabel("events")

@@ -12,6 +12,11 @@ the sensor (:mod:`arzsumo.sumo.sensor`) and handed to :meth:`RampMeter.step` eve
 and its maximum are tracked; an optional spillback override forces green while the queue
 is at or above ``spillback_queue``. The meter reads nothing from SUMO: it only sets the
 light.
+
+The counts (plan and light changes, override steps, queue maximum) run over a *window*:
+from the meter's creation until :meth:`RampMeter.start_window`, which returns them and
+starts a new window (the co-simulation opens one at the start of control, so the warm-up
+is counted apart).
 """
 
 from __future__ import annotations
@@ -169,8 +174,21 @@ class RampMeter:
             self.light_changes += 1
         return light
 
+    def start_window(self) -> dict[str, float]:
+        """Close the current counting window: return its :meth:`summary`, then count anew.
+
+        Plan and light changes and override steps restart from 0; the queue maximum
+        restarts from the next :meth:`step` (the light, the cycle and the pending plan
+        carry on unchanged).
+        """
+        closed = self.summary()
+        self.plan_changes = self.light_changes = self.override_steps = 0
+        self.max_queue = 0
+        return closed
+
     def summary(self) -> dict[str, float]:
-        """Counts of the run: plan and light changes, queue maximum, override steps."""
+        """Counts of the current window (see :meth:`start_window`): plan and light
+        changes, queue maximum (veh), override steps; the last queue and green share."""
         return {"plan_changes": self.plan_changes, "light_changes": self.light_changes,
                 "max_queue": self.max_queue, "queue": self.queue,
                 "override_steps": self.override_steps, "green_share": self.green_share}
