@@ -50,7 +50,7 @@ def test_user_errors_are_one_line_exit_2(args, message):
 
 def test_bad_scenario_values_from_file(tmp_path):
     cases = {
-        "rho_h_veh_km = -3": "rho_h = -0.003",
+        "rho_h_veh_km = -3": "[equilibrium] rho_h_veh_km = -3 is not allowed",
         "rho_h_veh_km = 260\nrho_a_veh_km = 100": "AO = ",
         "demand_h_veh_h = 9000\ndemand_a_veh_h = 5000": "exceeds what",
     }
