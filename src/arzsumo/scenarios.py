@@ -19,6 +19,7 @@ then the meaning (the model validates itself), and names the bad key and value.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -69,8 +70,8 @@ _DENSITY = "a density > 0 veh/km (both classes must be present)"
 EQUILIBRIUM_KEYS: dict[str, Key] = {
     "rho_h_veh_km": Key("rho_h", factor=VEH_KM_PER_VEH_M, allowed=_DENSITY),
     "rho_a_veh_km": Key("rho_a", factor=VEH_KM_PER_VEH_M, allowed=_DENSITY),
-    "v_h_kmh": Key("v_h", factor=KMH_PER_MS),
-    "v_a_kmh": Key("v_a", factor=KMH_PER_MS),
+    "v_h_kmh": Key("v_h", factor=KMH_PER_MS, allowed="a speed > 0 km/h"),
+    "v_a_kmh": Key("v_a", factor=KMH_PER_MS, allowed="a speed > 0 km/h"),
     "demand_h_veh_h": Key("demand_h", factor=VEH_H_PER_VEH_S, allowed="a demand > 0 veh/h"),
     "demand_a_veh_h": Key("demand_a", factor=VEH_H_PER_VEH_S, allowed="a demand > 0 veh/h"),
     "total_flow_veh_h": Key("flow", factor=VEH_H_PER_VEH_S, allowed="a flow > 0 veh/h"),
@@ -156,6 +157,8 @@ def _equilibrium(params: ModelParameters, preset: Preset, data: Mapping[str, Any
                                           si.get("rho_a", preset.rho_a), v_h=si.get("v_h"),
                                           v_a=si.get("v_a"))
     except ArzsumoError as exc:
+        # the model states a disagreeing speed in km/h already: name the key
+        exc.args = (re.sub(r"^v_([ha]) = ", r"v_\1_kmh = ", str(exc)),)
         raise in_user_terms(exc, at, eqt, EQUILIBRIUM_KEYS) from None
 
 

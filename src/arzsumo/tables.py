@@ -132,9 +132,10 @@ def in_user_terms(exc: ArzsumoError, at: str, table: Mapping[str, Any],
                   keys: Mapping[str, Key]) -> ScenarioError:
     """``exc`` (raised in SI with a field name) restated with the key and written value.
 
-    The result is a :class:`ScenarioError` (a bad value of the file). A field that a key of ``table`` sets is named by
-    that key with the value as written; a same-unit field left at its default is named
-    by its key with the default; anything else keeps its message, prefixed by ``at``.
+    The result is a :class:`ScenarioError` (a bad value of the file). A field that a key
+    of ``table`` sets is named by that key with the value as written; a same-unit field
+    left at its default is named by its key with the default; anything else keeps its
+    message, prefixed by ``at``.
     """
     field = getattr(exc, "field", None)
     matches = [key for key, spec in keys.items() if field is not None and spec.field == field]

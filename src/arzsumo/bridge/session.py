@@ -16,10 +16,13 @@ import numpy as np
 from arzsumo.bridge.config import RunSettings, run_settings_from_dict
 from arzsumo.bridge.cosim import CoSimResult, check_before_start, run_cosimulation
 from arzsumo.control.etc import EtcDesign
-from arzsumo.errors import ScenarioError
+from arzsumo.errors import ArzsumoError, ScenarioError
 from arzsumo.model import linearize
 from arzsumo.scenarios import Scenario, design_from_dict
-from arzsumo.sumo.config import SumoConfig, sumo_config_of
+from arzsumo.sumo.config import SUMO_KEYS, SumoConfig, sumo_config_of
+from arzsumo.sumo.measure import EdieGrid
+from arzsumo.sumo.network import NetworkSpec
+from arzsumo.tables import in_user_terms, not_allowed, written
 from arzsumo.twin.config import initial_from_dict
 from arzsumo.twin.initial import initial_fields
 from arzsumo.units import ms_to_kmh
@@ -75,14 +78,48 @@ def _horizon(horizon: float, cfg: SumoConfig) -> float:
     return float(horizon)
 
 
+def _check_model(sc: Scenario, cfg: SumoConfig) -> None:
+    """The road is SUMO's mainline, the measurement grid fits it, the characteristic speeds
+    are finite."""
+    road = NetworkSpec().length   # the network of `arzsumo build-net`
+    if abs(sc.params.length - road) > 1e-6:
+        model = sc.raw.get("model", {})
+        raise not_allowed(f"{sc.source}: [model]", "length_m",
+                          model.get("length_m", sc.params.length),
+                          f"the SUMO mainline length {road:g} m")
+    try:
+        EdieGrid(sc.params.length, cfg.cell_length, cfg.step_length)
+    except ArzsumoError as exc:
+        raise in_user_terms(exc, f"{sc.source}: [sumo]", sc.raw.get("sumo", {}),
+                            SUMO_KEYS) from None
+    lam = linearize(sc.equilibrium).eigenvalues
+    if not np.all(np.isfinite(lam)):
+        raise ScenarioError(f"{sc.source}: [model] and [equilibrium] give characteristic "
+                            f"speeds {', '.join(f'{v:.3g}' for v in ms_to_kmh(lam))} km/h; "
+                            "allowed: parameters that keep them finite")
+
+
+def _check_regime(sc: Scenario, settings: RunSettings, from_cli: bool) -> None:
+    """:func:`check_before_start`, its refusal naming where the controller was chosen."""
+    try:
+        check_before_start(settings, sc.equilibrium)
+    except ScenarioError as exc:
+        at = (f"--controller = {settings.controller}" if from_cli else
+              f"{sc.source}: [run] controller = {written(settings.controller)}")
+        reason = str(exc).split("this equilibrium: ", 1)[-1]
+        raise ScenarioError(f"{at} is not allowed at the "
+                            f"[equilibrium] of {sc.source}: {reason}") from None
+
+
 def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None = None,
                 horizon: float | None = None) -> PreparedRun:
     """Everything ``arzsumo run`` checks before SUMO starts, without starting it.
 
     Resolves and validates the ``[run]``, ``[sumo]``, ``[design]`` and ``[initial]`` tables
     of ``sc`` with the caller's overrides (``--controller``, ``--seed`` in [0, 2^31),
-    ``--horizon`` of at least one control period, s), refuses a PDE controller at a
-    free-flow scenario equilibrium, and draws the placement profile of ``start =
+    ``--horizon`` of at least one control period, s), checks that ``[sumo] cell_length_m``
+    divides the road and that the characteristic speeds are finite, refuses a PDE
+    controller at a free-flow scenario equilibrium, and draws the placement profile of ``start =
     "placement"``. Raises an :class:`arzsumo.errors.ArzsumoError` naming the key or option.
     """
     raw = sc.raw
@@ -94,8 +131,9 @@ def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None
         cfg = cfg.with_(horizon=_horizon(horizon, cfg))
     design = design_from_dict(raw, sc.source)
     ic = initial_from_dict(raw, sc.source, seed=cfg.seed)  # one seed draws all randomness
+    _check_model(sc, cfg)
     if settings.equilibrium == "scenario":
-        check_before_start(settings, sc.equilibrium)
+        _check_regime(sc, settings, controller is not None)
     initial = None
     if settings.start == "placement":
         n = round(sc.params.length / cfg.cell_length)

@@ -117,6 +117,9 @@ class SumoConfig:
         require(self.green_share_min <= self.green_share_max, "green_share_min",
                 self.green_share_min, f"at most green_share_max = {self.green_share_max}",
                 ScenarioError)
+        # a cell holds a vehicle or more; shorter cells only multiply the work
+        require(self.cell_length >= 1.0, "cell_length", self.cell_length, "at least 1 m",
+                ScenarioError)
         require(self.step_length <= 1.0, "step_length", self.step_length, "at most 1 s",
                 ScenarioError)
         subl = LANE_WIDTH / self.lateral_resolution
