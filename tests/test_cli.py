@@ -103,3 +103,16 @@ def test_design_check_reports_every_condition(tmp_path, monkeypatch, capsys):
     # the paper's own values fail select4 (sum A_i q_i^2 exceeds B): reported, not hidden
     select4 = next(c for c in out["conditions"] if c["label"] == "select4")
     assert select4["holds"] is False
+
+
+def test_design_check_ends_with_an_overall_verdict(tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv("ARZSUMO_CACHE", str(tmp_path))
+    assert main(["design-check", "--cells", "40", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    failing = [c for c in out["conditions"] if not c["holds"]]
+    assert out["all_hold"] is False and "select4" in out["failing"]
+    assert len(out["failing"]) == len(failing)
+    assert main(["design-check", "--cells", "40"]) == 0
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    assert last == (f"verdict: {len(failing)} of {len(out['conditions'])} conditions fail: "
+                    + ", ".join(out["failing"]))

@@ -38,7 +38,8 @@ def test_scenario_from_demand():
      r"penetration = 1.2 is not allowed"),
     ({"equilibrium": {"total_flow_veh_h": 20000, "penetration": 0.5}}, ScenarioError,
      r"flow = 20000 veh/h is not allowed at penetration 0.500: at most \d+ veh/h"),
-    ({"equilibrium": {"v_h_kmh": 32}}, ScenarioError, r"\[equilibrium\] v_h_kmh = 32.00 km/h disagrees"),
+    ({"equilibrium": {"v_h_kmh": 32}}, ScenarioError,
+     r"\[equilibrium\] v_h_kmh = 32.00 km/h disagrees"),
 ])
 def test_bad_scenarios_name_field_and_value(data, error, match):
     with pytest.raises(error, match=match):
