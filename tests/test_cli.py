@@ -50,7 +50,7 @@ def test_user_errors_are_one_line_exit_2(args, message):
 
 def test_bad_scenario_values_from_file(tmp_path):
     cases = {
-        "rho_h_veh_km = -3": "rho_h = -0.003",
+        "rho_h_veh_km = -3": "[equilibrium] rho_h_veh_km = -3 is not allowed",
         "rho_h_veh_km = 260\nrho_a_veh_km = 100": "AO = ",
         "demand_h_veh_h = 9000\ndemand_a_veh_h = 5000": "exceeds what",
     }
@@ -103,3 +103,16 @@ def test_design_check_reports_every_condition(tmp_path, monkeypatch, capsys):
     # the paper's own values fail select4 (sum A_i q_i^2 exceeds B): reported, not hidden
     select4 = next(c for c in out["conditions"] if c["label"] == "select4")
     assert select4["holds"] is False
+
+
+def test_design_check_ends_with_an_overall_verdict(tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv("ARZSUMO_CACHE", str(tmp_path))
+    assert main(["design-check", "--cells", "40", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    failing = [c for c in out["conditions"] if not c["holds"]]
+    assert out["all_hold"] is False and "select4" in out["failing"]
+    assert len(out["failing"]) == len(failing)
+    assert main(["design-check", "--cells", "40"]) == 0
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    assert last == (f"verdict: {len(failing)} of {len(out['conditions'])} conditions fail: "
+                    + ", ".join(out["failing"]))

@@ -1,6 +1,6 @@
 import pytest
 
-from arzsumo.errors import DemandError, ModelError, ScenarioError
+from arzsumo.errors import ScenarioError
 from arzsumo.scenarios import load_scenario, scenario_from_dict
 
 
@@ -20,22 +20,26 @@ def test_scenario_from_demand():
 @pytest.mark.parametrize(("data", "error", "match"), [
     ({"modle": {}}, ScenarioError,
      r"unknown key 'modle'; allowed: description, design, equilibrium"),
-    ({"model": {"spacing_x_m": 3}}, ScenarioError, r"\[model\]: unknown key 'spacing_x_m'"),
-    ({"model": {"tau_h_s": "fast"}}, ScenarioError, r"tau_h_s = 'fast' is not allowed"),
-    ({"model": {"preset": "paper"}}, ModelError, r"preset = 'paper' is unknown"),
-    ({"equilibrium": {"rho_h_veh_km": -5}}, ModelError, r"rho_h = -0.005"),
-    ({"equilibrium": {"rho_h_veh_km": 200, "rho_a_veh_km": 120}}, ModelError,
+    ({"model": {"spacing_x_m": 3}}, ScenarioError, r"\[model\] unknown key 'spacing_x_m'"),
+    ({"model": {"tau_h_s": "fast"}}, ScenarioError,
+     r'\[model\] tau_h_s = "fast" is not allowed: a finite number'),
+    ({"model": {"preset": "paper"}}, ScenarioError,
+     r'\[model\] preset = "paper" is not allowed: one of paper_aggressive'),
+    ({"equilibrium": {"rho_h_veh_km": -5}}, ScenarioError,
+     r"\[equilibrium\] rho_h_veh_km = -5 is not allowed: a density > 0 veh/km"),
+    ({"equilibrium": {"rho_h_veh_km": 200, "rho_a_veh_km": 120}}, ScenarioError,
      r"AO = .* below its maximum"),
-    ({"equilibrium": {"demand_h_veh_h": 9000, "demand_a_veh_h": 4000}}, DemandError,
+    ({"equilibrium": {"demand_h_veh_h": 9000, "demand_a_veh_h": 4000}}, ScenarioError,
      r"exceeds what the fundamental diagram can carry"),
     ({"equilibrium": {"rho_h_veh_km": 110, "demand_h_veh_h": 100}}, ScenarioError,
      r"not several"),
     ({"equilibrium": {"penetration": 0.5}}, ScenarioError, r"total_flow_veh_h is missing"),
-    ({"equilibrium": {"total_flow_veh_h": 5000, "penetration": 1.2}}, ModelError,
+    ({"equilibrium": {"total_flow_veh_h": 5000, "penetration": 1.2}}, ScenarioError,
      r"penetration = 1.2 is not allowed"),
-    ({"equilibrium": {"total_flow_veh_h": 20000, "penetration": 0.5}}, DemandError,
+    ({"equilibrium": {"total_flow_veh_h": 20000, "penetration": 0.5}}, ScenarioError,
      r"flow = 20000 veh/h is not allowed at penetration 0.500: at most \d+ veh/h"),
-    ({"equilibrium": {"v_h_kmh": 32}}, ModelError, r"v_h = 32.00 km/h disagrees"),
+    ({"equilibrium": {"v_h_kmh": 32}}, ScenarioError,
+     r"\[equilibrium\] v_h_kmh = 32.00 km/h disagrees"),
 ])
 def test_bad_scenarios_name_field_and_value(data, error, match):
     with pytest.raises(error, match=match):

@@ -13,7 +13,8 @@ import logging
 import sys
 from collections.abc import Callable, Sequence
 
-from arzsumo import __version__, cli_bridge, cli_control, cli_sumo, cli_sweep, cli_twin
+from arzsumo import __version__, cli_bridge, cli_control, cli_list, cli_sumo, cli_sweep, cli_twin
+from arzsumo.cli_args import Parser
 from arzsumo.cli_common import add_model_source, scenario_of
 from arzsumo.errors import ArzsumoError
 from arzsumo.model import linearize
@@ -77,16 +78,36 @@ def cmd_model(args: argparse.Namespace) -> int:
     return 0
 
 
+EPILOG = """\
+environment variables:
+  ARZSUMO_CACHE      directory of the backstepping kernel cache (kernels in its kernels/)
+                     (default: ~/.cache/arzsumo)
+  ARZSUMO_SUMO_NETS  directory of the SUMO network written by 'arzsumo build-net'
+                     (default: sumo_nets/ at the repository root)
+
+exit codes:
+  0    done
+  2    user error (bad argument, scenario or sweep file): one line on stderr
+  3    the PDE twin left the physical domain (twin, reproduce: partial results written)
+  4    some sweep runs were invalid, failed or crashed (sweep: the others completed)
+  130  interrupted (Ctrl-C)
+
+'arzsumo list' shows the shipped scenario and sweep files; 'arzsumo CMD --help' each
+command's options."""
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog="arzsumo",
         description="PDE boundary control of mixed-autonomy traffic, from the ARZ model "
-                    "into SUMO.")
+                    "into SUMO.", epilog=EPILOG)
     parser.add_argument("--version", action="version", version=f"arzsumo {__version__}")
     parser.add_argument("-v", "--verbose", action="store_true", help="debug logging")
-    sub = parser.add_subparsers(dest="command", required=True)
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    p = sub.add_parser("model", help="equilibrium, eigenvalues, regime and t_f of a model")
+    p = sub.add_parser("model", help="equilibrium, eigenvalues, regime and t_f of a model",
+                       description="Print the equilibrium of a preset or scenario, its "
+                                   "characteristic speeds, regime and finite time t_f.")
     add_model_source(p)
     p.add_argument("--json", action="store_true", help="print JSON with SI values")
     p.add_argument("--regime-map", metavar="FILE.png", help="draw the free/congested map")
@@ -97,12 +118,16 @@ def build_parser() -> argparse.ArgumentParser:
     cli_sumo.register(sub)
     cli_bridge.register(sub)
     cli_sweep.register(sub)
+    cli_list.register(sub)
     return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # --help, --version, or a refused argument (one line printed)
+        return int(exc.code or 0)
     logging.basicConfig(level=logging.DEBUG if args.verbose else logging.INFO,
                         format="%(levelname)s %(name)s: %(message)s")
     logging.getLogger("matplotlib").setLevel(logging.WARNING)

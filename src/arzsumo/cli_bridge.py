@@ -7,6 +7,9 @@ import json
 import logging
 from pathlib import Path
 
+from arzsumo.bridge.config import CONTROLLERS
+from arzsumo.cli_args import positive_float, seed_int
+
 log = logging.getLogger("arzsumo")
 
 #: the default scenario of ``arzsumo run`` (and ``make run``)
@@ -20,6 +23,12 @@ def cmd_run(args: argparse.Namespace) -> int:
 
     path = Path(args.scenario) if args.scenario else DEFAULT_SCENARIO
     sc = load_scenario(path)
+    if args.dry_run:
+        from arzsumo.bridge.session import prepare_run
+
+        print(prepare_run(sc, controller=args.controller, seed=args.seed,
+                          horizon=args.horizon).describe())
+        return 0
     session = run_in_sumo(sc, controller=args.controller, seed=args.seed,
                           horizon=args.horizon, progress=not args.quiet)
     out = Path(args.out) if args.out else Path("results") / (
@@ -50,21 +59,36 @@ def cmd_compare(args: argparse.Namespace) -> int:
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``run`` and ``compare`` to the top-level parser."""
-    p = sub.add_parser("run", help="closed loop in SUMO with the PDE twin alongside")
-    p.add_argument("scenario", nargs="?", help="scenario file (default scenarios/default.toml)")
-    p.add_argument("--out", help="results directory (default results/NAME-CONTROLLER-seedN)")
-    p.add_argument("--seed", type=int, help="SUMO seed (overrides [sumo] seed)")
-    p.add_argument("--controller", choices=["open", "backstepping", "etc", "observer-etc",
-                                            "alinea"], help="override [run] controller")
-    p.add_argument("--horizon", type=float, help="control horizon, s (overrides [sumo])")
+    p = sub.add_parser("run", help="closed loop in SUMO with the PDE twin alongside",
+                       description="Run a scenario's closed loop in SUMO: warm-up under the "
+                                   "nominal meter, then the [run] controller on the ramp "
+                                   "meter, with the PDE twins alongside; write the results.")
+    p.add_argument("scenario", nargs="?", metavar="SCENARIO.toml",
+                   help="scenario file (default scenarios/default.toml)")
+    p.add_argument("--out", metavar="DIR",
+                   help="results directory (default results/NAME-CONTROLLER-seedN)")
+    p.add_argument("--seed", type=seed_int,
+                   help="SUMO seed in [0, 2^31) (default: [sumo] seed)")
+    p.add_argument("--controller", choices=list(CONTROLLERS),
+                   help="controller (default: [run] controller)")
+    p.add_argument("--horizon", type=positive_float,
+                   help="control horizon after the warm-up, s; at least one control period "
+                        "(default: [sumo] horizon_s)")
+    p.add_argument("--dry-run", action="store_true",
+                   help="check the scenario and the options as the run would, print what "
+                        "it would do, and exit without starting SUMO")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG figures")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.set_defaults(func=cmd_run)
 
-    p = sub.add_parser("compare", help="one table across run directories (CSV and bar plot)")
-    p.add_argument("runs", nargs="+", help="results directories of arzsumo run")
-    p.add_argument("--out", default="comparison", help="directory for the CSV and plot")
+    p = sub.add_parser("compare", help="one table across run directories (CSV and bar plot)",
+                       description="Compare the summaries of several 'arzsumo run' results "
+                                   "directories in one table, a CSV and a bar plot.")
+    p.add_argument("runs", nargs="+", metavar="RUN_DIR",
+                   help="results directories of arzsumo run")
+    p.add_argument("--out", metavar="DIR", default="comparison",
+                   help="directory for the CSV and plot")
     p.add_argument("--allow-mixed", action="store_true",
                    help="tabulate results of different kinds (twin), scenarios, horizons or "
                         "warm-ups anyway; the table's header states the mix")

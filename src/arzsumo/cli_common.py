@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 
+from arzsumo.model.params import PRESETS
 from arzsumo.scenarios import Scenario, load_scenario, scenario_from_preset
 
 
@@ -19,5 +20,5 @@ def add_model_source(p: argparse.ArgumentParser) -> None:
     """Add the exclusive ``--preset`` | ``--scenario`` options to ``p``."""
     src = p.add_mutually_exclusive_group()
     src.add_argument("--preset", default="paper_base",
-                     help="named model preset (paper_base, paper_s12, paper_aggressive)")
+                     help=f"named model preset ({', '.join(sorted(PRESETS))})")
     src.add_argument("--scenario", metavar="FILE.toml", help="scenario file instead of a preset")

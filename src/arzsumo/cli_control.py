@@ -6,6 +6,7 @@ import argparse
 import json
 import time
 
+from arzsumo.cli_args import cells_int, positive_float
 from arzsumo.cli_common import add_model_source, scenario_of
 from arzsumo.errors import require
 from arzsumo.kernel_cache import cached_kernels
@@ -13,7 +14,8 @@ from arzsumo.kernel_cache import cached_kernels
 
 def _add_common(p: argparse.ArgumentParser) -> None:
     add_model_source(p)
-    p.add_argument("--cells", type=int, default=200, help="kernel grid cells (default 200)")
+    p.add_argument("--cells", type=cells_int, default=200,
+                   help="kernel grid cells, an integer >= 4")
 
 
 def _linearization(args: argparse.Namespace):
@@ -43,7 +45,8 @@ def cmd_kernels(args: argparse.Namespace) -> int:
 def _design(args: argparse.Namespace):
     from arzsumo.control.etc import PAPER_DESIGN
 
-    changes = {k: getattr(args, k) for k in ("mu", "sigma", "zeta") if getattr(args, k)}
+    changes = {k: getattr(args, k) for k in ("mu", "sigma", "zeta")
+               if getattr(args, k) is not None}
     return PAPER_DESIGN.with_(**changes)
 
 
@@ -83,25 +86,34 @@ def cmd_verify(args: argparse.Namespace) -> int:
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the controller commands to the top-level parser."""
-    p = sub.add_parser("kernels", help="solve (and cache) the backstepping kernels; plot them")
+    p = sub.add_parser("kernels", help="solve (and cache) the backstepping kernels; plot them",
+                       description="Solve the backstepping kernel equations of a model's "
+                                   "linearisation (cached in $ARZSUMO_CACHE), print their "
+                                   "boundary values and optionally plot K, M, L, N.")
     _add_common(p)
     p.add_argument("--plot", metavar="FILE.png", help="draw K, M, L, N")
     p.set_defaults(func=cmd_kernels)
 
     p = sub.add_parser("verify", help="finite-time convergence and transform checks on the "
-                                      "linear plant, or a controller run on it")
+                                      "linear plant, or a controller run on it",
+                       description="Check the backstepping design on the linear plant "
+                                   "(finite-time convergence, inverse transform), or run a "
+                                   "controller on it with periodic checks.")
     _add_common(p)
     p.add_argument("--controller", default="theory",
                    choices=["theory", "backstepping", "etc", "observer-etc"],
                    help="'theory': the backstepping checks (default); else run that "
                         "controller with periodic checks")
-    p.add_argument("--period", type=float, default=1.0, help="check period, s (default 1)")
-    p.add_argument("--horizon", type=float, default=450.0, help="run length, s (default 450)")
+    p.add_argument("--period", type=positive_float, default=1.0, help="check period, s")
+    p.add_argument("--horizon", type=positive_float, default=450.0, help="run length, s")
     _add_design(p)
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(func=cmd_verify)
 
-    p = sub.add_parser("design-check", help="ETC design conditions select1-select4 and tau*")
+    p = sub.add_parser("design-check", help="ETC design conditions select1-select4 and tau*",
+                       description="Evaluate the ETC design conditions select1-select4 and "
+                                   "the decay conditions of Theorem esthm, the minimum dwell "
+                                   "time tau*, and an overall verdict.")
     _add_common(p)
     _add_design(p)
     p.add_argument("--json", action="store_true", help="print JSON")
@@ -110,7 +122,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _add_design(p: argparse.ArgumentParser) -> None:
     for name in ("mu", "sigma", "zeta"):
-        p.add_argument(f"--{name}", type=float, help=f"ETC design {name} (default: paper)")
+        p.add_argument(f"--{name}", type=positive_float,
+                       help=f"ETC design {name}, > 0 (default: the paper's)")
 
 
 def cmd_design_check(args: argparse.Namespace) -> int:
@@ -126,6 +139,7 @@ def cmd_design_check(args: argparse.Namespace) -> int:
     report = check_design(lin.system, kernels, _design(args), alpha_x)
     if args.json:
         print(json.dumps({"conditions": [asdict(c) for c in report.conditions],
+                          "all_hold": report.all_hold, "failing": report.failing(),
                           "tau_star": report.tau_star, "constants": report.constants},
                          indent=2))
         return 0
@@ -135,4 +149,5 @@ def cmd_design_check(args: argparse.Namespace) -> int:
               f"{c.statement}")
     print(f"minimum dwell time tau* = {report.tau_star:.4g} s (Theorem minimalthm; c_4 from "
           "the sinusoidal initial state)")
+    print(f"verdict: {report.verdict()}")
     return 0

@@ -11,6 +11,7 @@ import logging
 import os
 from pathlib import Path
 
+from arzsumo.cli_args import positive_float, positive_int, seed_int
 from arzsumo.units import ms_to_kmh, veh_m_to_veh_km, veh_s_to_veh_h
 
 log = logging.getLogger("arzsumo")
@@ -82,24 +83,33 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the SUMO subcommands to the CLI's subparsers."""
-    p = sub.add_parser("build-net", help="write the SUMO network sources and build the network")
+    p = sub.add_parser("build-net", help="write the SUMO network sources and build the network",
+                       description="Write the XML sources of the on-ramp network, build it "
+                                   "with netconvert, and write sumo-gui files.")
     p.add_argument("--out", metavar="DIR",
-                   help="network directory (default: sumo_nets/ or $ARZSUMO_SUMO_NETS)")
+                   help="network directory (default: $ARZSUMO_SUMO_NETS, else sumo_nets/ at "
+                        "the repository root)")
     p.add_argument("--keep-sources", action="store_true",
                    help="rebuild from the XML sources in DIR instead of rewriting them")
     p.set_defaults(func=cmd_build_net)
 
     p = sub.add_parser("calibrate", help="fit the AO fundamental diagram and the meter curve "
-                                         "to SUMO runs")
+                                         "to SUMO runs",
+                       description="Run SUMO at several demands and meter plans, fit the AO "
+                                   "fundamental diagram per class and the meter's outflow "
+                                   "curve, and write them.")
     src = p.add_mutually_exclusive_group()
     src.add_argument("--preset", default="paper_base", help="model preset for vehicle types")
     src.add_argument("--scenario", metavar="FILE.toml", help="scenario file (may hold [sumo])")
     p.add_argument("--out", metavar="DIR", default="runs/calibration",
                    help="output directory (written atomically)")
-    p.add_argument("--seed", type=int, help="SUMO seed (default: the scenario's)")
-    p.add_argument("--step-length", type=float, help="SUMO step, s")
-    p.add_argument("--horizon", type=float, help="length of each run, s (default 450)")
-    p.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1),
+    p.add_argument("--seed", type=seed_int,
+                   help="SUMO seed in [0, 2^31) (default: the scenario's [sumo] seed)")
+    p.add_argument("--step-length", type=positive_float,
+                   help="SUMO step, s (default: the scenario's [sumo] step_length_s)")
+    p.add_argument("--horizon", type=positive_float,
+                   help="length of each run, s (default 450; 90 with --quick)")
+    p.add_argument("--jobs", type=positive_int, default=min(2, os.cpu_count() or 1),
                    help="SUMO runs at a time (default: up to 2)")
     p.add_argument("--quick", action="store_true",
                    help="a tiny smoke calibration (3 short runs)")

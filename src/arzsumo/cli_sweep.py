@@ -10,6 +10,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from arzsumo.cli_args import positive_int
+
 EXIT_SOME_FAILED = 4
 
 
@@ -41,9 +43,13 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``sweep`` to the top-level parser."""
-    p = sub.add_parser("sweep", help="run a sweep file on a process pool or a Dask cluster")
+    p = sub.add_parser("sweep", help="run a sweep file on a process pool or a Dask cluster",
+                       description="Expand a sweep file (a base scenario, an engine, axes and "
+                                   "seeds) into runs, run what is not finished yet, and write "
+                                   "one table and plots. 'arzsumo list' shows the shipped "
+                                   "sweep files.")
     p.add_argument("sweep", metavar="SWEEP.toml", help="sweep file (base, engine, axes)")
-    p.add_argument("--workers", type=int,
+    p.add_argument("--workers", type=positive_int,
                    help="local processes (default: one per core); ignored with --scheduler")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="Dask scheduler address, e.g. tcp://10.0.0.5:8786")

@@ -16,6 +16,7 @@ import json
 import logging
 from pathlib import Path
 
+from arzsumo.cli_args import positive_int
 from arzsumo.scenarios import load_scenario
 from arzsumo.units import veh_s_to_veh_h
 
@@ -93,7 +94,10 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``twin`` subcommand to the main parser's subparsers."""
-    p = subparsers.add_parser("twin", help="run the nonlinear PDE twin on a scenario")
+    p = subparsers.add_parser("twin", help="run the nonlinear PDE twin on a scenario",
+                              description="Run the nonlinear mixed-autonomy ARZ model (the PDE "
+                                          "twin) on a scenario with its [twin] controller and "
+                                          "[initial] condition; write fields, summary, plots.")
     p.add_argument("scenario", metavar="SCENARIO.toml",
                    help="scenario file with optional [twin] and [initial] tables")
     p.add_argument("--out", metavar="DIR",
@@ -105,18 +109,21 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(func=cmd_twin)
 
     r = subparsers.add_parser("reproduce",
-                              help="run every experiment of section 5 and compare with the paper")
+                              help="run every experiment of section 5 and compare with the paper",
+                              description="Run every section 5 experiment of the paper in the "
+                                          "PDE twin, compare each claim with the paper's, and "
+                                          "write a report.")
     r.add_argument("--out", metavar="DIR",
                    help="output directory (default results/reproduce)")
     r.add_argument("--quick", action="store_true",
                    help="tiny grid and horizon: a smoke test, numbers not meaningful")
     r.add_argument("--scenarios", metavar="DIR", default="scenarios/paper",
-                   help="directory of the section 5 scenario files (default scenarios/paper)")
+                   help="directory of the section 5 scenario files")
     r.add_argument("--only", metavar="NAME", nargs="*",
                    help="run only these scenario names")
     r.add_argument("--scheme", choices=("first", "muscl"),
                    help="override every scenario's [twin] scheme (files: first order)")
-    r.add_argument("--workers", type=int, default=1,
-                   help="processes (default 1; results do not depend on it)")
+    r.add_argument("--workers", type=positive_int, default=1,
+                   help="processes, an integer >= 1 (results do not depend on it)")
     r.add_argument("--no-plots", action="store_true", help="skip the PNG figures")
     r.set_defaults(func=cmd_reproduce)

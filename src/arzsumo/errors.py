@@ -9,7 +9,16 @@ from __future__ import annotations
 
 
 class ArzsumoError(Exception):
-    """A user-facing error: the message names the field, the value and what is allowed."""
+    """A user-facing error: the message names the field, the value and what is allowed.
+
+    Raised by :func:`require`, it also carries ``field``, ``value`` and ``allowed``, so a
+    caller that knows where the value came from (a scenario key, a CLI option) can restate
+    it in the user's terms (:func:`arzsumo.tables.in_user_terms`).
+    """
+
+    field: str | None = None
+    value: object = None
+    allowed: str | None = None
 
 
 class ModelError(ArzsumoError, ValueError):
@@ -28,4 +37,6 @@ def require(condition: bool, field: str, value: object, allowed: str,
             error: type[ArzsumoError] = ModelError) -> None:
     """Raise ``error`` with a message naming ``field``, ``value`` and what is ``allowed``."""
     if not condition:
-        raise error(f"{field} = {value!r} is not allowed: {allowed}")
+        exc = error(f"{field} = {value!r} is not allowed: {allowed}")
+        exc.field, exc.value, exc.allowed = field, value, allowed
+        raise exc

@@ -19,8 +19,8 @@ then the meaning (the model validates itself), and names the bad key and value.
 
 from __future__ import annotations
 
-import math
-from collections.abc import Callable, Mapping
+import re
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -34,50 +34,61 @@ from arzsumo.model.equilibrium import (
     equilibrium_from_demand,
     equilibrium_from_densities,
 )
-from arzsumo.model.params import ModelParameters, get_preset
-from arzsumo.units import kmh_to_ms, veh_h_to_veh_s, veh_km_to_veh_m
+from arzsumo.model.params import PRESETS, ModelParameters, Preset, get_preset
+from arzsumo.tables import (
+    Key,
+    check_keys,
+    checked,
+    in_user_terms,
+    not_allowed,
+    read_keys,
+    sub_table,
+    where,
+)
+from arzsumo.units import KMH_PER_MS, VEH_H_PER_VEH_S, VEH_KM_PER_VEH_M
 
-
-def _si(x: float) -> float:
-    return float(x)
-
-
-# TOML key -> (ModelParameters field, conversion to SI)
-MODEL_KEYS: dict[str, tuple[str, Callable[[float], Any]]] = {
-    "length_m": ("length", _si),
-    "road_width_m": ("road_width", _si),
-    "vehicle_width_m": ("vehicle_width", _si),
-    "spacing_h_m": ("spacing_h", _si),
-    "spacing_a_m": ("spacing_a", _si),
-    "tau_h_s": ("tau_h", _si),
-    "tau_a_s": ("tau_a", _si),
-    "gamma_h": ("gamma_h", _si),
-    "gamma_a": ("gamma_a", _si),
-    "ao_max_h": ("ao_max_h", _si),
-    "ao_max_a": ("ao_max_a", _si),
-    "v_free_h_kmh": ("v_free_h", kmh_to_ms),
-    "v_free_a_kmh": ("v_free_a", kmh_to_ms),
+#: [model] key -> ModelParameters field (SI), with its unit factor
+MODEL_KEYS: dict[str, Key] = {
+    "length_m": Key("length"),
+    "road_width_m": Key("road_width"),
+    "vehicle_width_m": Key("vehicle_width"),
+    "spacing_h_m": Key("spacing_h"),
+    "spacing_a_m": Key("spacing_a"),
+    "tau_h_s": Key("tau_h"),
+    "tau_a_s": Key("tau_a"),
+    "gamma_h": Key("gamma_h"),
+    "gamma_a": Key("gamma_a"),
+    "ao_max_h": Key("ao_max_h"),
+    "ao_max_a": Key("ao_max_a"),
+    "v_free_h_kmh": Key("v_free_h", factor=KMH_PER_MS, allowed="a speed > 0 km/h"),
+    "v_free_a_kmh": Key("v_free_a", factor=KMH_PER_MS, allowed="a speed > 0 km/h"),
 }
+PRESET_KEY = Key("preset", "string", choices=tuple(sorted(PRESETS)))
 
-EQUILIBRIUM_KEYS: dict[str, Callable[[float], Any]] = {
-    "rho_h_veh_km": veh_km_to_veh_m,
-    "rho_a_veh_km": veh_km_to_veh_m,
-    "v_h_kmh": kmh_to_ms,
-    "v_a_kmh": kmh_to_ms,
-    "demand_h_veh_h": veh_h_to_veh_s,
-    "demand_a_veh_h": veh_h_to_veh_s,
-    "total_flow_veh_h": veh_h_to_veh_s,
-    "penetration": _si,
+_DENSITY = "a density > 0 veh/km (both classes must be present)"
+#: [equilibrium] key -> argument of the equilibrium constructors (SI)
+EQUILIBRIUM_KEYS: dict[str, Key] = {
+    "rho_h_veh_km": Key("rho_h", factor=VEH_KM_PER_VEH_M, allowed=_DENSITY),
+    "rho_a_veh_km": Key("rho_a", factor=VEH_KM_PER_VEH_M, allowed=_DENSITY),
+    "v_h_kmh": Key("v_h", factor=KMH_PER_MS, allowed="a speed > 0 km/h"),
+    "v_a_kmh": Key("v_a", factor=KMH_PER_MS, allowed="a speed > 0 km/h"),
+    "demand_h_veh_h": Key("demand_h", factor=VEH_H_PER_VEH_S, allowed="a demand > 0 veh/h"),
+    "demand_a_veh_h": Key("demand_a", factor=VEH_H_PER_VEH_S, allowed="a demand > 0 veh/h"),
+    "total_flow_veh_h": Key("flow", factor=VEH_H_PER_VEH_S, allowed="a flow > 0 veh/h"),
+    "penetration": Key("penetration"),
 }
+BRANCH_KEY = Key("branch", "string", choices=("congested", "free"))
 
 #: Tables parsed elsewhere: [twin] and [initial] by arzsumo.twin.config, [sumo] by
 #: arzsumo.sumo.config, [run] by arzsumo.bridge.config, [sweep] (parameter, values) by
 #: arzsumo.studies.paper.reproduce (design sensitivity); [design] below.
 TOP_KEYS = {"name", "description", "model", "equilibrium", "twin", "initial", "design",
             "sumo", "run", "sweep"}
+TABLES = TOP_KEYS - {"name", "description"}
 
 #: ETC design keys of the [design] table (dimensionless or SI as in the paper, section 5)
 DESIGN_KEYS = {"zeta", "sigma", "eta", "A", "B", "varsigma", "mu", "m0"}
+_DESIGN_SPECS = {k: Key(k) for k in DESIGN_KEYS}
 
 
 @dataclass(frozen=True)
@@ -92,108 +103,103 @@ class Scenario:
     raw: Mapping[str, Any] = field(default_factory=dict, repr=False)
 
 
-def _section(data: Mapping[str, Any], name: str, where: str) -> dict[str, Any]:
-    value = data.get(name, {})
-    if not isinstance(value, dict):
-        raise ScenarioError(f"{where}: [{name}] must be a table, got {value!r}")
-    return dict(value)
-
-
-def _check_keys(table: Mapping[str, Any], allowed: set[str], where: str) -> None:
-    for key in table:
-        if key not in allowed:
-            raise ScenarioError(f"{where}: unknown key {key!r}; allowed: "
-                                f"{', '.join(sorted(allowed))}")
-
-
-def scenario_table(data: Mapping[str, Any], name: str, allowed: set[str],
+def scenario_table(data: Mapping[str, Any], name: str, allowed: set[str] | Mapping[str, Any],
                    source: str) -> dict[str, Any]:
     """The ``[name]`` table of a parsed scenario (empty if absent), keys checked against
     ``allowed``; the error names the file, the table and the key."""
-    table = _section(data, name, source)
-    _check_keys(table, allowed, f"{source} [{name}]")
-    return table
+    return sub_table(data, name, allowed, source)
 
 
-def _number(table: Mapping[str, Any], key: str, where: str) -> float:
-    value = table[key]
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise ScenarioError(f"{where}: {key} = {value!r} is not allowed: a finite number")
-    return float(value)
+def _model(data: Mapping[str, Any], source: str) -> tuple[Preset, ModelParameters]:
+    model = sub_table(data, "model", set(MODEL_KEYS) | {"preset"}, source)
+    at = where(source, "model")
+    name = checked(model["preset"], "string", at, "preset", PRESET_KEY.choices) \
+        if "preset" in model else "paper_base"
+    preset = get_preset(name)
+    changes = read_keys(model, MODEL_KEYS, at)
+    try:
+        return preset, preset.params.with_(**changes)
+    except ArzsumoError as exc:
+        raise in_user_terms(exc, at, model, MODEL_KEYS) from None
+
+
+def _equilibrium(params: ModelParameters, preset: Preset, data: Mapping[str, Any],
+                 source: str) -> Equilibrium:
+    eqt = sub_table(data, "equilibrium", set(EQUILIBRIUM_KEYS) | {"branch"}, source)
+    at = where(source, "equilibrium")
+    si = read_keys(eqt, EQUILIBRIUM_KEYS, at)
+    branch = (checked(eqt["branch"], "string", at, "branch", BRANCH_KEY.choices)
+              if "branch" in eqt else "congested")
+    has_demand = "demand_h_veh_h" in eqt or "demand_a_veh_h" in eqt
+    has_density = "rho_h_veh_km" in eqt or "rho_a_veh_km" in eqt
+    has_mix = "total_flow_veh_h" in eqt or "penetration" in eqt
+    if has_demand + has_density + has_mix > 1:
+        raise ScenarioError(f"{at} give either densities (rho_*_veh_km), demands "
+                            "(demand_*_veh_h) or total_flow_veh_h and penetration, not "
+                            "several")
+    speeds = "v_h_kmh" in eqt or "v_a_kmh" in eqt
+    pair = (("total_flow_veh_h", "penetration") if has_mix else
+            ("demand_h_veh_h", "demand_a_veh_h") if has_demand else ())
+    for key in pair:
+        if key not in eqt:
+            raise ScenarioError(f"{at} {key} is missing ({' and '.join(pair)} go together)")
+    if pair and speeds:
+        raise ScenarioError(f"{at} speeds follow from the {'flow' if has_mix else 'demands'}"
+                            "; remove v_*_kmh")
+    if not pair and "branch" in eqt:
+        raise ScenarioError(f"{at} branch applies to demands and flows only")
+    try:
+        if has_mix:
+            return equilibrium_at_penetration(params, si["flow"], si["penetration"], branch)
+        if has_demand:
+            return equilibrium_from_demand(params, si["demand_h"], si["demand_a"], branch)
+        return equilibrium_from_densities(params, si.get("rho_h", preset.rho_h),
+                                          si.get("rho_a", preset.rho_a), v_h=si.get("v_h"),
+                                          v_a=si.get("v_a"))
+    except ArzsumoError as exc:
+        # the model states a disagreeing speed in km/h already: name the key
+        exc.args = (re.sub(r"^v_([ha]) = ", r"v_\1_kmh = ", str(exc)),)
+        raise in_user_terms(exc, at, eqt, EQUILIBRIUM_KEYS) from None
+
+
+def _text(data: Mapping[str, Any], key: str, source: str, default: str) -> str:
+    return checked(data[key], "string", f"{source}:", key) if key in data else default
 
 
 def scenario_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scenario:
     """Validate a parsed scenario mapping and build a :class:`Scenario`."""
-    _check_keys(data, TOP_KEYS, source)
-    model = _section(data, "model", source)
-    where = f"{source} [model]"
-    _check_keys(model, set(MODEL_KEYS) | {"preset"}, where)
-    preset = get_preset(str(model.get("preset", "paper_base")))
-    changes = {MODEL_KEYS[k][0]: MODEL_KEYS[k][1](_number(model, k, where))
-               for k in model if k != "preset"}
-    params = preset.params.with_(**changes)
-
-    eqt = _section(data, "equilibrium", source)
-    where = f"{source} [equilibrium]"
-    _check_keys(eqt, set(EQUILIBRIUM_KEYS) | {"branch"}, where)
-    si = {k: EQUILIBRIUM_KEYS[k](_number(eqt, k, where)) for k in eqt if k != "branch"}
-    has_demand = "demand_h_veh_h" in si or "demand_a_veh_h" in si
-    has_density = "rho_h_veh_km" in si or "rho_a_veh_km" in si
-    has_mix = "total_flow_veh_h" in si or "penetration" in si
-    if has_demand + has_density + has_mix > 1:
-        raise ScenarioError(f"{where}: give either densities (rho_*_veh_km), demands "
-                            "(demand_*_veh_h) or total_flow_veh_h and penetration, not "
-                            "several")
-    if has_mix:
-        for key in ("total_flow_veh_h", "penetration"):
-            if key not in si:
-                raise ScenarioError(f"{where}: {key} is missing (total_flow_veh_h and "
-                                    "penetration go together)")
-        if "v_h_kmh" in si or "v_a_kmh" in si:
-            raise ScenarioError(f"{where}: speeds follow from the flow; remove v_*_kmh")
-        eq = equilibrium_at_penetration(params, si["total_flow_veh_h"], si["penetration"],
-                                        branch=str(eqt.get("branch", "congested")))
-    elif has_demand:
-        if "v_h_kmh" in si or "v_a_kmh" in si:
-            raise ScenarioError(f"{where}: speeds follow from demands; remove v_*_kmh")
-        for key in ("demand_h_veh_h", "demand_a_veh_h"):
-            if key not in si:
-                raise ScenarioError(f"{where}: {key} is missing (both class demands needed)")
-        eq = equilibrium_from_demand(params, si["demand_h_veh_h"], si["demand_a_veh_h"],
-                                     branch=str(eqt.get("branch", "congested")))
-    else:
-        if "branch" in eqt:
-            raise ScenarioError(f"{where}: branch applies to demands and flows only")
-        rho_h = si.get("rho_h_veh_km", preset.rho_h)
-        rho_a = si.get("rho_a_veh_km", preset.rho_a)
-        eq = equilibrium_from_densities(params, rho_h, rho_a, v_h=si.get("v_h_kmh"),
-                                        v_a=si.get("v_a_kmh"))
+    check_keys(data, TOP_KEYS, f"{source}:")
+    for name in TABLES & set(data):
+        if not isinstance(data[name], Mapping):
+            raise not_allowed(f"{source}:", name, data[name], f"a table [{name}]")
+    preset, params = _model(data, source)
+    eq = _equilibrium(params, preset, data, source)
     if "sumo" in data:  # validated by the SUMO side; stays in Scenario.raw
         from arzsumo.sumo.config import sumo_config_from_table
-        sumo_config_from_table(data["sumo"], f"{source} [sumo]")
-    name = str(data.get("name", Path(source).stem if source != "<dict>" else preset.name))
-    return Scenario(name, str(data.get("description", preset.description)), params, eq,
+        sumo_config_from_table(data["sumo"], where(source, "sumo"))
+    default_name = Path(source).stem if source != "<dict>" else preset.name
+    return Scenario(_text(data, "name", source, default_name),
+                    _text(data, "description", source, preset.description), params, eq,
                     source, dict(data))
 
 
 def design_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> EtcDesign:
     """The ETC design of the ``[design]`` table (paper values for missing keys)."""
-    table = _section(data, "design", source)
-    where = f"{source} [design]"
-    _check_keys(table, DESIGN_KEYS, where)
+    table = sub_table(data, "design", DESIGN_KEYS, source)
+    at = where(source, "design")
     changes: dict[str, Any] = {}
     for key, value in table.items():
         if key in ("A", "varsigma"):
-            if not isinstance(value, list) or not value:
-                raise ScenarioError(f"{where}: {key} = {value!r} is not allowed: a list of "
-                                    "numbers")
-            changes[key] = tuple(_number({key: v}, key, where) for v in value)
+            if not isinstance(value, list) or not value or any(
+                    isinstance(v, bool) or not isinstance(v, int | float) for v in value):
+                raise not_allowed(at, key, value, "a list of numbers")
+            changes[key] = tuple(float(v) for v in value)
         else:
-            changes[key] = _number(table, key, where)
+            changes[key] = float(checked(value, "number", at, key))
     try:
         return PAPER_DESIGN.with_(**changes)
     except ArzsumoError as exc:
-        raise ScenarioError(f"{where}: {exc}") from None
+        raise in_user_terms(exc, at, table, _DESIGN_SPECS) from None
 
 
 def load_scenario(path: str | Path) -> Scenario:
@@ -204,4 +210,5 @@ def load_scenario(path: str | Path) -> Scenario:
 
 def scenario_from_preset(name: str) -> Scenario:
     """The scenario of a bare preset."""
+    get_preset(name)  # an unknown name is named as the user gave it, with the known ones
     return scenario_from_dict({"name": name, "model": {"preset": name}}, f"preset {name}")

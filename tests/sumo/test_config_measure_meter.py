@@ -28,15 +28,15 @@ def test_sumo_table_converts_units():
 
 @pytest.mark.parametrize(("table", "message"), [
     ({"step_lenght_s": 0.1}, "unknown key 'step_lenght_s'"),
-    ({"step_length_s": "fast"}, "step_length_s = 'fast' is not allowed: a finite number"),
-    ({"step_length_s": 2.0}, "step_length = 2.0 is not allowed: at most 1 s"),
+    ({"step_length_s": "fast"}, 'step_length_s = "fast" is not allowed: a finite number'),
+    ({"step_length_s": 2.0}, "step_length_s = 2.0 is not allowed: at most 1 s"),
     ({"seed": 1.5}, "seed = 1.5 is not allowed: an integer"),
     ({"control_period_s": 0.25, "step_length_s": 0.1}, "a multiple of step_length"),
-    ({"hv_model": "Wiedemann"}, "hv_model = 'Wiedemann' is not allowed: Krauss or IDM"),
+    ({"hv_model": "Wiedemann"}, 'hv_model = "Wiedemann" is not allowed: one of Krauss, IDM'),
     ({"green_share": 1.2}, "green_share = 1.2 is not allowed: a number in [0, 1]"),
     ({"min_green_s": 4, "min_red_s": 4}, "at most meter_cycle"),
-    ({"lateral_resolution_m": 0.7}, "lateral_resolution = 0.7 is not allowed: a width "
-                                    "dividing the 6.5 m lane"),
+    ({"lateral_resolution_m": 0.7}, "lateral_resolution_m = 0.7 is not allowed: a width "
+                                      "dividing the 6.5 m lane"),
 ])
 def test_bad_sumo_table_names_key_and_value(table, message):
     with pytest.raises(ScenarioError, match=None) as info:

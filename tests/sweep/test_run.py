@@ -123,8 +123,8 @@ def test_an_invalid_run_is_recorded_and_the_others_complete(tmp_path, capsys):
     out = tmp_path / "out"
     assert main(["sweep", str(sweep), "--out", str(out), "--workers", "2", "--quiet"]) == 4
     printed = capsys.readouterr().out
-    assert "penetration=1.5,seed=1: invalid: ModelError: penetration = 1.5 is not allowed" \
-        in printed
+    assert "penetration=1.5,seed=1: invalid: ScenarioError: " in printed
+    assert "[equilibrium] penetration = 1.5 is not allowed" in printed
     df = pd.read_parquet(out / "summaries.parquet").set_index("run_id")
     assert df.loc["penetration=0.44,seed=1", "status"] == "ok"
     assert df.loc["penetration=0.44,seed=1", "triggers"] > 0

@@ -28,15 +28,15 @@ def test_defaults_and_units():
 
 
 @pytest.mark.parametrize(("data", "message"), [
-    ({"twin": {"cells": 2.5}}, r"\[twin\]: cells = 2.5 is not allowed: an integer"),
-    ({"twin": {"scheme": "weno"}}, "scheme = 'weno' is not allowed: one of first, muscl"),
-    ({"twin": {"cfl": 2}}, r"cfl = 2.0 is not allowed: a number in \(0, 1.0\]"),
-    ({"twin": {"controller": "alinea"}}, "controller = 'alinea' is not allowed: one of"),
+    ({"twin": {"cells": 2.5}}, r"s.toml: \[twin\] cells = 2.5 is not allowed: an integer"),
+    ({"twin": {"scheme": "weno"}}, 'scheme = "weno" is not allowed: one of first, muscl'),
+    ({"twin": {"cfl": 2}}, r"cfl = 2 is not allowed: a number in \(0, 1.0\]"),
+    ({"twin": {"controller": "alinea"}}, 'controller = "alinea" is not allowed: one of'),
     ({"twin": {"horizon": 10}}, "unknown key 'horizon'; allowed: cells"),
     ({"initial": {"kind": "linear", "amplitude": 0.1}}, "amplitude do.es. not apply"),
     ({"initial": {"amplitude": [0.1, 0.2]}}, "a number or a list of 4 numbers"),
-    ({"initial": {"kind": "spiral"}}, "kind = 'spiral' is not allowed"),
-    ({"twin": 3}, r"\[twin\] must be a table"),
+    ({"initial": {"kind": "spiral"}}, r'\[initial\] kind = "spiral" is not allowed'),
+    ({"twin": 3}, r"s.toml: twin = 3 is not allowed: a table \[twin\]"),
 ])
 def test_bad_values_name_key_value_allowed(data, message):
     with pytest.raises(ScenarioError, match=message):
@@ -118,7 +118,7 @@ def test_cli_twin_bad_scenario_is_one_line(tmp_path):
     proc = subprocess.run([sys.executable, "-m", "arzsumo.cli", "twin", str(scen)],
                           capture_output=True, text=True, timeout=120)
     assert proc.returncode == 2
-    assert "scheme = 'weno' is not allowed" in proc.stderr
+    assert f"{scen}: [twin] scheme = \"weno\" is not allowed" in proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1
 
 
@@ -152,7 +152,7 @@ def test_bad_design_table_is_named():
     from arzsumo.errors import ScenarioError
     from arzsumo.twin.config import twin_config_from_dict
 
-    with pytest.raises(ScenarioError, match=r"\[design\]: unknown key 'nu'"):
+    with pytest.raises(ScenarioError, match=r"\[design\] unknown key 'nu'"):
         twin_config_from_dict({"design": {"nu": 1.0}})
     with pytest.raises(ScenarioError, match=r"m0 = 0.5 is not allowed"):
         twin_config_from_dict({"design": {"m0": 0.5}})

@@ -25,13 +25,29 @@ from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from typing import Any
 
-from arzsumo.errors import ScenarioError, require
-from arzsumo.units import veh_h_to_veh_s
+from arzsumo.errors import ArzsumoError, ScenarioError, require
+from arzsumo.tables import Key, in_user_terms, read_keys, where
+from arzsumo.units import VEH_H_PER_VEH_S
 
 CONTROLLERS = ("open", "backstepping", "etc", "observer-etc", "alinea")
-RUN_KEYS = {"controller", "warmup_s", "start", "equilibrium", "kernel_cells", "twin_cells",
-            "twin_scheme", "smoothing_s", "alinea_target", "alinea_gain_veh_h_per_pct",
-            "alinea_saturation_veh_h"}
+#: [run] key -> RunSettings field (SI), with its unit factor; ALINEA's gain per % of
+#: occupancy in veh/h is 100/3600 veh/s per unit occupancy, hence the factor 36
+RUN_SPECS: dict[str, Key] = {
+    "controller": Key("controller", "string", choices=CONTROLLERS),
+    "warmup_s": Key("warmup"),
+    "start": Key("start", "string", choices=("warmup", "placement")),
+    "equilibrium": Key("equilibrium", "string", choices=("scenario", "measured")),
+    "kernel_cells": Key("kernel_cells", "integer"),
+    "twin_cells": Key("twin_cells", "integer"),
+    "twin_scheme": Key("twin_scheme", "string", choices=("first", "muscl")),
+    "smoothing_s": Key("smoothing"),
+    "alinea_target": Key("alinea_target"),
+    "alinea_gain_veh_h_per_pct": Key("alinea_gain", factor=VEH_H_PER_VEH_S / 100,
+                                     allowed="a gain > 0 veh/h per % of occupancy"),
+    "alinea_saturation_veh_h": Key("alinea_saturation", factor=VEH_H_PER_VEH_S,
+                                   allowed="a flow > 0 veh/h"),
+}
+RUN_KEYS = set(RUN_SPECS)
 
 
 @dataclass(frozen=True)
@@ -77,33 +93,22 @@ class RunSettings:
 
 def run_settings_from_dict(data: Mapping[str, Any], source: str = "<dict>",
                            **overrides: Any) -> RunSettings:
-    """Parse the ``[run]`` table of a parsed scenario mapping; ``overrides`` win."""
+    """Parse the ``[run]`` table of a parsed scenario mapping; ``overrides`` win.
+
+    Errors name the file, ``[run]``, the key and the value as written; an error about an
+    overridden field names ``--field`` (the CLI option) instead.
+    """
     from arzsumo.scenarios import scenario_table
 
     table = scenario_table(data, "run", RUN_KEYS, source)
-    where = f"{source} [run]"
-    # per % of occupancy -> per unit occupancy is the factor 100
-    conv = {"warmup_s": ("warmup", float), "smoothing_s": ("smoothing", float),
-            "alinea_target": ("alinea_target", float),
-            "alinea_gain_veh_h_per_pct": ("alinea_gain", lambda v: veh_h_to_veh_s(100 * v)),
-            "alinea_saturation_veh_h": ("alinea_saturation", veh_h_to_veh_s)}
-    values: dict[str, Any] = {}
-    for key, value in table.items():
-        if key in conv:
-            if isinstance(value, bool) or not isinstance(value, int | float):
-                raise ScenarioError(f"{where}: {key} = {value!r} is not allowed: a number")
-            name, to_si = conv[key]
-            values[name] = float(to_si(value))
-        elif key in ("kernel_cells", "twin_cells"):
-            if isinstance(value, bool) or not isinstance(value, int):
-                raise ScenarioError(f"{where}: {key} = {value!r} is not allowed: an integer")
-            values[key] = value
-        else:
-            if not isinstance(value, str):
-                raise ScenarioError(f"{where}: {key} = {value!r} is not allowed: a string")
-            values[key] = value
-    values.update({k: v for k, v in overrides.items() if v is not None})
+    at = where(source, "run")
+    values = read_keys(table, RUN_SPECS, at)
+    given = {k: v for k, v in overrides.items() if v is not None}
+    values.update(given)
     try:
         return RunSettings(**values)
-    except ScenarioError as exc:
-        raise ScenarioError(f"{where}: {exc}") from None
+    except ArzsumoError as exc:
+        if exc.field in given:
+            raise type(exc)(f"--{exc.field} = {exc.value} is not allowed: "
+                            f"{exc.allowed}") from None
+        raise in_user_terms(exc, at, table, RUN_SPECS) from None

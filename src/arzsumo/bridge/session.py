@@ -2,21 +2,30 @@
 
 The library function behind ``arzsumo run`` and the SUMO engine of ``arzsumo sweep``:
 it resolves the ``[run]``, ``[sumo]``, ``[design]`` and ``[initial]`` tables, applies the
-caller's overrides and runs :func:`arzsumo.bridge.cosim.run_cosimulation`. It writes
-nothing.
+caller's overrides (:func:`prepare_run`, which also serves ``arzsumo run --dry-run``) and
+runs :func:`arzsumo.bridge.cosim.run_cosimulation`. It writes nothing.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+import math
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from arzsumo.bridge.config import RunSettings, run_settings_from_dict
-from arzsumo.bridge.cosim import CoSimResult, run_cosimulation
-from arzsumo.errors import ScenarioError
+from arzsumo.bridge.cosim import CoSimResult, check_before_start, run_cosimulation
+from arzsumo.control.etc import EtcDesign
+from arzsumo.errors import ArzsumoError, ScenarioError
+from arzsumo.model import linearize
 from arzsumo.scenarios import Scenario, design_from_dict
-from arzsumo.sumo.config import SumoConfig, sumo_config_of
+from arzsumo.sumo.config import SUMO_KEYS, SumoConfig, sumo_config_of
+from arzsumo.sumo.measure import EdieGrid
+from arzsumo.sumo.network import NetworkSpec
+from arzsumo.tables import in_user_terms, not_allowed, written
+from arzsumo.twin.config import initial_from_dict
+from arzsumo.twin.initial import initial_fields
+from arzsumo.units import ms_to_kmh
 
 
 @dataclass(frozen=True)
@@ -34,6 +43,105 @@ class SumoSession:
             f"\n# sumo = {self.sumo!r}\n"
 
 
+@dataclass(frozen=True)
+class PreparedRun:
+    """A run checked and resolved, ready for SUMO: what :func:`prepare_run` returns."""
+
+    scenario: Scenario
+    settings: RunSettings
+    sumo: SumoConfig
+    design: EtcDesign
+    initial: np.ndarray | None = field(default=None, repr=False)
+
+    def describe(self) -> str:
+        """What the run would do, in human units (``arzsumo run --dry-run``)."""
+        s, c = self.settings, self.sumo
+        lam4 = ms_to_kmh(linearize(self.scenario.equilibrium).eigenvalues[3])
+        return (f"scenario {self.scenario.name} ({self.scenario.source}): valid\n"
+                f"  controller {s.controller}, start {s.start}, warm-up {s.warmup:g} s + "
+                f"control horizon {c.horizon:g} s, SUMO seed {c.seed}, step {c.step_length:g} s"
+                f"\n  equilibrium {s.equilibrium} (scenario lambda_4 = {lam4:.2f} km/h)")
+
+
+def _seed(seed: int) -> int:
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**31:
+        raise ScenarioError(f"--seed = {seed} is not allowed: an integer in [0, 2^31)")
+    return seed
+
+
+def _horizon(horizon: float, cfg: SumoConfig) -> float:
+    # at least one control period: a shorter run measures nothing (NaN summaries)
+    if not (math.isfinite(horizon) and horizon >= cfg.control_period):
+        raise ScenarioError(f"--horizon = {horizon:g} is not allowed: a control horizon of at "
+                            "least one control period ([sumo] control_period_s = "
+                            f"{cfg.control_period:g} s)")
+    return float(horizon)
+
+
+def _check_model(sc: Scenario, cfg: SumoConfig) -> None:
+    """The road is SUMO's mainline, the measurement grid fits it, the characteristic speeds
+    are finite."""
+    road = NetworkSpec().length   # the network of `arzsumo build-net`
+    if abs(sc.params.length - road) > 1e-6:
+        model = sc.raw.get("model", {})
+        raise not_allowed(f"{sc.source}: [model]", "length_m",
+                          model.get("length_m", sc.params.length),
+                          f"the SUMO mainline length {road:g} m")
+    try:
+        EdieGrid(sc.params.length, cfg.cell_length, cfg.step_length)
+    except ArzsumoError as exc:
+        raise in_user_terms(exc, f"{sc.source}: [sumo]", sc.raw.get("sumo", {}),
+                            SUMO_KEYS) from None
+    lam = linearize(sc.equilibrium).eigenvalues
+    if not np.all(np.isfinite(lam)):
+        raise ScenarioError(f"{sc.source}: [model] and [equilibrium] give characteristic "
+                            f"speeds {', '.join(f'{v:.3g}' for v in ms_to_kmh(lam))} km/h; "
+                            "allowed: parameters that keep them finite")
+
+
+def _check_regime(sc: Scenario, settings: RunSettings, from_cli: bool) -> None:
+    """:func:`check_before_start`, its refusal naming where the controller was chosen."""
+    try:
+        check_before_start(settings, sc.equilibrium)
+    except ScenarioError as exc:
+        at = (f"--controller = {settings.controller}" if from_cli else
+              f"{sc.source}: [run] controller = {written(settings.controller)}")
+        reason = str(exc).split("this equilibrium: ", 1)[-1]
+        raise ScenarioError(f"{at} is not allowed at the "
+                            f"[equilibrium] of {sc.source}: {reason}") from None
+
+
+def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None = None,
+                horizon: float | None = None) -> PreparedRun:
+    """Everything ``arzsumo run`` checks before SUMO starts, without starting it.
+
+    Resolves and validates the ``[run]``, ``[sumo]``, ``[design]`` and ``[initial]`` tables
+    of ``sc`` with the caller's overrides (``--controller``, ``--seed`` in [0, 2^31),
+    ``--horizon`` of at least one control period, s), checks that ``[sumo] cell_length_m``
+    divides the road and that the characteristic speeds are finite, refuses a PDE
+    controller at a free-flow scenario equilibrium, and draws the placement profile of ``start =
+    "placement"``. Raises an :class:`arzsumo.errors.ArzsumoError` naming the key or option.
+    """
+    raw = sc.raw
+    settings = run_settings_from_dict(raw, sc.source, controller=controller)
+    cfg = sumo_config_of(sc)
+    if seed is not None:
+        cfg = cfg.with_(seed=_seed(seed))
+    if horizon is not None:
+        cfg = cfg.with_(horizon=_horizon(horizon, cfg))
+    design = design_from_dict(raw, sc.source)
+    ic = initial_from_dict(raw, sc.source, seed=cfg.seed)  # one seed draws all randomness
+    _check_model(sc, cfg)
+    if settings.equilibrium == "scenario":
+        _check_regime(sc, settings, controller is not None)
+    initial = None
+    if settings.start == "placement":
+        n = round(sc.params.length / cfg.cell_length)
+        xc = (np.arange(n) + 0.5) * cfg.cell_length
+        initial = initial_fields(ic, sc.equilibrium, xc)
+    return PreparedRun(sc, settings, cfg, design, initial)
+
+
 def run_in_sumo(sc: Scenario, *, controller: str | None = None, seed: int | None = None,
                 horizon: float | None = None, progress: bool = False) -> SumoSession:
     """Run the closed loop of ``sc`` in SUMO (overrides win over the scenario's tables).
@@ -45,35 +153,17 @@ def run_in_sumo(sc: Scenario, *, controller: str | None = None, seed: int | None
     controller : str, optional
         Overrides ``[run] controller``.
     seed : int, optional
-        Overrides ``[sumo] seed``; an integer >= 0. The SUMO seed also draws a
+        Overrides ``[sumo] seed``; an integer in [0, 2^31). The SUMO seed also draws a
         ``[initial] kind = "random"`` wave when vehicles are placed (``start =
         "placement"``).
     horizon : float, optional
-        Overrides ``[sumo] horizon_s``, s.
+        Overrides ``[sumo] horizon_s``, s; at least one control period.
     progress : bool
         Draw a progress bar on stderr.
-    """
-    raw = sc.raw
-    settings = run_settings_from_dict(raw, sc.source, controller=controller)
-    cfg = sumo_config_of(sc)
-    if seed is not None:
-        if seed < 0:
-            raise ScenarioError(f"--seed = {seed} is not allowed: an integer >= 0")
-        cfg = cfg.with_(seed=seed)
-    if horizon is not None:
-        cfg = cfg.with_(horizon=horizon)
-    design = design_from_dict(raw, sc.source)
-    initial = None
-    if settings.start == "placement":
-        from arzsumo.twin.config import twin_config_from_dict
-        from arzsumo.twin.initial import initial_fields
 
-        n = round(sc.params.length / cfg.cell_length)
-        xc = (np.arange(n) + 0.5) * cfg.cell_length
-        ic = twin_config_from_dict(raw, sc.source).initial
-        if ic.kind == "random":  # one seed draws everything random in a SUMO run
-            ic = replace(ic, seed=cfg.seed)
-        initial = initial_fields(ic, sc.equilibrium, xc)
-    res = run_cosimulation(sc, settings, cfg, design, initial_fields=initial,
+    All checks happen in :func:`prepare_run` before SUMO starts.
+    """
+    run = prepare_run(sc, controller=controller, seed=seed, horizon=horizon)
+    res = run_cosimulation(sc, run.settings, run.sumo, run.design, initial_fields=run.initial,
                            progress=progress)
-    return SumoSession(res, settings, cfg)
+    return SumoSession(res, run.settings, run.sumo)

@@ -49,9 +49,34 @@ class Condition:
 
 @dataclass(frozen=True)
 class DesignReport:
+    """The conditions checked, tau* (s) and the constants they use."""
+
     conditions: tuple[Condition, ...]
     tau_star: float
     constants: dict[str, float]
+
+    @property
+    def all_hold(self) -> bool:
+        """Whether every condition holds (the design meets the theorems' hypotheses)."""
+        return all(c.holds for c in self.conditions)
+
+    def failing(self) -> list[str]:
+        """Names of the failing conditions; a repeated label gets its number (select1 #2)."""
+        labels = [c.label for c in self.conditions]
+        names, seen = [], dict.fromkeys(labels, 0)
+        for c in self.conditions:
+            seen[c.label] += 1
+            if not c.holds:
+                names.append(c.label if labels.count(c.label) == 1 else
+                             f"{c.label} #{seen[c.label]}")
+        return names
+
+    def verdict(self) -> str:
+        """One line: all conditions hold, or how many fail and which."""
+        bad, n = self.failing(), len(self.conditions)
+        if not bad:
+            return f"all {n} conditions hold"
+        return f"{len(bad)} of {n} conditions fail: {', '.join(bad)}"
 
 
 def _inverse_norm(kernels: Kernels) -> float:

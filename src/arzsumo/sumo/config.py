@@ -14,12 +14,13 @@ the key name; :func:`sumo_config_from_table` converts through :mod:`arzsumo.unit
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, fields, replace
 from typing import Any
 
-from arzsumo.errors import ScenarioError, require
-from arzsumo.units import veh_h_to_veh_s
+from arzsumo.errors import ArzsumoError, ScenarioError, require
+from arzsumo.tables import Key, check_keys, in_user_terms, read_keys, written
+from arzsumo.units import VEH_H_PER_VEH_S
 
 HV_MODELS = ("Krauss", "IDM")
 #: Width of the mainline lane, m (the network's).
@@ -116,11 +117,18 @@ class SumoConfig:
         require(self.green_share_min <= self.green_share_max, "green_share_min",
                 self.green_share_min, f"at most green_share_max = {self.green_share_max}",
                 ScenarioError)
+        # a cell holds a vehicle or more; shorter cells only multiply the work
+        require(self.cell_length >= 1.0, "cell_length", self.cell_length, "at least 1 m",
+                ScenarioError)
         require(self.step_length <= 1.0, "step_length", self.step_length, "at most 1 s",
                 ScenarioError)
         subl = LANE_WIDTH / self.lateral_resolution
         require(abs(subl - round(subl)) < 1e-6, "lateral_resolution", self.lateral_resolution,
                 f"a width dividing the {LANE_WIDTH} m lane, e.g. 0.5 or 0.25",
+                ScenarioError)
+        # a shorter run holds no complete control period: nothing measured, NaN summaries
+        require(self.horizon >= self.control_period, "horizon", self.horizon,
+                f"at least one control period (control_period = {self.control_period} s)",
                 ScenarioError)
         ratio = self.control_period / self.step_length
         require(abs(ratio - round(ratio)) < 1e-9, "control_period", self.control_period,
@@ -155,62 +163,51 @@ class SumoConfig:
         return replace(self, **changes)
 
 
-def _same(x: float) -> float:
-    return float(x)
-
-
-# TOML key -> (SumoConfig field, conversion to SI, kind)
-SUMO_KEYS: dict[str, tuple[str, Callable[[Any], Any], type]] = {
-    "step_length_s": ("step_length", _same, float),
-    "lateral_resolution_m": ("lateral_resolution", _same, float),
-    "seed": ("seed", int, int),
-    "horizon_s": ("horizon", _same, float),
-    "demand_h_veh_h": ("demand_h", veh_h_to_veh_s, float),
-    "demand_a_veh_h": ("demand_a", veh_h_to_veh_s, float),
-    "ramp_demand_veh_h": ("ramp_demand", veh_h_to_veh_s, float),
-    "ramp_av_share": ("ramp_av_share", _same, float),
-    "cell_length_m": ("cell_length", _same, float),
-    "control_period_s": ("control_period", _same, float),
-    "meter_cycle_s": ("meter_cycle", _same, float),
-    "min_green_s": ("min_green", _same, float),
-    "min_red_s": ("min_red", _same, float),
-    "green_share": ("green_share", _same, float),
-    "green_share_min": ("green_share_min", _same, float),
-    "green_share_max": ("green_share_max", _same, float),
-    "spillback_queue_veh": ("spillback_queue", int, int),
-    "time_to_teleport_s": ("time_to_teleport", _same, float),
-    "hv_model": ("hv_model", str, str),
-    "hv_sigma": ("hv_sigma", _same, float),
-    "av_model": ("av_model", str, str),
-    "min_gap_lat_m": ("min_gap_lat", _same, float),
+_DEMAND = "a demand >= 0 veh/h"
+#: [sumo] key -> SumoConfig field (SI), with its unit factor
+SUMO_KEYS: dict[str, Key] = {
+    "step_length_s": Key("step_length"),
+    "lateral_resolution_m": Key("lateral_resolution"),
+    "seed": Key("seed", "integer"),
+    "horizon_s": Key("horizon"),
+    "demand_h_veh_h": Key("demand_h", factor=VEH_H_PER_VEH_S, allowed=_DEMAND),
+    "demand_a_veh_h": Key("demand_a", factor=VEH_H_PER_VEH_S, allowed=_DEMAND),
+    "ramp_demand_veh_h": Key("ramp_demand", factor=VEH_H_PER_VEH_S, allowed=_DEMAND),
+    "ramp_av_share": Key("ramp_av_share"),
+    "cell_length_m": Key("cell_length"),
+    "control_period_s": Key("control_period"),
+    "meter_cycle_s": Key("meter_cycle"),
+    "min_green_s": Key("min_green"),
+    "min_red_s": Key("min_red"),
+    "green_share": Key("green_share"),
+    "green_share_min": Key("green_share_min"),
+    "green_share_max": Key("green_share_max"),
+    "spillback_queue_veh": Key("spillback_queue", "integer"),
+    "time_to_teleport_s": Key("time_to_teleport"),
+    "hv_model": Key("hv_model", "string", choices=HV_MODELS),
+    "hv_sigma": Key("hv_sigma"),
+    "av_model": Key("av_model", "string", choices=AV_MODELS),
+    "min_gap_lat_m": Key("min_gap_lat"),
 }
 
 
 def sumo_config_from_table(table: Mapping[str, Any], where: str = "[sumo]") -> SumoConfig:
-    """Validate a ``[sumo]`` scenario table (human units in key names) into a SumoConfig."""
+    """Validate a ``[sumo]`` scenario table (human units in key names) into a SumoConfig.
+
+    ``where`` prefixes every message (``x.toml: [sumo]``); errors name the key as written.
+    """
     if not isinstance(table, Mapping):
-        raise ScenarioError(f"{where} must be a table, got {table!r}")
-    changes: dict[str, Any] = {}
-    for key, value in table.items():
-        if key not in SUMO_KEYS:
-            raise ScenarioError(f"{where}: unknown key {key!r}; allowed: "
-                                f"{', '.join(sorted(SUMO_KEYS))}")
-        name, conv, kind = SUMO_KEYS[key]
-        ok = (isinstance(value, str) if kind is str else
-              isinstance(value, int) and not isinstance(value, bool) if kind is int else
-              isinstance(value, int | float) and not isinstance(value, bool)
-              and math.isfinite(value))
-        if not ok:
-            allowed = {str: "a string", int: "an integer", float: "a finite number"}[kind]
-            raise ScenarioError(f"{where}: {key} = {value!r} is not allowed: {allowed}")
-        changes[name] = conv(value)
+        raise ScenarioError(f"{where} = {written(table)} is not allowed: a table of SUMO "
+                            "settings")
+    check_keys(table, SUMO_KEYS, where)
+    changes = read_keys(table, SUMO_KEYS, where)
     try:
         return SumoConfig(**changes)
-    except ScenarioError as exc:
-        raise ScenarioError(f"{where}: {exc}") from None
+    except ArzsumoError as exc:
+        raise in_user_terms(exc, where, table, SUMO_KEYS) from None
 
 
 def sumo_config_of(scenario: Any) -> SumoConfig:
     """The SumoConfig of a loaded scenario (its ``[sumo]`` table; defaults without one)."""
     raw = getattr(scenario, "raw", {}) or {}
-    return sumo_config_from_table(raw.get("sumo", {}), f"{scenario.source} [sumo]")
+    return sumo_config_from_table(raw.get("sumo", {}), f"{scenario.source}: [sumo]")

@@ -45,6 +45,7 @@ from typing import Any
 
 from arzsumo.errors import ScenarioError
 from arzsumo.io import read_toml
+from arzsumo.tables import written
 
 ENGINES = ("twin", "sumo")
 #: the engine's seed field, set by the ``seeds`` key
@@ -210,7 +211,7 @@ def _apply(data: Mapping[str, Any], overrides: Mapping[str, Any]) -> dict[str, A
 def _flat_fields(table: Any, where: str, allowed: Mapping[str, set[str]]) -> dict[str, Any]:
     """``{"table.key": value}`` of a mapping written nested or with dotted keys; checked."""
     if not isinstance(table, Mapping):
-        raise SweepError(f"{where} = {table!r} is not allowed: a table of scenario fields")
+        raise SweepError(f"{where} = {written(table)} is not allowed: a table of scenario fields")
     flat: dict[str, Any] = {}
 
     def walk(prefix: str, body: Mapping[str, Any]) -> None:
@@ -239,9 +240,9 @@ def _check_field(name: str, where: str, allowed: Mapping[str, set[str]]) -> None
 
 def _scalar(value: Any, where: str) -> Scalar:
     if isinstance(value, float) and not math.isfinite(value):
-        raise SweepError(f"{where}: value {value!r} is not allowed: a finite number")
+        raise SweepError(f"{where}: value {written(value)} is not allowed: a finite number")
     if not isinstance(value, bool | int | float | str):
-        raise SweepError(f"{where}: value {value!r} is not allowed: a number, string or "
+        raise SweepError(f"{where}: value {written(value)} is not allowed: a number, string or "
                          "boolean (use set = [...] for lists)")
     return value
 
@@ -256,7 +257,7 @@ def _axis(raw: Any, i: int, source: str, allowed: Mapping[str, set[str]]) -> Axi
                              f"{', '.join(sorted(AXIS_KEYS))}")
     values = raw.get("values")
     if not isinstance(values, list) or not values:
-        raise SweepError(f"{where}: values = {values!r} is not allowed: a non-empty list")
+        raise SweepError(f"{where}: values = {written(values)} is not allowed: a non-empty list")
     vals = tuple(_scalar(v, where) for v in values)
     repeated = sorted({_format(v) for v in vals if [_format(w) for w in vals].count(
         _format(v)) > 1})
@@ -267,18 +268,18 @@ def _axis(raw: Any, i: int, source: str, allowed: Mapping[str, set[str]]) -> Axi
                          "of fields per value)")
     group = raw.get("group")
     if group is not None and not isinstance(group, str):
-        raise SweepError(f"{where}: group = {group!r} is not allowed: a string")
+        raise SweepError(f"{where}: group = {written(group)} is not allowed: a string")
     if "field" in raw:
         fld = raw["field"]
         if not isinstance(fld, str):
-            raise SweepError(f"{where}: field = {fld!r} is not allowed: 'table.key'")
+            raise SweepError(f"{where}: field = {written(fld)} is not allowed: 'table.key'")
         _check_field(fld, where, allowed)
         name = str(raw.get("name", fld.split(".", 1)[1]))
         return Axis(name, vals, tuple({fld: v} for v in vals), fld, group)
     sets = raw["set"]
     if not isinstance(sets, list) or len(sets) != len(vals):
         raise SweepError(f"{where}: set must be a list of {len(vals)} tables (one per value), "
-                         f"got {sets!r}")
+                         f"got {written(sets)}")
     if "name" not in raw or not isinstance(raw["name"], str):
         raise SweepError(f"{where}: name (the column of this axis) is missing")
     flat = tuple(_flat_fields(s, f"{where} set", allowed) for s in sets)
@@ -288,16 +289,22 @@ def _axis(raw: Any, i: int, source: str, allowed: Mapping[str, set[str]]) -> Axi
 def sweep_from_dict(data: Mapping[str, Any], source: str = "<dict>",
                     root: Path | None = None) -> SweepSpec:
     """Validate a parsed sweep file; ``base`` is read relative to ``root``."""
-    for key in data:
-        if key not in SWEEP_KEYS:
-            raise SweepError(f"{source}: unknown key {key!r}; allowed: "
-                             f"{', '.join(sorted(SWEEP_KEYS))}")
+    unknown = [k for k in data if k not in SWEEP_KEYS]
+    if unknown:
+        raise SweepError(f"{source}: unknown key {', '.join(repr(k) for k in unknown)}; "
+                         f"allowed: {', '.join(sorted(SWEEP_KEYS))}")
     engine = data.get("engine", "twin")
     if engine not in ENGINES:
-        raise SweepError(f"{source}: engine = {engine!r} is not allowed: one of "
+        raise SweepError(f"{source}: engine = {written(engine)} is not allowed: one of "
                          f"{', '.join(ENGINES)}")
-    if "base" not in data or not isinstance(data["base"], str):
+    if "base" not in data:
         raise SweepError(f"{source}: base (the scenario file the runs start from) is missing")
+    if not isinstance(data["base"], str):
+        raise SweepError(f"{source}: base = {written(data['base'])} is not allowed: a path "
+                         "(a string) relative to the sweep file")
+    if "description" in data and not isinstance(data["description"], str):
+        raise SweepError(f"{source}: description = {written(data['description'])} is not "
+                         "allowed: a string")
     base = (root or Path.cwd()) / data["base"]
     _, base_data = read_toml(base, f"{source}: base", SweepError)
     allowed = scenario_fields()
@@ -310,7 +317,7 @@ def sweep_from_dict(data: Mapping[str, Any], source: str = "<dict>",
         seeds = data["seeds"]
         if not isinstance(seeds, list) or not seeds or any(
                 isinstance(s, bool) or not isinstance(s, int) or s < 0 for s in seeds):
-            raise SweepError(f"{source}: seeds = {seeds!r} is not allowed: a non-empty list "
+            raise SweepError(f"{source}: seeds = {written(seeds)} is not allowed: a non-empty list "
                              "of integers >= 0")
         axes.append(_axis({"field": SEED_FIELD[engine], "name": "seed", "values": seeds},
                           len(axes) + 1, source, allowed))
@@ -322,14 +329,14 @@ def sweep_from_dict(data: Mapping[str, Any], source: str = "<dict>",
                          f"{', '.join(dup)}")
     paper = data.get("paper")
     if paper is not None and paper not in PAPER_TABLES:
-        raise SweepError(f"{source}: paper = {paper!r} is not allowed: one of "
+        raise SweepError(f"{source}: paper = {written(paper)} is not allowed: one of "
                          f"{', '.join(PAPER_TABLES)}")
     baseline = data.get("baseline", False)
     if not isinstance(baseline, bool):
-        raise SweepError(f"{source}: baseline = {baseline!r} is not allowed: true or false")
+        raise SweepError(f"{source}: baseline = {written(baseline)} is not allowed: true or false")
     name = data.get("name", Path(source).stem)
     if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9._-]+", name):
-        raise SweepError(f"{source}: name = {name!r} is not allowed: letters, digits, . _ -")
+        raise SweepError(f"{source}: name = {written(name)} is not allowed: letters, digits, . _ -")
     return SweepSpec(name, str(data.get("description", "")), engine, base, base_data, fixed,
                      tuple(axes), paper, baseline, source)
 

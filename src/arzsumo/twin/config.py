@@ -42,19 +42,45 @@ from dataclasses import asdict, dataclass, field
 from typing import Any
 
 from arzsumo.control.etc import PAPER_DESIGN, EtcDesign
-from arzsumo.errors import ArzsumoError, ScenarioError
+from arzsumo.errors import ArzsumoError, ScenarioError, require
+from arzsumo.tables import Key, checked, in_user_terms, not_allowed, read_keys, where, written
 from arzsumo.twin.controllers import CONTROLLERS
+from arzsumo.twin.flux import FLUXES, LIMITERS
 from arzsumo.twin.initial import KINDS, InitialCondition
+from arzsumo.twin.scheme import SCHEMES
 from arzsumo.twin.solver import SolverOptions
-from arzsumo.units import veh_h_to_veh_s
+from arzsumo.units import VEH_H_PER_VEH_S
 
 #: default initial condition of scenario files: a moderate stop-and-go wave
 DEFAULT_AMPLITUDE = (0.05, -0.05, 0.05, -0.05)
 
-TWIN_KEYS = {"cells", "scheme", "flux", "limiter", "cfl", "horizon_s", "control_period_s",
-             "output_period_s", "u_min_veh_h", "u_max_veh_h", "controller",
-             "constant_u_veh_h", "seed", "max_steps", "kernel_cells"}
-INITIAL_KEYS = {"kind", "amplitude", "wavenumber", "phase_rad", "fraction"}
+_U = "a flow in veh/h"
+#: [twin] key -> field of SolverOptions or TwinConfig (SI), with its unit factor
+TWIN_SPECS: dict[str, Key] = {
+    "cells": Key("cells", "integer"),
+    "scheme": Key("scheme", "string", choices=SCHEMES),
+    "flux": Key("flux", "string", choices=tuple(FLUXES)),
+    "limiter": Key("limiter", "string", choices=tuple(LIMITERS)),
+    "cfl": Key("cfl"),
+    "horizon_s": Key("horizon"),
+    "control_period_s": Key("control_period"),
+    "output_period_s": Key("output_period"),
+    "u_min_veh_h": Key("u_min", factor=VEH_H_PER_VEH_S, allowed="at most u_max_veh_h"),
+    "u_max_veh_h": Key("u_max", factor=VEH_H_PER_VEH_S, allowed=_U),
+    "controller": Key("controller", "string"),
+    "constant_u_veh_h": Key("constant_u", factor=VEH_H_PER_VEH_S, allowed=_U),
+    "seed": Key("seed", "integer"),
+    "max_steps": Key("max_steps", "integer"),
+    "kernel_cells": Key("kernel_cells", "integer"),
+}
+TWIN_KEYS = set(TWIN_SPECS)
+#: [initial] key -> InitialCondition field (``fraction`` is the amplitude f of the paper's
+#: nonrecurrent and linear profiles)
+INITIAL_SPECS: dict[str, Key] = {"kind": Key("kind", "string"), "amplitude": Key("amplitude"),
+                                 "wavenumber": Key("wavenumber"), "phase_rad": Key("phase"),
+                                 "fraction": Key("amplitude")}
+INITIAL_KEYS = set(INITIAL_SPECS)
+INITIAL_KINDS = tuple(k for k in KINDS if k != "array")
 
 
 @dataclass(frozen=True)
@@ -71,15 +97,13 @@ class TwinConfig:
     design: EtcDesign = PAPER_DESIGN
 
     def __post_init__(self) -> None:
-        if self.controller not in CONTROLLERS:
-            raise ScenarioError(f"controller = {self.controller!r} is not allowed: one of "
-                                f"{', '.join(sorted(CONTROLLERS))}")
-        if isinstance(self.kernel_cells, bool) or not isinstance(self.kernel_cells, int) \
-                or self.kernel_cells < 4:
-            raise ScenarioError(f"kernel_cells = {self.kernel_cells!r} is not allowed: an "
-                                "integer >= 4")
-        if not math.isfinite(self.constant_u):
-            raise ScenarioError(f"constant_u = {self.constant_u!r} is not allowed: finite")
+        require(self.controller in CONTROLLERS, "controller", self.controller,
+                f"one of {', '.join(sorted(CONTROLLERS))}", ScenarioError)
+        require(not isinstance(self.kernel_cells, bool) and isinstance(self.kernel_cells, int)
+                and self.kernel_cells >= 4, "kernel_cells", self.kernel_cells,
+                "an integer >= 4", ScenarioError)
+        require(math.isfinite(self.constant_u), "constant_u", self.constant_u, "finite",
+                ScenarioError)
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready summary (SI)."""
@@ -96,106 +120,70 @@ class TwinConfig:
                                                "seed": self.initial.seed}}
 
 
-def _table(data: Mapping[str, Any], name: str, allowed: set[str], where: str) -> dict:
-    from arzsumo.scenarios import scenario_table
-
-    return scenario_table(data, name, allowed, where)
-
-
-def _num(table: Mapping[str, Any], key: str, where: str) -> float:
-    value = table[key]
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise ScenarioError(f"{where}: {key} = {value!r} is not allowed: a finite number")
-    return float(value)
-
-
-def _int(table: Mapping[str, Any], key: str, where: str) -> int:
-    value = table[key]
-    if isinstance(value, bool) or not isinstance(value, int):
-        raise ScenarioError(f"{where}: {key} = {value!r} is not allowed: an integer")
-    return value
-
-
-def _str(table: Mapping[str, Any], key: str, where: str, allowed: tuple[str, ...] | None
-         ) -> str:
-    value = table[key]
-    if not isinstance(value, str) or (allowed is not None and value not in allowed):
-        what = f"one of {', '.join(allowed)}" if allowed else "a string"
-        raise ScenarioError(f"{where}: {key} = {value!r} is not allowed: {what}")
-    return value
-
-
-def _four(table: Mapping[str, Any], key: str, where: str) -> tuple[float, ...]:
+def _four(table: Mapping[str, Any], key: str, at: str) -> tuple[float, ...]:
     value = table[key]
     items = value if isinstance(value, list) else [value]
     if len(items) not in (1, 4) or any(isinstance(v, bool) or not isinstance(v, int | float)
                                        or not math.isfinite(v) for v in items):
-        raise ScenarioError(f"{where}: {key} = {value!r} is not allowed: a number or a list "
-                            "of 4 numbers for (rho_h, v_h, rho_a, v_a)")
+        raise not_allowed(at, key, value, "a number or a list of 4 numbers for (rho_h, v_h, "
+                                          "rho_a, v_a)")
     return tuple(float(v) for v in (items * 4 if len(items) == 1 else items))
 
 
-def twin_config_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> TwinConfig:
-    """Parse the ``[twin]`` and ``[initial]`` tables of a parsed scenario mapping."""
-    tw = _table(data, "twin", TWIN_KEYS, source)
-    where = f"{source} [twin]"
-    opts: dict[str, Any] = {}
-    for key in ("cells", "max_steps"):
-        if key in tw:
-            opts[key] = _int(tw, key, where)
-    for key, allowed in (("scheme", ("first", "muscl")), ("flux", None), ("limiter", None)):
-        if key in tw:
-            opts[key] = _str(tw, key, where, allowed)
-    for key, name in (("cfl", "cfl"), ("horizon_s", "horizon"),
-                      ("control_period_s", "control_period"),
-                      ("output_period_s", "output_period")):
-        if key in tw:
-            opts[name] = _num(tw, key, where)
-    for key, name in (("u_min_veh_h", "u_min"), ("u_max_veh_h", "u_max")):
-        if key in tw:
-            opts[name] = float(veh_h_to_veh_s(_num(tw, key, where)))
-    controller = _str(tw, "controller", where, None) if "controller" in tw else "open"
-    constant_u = (float(veh_h_to_veh_s(_num(tw, "constant_u_veh_h", where)))
-                  if "constant_u_veh_h" in tw else 0.0)
-    seed = _int(tw, "seed", where) if "seed" in tw else 0
-    kernel_cells = _int(tw, "kernel_cells", where) if "kernel_cells" in tw else 200
-    from arzsumo.scenarios import design_from_dict
+def initial_from_dict(data: Mapping[str, Any], source: str = "<dict>",
+                      seed: int = 0) -> InitialCondition:
+    """The ``[initial]`` table of a parsed scenario; ``seed`` draws a ``kind = "random"``
+    wave. Errors name the file, ``[initial]``, the key and the value as written."""
+    from arzsumo.scenarios import scenario_table
 
-    design = design_from_dict(data, source)
-
-    ini = _table(data, "initial", INITIAL_KEYS, source)
-    where_i = f"{source} [initial]"
-    kinds = tuple(k for k in KINDS if k != "array")
-    kind = _str(ini, "kind", where_i, kinds) if "kind" in ini else "sinusoid"
-    ic_args: dict[str, Any] = {"kind": kind}
-    if kind == "sinusoid":
-        ic_args["amplitude"] = (_four(ini, "amplitude", where_i) if "amplitude" in ini
-                                else DEFAULT_AMPLITUDE)
+    ini = scenario_table(data, "initial", INITIAL_KEYS, source)
+    at = where(source, "initial")
+    kind = checked(ini["kind"], "string", at, "kind", INITIAL_KINDS) if "kind" in ini \
+        else "sinusoid"
+    args: dict[str, Any] = {"kind": kind}
+    if kind in ("sinusoid", "random"):
+        args["amplitude"] = _four(ini, "amplitude", at) if "amplitude" in ini \
+            else DEFAULT_AMPLITUDE
         if "wavenumber" in ini:
-            ic_args["wavenumber"] = _four(ini, "wavenumber", where_i)
-        if "phase_rad" in ini:
-            ic_args["phase"] = _four(ini, "phase_rad", where_i)
-        extra = {"fraction"} & set(ini)
-    elif kind == "random":
-        ic_args["amplitude"] = (_four(ini, "amplitude", where_i) if "amplitude" in ini
-                                else DEFAULT_AMPLITUDE)
-        ic_args["seed"] = seed
-        if "wavenumber" in ini:
-            ic_args["wavenumber"] = _four(ini, "wavenumber", where_i)
-        extra = {"fraction", "phase_rad"} & set(ini)
+            args["wavenumber"] = _four(ini, "wavenumber", at)
+        if "phase_rad" in ini and kind == "sinusoid":
+            args["phase"] = _four(ini, "phase_rad", at)
+        if kind == "random":
+            args["seed"] = seed
+        extra = {"fraction"} | ({"phase_rad"} if kind == "random" else set())
     else:
         if kind in ("nonrecurrent", "linear"):
-            ic_args["amplitude"] = _num(ini, "fraction", where_i) if "fraction" in ini else 0.25
-        extra = {"amplitude", "wavenumber", "phase_rad"} & set(ini)
-        if kind == "equilibrium":
-            extra |= {"fraction"} & set(ini)
+            args["amplitude"] = float(checked(ini["fraction"], "number", at, "fraction")) \
+                if "fraction" in ini else 0.25
+        extra = {"amplitude", "wavenumber", "phase_rad"} | (
+            {"fraction"} if kind == "equilibrium" else set())
+    extra &= set(ini)
     if extra:
-        raise ScenarioError(f"{where_i}: {', '.join(sorted(extra))} do(es) not apply to "
-                            f"kind = {kind!r}")
+        raise ScenarioError(f"{at} {', '.join(sorted(extra))} do(es) not apply to "
+                            f"kind = {written(kind)}")
     try:
-        return TwinConfig(SolverOptions(**opts), InitialCondition(**ic_args), controller,
-                          constant_u, seed, kernel_cells, design)
-    except ScenarioError:
-        raise
+        return InitialCondition(**args)
     except ArzsumoError as exc:
-        raise ScenarioError(f"{source}: {exc}") from None
+        raise in_user_terms(exc, at, ini, INITIAL_SPECS) from None
+
+
+def twin_config_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> TwinConfig:
+    """Parse the ``[twin]``, ``[initial]`` and ``[design]`` tables of a parsed scenario.
+
+    Errors name the file, the table, the key and the value as written.
+    """
+    from arzsumo.scenarios import design_from_dict, scenario_table
+
+    tw = scenario_table(data, "twin", TWIN_KEYS, source)
+    at = where(source, "twin")
+    values = read_keys(tw, TWIN_SPECS, at)
+    own = {k: values.pop(k) for k in ("controller", "constant_u", "seed", "kernel_cells")
+           if k in values}
+    try:
+        solver = SolverOptions(**values)
+        initial = initial_from_dict(data, source, own.get("seed", 0))
+        return TwinConfig(solver, initial, design=design_from_dict(data, source), **own)
+    except ArzsumoError as exc:
+        if exc.field is None:       # [initial] and [design]: already in the user's terms
+            raise
+        raise in_user_terms(exc, at, tw, TWIN_SPECS) from None

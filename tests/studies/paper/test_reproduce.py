@@ -229,5 +229,5 @@ def test_twin_overrides_reach_every_scenario_and_are_validated():
                  twin={"scheme": "muscl"})
     for t in tasks:
         assert twin_config_from_dict(t.scenario.raw).solver.scheme == "muscl"
-    with pytest.raises(ScenarioError, match=r"scheme = 'third' is not allowed"):
+    with pytest.raises(ScenarioError, match=r'\[twin\] scheme = "third" is not allowed'):
         plan(load_experiments(PAPER_DIR), only=["base_etc"], twin={"scheme": "third"})

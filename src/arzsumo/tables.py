@@ -1,0 +1,151 @@
+"""Scenario tables read in the user's terms: shape, types, SI conversion, and errors.
+
+Every parser of a scenario table (``[model]``, ``[equilibrium]``, ``[sumo]``, ``[run]``,
+``[twin]``, ``[initial]``, ``[design]``) describes its keys with :class:`Key` and reads
+them with :func:`read_keys`. The dataclasses behind the tables check their meaning in SI
+with internal field names (:func:`arzsumo.errors.require`); :func:`in_user_terms` turns
+such an error back into the key as written and the value as written, so every message
+reads like ``scenarios/x.toml: [sumo] demand_h_veh_h = -100 is not allowed: a demand >= 0
+veh/h``.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from arzsumo.errors import ArzsumoError, ScenarioError
+from arzsumo.io import toml_value
+
+#: what a value of each kind must be (the type part of error messages)
+KIND_TEXT = {"number": "a finite number", "integer": "an integer", "string": "a string",
+             "bool": "true or false"}
+
+
+@dataclass(frozen=True)
+class Key:
+    """One key of a scenario table.
+
+    Parameters
+    ----------
+    field : str
+        The SI field it sets (of the dataclass behind the table).
+    kind : str
+        ``"number"`` (finite int or float), ``"integer"``, ``"string"`` or ``"bool"``.
+    factor : float
+        User units per SI unit: 3.6 for km/h, 3600 for veh/h, 1000 for veh/km, 1 for SI.
+    allowed : str, optional
+        What is allowed, in the key's units; replaces the SI check's text when that
+        would mislead (numbers in veh/s, m/s or veh/m).
+    choices : tuple of str
+        The allowed strings of a ``"string"`` key (empty: any string).
+    """
+
+    field: str
+    kind: str = "number"
+    factor: float = 1.0
+    allowed: str | None = None
+    choices: tuple[str, ...] = ()
+
+
+def written(value: Any) -> str:
+    """``value`` as it is written in a TOML file (``-100``, ``"fast"``, ``[1, 2]``)."""
+    try:
+        return toml_value(value)
+    except TypeError:
+        return repr(value)
+
+
+def where(source: str, table: str) -> str:
+    """The prefix of a message about ``[table]`` of ``source``: ``x.toml: [sumo]``."""
+    return f"{source}: [{table}]"
+
+
+def not_allowed(at: str, key: str, value: Any, allowed: str,
+                error: type[ArzsumoError] = ScenarioError) -> ArzsumoError:
+    """``error``: ``{at} {key} = {value as written} is not allowed: {allowed}``."""
+    return error(f"{at} {key} = {written(value)} is not allowed: {allowed}")
+
+
+def check_keys(table: Mapping[str, Any], allowed: set[str] | Mapping[str, Any],
+               at: str) -> None:
+    """Refuse keys of ``table`` outside ``allowed``, naming all of them."""
+    unknown = [k for k in table if k not in allowed]
+    if unknown:
+        what = "key" if len(unknown) == 1 else "keys"
+        raise ScenarioError(f"{at} unknown {what} {', '.join(repr(k) for k in unknown)}; "
+                            f"allowed: {', '.join(sorted(allowed))}")
+
+
+def sub_table(data: Mapping[str, Any], name: str, allowed: set[str] | Mapping[str, Any],
+              source: str) -> dict[str, Any]:
+    """The ``[name]`` table of ``data`` (empty if absent), its keys checked."""
+    value = data.get(name, {})
+    if not isinstance(value, Mapping):
+        raise not_allowed(f"{source}:", name, value, f"a table [{name}]")
+    check_keys(value, allowed, where(source, name))
+    return dict(value)
+
+
+def checked(value: Any, kind: str, at: str, key: str,
+            choices: tuple[str, ...] = ()) -> Any:
+    """``value`` if it is of ``kind`` (and among ``choices``); a one-line error otherwise."""
+    if kind == "number":
+        ok = (isinstance(value, int | float) and not isinstance(value, bool)
+              and math.isfinite(value))
+    elif kind == "integer":
+        ok = isinstance(value, int) and not isinstance(value, bool)
+    elif kind == "bool":
+        ok = isinstance(value, bool)
+    else:
+        ok = isinstance(value, str) and (not choices or value in choices)
+    if not ok:
+        text = f"one of {', '.join(choices)}" if choices else KIND_TEXT[kind]
+        raise not_allowed(at, key, value, text)
+    return value
+
+
+def read_keys(table: Mapping[str, Any], keys: Mapping[str, Key], at: str) -> dict[str, Any]:
+    """``{field: SI value}`` of the keys of ``table`` that ``keys`` describes."""
+    out: dict[str, Any] = {}
+    for key, value in table.items():
+        spec = keys.get(key)
+        if spec is None:
+            continue
+        value = checked(value, spec.kind, at, key, spec.choices)
+        out[spec.field] = value / spec.factor if spec.kind == "number" else value
+    return out
+
+
+def _user_names(text: str, keys: Mapping[str, Key]) -> str:
+    """``text`` with SI field names of same-unit keys replaced by the keys' names."""
+    for key, spec in keys.items():
+        if spec.field != key and spec.factor == 1.0:
+            text = re.sub(rf"\b{re.escape(spec.field)}\b", key, text)
+    return text
+
+
+def in_user_terms(exc: ArzsumoError, at: str, table: Mapping[str, Any],
+                  keys: Mapping[str, Key]) -> ScenarioError:
+    """``exc`` (raised in SI with a field name) restated with the key and written value.
+
+    The result is a :class:`ScenarioError` (a bad value of the file). A field that a key
+    of ``table`` sets is named by that key with the value as written; a same-unit field
+    left at its default is named by its key with the default; anything else keeps its
+    message, prefixed by ``at``.
+    """
+    field = getattr(exc, "field", None)
+    matches = [key for key, spec in keys.items() if field is not None and spec.field == field]
+    for key in sorted(matches, key=lambda k: k not in table):     # keys written first
+        spec = keys[key]
+        allowed = spec.allowed or _user_names(str(exc.allowed), keys)
+        if key in table:
+            return ScenarioError(f"{at} {key} = {written(table[key])} is not allowed: "
+                                 f"{allowed}")
+        if spec.factor == 1.0:
+            return ScenarioError(f"{at} {key} = {written(exc.value)} (the default) is not "
+                                 f"allowed: {allowed}")
+    return ScenarioError(f"{at} {_user_names(str(exc), keys)}")
