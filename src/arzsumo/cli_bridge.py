@@ -15,17 +15,21 @@ DEFAULT_SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "default.
 
 def cmd_run(args: argparse.Namespace) -> int:
     from arzsumo.bridge.outputs import write_results
-    from arzsumo.bridge.session import run_in_sumo
+    from arzsumo.bridge.session import default_run_name, resolve_run, run_in_sumo
+    from arzsumo.outdir import OutputDir
     from arzsumo.scenarios import load_scenario
 
     path = Path(args.scenario) if args.scenario else DEFAULT_SCENARIO
     sc = load_scenario(path)
-    session = run_in_sumo(sc, controller=args.controller, seed=args.seed,
-                          horizon=args.horizon, progress=not args.quiet)
-    out = Path(args.out) if args.out else Path("results") / (
-        f"{sc.name}-{session.settings.controller}-seed{session.sumo.seed}")
-    text = path.read_text(encoding="utf-8") + session.resolved_comment()
-    out, summ = write_results(session.result, out, text, plots=not args.no_plots)
+    settings, cfg = resolve_run(sc, controller=args.controller, seed=args.seed,
+                                horizon=args.horizon)
+    out = Path(args.out) if args.out else Path("results") / default_run_name(sc, settings, cfg)
+    # the output is checked and claimed before SUMO starts; Ctrl-C or an error removes it
+    with OutputDir(out, "run", overwrite=args.overwrite) as target:
+        session = run_in_sumo(sc, controller=args.controller, seed=args.seed,
+                              horizon=args.horizon, progress=not args.quiet)
+        text = path.read_text(encoding="utf-8") + session.resolved_comment()
+        _, summ = write_results(session.result, target, text, plots=not args.no_plots)
     if args.json:
         from arzsumo.twin.output import json_safe
 
@@ -51,7 +55,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     """Add ``run`` and ``compare`` to the top-level parser."""
     p = sub.add_parser("run", help="closed loop in SUMO with the PDE twin alongside")
     p.add_argument("scenario", nargs="?", help="scenario file (default scenarios/default.toml)")
-    p.add_argument("--out", help="results directory (default results/NAME-CONTROLLER-seedN)")
+    p.add_argument("--out", help="results directory (default results/NAME-CONTROLLER-seedN-hTs)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace a previous run result in the --out directory")
     p.add_argument("--seed", type=int, help="SUMO seed (overrides [sumo] seed)")
     p.add_argument("--controller", choices=["open", "backstepping", "etc", "observer-etc",
                                             "alinea"], help="override [run] controller")

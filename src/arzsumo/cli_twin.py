@@ -25,13 +25,15 @@ EXIT_INCOMPLETE = 3
 
 
 def cmd_twin(args: argparse.Namespace) -> int:
+    from arzsumo.outdir import OutputDir
     from arzsumo.twin.output import json_safe, write_run
     from arzsumo.twin.run import run_twin
 
     sc = load_scenario(args.scenario)
-    run = run_twin(sc, baseline=not args.no_baseline)
     out = Path(args.out) if args.out else Path("results") / "twin" / sc.name
-    write_run(run, out, plots=not args.no_plots)
+    with OutputDir(out, "twin", overwrite=args.overwrite) as target:  # checked before the run
+        run = run_twin(sc, baseline=not args.no_baseline)
+        write_run(run, target, plots=not args.no_plots)
     summary = run.summary()
     if args.json:
         print(json.dumps(json_safe(summary), indent=2))
@@ -67,15 +69,17 @@ def _print(s: dict, out: Path) -> None:
 
 
 def cmd_reproduce(args: argparse.Namespace) -> int:
+    from arzsumo.outdir import OutputDir
     from arzsumo.twin.compare import REPRODUCED, claims
     from arzsumo.twin.reproduce import reproduce
     from arzsumo.twin.reproduce_output import write_reproduction
 
-    rep = reproduce(args.scenarios, quick=args.quick, only=args.only or None,
-                    workers=args.workers,
-                    twin={"scheme": args.scheme} if args.scheme else None)
     out = Path(args.out) if args.out else Path("results") / "reproduce"
-    write_reproduction(rep, out, plots=not args.no_plots)
+    with OutputDir(out, "reproduce", overwrite=args.overwrite) as target:
+        rep = reproduce(args.scenarios, quick=args.quick, only=args.only or None,
+                        workers=args.workers,
+                        twin={"scheme": args.scheme} if args.scheme else None)
+        write_reproduction(rep, target, plots=not args.no_plots)
     cl = claims(rep)
     print(f"reproduce: {len(rep.records)} runs, {rep.open_loops} open loops, "
           f"{rep.wall_time:.1f} s{' (quick)' if rep.quick else ''}")
@@ -97,6 +101,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="scenario file with optional [twin] and [initial] tables")
     p.add_argument("--out", metavar="DIR",
                    help="output directory (default results/twin/<scenario name>)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace a previous twin result in the --out directory")
     p.add_argument("--json", action="store_true", help="print the summary as JSON (SI)")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG figures")
     p.add_argument("--no-baseline", action="store_true",
@@ -107,6 +113,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                               help="run every experiment of section 5 and compare with the paper")
     r.add_argument("--out", metavar="DIR",
                    help="output directory (default results/reproduce)")
+    r.add_argument("--overwrite", action="store_true",
+                   help="replace a previous reproduce result in the --out directory")
     r.add_argument("--quick", action="store_true",
                    help="tiny grid and horizon: a smoke test, numbers not meaningful")
     r.add_argument("--scenarios", metavar="DIR", default="scenarios/paper",

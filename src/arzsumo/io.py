@@ -7,12 +7,14 @@ import json
 import math
 import os
 import re
-import shutil
 import tempfile
 import tomllib
 from collections.abc import Iterator, Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from arzsumo.outdir import OutputDir
 
 
 def _umask() -> int:
@@ -44,28 +46,32 @@ def atomic_file(path: str | os.PathLike[str]) -> Iterator[Path]:
 
 
 @contextlib.contextmanager
-def atomic_dir(path: str | os.PathLike[str]) -> Iterator[Path]:
-    """Yield a temporary directory beside ``path``; rename it to ``path`` on success.
+def atomic_dir(out: str | os.PathLike[str] | OutputDir, kind: str, *,
+               overwrite: bool = False) -> Iterator[Path]:
+    """Yield a temporary directory beside ``out``; put it in place as ``out`` on success.
 
-    An existing ``path`` is replaced only once the new results are complete.
+    ``out`` is a path, checked by the policy of :class:`arzsumo.outdir.OutputDir` (a
+    previous result of ``kind`` is replaced only with ``overwrite``; anything else that
+    exists is refused), or an :class:`~arzsumo.outdir.OutputDir` claimed earlier.
     """
-    target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.partial.", dir=target.parent))
-    try:
-        yield tmp
-        os.chmod(tmp, DIR_MODE)
-        if target.exists():
-            old = target.with_name(f".{target.name}.old")
-            shutil.rmtree(old, ignore_errors=True)
-            os.replace(target, old)
-            os.replace(tmp, target)
-            shutil.rmtree(old, ignore_errors=True)
-        else:
-            os.replace(tmp, target)
-    finally:
-        if tmp.exists():
-            shutil.rmtree(tmp, ignore_errors=True)
+    from arzsumo.outdir import OutputDir
+
+    if isinstance(out, OutputDir):
+        if out.kind != kind:
+            raise ValueError(f"output directory of kind {out.kind!r} written as {kind!r}")
+        od = out
+    else:
+        od = OutputDir(out, kind, overwrite=overwrite, scratch=False)  # only files written
+    with od:
+        yield od.tmp
+        od.commit()
+
+
+def target_of(out: str | os.PathLike[str] | OutputDir) -> Path:
+    """The path a result written to ``out`` ends up at."""
+    from arzsumo.outdir import OutputDir
+
+    return out.path if isinstance(out, OutputDir) else Path(out)
 
 
 def read_toml(path: str | os.PathLike[str], field: str,

@@ -34,6 +34,26 @@ class SumoSession:
             f"\n# sumo = {self.sumo!r}\n"
 
 
+def resolve_run(sc: Scenario, *, controller: str | None = None, seed: int | None = None,
+                horizon: float | None = None) -> tuple[RunSettings, SumoConfig]:
+    """The run settings and SUMO configuration of ``sc`` under the caller's overrides
+    (see :func:`run_in_sumo`), known before SUMO starts."""
+    settings = run_settings_from_dict(sc.raw, sc.source, controller=controller)
+    cfg = sumo_config_of(sc)
+    if seed is not None:
+        if seed < 0:
+            raise ScenarioError(f"--seed = {seed} is not allowed: an integer >= 0")
+        cfg = cfg.with_(seed=seed)
+    if horizon is not None:
+        cfg = cfg.with_(horizon=horizon)
+    return settings, cfg
+
+
+def default_run_name(sc: Scenario, settings: RunSettings, cfg: SumoConfig) -> str:
+    """``NAME-CONTROLLER-seedN-hTs``: unique per scenario, controller, seed and horizon (s)."""
+    return f"{sc.name}-{settings.controller}-seed{cfg.seed}-h{cfg.horizon:g}s"
+
+
 def run_in_sumo(sc: Scenario, *, controller: str | None = None, seed: int | None = None,
                 horizon: float | None = None, progress: bool = False) -> SumoSession:
     """Run the closed loop of ``sc`` in SUMO (overrides win over the scenario's tables).
@@ -54,14 +74,7 @@ def run_in_sumo(sc: Scenario, *, controller: str | None = None, seed: int | None
         Draw a progress bar on stderr.
     """
     raw = sc.raw
-    settings = run_settings_from_dict(raw, sc.source, controller=controller)
-    cfg = sumo_config_of(sc)
-    if seed is not None:
-        if seed < 0:
-            raise ScenarioError(f"--seed = {seed} is not allowed: an integer >= 0")
-        cfg = cfg.with_(seed=seed)
-    if horizon is not None:
-        cfg = cfg.with_(horizon=horizon)
+    settings, cfg = resolve_run(sc, controller=controller, seed=seed, horizon=horizon)
     design = design_from_dict(raw, sc.source)
     initial = None
     if settings.start == "placement":

@@ -20,7 +20,8 @@ from typing import Any
 import numpy as np
 
 from arzsumo.errors import ArzsumoError
-from arzsumo.io import atomic_dir, read_toml, toml_value
+from arzsumo.io import atomic_dir, read_toml, target_of, toml_value
+from arzsumo.outdir import OutputDir
 from arzsumo.sumo.calibrate import Calibration
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.meter import GreenShareCurve
@@ -117,12 +118,13 @@ def calibration_json(cal: Calibration, cfg: SumoConfig) -> dict[str, Any]:
     })
 
 
-def write_calibration(out: str | Path, cal: Calibration, cfg: SumoConfig) -> Path:
-    """Write all calibration outputs into directory ``out`` (atomically)."""
+def write_calibration(out: str | Path | OutputDir, cal: Calibration, cfg: SumoConfig,
+                      overwrite: bool = False) -> Path:
+    """Write all calibration outputs into directory ``out`` atomically (a previous
+    ``calibration`` result is replaced only with ``overwrite``, see :mod:`arzsumo.outdir`)."""
     from arzsumo.plots.calibration import write_calibration_figure
 
-    out = Path(out)
-    with atomic_dir(out) as tmp:
+    with atomic_dir(out, "calibration", overwrite=overwrite) as tmp:
         (tmp / "calibrated_model.toml").write_text(scenario_text(cal, cfg), encoding="utf-8")
         (tmp / "meter_curve.toml").write_text(curve_text(cal.curve, cfg), encoding="utf-8")
         (tmp / "calibration.json").write_text(json.dumps(calibration_json(cal, cfg), indent=2),
@@ -140,4 +142,4 @@ def write_calibration(out: str | Path, cal: Calibration, cfg: SumoConfig) -> Pat
             {"h": (p.v_free_h, p.ao_max_h, p.gamma_h), "a": (p.v_free_a, p.ao_max_a, p.gamma_a)},
             {k: f.r2 for k, f in cal.fits.items()},
             (np.asarray(cal.curve.green_share), np.asarray(cal.curve.outflow)), mark)
-    return out
+    return target_of(out)

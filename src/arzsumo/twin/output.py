@@ -19,7 +19,8 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from arzsumo.io import atomic_dir
+from arzsumo.io import atomic_dir, target_of
+from arzsumo.outdir import OutputDir
 from arzsumo.twin.run import TwinRun
 
 
@@ -58,15 +59,17 @@ def json_safe(obj: Any) -> Any:
     return obj
 
 
-def write_run(run: TwinRun, out: str | Path, plots: bool = True) -> Path:
-    """Write ``run`` into the directory ``out`` (replaced atomically); return its path."""
+def write_run(run: TwinRun, out: str | Path | OutputDir, plots: bool = True,
+              overwrite: bool = False) -> Path:
+    """Write ``run`` into the directory ``out`` atomically (a previous ``twin`` result is
+    replaced only with ``overwrite``, see :mod:`arzsumo.outdir`); return its path."""
     from arzsumo.plots.twin import write_twin_plots
 
-    with atomic_dir(out) as tmp:
+    with atomic_dir(out, "twin", overwrite=overwrite) as tmp:
         pq.write_table(fields_table(run), tmp / "fields.parquet")
         pq.write_table(control_table(run), tmp / "control.parquet")
         (tmp / "summary.json").write_text(json.dumps(json_safe(run.summary()), indent=2)
                                           + "\n", encoding="utf-8")
         if plots:
             write_twin_plots(run, tmp)
-    return Path(out)
+    return target_of(out)

@@ -23,7 +23,8 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from arzsumo.io import atomic_dir
+from arzsumo.io import atomic_dir, target_of
+from arzsumo.outdir import OutputDir
 from arzsumo.twin.compare import (
     NOT_REPRODUCED,
     REPRODUCED,
@@ -210,11 +211,13 @@ def report_markdown(rep: Reproduction) -> str:
     return "\n".join(parts)
 
 
-def write_reproduction(rep: Reproduction, out: str | Path, plots: bool = True) -> Path:
-    """Write ``rep`` into directory ``out`` (replaced atomically); return its path."""
+def write_reproduction(rep: Reproduction, out: str | Path | OutputDir, plots: bool = True,
+                       overwrite: bool = False) -> Path:
+    """Write ``rep`` into directory ``out`` atomically (a previous ``reproduce`` result is
+    replaced only with ``overwrite``, see :mod:`arzsumo.outdir`); return its path."""
     from arzsumo.plots.reproduce import write_reproduce_plots
 
-    with atomic_dir(out) as tmp:
+    with atomic_dir(out, "reproduce", overwrite=overwrite) as tmp:
         (tmp / "report.md").write_text(report_markdown(rep), encoding="utf-8")
         for name, rows in (("diffperformance", performance_table(rep)),
                            ("totaldelay", delay_table(rep)),
@@ -229,4 +232,4 @@ def write_reproduction(rep: Reproduction, out: str | Path, plots: bool = True) -
             encoding="utf-8")
         if plots:
             write_reproduce_plots(rep, tmp)
-    return Path(out)
+    return target_of(out)
