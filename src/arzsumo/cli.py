@@ -19,6 +19,7 @@ from collections.abc import Callable, Sequence
 
 from arzsumo import __version__, cli_bridge, cli_control, cli_sumo, cli_sweep, cli_twin
 from arzsumo.errors import ArzsumoError
+from arzsumo.interrupts import EXIT_INTERRUPTED
 from arzsumo.model import linearize
 from arzsumo.scenarios import Scenario, load_scenario, scenario_from_preset
 from arzsumo.units import ms_to_kmh
@@ -114,9 +115,6 @@ def build_parser() -> argparse.ArgumentParser:
     cli_bridge.register(sub)
     cli_sweep.register(sub)
     return parser
-
-
-EXIT_INTERRUPTED = 130
 
 
 def _interrupt(signum: int, frame: object) -> None:

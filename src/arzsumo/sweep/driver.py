@@ -34,6 +34,7 @@ from typing import Any
 import pandas as pd
 
 from arzsumo import __version__
+from arzsumo.interrupts import worker_pool
 from arzsumo.io import atomic_dir, atomic_file
 from arzsumo.outdir import resumable_dir
 from arzsumo.progress import Progress
@@ -113,8 +114,7 @@ def run_local(tasks: Iterable[RunTask], workers: int, on_done: OnDone,
     queue = deque(tasks)
     while queue:
         suspects: list[RunTask] = []
-        with cf.ProcessPoolExecutor(max_workers=max(1, min(workers, len(queue))),
-                                    mp_context=ctx) as pool:
+        with worker_pool(max(1, min(workers, len(queue))), ctx) as pool:
             running: dict[cf.Future[RunOutcome], RunTask] = {}
             while (queue or running) and not suspects:
                 while queue and len(running) < workers:
@@ -130,7 +130,7 @@ def run_local(tasks: Iterable[RunTask], workers: int, on_done: OnDone,
             suspects += list(running.values())
         for task in suspects:
             log.warning("run %s: a worker process died; running it again alone", task.run_id)
-            with cf.ProcessPoolExecutor(max_workers=1, mp_context=ctx) as alone:
+            with worker_pool(1, ctx) as alone:
                 try:
                     on_done(alone.submit(fn, task).result())
                 except BrokenProcessPool:

@@ -21,7 +21,6 @@ import logging
 import math
 import time
 from collections.abc import Mapping, Sequence
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -30,6 +29,7 @@ import numpy as np
 
 from arzsumo.control.events import lyapunov_convergence_time
 from arzsumo.errors import ScenarioError
+from arzsumo.interrupts import worker_pool
 from arzsumo.scenarios import DESIGN_KEYS, Scenario, load_scenario, scenario_from_dict
 from arzsumo.twin.config import twin_config_from_dict
 from arzsumo.twin.metrics import Performance
@@ -227,7 +227,7 @@ def _controlled(task: _Task, baseline: tuple[Performance, bool, str]) -> RunReco
 def _map(fn: Any, args: list[tuple], workers: int) -> list[Any]:
     if workers <= 1 or len(args) <= 1:
         return [fn(*a) for a in args]
-    with ProcessPoolExecutor(max_workers=workers) as pool:
+    with worker_pool(workers) as pool:
         return list(pool.map(fn, *zip(*args, strict=True)))
 
 
