@@ -13,7 +13,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 run: $(STAMP)
-	$(BIN)/arzsumo run
+	$(BIN)/arzsumo run --overwrite
 
 test: $(STAMP)
 	$(BIN)/lint-imports

@@ -2,7 +2,9 @@
 
 Each command loads and validates its input, calls one library function and prints or
 saves. User mistakes (:class:`arzsumo.errors.ArzsumoError`) end as one line on stderr
-with exit code 2; logging is configured here and nowhere else.
+with exit code 2; Ctrl-C (SIGINT) ends as ``arzsumo: interrupted`` with exit code 130,
+after the command's temporary files are removed; logging is configured here and nowhere
+else.
 """
 
 from __future__ import annotations
@@ -10,13 +12,16 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import signal
 import sys
+import threading
 from collections.abc import Callable, Sequence
 
 from arzsumo import __version__, cli_bridge, cli_control, cli_list, cli_sumo, cli_sweep, cli_twin
 from arzsumo.cli_args import Parser
 from arzsumo.cli_common import add_model_source, scenario_of
 from arzsumo.errors import ArzsumoError
+from arzsumo.interrupts import EXIT_INTERRUPTED
 from arzsumo.model import linearize
 from arzsumo.scenarios import Scenario
 from arzsumo.units import ms_to_kmh
@@ -122,6 +127,12 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _interrupt(signum: int, frame: object) -> None:
+    # a second Ctrl-C must not cut short the removal of the partial output
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    raise KeyboardInterrupt
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     try:
@@ -132,11 +143,19 @@ def main(argv: Sequence[str] | None = None) -> int:
                         format="%(levelname)s %(name)s: %(message)s")
     logging.getLogger("matplotlib").setLevel(logging.WARNING)
     func: Command = args.func
+    main_thread = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGINT, _interrupt) if main_thread else None
     try:
         return func(args)
     except ArzsumoError as exc:
         print(f"arzsumo: error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print("arzsumo: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    finally:
+        if main_thread:
+            signal.signal(signal.SIGINT, previous)
 
 
 if __name__ == "__main__":

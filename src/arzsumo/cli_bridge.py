@@ -17,24 +17,26 @@ DEFAULT_SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "default.
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from arzsumo.bridge.session import run_in_sumo
+    from arzsumo.bridge.session import default_run_name, prepare_run, run_in_sumo
+    from arzsumo.outdir import OutputDir
     from arzsumo.outputs.bridge import write_results
     from arzsumo.scenarios import load_scenario
 
     path = Path(args.scenario) if args.scenario else DEFAULT_SCENARIO
     sc = load_scenario(path)
+    prepared = prepare_run(sc, controller=args.controller, seed=args.seed,
+                           horizon=args.horizon)
     if args.dry_run:
-        from arzsumo.bridge.session import prepare_run
-
-        print(prepare_run(sc, controller=args.controller, seed=args.seed,
-                          horizon=args.horizon).describe())
+        print(prepared.describe())
         return 0
-    session = run_in_sumo(sc, controller=args.controller, seed=args.seed,
-                          horizon=args.horizon, progress=not args.quiet)
-    out = Path(args.out) if args.out else Path("results") / (
-        f"{sc.name}-{session.settings.controller}-seed{session.sumo.seed}")
-    text = path.read_text(encoding="utf-8") + session.resolved_comment()
-    out, summ = write_results(session.result, out, text, plots=not args.no_plots)
+    out = Path(args.out) if args.out else Path("results") / default_run_name(
+        sc, prepared.settings, prepared.sumo)
+    # the output is checked and claimed before SUMO starts; Ctrl-C or an error removes it
+    with OutputDir(out, "run", overwrite=args.overwrite) as target:
+        session = run_in_sumo(sc, controller=args.controller, seed=args.seed,
+                              horizon=args.horizon, progress=not args.quiet)
+        text = path.read_text(encoding="utf-8") + session.resolved_comment()
+        _, summ = write_results(session.result, target, text, plots=not args.no_plots)
     if args.json:
         from arzsumo.io import json_safe
 
@@ -66,7 +68,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("scenario", nargs="?", metavar="SCENARIO.toml",
                    help="scenario file (default scenarios/default.toml)")
     p.add_argument("--out", metavar="DIR",
-                   help="results directory (default results/NAME-CONTROLLER-seedN)")
+                   help="results directory (default results/NAME-CONTROLLER-seedN-hTs)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace a previous run result in the --out directory")
     p.add_argument("--seed", type=seed_int,
                    help="SUMO seed in [0, 2^31) (default: [sumo] seed)")
     p.add_argument("--controller", choices=list(CONTROLLERS),

@@ -37,6 +37,7 @@ def cmd_build_net(args: argparse.Namespace) -> int:
 
 
 def cmd_calibrate(args: argparse.Namespace) -> int:
+    from arzsumo.outdir import OutputDir
     from arzsumo.outputs.calibration import write_calibration
     from arzsumo.scenarios import load_scenario, scenario_from_preset
     from arzsumo.sumo.calibrate import CalibrationPlan, calibrate
@@ -54,8 +55,10 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     if args.horizon is not None:
         plan = CalibrationPlan(**{**plan.__dict__, "horizon": args.horizon,
                                   "warmup": min(plan.warmup, args.horizon / 3)})
-    cal = calibrate(sc.params, cfg, plan, jobs=args.jobs)
-    out = write_calibration(args.out, cal, cfg)
+    with OutputDir(args.out, "calibration", overwrite=args.overwrite) as target:
+        cal = calibrate(sc.params, cfg, plan, jobs=args.jobs)
+        write_calibration(target, cal, cfg)
+    out = args.out
     for cls, name in (("h", "HV"), ("a", "AV")):
         f = cal.fits[cls]
         print(f"{name}: V = {ms_to_kmh(f.v_free):.1f} km/h, AO_max = {f.ao_max:.3f}, "
@@ -103,6 +106,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     src.add_argument("--scenario", metavar="FILE.toml", help="scenario file (may hold [sumo])")
     p.add_argument("--out", metavar="DIR", default="runs/calibration",
                    help="output directory (written atomically)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace a previous calibration result in the --out directory")
     p.add_argument("--seed", type=seed_int,
                    help="SUMO seed in [0, 2^31) (default: the scenario's [sumo] seed)")
     p.add_argument("--step-length", type=positive_float,

@@ -27,13 +27,15 @@ EXIT_INCOMPLETE = 3
 
 def cmd_twin(args: argparse.Namespace) -> int:
     from arzsumo.io import json_safe
+    from arzsumo.outdir import OutputDir
     from arzsumo.outputs.twin import write_run
     from arzsumo.twin.run import run_twin
 
     sc = load_scenario(args.scenario)
-    run = run_twin(sc, baseline=not args.no_baseline)
     out = Path(args.out) if args.out else Path("results") / "twin" / sc.name
-    write_run(run, out, plots=not args.no_plots)
+    with OutputDir(out, "twin", overwrite=args.overwrite) as target:  # checked before the run
+        run = run_twin(sc, baseline=not args.no_baseline)
+        write_run(run, target, plots=not args.no_plots)
     summary = run.summary()
     if args.json:
         print(json.dumps(json_safe(summary), indent=2))
@@ -69,15 +71,17 @@ def _print(s: dict, out: Path) -> None:
 
 
 def cmd_reproduce(args: argparse.Namespace) -> int:
+    from arzsumo.outdir import OutputDir
     from arzsumo.studies.paper.compare import REPRODUCED, claims
     from arzsumo.studies.paper.report import write_reproduction
     from arzsumo.studies.paper.reproduce import reproduce
 
-    rep = reproduce(args.scenarios, quick=args.quick, only=args.only or None,
-                    workers=args.workers,
-                    twin={"scheme": args.scheme} if args.scheme else None)
     out = Path(args.out) if args.out else Path("results") / "reproduce"
-    write_reproduction(rep, out, plots=not args.no_plots)
+    with OutputDir(out, "reproduce", overwrite=args.overwrite) as target:
+        rep = reproduce(args.scenarios, quick=args.quick, only=args.only or None,
+                        workers=args.workers,
+                        twin={"scheme": args.scheme} if args.scheme else None)
+        write_reproduction(rep, target, plots=not args.no_plots)
     cl = claims(rep)
     print(f"reproduce: {len(rep.records)} runs, {rep.open_loops} open loops, "
           f"{rep.wall_time:.1f} s{' (quick)' if rep.quick else ''}")
@@ -102,6 +106,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="scenario file with optional [twin] and [initial] tables")
     p.add_argument("--out", metavar="DIR",
                    help="output directory (default results/twin/<scenario name>)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace a previous twin result in the --out directory")
     p.add_argument("--json", action="store_true", help="print the summary as JSON (SI)")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG figures")
     p.add_argument("--no-baseline", action="store_true",
@@ -115,6 +121,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                                           "write a report.")
     r.add_argument("--out", metavar="DIR",
                    help="output directory (default results/reproduce)")
+    r.add_argument("--overwrite", action="store_true",
+                   help="replace a previous reproduce result in the --out directory")
     r.add_argument("--quick", action="store_true",
                    help="tiny grid and horizon: a smoke test, numbers not meaningful")
     r.add_argument("--scenarios", metavar="DIR", default="scenarios/paper",

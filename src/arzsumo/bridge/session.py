@@ -142,6 +142,11 @@ def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None
     return PreparedRun(sc, settings, cfg, design, initial)
 
 
+def default_run_name(sc: Scenario, settings: RunSettings, cfg: SumoConfig) -> str:
+    """``NAME-CONTROLLER-seedN-hTs``: unique per scenario, controller, seed and horizon (s)."""
+    return f"{sc.name}-{settings.controller}-seed{cfg.seed}-h{cfg.horizon:g}s"
+
+
 def run_in_sumo(sc: Scenario, *, controller: str | None = None, seed: int | None = None,
                 horizon: float | None = None, progress: bool = False) -> SumoSession:
     """Run the closed loop of ``sc`` in SUMO (overrides win over the scenario's tables).

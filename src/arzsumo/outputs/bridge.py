@@ -40,8 +40,9 @@ from arzsumo.bridge.cosim import CoSimResult
 from arzsumo.bridge.estimator import fill_speeds
 from arzsumo.control.base import ControlLog
 from arzsumo.control.events import release_time
-from arzsumo.io import atomic_dir, json_safe
+from arzsumo.io import json_safe
 from arzsumo.model.characteristic import linearize
+from arzsumo.outdir import OutputDir, atomic_dir, target_of
 from arzsumo.schema import CELLS, PERIODS, RUN_SUMMARY, key_units, with_units
 from arzsumo.twin.metrics import performance
 
@@ -160,13 +161,14 @@ def cells_table(res: CoSimResult) -> pa.Table:
     return with_units(pa.concat_tables(parts), CELLS, "cells")
 
 
-def write_results(res: CoSimResult, out: str | Path, scenario_text: str,
-                  plots: bool = True) -> tuple[Path, dict[str, Any]]:
-    """Write everything into ``out`` (replaced atomically); return the path and summary."""
+def write_results(res: CoSimResult, out: str | Path | OutputDir, scenario_text: str,
+                  plots: bool = True, overwrite: bool = False) -> tuple[Path, dict[str, Any]]:
+    """Write everything into ``out`` atomically (a previous ``run`` result there is replaced
+    only with ``overwrite``, see :mod:`arzsumo.outdir`); return the path and summary."""
     from arzsumo.plots.bridge import write_bridge_plots
 
     summ = summary(res)
-    with atomic_dir(out) as tmp:
+    with atomic_dir(out, "run", overwrite=overwrite) as tmp:
         pq.write_table(periods_table(res), tmp / "periods.parquet")
         pq.write_table(cells_table(res), tmp / "cells.parquet")
         (tmp / "scenario.toml").write_text(scenario_text, encoding="utf-8")
@@ -174,4 +176,4 @@ def write_results(res: CoSimResult, out: str | Path, scenario_text: str,
                                           encoding="utf-8")
         if plots:
             write_bridge_plots(res, tmp)
-    return Path(out), summ
+    return target_of(out), summ

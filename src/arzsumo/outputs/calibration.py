@@ -11,17 +11,18 @@ from pathlib import Path
 
 import numpy as np
 
-from arzsumo.io import atomic_dir
+from arzsumo.outdir import OutputDir, atomic_dir, target_of
 from arzsumo.plots.calibration import write_calibration_figure
 from arzsumo.sumo.calibrate import Calibration
 from arzsumo.sumo.calibration_io import calibration_json, curve_text, scenario_text
 from arzsumo.sumo.config import SumoConfig
 
 
-def write_calibration(out: str | Path, cal: Calibration, cfg: SumoConfig) -> Path:
-    """Write all calibration outputs into directory ``out`` (atomically)."""
-    out = Path(out)
-    with atomic_dir(out) as tmp:
+def write_calibration(out: str | Path | OutputDir, cal: Calibration, cfg: SumoConfig,
+                      overwrite: bool = False) -> Path:
+    """Write all calibration outputs into directory ``out`` atomically (a previous
+    ``calibration`` result is replaced only with ``overwrite``, see :mod:`arzsumo.outdir`)."""
+    with atomic_dir(out, "calibration", overwrite=overwrite) as tmp:
         (tmp / "calibrated_model.toml").write_text(scenario_text(cal, cfg), encoding="utf-8")
         (tmp / "meter_curve.toml").write_text(curve_text(cal.curve, cfg), encoding="utf-8")
         (tmp / "calibration.json").write_text(json.dumps(calibration_json(cal, cfg), indent=2),
@@ -39,4 +40,4 @@ def write_calibration(out: str | Path, cal: Calibration, cfg: SumoConfig) -> Pat
             {"h": (p.v_free_h, p.ao_max_h, p.gamma_h), "a": (p.v_free_a, p.ao_max_a, p.gamma_a)},
             {k: f.r2 for k, f in cal.fits.items()},
             (np.asarray(cal.curve.green_share), np.asarray(cal.curve.outflow)), mark)
-    return out
+    return target_of(out)

@@ -17,7 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from arzsumo.io import atomic_dir, json_safe
+from arzsumo.io import json_safe
+from arzsumo.outdir import OutputDir, atomic_dir, target_of
 
 
 @dataclass(frozen=True)
@@ -70,11 +71,13 @@ def write_figures(figs: ReproduceFigures, out: str | Path) -> list[Path]:
     return written
 
 
-def write_report(out: str | Path, markdown: str, tables: Mapping[str, Sequence[Mapping]],
-                 summaries: Mapping[str, Any], figures: ReproduceFigures | None) -> Path:
+def write_report(out: str | Path | OutputDir, markdown: str,
+                 tables: Mapping[str, Sequence[Mapping]], summaries: Mapping[str, Any],
+                 figures: ReproduceFigures | None, overwrite: bool = False) -> Path:
     """Write ``report.md``, one ``<name>.csv`` per table, ``summaries.json`` and (unless
-    ``figures`` is None) the figures into ``out`` (replaced atomically); return its path."""
-    with atomic_dir(out) as tmp:
+    ``figures`` is None) the figures into ``out`` atomically (a previous ``reproduce``
+    result is replaced only with ``overwrite``, see :mod:`arzsumo.outdir`); return its path."""
+    with atomic_dir(out, "reproduce", overwrite=overwrite) as tmp:
         (tmp / "report.md").write_text(markdown, encoding="utf-8")
         for name, rows in tables.items():
             _write_csv(tmp / f"{name}.csv", rows)
@@ -82,4 +85,4 @@ def write_report(out: str | Path, markdown: str, tables: Mapping[str, Sequence[M
             json.dumps(json_safe(dict(summaries)), indent=1) + "\n", encoding="utf-8")
         if figures is not None:
             write_figures(figures, tmp)
-    return Path(out)
+    return target_of(out)

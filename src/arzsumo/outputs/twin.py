@@ -20,7 +20,8 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from arzsumo.io import atomic_dir, json_safe
+from arzsumo.io import json_safe
+from arzsumo.outdir import OutputDir, atomic_dir, target_of
 from arzsumo.schema import TWIN_CONTROL, TWIN_FIELDS, with_units
 from arzsumo.twin.run import TwinRun
 
@@ -48,15 +49,17 @@ def control_table(run: TwinRun) -> pa.Table:
     return with_units(table, TWIN_CONTROL, "control")
 
 
-def write_run(run: TwinRun, out: str | Path, plots: bool = True) -> Path:
-    """Write ``run`` into the directory ``out`` (replaced atomically); return its path."""
+def write_run(run: TwinRun, out: str | Path | OutputDir, plots: bool = True,
+              overwrite: bool = False) -> Path:
+    """Write ``run`` into the directory ``out`` atomically (a previous ``twin`` result is
+    replaced only with ``overwrite``, see :mod:`arzsumo.outdir`); return its path."""
     from arzsumo.plots.twin import write_twin_plots
 
-    with atomic_dir(out) as tmp:
+    with atomic_dir(out, "twin", overwrite=overwrite) as tmp:
         pq.write_table(fields_table(run), tmp / "fields.parquet")
         pq.write_table(control_table(run), tmp / "control.parquet")
         (tmp / "summary.json").write_text(json.dumps(json_safe(run.summary()), indent=2)
                                           + "\n", encoding="utf-8")
         if plots:
             write_twin_plots(run, tmp)
-    return Path(out)
+    return target_of(out)

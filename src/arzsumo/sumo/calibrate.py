@@ -14,7 +14,6 @@ simulation per process, so runs go to worker processes), then
 
 from __future__ import annotations
 
-import concurrent.futures as cf
 import logging
 import multiprocessing
 from dataclasses import dataclass, field
@@ -24,6 +23,7 @@ import numpy as np
 from scipy.optimize import curve_fit
 
 from arzsumo.errors import ArzsumoError
+from arzsumo.interrupts import worker_pool
 from arzsumo.model.characteristic import linearize
 from arzsumo.model.equilibrium import Equilibrium
 from arzsumo.model.params import ModelParameters
@@ -105,7 +105,7 @@ def run_calibration_runs(params: ModelParameters, base: SumoConfig, plan: Calibr
     """Make the runs of ``plan``, ``jobs`` SUMO processes at a time."""
     runs = plan.runs(base)
     ctx = multiprocessing.get_context("spawn")
-    with cf.ProcessPoolExecutor(max_workers=max(1, jobs), mp_context=ctx) as pool:
+    with worker_pool(max(1, jobs), ctx) as pool:
         futures = [pool.submit(_run_one, params, cfg, lv, g, plan.warmup)
                    for lv, g, cfg in runs]
         results = []

@@ -2,7 +2,8 @@
 
 The binaries come from the ``eclipse-sumo`` wheel (``sumo.SUMO_HOME/bin``). The network
 directory ``sumo_nets/`` sits at the repository root; the environment variable
-``ARZSUMO_SUMO_NETS`` or an explicit argument overrides it.
+``ARZSUMO_SUMO_NETS`` or an explicit argument overrides it. SUMO's temporary files (route,
+detector and statistics files) go under :func:`scratch_dir`.
 """
 
 from __future__ import annotations
@@ -11,9 +12,11 @@ import os
 from pathlib import Path
 
 from arzsumo.errors import ArzsumoError
+from arzsumo.outdir import SCRATCH_ENV
 
 #: Environment variable that overrides the network directory.
 NETS_ENV = "ARZSUMO_SUMO_NETS"
+
 
 #: File names inside a network directory.
 NET_FILE = "ramp.net.xml"
@@ -58,4 +61,18 @@ def nets_dir(override: str | os.PathLike[str] | None = None) -> Path:
     if not (path / NET_FILE).is_file():
         raise SumoError(f"net_dir = {str(path)!r} holds no {NET_FILE}; allowed: a directory "
                         "written by `arzsumo build-net` (or set ARZSUMO_SUMO_NETS)")
+    return path
+
+
+def scratch_dir() -> Path | None:
+    """Where SUMO's temporary files go: ``$ARZSUMO_SCRATCH_DIR`` (created if missing), or
+    None for the system's temporary directory."""
+    env = os.environ.get(SCRATCH_ENV)
+    if not env:
+        return None
+    path = Path(env)
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError:  # the run that set it is gone: fall back rather than fail
+        return None
     return path

@@ -27,7 +27,7 @@ from types import ModuleType, TracebackType
 from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.demand import InitialVehicle, demand_flows, write_route_file
-from arzsumo.sumo.paths import NET_FILE, SumoError, nets_dir, sumo_binary
+from arzsumo.sumo.paths import NET_FILE, SumoError, nets_dir, scratch_dir, sumo_binary
 
 log = logging.getLogger(__name__)
 
@@ -116,7 +116,8 @@ class SumoSimulation:
         self.net_file, self.route_file, self.cfg = Path(net_file), Path(route_file), cfg
         self.requested_initial = requested_initial
         self._own_workdir = workdir is None
-        self.workdir = Path(workdir) if workdir else Path(tempfile.mkdtemp(prefix="arzsumo-"))
+        self.workdir = Path(workdir) if workdir else Path(
+            tempfile.mkdtemp(prefix="arzsumo-", dir=scratch_dir()))
         self.extra_args = tuple(extra_args)
         self._cleanup = tuple(cleanup)
         self._flows = demand_flows(cfg)
@@ -220,8 +221,9 @@ class SumoSimulation:
                          self.emergency_stops, self.emergency_braking,
                          self.requested(ramp_only=True), self.inserted_ramp)
 
-    def close(self) -> RunReport | None:
-        """Close SUMO (safe to call twice); keep the final :attr:`report`."""
+    def close(self, warn: bool = True) -> RunReport | None:
+        """Close SUMO (safe to call twice); keep the final :attr:`report`; ``warn`` about
+        undelivered demand (not when the run ends on an error or Ctrl-C)."""
         global _ACTIVE
         if self.closed or not self.started:
             self.closed = True
@@ -242,7 +244,7 @@ class SumoSimulation:
         if self.report is not None:
             self.report = RunReport(**{**self.report.__dict__,
                                        "emergency_braking": self.emergency_braking})
-            if self.report.delivered_main < 0.98:
+            if warn and self.report.delivered_main < 0.98:
                 log.warning("mainline demand not delivered: %s", self.report.summary())
         self._remove_files()
         return self.report
@@ -265,7 +267,7 @@ class SumoSimulation:
 
     def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
                  tb: TracebackType | None) -> None:
-        self.close()
+        self.close(warn=exc_type is None)
 
 
 def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
@@ -274,17 +276,21 @@ def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
     """A started simulation of the default network with the demand of ``cfg``.
 
     The route file (and, with ``e2_chain``, an E2 detector per measurement cell, see
-    :mod:`arzsumo.sumo.detectors`) goes to a temporary directory removed when the run
-    closes.
+    :mod:`arzsumo.sumo.detectors`) goes to a temporary directory (under
+    :func:`~arzsumo.sumo.paths.scratch_dir`) removed when the run closes.
     """
     net = nets_dir(net_dir) / NET_FILE
-    workdir = Path(tempfile.mkdtemp(prefix="arzsumo-"))
-    route = write_route_file(workdir / "run.rou.xml", params, cfg, initial)
-    if e2_chain:
-        from arzsumo.sumo.detectors import write_e2_chain
+    workdir = Path(tempfile.mkdtemp(prefix="arzsumo-", dir=scratch_dir()))
+    try:
+        route = write_route_file(workdir / "run.rou.xml", params, cfg, initial)
+        if e2_chain:
+            from arzsumo.sumo.detectors import write_e2_chain
 
-        add = write_e2_chain(workdir / "e2.add.xml", params.length, cfg.cell_length)
-        extra_args = ("--additional-files", str(add), *extra_args)
+            add = write_e2_chain(workdir / "e2.add.xml", params.length, cfg.cell_length)
+            extra_args = ("--additional-files", str(add), *extra_args)
+    except BaseException:  # a bad demand or Ctrl-C: leave no temporary files
+        shutil.rmtree(workdir, ignore_errors=True)
+        raise
     sim = SumoSimulation(net, route, cfg, requested_initial=len(initial), workdir=workdir,
                          extra_args=extra_args, cleanup=(workdir,))
     return sim.start()

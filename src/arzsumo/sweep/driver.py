@@ -35,7 +35,9 @@ from typing import Any
 import pandas as pd
 
 from arzsumo import __version__
-from arzsumo.io import atomic_dir, atomic_file
+from arzsumo.interrupts import worker_pool
+from arzsumo.io import atomic_file
+from arzsumo.outdir import atomic_dir, resumable_dir
 from arzsumo.progress import Progress
 from arzsumo.sweep.spec import RunSpec, SweepError, SweepSpec
 from arzsumo.sweep.table import arrow_table, read_record, run_dir, sweep_table
@@ -78,7 +80,7 @@ def write_outcome(out: Path, run: RunSpec, outcome: RunOutcome) -> None:
     record = {"run_id": run.run_id, "index": run.index, "columns": dict(run.columns),
               "overrides": dict(run.overrides), "sha256": run.sha256, "engine": run.engine,
               "status": outcome.status, "execution": outcome.execution}
-    with atomic_dir(run_dir(out, run)) as tmp:
+    with atomic_dir(run_dir(out, run), "sweep-run", overwrite=True) as tmp:
         (tmp / "scenario.toml").write_text(
             f"# run {run.run_id} of a sweep: the resolved scenario\n"
             + outcome.scenario_toml, encoding="utf-8")
@@ -116,8 +118,7 @@ def run_local(tasks: Iterable[Any], workers: int, on_done: Callable[[Any], None]
     queue = deque(tasks)
     while queue:
         suspects: list[RunTask] = []
-        with cf.ProcessPoolExecutor(max_workers=max(1, min(workers, len(queue))),
-                                    mp_context=ctx) as pool:
+        with worker_pool(max(1, min(workers, len(queue))), ctx) as pool:
             running: dict[cf.Future[RunOutcome], RunTask] = {}
             while (queue or running) and not suspects:
                 while queue and len(running) < workers:
@@ -134,7 +135,7 @@ def run_local(tasks: Iterable[Any], workers: int, on_done: Callable[[Any], None]
         for task in suspects:
             log.warning("run %s: a worker process died; running it again alone",
                         getattr(task, "run_id", task))
-            with cf.ProcessPoolExecutor(max_workers=1, mp_context=ctx) as alone:
+            with worker_pool(1, ctx) as alone:
                 try:
                     on_done(alone.submit(fn, task).result())
                 except BrokenProcessPool:
@@ -246,7 +247,8 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
     ----------
     spec : SweepSpec
     out : path
-        Output directory (created; reused by a restart).
+        Output directory: new, empty, or a sweep output (continued); anything else is
+        refused (:func:`arzsumo.outdir.resumable_dir`).
     workers : int, optional
         Processes of the local pool (default: one per core). Ignored with ``scheduler``.
     scheduler : str, optional
@@ -256,11 +258,17 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
         passes :func:`arzsumo.studies.paper.values.paper_points` of ``spec.paper``).
     """
     t0 = time.perf_counter()
-    out = Path(out)
     runs = spec.runs()
     if workers is not None and workers < 1:
         raise SweepError(f"--workers = {workers} is not allowed: an integer >= 1")
-    out.mkdir(parents=True, exist_ok=True)
+    with resumable_dir(out, "sweep") as target:
+        return _run(spec, target, runs, workers, scheduler, progress, plots, paper, t0)
+
+
+def _run(spec: SweepSpec, out: Path, runs: list[RunSpec], workers: int | None,
+         scheduler: str | None, progress: bool, plots: bool,
+         paper: Mapping[str, Mapping[float, float]] | None, t0: float) -> SweepReport:
+    """The body of :func:`run_sweep` inside its claimed output directory ``out``."""
     with atomic_file(out / "sweep.toml") as tmp:
         tmp.write_text(spec.text or f"# sweep {spec.name} (built in code)\n", encoding="utf-8")
     todo = [r for r in runs if not _finished(out, r)]

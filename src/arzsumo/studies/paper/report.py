@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from arzsumo.control.etc import PAPER_DESIGN
+from arzsumo.outdir import OutputDir
 from arzsumo.outputs.reproduce import ReproduceFigures, write_report
 from arzsumo.studies.paper.compare import (
     NOT_REPRODUCED,
@@ -230,8 +231,10 @@ def figure_data(rep: Reproduction) -> ReproduceFigures:
                             {p: float(getattr(PAPER_DESIGN, p)) for p in sweeps})
 
 
-def write_reproduction(rep: Reproduction, out: str | Path, plots: bool = True) -> Path:
-    """Write ``rep`` into directory ``out`` (replaced atomically); return its path."""
+def write_reproduction(rep: Reproduction, out: str | Path | OutputDir, plots: bool = True,
+                       overwrite: bool = False) -> Path:
+    """Write ``rep`` into directory ``out`` atomically (a previous ``reproduce`` result is
+    replaced only with ``overwrite``, see :mod:`arzsumo.outdir`); return its path."""
     tables = {"diffperformance": performance_table(rep), "totaldelay": delay_table(rep),
               "diffpene": penetration_table(rep), "events": events_table(rep),
               "sensitivity": sensitivity_table(rep),
@@ -239,4 +242,4 @@ def write_reproduction(rep: Reproduction, out: str | Path, plots: bool = True) -
               "runs": [run_row(r) for r in rep.records]}
     return write_report(out, report_markdown(rep), tables,
                         {r.name: r.summary for r in rep.records},
-                        figure_data(rep) if plots else None)
+                        figure_data(rep) if plots else None, overwrite=overwrite)
