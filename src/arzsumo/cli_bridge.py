@@ -9,16 +9,15 @@ from pathlib import Path
 
 log = logging.getLogger("arzsumo")
 
-#: the default scenario of ``arzsumo run`` (and ``make run``)
-DEFAULT_SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "default.toml"
-
 
 def cmd_run(args: argparse.Namespace) -> int:
     from arzsumo.bridge.outputs import write_results
     from arzsumo.bridge.session import run_in_sumo
+    from arzsumo.resources import default_scenario
     from arzsumo.scenarios import load_scenario
 
-    path = Path(args.scenario) if args.scenario else DEFAULT_SCENARIO
+    # the shipped default, found in the package so that any working directory will do
+    path = Path(args.scenario) if args.scenario else default_scenario()
     sc = load_scenario(path)
     session = run_in_sumo(sc, controller=args.controller, seed=args.seed,
                           horizon=args.horizon, progress=not args.quiet)
@@ -50,7 +49,8 @@ def cmd_compare(args: argparse.Namespace) -> int:
 def register(sub: argparse._SubParsersAction) -> None:
     """Add ``run`` and ``compare`` to the top-level parser."""
     p = sub.add_parser("run", help="closed loop in SUMO with the PDE twin alongside")
-    p.add_argument("scenario", nargs="?", help="scenario file (default scenarios/default.toml)")
+    p.add_argument("scenario", nargs="?", help="scenario file (default: the shipped "
+                   "scenarios/default.toml)")
     p.add_argument("--out", help="results directory (default results/NAME-CONTROLLER-seedN)")
     p.add_argument("--seed", type=int, help="SUMO seed (overrides [sumo] seed)")
     p.add_argument("--controller", choices=["open", "backstepping", "etc", "observer-etc",

@@ -9,7 +9,6 @@ from __future__ import annotations
 import argparse
 import logging
 import os
-from pathlib import Path
 
 from arzsumo.units import ms_to_kmh, veh_m_to_veh_km, veh_s_to_veh_h
 
@@ -21,9 +20,9 @@ def cmd_build_net(args: argparse.Namespace) -> int:
     from arzsumo.sumo.config import SumoConfig
     from arzsumo.sumo.demand import write_gui_files
     from arzsumo.sumo.network import NetworkSpec, build_network, edge_lengths
-    from arzsumo.sumo.paths import CONFIG_FILE, NET_FILE, ROUTE_FILE, default_nets_dir
+    from arzsumo.sumo.paths import CONFIG_FILE, NET_FILE, ROUTE_FILE, build_nets_dir
 
-    out = Path(args.out) if args.out else default_nets_dir()
+    out = build_nets_dir(args.out)
     spec = NetworkSpec()
     net = build_network(out, spec, write=not args.keep_sources)
     write_gui_files(out, get_preset("paper_base").params, SumoConfig(), NET_FILE, ROUTE_FILE,
@@ -84,7 +83,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     """Add the SUMO subcommands to the CLI's subparsers."""
     p = sub.add_parser("build-net", help="write the SUMO network sources and build the network")
     p.add_argument("--out", metavar="DIR",
-                   help="network directory (default: sumo_nets/ or $ARZSUMO_SUMO_NETS)")
+                   help="network directory (default: $ARZSUMO_SUMO_NETS, else sumo_nets/ of "
+                        "a source checkout)")
     p.add_argument("--keep-sources", action="store_true",
                    help="rebuild from the XML sources in DIR instead of rewriting them")
     p.set_defaults(func=cmd_build_net)

@@ -14,9 +14,10 @@ import numpy as np
 
 from arzsumo.bridge.config import RunSettings, run_settings_from_dict
 from arzsumo.bridge.cosim import CoSimResult, run_cosimulation
-from arzsumo.errors import ScenarioError
+from arzsumo.errors import ArzsumoError, ScenarioError
 from arzsumo.scenarios import Scenario, design_from_dict
 from arzsumo.sumo.config import SumoConfig, sumo_config_of
+from arzsumo.sumo.meter import DEFAULT_CURVE, GreenShareCurve
 
 
 @dataclass(frozen=True)
@@ -52,6 +53,9 @@ def run_in_sumo(sc: Scenario, *, controller: str | None = None, seed: int | None
         Overrides ``[sumo] horizon_s``, s.
     progress : bool
         Draw a progress bar on stderr.
+
+    The meter inverts the curve of ``[sumo] meter_curve`` (``arzsumo calibrate``'s
+    ``meter_curve.toml``), or :data:`~arzsumo.sumo.meter.DEFAULT_CURVE` without the key.
     """
     raw = sc.raw
     settings = run_settings_from_dict(raw, sc.source, controller=controller)
@@ -63,6 +67,7 @@ def run_in_sumo(sc: Scenario, *, controller: str | None = None, seed: int | None
     if horizon is not None:
         cfg = cfg.with_(horizon=horizon)
     design = design_from_dict(raw, sc.source)
+    curve = meter_curve_of(cfg, sc.source)  # before SUMO starts: a bad file stops nothing
     initial = None
     if settings.start == "placement":
         from arzsumo.twin.config import twin_config_from_dict
@@ -74,6 +79,19 @@ def run_in_sumo(sc: Scenario, *, controller: str | None = None, seed: int | None
         if ic.kind == "random":  # one seed draws everything random in a SUMO run
             ic = replace(ic, seed=cfg.seed)
         initial = initial_fields(ic, sc.equilibrium, xc)
-    res = run_cosimulation(sc, settings, cfg, design, initial_fields=initial,
+    res = run_cosimulation(sc, settings, cfg, design, initial_fields=initial, curve=curve,
                            progress=progress)
     return SumoSession(res, settings, cfg)
+
+
+def meter_curve_of(cfg: SumoConfig, source: str) -> GreenShareCurve:
+    """The meter curve of ``[sumo] meter_curve`` (an absolute path after
+    :func:`~arzsumo.sumo.config.sumo_config_of`), or DEFAULT_CURVE without the key."""
+    if not cfg.meter_curve:
+        return DEFAULT_CURVE
+    from arzsumo.sumo.calibration_io import load_green_share_curve
+
+    try:
+        return load_green_share_curve(cfg.meter_curve)
+    except ArzsumoError as exc:
+        raise ScenarioError(f"{source} [sumo] meter_curve: {exc}") from None
