@@ -12,17 +12,16 @@ from arzsumo.cli_args import positive_float, seed_int
 
 log = logging.getLogger("arzsumo")
 
-#: the default scenario of ``arzsumo run`` (and ``make run``)
-DEFAULT_SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "default.toml"
-
 
 def cmd_run(args: argparse.Namespace) -> int:
     from arzsumo.bridge.session import default_run_name, prepare_run, run_in_sumo
     from arzsumo.outdir import OutputDir
     from arzsumo.outputs.bridge import write_results
+    from arzsumo.resources import default_scenario
     from arzsumo.scenarios import load_scenario
 
-    path = Path(args.scenario) if args.scenario else DEFAULT_SCENARIO
+    # the shipped default, found in the package so that any working directory will do
+    path = Path(args.scenario) if args.scenario else default_scenario()
     sc = load_scenario(path)
     prepared = prepare_run(sc, controller=args.controller, seed=args.seed,
                            horizon=args.horizon)
@@ -66,7 +65,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                                    "nominal meter, then the [run] controller on the ramp "
                                    "meter, with the PDE twins alongside; write the results.")
     p.add_argument("scenario", nargs="?", metavar="SCENARIO.toml",
-                   help="scenario file (default scenarios/default.toml)")
+                   help="scenario file (default: the shipped scenarios/default.toml)")
     p.add_argument("--out", metavar="DIR",
                    help="results directory (default results/NAME-CONTROLLER-seedN-hTs)")
     p.add_argument("--overwrite", action="store_true",

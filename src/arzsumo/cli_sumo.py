@@ -9,7 +9,6 @@ from __future__ import annotations
 import argparse
 import logging
 import os
-from pathlib import Path
 
 from arzsumo.cli_args import positive_float, positive_int, seed_int
 from arzsumo.units import ms_to_kmh, veh_m_to_veh_km, veh_s_to_veh_h
@@ -22,9 +21,9 @@ def cmd_build_net(args: argparse.Namespace) -> int:
     from arzsumo.sumo.config import SumoConfig
     from arzsumo.sumo.demand import write_gui_files
     from arzsumo.sumo.network import NetworkSpec, edge_lengths, rebuild_network
-    from arzsumo.sumo.paths import CONFIG_FILE, NET_FILE, ROUTE_FILE, default_nets_dir
+    from arzsumo.sumo.paths import CONFIG_FILE, NET_FILE, ROUTE_FILE, build_nets_dir
 
-    out = Path(args.out) if args.out else default_nets_dir()
+    out = build_nets_dir(args.out)
     spec = NetworkSpec()
     net, changed = rebuild_network(out, spec, write=not args.keep_sources)
     write_gui_files(out, get_preset("paper_base").params, SumoConfig(), NET_FILE, ROUTE_FILE,
@@ -90,8 +89,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                        description="Write the XML sources of the on-ramp network, build it "
                                    "with netconvert, and write sumo-gui files.")
     p.add_argument("--out", metavar="DIR",
-                   help="network directory (default: $ARZSUMO_SUMO_NETS, else sumo_nets/ at "
-                        "the repository root)")
+                   help="network directory (default: $ARZSUMO_SUMO_NETS, else sumo_nets/ of "
+                        "a source checkout)")
     p.add_argument("--keep-sources", action="store_true",
                    help="rebuild from the XML sources in DIR instead of rewriting them")
     p.set_defaults(func=cmd_build_net)

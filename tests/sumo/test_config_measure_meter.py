@@ -37,6 +37,7 @@ def test_sumo_table_converts_units():
     ({"min_green_s": 4, "min_red_s": 4}, "at most meter_cycle"),
     ({"lateral_resolution_m": 0.7}, "lateral_resolution_m = 0.7 is not allowed: a width "
                                       "dividing the 6.5 m lane"),
+    ({"meter_curve": 3}, "meter_curve = 3 is not allowed: a string"),
 ])
 def test_bad_sumo_table_names_key_and_value(table, message):
     with pytest.raises(ScenarioError, match=None) as info:

@@ -21,6 +21,7 @@ from arzsumo.model import linearize
 from arzsumo.scenarios import Scenario, design_from_dict
 from arzsumo.sumo.config import SUMO_KEYS, SumoConfig, sumo_config_of
 from arzsumo.sumo.measure import EdieGrid
+from arzsumo.sumo.meter import DEFAULT_CURVE, GreenShareCurve
 from arzsumo.sumo.network import NetworkSpec
 from arzsumo.tables import in_user_terms, not_allowed, written
 from arzsumo.twin.config import initial_from_dict
@@ -52,6 +53,7 @@ class PreparedRun:
     sumo: SumoConfig
     design: EtcDesign
     initial: np.ndarray | None = field(default=None, repr=False)
+    curve: GreenShareCurve = DEFAULT_CURVE
 
     def describe(self) -> str:
         """What the run would do, in human units (``arzsumo run --dry-run``)."""
@@ -139,7 +141,8 @@ def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None
         n = round(sc.params.length / cfg.cell_length)
         xc = (np.arange(n) + 0.5) * cfg.cell_length
         initial = initial_fields(ic, sc.equilibrium, xc)
-    return PreparedRun(sc, settings, cfg, design, initial)
+    curve = meter_curve_of(cfg, sc.source)   # a bad curve file stops the run before SUMO
+    return PreparedRun(sc, settings, cfg, design, initial, curve)
 
 
 def default_run_name(sc: Scenario, settings: RunSettings, cfg: SumoConfig) -> str:
@@ -170,5 +173,19 @@ def run_in_sumo(sc: Scenario, *, controller: str | None = None, seed: int | None
     """
     run = prepare_run(sc, controller=controller, seed=seed, horizon=horizon)
     res = run_cosimulation(sc, run.settings, run.sumo, run.design, initial_fields=run.initial,
+                           curve=run.curve,
                            progress=progress)
     return SumoSession(res, run.settings, run.sumo)
+
+
+def meter_curve_of(cfg: SumoConfig, source: str) -> GreenShareCurve:
+    """The meter curve of ``[sumo] meter_curve`` (an absolute path after
+    :func:`~arzsumo.sumo.config.sumo_config_of`), or DEFAULT_CURVE without the key."""
+    if not cfg.meter_curve:
+        return DEFAULT_CURVE
+    from arzsumo.sumo.calibration_io import load_green_share_curve
+
+    try:
+        return load_green_share_curve(cfg.meter_curve)
+    except ArzsumoError as exc:
+        raise ScenarioError(f"{source}: [sumo] meter_curve: {exc}") from None

@@ -9,13 +9,16 @@ the key name; :func:`sumo_config_from_table` converts through :mod:`arzsumo.unit
     demand_a_veh_h = 1560
     ramp_demand_veh_h = 1200
     meter_cycle_s = 6
+    meter_curve = "calibration/meter_curve.toml"   # relative to the scenario file
 """
 
 from __future__ import annotations
 
+import copy
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, fields, replace
+from pathlib import Path
 from typing import Any
 
 from arzsumo.errors import ArzsumoError, ScenarioError, require
@@ -68,6 +71,10 @@ class SumoConfig:
         AV car-following model ("ACC" or "CACC").
     min_gap_lat : float
         Lateral gap kept by both classes, m.
+    meter_curve : str
+        Meter-curve file (``meter_curve.toml`` of ``arzsumo calibrate``: mainline outflow
+        against green share) that the actuator inverts; "" keeps the built-in
+        :data:`arzsumo.sumo.meter.DEFAULT_CURVE`. :func:`sumo_config_of` makes it absolute.
     """
 
     step_length: float = 0.1
@@ -92,6 +99,7 @@ class SumoConfig:
     hv_sigma: float = 0.5
     av_model: str = "ACC"
     min_gap_lat: float = 0.15
+    meter_curve: str = ""
 
     def __post_init__(self) -> None:
         def pos(name: str) -> None:
@@ -188,6 +196,7 @@ SUMO_KEYS: dict[str, Key] = {
     "hv_sigma": Key("hv_sigma"),
     "av_model": Key("av_model", "string", choices=AV_MODELS),
     "min_gap_lat_m": Key("min_gap_lat"),
+    "meter_curve": Key("meter_curve", "string"),
 }
 
 
@@ -208,6 +217,33 @@ def sumo_config_from_table(table: Mapping[str, Any], where: str = "[sumo]") -> S
 
 
 def sumo_config_of(scenario: Any) -> SumoConfig:
-    """The SumoConfig of a loaded scenario (its ``[sumo]`` table; defaults without one)."""
+    """The SumoConfig of a loaded scenario (its ``[sumo]`` table; defaults without one).
+
+    A relative ``meter_curve`` is read from the scenario file's directory (from the working
+    directory for a scenario not read from a file); the file must exist.
+    """
     raw = getattr(scenario, "raw", {}) or {}
-    return sumo_config_from_table(raw.get("sumo", {}), f"{scenario.source}: [sumo]")
+    cfg = sumo_config_from_table(raw.get("sumo", {}), f"{scenario.source}: [sumo]")
+    if not cfg.meter_curve:
+        return cfg
+    source = Path(scenario.source)
+    path = Path(cfg.meter_curve).expanduser()
+    if not path.is_absolute() and source.is_file():
+        path = source.parent / path
+    if not path.is_file():
+        raise ScenarioError(f"{scenario.source}: [sumo] meter_curve = "
+                            f"{written(cfg.meter_curve)} is not allowed: there is no file "
+                            f"{str(path)!r}; allowed: a meter_curve.toml of `arzsumo "
+                            "calibrate`, relative to the scenario file")
+    return cfg.with_(meter_curve=str(path.resolve()))
+
+
+def anchor_meter_curve(data: Mapping[str, Any], base_dir: Path) -> dict[str, Any]:
+    """A copy of a parsed scenario whose relative ``[sumo] meter_curve`` is made absolute
+    against ``base_dir`` (the directory of the file it was written in)."""
+    out = copy.deepcopy(dict(data))
+    table = out.get("sumo")
+    value = table.get("meter_curve") if isinstance(table, dict) else None
+    if isinstance(value, str) and value and not Path(value).expanduser().is_absolute():
+        table["meter_curve"] = str(base_dir / value)
+    return out

@@ -1,8 +1,9 @@
 """Where the SUMO binaries and the shipped network live.
 
 The binaries come from the ``eclipse-sumo`` wheel (``sumo.SUMO_HOME/bin``). The network
-directory ``sumo_nets/`` sits at the repository root; the environment variable
-``ARZSUMO_SUMO_NETS`` or an explicit argument overrides it. SUMO's temporary files (route,
+ships inside the package (``arzsumo/data/sumo_nets``, :mod:`arzsumo.resources`; the
+repository's ``sumo_nets/`` links to it); the environment variable ``ARZSUMO_SUMO_NETS``
+or an explicit argument overrides it. SUMO's temporary files (route,
 detector and statistics files) go under :func:`scratch_dir`.
 """
 
@@ -13,6 +14,7 @@ from pathlib import Path
 
 from arzsumo.errors import ArzsumoError
 from arzsumo.outdir import SCRATCH_ENV
+from arzsumo.resources import shipped_nets_dir
 
 #: Environment variable that overrides the network directory.
 NETS_ENV = "ARZSUMO_SUMO_NETS"
@@ -48,11 +50,36 @@ def sumo_binary(name: str) -> Path:
 
 
 def default_nets_dir() -> Path:
-    """The network directory: ``$ARZSUMO_SUMO_NETS`` or ``sumo_nets/`` at the repository root."""
+    """The network directory: ``$ARZSUMO_SUMO_NETS`` or the one shipped in the package."""
     env = os.environ.get(NETS_ENV)
     if env:
         return Path(env)
-    return Path(__file__).resolve().parents[3] / "sumo_nets"
+    return shipped_nets_dir()
+
+
+def build_nets_dir(override: str | os.PathLike[str] | None = None) -> Path:
+    """Where ``arzsumo build-net`` writes: ``override``, ``$ARZSUMO_SUMO_NETS``, or the
+    shipped directory when it belongs to a source checkout.
+
+    An installed package's files are not the user's to rewrite (a reinstall would undo the
+    change silently), so an installed or read-only shipped directory is refused.
+    """
+    if override is not None:
+        return Path(override)
+    path = default_nets_dir()
+    if os.environ.get(NETS_ENV):
+        return path
+    refuse_installed_nets(path)
+    return path
+
+
+def refuse_installed_nets(path: Path) -> None:
+    """Raise SumoError if ``path`` is inside an installed package or not writable."""
+    installed = any(part in ("site-packages", "dist-packages") for part in path.parts)
+    if installed or not os.access(path, os.W_OK):
+        why = "is inside the installed package" if installed else "is not writable"
+        raise SumoError(f"network directory {str(path)!r} {why}; allowed: "
+                        f"`arzsumo build-net --out DIR` or {NETS_ENV}=DIR")
 
 
 def nets_dir(override: str | os.PathLike[str] | None = None) -> Path:

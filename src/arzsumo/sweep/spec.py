@@ -307,12 +307,15 @@ def sweep_from_dict(data: Mapping[str, Any], source: str = "<dict>",
                          "allowed: a string")
     base = (root or Path.cwd()) / data["base"]
     _, base_data = read_toml(base, f"{source}: base", SweepError)
+    # file paths inside a scenario are relative to the file that names them
+    base_data = _anchor_scenario(base_data, base.parent)
     allowed = scenario_fields()
-    fixed = _flat_fields(data.get("set", {}), f"{source} [set]", allowed)
+    fixed = _anchor(_flat_fields(data.get("set", {}), f"{source} [set]", allowed), root)
     raw_axes = data.get("axis", [])
     if not isinstance(raw_axes, list):
         raise SweepError(f"{source}: axis must be an array of tables ([[axis]])")
     axes = [_axis(a, i + 1, source, allowed) for i, a in enumerate(raw_axes)]
+    axes = [replace(a, sets=tuple(_anchor(s, root) for s in a.sets)) for a in axes]
     if "seeds" in data:
         seeds = data["seeds"]
         if not isinstance(seeds, list) or not seeds or any(
@@ -339,6 +342,21 @@ def sweep_from_dict(data: Mapping[str, Any], source: str = "<dict>",
         raise SweepError(f"{source}: name = {written(name)} is not allowed: letters, digits, . _ -")
     return SweepSpec(name, str(data.get("description", "")), engine, base, base_data, fixed,
                      tuple(axes), paper, baseline, source)
+
+
+def _anchor_scenario(data: Mapping[str, Any], base_dir: Path) -> dict[str, Any]:
+    from arzsumo.sumo.config import anchor_meter_curve
+
+    return anchor_meter_curve(data, base_dir)
+
+
+def _anchor(flat: Mapping[str, Any], root: Path | None) -> dict[str, Any]:
+    """Flat fields with a relative ``sumo.meter_curve`` made relative to the sweep file."""
+    key = "sumo.meter_curve"
+    if key not in flat:
+        return dict(flat)
+    data = _anchor_scenario({"sumo": {"meter_curve": flat[key]}}, root or Path.cwd())
+    return {**flat, key: data["sumo"]["meter_curve"]}
 
 
 def load_sweep(path: str | Path) -> SweepSpec:
