@@ -108,17 +108,22 @@ class SumoSimulation:
         Directory for SUMO's statistics output; a temporary one by default.
     extra_args : sequence of str
         Further SUMO options.
+    output_dir : Path, optional
+        Where SUMO's statistics output goes instead, kept after the run (for
+        :mod:`arzsumo.sumo.network_measures`).
     """
 
     def __init__(self, net_file: Path, route_file: Path, cfg: SumoConfig, *,
                  requested_initial: int = 0, workdir: Path | None = None,
-                 extra_args: Sequence[str] = (), cleanup: Sequence[Path] = ()) -> None:
+                 extra_args: Sequence[str] = (), cleanup: Sequence[Path] = (),
+                 output_dir: Path | None = None) -> None:
         self.net_file, self.route_file, self.cfg = Path(net_file), Path(route_file), cfg
         self.requested_initial = requested_initial
         self._own_workdir = workdir is None
         self.workdir = Path(workdir) if workdir else Path(
             tempfile.mkdtemp(prefix="arzsumo-", dir=scratch_dir()))
         self.extra_args = tuple(extra_args)
+        self.output_dir = Path(output_dir) if output_dir is not None else None
         self._cleanup = tuple(cleanup)
         self._flows = demand_flows(cfg)
         self._lib: ModuleType | None = None
@@ -132,7 +137,7 @@ class SumoSimulation:
     # -- command line --------------------------------------------------------------------
     @property
     def stats_file(self) -> Path:
-        return self.workdir / "statistics.xml"
+        return (self.output_dir or self.workdir) / "statistics.xml"
 
     def command(self) -> list[str]:
         """The SUMO command line (the one place it is built)."""
@@ -272,12 +277,14 @@ class SumoSimulation:
 
 def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
                     initial: Sequence[InitialVehicle] = (), net_dir: Path | None = None,
-                    extra_args: Sequence[str] = (), e2_chain: bool = False) -> SumoSimulation:
+                    extra_args: Sequence[str] = (), e2_chain: bool = False,
+                    output_dir: Path | None = None) -> SumoSimulation:
     """A started simulation of the default network with the demand of ``cfg``.
 
     The route file (and, with ``e2_chain``, an E2 detector per measurement cell, see
     :mod:`arzsumo.sumo.detectors`) goes to a temporary directory (under
-    :func:`~arzsumo.sumo.paths.scratch_dir`) removed when the run closes.
+    :func:`~arzsumo.sumo.paths.scratch_dir`) removed when the run closes. With
+    ``output_dir``, SUMO's statistics output is written there and kept.
     """
     net = nets_dir(net_dir) / NET_FILE
     workdir = Path(tempfile.mkdtemp(prefix="arzsumo-", dir=scratch_dir()))
@@ -292,5 +299,5 @@ def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
         shutil.rmtree(workdir, ignore_errors=True)
         raise
     sim = SumoSimulation(net, route, cfg, requested_initial=len(initial), workdir=workdir,
-                         extra_args=extra_args, cleanup=(workdir,))
+                         extra_args=extra_args, cleanup=(workdir,), output_dir=output_dir)
     return sim.start()

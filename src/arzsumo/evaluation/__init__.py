@@ -1,0 +1,21 @@
+"""Evaluation: statistics over seeds (and, in :mod:`arzsumo.sumo.network_measures`,
+network-wide measures from SUMO's own outputs).
+
+* :mod:`~arzsumo.evaluation.stats`: mean with a 95 % t interval, paired differences
+  treatment - baseline with t and bootstrap intervals, wins and losses per seed.
+
+Importing this package imports neither libsumo nor sumolib.
+"""
+
+from arzsumo.evaluation.stats import (
+    MeanCI,
+    PairedComparison,
+    StatisticsError,
+    bootstrap_mean_ci,
+    mean_ci,
+    paired_difference,
+    wins_losses,
+)
+
+__all__ = ["MeanCI", "PairedComparison", "StatisticsError", "bootstrap_mean_ci", "mean_ci",
+           "paired_difference", "wins_losses"]
