@@ -39,6 +39,9 @@ class SyntheticRun:
         ``outflow_period``).
     inlet_period, outflow_period : float
         s.
+    inlet_speed : float
+        Relative amplitude of the inlet speeds' departure from Ve at the inlet densities
+        (a cosine of the inlet period), so that vehicles enter off the diagram.
     """
 
     rho_h: float
@@ -49,6 +52,7 @@ class SyntheticRun:
     outflow: float = 0.15
     inlet_period: float = 90.0
     outflow_period: float = 70.0
+    inlet_speed: float = 0.05
 
 
 def boundary_data(params: ModelParameters, run: SyntheticRun, t: np.ndarray,
@@ -63,7 +67,7 @@ def boundary_data(params: ModelParameters, run: SyntheticRun, t: np.ndarray,
     s_in = np.sin(2.0 * math.pi * mid / run.inlet_period)
     rho_h, rho_a = eq.rho_h * (1.0 + run.inlet * s_in), eq.rho_a * (1.0 + run.inlet * s_in)
     ve_h, ve_a = equilibrium_speeds(params, rho_h, rho_a)
-    off = 1.0 + 0.5 * run.inlet * np.cos(2.0 * math.pi * mid / run.inlet_period)
+    off = 1.0 + run.inlet_speed * np.cos(2.0 * math.pi * mid / run.inlet_period)
     inlet = np.stack([rho_h, ve_h * off, rho_a, ve_a * off], axis=1)
     outflow = eq.q * (1.0 + run.outflow * np.sin(2.0 * math.pi * mid / run.outflow_period
                                                   + 1.0))
