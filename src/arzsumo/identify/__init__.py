@@ -28,7 +28,7 @@ The uncertainty. 1-sigma from the Jacobian at the optimum, covariance s^2 (J^T J
 with s^2 the residual variance, mapped from log coordinates to the parameters; and
 optionally a seeded bootstrap over runs (refit on runs drawn with replacement).
 :func:`validate` reports the relative RMSE per run, class and variable, e.g. on held-out
-runs.
+runs. :mod:`synthetic` makes data with the twin itself, for recovery tests.
 """
 
 from arzsumo.identify.data import VARIABLES, IdentifyError, ReplayData
@@ -42,6 +42,7 @@ from arzsumo.identify.objective import (
     validate,
 )
 from arzsumo.identify.replay import ReplayOptions, ReplayRun, replay, run_replay
+from arzsumo.identify.synthetic import SyntheticRun, synthetic_data
 
 __all__ = [
     "DEFAULT_BOUNDS",
@@ -55,10 +56,12 @@ __all__ = [
     "ReplayData",
     "ReplayOptions",
     "ReplayRun",
+    "SyntheticRun",
     "ValidationReport",
     "covariance",
     "identify",
     "replay",
     "run_replay",
+    "synthetic_data",
     "validate",
 ]
