@@ -1,0 +1,202 @@
+"""One observed run for identification: fields, initial state and boundary data (SI).
+
+:class:`ReplayData` is what the replay twin needs to reproduce a run, and what it is
+compared with. It is built from arrays (the SUMO layer aggregates its cells into them)
+or from a twin run (:meth:`ReplayData.from_twin`, synthetic data with known parameters).
+
+Periods: ``t`` holds the ends of the periods, t_0 < t_1 < ... (s, t_0 > 0); period k is
+(t_{k-1}, t_k] with t_{-1} = 0. During period k the inlet ghost cell holds
+``inlet[k]`` and the outlet carries ``outflow[k]``; ``fields[k]`` is observed at t_k.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from arzsumo.errors import ArzsumoError
+
+#: Variable names, in the storage order of fields, inlet, initial and scale.
+VARIABLES = ("rho_h", "v_h", "rho_a", "v_a")
+#: Their SI units.
+UNITS = ("veh/m", "m/s", "veh/m", "m/s")
+
+
+class IdentifyError(ArzsumoError, ValueError):
+    """Invalid identification input: data shapes or values, parameter names, bounds."""
+
+
+def _array(name: str, value: ArrayLike, shape: tuple[int, ...], nan_ok: bool = False
+           ) -> np.ndarray:
+    """A read-only float copy of ``value`` with ``shape``; finite unless ``nan_ok``."""
+    try:
+        arr = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise IdentifyError(f"{name} is not allowed: numbers expected") from None
+    if arr.shape != shape:
+        raise IdentifyError(f"{name} has shape {arr.shape}; expected {shape}")
+    bad = np.isinf(arr) if nan_ok else ~np.isfinite(arr)
+    if bad.any():
+        idx = tuple(int(i) for i in np.argwhere(bad)[0])
+        raise IdentifyError(f"{name}{list(idx)} = {arr[idx]} is not allowed: a finite number")
+    arr.setflags(write=False)
+    return arr
+
+
+def _positive_densities(name: str, arr: np.ndarray, axis: int) -> None:
+    """Densities (rows 0 and 2 along ``axis``) must be > 0 where given."""
+    rho = np.take(arr, [0, 2], axis=axis)
+    bad = rho <= 0.0                       # NaN compares False: unobserved is fine
+    if bad.any():
+        idx = tuple(int(i) for i in np.argwhere(bad)[0])
+        raise IdentifyError(f"{name} has density {rho[idx]} veh/m at index {list(idx)}; "
+                            "allowed: densities > 0 (the twin divides by them)")
+
+
+@dataclass(frozen=True)
+class ReplayData:
+    """One observed run, validated on construction. All SI.
+
+    Parameters
+    ----------
+    t : ndarray (T,)
+        Ends of the periods, s, strictly increasing, t[0] > 0.
+    x : ndarray (N,)
+        Observation positions (cell centres), m, strictly increasing, >= 0.
+    fields : ndarray (T, 4, N)
+        Observed (rho_h veh/m, v_h m/s, rho_a veh/m, v_a m/s) at (t[k], x); NaN where
+        unobserved (e.g. the speed of an empty cell).
+    initial : ndarray (4, N)
+        State at t = 0 on ``x``, complete (no NaN), densities > 0.
+    inlet : ndarray (T, 4)
+        Boundary state (rho_h, v_h, rho_a, v_a) the inlet ghost cell holds during period k.
+    outflow : ndarray (T,)
+        Total outflow at x = L during period k, veh/s, >= 0.
+    scale : ndarray (4,), optional
+        Reference scale per variable for relative errors (e.g. the equilibrium values);
+        default: the mean of the observed values per variable.
+    name : str
+        A label for reports (e.g. "seed 3").
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    fields: np.ndarray
+    initial: np.ndarray
+    inlet: np.ndarray
+    outflow: np.ndarray
+    scale: np.ndarray | None = None
+    name: str = "run"
+    mask: np.ndarray = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        t = _array(f"{self.name}: t", self.t, (np.size(self.t),))
+        x = _array(f"{self.name}: x", self.x, (np.size(self.x),))
+        if t.size < 1 or x.size < 2:
+            raise IdentifyError(f"{self.name}: t has {t.size} and x {x.size} values; expected "
+                                "at least 1 period and 2 positions")
+        if t[0] <= 0.0 or np.any(np.diff(t) <= 0.0):
+            raise IdentifyError(f"{self.name}: t = {t[:4].tolist()}... s is not allowed: "
+                                "strictly increasing period ends after 0 s")
+        if x[0] < 0.0 or np.any(np.diff(x) <= 0.0):
+            raise IdentifyError(f"{self.name}: x = {x[:4].tolist()}... m is not allowed: "
+                                "strictly increasing positions >= 0 m")
+        n_t, n_x = t.size, x.size
+        fields_ = _array(f"{self.name}: fields", self.fields, (n_t, 4, n_x), nan_ok=True)
+        initial = _array(f"{self.name}: initial", self.initial, (4, n_x))
+        inlet = _array(f"{self.name}: inlet", self.inlet, (n_t, 4))
+        outflow = _array(f"{self.name}: outflow", self.outflow, (n_t,))
+        for label, arr, axis in (("fields", fields_, 1), ("initial", initial, 0),
+                                 ("inlet", inlet, 1)):
+            _positive_densities(f"{self.name}: {label}", arr, axis)
+        if outflow.min() < 0.0:
+            raise IdentifyError(f"{self.name}: outflow = {outflow.min()} veh/s is not "
+                                "allowed: a flow >= 0 veh/s")
+        mask = np.isfinite(fields_)
+        mask.setflags(write=False)
+        for k, var in enumerate(VARIABLES):
+            if not mask[:, k].any():
+                raise IdentifyError(f"{self.name}: fields of {var} are all NaN; expected "
+                                    "some observed values")
+        scale = self.scale
+        if scale is None:
+            scale = np.array([np.mean(np.abs(fields_[:, k][mask[:, k]])) for k in range(4)])
+        scale = _array(f"{self.name}: scale", scale, (4,))
+        if scale.min() <= 0.0:
+            raise IdentifyError(f"{self.name}: scale = {scale.tolist()} is not allowed: "
+                                "4 reference values > 0 (rho_h, v_h, rho_a, v_a)")
+        for key, value in (("t", t), ("x", x), ("fields", fields_), ("initial", initial),
+                           ("inlet", inlet), ("outflow", outflow), ("scale", scale),
+                           ("mask", mask)):
+            object.__setattr__(self, key, value)
+
+    @property
+    def periods(self) -> int:
+        """Number of periods T."""
+        return int(self.t.size)
+
+    @property
+    def observed(self) -> int:
+        """Number of observed (finite) values in ``fields``."""
+        return int(self.mask.sum())
+
+    @classmethod
+    def from_arrays(cls, t: ArrayLike, x: ArrayLike, fields: ArrayLike, initial: ArrayLike,
+                    inlet: ArrayLike, outflow: ArrayLike, *, scale: ArrayLike | None = None,
+                    name: str = "run") -> ReplayData:
+        """The data from array-likes (copied, validated); see the class for shapes."""
+        return cls(t, x, fields, initial, inlet, outflow, scale, name)  # type: ignore[arg-type]
+
+    @classmethod
+    def from_twin(cls, params: object, t: ArrayLike, initial: ArrayLike, inlet: ArrayLike,
+                  outflow: ArrayLike, options: object = None, *, noise: float = 0.0,
+                  seed: int = 0, scale: ArrayLike | None = None,
+                  name: str = "synthetic") -> ReplayData:
+        """Synthetic data: the replay twin's own fields under ``params``, plus noise.
+
+        Parameters
+        ----------
+        params : ModelParameters
+            The "true" parameters.
+        t, inlet, outflow : array-like
+            Period ends (s), inlet ghost states (T, 4) and outflows (T,) veh/s.
+        initial : array-like (4, cells)
+            State at t = 0 on the twin's cell centres (``options.cells``); the data's
+            positions ``x`` are these centres, so a replay on the same grid reproduces
+            the fields exactly.
+        options : ReplayOptions, optional
+        noise : float
+            Standard deviation of the added Gaussian noise, as a fraction of ``scale``
+            per variable (e.g. 0.02); densities are kept > 0.
+        seed : int
+            Seed of the noise.
+        scale : array-like (4,), optional
+            Reference scale for noise and relative errors; default the noiseless
+            fields' mean per variable.
+
+        Raises
+        ------
+        IdentifyError
+            If the twin leaves the physical domain under ``params`` (the message says where).
+        """
+        from arzsumo.identify.replay import ReplayOptions, replay_grid, run_replay
+
+        opts = options if options is not None else ReplayOptions()
+        x = replay_grid(params, opts)                          # type: ignore[arg-type]
+        t_arr, inlet_arr = np.asarray(t, float), np.asarray(inlet, float)
+        clean = cls(t_arr, x, np.ones((t_arr.size, 4, x.size)), initial, inlet_arr,
+                    outflow, np.ones(4), name)
+        run = run_replay(params, clean, opts)                  # type: ignore[arg-type]
+        if run.stopped is not None:
+            raise IdentifyError(f"{name}: the generating twin stopped: {run.reason}")
+        obs = run.fields
+        ref = (np.array([obs[:, k].mean() for k in range(4)]) if scale is None
+               else np.asarray(scale, float))
+        if noise > 0.0:
+            rng = np.random.default_rng(seed)
+            obs = obs + noise * ref[None, :, None] * rng.standard_normal(obs.shape)
+            for k in (0, 2):                                   # keep densities positive
+                obs[:, k] = np.maximum(obs[:, k], 1e-3 * ref[k])
+        return cls(t_arr, x, obs, initial, inlet_arr, outflow, ref, name)

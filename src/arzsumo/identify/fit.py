@@ -1,0 +1,249 @@
+"""The fit: bounded nonlinear least squares of the replay residual, with uncertainties.
+
+:func:`identify` minimises the stacked relative replay residual of several runs
+(:mod:`arzsumo.identify.objective`) with :func:`scipy.optimize.least_squares` (trust-region
+reflective, bounds, forward-difference Jacobian) in the log coordinates z = log(p / p0).
+
+Uncertainty. With J the Jacobian of the residual in z at the optimum, m residuals, n
+parameters and s^2 = sum(r^2) / (m - n) the residual variance, the covariance of z is
+s^2 (J^T J)^-1 (pseudo-inverse where J is rank deficient), and that of p follows by the
+delta method, cov_p = diag(p) cov_z diag(p). It assumes independent residuals of equal
+variance, so it is a lower bound where model error (not noise) dominates, as it will on
+SUMO data. Optionally, a bootstrap over runs refits on runs drawn with replacement
+(seeded) and reports the spread of the refitted values, which also carries the run-to-run
+variation.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import OptimizeResult, least_squares
+
+from arzsumo.identify.data import IdentifyError, ReplayData
+from arzsumo.identify.objective import (
+    DEFAULT_PENALTY,
+    DEFAULT_WHICH,
+    Objective,
+    ParameterSpace,
+    ValidationReport,
+    check_datasets,
+    check_weights,
+    validate,
+)
+from arzsumo.identify.replay import ReplayOptions
+from arzsumo.model.params import ModelParameters
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class FitSettings:
+    """Settings of :func:`scipy.optimize.least_squares` and of the bootstrap.
+
+    Parameters
+    ----------
+    max_nfev : int
+        Largest number of residual evaluations outside the Jacobian (scipy's count).
+    diff_step : float
+        Forward-difference step in z, i.e. a relative step of the parameters (1e-3: the
+        replay is continuous in the parameters but its adaptive time step adds noise of
+        about 1e-6 relative, which a much smaller step would amplify).
+    ftol, xtol, gtol : float
+        scipy's stopping tolerances.
+    x_scale : float
+        Characteristic change of z (1: parameters move by factors of order e).
+    bootstrap : int
+        Number of bootstrap refits over runs (0: none).
+    seed : int
+        Seed of the bootstrap draws.
+    """
+
+    max_nfev: int = 40
+    diff_step: float = 1e-3
+    ftol: float = 1e-6
+    xtol: float = 1e-6
+    gtol: float = 1e-8
+    x_scale: float = 1.0
+    bootstrap: int = 0
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        for name in ("max_nfev", "bootstrap"):
+            value = getattr(self, name)
+            if not isinstance(value, int) or value < (1 if name == "max_nfev" else 0):
+                raise IdentifyError(f"{name} = {value!r} is not allowed: an integer >= "
+                                    f"{1 if name == 'max_nfev' else 0}")
+        for name in ("diff_step", "ftol", "xtol", "gtol", "x_scale"):
+            value = getattr(self, name)
+            if not (isinstance(value, int | float) and 0.0 < value < np.inf):
+                raise IdentifyError(f"{name} = {value!r} is not allowed: a number > 0")
+
+
+@dataclass(frozen=True)
+class IdentificationResult:
+    """The identified parameters, their uncertainties and the cost of the fit.
+
+    Attributes
+    ----------
+    params : ModelParameters
+        The guess with the fitted parameters replaced.
+    which : tuple of str
+        The fitted parameters, in the order of the arrays below.
+    values, sigma : ndarray (n,)
+        Fitted values and 1-sigma uncertainties from the Jacobian (SI units).
+    correlation : ndarray (n, n)
+        Correlation matrix of the fitted parameters (from the same covariance).
+    at_bound : ndarray (n,) of bool
+        Parameters that ended on a bound (their sigma is not meaningful).
+    bootstrap : ndarray (B, n) or None
+        Refitted values, one row per bootstrap draw of runs.
+    training : ValidationReport
+        Relative RMSE per run and variable on the training runs at the optimum.
+    cost : float
+        Half the sum of squared residuals at the optimum.
+    residuals : int
+        Number of residuals m (observed values over all runs).
+    nfev : int
+        scipy's count of residual evaluations (without those of the Jacobian).
+    evaluations : int
+        All residual evaluations, Jacobian columns included (each replays every run).
+    wall_time : float
+        Seconds for the fit (bootstrap excluded).
+    failures : int
+        Replays that stopped (twin outside the physical domain) during the fit.
+    success : bool
+    message : str
+        scipy's status message.
+    """
+
+    params: ModelParameters
+    which: tuple[str, ...]
+    values: np.ndarray
+    sigma: np.ndarray
+    correlation: np.ndarray
+    at_bound: np.ndarray
+    bootstrap: np.ndarray | None
+    training: ValidationReport
+    cost: float
+    residuals: int
+    nfev: int
+    evaluations: int
+    wall_time: float
+    failures: int
+    success: bool
+    message: str
+
+    @property
+    def bootstrap_sigma(self) -> np.ndarray | None:
+        """Standard deviation of the bootstrap refits (n,), or None."""
+        if self.bootstrap is None or len(self.bootstrap) < 2:
+            return None
+        return np.std(self.bootstrap, axis=0, ddof=1)
+
+    def as_dict(self) -> dict[str, dict[str, float]]:
+        """{name: {"value", "sigma"[, "bootstrap_sigma"]}} in SI units."""
+        boot = self.bootstrap_sigma
+        out: dict[str, dict[str, float]] = {}
+        for i, name in enumerate(self.which):
+            row = {"value": float(self.values[i]), "sigma": float(self.sigma[i])}
+            if boot is not None:
+                row["bootstrap_sigma"] = float(boot[i])
+            out[name] = row
+        return out
+
+
+def covariance(jac: np.ndarray, residuals: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """Covariance of the parameters p (n,), s^2 (J^T J)^-1 in z mapped to p (module doc)."""
+    m, n = jac.shape
+    s2 = float(residuals @ residuals) / max(m - n, 1)
+    cov_z = s2 * np.linalg.pinv(jac.T @ jac)
+    return cov_z * np.outer(p, p)
+
+
+def _solve(objective: Objective, z0: np.ndarray, settings: FitSettings) -> OptimizeResult:
+    lo, hi = objective.space.z_bounds()
+    return least_squares(objective, np.clip(z0, lo, hi), jac="2-point", bounds=(lo, hi),
+                         method="trf", x_scale=settings.x_scale, diff_step=settings.diff_step,
+                         max_nfev=settings.max_nfev, ftol=settings.ftol, xtol=settings.xtol,
+                         gtol=settings.gtol)
+
+
+def _bootstrap(space: ParameterSpace, runs: tuple[ReplayData, ...], z_opt: np.ndarray,
+               weights: np.ndarray, options: ReplayOptions, penalty: float,
+               settings: FitSettings) -> np.ndarray:
+    """Refits on runs drawn with replacement, started at the optimum; (B, n) values."""
+    rng = np.random.default_rng(settings.seed)
+    rows = []
+    for b in range(settings.bootstrap):
+        pick = rng.integers(0, len(runs), size=len(runs))
+        obj = Objective(space, [runs[i] for i in pick], weights, options, penalty)
+        res = _solve(obj, z_opt, settings)
+        rows.append(space.to_p(res.x))
+        log.info("bootstrap %d/%d on runs %s: %s", b + 1, settings.bootstrap, pick.tolist(),
+                 np.array2string(rows[-1], precision=4))
+    return np.array(rows)
+
+
+def identify(datasets: Sequence[ReplayData], initial_guess: ModelParameters,
+             bounds: Mapping[str, tuple[float, float]] | None = None,
+             which: Sequence[str] = DEFAULT_WHICH, weights: Sequence[float] | None = None,
+             *, options: ReplayOptions | None = None, settings: FitSettings | None = None,
+             penalty: float = DEFAULT_PENALTY) -> IdentificationResult:
+    """Fit the model parameters ``which`` to the runs ``datasets`` by replay least squares.
+
+    Parameters
+    ----------
+    datasets : sequence of ReplayData
+        Training runs, fitted together.
+    initial_guess : ModelParameters
+        Start of the fit; the parameters not in ``which`` stay as they are here.
+    bounds : mapping name -> (lower, upper), optional
+        Physical units (m/s, -, -, s, m); default
+        :data:`arzsumo.identify.objective.DEFAULT_BOUNDS`. The guess must lie within.
+    which : sequence of str
+        Parameters to fit (names of :class:`ModelParameters` fields; see
+        :data:`arzsumo.identify.objective.DEFAULT_BOUNDS` for those allowed).
+    weights : 4 floats, optional
+        Weights of the residuals of (rho_h, v_h, rho_a, v_a); default all 1.
+    options : ReplayOptions, optional
+        Numerics of the replay twin.
+    settings : FitSettings, optional
+    penalty : float
+        Residual (in scale units) of a value the replay could not predict.
+
+    Returns
+    -------
+    IdentificationResult
+    """
+    runs = check_datasets(datasets)
+    space = ParameterSpace.make(initial_guess, which, bounds)
+    w = check_weights(weights)
+    opts = options if options is not None else ReplayOptions()
+    cfg = settings if settings is not None else FitSettings()
+    if not (isinstance(penalty, int | float) and 0.0 < penalty < np.inf):
+        raise IdentifyError(f"penalty = {penalty!r} is not allowed: a number > 0")
+    objective = Objective(space, runs, w, opts, float(penalty))
+    start = time.perf_counter()
+    res = _solve(objective, np.zeros(len(space.which)), cfg)
+    wall = time.perf_counter() - start
+    p = space.to_p(res.x)
+    cov = covariance(res.jac, res.fun, p)
+    sigma = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(sigma, sigma)
+    params = space.params(p)
+    log.info("identified %s in %.1f s (%d evaluations, %d twin failures): %s",
+             ", ".join(space.which), wall, objective.evaluations, objective.failures,
+             res.message)
+    boot = (_bootstrap(space, runs, res.x, w, opts, float(penalty), cfg)
+            if cfg.bootstrap > 0 else None)
+    return IdentificationResult(
+        params, space.which, p, sigma, corr, res.active_mask != 0, boot,
+        validate(params, runs, opts, penalty), float(res.cost), int(res.fun.size),
+        int(res.nfev), objective.evaluations, wall, objective.failures, bool(res.success),
+        str(res.message))

@@ -1,0 +1,222 @@
+"""The replay twin: the nonlinear twin driven by a run's boundary data, sampled like the run.
+
+:func:`run_replay` starts a :class:`arzsumo.twin.TwinStepper` from the data's initial
+state (interpolated to the twin grid), holds the inlet ghost cell at ``data.inlet[k]``
+and the outlet flow at ``data.outflow[k]`` during period k, and samples the primitive
+fields at ``data.x`` at every period end. This is what the SUMO closed loop does with its
+replay twin (a ghost-cell inlet and the measured outflow), with the boundary data given
+up front.
+
+Outlet. The twin's outlet carries q* + U, with q* the flow of its reference equilibrium.
+We take the uniform equilibrium at the spatial means of the initial densities (always
+admissible, because AO is linear in the densities) and set U_k = outflow_k - q*, so the
+metered outlet flow equals ``outflow_k`` whatever the parameters. The reference
+equilibrium has no other role here: the ghost-cell inlet replaces the paper's l4 inlet
+condition, so the replay is posed in free flow as in congestion.
+
+Admissibility. A parameter set with a smaller AO_max may not hold a state the data holds.
+Densities of the initial state and of the inlet are scaled down where AO exceeds
+``ao_limit`` AO_max (as the SUMO bridge does at a twin start); if the twin still leaves
+the physical domain, the run stops there and the later periods are NaN (the fit turns
+them into a penalty).
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from arzsumo.errors import ArzsumoError
+from arzsumo.identify.data import IdentifyError, ReplayData
+from arzsumo.model.equilibrium import Equilibrium
+from arzsumo.model.fd import area_occupancy
+from arzsumo.model.params import ModelParameters
+from arzsumo.twin.boundary import Inlet
+from arzsumo.twin.solver import SolverOptions, TwinStepper, TwinStoppedError
+from arzsumo.twin.state import cell_centres
+
+
+@dataclass(frozen=True)
+class ReplayOptions:
+    """Numerics of the replay twin.
+
+    Parameters
+    ----------
+    cells : int
+        Finite volumes on [0, L] (50 cells of 20 m by default: see
+        ``benchmarks/bench_identify.py`` for cost and accuracy against finer grids).
+    scheme, flux, limiter, cfl :
+        As :class:`arzsumo.twin.SolverOptions`.
+    ao_limit : float
+        Densities of the initial and inlet states are scaled down to AO <= ao_limit AO_max
+        of the parameters being tried, in (0, 1).
+    max_steps : int
+        Safety limit on the time steps of one replay.
+    """
+
+    cells: int = 50
+    scheme: str = "first"
+    flux: str = "hll"
+    limiter: str = "vanleer"
+    cfl: float = 0.9
+    ao_limit: float = 0.98
+    max_steps: int = 1_000_000
+
+    def __post_init__(self) -> None:
+        self.solver()                                   # validates the numerics
+        if not 0.0 < self.ao_limit < 1.0:
+            raise IdentifyError(f"ao_limit = {self.ao_limit!r} is not allowed: a fraction "
+                                "of AO_max in (0, 1)")
+
+    def solver(self) -> SolverOptions:
+        """The twin's :class:`SolverOptions` for these numerics."""
+        return SolverOptions(cells=self.cells, scheme=self.scheme, flux=self.flux,
+                             limiter=self.limiter, cfl=self.cfl, max_steps=self.max_steps)
+
+
+@dataclass(frozen=True)
+class HeldInlet(Inlet):
+    """A ghost-cell inlet: the boundary state at x = 0 is ``state``, set per period.
+
+    The fields of :class:`Inlet` (densities, flow, l4) are not used; ``state`` holds
+    (rho_h veh/m, v_h m/s, rho_a veh/m, v_a m/s) and is overwritten in place by :meth:`hold`.
+    """
+
+    state: np.ndarray = field(default_factory=lambda: np.ones(4))
+
+    def hold(self, z: np.ndarray) -> None:
+        """Hold the boundary state ``z`` (4,) from now on."""
+        self.state[:] = z
+
+    def boundary_primitive(self, t: float, z0: np.ndarray) -> np.ndarray:
+        return self.state
+
+
+@dataclass(frozen=True)
+class ReplayRun:
+    """Fields of one replay and how it ended.
+
+    Attributes
+    ----------
+    fields : ndarray (T, 4, N)
+        Predicted (rho_h, v_h, rho_a, v_a) at (data.t, data.x); NaN from the period in
+        which the twin stopped.
+    stopped : float or None
+        Time (s) at which the twin left the physical domain, None if it completed.
+    reason : str
+        The twin's stop message ("" if it completed).
+    steps : int
+        Time steps taken.
+    vehicles_out : float
+        Vehicles that left at x = L (until the stop, if any).
+    outlet_limited : float
+        Seconds during which the arriving flow, not ``data.outflow``, set the outflow (the
+        last cell was in free flow and could not deliver it).
+    """
+
+    fields: np.ndarray
+    stopped: float | None
+    reason: str
+    steps: int
+    vehicles_out: float = 0.0
+    outlet_limited: float = 0.0
+
+
+class _NoRegimeWarning(logging.Filter):
+    """Drop the twin's free-flow warning: it is about the l4 inlet, which is not used here."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return not str(record.msg).startswith("the equilibrium is in free flow")
+
+
+@contextmanager
+def _quiet_regime() -> Iterator[None]:
+    logger = logging.getLogger("arzsumo.twin.solver")
+    flt = _NoRegimeWarning()
+    logger.addFilter(flt)
+    try:
+        yield
+    finally:
+        logger.removeFilter(flt)
+
+
+def replay_grid(params: ModelParameters, options: ReplayOptions) -> np.ndarray:
+    """Cell centres (m) of the replay twin."""
+    return cell_centres(params.length, options.cells)
+
+
+def admissible(params: ModelParameters, z: np.ndarray, ao_limit: float) -> np.ndarray:
+    """Primitive states ``z`` (4, n) with densities scaled to AO <= ao_limit AO_max."""
+    ao = area_occupancy(params, z[0], z[2])
+    scale = np.minimum(1.0, ao_limit * params.ao_max / ao)
+    if np.all(scale == 1.0):
+        return z
+    out = np.array(z, float)
+    out[0] *= scale
+    out[2] *= scale
+    return out
+
+
+def _on_grid(values: np.ndarray, x_from: np.ndarray, x_to: np.ndarray) -> np.ndarray:
+    """Rows of ``values`` (4, len(x_from)) linearly interpolated to ``x_to`` (held at ends)."""
+    if x_from.shape == x_to.shape and np.array_equal(x_from, x_to):
+        return values
+    return np.vstack([np.interp(x_to, x_from, row) for row in values])
+
+
+def _stepper(params: ModelParameters, data: ReplayData, options: ReplayOptions,
+             x_twin: np.ndarray) -> tuple[TwinStepper, HeldInlet]:
+    init = admissible(params, _on_grid(data.initial, data.x, x_twin), options.ao_limit)
+    eq = Equilibrium(params, float(init[0].mean()), float(init[2].mean()))
+    inlet = HeldInlet(eq.rho_h, eq.rho_a, eq.q, np.zeros(4))
+    with _quiet_regime():
+        return TwinStepper(eq, init, options.solver(), inlet), inlet
+
+
+def run_replay(params: ModelParameters, data: ReplayData,
+               options: ReplayOptions | None = None) -> ReplayRun:
+    """Replay ``data`` with the twin under ``params``; see the module docstring.
+
+    Parameters
+    ----------
+    params : ModelParameters
+    data : ReplayData
+        ``data.x`` must lie in [0, params.length].
+    options : ReplayOptions, optional
+
+    Returns
+    -------
+    ReplayRun
+        Never raises for a parameter set under which the twin leaves the physical domain:
+        ``stopped`` and ``reason`` say when and why, and the fields are NaN from there.
+    """
+    opts = options if options is not None else ReplayOptions()
+    if data.x[-1] > params.length:
+        raise IdentifyError(f"{data.name}: x reaches {data.x[-1]} m, beyond the road length "
+                            f"L = {params.length} m; allowed: positions in [0, L]")
+    x_twin = replay_grid(params, opts)
+    out = np.full((data.periods, 4, data.x.size), np.nan)
+    inlet_states = admissible(params, data.inlet.T, opts.ao_limit).T
+    try:
+        stepper, inlet = _stepper(params, data, opts, x_twin)
+    except ArzsumoError as exc:                        # start state not representable
+        return ReplayRun(out, 0.0, str(exc), 0)
+    for k in range(data.periods):
+        inlet.hold(inlet_states[k])
+        try:
+            stepper.advance(float(data.t[k]), float(data.outflow[k]) - stepper.q_star)
+        except TwinStoppedError as exc:
+            return ReplayRun(out, exc.t, str(exc), stepper.steps, stepper.outflow,
+                             stepper.outlet_limited_time)
+        out[k] = _on_grid(stepper.primitive(), x_twin, data.x)
+    return ReplayRun(out, None, "", stepper.steps, stepper.outflow, stepper.outlet_limited_time)
+
+
+def replay(params: ModelParameters, data: ReplayData,
+           options: ReplayOptions | None = None) -> np.ndarray:
+    """Predicted fields (T, 4, N) of ``data`` under ``params``; NaN after a twin stop."""
+    return run_replay(params, data, options).fields
