@@ -19,6 +19,7 @@ from arzsumo.model import get_preset
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.meter import RampMeter
 from arzsumo.sumo.network_measures import network_options, network_summary
+from arzsumo.sumo.sensor import ramp_queue
 from arzsumo.sumo.simulation import open_simulation
 
 
@@ -31,7 +32,7 @@ def run(cfg: SumoConfig, out: Path | None) -> tuple[float, float, float, int]:
         meter = RampMeter(sim.lib, cfg)
         while sim.time < cfg.horizon - 1e-9:
             sim.step()
-            meter.step()
+            meter.step(ramp_queue(sim.lib))
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     assert sim.report is not None
     if out is None:

@@ -18,6 +18,7 @@ from arzsumo.sumo.network_measures import (
     read_trips,
 )
 from arzsumo.sumo.paths import SumoError
+from arzsumo.sumo.sensor import ramp_queue
 from arzsumo.sumo.simulation import open_simulation
 
 PARAMS = get_preset("paper_base").params
@@ -42,7 +43,7 @@ def _run(out: Path, green_share: float) -> Run:
         meter = RampMeter(lib, cfg)
         while sim.time < cfg.horizon - 1e-9:
             sim.step()
-            meter.step()
+            meter.step(ramp_queue(sim.lib))
             ids = [*lib.vehicle.getIDList(), *lib.simulation.getPendingVehicles()]
             ramp = sum(1 for v in ids if v.startswith("ramp"))
             integral["ramp"] += ramp * cfg.step_length

@@ -2,7 +2,8 @@
 
 :class:`ReplayData` is what the replay twin needs to reproduce a run, and what it is
 compared with. It is built from arrays (the SUMO layer aggregates its cells into them)
-or from a twin run (:meth:`ReplayData.from_twin`, synthetic data with known parameters).
+or from a twin run (:func:`arzsumo.identify.synthetic.data_from_twin`, synthetic data with
+known parameters).
 
 Periods: ``t`` holds the ends of the periods, t_0 < t_1 < ... (s, t_0 > 0); period k is
 (t_{k-1}, t_k] with t_{-1} = 0. During period k the inlet ghost cell holds
@@ -148,55 +149,3 @@ class ReplayData:
                     name: str = "run") -> ReplayData:
         """The data from array-likes (copied, validated); see the class for shapes."""
         return cls(t, x, fields, initial, inlet, outflow, scale, name)  # type: ignore[arg-type]
-
-    @classmethod
-    def from_twin(cls, params: object, t: ArrayLike, initial: ArrayLike, inlet: ArrayLike,
-                  outflow: ArrayLike, options: object = None, *, noise: float = 0.0,
-                  seed: int = 0, scale: ArrayLike | None = None,
-                  name: str = "synthetic") -> ReplayData:
-        """Synthetic data: the replay twin's own fields under ``params``, plus noise.
-
-        Parameters
-        ----------
-        params : ModelParameters
-            The "true" parameters.
-        t, inlet, outflow : array-like
-            Period ends (s), inlet ghost states (T, 4) and outflows (T,) veh/s.
-        initial : array-like (4, cells)
-            State at t = 0 on the twin's cell centres (``options.cells``); the data's
-            positions ``x`` are these centres, so a replay on the same grid reproduces
-            the fields exactly.
-        options : ReplayOptions, optional
-        noise : float
-            Standard deviation of the added Gaussian noise, as a fraction of ``scale``
-            per variable (e.g. 0.02); densities are kept > 0.
-        seed : int
-            Seed of the noise.
-        scale : array-like (4,), optional
-            Reference scale for noise and relative errors; default the noiseless
-            fields' mean per variable.
-
-        Raises
-        ------
-        IdentifyError
-            If the twin leaves the physical domain under ``params`` (the message says where).
-        """
-        from arzsumo.identify.replay import ReplayOptions, replay_grid, run_replay
-
-        opts = options if options is not None else ReplayOptions()
-        x = replay_grid(params, opts)                          # type: ignore[arg-type]
-        t_arr, inlet_arr = np.asarray(t, float), np.asarray(inlet, float)
-        clean = cls(t_arr, x, np.ones((t_arr.size, 4, x.size)), initial, inlet_arr,
-                    outflow, np.ones(4), name)
-        run = run_replay(params, clean, opts)                  # type: ignore[arg-type]
-        if run.stopped is not None:
-            raise IdentifyError(f"{name}: the generating twin stopped: {run.reason}")
-        obs = run.fields
-        ref = (np.array([obs[:, k].mean() for k in range(4)]) if scale is None
-               else np.asarray(scale, float))
-        if noise > 0.0:
-            rng = np.random.default_rng(seed)
-            obs = obs + noise * ref[None, :, None] * rng.standard_normal(obs.shape)
-            for k in (0, 2):                                   # keep densities positive
-                obs[:, k] = np.maximum(obs[:, k], 1e-3 * ref[k])
-        return cls(t_arr, x, obs, initial, inlet_arr, outflow, ref, name)

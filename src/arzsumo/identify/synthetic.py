@@ -3,7 +3,7 @@
 A run starts from a stop-and-go wave around an equilibrium of the true parameters
 (density up where speed is down, speeds off the fundamental diagram so that relaxation
 shows), under a time-varying inlet state and outflow; Gaussian noise may be added to the
-observed fields (:meth:`ReplayData.from_twin`).
+observed fields (:func:`data_from_twin`).
 """
 
 from __future__ import annotations
@@ -12,9 +12,10 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
-from arzsumo.identify.data import ReplayData
-from arzsumo.identify.replay import ReplayOptions, replay_grid
+from arzsumo.identify.data import IdentifyError, ReplayData
+from arzsumo.identify.replay import ReplayOptions, replay_grid, run_replay
 from arzsumo.model.equilibrium import equilibrium_from_densities
 from arzsumo.model.fd import equilibrium_speeds
 from arzsumo.model.params import ModelParameters
@@ -96,5 +97,55 @@ def synthetic_data(params: ModelParameters, run: SyntheticRun, *, horizon: float
     initial, inlet, outflow = boundary_data(params, run, t, opts.cells)
     eq = equilibrium_from_densities(params, run.rho_h, run.rho_a)
     scale = np.array([eq.rho_h, eq.v_h, eq.rho_a, eq.v_a])
-    return ReplayData.from_twin(params, t, initial, inlet, outflow, opts, noise=noise,
+    return data_from_twin(params, t, initial, inlet, outflow, opts, noise=noise,
                                 seed=seed, scale=scale, name=name)
+
+
+def data_from_twin(params: ModelParameters, t: ArrayLike, initial: ArrayLike,
+                   inlet: ArrayLike, outflow: ArrayLike, options: ReplayOptions | None = None,
+                   *, noise: float = 0.0, seed: int = 0, scale: ArrayLike | None = None,
+                   name: str = "synthetic") -> ReplayData:
+    """Synthetic data: the replay twin's own fields under ``params``, plus noise.
+
+    Parameters
+    ----------
+    params : ModelParameters
+        The "true" parameters.
+    t, inlet, outflow : array-like
+        Period ends (s), inlet ghost states (T, 4) and outflows (T,) veh/s.
+    initial : array-like (4, cells)
+        State at t = 0 on the twin's cell centres (``options.cells``); the data's
+        positions ``x`` are these centres, so a replay on the same grid reproduces
+        the fields exactly.
+    options : ReplayOptions, optional
+    noise : float
+        Standard deviation of the added Gaussian noise, as a fraction of ``scale``
+        per variable (e.g. 0.02); densities are kept > 0.
+    seed : int
+        Seed of the noise.
+    scale : array-like (4,), optional
+        Reference scale for noise and relative errors; default the noiseless
+        fields' mean per variable.
+
+    Raises
+    ------
+    IdentifyError
+        If the twin leaves the physical domain under ``params`` (the message says where).
+    """
+    opts = options if options is not None else ReplayOptions()
+    x = replay_grid(params, opts)
+    t_arr, inlet_arr = np.asarray(t, float), np.asarray(inlet, float)
+    clean = ReplayData(t_arr, x, np.ones((t_arr.size, 4, x.size)), initial, inlet_arr,
+                       outflow, np.ones(4), name)
+    run = run_replay(params, clean, opts)
+    if run.stopped is not None:
+        raise IdentifyError(f"{name}: the generating twin stopped: {run.reason}")
+    obs = run.fields
+    ref = (np.array([obs[:, k].mean() for k in range(4)]) if scale is None
+           else np.asarray(scale, float))
+    if noise > 0.0:
+        rng = np.random.default_rng(seed)
+        obs = obs + noise * ref[None, :, None] * rng.standard_normal(obs.shape)
+        for k in (0, 2):                                   # keep densities positive
+            obs[:, k] = np.maximum(obs[:, k], 1e-3 * ref[k])
+    return ReplayData(t_arr, x, obs, initial, inlet_arr, outflow, ref, name)
