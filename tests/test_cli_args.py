@@ -87,7 +87,7 @@ def test_every_command_has_help_and_description():
 def test_help_shows_defaults_environment_and_exit_codes(capsys):
     assert main(["--help"]) == 0
     top = capsys.readouterr().out
-    for text in ("ARZSUMO_CACHE", "~/.cache/arzsumo", "ARZSUMO_SUMO_NETS", "sumo_nets/",
+    for text in ("ARZSUMO_CACHE", "~/.cache/arzsumo", "ARZSUMO_SUMO_NETS", "arzsumo/data/sumo_nets",
                  "0    done", "2    user error", "3    the PDE twin left", "4    some sweep",
                  "130  interrupted", "arzsumo list"):
         assert text in top, text
@@ -109,7 +109,8 @@ def test_list_shows_shipped_scenarios_and_sweeps(capsys, monkeypatch):
     assert "scenarios/sweeps/penetration_twin.toml" in out
     assert main(["list", "--json"]) == 0
     files = json.loads(capsys.readouterr().out)
-    shipped = {p.relative_to(ROOT).as_posix() for p in (ROOT / "scenarios").rglob("*.toml")}
+    data = ROOT / "src" / "arzsumo" / "data"      # the package's own copy (shipped)
+    shipped = {p.relative_to(ROOT).as_posix() for p in (data / "scenarios").rglob("*.toml")}
     assert {f["path"] for f in files} == shipped
     assert all(f["description"] for f in files)         # every shipped file says what it is
     groups = {f["name"]: f["group"] for f in files}

@@ -88,7 +88,7 @@ environment variables:
   ARZSUMO_CACHE      directory of the backstepping kernel cache (kernels in its kernels/)
                      (default: ~/.cache/arzsumo)
   ARZSUMO_SUMO_NETS  directory of the SUMO network written by 'arzsumo build-net'
-                     (default: sumo_nets/ at the repository root)
+                     (default: the network shipped in the package, arzsumo/data/sumo_nets)
 
 exit codes:
   0    done

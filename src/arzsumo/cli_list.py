@@ -7,9 +7,9 @@ import json
 import tomllib
 from pathlib import Path
 
-#: the shipped scenario files (scenarios/ at the repository root)
-SCENARIO_ROOT = Path(__file__).resolve().parents[2] / "scenarios"
-#: (group, directory under SCENARIO_ROOT) in the order they are listed
+from arzsumo.resources import shipped_scenarios_dir
+
+#: (group, directory under the shipped scenarios) in the order they are listed
 GROUPS = (("scenarios", "."), ("paper experiments (arzsumo reproduce)", "paper"),
           ("sweeps (arzsumo sweep)", "sweeps"))
 
@@ -37,8 +37,9 @@ def _shown(path: Path) -> str:
         return str(path)
 
 
-def shipped(root: Path = SCENARIO_ROOT) -> list[dict[str, str]]:
+def shipped(root: Path | None = None) -> list[dict[str, str]]:
     """Every shipped file: group, path, name (stem) and description."""
+    root = shipped_scenarios_dir() if root is None else root
     return [{"group": group, "path": _shown(f), "name": f.stem, "description": describe(f)}
             for group, sub in GROUPS for f in sorted((root / sub).glob("*.toml"))]
 
@@ -49,8 +50,7 @@ def cmd_list(args: argparse.Namespace) -> int:
         print(json.dumps(files, indent=2))
         return 0
     if not files:
-        print(f"no scenario files under {SCENARIO_ROOT} (an installed package ships none; "
-              "use a checkout of the repository)")
+        print(f"no scenario files under {shipped_scenarios_dir()}")
         return 0
     width = max(len(f["path"]) for f in files)
     for group, _ in GROUPS:
@@ -64,7 +64,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     """Add ``list`` to the top-level parser."""
     p = sub.add_parser("list", help="list the shipped scenario and sweep files",
                        description="List the scenario files, the paper's experiments and "
-                                   f"the sweep files shipped in {SCENARIO_ROOT}, with their "
+                                   "the sweep files shipped with the package, with their "
                                    "descriptions (the description key or the first comment "
                                    "line).")
     p.add_argument("--json", action="store_true",

@@ -78,7 +78,10 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
 
     out = Path(args.out) if args.out else Path("results") / "reproduce"
     with OutputDir(out, "reproduce", overwrite=args.overwrite) as target:
-        rep = reproduce(args.scenarios, quick=args.quick, only=args.only or None,
+        from arzsumo.resources import shipped_scenarios_dir
+
+        paper = args.scenarios or shipped_scenarios_dir() / "paper"
+        rep = reproduce(paper, quick=args.quick, only=args.only or None,
                         workers=args.workers,
                         twin={"scheme": args.scheme} if args.scheme else None)
         write_reproduction(rep, target, plots=not args.no_plots)
@@ -125,8 +128,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="replace a previous reproduce result in the --out directory")
     r.add_argument("--quick", action="store_true",
                    help="tiny grid and horizon: a smoke test, numbers not meaningful")
-    r.add_argument("--scenarios", metavar="DIR", default="scenarios/paper",
-                   help="directory of the section 5 scenario files")
+    r.add_argument("--scenarios", metavar="DIR", default=None,
+                   help="directory of the section 5 scenario files (default: the shipped paper/ "
+                        "scenarios)")
     r.add_argument("--only", metavar="NAME", nargs="*",
                    help="run only these scenario names")
     r.add_argument("--scheme", choices=("first", "muscl"),
