@@ -29,6 +29,7 @@ from arzsumo.errors import ArzsumoError, require
 from arzsumo.model.equilibrium import Equilibrium
 from arzsumo.twin.boundary import Inlet
 from arzsumo.twin.flux import FLUXES, LIMITERS
+from arzsumo.twin.sampling import Checks, Samples
 from arzsumo.twin.scheme import SCHEMES, Transport, max_cell_speed
 from arzsumo.twin.state import (
     cell_centres,
@@ -333,8 +334,11 @@ def simulate(eq: Equilibrium, initial: np.ndarray, *, controller: Controller | N
     ctrl = controller if controller is not None else OpenLoop()
     ctrl.reset()
     stepper = TwinStepper(eq, initial, opts, inlet)
-    checks = _Checks(ctrl, opts, stepper.q_star)
-    samples = _Samples(opts)
+    q_star = stepper.q_star
+    bounds = (-q_star if opts.u_min is None else opts.u_min,
+              q_star if opts.u_max is None else opts.u_max)
+    checks = Checks(ctrl, opts.control_period, opts.horizon, bounds)
+    samples = Samples(opts.horizon, opts.output_period, opts.cells)
     start = _time.perf_counter()
     status = _time_loop(stepper, checks, samples, opts, callback)
     wall = _time.perf_counter() - start
@@ -352,50 +356,7 @@ def simulate(eq: Equilibrium, initial: np.ndarray, *, controller: Controller | N
                        "outlet_limited_time": stepper.outlet_limited_time})
 
 
-class _Samples:
-    """Primitive fields sampled every output period (preallocated)."""
-
-    def __init__(self, opts: SolverOptions) -> None:
-        n = math.floor(opts.horizon / opts.output_period + 1e-9) + 1
-        self.t, self.f, self.k = np.empty(n), np.empty((n, 4, opts.cells)), 0
-        self.period = opts.output_period
-
-    def due(self, t: float, eps: float) -> bool:
-        return self.k < self.t.size and t >= self.k * self.period - eps
-
-    def take(self, t: float, fields: np.ndarray) -> None:
-        self.t[self.k], self.f[self.k] = t, fields
-        self.k += 1
-
-
-class _Checks:
-    """The controller's checks, once per control period: U held between them, saturated
-    to [u_min, u_max] (default -q* .. q*), and the time it spent saturated (s)."""
-
-    def __init__(self, ctrl: Controller, opts: SolverOptions, q_star: float) -> None:
-        self.ctrl, self.period, self.horizon = ctrl, opts.control_period, opts.horizon
-        self.bounds = (-q_star if opts.u_min is None else opts.u_min,
-                       q_star if opts.u_max is None else opts.u_max)
-        self.t: list[float] = []
-        self.u: list[float] = []
-        self.requested: list[float] = []
-        self.held, self.saturated, self.k = 0.0, 0.0, 0
-
-    def due(self, t: float, eps: float) -> bool:
-        return t >= self.k * self.period - eps
-
-    def check(self, t: float, state: MacroState) -> None:
-        requested = float(self.ctrl.check(state))
-        self.held = min(max(requested, self.bounds[0]), self.bounds[1])
-        if self.held != requested:
-            self.saturated += min(self.period, self.horizon - t)
-        self.t.append(t)
-        self.u.append(self.held)
-        self.requested.append(requested)
-        self.k += 1
-
-
-def _time_loop(stepper: TwinStepper, checks: _Checks, samples: _Samples,
+def _time_loop(stepper: TwinStepper, checks: Checks, samples: Samples,
                opts: SolverOptions, callback: StepCallback | None) -> str:
     """Advance to the horizon between output samples and checks; return the status."""
     eps = 1e-9 * max(1.0, opts.horizon)
