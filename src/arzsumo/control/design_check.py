@@ -90,24 +90,41 @@ def _inverse_norm(kernels: Kernels) -> float:
     return float(np.linalg.norm(np.array(cols).T, 2))
 
 
-def check_design(system: CharacteristicSystem, kernels: Kernels, design: EtcDesign,
-                 alpha_x_at_l: np.ndarray | None = None) -> DesignReport:
-    """Evaluate select1-select4, the decay condition of esthm, and tau* (module docstring)."""
-    n, lam, lm = system.n, system.lam_plus, system.lam_minus
-    length, mu_d = system.length, design.mu
-    A = np.array(design.A)
-    vs = np.array(design.varsigma)
-    q, r = system.Q, system.R
-    sig = system.sigma(kernels.x)
-    w = trapezoid_weights(kernels.n_cells, kernels.h)[-1]
-    r_norm = float(np.linalg.norm(r))
-    b_exp = design.B * math.exp(mu_d * length / lm)
-    l_ll = kernels.L[:, -1, -1]
-    j = np.linalg.norm(sig[-1, :n, :n], axis=0)
-    eps = 8 * l_ll**2 * lam**2 + 8 * j * r_norm**2
-    p3 = float(min((A / lam * np.exp(-mu_d * length / lam)).min(), design.B / lm))
+@dataclass(frozen=True)
+class _Constants:
+    """The constants of bounddt and minimalthm (module docstring); eps has one entry per
+    positive-speed state."""
+
+    eps: np.ndarray
+    p1: float
+    p3: float
+    gamma: float
+    c1: float
+    c2: float
+    c3: float
+    c4: float
+    phi1: float
+    phi2: float
+    b_exp: float
+
+
+def _norm_equivalences(system: CharacteristicSystem, kernels: Kernels,
+                       design: EtcDesign) -> tuple[float, float]:
+    """p_1 = 1 / ||inverse transform||^2 (on at most about 60 cells) and p_3 = the smallest
+    weight of V."""
+    lam, lm, A = system.lam_plus, system.lam_minus, np.array(design.A)
+    p3 = float(min((A / lam * np.exp(-design.mu * system.length / lam)).min(),
+                   design.B / lm))
     p1 = 1.0 / _inverse_norm(kernels) ** 2 if kernels.n_cells <= 60 else 1.0 / _inverse_norm(
         _coarsen(kernels)) ** 2
+    return p1, p3
+
+
+def _inverse_kernel_bounds(system: CharacteristicSystem, kernels: Kernels,
+                           sig: np.ndarray) -> tuple[float, float, float]:
+    """c_1, c_2, c_3 of bounddt from the inverse kernels' last row L(L, xi), N(L, xi)."""
+    n, lam, lm = system.n, system.lam_plus, system.lam_minus
+    w = trapezoid_weights(kernels.n_cells, kernels.h)[-1]
     l_row, n_row = kernels.L[:, -1, :], kernels.N[-1, :]
     l_xi = np.gradient(l_row, kernels.x, axis=1)
     n_xi = np.gradient(n_row, kernels.x)
@@ -118,6 +135,22 @@ def check_design(system: CharacteristicSystem, kernels: Kernels, design: EtcDesi
     s_pm_l = sig[-1, :n, n]
     c3 = max(float(w @ (np.linalg.norm(s_pm_l) * np.linalg.norm(l_row, axis=0)) ** 2),
              float(w @ (np.linalg.norm(s_pm_l) * n_row) ** 2))
+    return c1, c2, c3
+
+
+def _constants(system: CharacteristicSystem, kernels: Kernels, design: EtcDesign,
+               alpha_x_at_l: np.ndarray | None) -> _Constants:
+    """Every constant the conditions and tau* use (module docstring)."""
+    n, lam, lm = system.n, system.lam_plus, system.lam_minus
+    A, r = np.array(design.A), system.R
+    sig = system.sigma(kernels.x)
+    r_norm = float(np.linalg.norm(r))
+    b_exp = design.B * math.exp(design.mu * system.length / lm)
+    j = np.linalg.norm(sig[-1, :n, :n], axis=0)
+    eps = 8 * kernels.L[:, -1, -1]**2 * lam**2 + 8 * j * r_norm**2
+    p1, p3 = _norm_equivalences(system, kernels, design)
+    c1, c2, c3 = _inverse_kernel_bounds(system, kernels, sig)
+    s_pm_l = sig[-1, :n, n]
     phi1 = (8 * kernels.N[-1, -1] ** 2 * lm**2 + 2 * float(r @ s_pm_l) ** 2) * r_norm**2
     phi2 = 8 / p3 * (c1 + c2 / p1) + 8 * c3 * r_norm**2 / p3
     sig_pp_max = float(np.linalg.norm(sig[:, :n, :n], axis=(1, 2)).max())
@@ -125,11 +158,18 @@ def check_design(system: CharacteristicSystem, kernels: Kernels, design: EtcDesi
     gamma = 2 * A.max() / (p3 * lam.min()) * (sig_pp_max + (1 + 1 / p1) * sig_pm_max)
     ax = np.zeros(n) if alpha_x_at_l is None else np.asarray(alpha_x_at_l)
     c4 = 2 * float(np.linalg.norm(r * lam)) ** 2 * float(ax @ ax)
-    zeta, sigma, eta = design.zeta, design.sigma, design.eta
-    aq = float(A @ q**2)
+    return _Constants(eps, p1, p3, gamma, c1, c2, c3, c4, phi1, phi2, b_exp)
+
+
+def _select_conditions(system: CharacteristicSystem, design: EtcDesign,
+                       k: _Constants) -> list[Condition]:
+    """select1 and select3 for each varsigma_i, select2 and select4 for varsigma_{n+1}."""
+    n, lam, length, mu_d = system.n, system.lam_plus, system.length, design.mu
+    A, vs, zeta, eps = np.array(design.A), np.array(design.varsigma), design.zeta, k.eps
+    aq = float(A @ system.Q**2)
     conds = []
     for i in range(n):
-        need = max(zeta * b_exp * eps[i], zeta * mu_d * eps[i])
+        need = max(zeta * k.b_exp * eps[i], zeta * mu_d * eps[i])
         conds.append(Condition("select1", f"varsigma_{i + 1} >= max(zeta B e^(mu L/Lambda-) "
                                f"eps_{i + 1}, zeta mu eps_{i + 1})", vs[i], need, vs[i] >= need))
     need4 = max(0.0, -2 * zeta * mu_d * (aq - design.B))
@@ -141,19 +181,39 @@ def check_design(system: CharacteristicSystem, kernels: Kernels, design: EtcDesi
                                f"{i + 1})", vs[i], bound, vs[i] <= bound))
     conds.append(Condition("select4", "varsigma_4 + sum A_i q_i^2 - B <= 0",
                            vs[n] + aq - design.B, 0.0, vs[n] + aq - design.B <= 0))
-    rate = mu_d * (1 - sigma) - gamma
-    conds.append(Condition("esthm", "mu (1 - sigma) - gamma > 0 (decay rate of V_d)",
-                           rate, 0.0, rate > 0))
-    conds.append(Condition("esthm", "eta >= mu (1 - sigma) - gamma", eta, rate, eta >= rate))
+    return conds
+
+
+def _decay_conditions(design: EtcDesign, gamma: float) -> list[Condition]:
+    """esthm: V_d decays (mu (1 - sigma) > gamma) and eta is at least that rate."""
+    rate = design.mu * (1 - design.sigma) - gamma
+    return [Condition("esthm", "mu (1 - sigma) - gamma > 0 (decay rate of V_d)",
+                      rate, 0.0, rate > 0),
+            Condition("esthm", "eta >= mu (1 - sigma) - gamma", design.eta, rate,
+                      design.eta >= rate)]
+
+
+def _tau_star(design: EtcDesign, k: _Constants) -> tuple[float, tuple[float, float, float]]:
+    """tau* (s) of minimalthm and its varphi_1..3."""
+    zeta, sigma, eta, mu_d = design.zeta, design.sigma, design.eta, design.mu
     vphi1 = 1 / (2 * zeta) - mu_d * sigma
-    vphi2 = 1 + phi1 + (1 - sigma) * mu_d / (2 * zeta) - gamma + eta
-    vphi3 = b_exp * (phi2 + c4) / (mu_d * sigma) + 1 + eta + phi1
+    vphi2 = 1 + k.phi1 + (1 - sigma) * mu_d / (2 * zeta) - k.gamma + eta
+    vphi3 = k.b_exp * (k.phi2 + k.c4) / (mu_d * sigma) + 1 + eta + k.phi1
     tau, _ = quad(lambda s: 1.0 / (vphi1 * s * s + vphi2 * s + vphi3), 0.0, 1.0)
-    constants = {"p1": float(p1), "p3": p3, "gamma": gamma, "c1": c1, "c2": c2, "c3": c3, "c4": c4,
-                 "phi1": phi1, "phi2": phi2, "varphi1": vphi1, "varphi2": vphi2,
-                 "varphi3": vphi3, "B_exp": b_exp}
-    constants.update({f"eps_{i + 1}": float(eps[i]) for i in range(n)})
-    return DesignReport(tuple(conds), float(tau), {k: float(v) for k, v in constants.items()})
+    return float(tau), (vphi1, vphi2, vphi3)
+
+
+def check_design(system: CharacteristicSystem, kernels: Kernels, design: EtcDesign,
+                 alpha_x_at_l: np.ndarray | None = None) -> DesignReport:
+    """Evaluate select1-select4, the decay condition of esthm, and tau* (module docstring)."""
+    k = _constants(system, kernels, design, alpha_x_at_l)
+    conds = _select_conditions(system, design, k) + _decay_conditions(design, k.gamma)
+    tau, (vphi1, vphi2, vphi3) = _tau_star(design, k)
+    constants = {"p1": float(k.p1), "p3": k.p3, "gamma": k.gamma, "c1": k.c1, "c2": k.c2,
+                 "c3": k.c3, "c4": k.c4, "phi1": k.phi1, "phi2": k.phi2, "varphi1": vphi1,
+                 "varphi2": vphi2, "varphi3": vphi3, "B_exp": k.b_exp}
+    constants.update({f"eps_{i + 1}": float(k.eps[i]) for i in range(system.n)})
+    return DesignReport(tuple(conds), tau, {name: float(v) for name, v in constants.items()})
 
 
 def _coarsen(kernels: Kernels, target: int = 50) -> Kernels:

@@ -91,6 +91,48 @@ class Kernels:
         return float(self.x[1] - self.x[0])
 
 
+@dataclass(frozen=True)
+class _KernelProblem:
+    """The kernel equations' data on the grid, and their pointwise pieces (vectorised).
+
+    ``sig_nodes`` is Sigma at the nodes, shape (n_cells+1, n+1, n+1); ``s_pm_nodes`` its
+    Sigma+- block, shape (n_cells+1, n); speeds in m/s, Q dimensionless.
+    """
+
+    system: CharacteristicSystem
+    x: np.ndarray
+    sig_nodes: np.ndarray
+    s_pm_nodes: np.ndarray
+
+    @classmethod
+    def on_grid(cls, system: CharacteristicSystem, n_cells: int) -> _KernelProblem:
+        x = np.linspace(0.0, system.length, n_cells + 1)
+        sig_nodes = system.sigma(x)
+        return cls(system, x, sig_nodes, sig_nodes[:, :system.n, system.n])
+
+    @property
+    def h(self) -> float:
+        return self.x[1] - self.x[0]
+
+    def k_diag(self, xd: np.ndarray) -> np.ndarray:
+        """k_i on the diagonal at positions xd (boundary condition): shape (n, len(xd))."""
+        n, lam, mu = self.system.n, self.system.lam_plus, self.system.lam_minus
+        return (-self.system.sigma(xd)[:, n, :n] / (lam + mu)).T
+
+    def m_bc(self, k0: np.ndarray) -> float:
+        """M(x, 0) from k_i(x, 0) (boundary condition on xi = 0)."""
+        return float((k0 * self.system.lam_plus) @ self.system.Q / self.system.lam_minus)
+
+    def rhs_k(self, kv: np.ndarray, mv: np.ndarray, sig: np.ndarray) -> np.ndarray:
+        """(K Sigma++ + M Sigma-+)_i at points: kv (n, P), mv (P,), sig (P, n+1, n+1)."""
+        n = self.system.n
+        return np.einsum("mp,pmi->ip", kv, sig[:, :n, :n]) + mv * sig[:, n, :n].T
+
+    def g_m(self, kv: np.ndarray, s_pm: np.ndarray) -> np.ndarray:
+        """K Sigma+- / mu at points: kv (n, P), s_pm (P, n)."""
+        return np.einsum("mp,pm->p", kv, s_pm) / self.system.lam_minus
+
+
 def solve_kernels(system: CharacteristicSystem, n_cells: int) -> Kernels:
     """Solve the kernel equations (module docstring) on ``n_cells`` uniform cells.
 
@@ -103,73 +145,73 @@ def solve_kernels(system: CharacteristicSystem, n_cells: int) -> Kernels:
     """
     require(isinstance(n_cells, int | np.integer) and n_cells >= 4, "n_cells", n_cells,
             "an integer >= 4", ModelError)
-    n, lam, mu = system.n, system.lam_plus, system.lam_minus
-    q = system.Q
-    x = np.linspace(0.0, system.length, n_cells + 1)
-    h = x[1] - x[0]
-    sig_nodes = system.sigma(x)                         # (N+1, n+1, n+1)
-    s_pm_nodes = sig_nodes[:, :n, n]                    # Sigma+-(xi): (N+1, n)
-
-    def k_diag(xd: np.ndarray) -> np.ndarray:
-        """k_i on the diagonal at positions xd: shape (n, len(xd))."""
-        return (-system.sigma(xd)[:, n, :n] / (lam + mu)).T
-
-    def m_bc(k0: np.ndarray) -> float:
-        """M(x, 0) from k_i(x, 0)."""
-        return float((k0 * lam) @ q / mu)
-
-    def rhs_k(kv: np.ndarray, mv: np.ndarray, sig: np.ndarray) -> np.ndarray:
-        """(K Sigma++ + M Sigma-+)_i at points: kv (n, P), mv (P,), sig (P, n+1, n+1)."""
-        return np.einsum("mp,pmi->ip", kv, sig[:, :n, :n]) + mv * sig[:, n, :n].T
-
-    def g_m(kv: np.ndarray, s_pm: np.ndarray) -> np.ndarray:
-        """K Sigma+- / mu at points: kv (n, P), s_pm (P, n)."""
-        return np.einsum("mp,pm->p", kv, s_pm) / mu
-
-    K = np.zeros((n, n_cells + 1, n_cells + 1))
+    prob = _KernelProblem.on_grid(system, n_cells)
+    K = np.zeros((system.n, n_cells + 1, n_cells + 1))
     M = np.zeros((n_cells + 1, n_cells + 1))
-    K[:, 0, 0] = k_diag(x[:1])[:, 0]
-    M[0, 0] = m_bc(K[:, 0, 0])
-
+    K[:, 0, 0] = prob.k_diag(prob.x[:1])[:, 0]
+    M[0, 0] = prob.m_bc(K[:, 0, 0])
     for j in range(1, n_cells + 1):
-        # diagonal node (x_j, x_j): k exact, M along (1, 1) from (x_{j-1}, x_{j-1})
-        K[:, j, j] = k_diag(x[j:j + 1])[:, 0]
-        M[j, j] = M[j - 1, j - 1] + 0.5 * h * (
-            g_m(K[:, j, j:j + 1], s_pm_nodes[j:j + 1])[0]
-            + g_m(K[:, j - 1, j - 1:j], s_pm_nodes[j - 1:j])[0])
-        ls = np.arange(j)
-        xi = x[:j]
-        # feet of the k_i characteristics: on the previous row, or on the diagonal
-        xi_row = xi[None, :] + (lam[:, None] / mu) * h             # (n, j)
-        on_row = xi_row <= x[j - 1] + 1e-12 * h
-        s_diag = (x[j] - xi[None, :]) / (lam[:, None] + mu)
-        s = np.where(on_row, h / mu, s_diag)                       # characteristic step
-        xf = np.where(on_row, x[j - 1], x[j] - mu * s_diag)
-        xif = np.where(on_row, xi_row, xf)                         # diagonal: xi = x
-        row_vals = np.concatenate([K[:, j - 1, :j], M[None, j - 1, :j]])
-        foot_row = interpolate(x[:j], row_vals, xif)                 # (n+1, n, j)
-        m_on_diag = interpolate(x[: j + 1], np.diag(M)[None, : j + 1], xf)[0]
-        k_on_diag = k_diag(xf.ravel()).reshape(n, n, j)
-        foot_k = np.where(on_row[None], foot_row[:n], k_on_diag)   # [m, i, l]: k_m at foot i
-        foot_m = np.where(on_row, foot_row[n], m_on_diag)          # [i, l]
-        sig_f = system.sigma(xif.ravel()).reshape(n, j, n + 1, n + 1)
-        rhs_f = np.einsum("mil,ilmi->il", foot_k, sig_f[:, :, :n, :n]) \
-            + foot_m * np.einsum("ili->il", sig_f[:, :, n, :n])
-        own_k = np.einsum("iil->il", foot_k)                       # k_i at its own foot
-        # Heun's method along the characteristics: predictor, then corrector
-        sig_n = sig_nodes[ls]
-        m_prev = np.concatenate([[0.0], M[j - 1, : j - 1]])        # M(x_{j-1}, xi_{l-1})
-        g_prev = np.concatenate([[0.0], g_m(K[:, j - 1, : j - 1], s_pm_nodes[: j - 1])])
-        k_node = own_k + s * rhs_f
-        m_node = m_prev + h * g_prev
-        m_node[0] = m_bc(k_node[:, 0])
-        k_node = own_k + 0.5 * s * (rhs_f + rhs_k(k_node, m_node, sig_n))
-        m_node = m_prev + 0.5 * h * (g_prev + g_m(k_node, s_pm_nodes[:j]))
-        m_node[0] = m_bc(k_node[:, 0])
-        K[:, j, :j] = k_node
-        M[j, :j] = m_node
-    L, N = _invert_volterra(K, M, h)
-    return Kernels(x, K, M, L, N)
+        _march_diagonal(prob, K, M, j)
+        K[:, j, :j], M[j, :j] = _march_row(prob, K, M, j)
+    L, N = _invert_volterra(K, M, prob.h)
+    return Kernels(prob.x, K, M, L, N)
+
+
+def _march_diagonal(prob: _KernelProblem, K: np.ndarray, M: np.ndarray, j: int) -> None:
+    """Fill the diagonal node (x_j, x_j): k exact, M by the trapezoid rule along (1, 1)
+    from (x_{j-1}, x_{j-1})."""
+    x, h, s_pm = prob.x, prob.h, prob.s_pm_nodes
+    K[:, j, j] = prob.k_diag(x[j:j + 1])[:, 0]
+    M[j, j] = M[j - 1, j - 1] + 0.5 * h * (
+        prob.g_m(K[:, j, j:j + 1], s_pm[j:j + 1])[0]
+        + prob.g_m(K[:, j - 1, j - 1:j], s_pm[j - 1:j])[0])
+
+
+def _k_feet(prob: _KernelProblem, K: np.ndarray, M: np.ndarray,
+            j: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Feet of the k_i characteristics through (x_j, xi_l), l < j: on the previous row
+    x_{j-1}, or on the diagonal, whichever comes first.
+
+    Returns the step along each characteristic s (n, j), s; k_i at its own foot (n, j),
+    1/m; and the right-hand side K Sigma++ + M Sigma-+ at the feet (n, j), 1/m^2.
+    """
+    system, x, h = prob.system, prob.x, prob.h
+    n, lam, mu = system.n, system.lam_plus, system.lam_minus
+    xi = x[:j]
+    xi_row = xi[None, :] + (lam[:, None] / mu) * h             # (n, j)
+    on_row = xi_row <= x[j - 1] + 1e-12 * h
+    s_diag = (x[j] - xi[None, :]) / (lam[:, None] + mu)
+    s = np.where(on_row, h / mu, s_diag)                       # characteristic step
+    xf = np.where(on_row, x[j - 1], x[j] - mu * s_diag)
+    xif = np.where(on_row, xi_row, xf)                         # diagonal: xi = x
+    row_vals = np.concatenate([K[:, j - 1, :j], M[None, j - 1, :j]])
+    foot_row = interpolate(x[:j], row_vals, xif)                 # (n+1, n, j)
+    m_on_diag = interpolate(x[: j + 1], np.diag(M)[None, : j + 1], xf)[0]
+    k_on_diag = prob.k_diag(xf.ravel()).reshape(n, n, j)
+    foot_k = np.where(on_row[None], foot_row[:n], k_on_diag)   # [m, i, l]: k_m at foot i
+    foot_m = np.where(on_row, foot_row[n], m_on_diag)          # [i, l]
+    sig_f = system.sigma(xif.ravel()).reshape(n, j, n + 1, n + 1)
+    rhs_f = np.einsum("mil,ilmi->il", foot_k, sig_f[:, :, :n, :n]) \
+        + foot_m * np.einsum("ili->il", sig_f[:, :, n, :n])
+    own_k = np.einsum("iil->il", foot_k)                       # k_i at its own foot
+    return s, own_k, rhs_f
+
+
+def _march_row(prob: _KernelProblem, K: np.ndarray, M: np.ndarray,
+               j: int) -> tuple[np.ndarray, np.ndarray]:
+    """k_i(x_j, xi_l) (n, j) and M(x_j, xi_l) (j,), l < j, 1/m: Heun's method along the
+    characteristics (predictor, then corrector), M(x_j, 0) from its boundary condition."""
+    s, own_k, rhs_f = _k_feet(prob, K, M, j)
+    h, s_pm = prob.h, prob.s_pm_nodes
+    m_prev = np.concatenate([[0.0], M[j - 1, : j - 1]])        # M(x_{j-1}, xi_{l-1})
+    g_prev = np.concatenate([[0.0], prob.g_m(K[:, j - 1, : j - 1], s_pm[: j - 1])])
+    k_node = own_k + s * rhs_f
+    m_node = m_prev + h * g_prev
+    m_node[0] = prob.m_bc(k_node[:, 0])
+    k_node = own_k + 0.5 * s * (rhs_f + prob.rhs_k(k_node, m_node, prob.sig_nodes[:j]))
+    m_node = m_prev + 0.5 * h * (g_prev + prob.g_m(k_node, s_pm[:j]))
+    m_node[0] = prob.m_bc(k_node[:, 0])
+    return k_node, m_node
 
 
 def trapezoid_weights(n_cells: int, h: float) -> np.ndarray:

@@ -11,13 +11,19 @@ and the forward/inverse transforms are checked against each other.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from arzsumo.control.backstepping import Backstepping
+from arzsumo.control.base import Controller
+from arzsumo.control.etc import PAPER_DESIGN, EventTriggered, Lyapunov
 from arzsumo.control.kernels import Kernels, solve_kernels
-from arzsumo.control.plant import LinearPlant
+from arzsumo.control.observer import ObserverEtc
+from arzsumo.control.plant import LinearPlant, step_dividing
 from arzsumo.control.transform import BacksteppingLaw, BacksteppingTransform
+from arzsumo.errors import ModelError
 from arzsumo.model.characteristic import Linearization
 
 
@@ -139,51 +145,56 @@ class ClosedLoopRun:
         }
 
 
-def run_closed_loop(lin: Linearization, kernels: Kernels, controller: str = "etc",
-                    period: float = 1.0, horizon: float = 450.0, design=None,
-                    amplitude: float = 0.1) -> ClosedLoopRun:
-    """Run ``controller`` ("backstepping", "etc", "observer-etc") on the linear plant.
+def _controller_check(lin: Linearization, kernels: Kernels, controller: str,
+                      design) -> tuple[Controller, Callable[[float, np.ndarray], float]]:
+    """The controller named ``controller`` and its check(t, w) -> U-bar on the Riemann state.
 
-    The controller is checked every ``period`` s (the plant step divides it) and its
-    output held in between; the plant starts from the sinusoidal stop-and-go deviation.
+    The observer-based ETC sees only the measured w-(0), the others the full state.
     """
-    from arzsumo.control.backstepping import Backstepping
-    from arzsumo.control.etc import PAPER_DESIGN, EventTriggered, Lyapunov
-    from arzsumo.control.observer import ObserverEtc
-    from arzsumo.control.plant import step_dividing
-    from arzsumo.errors import ModelError
-
-    design = design or PAPER_DESIGN
-    system, n = lin.system, kernels.n_cells
-    dt = step_dividing(period, LinearPlant(system, n).dt)
-    plant = LinearPlant(system, n, dt=dt)
-    w0 = lin.to_riemann(sinusoidal_deviation(lin, kernels.x, amplitude), kernels.x)
-    plant.reset(w0)
     if controller == "backstepping":
-        ctrl = Backstepping(lin, kernels)
-        check = ctrl.check_riemann
-    elif controller == "etc":
+        ctrl: Controller = Backstepping(lin, kernels)
+        return ctrl, ctrl.check_riemann
+    if controller == "etc":
         ctrl = EventTriggered(lin, kernels, design)
-        check = ctrl.check_riemann
-    elif controller == "observer-etc":
-        ctrl = ObserverEtc(lin, kernels, design)
-        check = lambda t, w: ctrl.check_measurement(t, float(w[-1, 0]))  # noqa: E731
-    else:
-        raise ModelError(f"controller = {controller!r} is not allowed: 'backstepping', 'etc' "
-                         "or 'observer-etc'")
-    transform = BacksteppingTransform(kernels)
-    lyap = Lyapunov(system, kernels.x, design)
-    ts, vs, norms, errs = [], [], [], []
+        return ctrl, ctrl.check_riemann
+    if controller == "observer-etc":
+        obs = ObserverEtc(lin, kernels, design)
+        return obs, lambda t, w: obs.check_measurement(t, float(w[-1, 0]))
+    raise ModelError(f"controller = {controller!r} is not allowed: 'backstepping', 'etc' "
+                     "or 'observer-etc'")
 
-    def observe(t: float, w: np.ndarray) -> None:
-        ts.append(t)
-        vs.append(lyap(*transform.forward(w)))
-        norms.append(z_norm(lin, w, kernels.x))
-        if controller == "observer-etc":
-            errs.append(np.linalg.norm(w - ctrl.observer.estimate) / np.linalg.norm(w0))
-        else:
-            errs.append(np.nan)
 
+class _CheckSeries:
+    """Series recorded at each check from the *true* state: t (s), V (label lyapunov), the
+    L2 norm of z, and the observer's relative estimation error (NaN without observer)."""
+
+    def __init__(self, lin: Linearization, kernels: Kernels, design, w0: np.ndarray,
+                 observer_etc: ObserverEtc | None) -> None:
+        self.lin, self.x, self.w0, self.observer_etc = lin, kernels.x, w0, observer_etc
+        self.transform = BacksteppingTransform(kernels)
+        self.lyap = Lyapunov(lin.system, kernels.x, design)
+        self.t: list[float] = []
+        self.V: list[float] = []
+        self.norm: list[float] = []
+        self.error: list[float] = []
+
+    def __call__(self, t: float, w: np.ndarray) -> None:
+        self.t.append(t)
+        self.V.append(self.lyap(*self.transform.forward(w)))
+        self.norm.append(z_norm(self.lin, w, self.x))
+        self.error.append(np.nan if self.observer_etc is None else
+                          np.linalg.norm(w - self.observer_etc.observer.estimate)
+                          / np.linalg.norm(self.w0))
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        return np.array(self.t), np.array(self.V), np.array(self.norm), np.array(self.error)
+
+
+def _run_held(plant: LinearPlant, check: Callable[[float, np.ndarray], float],
+              observe: _CheckSeries, w0: np.ndarray, period: float, horizon: float) -> None:
+    """Step ``plant`` from ``w0`` to ``horizon`` s, checking every ``period`` s (at 0, Delta,
+    ..., T - Delta) and holding the check's output in between; observe at every check."""
+    dt = plant.dt
     held = check(0.0, w0)
     observe(0.0, w0)
     plant.u_bar_applied = held
@@ -194,15 +205,34 @@ def run_closed_loop(lin: Linearization, kernels: Kernels, controller: str = "etc
         nonlocal held, count
         count += 1
         if count % steps_per_check == 0:
-            if t < horizon - 0.5 * dt:       # checks at 0, Delta, ..., T - Delta
+            if t < horizon - 0.5 * dt:
                 held = check(t, w)
             observe(t, w)
         return held
 
     while plant.t < horizon - 0.5 * dt:
         plant.step(u_bar_fn)
-    return ClosedLoopRun(controller, period, horizon, np.array(ts), np.array(vs),
-                         np.array(norms), np.array(errs), ctrl.log)
+
+
+def run_closed_loop(lin: Linearization, kernels: Kernels, controller: str = "etc",
+                    period: float = 1.0, horizon: float = 450.0, design=None,
+                    amplitude: float = 0.1) -> ClosedLoopRun:
+    """Run ``controller`` ("backstepping", "etc", "observer-etc") on the linear plant.
+
+    The controller is checked every ``period`` s (the plant step divides it) and its
+    output held in between; the plant starts from the sinusoidal stop-and-go deviation.
+    """
+    design = design or PAPER_DESIGN
+    system, n = lin.system, kernels.n_cells
+    dt = step_dividing(period, LinearPlant(system, n).dt)
+    plant = LinearPlant(system, n, dt=dt)
+    w0 = lin.to_riemann(sinusoidal_deviation(lin, kernels.x, amplitude), kernels.x)
+    plant.reset(w0)
+    ctrl, check = _controller_check(lin, kernels, controller, design)
+    series = _CheckSeries(lin, kernels, design, w0,
+                          ctrl if isinstance(ctrl, ObserverEtc) else None)
+    _run_held(plant, check, series, w0, period, horizon)
+    return ClosedLoopRun(controller, period, horizon, *series.arrays(), ctrl.log)
 
 
 def sensitivity(lin: Linearization, kernels: Kernels, parameter: str,

@@ -23,7 +23,7 @@ from arzsumo.errors import ModelError, require
 from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.demand import InitialVehicle
-from arzsumo.sumo.vtypes import AV_TYPE, HV_TYPE, vehicle_types
+from arzsumo.sumo.vtypes import AV_TYPE, HV_TYPE, VehicleType, vehicle_types
 
 #: Number of lateral columns for initial vehicles (d = 2 m on a 6.5 m lane).
 COLUMNS = 3
@@ -59,6 +59,62 @@ def column_offsets(road_width: float, vehicle_width: float, n: int = COLUMNS) ->
     return np.linspace(-edge, edge, n) if n > 1 else np.zeros(1)
 
 
+def _check_profiles(params: ModelParameters, x: np.ndarray, arrays: list[np.ndarray]) -> None:
+    """Each profile has the shape of ``x``, finite values >= 0; ``x`` increases inside (0, L)."""
+    for name, a in zip(("rho_h", "v_h", "rho_a", "v_a"), arrays, strict=True):
+        require(a.shape == x.shape, name, a.shape, f"the shape of x {x.shape}")
+        require(bool(np.all(np.isfinite(a)) and np.all(a >= 0)), name, "array",
+                "finite values >= 0")
+    require(x.ndim == 1 and x.size >= 1 and bool(np.all(np.diff(x) > 0))
+            and x[0] > 0 and x[-1] < params.length, "x", "array",
+            f"increasing cell centres inside (0, {params.length}) m")
+
+
+def _candidates(x: np.ndarray, rho_h: np.ndarray, rho_a: np.ndarray,
+                length: float) -> list[tuple[float, str, int]]:
+    """(target front m, class, index in its class) of every vehicle, downstream first."""
+    cand = [(p, HV_TYPE, k) for k, p in enumerate(_targets(x, rho_h, length))]
+    cand += [(p, AV_TYPE, k) for k, p in enumerate(_targets(x, rho_a, length))]
+    cand.sort(key=lambda c: -c[0])
+    return cand
+
+
+def _column(allowed: np.ndarray, target: float, order: np.ndarray) -> int:
+    """Best fit: the column with the least room left above ``target`` (m), else the
+    roomiest; ``order`` (a random permutation) decides ties."""
+    fits = order[allowed[order] >= target]
+    return int(fits[np.argmin(allowed[fits])] if fits.size else
+               order[np.argmax(allowed[order])])
+
+
+def _fill_columns(cand: list[tuple[float, str, int]], kinds: dict[str, VehicleType],
+                  lats: np.ndarray, length: float, rng: np.random.Generator,
+                  ) -> tuple[list[tuple[str, str, float, float]], int, float, int]:
+    """Put the candidates, downstream first, into the lateral columns ``lats`` (m).
+
+    Returns (id, class, front m, lateral offset m) of each placed vehicle, the number moved
+    upstream, the largest shift (m) and the number dropped.
+    """
+    # back of the last vehicle placed in each column (+inf: free)
+    back = np.full(lats.size, np.inf)
+    placed: list[tuple[str, str, float, float]] = []
+    moved, max_shift, dropped = 0, 0.0, 0
+    for target, vtype, k in cand:
+        t = kinds[vtype]
+        allowed = np.minimum(back - t.min_gap, length)
+        col = _column(allowed, target, rng.permutation(lats.size))
+        front = min(target, float(allowed[col]))
+        if front < 0.0:
+            dropped += 1
+            continue
+        if front < target - 1e-9:
+            moved += 1
+            max_shift = max(max_shift, target - front)
+        back[col] = front - t.length
+        placed.append((f"{vtype}_init.{k}", vtype, front, float(lats[col])))
+    return placed, moved, max_shift, dropped
+
+
 def place_vehicles(params: ModelParameters, cfg: SumoConfig, x: ArrayLike, rho_h: ArrayLike,
                    v_h: ArrayLike, rho_a: ArrayLike, v_a: ArrayLike,
                    ) -> tuple[list[InitialVehicle], PlacementReport]:
@@ -85,42 +141,15 @@ def place_vehicles(params: ModelParameters, cfg: SumoConfig, x: ArrayLike, rho_h
     """
     x = np.asarray(x, float)
     arrays = [np.asarray(a, float) for a in (rho_h, v_h, rho_a, v_a)]
-    for name, a in zip(("rho_h", "v_h", "rho_a", "v_a"), arrays, strict=True):
-        require(a.shape == x.shape, name, a.shape, f"the shape of x {x.shape}")
-        require(bool(np.all(np.isfinite(a)) and np.all(a >= 0)), name, "array",
-                "finite values >= 0")
-    require(x.ndim == 1 and x.size >= 1 and bool(np.all(np.diff(x) > 0))
-            and x[0] > 0 and x[-1] < params.length, "x", "array",
-            f"increasing cell centres inside (0, {params.length}) m")
+    _check_profiles(params, x, arrays)
     hv_t, av_t = vehicle_types(params, cfg)
-    kinds = {HV_TYPE: hv_t, AV_TYPE: av_t}
-    cand = [(p, HV_TYPE, k) for k, p in enumerate(_targets(x, arrays[0], params.length))]
-    cand += [(p, AV_TYPE, k) for k, p in enumerate(_targets(x, arrays[2], params.length))]
-    cand.sort(key=lambda c: -c[0])
-    lats = column_offsets(params.road_width, params.vehicle_width)
-    rng = np.random.default_rng(cfg.seed)
-    # back of the last vehicle placed in each column (+inf: free)
-    back = np.full(lats.size, np.inf)
-    out: list[InitialVehicle] = []
-    moved, max_shift, dropped = 0, 0.0, 0
-    for target, vtype, k in cand:
-        t = kinds[vtype]
-        allowed = np.minimum(back - t.min_gap, params.length)
-        order = rng.permutation(lats.size)
-        fits = order[allowed[order] >= target]
-        # best fit: the column with the least room left above the target, else the roomiest
-        col = int(fits[np.argmin(allowed[fits])] if fits.size else
-                  order[np.argmax(allowed[order])])
-        front = min(target, float(allowed[col]))
-        if front < 0.0:
-            dropped += 1
-            continue
-        if front < target - 1e-9:
-            moved += 1
-            max_shift = max(max_shift, target - front)
-        back[col] = front - t.length
-        speed = float(np.interp(front, x, arrays[1] if vtype == HV_TYPE else arrays[3]))
-        out.append(InitialVehicle(f"{vtype}_init.{k}", vtype, front, speed, float(lats[col])))
+    speeds = {HV_TYPE: arrays[1], AV_TYPE: arrays[3]}
+    placed, moved, max_shift, dropped = _fill_columns(
+        _candidates(x, arrays[0], arrays[2], params.length), {HV_TYPE: hv_t, AV_TYPE: av_t},
+        column_offsets(params.road_width, params.vehicle_width), params.length,
+        np.random.default_rng(cfg.seed))
+    out = [InitialVehicle(vid, vtype, front, float(np.interp(front, x, speeds[vtype])), lat)
+           for vid, vtype, front, lat in placed]
     out.sort(key=lambda v: v.id)
     n_h = sum(1 for v in out if v.type == HV_TYPE)
     report = PlacementReport(n_h, len(out) - n_h, moved, max_shift, dropped)

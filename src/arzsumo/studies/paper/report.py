@@ -104,103 +104,115 @@ def _reasons(rows: Sequence[dict[str, Any]]) -> str:
     return "\n".join(f"- {reason} ({', '.join(cells)})." for reason, cells in by_reason.items())
 
 
-def report_markdown(rep: Reproduction) -> str:
-    """The text of ``report.md``."""
-    perf, delay = performance_table(rep), delay_table(rep)
-    pen, ev, sens = penetration_table(rep), events_table(rep), sensitivity_table(rep)
-    cl = claims(rep)
-    n_ok = sum(c.verdict == REPRODUCED for c in cl)
+def _section(title: str, *blocks: str) -> list[str]:
+    """A markdown section: its title and blocks, each followed by a blank line."""
+    return [title, ""] + [line for block in blocks for line in (block, "")]
+
+
+def _overview(rep: Reproduction) -> list[str]:
+    """Title, what was run, how to read the verdicts, and the runs without a baseline."""
     stopped = [f"{r.name}: {r.summary['open_loop_baseline']}" for r in rep.records
                if not r.summary["complete"]
                or str(r.summary["open_loop_baseline"]).startswith("no comparison")]
-    parts = [
-        "# Reproduction of section 5 on the nonlinear PDE twin",
-        "",
-        f"{len(rep.records)} runs ({rep.open_loops} open loops shared by the controllers of "
-        f"each scenario) from `{rep.source}`, {rep.wall_time:.0f} s wall time on "
-        f"{rep.workers} process(es)."
-        + (f" **Quick mode** ({QUICK_TWIN}): the numbers are not meaningful." if rep.quick
-           else "")
-        + (f" Overrides of every `[twin]`: {rep.overrides}." if rep.overrides else ""),
-        "",
+    runs = (f"{len(rep.records)} runs ({rep.open_loops} open loops shared by the controllers "
+            f"of each scenario) from `{rep.source}`, {rep.wall_time:.0f} s wall time on "
+            f"{rep.workers} process(es)."
+            + (f" **Quick mode** ({QUICK_TWIN}): the numbers are not meaningful." if rep.quick
+               else "")
+            + (f" Overrides of every `[twin]`: {rep.overrides}." if rep.overrides else ""))
+    reading = (
         "Relative changes are against the open loop of the same scenario, in percent "
         "(negative = better). *yes* = reproduced in direction (same sign, at least "
         "0.05 % in size), **no** = not reproduced. Magnitudes are not expected to match: "
         "the paper does not give the vehicle width d (2.0 m here), the initial amplitude "
         "(2 % stop-and-go here), the aggressive case's speeds and maximum AOs; its 1/4 "
         "profile fraction is infeasible (0.15 here); the grid is 200 cells (first order "
-        "unless overridden).",
-        "",
-        ("Runs without a baseline because they or their open loop left the physical "
-         "domain (kept, marked incomplete): " + "; ".join(stopped) + "." if stopped else
-         "All runs and their open loops completed."),
-        "",
-        f"## Claims ({n_ok} of {len(cl)} reproduced in direction)",
-        "",
-        _claims_md(cl),
-        "",
-        "## Table diffperformance",
-        "",
-        markdown_table(perf, ["label", "paper_J_fuel_percent", "ours_J_fuel_percent",
-                              "J_fuel_percent_verdict", "paper_J_discom_percent",
-                              "ours_J_discom_percent", "J_discom_percent_verdict",
-                              "paper_J_TTT_percent", "ours_J_TTT_percent",
-                              "J_TTT_percent_verdict", "paper_release_time_s",
-                              "ours_release_time_s"],
-                       ["scenario", "J_fuel paper", "ours", "", "J_discom paper", "ours", "",
-                        "J_TTT paper", "ours", "", "release paper (s)", "ours (s)"]),
-        "",
-        "## Table totaldelay",
-        "",
-        markdown_table(delay, ["label", "paper_HV_delay_percent", "ours_HV_delay_percent",
-                               "HV_delay_percent_verdict", "paper_AV_delay_percent",
-                               "ours_AV_delay_percent", "AV_delay_percent_verdict",
-                               "paper_total_delay_percent", "ours_total_delay_percent",
-                               "total_delay_percent_verdict"],
-                       ["scenario", "HV paper", "ours", "", "AV paper", "ours", "",
-                        "total paper", "ours", ""]),
-        "",
-        "Reasons where a cell is not reproduced:",
-        "",
-        _reasons(perf + delay),
-        "",
-        "## Table diffpene (equal inflow 5680 veh/h, congested branch)",
-        "",
-        markdown_table(pen, ["penetration_percent", "rho_h_veh_km", "rho_a_veh_km",
-                             "paper_release_time_s", "ours_release_time_s", "paper_triggers",
-                             "ours_triggers"],
-                       ["AV %", "rho_h (veh/km)", "rho_a (veh/km)", "release paper (s)",
-                        "ours (s)", "triggers paper", "ours"]),
-        "",
-        "## Triggers and release times in the text and figures",
-        "",
-        markdown_table(ev, ["label", "paper_triggers", "ours_triggers", "paper_release_time_s",
-                            "ours_release_time_s", "ours_final_norm_ratio",
-                            "ours_lyapunov_time_s", "where"],
-                       ["run", "triggers paper", "ours", "release paper (s)", "ours (s)",
-                        "norm ratio at end", "Lyapunov time (s)", "paper source"]),
-        "",
-        f"Lyapunov time: first time after which V (label lyapunov, evaluated by the "
-        f"controller on the linearised Riemann state of the twin) stays below "
-        f"{LYAPUNOV_FRACTION:g} V(0).",
-        "",
-        "## Sensitivity (figure sensitive_analysis)",
-        "",
-        markdown_table(sens, ["parameter", "value", "triggers", "release_time_s",
-                              "lyapunov_time_s", "final_norm_ratio"],
-                       ["parameter", "value", "triggers", "release (s)", "Lyapunov time (s)",
-                        "norm ratio at end"]),
-        "",
-        "## Figures",
-        "",
-        "![release instants](release_instants.png)",
-        "",
-        "![penetration](penetration.png)",
-        "",
-        "![sensitivity](sensitivity.png)",
-        "",
-    ]
-    return "\n".join(parts)
+        "unless overridden).")
+    baseline = ("Runs without a baseline because they or their open loop left the physical "
+                "domain (kept, marked incomplete): " + "; ".join(stopped) + "." if stopped
+                else "All runs and their open loops completed.")
+    return _section("# Reproduction of section 5 on the nonlinear PDE twin", runs, reading,
+                    baseline)
+
+
+def _claims_section(cl: Sequence[Claim]) -> list[str]:
+    """Every claim with its verdict, and how many are reproduced."""
+    n_ok = sum(c.verdict == REPRODUCED for c in cl)
+    return _section(f"## Claims ({n_ok} of {len(cl)} reproduced in direction)",
+                    _claims_md(cl))
+
+
+def _performance_section(perf: Sequence[dict[str, Any]]) -> list[str]:
+    """Table diffperformance: relative J_fuel, J_discom, J_TTT (%) and release time (s)."""
+    return _section("## Table diffperformance", markdown_table(
+        perf, ["label", "paper_J_fuel_percent", "ours_J_fuel_percent",
+               "J_fuel_percent_verdict", "paper_J_discom_percent", "ours_J_discom_percent",
+               "J_discom_percent_verdict", "paper_J_TTT_percent", "ours_J_TTT_percent",
+               "J_TTT_percent_verdict", "paper_release_time_s", "ours_release_time_s"],
+        ["scenario", "J_fuel paper", "ours", "", "J_discom paper", "ours", "",
+         "J_TTT paper", "ours", "", "release paper (s)", "ours (s)"]))
+
+
+def _delay_section(perf: Sequence[dict[str, Any]],
+                   delay: Sequence[dict[str, Any]]) -> list[str]:
+    """Table totaldelay (%), then the reasons of the cells of both tables not reproduced."""
+    table = markdown_table(
+        delay, ["label", "paper_HV_delay_percent", "ours_HV_delay_percent",
+                "HV_delay_percent_verdict", "paper_AV_delay_percent", "ours_AV_delay_percent",
+                "AV_delay_percent_verdict", "paper_total_delay_percent",
+                "ours_total_delay_percent", "total_delay_percent_verdict"],
+        ["scenario", "HV paper", "ours", "", "AV paper", "ours", "", "total paper", "ours",
+         ""])
+    return _section("## Table totaldelay", table, "Reasons where a cell is not reproduced:",
+                    _reasons([*perf, *delay]))
+
+
+def _penetration_section(pen: Sequence[dict[str, Any]]) -> list[str]:
+    """Table diffpene: densities (veh/km), release time (s) and triggers per AV share."""
+    return _section("## Table diffpene (equal inflow 5680 veh/h, congested branch)",
+                    markdown_table(pen, ["penetration_percent", "rho_h_veh_km", "rho_a_veh_km",
+                                         "paper_release_time_s", "ours_release_time_s",
+                                         "paper_triggers", "ours_triggers"],
+                                   ["AV %", "rho_h (veh/km)", "rho_a (veh/km)",
+                                    "release paper (s)", "ours (s)", "triggers paper", "ours"]))
+
+
+def _events_section(ev: Sequence[dict[str, Any]]) -> list[str]:
+    """Triggers and release times (s) stated in the text and figures, and the Lyapunov time."""
+    table = markdown_table(ev, ["label", "paper_triggers", "ours_triggers",
+                                "paper_release_time_s", "ours_release_time_s",
+                                "ours_final_norm_ratio", "ours_lyapunov_time_s", "where"],
+                           ["run", "triggers paper", "ours", "release paper (s)", "ours (s)",
+                            "norm ratio at end", "Lyapunov time (s)", "paper source"])
+    lyapunov = (f"Lyapunov time: first time after which V (label lyapunov, evaluated by the "
+                f"controller on the linearised Riemann state of the twin) stays below "
+                f"{LYAPUNOV_FRACTION:g} V(0).")
+    return _section("## Triggers and release times in the text and figures", table, lyapunov)
+
+
+def _sensitivity_section(sens: Sequence[dict[str, Any]]) -> list[str]:
+    """The sweeps over mu, sigma, zeta: triggers, release and Lyapunov times (s)."""
+    return _section("## Sensitivity (figure sensitive_analysis)",
+                    markdown_table(sens, ["parameter", "value", "triggers", "release_time_s",
+                                          "lyapunov_time_s", "final_norm_ratio"],
+                                   ["parameter", "value", "triggers", "release (s)",
+                                    "Lyapunov time (s)", "norm ratio at end"]))
+
+
+def _figures_section() -> list[str]:
+    """Links to the three figures written beside ``report.md``."""
+    return _section("## Figures", "![release instants](release_instants.png)",
+                    "![penetration](penetration.png)", "![sensitivity](sensitivity.png)")
+
+
+def report_markdown(rep: Reproduction) -> str:
+    """The text of ``report.md``, assembled section by section."""
+    perf, delay = performance_table(rep), delay_table(rep)
+    sections = [_overview(rep), _claims_section(claims(rep)), _performance_section(perf),
+                _delay_section(perf, delay), _penetration_section(penetration_table(rep)),
+                _events_section(events_table(rep)), _sensitivity_section(sensitivity_table(rep)),
+                _figures_section()]
+    return "\n".join(line for section in sections for line in section)
 
 
 def figure_data(rep: Reproduction) -> ReproduceFigures:
