@@ -12,13 +12,12 @@ from __future__ import annotations
 
 import argparse
 import time
+from dataclasses import replace
 from pathlib import Path
 
-from arzsumo.bridge.config import run_settings_from_dict
 from arzsumo.bridge.cosim import run_cosimulation
 from arzsumo.control.etc import PAPER_DESIGN
-from arzsumo.scenarios import load_scenario
-from arzsumo.sumo.config import sumo_config_of
+from arzsumo.scenario import load_scenario
 from arzsumo.sumo.simulation import open_simulation
 
 DEFAULT = Path(__file__).resolve().parents[1] / "scenarios" / "default.toml"
@@ -39,8 +38,8 @@ def main() -> None:
     ap.add_argument("--horizon", type=float, default=450.0)
     args = ap.parse_args()
     sc = load_scenario(DEFAULT)
-    settings = run_settings_from_dict(sc.raw, sc.source, controller=args.controller)
-    cfg = sumo_config_of(sc).with_(horizon=args.horizon)
+    settings = replace(sc.run, controller=args.controller)
+    cfg = sc.sumo.with_(horizon=args.horizon)
     total = settings.warmup + args.horizon
     run_cosimulation(sc, settings, cfg.with_(horizon=10.0), PAPER_DESIGN)   # kernels cached
     t_bare, t_co, last = [], [], None

@@ -11,7 +11,7 @@ from arzsumo.resources import (
     shipped_scenarios_dir,
     shipped_sweeps_dir,
 )
-from arzsumo.scenarios import load_scenario
+from arzsumo.scenario import load_scenario
 from arzsumo.sweep.spec import load_sweep
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -30,7 +30,7 @@ def test_shipped_dirs_are_inside_the_package_and_hold_their_files():
     assert sorted(p.stem for p in shipped_sweeps_dir().glob("*.toml")) == list(SWEEPS)
     assert len(list((shipped_scenarios_dir() / "paper").glob("*.toml"))) == 20
     sc = load_scenario(default_scenario())
-    assert sc.name == "default" and sc.raw["sumo"]["demand_h_veh_h"] == 4104
+    assert sc.name == "default" and sc.sumo.demand_h * 3600 == pytest.approx(4104)
 
 
 @pytest.mark.skipif(not (ROOT / "pyproject.toml").is_file(), reason="needs a source checkout")

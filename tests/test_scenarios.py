@@ -1,7 +1,7 @@
 import pytest
 
 from arzsumo.errors import ScenarioError
-from arzsumo.scenarios import load_scenario, scenario_from_dict
+from arzsumo.scenario import load_scenario, scenario_from_dict
 
 
 def test_scenario_units_are_converted_to_si():

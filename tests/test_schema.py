@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import re
+from dataclasses import replace
 from pathlib import Path
 
 import pandas as pd
@@ -45,19 +46,18 @@ def _assert_all_units(table: pa.Table) -> dict[str, str]:
 @pytest.fixture(scope="module")
 def run_dir(tmp_path_factory):
     """A short closed loop in SUMO (ETC), written as ``arzsumo run`` writes it."""
-    from arzsumo.bridge.config import run_settings_from_dict
+
     from arzsumo.bridge.cosim import run_cosimulation
     from arzsumo.control.etc import PAPER_DESIGN
     from arzsumo.outputs.bridge import write_results
-    from arzsumo.scenarios import load_scenario
-    from arzsumo.sumo.config import sumo_config_of
+    from arzsumo.scenario import load_scenario
 
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv("ARZSUMO_CACHE", str(tmp_path_factory.mktemp("cache")))
         sc = load_scenario(ROOT / "scenarios" / "default.toml")
-        settings = run_settings_from_dict(sc.raw, sc.source, controller="etc", warmup=20.0,
-                                          kernel_cells=40, twin_cells=40)
-        cfg = sumo_config_of(sc).with_(horizon=20.0, seed=3)
+        settings = replace(sc.run, controller="etc", warmup=20.0,
+                           kernel_cells=40, twin_cells=40)
+        cfg = sc.sumo.with_(horizon=20.0, seed=3)
         res = run_cosimulation(sc, settings, cfg, PAPER_DESIGN)
         path, summ = write_results(res, tmp_path_factory.mktemp("run") / "run", "# t\n",
                                    plots=False)

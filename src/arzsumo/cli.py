@@ -23,7 +23,7 @@ from arzsumo.cli_common import add_model_source, scenario_of
 from arzsumo.errors import ArzsumoError
 from arzsumo.interrupts import EXIT_INTERRUPTED
 from arzsumo.model import linearize
-from arzsumo.scenarios import Scenario
+from arzsumo.scenario import Scenario
 from arzsumo.units import ms_to_kmh
 
 log = logging.getLogger("arzsumo")

@@ -7,8 +7,8 @@ import json
 import logging
 from pathlib import Path
 
-from arzsumo.bridge.config import CONTROLLERS
 from arzsumo.cli_args import positive_float, seed_int
+from arzsumo.control.registry import controller_names
 
 log = logging.getLogger("arzsumo")
 
@@ -18,7 +18,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     from arzsumo.outdir import OutputDir
     from arzsumo.outputs.bridge import write_results
     from arzsumo.resources import default_scenario
-    from arzsumo.scenarios import load_scenario
+    from arzsumo.scenario import load_scenario
 
     # the shipped default, found in the package so that any working directory will do
     path = Path(args.scenario) if args.scenario else default_scenario()
@@ -72,7 +72,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="replace a previous run result in the --out directory")
     p.add_argument("--seed", type=seed_int,
                    help="SUMO seed in [0, 2^31) (default: [sumo] seed)")
-    p.add_argument("--controller", choices=list(CONTROLLERS),
+    p.add_argument("--controller", choices=list(controller_names("sumo")),
                    help="controller (default: [run] controller)")
     p.add_argument("--horizon", type=positive_float,
                    help="control horizon after the warm-up, s; at least one control period "

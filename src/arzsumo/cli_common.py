@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 
 from arzsumo.model.params import PRESETS
-from arzsumo.scenarios import Scenario, load_scenario, scenario_from_preset
+from arzsumo.scenario import Scenario, load_scenario, scenario_from_preset
 
 
 def scenario_of(args: argparse.Namespace) -> Scenario:

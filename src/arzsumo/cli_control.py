@@ -8,6 +8,7 @@ import time
 
 from arzsumo.cli_args import cells_int, positive_float
 from arzsumo.cli_common import add_model_source, scenario_of
+from arzsumo.control.registry import pde_controller_names
 from arzsumo.errors import require
 from arzsumo.kernel_cache import cached_kernels
 
@@ -101,7 +102,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                                    "controller on it with periodic checks.")
     _add_common(p)
     p.add_argument("--controller", default="theory",
-                   choices=["theory", "backstepping", "etc", "observer-etc"],
+                   choices=["theory", *pde_controller_names()],
                    help="'theory': the backstepping checks (default); else run that "
                         "controller with periodic checks")
     p.add_argument("--period", type=positive_float, default=1.0, help="check period, s")

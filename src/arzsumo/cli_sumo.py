@@ -38,12 +38,11 @@ def cmd_build_net(args: argparse.Namespace) -> int:
 def cmd_calibrate(args: argparse.Namespace) -> int:
     from arzsumo.outdir import OutputDir
     from arzsumo.outputs.calibration import write_calibration
-    from arzsumo.scenarios import load_scenario, scenario_from_preset
+    from arzsumo.scenario import load_scenario, scenario_from_preset
     from arzsumo.sumo.calibrate import CalibrationPlan, calibrate
-    from arzsumo.sumo.config import sumo_config_of
 
     sc = load_scenario(args.scenario) if args.scenario else scenario_from_preset(args.preset)
-    cfg = sumo_config_of(sc)
+    cfg = sc.sumo
     changes = {"seed": args.seed, "step_length": args.step_length}
     cfg = cfg.with_(**{k: v for k, v in changes.items() if v is not None})
     plan = CalibrationPlan()

@@ -22,7 +22,7 @@ from arzsumo.io import toml_value
 
 #: what a value of each kind must be (the type part of error messages)
 KIND_TEXT = {"number": "a finite number", "integer": "an integer", "string": "a string",
-             "bool": "true or false"}
+             "bool": "true or false", "numbers": "a list of numbers"}
 
 
 @dataclass(frozen=True)
@@ -34,7 +34,8 @@ class Key:
     field : str
         The SI field it sets (of the dataclass behind the table).
     kind : str
-        ``"number"`` (finite int or float), ``"integer"``, ``"string"`` or ``"bool"``.
+        ``"number"`` (finite int or float), ``"integer"``, ``"string"``, ``"bool"`` or
+        ``"numbers"`` (a non-empty list of finite numbers, read as a tuple).
     factor : float
         User units per SI unit: 3.6 for km/h, 3600 for veh/h, 1000 for veh/km, 1 for SI.
     allowed : str, optional
@@ -42,6 +43,11 @@ class Key:
         would mislead (numbers in veh/s, m/s or veh/m).
     choices : tuple of str
         The allowed strings of a ``"string"`` key (empty: any string).
+    unit : str
+        The key's unit as written in files ("km/h", "veh/h", "s", "m"; "" for none):
+        what ``docs/scenarios.md`` states.
+    doc : str
+        What the key means (one line, for ``docs/scenarios.md``).
     """
 
     field: str
@@ -49,6 +55,8 @@ class Key:
     factor: float = 1.0
     allowed: str | None = None
     choices: tuple[str, ...] = ()
+    unit: str = ""
+    doc: str = ""
 
 
 def written(value: Any) -> str:
@@ -80,6 +88,14 @@ def check_keys(table: Mapping[str, Any], allowed: set[str] | Mapping[str, Any],
                             f"allowed: {', '.join(sorted(allowed))}")
 
 
+def check_renamed(table: Mapping[str, Any], renamed: Mapping[str, str], at: str) -> None:
+    """Refuse a key of ``table`` that was renamed, naming its new name (one line)."""
+    for old, new in renamed.items():
+        if old in table:
+            raise ScenarioError(f"{at} {old} was renamed: write {new} = "
+                                f"{written(table[old])} instead")
+
+
 def sub_table(data: Mapping[str, Any], name: str, allowed: set[str] | Mapping[str, Any],
               source: str) -> dict[str, Any]:
     """The ``[name]`` table of ``data`` (empty if absent), its keys checked."""
@@ -100,6 +116,10 @@ def checked(value: Any, kind: str, at: str, key: str,
         ok = isinstance(value, int) and not isinstance(value, bool)
     elif kind == "bool":
         ok = isinstance(value, bool)
+    elif kind == "numbers":
+        ok = isinstance(value, list) and bool(value) and all(
+            isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+            for v in value)
     else:
         ok = isinstance(value, str) and (not choices or value in choices)
     if not ok:
@@ -116,7 +136,11 @@ def read_keys(table: Mapping[str, Any], keys: Mapping[str, Key], at: str) -> dic
         if spec is None:
             continue
         value = checked(value, spec.kind, at, key, spec.choices)
-        out[spec.field] = value / spec.factor if spec.kind == "number" else value
+        if spec.kind == "numbers":
+            value = tuple(float(v) / spec.factor for v in value)
+        elif spec.kind == "number":
+            value = value / spec.factor
+        out[spec.field] = value
     return out
 
 

@@ -7,20 +7,19 @@ import json
 import os
 import subprocess
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import pandas as pd
 import pytest
 
 from arzsumo.bridge.compare import bar_title, row_of
-from arzsumo.bridge.config import run_settings_from_dict
 from arzsumo.bridge.cosim import run_cosimulation
 from arzsumo.cli import main
 from arzsumo.control.etc import PAPER_DESIGN
 from arzsumo.outputs.bridge import write_results
 from arzsumo.outputs.compare import compare_runs
-from arzsumo.scenarios import load_scenario
-from arzsumo.sumo.config import sumo_config_of
+from arzsumo.scenario import load_scenario
 
 DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "default.toml"
 SRC = str(Path(__file__).resolve().parents[2] / "src")
@@ -50,9 +49,9 @@ def dirs(tmp_path_factory):
                                             ("a1", "alinea", 1, 12.0),
                                             ("a2", "alinea", 2, 12.0),
                                             ("long", "open", 1, 18.0)):
-        settings = run_settings_from_dict(sc.raw, sc.source, controller=controller,
-                                          warmup=12.0, twin_cells=40)
-        cfg = sumo_config_of(sc).with_(horizon=horizon, seed=seed)
+        settings = replace(sc.run, controller=controller,
+                           warmup=12.0, twin_cells=40)
+        cfg = sc.sumo.with_(horizon=horizon, seed=seed)
         res = run_cosimulation(sc, settings, cfg, PAPER_DESIGN)
         out[name] = write_results(res, root / name, "# test\n", plots=False)[0]
     (root / "twin.toml").write_text(TWIN)

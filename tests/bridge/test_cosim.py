@@ -5,20 +5,20 @@ import signal
 import subprocess
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
-from arzsumo.bridge.config import RunSettings, run_settings_from_dict
 from arzsumo.bridge.cosim import run_cosimulation
 from arzsumo.cli import main
 from arzsumo.control.etc import PAPER_DESIGN
 from arzsumo.errors import ScenarioError
 from arzsumo.outputs.bridge import write_results
-from arzsumo.scenarios import load_scenario
-from arzsumo.sumo.config import sumo_config_of
+from arzsumo.scenario import load_scenario
+from arzsumo.scenario.run import RunSettings
 
 DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "default.toml"
 pytestmark = pytest.mark.sumo
@@ -30,9 +30,9 @@ def scenario():
 
 
 def _short(scenario, controller, seed=42, horizon=60.0, warmup=40.0):
-    settings = run_settings_from_dict(scenario.raw, scenario.source, controller=controller,
-                                      warmup=warmup, kernel_cells=50, twin_cells=50)
-    cfg = sumo_config_of(scenario).with_(horizon=horizon, seed=seed)
+    settings = replace(scenario.run, controller=controller,
+                       warmup=warmup, kernel_cells=50, twin_cells=50)
+    cfg = scenario.sumo.with_(horizon=horizon, seed=seed)
     return run_cosimulation(scenario, settings, cfg, PAPER_DESIGN)
 
 
@@ -99,7 +99,7 @@ def test_free_flow_with_a_pde_controller_is_refused_before_sumo_starts(tmp_path,
     path.write_text(text)
     sc = load_scenario(path)
     with pytest.raises(ScenarioError, match=r"lambda_4 = .* >= 0 \(free flow\)"):
-        run_cosimulation(sc, RunSettings(controller="etc"), sumo_config_of(sc), PAPER_DESIGN)
+        run_cosimulation(sc, RunSettings(controller="etc"), sc.sumo, PAPER_DESIGN)
     t0 = time.perf_counter()
     assert main(["run", str(path), "--quiet", "--out", str(tmp_path / "out")]) == 2
     assert time.perf_counter() - t0 < 5                  # no SUMO run happened

@@ -7,6 +7,7 @@ control window's counts.
 """
 
 import json
+from dataclasses import replace
 from itertools import pairwise
 from pathlib import Path
 
@@ -14,12 +15,10 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
-from arzsumo.bridge.config import run_settings_from_dict
 from arzsumo.bridge.cosim import run_cosimulation
 from arzsumo.control.etc import PAPER_DESIGN
 from arzsumo.outputs.bridge import write_results
-from arzsumo.scenarios import load_scenario
-from arzsumo.sumo.config import sumo_config_of
+from arzsumo.scenario import load_scenario
 from arzsumo.sumo.meter import plan_green_steps
 
 DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "default.toml"
@@ -32,9 +31,9 @@ def result(tmp_path_factory):
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv("ARZSUMO_CACHE", str(tmp_path_factory.mktemp("cache")))
         sc = load_scenario(DEFAULT)
-        settings = run_settings_from_dict(sc.raw, sc.source, controller="backstepping",
-                                          warmup=WARMUP, kernel_cells=50, twin_cells=50)
-        cfg = sumo_config_of(sc).with_(horizon=HORIZON, seed=1)
+        settings = replace(sc.run, controller="backstepping",
+                           warmup=WARMUP, kernel_cells=50, twin_cells=50)
+        cfg = sc.sumo.with_(horizon=HORIZON, seed=1)
         res = run_cosimulation(sc, settings, cfg, PAPER_DESIGN)
         path, _ = write_results(res, tmp_path_factory.mktemp("run") / "bs", "# test\n",
                                 plots=False)

@@ -18,7 +18,7 @@ from arzsumo.bridge.session import prepare_run
 from arzsumo.cli import main
 from arzsumo.errors import ScenarioError
 from arzsumo.io import dump_toml
-from arzsumo.scenarios import load_scenario, scenario_from_dict
+from arzsumo.scenario import load_scenario, scenario_from_dict
 from arzsumo.sweep.spec import scenario_fields
 
 DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "default.toml"
@@ -65,8 +65,10 @@ def test_placement_draws_the_initial_profile_on_the_sumo_cells():
     ({"run": {"controller": "pid"}}, {}, r'\[run\] controller = "pid" is not allowed: one of'),
     ({"run": {"kernel_cells": {"a": 1}}}, {},
      r"\[run\] kernel_cells = \{a = 1\} is not allowed: an integer"),
-    ({"run": {"equilibrium": "measured", "warmup_s": 30}}, {},
-     r'\[run\] equilibrium = "measured" is not allowed: .measured. needs warmup_s >= 60'),
+    ({"run": {"operating_point": "measured", "warmup_s": 30}}, {},
+     r'\[run\] operating_point = "measured" is not allowed: .measured. needs warmup_s >= 60'),
+    ({"run": {"equilibrium": "measured"}}, {},
+     r'^x.toml: \[run\] equilibrium was renamed: write operating_point = "measured" instead$'),
     ({"design": {"mu": -1}}, {}, r"\[design\] mu = -1 is not allowed: a number > 0"),
     ({"initial": {"kind": "linear", "fraction": 1.5}}, {},
      r"\[initial\] fraction = 1.5 is not allowed: a fraction f in \(-1, 1\)"),

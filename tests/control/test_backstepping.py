@@ -85,18 +85,28 @@ def test_controller_applies_the_law_in_physical_units(lin, kernels):
 
 
 def test_registry_builds_every_controller(lin, kernels):
-    from arzsumo.control import CONTROLLERS, make_controller
-    from arzsumo.errors import ModelError
+    from arzsumo.control import make_controller
+    from arzsumo.control.registry import Alinea as AlineaClass
+    from arzsumo.control.registry import ControllerInputs, controller_names, controller_spec
+    from arzsumo.errors import ModelError, ScenarioError
 
     eq = lin.equilibrium
     x = kernels.x
     z = sinusoidal_deviation(lin, x)
     state = MacroState(0.0, x, eq.rho_h + z[0], eq.v_h + z[1], eq.rho_a + z[2], eq.v_a + z[3])
-    us = {name: make_controller(name, lin, kernels).check(state) for name in CONTROLLERS}
-    assert us["open"] == 0.0
+    alinea = {"outflow_of_green": lambda g: 0.2 + 0.3 * g, "nominal_green": 0.5,
+              "target": 0.2}
+    inputs = ControllerInputs(lin, kernels, constant_u=0.125, alinea=alinea)
+    us = {name: controller_spec(name).build(inputs).check(state)
+          for name in controller_names()}
+    assert set(us) == {"open", "backstepping", "etc", "observer-etc", "constant", "alinea"}
+    assert us["open"] == 0.0 and us["constant"] == 0.125
     assert us["backstepping"] == pytest.approx(us["etc"])        # first ETC check is an event
-    with pytest.raises(ModelError, match="controller = 'pid' is not allowed"):
+    assert isinstance(controller_spec("alinea").build(inputs), AlineaClass)
+    with pytest.raises(ScenarioError, match="controller = 'pid' is not allowed"):
         make_controller("pid", lin, kernels)
+    with pytest.raises(ModelError, match="needs backstepping kernels"):
+        make_controller("etc", lin, None)
 
 
 def test_alinea_integrates_occupancy_error():

@@ -7,8 +7,8 @@ import pytest
 
 from arzsumo.errors import ArzsumoError, ModelError, ScenarioError
 from arzsumo.model import get_preset
-from arzsumo.scenarios import scenario_from_dict
-from arzsumo.sumo.config import SumoConfig, sumo_config_from_table, sumo_config_of
+from arzsumo.scenario import scenario_from_dict
+from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.demand import Flow, demand_flows, route_file_text
 from arzsumo.sumo.measure import EdieGrid
 from arzsumo.sumo.meter import GreenShareCurve, plan_green_steps
@@ -19,8 +19,9 @@ PARAMS = get_preset("paper_base").params
 
 
 def test_sumo_table_converts_units():
-    cfg = sumo_config_from_table({"step_length_s": 0.2, "demand_h_veh_h": 3600,
-                                  "ramp_demand_veh_h": 720, "seed": 7, "av_model": "CACC"})
+    cfg = scenario_from_dict({"sumo": {"step_length_s": 0.2, "demand_h_veh_h": 3600,
+                                       "ramp_demand_veh_h": 720, "seed": 7,
+                                       "av_model": "CACC"}}).sumo
     assert cfg.step_length == 0.2 and cfg.seed == 7 and cfg.av_model == "CACC"
     assert cfg.demand_h == pytest.approx(1.0)
     assert cfg.ramp_demand == pytest.approx(0.2)
@@ -41,15 +42,15 @@ def test_sumo_table_converts_units():
 ])
 def test_bad_sumo_table_names_key_and_value(table, message):
     with pytest.raises(ScenarioError, match=None) as info:
-        sumo_config_from_table(table, "test [sumo]")
+        scenario_from_dict({"sumo": table}, "test")
     assert message in str(info.value)
-    assert str(info.value).startswith("test [sumo]")
+    assert str(info.value).startswith("test: [sumo]")
 
 
 def test_scenario_sumo_table_is_validated_and_reachable():
     sc = scenario_from_dict({"model": {"preset": "paper_base"},
                              "sumo": {"horizon_s": 60, "seed": 3}})
-    assert sumo_config_of(sc).horizon == 60 and sumo_config_of(sc).seed == 3
+    assert sc.sumo.horizon == 60 and sc.sumo.seed == 3
     with pytest.raises(ScenarioError, match="unknown key 'horizon'"):
         scenario_from_dict({"sumo": {"horizon": 60}})
 

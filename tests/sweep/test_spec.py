@@ -7,9 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from arzsumo.scenarios import scenario_from_dict
+from arzsumo.scenario import scenario_from_dict
 from arzsumo.sweep import SweepError, load_sweep, sweep_from_dict
-from arzsumo.twin.config import twin_config_from_dict
 
 ROOT = Path(__file__).resolve().parents[2]
 BASE = "scenarios/paper/penetration_44_etc.toml"
@@ -34,7 +33,7 @@ def test_product_order_ids_and_resolved_scenarios():
     assert r.scenario["initial"]["kind"] == "random"
     assert spec.base_data["twin"]["cells"] == 200          # the base is not modified
     # every resolved scenario is a valid scenario, and the seed reaches the random wave
-    cfg = twin_config_from_dict(r.scenario, "run")
+    cfg = scenario_from_dict(r.scenario, "run").twin
     assert cfg.seed == 2 and cfg.initial.seed == 2 and cfg.initial.kind == "random"
     assert scenario_from_dict(r.scenario).equilibrium.penetration == pytest.approx(0.5)
     assert len({x.sha256 for x in runs}) == 6

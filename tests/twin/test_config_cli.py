@@ -11,9 +11,19 @@ import pytest
 
 from arzsumo.cli import main
 from arzsumo.control.base import ConstantControl
+from arzsumo.control.registry import (
+    ControllerSpec,
+    controller_names,
+    register_controller,
+    unregister_controller,
+)
 from arzsumo.errors import ScenarioError
-from arzsumo.twin.config import twin_config_from_dict
-from arzsumo.twin.controllers import CONTROLLERS, make_controller, register_controller
+from arzsumo.runs.twin import twin_controller
+from arzsumo.scenario import scenario_from_dict
+
+
+def twin_config_from_dict(data, source="<dict>"):
+    return scenario_from_dict(data, source).twin
 
 
 def test_defaults_and_units():
@@ -44,18 +54,22 @@ def test_bad_values_name_key_value_allowed(data, message):
 
 
 def test_registry_plugs_controllers_in(base_lin):
-    assert {"open", "constant"} <= set(CONTROLLERS)
-    register_controller("test-const", lambda lin, cfg: ConstantControl(0.05))
+    assert {"open", "constant"} <= set(controller_names("twin"))
+    assert "alinea" not in controller_names("twin")
+    register_controller(ControllerSpec("test-const", lambda inp: ConstantControl(0.05),
+                                       sumo=False))
     try:
         cfg = twin_config_from_dict({"twin": {"controller": "test-const"}})
-        ctrl = make_controller(cfg.controller, base_lin, cfg)
+        ctrl = twin_controller(cfg, base_lin)
         assert isinstance(ctrl, ConstantControl) and ctrl.u == 0.05
         with pytest.raises(ValueError, match="already registered"):
-            register_controller("test-const", lambda lin, cfg: ConstantControl(0.0))
+            register_controller(ControllerSpec("test-const", lambda inp: ConstantControl(0)))
+        with pytest.raises(ScenarioError, match=r'\[run\] controller = "test-const" is not'):
+            scenario_from_dict({"run": {"controller": "test-const"}})
     finally:
-        CONTROLLERS.pop("test-const")
-    with pytest.raises(ScenarioError, match="controller = 'nope' is unknown; allowed:"):
-        make_controller("nope", base_lin, cfg)
+        unregister_controller("test-const")
+    with pytest.raises(ScenarioError, match="controller = 'test-const' is not allowed: one of"):
+        twin_controller(cfg, base_lin)
 
 
 SHORT = """
@@ -124,9 +138,7 @@ def test_cli_twin_bad_scenario_is_one_line(tmp_path):
 
 def test_pde_controllers_run_in_the_twin_with_a_design_table(tmp_path, monkeypatch):
     """backstepping updates at every check; ETC far less often; [design] reaches the ETC."""
-    from arzsumo.scenarios import scenario_from_dict
-    from arzsumo.twin.config import twin_config_from_dict
-    from arzsumo.twin.run import run_twin
+    from arzsumo.runs.twin import run_twin
 
     monkeypatch.setenv("ARZSUMO_CACHE", str(tmp_path))
     base = {"model": {"preset": "paper_base"},
@@ -147,11 +159,6 @@ def test_pde_controllers_run_in_the_twin_with_a_design_table(tmp_path, monkeypat
 
 
 def test_bad_design_table_is_named():
-    import pytest
-
-    from arzsumo.errors import ScenarioError
-    from arzsumo.twin.config import twin_config_from_dict
-
     with pytest.raises(ScenarioError, match=r"\[design\] unknown key 'nu'"):
         twin_config_from_dict({"design": {"nu": 1.0}})
     with pytest.raises(ScenarioError, match=r"m0 = 0.5 is not allowed"):

@@ -39,20 +39,19 @@ from typing import Any
 import numpy as np
 
 from arzsumo.bridge.actuator import MeterActuator
-from arzsumo.bridge.config import RunSettings
 from arzsumo.bridge.estimator import Estimator, FundamentalDiagramFill
 from arzsumo.bridge.records import PeriodRecord, columns
 from arzsumo.bridge.twins import TwinPair
-from arzsumo.control.alinea import Alinea
-from arzsumo.control.base import Controller, ControlLog, MacroState, OpenLoop
+from arzsumo.control.base import Controller, ControlLog, MacroState
 from arzsumo.control.etc import EtcDesign
-from arzsumo.control.registry import PDE_CONTROLLERS, make_controller
+from arzsumo.control.registry import ControllerInputs, controller_spec, is_pde
 from arzsumo.errors import ArzsumoError, ScenarioError
 from arzsumo.model.characteristic import Linearization, linearize
 from arzsumo.model.equilibrium import Equilibrium
 from arzsumo.model.params import ModelParameters
 from arzsumo.progress import Progress
-from arzsumo.scenarios import Scenario
+from arzsumo.scenario import Scenario
+from arzsumo.scenario.run import RunSettings
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.meter import DEFAULT_CURVE, GreenShareCurve, RampMeter
 from arzsumo.sumo.sensor import PeriodMeasurement, SumoSensor
@@ -70,7 +69,7 @@ DEFAULT_OCCUPANCY_TARGET = 0.2
 def check_before_start(settings: RunSettings, eq: Equilibrium) -> Linearization:
     """Refuse a PDE controller at a free-flow equilibrium (lambda_4 >= 0), before SUMO runs."""
     lin = linearize(eq)
-    if settings.controller in PDE_CONTROLLERS and lin.regime != "congested":
+    if is_pde(settings.controller) and lin.regime != "congested":
         raise ScenarioError(
             f"controller = {settings.controller!r} is not allowed at this equilibrium: "
             f"lambda_4 = {lin.eigenvalues[3] * 3.6:.2f} km/h >= 0 (free flow); PDE "
@@ -178,15 +177,13 @@ def occupancy_target(settings: RunSettings, warm: list[PeriodMeasurement],
 def build_controller(name: str, lin: Linearization, kernels: Any, design: EtcDesign,
                      settings: RunSettings, curve: GreenShareCurve, cfg: SumoConfig,
                      alinea_target: float) -> Controller:
-    """A reset controller of ``name`` for the closed loop."""
-    ctrl: Controller
-    if name == "open":
-        ctrl = OpenLoop()
-    elif name == "alinea":
-        ctrl = Alinea(curve.outflow_at, cfg.green_share, alinea_target, settings.alinea_gain,
-                      settings.alinea_saturation, cfg.green_share_min, cfg.green_share_max)
-    else:
-        ctrl = make_controller(name, lin, kernels, design)
+    """A reset controller of ``name`` for the closed loop (the registry's builder)."""
+    alinea = {"outflow_of_green": curve.outflow_at, "nominal_green": cfg.green_share,
+              "target": alinea_target, "gain": settings.alinea_gain,
+              "saturation_flow": settings.alinea_saturation,
+              "green_min": cfg.green_share_min, "green_max": cfg.green_share_max}
+    ctrl = controller_spec(name, "sumo").build(ControllerInputs(lin, kernels, design,
+                                                                alinea=alinea))
     ctrl.reset()
     return ctrl
 
@@ -314,11 +311,11 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
         eq = operating_point(settings, scenario.equilibrium, warm, period)
         lin = linearize(eq)
         kernels = (cached_kernels(lin.system, settings.kernel_cells)
-                   if settings.controller in PDE_CONTROLLERS else None)
+                   if is_pde(settings.controller) else None)
         target = occupancy_target(settings, warm, period)
         ctrl = build_controller(settings.controller, lin, kernels, design, settings, curve,
                                 cfg, target)
-        ref_name = settings.controller if settings.controller in PDE_CONTROLLERS else "open"
+        ref_name = settings.controller if is_pde(settings.controller) else "open"
         ref_ctrl = build_controller(ref_name, lin, kernels, design, settings, curve, cfg,
                                     target)
         q_nom = curve.outflow_at(cfg.green_share)

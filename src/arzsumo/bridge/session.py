@@ -1,9 +1,9 @@
 """One closed-loop run of a scenario in SUMO, from a validated scenario to a result.
 
 The library function behind ``arzsumo run`` and the SUMO engine of ``arzsumo sweep``:
-it resolves the ``[run]``, ``[sumo]``, ``[design]`` and ``[initial]`` tables, applies the
-caller's overrides (:func:`prepare_run`, which also serves ``arzsumo run --dry-run``) and
-runs :func:`arzsumo.bridge.cosim.run_cosimulation`. It writes nothing.
+it takes the ``run``, ``sumo``, ``design`` and ``initial`` sections of a scenario, applies
+the caller's overrides (:func:`prepare_run`, which also serves ``arzsumo run --dry-run``)
+and runs :func:`arzsumo.bridge.cosim.run_cosimulation`. It writes nothing.
 """
 
 from __future__ import annotations
@@ -13,18 +13,19 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from arzsumo.bridge.config import RunSettings, run_settings_from_dict
 from arzsumo.bridge.cosim import CoSimResult, check_before_start, run_cosimulation
 from arzsumo.control.etc import EtcDesign
 from arzsumo.errors import ArzsumoError, ScenarioError
 from arzsumo.model import linearize
-from arzsumo.scenarios import Scenario, design_from_dict
-from arzsumo.sumo.config import SUMO_KEYS, SumoConfig, sumo_config_of
+from arzsumo.scenario import Scenario
+from arzsumo.scenario.run import RunSettings
+from arzsumo.scenario.sumo import SUMO_KEYS
+from arzsumo.scenario.twin import seeded
+from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.measure import EdieGrid
 from arzsumo.sumo.meter import DEFAULT_CURVE, GreenShareCurve
 from arzsumo.sumo.network import NetworkSpec
 from arzsumo.tables import in_user_terms, not_allowed, written
-from arzsumo.twin.config import initial_from_dict
 from arzsumo.twin.initial import initial_fields
 from arzsumo.units import ms_to_kmh
 
@@ -80,19 +81,31 @@ def _horizon(horizon: float, cfg: SumoConfig) -> float:
     return float(horizon)
 
 
+def _override(sc: Scenario, dotted: str, value: object, option: str) -> Scenario:
+    """``sc`` with ``dotted`` (``table.key``) set from a CLI option; an error about that key
+    names the option as the user typed it."""
+    table, key = dotted.split(".")
+    try:
+        return sc.with_({dotted: value})
+    except ScenarioError as exc:
+        prefix = f"{sc.source}: [{table}] {key} = {written(value)} "
+        if str(exc).startswith(prefix):
+            raise ScenarioError(f"{option} = {value} " + str(exc)[len(prefix):]) from None
+        raise
+
+
 def _check_model(sc: Scenario, cfg: SumoConfig) -> None:
     """The road is SUMO's mainline, the measurement grid fits it, the characteristic speeds
     are finite."""
     road = NetworkSpec().length   # the network of `arzsumo build-net`
     if abs(sc.params.length - road) > 1e-6:
-        model = sc.raw.get("model", {})
         raise not_allowed(f"{sc.source}: [model]", "length_m",
-                          model.get("length_m", sc.params.length),
+                          sc.written("model", "length_m", sc.params.length),
                           f"the SUMO mainline length {road:g} m")
     try:
         EdieGrid(sc.params.length, cfg.cell_length, cfg.step_length)
     except ArzsumoError as exc:
-        raise in_user_terms(exc, f"{sc.source}: [sumo]", sc.raw.get("sumo", {}),
+        raise in_user_terms(exc, f"{sc.source}: [sumo]", sc.tables.get("sumo", {}),
                             SUMO_KEYS) from None
     lam = linearize(sc.equilibrium).eigenvalues
     if not np.all(np.isfinite(lam)):
@@ -117,22 +130,22 @@ def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None
                 horizon: float | None = None) -> PreparedRun:
     """Everything ``arzsumo run`` checks before SUMO starts, without starting it.
 
-    Resolves and validates the ``[run]``, ``[sumo]``, ``[design]`` and ``[initial]`` tables
-    of ``sc`` with the caller's overrides (``--controller``, ``--seed`` in [0, 2^31),
-    ``--horizon`` of at least one control period, s), checks that ``[sumo] cell_length_m``
-    divides the road and that the characteristic speeds are finite, refuses a PDE
-    controller at a free-flow scenario equilibrium, and draws the placement profile of ``start =
-    "placement"``. Raises an :class:`arzsumo.errors.ArzsumoError` naming the key or option.
+    Applies the caller's overrides to the ``run`` and ``sumo`` sections of ``sc``
+    (``--controller``, ``--seed`` in [0, 2^31), ``--horizon`` of at least one control
+    period, s; validated again by :meth:`~arzsumo.scenario.Scenario.with_`), checks that
+    ``[sumo] cell_length_m`` divides the road and that the characteristic speeds are
+    finite, refuses a PDE controller at a free-flow scenario equilibrium, and draws the
+    placement profile of ``start = "placement"``. Raises an
+    :class:`arzsumo.errors.ArzsumoError` naming the key or option.
     """
-    raw = sc.raw
-    settings = run_settings_from_dict(raw, sc.source, controller=controller)
-    cfg = sumo_config_of(sc)
+    if controller is not None:
+        sc = _override(sc, "run.controller", controller, "--controller")
     if seed is not None:
-        cfg = cfg.with_(seed=_seed(seed))
+        sc = _override(sc, "sumo.seed", _seed(seed), "--seed")
     if horizon is not None:
-        cfg = cfg.with_(horizon=_horizon(horizon, cfg))
-    design = design_from_dict(raw, sc.source)
-    ic = initial_from_dict(raw, sc.source, seed=cfg.seed)  # one seed draws all randomness
+        sc = _override(sc, "sumo.horizon_s", _horizon(horizon, sc.sumo), "--horizon")
+    settings, cfg, design = sc.run, sc.sumo, sc.design
+    ic = seeded(sc.initial, cfg.seed)  # one seed draws all randomness
     _check_model(sc, cfg)
     if settings.equilibrium == "scenario":
         _check_regime(sc, settings, controller is not None)
@@ -172,15 +185,14 @@ def run_in_sumo(sc: Scenario, *, controller: str | None = None, seed: int | None
     All checks happen in :func:`prepare_run` before SUMO starts.
     """
     run = prepare_run(sc, controller=controller, seed=seed, horizon=horizon)
-    res = run_cosimulation(sc, run.settings, run.sumo, run.design, initial_fields=run.initial,
-                           curve=run.curve,
-                           progress=progress)
+    res = run_cosimulation(run.scenario, run.settings, run.sumo, run.design,
+                           initial_fields=run.initial, curve=run.curve, progress=progress)
     return SumoSession(res, run.settings, run.sumo)
 
 
 def meter_curve_of(cfg: SumoConfig, source: str) -> GreenShareCurve:
-    """The meter curve of ``[sumo] meter_curve`` (an absolute path after
-    :func:`~arzsumo.sumo.config.sumo_config_of`), or DEFAULT_CURVE without the key."""
+    """The meter curve of ``[sumo] meter_curve`` (made absolute when the scenario was
+    parsed, :func:`~arzsumo.scenario.sumo.sumo_section`), or DEFAULT_CURVE without it."""
     if not cfg.meter_curve:
         return DEFAULT_CURVE
     from arzsumo.sumo.calibration_io import load_green_share_curve

@@ -5,15 +5,23 @@ Pure math: no SUMO, no files, no plotting. May import ``model``, ``units`` and `
 """
 
 from arzsumo.control.base import ConstantControl, Controller, ControlLog, MacroState, OpenLoop
-from arzsumo.control.registry import CONTROLLERS, PDE_CONTROLLERS, make_controller
+from arzsumo.control.registry import (
+    controller_names,
+    controller_spec,
+    is_pde,
+    make_controller,
+    pde_controller_names,
+)
 
 __all__ = [
-    "CONTROLLERS",
-    "PDE_CONTROLLERS",
     "ConstantControl",
     "ControlLog",
     "Controller",
     "MacroState",
     "OpenLoop",
+    "controller_names",
+    "controller_spec",
+    "is_pde",
     "make_controller",
+    "pde_controller_names",
 ]

@@ -1,31 +1,146 @@
-"""Controllers by name, as the twin, the SUMO bridge and scenario files refer to them."""
+"""The one registry of controllers: names, what each needs, and how to build one.
+
+Every list of controller names in the package comes from here: the ``[twin] controller``
+and ``[run] controller`` keys of scenario files, ``arzsumo run --controller``, the sweep
+and the closed loop in SUMO. An entry says whether the controller is a PDE controller
+(it needs backstepping kernels and a congested equilibrium), where it runs (the twin,
+``arzsumo twin``; SUMO, ``arzsumo run``) and how to build a fresh instance from
+:class:`ControllerInputs`. The caller supplies the kernels (this room solves nothing: the
+kernel cache lives above it)::
+
+    spec = controller_spec("etc")
+    kernels = cached_kernels(lin.system, cells) if spec.pde else None
+    ctrl = spec.build(ControllerInputs(lin, kernels, design))
+
+Scenario files are validated when they are read, so an entry must exist before then:
+:func:`register_controller` adds one.
+"""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from arzsumo.control.alinea import Alinea
 from arzsumo.control.backstepping import Backstepping
-from arzsumo.control.base import Controller, OpenLoop
+from arzsumo.control.base import ConstantControl, Controller, OpenLoop
 from arzsumo.control.etc import PAPER_DESIGN, EtcDesign, EventTriggered
 from arzsumo.control.kernels import Kernels
 from arzsumo.control.observer import ObserverEtc
-from arzsumo.errors import ModelError
+from arzsumo.errors import ModelError, ScenarioError
 from arzsumo.model.characteristic import Linearization
 
-#: names of the PDE controllers that need kernels (and a congested equilibrium)
-PDE_CONTROLLERS = ("backstepping", "etc", "observer-etc")
-CONTROLLERS = ("open", *PDE_CONTROLLERS)
+
+@dataclass(frozen=True)
+class ControllerInputs:
+    """What a builder may read (SI).
+
+    Parameters
+    ----------
+    lin : Linearization
+        The linearisation at the operating equilibrium.
+    kernels : Kernels, optional
+        Backstepping kernels (PDE controllers only).
+    design : EtcDesign
+        ETC design (paper section 5 by default).
+    constant_u : float
+        U of the ``constant`` controller, veh/s.
+    alinea : dict
+        Keyword arguments of :class:`arzsumo.control.alinea.Alinea` (``alinea`` only).
+    """
+
+    lin: Linearization | None = None
+    kernels: Kernels | None = None
+    design: EtcDesign = PAPER_DESIGN
+    constant_u: float = 0.0
+    alinea: dict[str, Any] = field(default_factory=dict)
+
+
+Builder = Callable[[ControllerInputs], Controller]
+
+
+@dataclass(frozen=True)
+class ControllerSpec:
+    """One registered controller: its name, needs, where it runs, and its builder."""
+
+    name: str
+    build: Builder
+    pde: bool = False       # needs kernels on a congested equilibrium (lambda_4 < 0)
+    twin: bool = True       # available to ``arzsumo twin`` ([twin] controller)
+    sumo: bool = True       # available to ``arzsumo run`` ([run] controller)
+    description: str = ""
+
+
+def _pde(cls: Any) -> Builder:
+    def build(inp: ControllerInputs) -> Controller:
+        if inp.kernels is None or inp.lin is None:
+            raise ModelError(f"controller {cls.name!r} needs backstepping kernels")
+        if cls is Backstepping:
+            return Backstepping(inp.lin, inp.kernels)
+        return cls(inp.lin, inp.kernels, inp.design)
+
+    return build
+
+
+REGISTRY: dict[str, ControllerSpec] = {}
+
+
+def register_controller(spec: ControllerSpec, *, replace: bool = False) -> None:
+    """Add ``spec`` under its name (scenario keys ``[twin]``/``[run] controller``)."""
+    if spec.name in REGISTRY and not replace:
+        raise ValueError(f"controller {spec.name!r} is already registered; pass replace=True")
+    REGISTRY[spec.name] = spec
+
+
+def unregister_controller(name: str) -> None:
+    """Remove ``name`` (tests that registered one clean up with it)."""
+    REGISTRY.pop(name, None)
+
+
+for _spec in (
+    ControllerSpec("open", lambda inp: OpenLoop(), description="no control (U = 0)"),
+    ControllerSpec("backstepping", _pde(Backstepping), pde=True,
+                   description="continuous PDE backstepping, checked every period"),
+    ControllerSpec("etc", _pde(EventTriggered), pde=True,
+                   description="dynamic event-triggered backstepping (the paper's)"),
+    ControllerSpec("observer-etc", _pde(ObserverEtc), pde=True,
+                   description="ETC on the state of a boundary observer"),
+    ControllerSpec("constant", lambda inp: ConstantControl(inp.constant_u), sumo=False,
+                   description="U held at [twin] constant_u_veh_h"),
+    ControllerSpec("alinea", lambda inp: Alinea(**inp.alinea), twin=False,
+                   description="ALINEA on the downstream occupancy (the engineer's baseline)"),
+):
+    register_controller(_spec)
+
+
+def controller_names(engine: str | None = None) -> tuple[str, ...]:
+    """Registered names, in registration order; ``engine`` "twin" or "sumo" filters."""
+    return tuple(n for n, s in REGISTRY.items() if engine is None or getattr(s, engine))
+
+
+def pde_controller_names() -> tuple[str, ...]:
+    """Names of the PDE controllers (kernels needed)."""
+    return tuple(n for n, s in REGISTRY.items() if s.pde)
+
+
+def is_pde(name: str) -> bool:
+    """Whether ``name`` is a PDE controller (False for an unknown name)."""
+    spec = REGISTRY.get(name)
+    return spec is not None and spec.pde
+
+
+def controller_spec(name: str, engine: str | None = None) -> ControllerSpec:
+    """The entry of ``name`` (available to ``engine``); the error lists the allowed names."""
+    spec = REGISTRY.get(name)
+    if spec is None or (engine is not None and not getattr(spec, engine)):
+        raise ScenarioError(f"controller = {name!r} is not allowed: one of "
+                            f"{', '.join(controller_names(engine))}")
+    return spec
 
 
 def make_controller(name: str, lin: Linearization, kernels: Kernels | None = None,
                     design: EtcDesign = PAPER_DESIGN) -> Controller:
-    """A fresh controller called ``name`` for the equilibrium of ``lin``."""
-    if name == "open":
-        return OpenLoop()
-    if name not in PDE_CONTROLLERS:
-        raise ModelError(f"controller = {name!r} is not allowed: one of {', '.join(CONTROLLERS)}")
-    if kernels is None:
-        raise ModelError(f"controller {name!r} needs backstepping kernels")
-    if name == "backstepping":
-        return Backstepping(lin, kernels)
-    if name == "etc":
-        return EventTriggered(lin, kernels, design)
-    return ObserverEtc(lin, kernels, design)
+    """A fresh controller called ``name`` for the equilibrium of ``lin`` (no ALINEA
+    arguments, no constant U: for those, build through :func:`controller_spec`)."""
+    return controller_spec(name).build(ControllerInputs(lin, kernels, design))

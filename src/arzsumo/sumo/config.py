@@ -1,29 +1,16 @@
-"""Settings of a SUMO run and the ``[sumo]`` table of scenario files.
+"""Settings of a SUMO run (:class:`SumoConfig`, SI: s, m, veh/s).
 
-Everything inside :class:`SumoConfig` is SI (s, m, veh/s). Scenario files write the unit in
-the key name; :func:`sumo_config_from_table` converts through :mod:`arzsumo.units`::
-
-    [sumo]
-    step_length_s = 0.1
-    demand_h_veh_h = 4104
-    demand_a_veh_h = 1560
-    ramp_demand_veh_h = 1200
-    meter_cycle_s = 6
-    meter_curve = "calibration/meter_curve.toml"   # relative to the scenario file
+Scenario files set them in their ``[sumo]`` table, in the units the key names state; the
+keys and their conversions are listed once, in :mod:`arzsumo.scenario.sumo`.
 """
 
 from __future__ import annotations
 
-import copy
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass, fields, replace
-from pathlib import Path
 from typing import Any
 
-from arzsumo.errors import ArzsumoError, ScenarioError, require
-from arzsumo.tables import Key, check_keys, in_user_terms, read_keys, written
-from arzsumo.units import VEH_H_PER_VEH_S
+from arzsumo.errors import ScenarioError, require
 
 HV_MODELS = ("Krauss", "IDM")
 #: Width of the mainline lane, m (the network's).
@@ -74,7 +61,7 @@ class SumoConfig:
     meter_curve : str
         Meter-curve file (``meter_curve.toml`` of ``arzsumo calibrate``: mainline outflow
         against green share) that the actuator inverts; "" keeps the built-in
-        :data:`arzsumo.sumo.meter.DEFAULT_CURVE`. :func:`sumo_config_of` makes it absolute.
+        :data:`arzsumo.sumo.meter.DEFAULT_CURVE`. :mod:`arzsumo.scenario.sumo` makes it absolute.
     """
 
     step_length: float = 0.1
@@ -169,81 +156,3 @@ class SumoConfig:
             raise ScenarioError(f"unknown SUMO setting(s) {sorted(unknown)}; allowed: "
                                 f"{', '.join(f.name for f in fields(self))}")
         return replace(self, **changes)
-
-
-_DEMAND = "a demand >= 0 veh/h"
-#: [sumo] key -> SumoConfig field (SI), with its unit factor
-SUMO_KEYS: dict[str, Key] = {
-    "step_length_s": Key("step_length"),
-    "lateral_resolution_m": Key("lateral_resolution"),
-    "seed": Key("seed", "integer"),
-    "horizon_s": Key("horizon"),
-    "demand_h_veh_h": Key("demand_h", factor=VEH_H_PER_VEH_S, allowed=_DEMAND),
-    "demand_a_veh_h": Key("demand_a", factor=VEH_H_PER_VEH_S, allowed=_DEMAND),
-    "ramp_demand_veh_h": Key("ramp_demand", factor=VEH_H_PER_VEH_S, allowed=_DEMAND),
-    "ramp_av_share": Key("ramp_av_share"),
-    "cell_length_m": Key("cell_length"),
-    "control_period_s": Key("control_period"),
-    "meter_cycle_s": Key("meter_cycle"),
-    "min_green_s": Key("min_green"),
-    "min_red_s": Key("min_red"),
-    "green_share": Key("green_share"),
-    "green_share_min": Key("green_share_min"),
-    "green_share_max": Key("green_share_max"),
-    "spillback_queue_veh": Key("spillback_queue", "integer"),
-    "time_to_teleport_s": Key("time_to_teleport"),
-    "hv_model": Key("hv_model", "string", choices=HV_MODELS),
-    "hv_sigma": Key("hv_sigma"),
-    "av_model": Key("av_model", "string", choices=AV_MODELS),
-    "min_gap_lat_m": Key("min_gap_lat"),
-    "meter_curve": Key("meter_curve", "string"),
-}
-
-
-def sumo_config_from_table(table: Mapping[str, Any], where: str = "[sumo]") -> SumoConfig:
-    """Validate a ``[sumo]`` scenario table (human units in key names) into a SumoConfig.
-
-    ``where`` prefixes every message (``x.toml: [sumo]``); errors name the key as written.
-    """
-    if not isinstance(table, Mapping):
-        raise ScenarioError(f"{where} = {written(table)} is not allowed: a table of SUMO "
-                            "settings")
-    check_keys(table, SUMO_KEYS, where)
-    changes = read_keys(table, SUMO_KEYS, where)
-    try:
-        return SumoConfig(**changes)
-    except ArzsumoError as exc:
-        raise in_user_terms(exc, where, table, SUMO_KEYS) from None
-
-
-def sumo_config_of(scenario: Any) -> SumoConfig:
-    """The SumoConfig of a loaded scenario (its ``[sumo]`` table; defaults without one).
-
-    A relative ``meter_curve`` is read from the scenario file's directory (from the working
-    directory for a scenario not read from a file); the file must exist.
-    """
-    raw = getattr(scenario, "raw", {}) or {}
-    cfg = sumo_config_from_table(raw.get("sumo", {}), f"{scenario.source}: [sumo]")
-    if not cfg.meter_curve:
-        return cfg
-    source = Path(scenario.source)
-    path = Path(cfg.meter_curve).expanduser()
-    if not path.is_absolute() and source.is_file():
-        path = source.parent / path
-    if not path.is_file():
-        raise ScenarioError(f"{scenario.source}: [sumo] meter_curve = "
-                            f"{written(cfg.meter_curve)} is not allowed: there is no file "
-                            f"{str(path)!r}; allowed: a meter_curve.toml of `arzsumo "
-                            "calibrate`, relative to the scenario file")
-    return cfg.with_(meter_curve=str(path.resolve()))
-
-
-def anchor_meter_curve(data: Mapping[str, Any], base_dir: Path) -> dict[str, Any]:
-    """A copy of a parsed scenario whose relative ``[sumo] meter_curve`` is made absolute
-    against ``base_dir`` (the directory of the file it was written in)."""
-    out = copy.deepcopy(dict(data))
-    table = out.get("sumo")
-    value = table.get("meter_curve") if isinstance(table, dict) else None
-    if isinstance(value, str) and value and not Path(value).expanduser().is_absolute():
-        table["meter_curve"] = str(base_dir / value)
-    return out

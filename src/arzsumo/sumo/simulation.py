@@ -239,8 +239,8 @@ class SumoSimulation:
         except Exception:  # SUMO already broken: keep counts without the live figures
             self.report = None
         try:
-            assert self._lib is not None
-            self._lib.close()
+            if self._lib is not None:   # started means loaded; a failed start has none
+                self._lib.close()
         except Exception as exc:  # pragma: no cover - SUMO failing to close
             log.warning("SUMO close: %s", _one_line(exc))
         finally:

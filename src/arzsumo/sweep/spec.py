@@ -45,6 +45,8 @@ from typing import Any
 
 from arzsumo.errors import ScenarioError
 from arzsumo.io import read_toml
+from arzsumo.scenario import RENAMED, scenario_fields
+from arzsumo.scenario.sumo import anchor_meter_curve
 from arzsumo.tables import written
 
 ENGINES = ("twin", "sumo")
@@ -60,19 +62,6 @@ Scalar = bool | int | float | str
 
 class SweepError(ScenarioError):
     """An invalid sweep file, key or value."""
-
-
-def scenario_fields() -> dict[str, set[str]]:
-    """The keys each scenario table accepts (what a sweep may change)."""
-    from arzsumo.bridge.config import RUN_KEYS
-    from arzsumo.scenarios import DESIGN_KEYS, EQUILIBRIUM_KEYS, MODEL_KEYS
-    from arzsumo.sumo.config import SUMO_KEYS
-    from arzsumo.twin.config import INITIAL_KEYS, TWIN_KEYS
-
-    return {"model": set(MODEL_KEYS) | {"preset"},
-            "equilibrium": set(EQUILIBRIUM_KEYS) | {"branch"},
-            "twin": set(TWIN_KEYS), "initial": set(INITIAL_KEYS), "design": set(DESIGN_KEYS),
-            "sumo": set(SUMO_KEYS), "run": set(RUN_KEYS)}
 
 
 @dataclass(frozen=True)
@@ -233,6 +222,10 @@ def _check_field(name: str, where: str, allowed: Mapping[str, set[str]]) -> None
     if len(parts) != 2 or parts[0] not in allowed:
         raise SweepError(f"{where}: field {name!r} is not allowed: 'table.key' with table one "
                          f"of {', '.join(sorted(allowed))}")
+    new = RENAMED.get(parts[0], {}).get(parts[1])
+    if new is not None:
+        raise SweepError(f"{where}: field {name!r} was renamed: write "
+                         f"'{parts[0]}.{new}' instead")
     if parts[1] not in allowed[parts[0]]:
         raise SweepError(f"{where}: field {name!r} is not allowed: [{parts[0]}] has "
                          f"{', '.join(sorted(allowed[parts[0]]))}")
@@ -308,7 +301,7 @@ def sweep_from_dict(data: Mapping[str, Any], source: str = "<dict>",
     base = (root or Path.cwd()) / data["base"]
     _, base_data = read_toml(base, f"{source}: base", SweepError)
     # file paths inside a scenario are relative to the file that names them
-    base_data = _anchor_scenario(base_data, base.parent)
+    base_data = anchor_meter_curve(base_data, base.parent)
     allowed = scenario_fields()
     fixed = _anchor(_flat_fields(data.get("set", {}), f"{source} [set]", allowed), root)
     raw_axes = data.get("axis", [])
@@ -344,18 +337,12 @@ def sweep_from_dict(data: Mapping[str, Any], source: str = "<dict>",
                      tuple(axes), paper, baseline, source)
 
 
-def _anchor_scenario(data: Mapping[str, Any], base_dir: Path) -> dict[str, Any]:
-    from arzsumo.sumo.config import anchor_meter_curve
-
-    return anchor_meter_curve(data, base_dir)
-
-
 def _anchor(flat: Mapping[str, Any], root: Path | None) -> dict[str, Any]:
     """Flat fields with a relative ``sumo.meter_curve`` made relative to the sweep file."""
     key = "sumo.meter_curve"
     if key not in flat:
         return dict(flat)
-    data = _anchor_scenario({"sumo": {"meter_curve": flat[key]}}, root or Path.cwd())
+    data = anchor_meter_curve({"sumo": {"meter_curve": flat[key]}}, root or Path.cwd())
     return {**flat, key: data["sumo"]["meter_curve"]}
 
 

@@ -92,8 +92,8 @@ def _parquet(table: pa.Table) -> bytes:
 
 def _run_twin(task: RunTask) -> tuple[str, dict[str, Any], dict[str, bytes]]:
     from arzsumo.outputs.twin import control_table
-    from arzsumo.scenarios import scenario_from_dict
-    from arzsumo.twin.run import run_twin
+    from arzsumo.runs.twin import run_twin
+    from arzsumo.scenario import scenario_from_dict
 
     sc = scenario_from_dict(task.scenario, task.source)
     run = run_twin(sc, baseline=task.baseline)
@@ -104,7 +104,7 @@ def _run_twin(task: RunTask) -> tuple[str, dict[str, Any], dict[str, bytes]]:
 def _run_sumo(task: RunTask) -> tuple[str, dict[str, Any], dict[str, bytes]]:
     from arzsumo.bridge.session import run_in_sumo
     from arzsumo.outputs.bridge import periods_table, summary
-    from arzsumo.scenarios import scenario_from_dict
+    from arzsumo.scenario import scenario_from_dict
 
     sc = scenario_from_dict(task.scenario, task.source)
     session = run_in_sumo(sc)

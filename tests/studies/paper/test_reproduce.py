@@ -10,7 +10,8 @@ import pytest
 
 from arzsumo.cli import main
 from arzsumo.errors import ScenarioError
-from arzsumo.scenarios import load_scenario
+from arzsumo.runs.twin import run_twin
+from arzsumo.scenario import load_scenario
 from arzsumo.studies.paper.compare import (
     NOT_REPRODUCED,
     REPRODUCED,
@@ -20,7 +21,6 @@ from arzsumo.studies.paper.compare import (
 )
 from arzsumo.studies.paper.report import write_reproduction
 from arzsumo.studies.paper.reproduce import DEFAULT_DIR, load_experiments, plan, reproduce
-from arzsumo.twin.run import run_twin
 
 PAPER_DIR = Path(__file__).resolve().parents[3] / "scenarios" / "paper"
 SUBSET = ["base_open", "base_backstepping", "base_etc", "penetration_44_etc",
@@ -191,7 +191,7 @@ def test_claims_cover_the_headlines(quick):
 
 
 @pytest.mark.parametrize(("sweep", "match"), [
-    ({"parameter": "nu", "values": [1.0]}, r"parameter = 'nu' is not allowed: one of"),
+    ({"parameter": "nu", "values": [1.0]}, r'parameter = "nu" is not allowed: one of'),
     ({"parameter": "mu", "values": []}, r"values = \[\] is not allowed"),
     ({"parameter": "mu"}, r"exactly the keys parameter and values"),
 ])
@@ -223,11 +223,9 @@ def test_cli_reproduce_quick(tmp_path, monkeypatch, capsys):
 
 
 def test_twin_overrides_reach_every_scenario_and_are_validated():
-    from arzsumo.twin.config import twin_config_from_dict
-
     tasks = plan(load_experiments(PAPER_DIR), only=["base_etc", "linear_etc"],
                  twin={"scheme": "muscl"})
     for t in tasks:
-        assert twin_config_from_dict(t.scenario.raw).solver.scheme == "muscl"
+        assert t.scenario.twin.solver.scheme == "muscl"
     with pytest.raises(ScenarioError, match=r'\[twin\] scheme = "third" is not allowed'):
         plan(load_experiments(PAPER_DIR), only=["base_etc"], twin={"scheme": "third"})

@@ -17,7 +17,6 @@ the same order.
 
 from __future__ import annotations
 
-import json
 import logging
 import math
 import time
@@ -31,11 +30,10 @@ import numpy as np
 from arzsumo.control.events import lyapunov_convergence_time
 from arzsumo.errors import ScenarioError
 from arzsumo.io import json_safe
-from arzsumo.scenarios import DESIGN_KEYS, Scenario, load_scenario, scenario_from_dict
+from arzsumo.runs.twin import TwinRun, compare_to_open_loop, run_twin
+from arzsumo.scenario import Scenario, load_scenario
 from arzsumo.sweep.driver import map_runs
-from arzsumo.twin.config import twin_config_from_dict
 from arzsumo.twin.metrics import Performance
-from arzsumo.twin.run import TwinRun, compare_to_open_loop, run_twin
 
 log = logging.getLogger(__name__)
 
@@ -47,14 +45,6 @@ QUICK_TWIN = {"cells": 40, "horizon_s": 40.0, "kernel_cells": 40}
 
 #: Lyapunov convergence time: first time after which V stays below this fraction of V(0).
 LYAPUNOV_FRACTION = 0.01
-
-#: [twin] keys that do not change the open loop (the grouping of baselines ignores them).
-CONTROL_ONLY_KEYS = {"controller", "constant_u_veh_h", "kernel_cells", "u_min_veh_h",
-                     "u_max_veh_h", "seed"}
-
-SWEEP_KEYS = {"parameter", "values"}
-SWEEPABLE = tuple(sorted(DESIGN_KEYS - {"A", "varsigma"}))
-
 
 @dataclass(frozen=True)
 class RunRecord:
@@ -124,38 +114,21 @@ class _Task:
 
 
 def _sweep_of(sc: Scenario) -> tuple[str, list[float]] | None:
-    table = sc.raw.get("sweep")
-    if table is None:
-        return None
-    where = f"{sc.source} [sweep]"
-    if not isinstance(table, dict) or set(table) != SWEEP_KEYS:
-        raise ScenarioError(f"{where}: sweep = {table!r} is not allowed: a table with "
-                            "exactly the keys parameter and values")
-    par, values = table["parameter"], table["values"]
-    if par not in SWEEPABLE:
-        raise ScenarioError(f"{where}: parameter = {par!r} is not allowed: one of "
-                            f"{', '.join(SWEEPABLE)}")
-    if not isinstance(values, list) or not values or any(
-            isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v)
-            for v in values):
-        raise ScenarioError(f"{where}: values = {values!r} is not allowed: a non-empty list "
-                            "of finite numbers")
-    return par, [float(v) for v in values]
+    """The design sweep of the scenario's ``[sweep]`` table (parameter, values), if any."""
+    return None if sc.sweep is None else (sc.sweep.parameter, list(sc.sweep.values))
 
 
 def _with(sc: Scenario, **tables: Mapping[str, Any]) -> Scenario:
-    """``sc`` rebuilt with some top-level tables updated (validated again)."""
-    raw = dict(sc.raw)
-    for name, changes in tables.items():
-        raw[name] = {**raw.get(name, {}), **changes}
-    return scenario_from_dict(raw, sc.source)
+    """``sc`` with some keys of some tables changed (validated again)."""
+    return sc.with_({f"{name}.{key}": value for name, changes in tables.items()
+                     for key, value in changes.items()})
 
 
 def _baseline_key(sc: Scenario) -> str:
-    raw = {k: v for k, v in sc.raw.items()
-           if k not in ("name", "description", "design", "sweep")}
-    raw["twin"] = {k: v for k, v in raw.get("twin", {}).items() if k not in CONTROL_ONLY_KEYS}
-    return json.dumps(raw, sort_keys=True, default=str)
+    """What decides the open loop: model, equilibrium, solver options (U range aside: the
+    open loop applies U = 0) and the initial fields; not the controller nor its design."""
+    solver = replace(sc.twin.solver, u_min=None, u_max=None)
+    return repr((sc.params, sc.equilibrium, solver, sc.twin.initial))
 
 
 def load_experiments(directory: str | Path = DEFAULT_DIR) -> list[Scenario]:
@@ -187,7 +160,6 @@ def plan(scenarios: Sequence[Scenario], *, quick: bool = False,
         changes = {**(QUICK_TWIN if quick else {}), **(twin or {})}
         if changes:
             sc = _with(sc, twin=changes)
-        twin_config_from_dict(sc.raw, sc.source)          # fail before any run starts
         sweep = _sweep_of(sc)
         items = ([(sc, None)] if sweep is None else
                  [(_with(sc, design={sweep[0]: v}), (sweep[0], v)) for v in sweep[1]])
@@ -211,7 +183,7 @@ def _record(run: TwinRun, sweep: tuple[str, float] | None) -> RunRecord:
 def _open_loop(task: _Task) -> tuple[Performance, bool, str, RunRecord | None]:
     """The open loop of a task's group; its record too when the task is the open loop."""
     sc = task.scenario
-    cfg = twin_config_from_dict(sc.raw, sc.source)
+    cfg = sc.twin
     run = run_twin(sc, replace(cfg, controller="open"), baseline=False)
     own = cfg.controller == "open"
     res = run.result

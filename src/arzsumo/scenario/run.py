@@ -1,12 +1,12 @@
-"""The ``[run]`` table of a scenario: what ``arzsumo run`` does (human units in key names).
+"""The ``[run]`` section: what ``arzsumo run`` does around SUMO (human units in key names).
 
 Example::
 
     [run]
-    controller = "etc"          # open, backstepping, etc, observer-etc, alinea
+    controller = "etc"          # a name of arzsumo.control.registry that runs in SUMO
     warmup_s = 150              # nominal meter until control starts
     start = "warmup"            # or "placement": vehicles placed from [initial] at t = 0
-    equilibrium = "scenario"    # or "measured": mean of the last 60 s of the warm-up
+    operating_point = "scenario"  # or "measured": mean of the last 60 s of the warm-up
     kernel_cells = 100          # backstepping kernel grid
     twin_cells = 100            # PDE twin grid (replay and reference)
     twin_scheme = "muscl"       # or "first"
@@ -15,39 +15,51 @@ Example::
     alinea_gain_veh_h_per_pct = 70
     alinea_saturation_veh_h = 1800
 
-The control horizon is ``[sumo] horizon_s`` after the warm-up.
+The control horizon, the control period and the seed are ``[sumo]`` keys.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from typing import Any
 
+from arzsumo.control.registry import controller_names
 from arzsumo.errors import ArzsumoError, ScenarioError, require
-from arzsumo.tables import Key, in_user_terms, read_keys, where
+from arzsumo.tables import Key, in_user_terms, read_keys
 from arzsumo.units import VEH_H_PER_VEH_S
 
-CONTROLLERS = ("open", "backstepping", "etc", "observer-etc", "alinea")
+#: backstepping kernel grid of both `arzsumo run` and `arzsumo twin` (one default)
+KERNEL_CELLS = 100
+
 #: [run] key -> RunSettings field (SI), with its unit factor; ALINEA's gain per % of
 #: occupancy in veh/h is 100/3600 veh/s per unit occupancy, hence the factor 36
-RUN_SPECS: dict[str, Key] = {
-    "controller": Key("controller", "string", choices=CONTROLLERS),
-    "warmup_s": Key("warmup"),
-    "start": Key("start", "string", choices=("warmup", "placement")),
-    "equilibrium": Key("equilibrium", "string", choices=("scenario", "measured")),
-    "kernel_cells": Key("kernel_cells", "integer"),
-    "twin_cells": Key("twin_cells", "integer"),
-    "twin_scheme": Key("twin_scheme", "string", choices=("first", "muscl")),
-    "smoothing_s": Key("smoothing"),
-    "alinea_target": Key("alinea_target"),
+RUN_KEYS: dict[str, Key] = {
+    "controller": Key("controller", "string", doc="controller on the ramp meter (a name of "
+                                                  "the registry that runs in SUMO)"),
+    "warmup_s": Key("warmup", unit="s", doc="time under the nominal meter before control"),
+    "start": Key("start", "string", choices=("warmup", "placement"),
+                 doc="\"placement\": vehicles placed from [initial] at t = 0"),
+    "operating_point": Key("equilibrium", "string", choices=("scenario", "measured"),
+                           doc="equilibrium the controller is designed at: the scenario's, "
+                               "or measured over the last 60 s of the warm-up"),
+    "kernel_cells": Key("kernel_cells", "integer", doc="grid of the backstepping kernels"),
+    "twin_cells": Key("twin_cells", "integer", doc="grid of the twins alongside SUMO"),
+    "twin_scheme": Key("twin_scheme", "string", choices=("first", "muscl"),
+                       doc="scheme of the twins alongside SUMO"),
+    "smoothing_s": Key("smoothing", unit="s",
+                       doc="time constant of the measured boundary data fed to the twins"),
+    "alinea_target": Key("alinea_target", doc="ALINEA occupancy target (fraction); 0: "
+                                              "measured at the end of the warm-up"),
     "alinea_gain_veh_h_per_pct": Key("alinea_gain", factor=VEH_H_PER_VEH_S / 100,
-                                     allowed="a gain > 0 veh/h per % of occupancy"),
+                                     allowed="a gain > 0 veh/h per % of occupancy",
+                                     unit="veh/h per %", doc="ALINEA gain K_R"),
     "alinea_saturation_veh_h": Key("alinea_saturation", factor=VEH_H_PER_VEH_S,
-                                   allowed="a flow > 0 veh/h"),
+                                   allowed="a flow > 0 veh/h", unit="veh/h",
+                                   doc="ramp flow of an always-green meter"),
 }
-RUN_KEYS = set(RUN_SPECS)
+#: keys renamed since earlier versions: old -> new (refused with a one-line hint)
+RUN_RENAMED = {"equilibrium": "operating_point"}
 
 
 @dataclass(frozen=True)
@@ -58,7 +70,7 @@ class RunSettings:
     warmup: float = 150.0
     start: str = "warmup"
     equilibrium: str = "scenario"
-    kernel_cells: int = 100
+    kernel_cells: int = KERNEL_CELLS
     twin_cells: int = 100
     twin_scheme: str = "muscl"
     smoothing: float = 30.0
@@ -70,7 +82,8 @@ class RunSettings:
         def check(ok: bool, name: str, allowed: str) -> None:
             require(ok, name, getattr(self, name), allowed, ScenarioError)
 
-        check(self.controller in CONTROLLERS, "controller", f"one of {', '.join(CONTROLLERS)}")
+        names = controller_names("sumo")
+        check(self.controller in names, "controller", f"one of {', '.join(names)}")
         check(math.isfinite(self.warmup) and self.warmup >= 0, "warmup", "a time >= 0 s")
         check(self.start in ("warmup", "placement"), "start", "'warmup' or 'placement'")
         check(self.equilibrium in ("scenario", "measured"), "equilibrium",
@@ -91,24 +104,10 @@ class RunSettings:
         return asdict(self)
 
 
-def run_settings_from_dict(data: Mapping[str, Any], source: str = "<dict>",
-                           **overrides: Any) -> RunSettings:
-    """Parse the ``[run]`` table of a parsed scenario mapping; ``overrides`` win.
-
-    Errors name the file, ``[run]``, the key and the value as written; an error about an
-    overridden field names ``--field`` (the CLI option) instead.
-    """
-    from arzsumo.scenarios import scenario_table
-
-    table = scenario_table(data, "run", RUN_KEYS, source)
-    at = where(source, "run")
-    values = read_keys(table, RUN_SPECS, at)
-    given = {k: v for k, v in overrides.items() if v is not None}
-    values.update(given)
+def run_section(table: dict[str, Any], at: str) -> RunSettings:
+    """The RunSettings of a ``[run]`` table (keys already checked); errors name the key
+    and the value as written."""
     try:
-        return RunSettings(**values)
+        return RunSettings(**read_keys(table, RUN_KEYS, at))
     except ArzsumoError as exc:
-        if exc.field in given:
-            raise type(exc)(f"--{exc.field} = {exc.value} is not allowed: "
-                            f"{exc.allowed}") from None
-        raise in_user_terms(exc, at, table, RUN_SPECS) from None
+        raise in_user_terms(exc, at, table, RUN_KEYS) from None

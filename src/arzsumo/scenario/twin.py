@@ -1,4 +1,4 @@
-"""The ``[twin]`` and ``[initial]`` tables of a scenario file (human units in key names).
+"""The ``[twin]`` and ``[initial]`` sections: what ``arzsumo twin`` (and ``reproduce``) runs.
 
 Example::
 
@@ -13,15 +13,10 @@ Example::
     output_period_s = 1
     u_min_veh_h = -2000         # feasible range of U; default -q* .. +q*
     u_max_veh_h = 2000
-    controller = "open"         # a name registered in arzsumo.twin.controllers
+    controller = "open"         # a name of arzsumo.control.registry that runs in the twin
     constant_u_veh_h = 0        # for controller = "constant"
     seed = 0                    # draws the [initial] kind = "random" wave; else recorded only
     kernel_cells = 200          # grid of the backstepping kernels (PDE controllers)
-
-    [design]                    # ETC design (defaults: the paper's section 5 values)
-    mu = 5e-4
-    sigma = 1e-4
-    zeta = 8e-3
 
     [initial]
     kind = "sinusoid"           # equilibrium, sinusoid, nonrecurrent, linear, random
@@ -30,21 +25,21 @@ Example::
     phase_rad = 0
     fraction = 0.25             # nonrecurrent / linear: the paper's 1/4
 
-Loading checks the shape (known keys, types) and then the meaning (the dataclasses
-validate themselves); errors name the key, the value and what is allowed.
+The [twin] keys configure ``arzsumo twin`` only; ``arzsumo run`` reads [sumo] and [run].
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
 from arzsumo.control.etc import PAPER_DESIGN, EtcDesign
+from arzsumo.control.registry import controller_names
 from arzsumo.errors import ArzsumoError, ScenarioError, require
-from arzsumo.tables import Key, checked, in_user_terms, not_allowed, read_keys, where, written
-from arzsumo.twin.controllers import CONTROLLERS
+from arzsumo.scenario.run import KERNEL_CELLS
+from arzsumo.tables import Key, checked, in_user_terms, not_allowed, read_keys, written
 from arzsumo.twin.flux import FLUXES, LIMITERS
 from arzsumo.twin.initial import KINDS, InitialCondition
 from arzsumo.twin.scheme import SCHEMES
@@ -56,31 +51,42 @@ DEFAULT_AMPLITUDE = (0.05, -0.05, 0.05, -0.05)
 
 _U = "a flow in veh/h"
 #: [twin] key -> field of SolverOptions or TwinConfig (SI), with its unit factor
-TWIN_SPECS: dict[str, Key] = {
-    "cells": Key("cells", "integer"),
-    "scheme": Key("scheme", "string", choices=SCHEMES),
-    "flux": Key("flux", "string", choices=tuple(FLUXES)),
-    "limiter": Key("limiter", "string", choices=tuple(LIMITERS)),
-    "cfl": Key("cfl"),
-    "horizon_s": Key("horizon"),
-    "control_period_s": Key("control_period"),
-    "output_period_s": Key("output_period"),
-    "u_min_veh_h": Key("u_min", factor=VEH_H_PER_VEH_S, allowed="at most u_max_veh_h"),
-    "u_max_veh_h": Key("u_max", factor=VEH_H_PER_VEH_S, allowed=_U),
-    "controller": Key("controller", "string"),
-    "constant_u_veh_h": Key("constant_u", factor=VEH_H_PER_VEH_S, allowed=_U),
-    "seed": Key("seed", "integer"),
-    "max_steps": Key("max_steps", "integer"),
-    "kernel_cells": Key("kernel_cells", "integer"),
+TWIN_KEYS: dict[str, Key] = {
+    "cells": Key("cells", "integer", doc="finite volumes on the road"),
+    "scheme": Key("scheme", "string", choices=SCHEMES, doc="first order or MUSCL"),
+    "flux": Key("flux", "string", choices=tuple(FLUXES), doc="numerical flux"),
+    "limiter": Key("limiter", "string", choices=tuple(LIMITERS),
+                   doc="slope limiter (muscl only)"),
+    "cfl": Key("cfl", doc="target Courant number, in (0, 1]"),
+    "horizon_s": Key("horizon", unit="s", doc="simulated time of `arzsumo twin`"),
+    "control_period_s": Key("control_period", unit="s",
+                            doc="time between controller checks in the twin"),
+    "output_period_s": Key("output_period", unit="s", doc="time between stored fields"),
+    "u_min_veh_h": Key("u_min", factor=VEH_H_PER_VEH_S, allowed="at most u_max_veh_h",
+                       unit="veh/h", doc="lowest U (default -q*)"),
+    "u_max_veh_h": Key("u_max", factor=VEH_H_PER_VEH_S, allowed=_U, unit="veh/h",
+                       doc="highest U (default +q*)"),
+    "controller": Key("controller", "string", doc="controller of the twin run (a name of "
+                                                  "the registry that runs in the twin)"),
+    "constant_u_veh_h": Key("constant_u", factor=VEH_H_PER_VEH_S, allowed=_U, unit="veh/h",
+                            doc="U of controller = \"constant\""),
+    "seed": Key("seed", "integer", doc="draws an [initial] kind = \"random\" wave; "
+                                       "recorded otherwise"),
+    "max_steps": Key("max_steps", "integer", doc="safety limit on the time steps"),
+    "kernel_cells": Key("kernel_cells", "integer", doc="grid of the backstepping kernels"),
 }
-TWIN_KEYS = set(TWIN_SPECS)
 #: [initial] key -> InitialCondition field (``fraction`` is the amplitude f of the paper's
 #: nonrecurrent and linear profiles)
-INITIAL_SPECS: dict[str, Key] = {"kind": Key("kind", "string"), "amplitude": Key("amplitude"),
-                                 "wavenumber": Key("wavenumber"), "phase_rad": Key("phase"),
-                                 "fraction": Key("amplitude")}
-INITIAL_KEYS = set(INITIAL_SPECS)
 INITIAL_KINDS = tuple(k for k in KINDS if k != "array")
+INITIAL_KEYS: dict[str, Key] = {
+    "kind": Key("kind", "string", choices=INITIAL_KINDS, doc="shape of the initial profile"),
+    "amplitude": Key("amplitude", doc="sinusoid, random: relative amplitudes of (rho_h, "
+                                      "v_h, rho_a, v_a), one number or 4"),
+    "wavenumber": Key("wavenumber", doc="sinusoid: periods over the road (one or 4); "
+                                        "random: the highest mode"),
+    "phase_rad": Key("phase", unit="rad", doc="sinusoid: phases (one or 4)"),
+    "fraction": Key("amplitude", doc="nonrecurrent, linear: the fraction f (paper: 1/4)"),
+}
 
 
 @dataclass(frozen=True)
@@ -93,12 +99,13 @@ class TwinConfig:
     controller: str = "open"
     constant_u: float = 0.0
     seed: int = 0
-    kernel_cells: int = 200
+    kernel_cells: int = KERNEL_CELLS
     design: EtcDesign = PAPER_DESIGN
 
     def __post_init__(self) -> None:
-        require(self.controller in CONTROLLERS, "controller", self.controller,
-                f"one of {', '.join(sorted(CONTROLLERS))}", ScenarioError)
+        names = controller_names("twin")
+        require(self.controller in names, "controller", self.controller,
+                f"one of {', '.join(names)}", ScenarioError)
         require(not isinstance(self.kernel_cells, bool) and isinstance(self.kernel_cells, int)
                 and self.kernel_cells >= 4, "kernel_cells", self.kernel_cells,
                 "an integer >= 4", ScenarioError)
@@ -120,6 +127,11 @@ class TwinConfig:
                                                "seed": self.initial.seed}}
 
 
+def seeded(initial: InitialCondition, seed: int) -> InitialCondition:
+    """``initial`` with the run's seed when it draws a random wave (unchanged otherwise)."""
+    return replace(initial, seed=seed) if initial.kind == "random" else initial
+
+
 def _four(table: Mapping[str, Any], key: str, at: str) -> tuple[float, ...]:
     value = table[key]
     items = value if isinstance(value, list) else [value]
@@ -130,28 +142,26 @@ def _four(table: Mapping[str, Any], key: str, at: str) -> tuple[float, ...]:
     return tuple(float(v) for v in (items * 4 if len(items) == 1 else items))
 
 
-def initial_from_dict(data: Mapping[str, Any], source: str = "<dict>",
-                      seed: int = 0) -> InitialCondition:
-    """The ``[initial]`` table of a parsed scenario; ``seed`` draws a ``kind = "random"``
-    wave. Errors name the file, ``[initial]``, the key and the value as written."""
-    from arzsumo.scenarios import scenario_table
+def _wave_args(ini: Mapping[str, Any], kind: str, at: str) -> tuple[dict[str, Any], set[str]]:
+    """Arguments of a sinusoid or random wave, and the keys that do not apply."""
+    args: dict[str, Any] = {"amplitude": _four(ini, "amplitude", at) if "amplitude" in ini
+                            else DEFAULT_AMPLITUDE}
+    if "wavenumber" in ini:
+        args["wavenumber"] = _four(ini, "wavenumber", at)
+    if "phase_rad" in ini and kind == "sinusoid":
+        args["phase"] = _four(ini, "phase_rad", at)
+    return args, {"fraction"} | ({"phase_rad"} if kind == "random" else set())
 
-    ini = scenario_table(data, "initial", INITIAL_KEYS, source)
-    at = where(source, "initial")
+
+def initial_section(ini: Mapping[str, Any], at: str) -> InitialCondition:
+    """The InitialCondition of an ``[initial]`` table (seed 0: the engine that runs it
+    seeds a random wave, :func:`seeded`)."""
     kind = checked(ini["kind"], "string", at, "kind", INITIAL_KINDS) if "kind" in ini \
         else "sinusoid"
-    args: dict[str, Any] = {"kind": kind}
     if kind in ("sinusoid", "random"):
-        args["amplitude"] = _four(ini, "amplitude", at) if "amplitude" in ini \
-            else DEFAULT_AMPLITUDE
-        if "wavenumber" in ini:
-            args["wavenumber"] = _four(ini, "wavenumber", at)
-        if "phase_rad" in ini and kind == "sinusoid":
-            args["phase"] = _four(ini, "phase_rad", at)
-        if kind == "random":
-            args["seed"] = seed
-        extra = {"fraction"} | ({"phase_rad"} if kind == "random" else set())
+        args, extra = _wave_args(ini, kind, at)
     else:
+        args = {}
         if kind in ("nonrecurrent", "linear"):
             args["amplitude"] = float(checked(ini["fraction"], "number", at, "fraction")) \
                 if "fraction" in ini else 0.25
@@ -162,28 +172,19 @@ def initial_from_dict(data: Mapping[str, Any], source: str = "<dict>",
         raise ScenarioError(f"{at} {', '.join(sorted(extra))} do(es) not apply to "
                             f"kind = {written(kind)}")
     try:
-        return InitialCondition(**args)
+        return InitialCondition(kind=kind, **args)
     except ArzsumoError as exc:
-        raise in_user_terms(exc, at, ini, INITIAL_SPECS) from None
+        raise in_user_terms(exc, at, ini, INITIAL_KEYS) from None
 
 
-def twin_config_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> TwinConfig:
-    """Parse the ``[twin]``, ``[initial]`` and ``[design]`` tables of a parsed scenario.
-
-    Errors name the file, the table, the key and the value as written.
-    """
-    from arzsumo.scenarios import design_from_dict, scenario_table
-
-    tw = scenario_table(data, "twin", TWIN_KEYS, source)
-    at = where(source, "twin")
-    values = read_keys(tw, TWIN_SPECS, at)
+def twin_section(tw: Mapping[str, Any], at: str, initial: InitialCondition,
+                 design: EtcDesign) -> TwinConfig:
+    """The TwinConfig of a ``[twin]`` table with the scenario's [initial] and [design]."""
+    values = read_keys(tw, TWIN_KEYS, at)
     own = {k: values.pop(k) for k in ("controller", "constant_u", "seed", "kernel_cells")
            if k in values}
     try:
-        solver = SolverOptions(**values)
-        initial = initial_from_dict(data, source, own.get("seed", 0))
-        return TwinConfig(solver, initial, design=design_from_dict(data, source), **own)
+        return TwinConfig(SolverOptions(**values), seeded(initial, own.get("seed", 0)),
+                          design=design, **own)
     except ArzsumoError as exc:
-        if exc.field is None:       # [initial] and [design]: already in the user's terms
-            raise
-        raise in_user_terms(exc, at, tw, TWIN_SPECS) from None
+        raise in_user_terms(exc, at, tw, TWIN_KEYS) from None

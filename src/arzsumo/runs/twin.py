@@ -14,11 +14,12 @@ import numpy as np
 from arzsumo import __version__
 from arzsumo.control.base import Controller
 from arzsumo.control.events import release_time
-from arzsumo.model.characteristic import linearize
-from arzsumo.scenarios import Scenario
+from arzsumo.model.characteristic import Linearization, linearize
+from arzsumo.control.registry import ControllerInputs, controller_spec
+from arzsumo.kernel_cache import cached_kernels
+from arzsumo.scenario import Scenario
+from arzsumo.scenario.twin import TwinConfig
 from arzsumo.schema import TWIN_SUMMARY, key_units
-from arzsumo.twin.config import TwinConfig, twin_config_from_dict
-from arzsumo.twin.controllers import make_controller
 from arzsumo.twin.initial import initial_fields
 from arzsumo.twin.metrics import (
     Performance,
@@ -101,6 +102,14 @@ class TwinRun:
         return summ
 
 
+def twin_controller(cfg: TwinConfig, lin: Linearization) -> Controller:
+    """A fresh controller of ``cfg`` (the registry's builder; kernels from the cache on
+    ``cfg.kernel_cells`` cells for a PDE controller)."""
+    spec = controller_spec(cfg.controller, "twin")
+    kernels = cached_kernels(lin.system, cfg.kernel_cells) if spec.pde else None
+    return spec.build(ControllerInputs(lin, kernels, cfg.design, cfg.constant_u))
+
+
 def run_twin(scenario: Scenario, config: TwinConfig | None = None, *,
              controller: Controller | None = None, baseline: bool = True) -> TwinRun:
     """Run the twin on ``scenario``.
@@ -108,8 +117,8 @@ def run_twin(scenario: Scenario, config: TwinConfig | None = None, *,
     Parameters
     ----------
     scenario : Scenario
-        Model and equilibrium; its ``[twin]``/``[initial]`` tables give the configuration
-        unless ``config`` is passed.
+        Model and equilibrium; its ``twin`` section (``[twin]``, ``[initial]``,
+        ``[design]``) is the configuration unless ``config`` is passed.
     config : TwinConfig, optional
     controller : Controller, optional
         Overrides the configured controller name (for callers holding an instance).
@@ -117,10 +126,10 @@ def run_twin(scenario: Scenario, config: TwinConfig | None = None, *,
         Also run the open loop of the same scenario to report relative changes (skipped
         when the controller is the open loop).
     """
-    cfg = config or twin_config_from_dict(scenario.raw, scenario.source)
+    cfg = config or scenario.twin
     eq = scenario.equilibrium
     lin = linearize(eq)
-    ctrl = controller or make_controller(cfg.controller, lin, cfg)
+    ctrl = controller or twin_controller(cfg, lin)
     x = cell_centres(eq.params.length, cfg.solver.cells)
     init = initial_fields(cfg.initial, eq, x)
     res = simulate(eq, init, controller=ctrl, options=cfg.solver)

@@ -1,0 +1,101 @@
+"""The ``[sumo]`` section: how ``arzsumo run`` (and ``calibrate``) drive SUMO.
+
+Every key of the table, its unit and its conversion to the SI field of
+:class:`arzsumo.sumo.config.SumoConfig`::
+
+    [sumo]
+    step_length_s = 0.1
+    demand_h_veh_h = 4104
+    demand_a_veh_h = 1560
+    ramp_demand_veh_h = 1200
+    meter_cycle_s = 6
+    meter_curve = "calibration/meter_curve.toml"   # relative to the scenario file
+"""
+
+from __future__ import annotations
+
+import copy
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from arzsumo.errors import ArzsumoError, ScenarioError
+from arzsumo.sumo.config import AV_MODELS, HV_MODELS, SumoConfig
+from arzsumo.tables import Key, in_user_terms, read_keys, written
+from arzsumo.units import VEH_H_PER_VEH_S
+
+_DEMAND = "a demand >= 0 veh/h"
+#: [sumo] key -> SumoConfig field (SI), with its unit factor
+SUMO_KEYS: dict[str, Key] = {
+    "step_length_s": Key("step_length", unit="s", doc="SUMO time step (ACC/CACC need small "
+                                                      "steps), at most 1 s"),
+    "lateral_resolution_m": Key("lateral_resolution", unit="m",
+                                doc="sublane width; divides the 6.5 m lane"),
+    "seed": Key("seed", "integer", doc="SUMO random seed, in [0, 2^31); also draws an "
+                                       "[initial] kind = \"random\" placement"),
+    "horizon_s": Key("horizon", unit="s", doc="control horizon after the warm-up "
+                                              "(`arzsumo run --horizon`)"),
+    "demand_h_veh_h": Key("demand_h", factor=VEH_H_PER_VEH_S, allowed=_DEMAND, unit="veh/h",
+                          doc="HV flow requested at the mainline entrance"),
+    "demand_a_veh_h": Key("demand_a", factor=VEH_H_PER_VEH_S, allowed=_DEMAND, unit="veh/h",
+                          doc="AV flow requested at the mainline entrance"),
+    "ramp_demand_veh_h": Key("ramp_demand", factor=VEH_H_PER_VEH_S, allowed=_DEMAND,
+                             unit="veh/h", doc="flow requested on the on-ramp"),
+    "ramp_av_share": Key("ramp_av_share", doc="share of AVs in the ramp demand, in [0, 1]"),
+    "cell_length_m": Key("cell_length", unit="m",
+                         doc="measurement cell length (divides the road length)"),
+    "control_period_s": Key("control_period", unit="s",
+                            doc="measurement window and meter update period of `arzsumo "
+                                "run` (a multiple of the step)"),
+    "meter_cycle_s": Key("meter_cycle", unit="s", doc="ramp meter signal cycle"),
+    "min_green_s": Key("min_green", unit="s", doc="minimum green time per cycle"),
+    "min_red_s": Key("min_red", unit="s", doc="minimum red time per cycle"),
+    "green_share": Key("green_share", doc="nominal green share of the cycle (open loop)"),
+    "green_share_min": Key("green_share_min", doc="lowest commanded green share"),
+    "green_share_max": Key("green_share_max", doc="highest commanded green share"),
+    "spillback_queue_veh": Key("spillback_queue", "integer", unit="veh",
+                               doc="ramp queue that forces green; 0 disables it"),
+    "time_to_teleport_s": Key("time_to_teleport", unit="s",
+                              doc="SUMO's --time-to-teleport; -1 disables teleports"),
+    "hv_model": Key("hv_model", "string", choices=HV_MODELS, doc="HV car-following model"),
+    "hv_sigma": Key("hv_sigma", doc="HV driver imperfection, in [0, 1]"),
+    "av_model": Key("av_model", "string", choices=AV_MODELS, doc="AV car-following model"),
+    "min_gap_lat_m": Key("min_gap_lat", unit="m", doc="lateral gap kept by both classes"),
+    "meter_curve": Key("meter_curve", "string",
+                       doc="meter_curve.toml of `arzsumo calibrate`, relative to the scenario "
+                           "file; \"\" keeps the built-in curve"),
+}
+
+
+def sumo_section(table: Mapping[str, Any], at: str, source: str = "<dict>") -> SumoConfig:
+    """The SumoConfig of a ``[sumo]`` table (keys already checked against SUMO_KEYS).
+
+    A relative ``meter_curve`` is read from the directory of ``source`` (the working
+    directory for a scenario not read from a file) and made absolute; the file must exist.
+    """
+    changes = read_keys(table, SUMO_KEYS, at)
+    try:
+        cfg = SumoConfig(**changes)
+    except ArzsumoError as exc:
+        raise in_user_terms(exc, at, table, SUMO_KEYS) from None
+    if not cfg.meter_curve:
+        return cfg
+    path = Path(cfg.meter_curve).expanduser()
+    if not path.is_absolute() and Path(source).is_file():
+        path = Path(source).parent / path
+    if not path.is_file():
+        raise ScenarioError(f"{at} meter_curve = {written(cfg.meter_curve)} is not allowed: "
+                            f"there is no file {str(path)!r}; allowed: a meter_curve.toml of "
+                            "`arzsumo calibrate`, relative to the scenario file")
+    return cfg.with_(meter_curve=str(path.resolve()))
+
+
+def anchor_meter_curve(data: Mapping[str, Any], base_dir: Path) -> dict[str, Any]:
+    """A copy of a parsed scenario whose relative ``[sumo] meter_curve`` is made absolute
+    against ``base_dir`` (the directory of the file it was written in)."""
+    out = copy.deepcopy(dict(data))
+    table = out.get("sumo")
+    value = table.get("meter_curve") if isinstance(table, dict) else None
+    if isinstance(value, str) and value and not Path(value).expanduser().is_absolute():
+        table["meter_curve"] = str(base_dir / value)
+    return out
