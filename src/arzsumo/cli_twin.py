@@ -2,7 +2,7 @@
 ``arzsumo reproduce [--out DIR] [--quick]``: run every experiment of section 5.
 
 Registered into the main parser by :func:`register`; the work is done by
-:func:`arzsumo.runs.twin.run_twin` and :func:`arzsumo.outputs.twin.write_run`, and by
+:func:`arzsumo.engines.twin.run_twin` and :func:`arzsumo.outputs.twin.write_run`, and by
 :func:`arzsumo.studies.paper.reproduce.reproduce` and
 :func:`arzsumo.studies.paper.report.write_reproduction`.
 Exit codes: 0 completed, 3 stopped early (state left the physical domain; the partial
@@ -26,10 +26,10 @@ EXIT_INCOMPLETE = 3
 
 
 def cmd_twin(args: argparse.Namespace) -> int:
+    from arzsumo.engines.twin import run_twin
     from arzsumo.io import json_safe
     from arzsumo.outdir import OutputDir
     from arzsumo.outputs.twin import write_run
-    from arzsumo.runs.twin import run_twin
 
     sc = load_scenario(args.scenario)
     out = Path(args.out) if args.out else Path("results") / "twin" / sc.name

@@ -17,8 +17,8 @@ from arzsumo.control.registry import (
     register_controller,
     unregister_controller,
 )
+from arzsumo.engines.twin import twin_controller
 from arzsumo.errors import ScenarioError
-from arzsumo.runs.twin import twin_controller
 from arzsumo.scenario import scenario_from_dict
 
 
@@ -138,7 +138,7 @@ def test_cli_twin_bad_scenario_is_one_line(tmp_path):
 
 def test_pde_controllers_run_in_the_twin_with_a_design_table(tmp_path, monkeypatch):
     """backstepping updates at every check; ETC far less often; [design] reaches the ETC."""
-    from arzsumo.runs.twin import run_twin
+    from arzsumo.engines.twin import run_twin
 
     monkeypatch.setenv("ARZSUMO_CACHE", str(tmp_path))
     base = {"model": {"preset": "paper_base"},

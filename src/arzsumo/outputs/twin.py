@@ -6,7 +6,7 @@ Layout of ``DIR`` (written atomically with :func:`arzsumo.io.atomic_dir`)::
 
     fields.parquet    long table: t_s, x_m, rho_h, v_h, rho_a, v_a (SI: veh/m, m/s)
     control.parquet   t_s, u_applied, u_requested, u_continuous, triggered (veh/s)
-    summary.json      :meth:`arzsumo.runs.twin.TwinRun.summary`
+    summary.json      :meth:`arzsumo.engines.twin.TwinRun.summary`
     fields_h.png, fields_a.png, control.png
 """
 
@@ -20,9 +20,9 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+from arzsumo.engines.twin import TwinRun
 from arzsumo.io import json_safe
 from arzsumo.outdir import OutputDir, atomic_dir, target_of
-from arzsumo.runs.twin import TwinRun
 from arzsumo.schema import TWIN_CONTROL, TWIN_FIELDS, with_units
 
 

@@ -2,7 +2,7 @@
 cl_event, as heatmaps) and the control input with release instants (figure event-control).
 
 Two layers: ``*_figure`` functions take arrays and return a Figure; :func:`write_twin_plots`
-takes a :class:`arzsumo.runs.twin.TwinRun` and saves PNGs atomically.
+takes a :class:`arzsumo.engines.twin.TwinRun` and saves PNGs atomically.
 """
 
 from __future__ import annotations

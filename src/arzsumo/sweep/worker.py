@@ -91,8 +91,8 @@ def _parquet(table: pa.Table) -> bytes:
 
 
 def _run_twin(task: RunTask) -> tuple[str, dict[str, Any], dict[str, bytes]]:
+    from arzsumo.engines.twin import run_twin
     from arzsumo.outputs.twin import control_table
-    from arzsumo.runs.twin import run_twin
     from arzsumo.scenario import scenario_from_dict
 
     sc = scenario_from_dict(task.scenario, task.source)

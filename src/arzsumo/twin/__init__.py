@@ -5,7 +5,7 @@ Numerics only, in :mod:`state`, :mod:`flux`, :mod:`source`, :mod:`boundary`,
 ``control``, ``model``, ``units`` and ``errors`` (the "math" contract in
 ``pyproject.toml``). Scenarios become twin runs elsewhere: the ``[twin]`` and
 ``[initial]`` sections in :mod:`arzsumo.scenario.twin`, the controllers in
-:mod:`arzsumo.control.registry`, a run in :mod:`arzsumo.runs.twin`; runs are written by
+:mod:`arzsumo.control.registry`, a run in :mod:`arzsumo.engines.twin`; runs are written by
 :mod:`arzsumo.outputs.twin`; paper reproduction lives in :mod:`arzsumo.studies.paper`.
 """
 

@@ -9,8 +9,8 @@ from pathlib import Path
 import pytest
 
 from arzsumo.cli import main
+from arzsumo.engines.twin import run_twin
 from arzsumo.errors import ScenarioError
-from arzsumo.runs.twin import run_twin
 from arzsumo.scenario import load_scenario
 from arzsumo.studies.paper.compare import (
     NOT_REPRODUCED,

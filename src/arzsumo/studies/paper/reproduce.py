@@ -28,9 +28,9 @@ from typing import Any
 import numpy as np
 
 from arzsumo.control.events import lyapunov_convergence_time
+from arzsumo.engines.twin import TwinRun, compare_to_open_loop, run_twin
 from arzsumo.errors import ScenarioError
 from arzsumo.io import json_safe
-from arzsumo.runs.twin import TwinRun, compare_to_open_loop, run_twin
 from arzsumo.scenario import Scenario, load_scenario
 from arzsumo.sweep.driver import map_runs
 from arzsumo.twin.metrics import Performance

@@ -14,9 +14,9 @@ import numpy as np
 from arzsumo import __version__
 from arzsumo.control.base import Controller
 from arzsumo.control.events import release_time
-from arzsumo.model.characteristic import Linearization, linearize
 from arzsumo.control.registry import ControllerInputs, controller_spec
 from arzsumo.kernel_cache import cached_kernels
+from arzsumo.model.characteristic import Linearization, linearize
 from arzsumo.scenario import Scenario
 from arzsumo.scenario.twin import TwinConfig
 from arzsumo.schema import TWIN_SUMMARY, key_units
