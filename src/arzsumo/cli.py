@@ -17,7 +17,16 @@ import sys
 import threading
 from collections.abc import Callable, Sequence
 
-from arzsumo import __version__, cli_bridge, cli_control, cli_list, cli_sumo, cli_sweep, cli_twin
+from arzsumo import (
+    __version__,
+    cli_bridge,
+    cli_control,
+    cli_evaluate,
+    cli_list,
+    cli_sumo,
+    cli_sweep,
+    cli_twin,
+)
 from arzsumo.cli_args import Parser
 from arzsumo.cli_common import add_model_source, scenario_of
 from arzsumo.errors import ArzsumoError
@@ -94,7 +103,8 @@ exit codes:
   0    done
   2    user error (bad argument, scenario or sweep file): one line on stderr
   3    the PDE twin left the physical domain (twin, reproduce: partial results written)
-  4    some sweep runs were invalid, failed or crashed (sweep: the others completed)
+  4    some sweep runs were invalid, failed or crashed (sweep, evaluate: the others
+       completed)
   130  interrupted (Ctrl-C)
 
 'arzsumo list' shows the shipped scenario and sweep files; 'arzsumo CMD --help' each
@@ -123,6 +133,7 @@ def build_parser() -> argparse.ArgumentParser:
     cli_sumo.register(sub)
     cli_bridge.register(sub)
     cli_sweep.register(sub)
+    cli_evaluate.register(sub)
     cli_list.register(sub)
     return parser
 

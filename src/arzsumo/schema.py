@@ -122,6 +122,19 @@ _COMMON = {"scenario": TEXT, "source": TEXT, "version": TEXT, "seed": TEXT,
            "controller": TEXT, "complete": TEXT, "units": TEXT, "units_by_key": TEXT,
            "triggers": "count", "release_time": "s", **_EQUILIBRIUM}
 
+#: SUMO's network measures (``network``: control window; ``network_whole_run``: from t = 0)
+_NETWORK = {"network*.window": TEXT, "network*.begin_s": "s", "network*.end_s": "s",
+            "network*.time_spent_s.*": "veh*s", "network*.time_loss_s.*": "veh*s",
+            "network*.depart_delay_s.*": "veh*s", "network*.waiting_time_s.*": "veh*s",
+            "network*.fuel_g.*": "g", "network*.co2_g.*": "g",
+            "network*.distance_m.*": "veh*m", "network*.vehicles.*": "veh",
+            "network*.throughput_veh_h.*": "veh/h"}
+#: the measured section over the control window
+_SECTION = {"section.window": TEXT, "section.speed_mean_kmh.*": "km/h",
+            "section.speed_sd_kmh.*": "km/h", "section.speed_samples.*": "count",
+            **{f"section.{k}.*": u for k, u in _RUN_INDICES.items()},
+            "section.until_s": "s"}
+
 #: units of the keys of ``arzsumo run``'s summary.json (dotted; ``*`` within a name)
 RUN_SUMMARY: dict[str, str] = {
     **_COMMON, "kind": TEXT, "lambda_4": "m/s", "q_nominal": "veh/s", "horizon": "s",
@@ -138,7 +151,7 @@ RUN_SUMMARY: dict[str, str] = {
     "inserted": "veh", "requested": "veh", "waiting": "veh", "arrived": "veh",
     "teleports": "count", "collisions": "count", "emergency_braking": "count",
     "placement": TEXT, "wall_time": "s", "timings.*": "s",
-    "controller_time_per_period": "s",
+    "controller_time_per_period": "s", **_NETWORK, **_SECTION,
     "settings.warmup": "s", "settings.smoothing": "s", "settings.alinea_target": "1",
     "settings.alinea_gain": "veh/s", "settings.alinea_saturation": "veh/s",
     "settings.kernel_cells": "count", "settings.twin_cells": "count", "settings.*": TEXT,

@@ -22,6 +22,13 @@ The meter's counts (plan and light changes, queue maximum) cover the control win
 the meter's window is closed at the start of control and the warm-up's counts are kept
 apart (``CoSimResult.warmup_meter``).
 
+SUMO writes its own outputs (tripinfo of every loaded vehicle with emissions, edge data,
+statistics; :func:`~arzsumo.sumo.network_measures.network_options`) into a scratch
+directory; after the run they become the network measures of the control window and of
+the whole run (:mod:`arzsumo.sumo.window`, ``CoSimResult.network``), the sensor's speed
+moments of the section (``CoSimResult.section_speed``), and the compressed tripinfo kept
+with the results.
+
 A detector sample's path: ``SumoSensor.observe`` (libsumo, every step) ->
 ``PeriodMeasurement`` -> ``Estimator.estimate`` -> ``MacroState`` -> ``Controller.check``
 -> U -> ``MeterActuator.apply`` -> ``RampMeter.command_outflow`` -> the light, set by
@@ -32,8 +39,11 @@ from __future__ import annotations
 
 import logging
 import math
+import shutil
+import tempfile
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -54,8 +64,11 @@ from arzsumo.scenario import Scenario
 from arzsumo.scenario.run import RunSettings
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.meter import DEFAULT_CURVE, GreenShareCurve, RampMeter
+from arzsumo.sumo.network_measures import network_options
+from arzsumo.sumo.paths import scratch_dir
 from arzsumo.sumo.sensor import PeriodMeasurement, SumoSensor
 from arzsumo.sumo.simulation import RunReport, SumoSimulation, open_simulation
+from arzsumo.sumo.window import NetworkMeasures, WindowStart, measure_network
 from arzsumo.twin.solver import SolverOptions
 
 log = logging.getLogger(__name__)
@@ -107,6 +120,11 @@ class CoSimResult:
     timings: dict[str, float]
     #: meter counts from t = 0 to the start of control, and that time (``duration_s``, s)
     warmup_meter: dict[str, float] = field(default_factory=dict)
+    #: SUMO's network measures (control window, whole run) and its tripinfo file
+    network: NetworkMeasures | None = None
+    #: per-vehicle speed moments on the section over the control window, per class
+    #: (``speed_mean_kmh``, ``speed_sd_kmh``, ``speed_samples``)
+    section_speed: dict[str, dict[str, float]] = field(default_factory=dict)
 
 
 class SumoPlant:
@@ -116,7 +134,7 @@ class SumoPlant:
                  curve: GreenShareCurve) -> None:
         self.sim = sim
         self.meter = RampMeter(sim.lib, cfg, curve)
-        self.sensor = SumoSensor(sim.lib, length, cfg)
+        self.sensor = SumoSensor(sim.lib, length, cfg, window=True)
         self.timings = {"sumo_step": 0.0, "measure_actuate": 0.0}
 
     def advance(self) -> PeriodMeasurement:
@@ -284,6 +302,20 @@ def place_initial(params: ModelParameters, settings: RunSettings, cfg: SumoConfi
     return initial, rep.summary()
 
 
+@dataclass
+class Controlled:
+    """What the warm-up and the control window left: the loop (plant, controller, twins),
+    its trace, the design point, the warm-up's meter counts and the window's start."""
+
+    loop: ClosedLoop
+    trace: Trace
+    ref_ctrl: Controller
+    eq: Equilibrium
+    q_nom: float
+    warmup_meter: dict[str, float]
+    start: WindowStart
+
+
 def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
                      design: EtcDesign, *, initial_fields: np.ndarray | None = None,
                      curve: GreenShareCurve = DEFAULT_CURVE,
@@ -293,44 +325,61 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
     ``initial_fields`` (4, cells on the micro grid) places vehicles at t = 0 when
     ``settings.start == "placement"``.
     """
-    from arzsumo.kernel_cache import cached_kernels
-
     wall0 = time.perf_counter()
-    params, period = scenario.params, cfg.control_period
     if settings.equilibrium == "scenario":
         check_before_start(settings, scenario.equilibrium)
     run_cfg = cfg.with_(horizon=settings.warmup + cfg.horizon)
-    initial, placement = place_initial(params, settings, run_cfg, initial_fields)
+    initial, placement = place_initial(scenario.params, settings, run_cfg, initial_fields)
     bar = Progress(run_cfg.horizon, f"{settings.controller} seed {cfg.seed}",
                    enabled=progress)
-    with open_simulation(params, run_cfg, initial=initial) as sim:
-        plant = SumoPlant(sim, params.length, run_cfg, curve)
-        warm = warm_up(plant, settings.warmup, period, bar)
-        plant.timings = dict.fromkeys(plant.timings, 0.0)   # time the control window only
-        warmup_meter = {**plant.meter.start_window(), "duration_s": float(warm[-1].t)}
-        eq = operating_point(settings, scenario.equilibrium, warm, period)
-        lin = linearize(eq)
-        kernels = (cached_kernels(lin.system, settings.kernel_cells)
-                   if is_pde(settings.controller) else None)
-        target = occupancy_target(settings, warm, period)
-        ctrl = build_controller(settings.controller, lin, kernels, design, settings, curve,
-                                cfg, target)
-        ref_name = settings.controller if is_pde(settings.controller) else "open"
-        ref_ctrl = build_controller(ref_name, lin, kernels, design, settings, curve, cfg,
-                                    target)
-        q_nom = curve.outflow_at(cfg.green_share)
-        opts = SolverOptions(cells=settings.twin_cells, scheme=settings.twin_scheme,
-                             horizon=cfg.horizon, control_period=period)
-        twins = TwinPair(eq, lin, warm[-1].cells, opts, settings.smoothing, ref_ctrl, q_nom)
-        actuator = MeterActuator(plant.meter, q_nom, settings.controller == "open")
-        loop = ClosedLoop(plant, FundamentalDiagramFill(params), ctrl, actuator, twins,
-                          period)
-        trace = loop.run(warm[-1], cfg.horizon, bar)
-        meter_summary = plant.meter.summary()
+    net_dir = Path(tempfile.mkdtemp(prefix="arzsumo-net-", dir=scratch_dir()))
+    try:
+        with open_simulation(scenario.params, run_cfg, initial=initial,
+                             extra_args=network_options(net_dir), output_dir=net_dir) as sim:
+            c = control(sim, scenario, settings, cfg, design, curve, bar)
+            meter_summary = c.loop.plant.meter.summary()
+        records = c.trace.records
+        outlet = round(sum((r.outflow_h + r.outflow_a) * cfg.control_period for r in records))
+        network = measure_network(net_dir, c.start, sim.time, outlet)
+    finally:
+        shutil.rmtree(net_dir, ignore_errors=True)
     bar.close()
-    return CoSimResult(scenario, settings, cfg, eq, q_nom, np.asarray(trace.t), trace.x,
+    loop, trace = c.loop, c.trace
+    return CoSimResult(scenario, settings, cfg, c.eq, c.q_nom, np.asarray(trace.t), trace.x,
                        np.asarray(trace.micro), np.asarray(trace.replay),
-                       np.asarray(trace.reference), columns(trace.records), ctrl.log,
-                       ref_ctrl.log, meter_summary, sim.report, twins.status(), placement,
-                       time.perf_counter() - wall0, {**plant.timings, **loop.timings},
-                       warmup_meter)
+                       np.asarray(trace.reference), columns(records), loop.controller.log,
+                       c.ref_ctrl.log, meter_summary, sim.report, loop.twins.status(),
+                       placement, time.perf_counter() - wall0,
+                       {**loop.plant.timings, **loop.timings}, c.warmup_meter, network,
+                       loop.plant.sensor.speeds.summary())
+
+
+def control(sim: SumoSimulation, scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
+            design: EtcDesign, curve: GreenShareCurve, bar: Progress) -> Controlled:
+    """Warm-up, then the control window, in the open ``sim`` (steps 3-6 of the module
+    docstring); ``cfg`` has the control horizon."""
+    from arzsumo.kernel_cache import cached_kernels
+
+    params, period = scenario.params, cfg.control_period
+    plant = SumoPlant(sim, params.length, cfg, curve)
+    warm = warm_up(plant, settings.warmup, period, bar)
+    plant.timings = dict.fromkeys(plant.timings, 0.0)   # time the control window only
+    warmup_meter = {**plant.meter.start_window(), "duration_s": float(warm[-1].t)}
+    start = plant.sensor.start_window(warm[-1].t)
+    eq = operating_point(settings, scenario.equilibrium, warm, period)
+    lin = linearize(eq)
+    kernels = (cached_kernels(lin.system, settings.kernel_cells)
+               if is_pde(settings.controller) else None)
+    target = occupancy_target(settings, warm, period)
+    ctrl = build_controller(settings.controller, lin, kernels, design, settings, curve,
+                            cfg, target)
+    ref_name = settings.controller if is_pde(settings.controller) else "open"
+    ref_ctrl = build_controller(ref_name, lin, kernels, design, settings, curve, cfg, target)
+    q_nom = curve.outflow_at(cfg.green_share)
+    opts = SolverOptions(cells=settings.twin_cells, scheme=settings.twin_scheme,
+                         horizon=cfg.horizon, control_period=period)
+    twins = TwinPair(eq, lin, warm[-1].cells, opts, settings.smoothing, ref_ctrl, q_nom)
+    actuator = MeterActuator(plant.meter, q_nom, settings.controller == "open")
+    loop = ClosedLoop(plant, FundamentalDiagramFill(params), ctrl, actuator, twins, period)
+    trace = loop.run(warm[-1], cfg.horizon, bar)
+    return Controlled(loop, trace, ref_ctrl, eq, q_nom, warmup_meter, start)

@@ -11,6 +11,8 @@ Every file, column (with units, stored in the Parquet field metadata from
     cells.parquet     per period and cell: source (micro, replay, reference), t_s, x_m,
                       rho_h, v_h, rho_a, v_a (SI; micro speeds NaN in empty cells)
     summary.json      see :func:`summary`
+    tripinfo.xml.gz   SUMO's tripinfo output (every loaded vehicle, with emissions),
+                      compressed; ``arzsumo.sumo.network_measures.read_trips`` reads it
     scenario.toml     the resolved scenario (as loaded) and settings
     fields_h.png, fields_a.png   micro | replay twin | reference twin, per class
     control.png       U, green share, light, queue, release instants
@@ -47,6 +49,8 @@ from arzsumo.schema import CELLS, PERIODS, RUN_SUMMARY, key_units, with_units
 from arzsumo.twin.metrics import performance
 
 VARIABLES = ("rho_h", "v_h", "rho_a", "v_a")
+#: SUMO's tripinfo output of the run (every loaded vehicle), gzip-compressed
+TRIPINFO_GZ = "tripinfo.xml.gz"
 
 
 def _indices(res: CoSimResult, fields: np.ndarray) -> dict[str, Any]:
@@ -95,6 +99,18 @@ def warmup_summary(res: CoSimResult) -> dict[str, Any]:
             "light_changes": int(w["light_changes"]), "max_ramp_queue": int(w["max_queue"])}
 
 
+#: ``summary.json["section"]["window"]``
+SECTION_WINDOW = ("measured section x in [0, L] over the control window: indices from the "
+                  "Edie cells, speed moments from every vehicle on main every step")
+
+
+def section_summary(res: CoSimResult, micro: dict[str, Any]) -> dict[str, Any]:
+    """The section's measures, labelled as such: per-vehicle speed moments per class (km/h)
+    and the micro indices ``micro`` (:func:`_indices`; also at the top level, kept for
+    compatibility)."""
+    return {"window": SECTION_WINDOW, **res.section_speed, **micro}
+
+
 def summary(res: CoSimResult) -> dict[str, Any]:
     """The run's summary: meter counts, events, indices (micro and twins), fidelity, accounting.
 
@@ -111,6 +127,8 @@ def summary(res: CoSimResult) -> dict[str, Any]:
                          list(log.u_continuous[:n]), list(log.triggered[:n]))
     v = res.micro[:, [1, 3]]
     eq = res.equilibrium
+    micro = _indices(res, res.micro)
+    net = res.network
     summ = {
         "kind": KIND,
         "scenario": res.scenario.name, "source": res.scenario.source, "version": __version__,
@@ -124,7 +142,10 @@ def summary(res: CoSimResult) -> dict[str, Any]:
         "release_time": release_time(clipped.t, clipped.triggered, horizon),
         "max_ramp_queue": int(res.meter["max_queue"]),
         "speed_variance": {"h": float(np.nanvar(v[:, 0])), "a": float(np.nanvar(v[:, 1]))},
-        **{k: v for k, v in _indices(res, res.micro).items()},
+        **micro,
+        "section": section_summary(res, micro),
+        "network": net.window if net else None,
+        "network_whole_run": net.whole_run if net else None,
         "twin_replay": _indices(res, res.replay), "twin_reference": _indices(res, res.reference),
         "rmse": {"replay": rmse(res, res.replay), "reference": rmse(res, res.reference)},
         "twin_status": res.twin_status,
@@ -174,6 +195,8 @@ def write_results(res: CoSimResult, out: str | Path | OutputDir, scenario_text: 
         (tmp / "scenario.toml").write_text(scenario_text, encoding="utf-8")
         (tmp / "summary.json").write_text(json.dumps(json_safe(summ), indent=2) + "\n",
                                           encoding="utf-8")
+        if res.network is not None:
+            (tmp / TRIPINFO_GZ).write_bytes(res.network.tripinfo_gz)
         if plots:
             write_bridge_plots(res, tmp)
     return target_of(out), summ

@@ -7,6 +7,9 @@ One :class:`SumoSensor` per run. After each SUMO step :meth:`SumoSensor.observe`
 * the lane occupancy downstream of the merge (ALINEA's measurement), and
 * the ramp queue (halted vehicles on ``ramp_up`` plus ramp vehicles still waiting to be
   inserted), which the meter's spillback override needs every step,
+* until the control window opens (:meth:`SumoSensor.start_window`), every vehicle's fuel
+  and CO2 (:class:`~arzsumo.sumo.window.WarmupLedger`); after, the speed moments per class
+  of the vehicles on ``main`` (:class:`SpeedMoments`, from the samples above),
 
 and when a control period is complete returns one :class:`PeriodMeasurement`. Nothing
 else in the closed loop reads SUMO; the meter only writes the traffic light.
@@ -14,12 +17,17 @@ else in the closed loop reads SUMO; the meter only writes the traffic light.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from types import ModuleType
+
+import numpy as np
 
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.measure import CellData, MainlineSensor
 from arzsumo.sumo.network import DOWN, RAMP_UP
+from arzsumo.sumo.window import WarmupLedger, WindowStart
+from arzsumo.units import ms_to_kmh
 
 #: the lane whose occupancy ALINEA regulates (downstream of the merge)
 OCCUPANCY_LANE = f"{DOWN}_0"
@@ -50,6 +58,38 @@ class PeriodMeasurement:
         return self.cells.t
 
 
+class SpeedMoments:
+    """Count, sum and sum of squares of per-vehicle speeds (m/s) per class (HV, AV),
+    accumulated over vehicle-steps."""
+
+    CLASSES = ("h", "a")
+
+    def __init__(self) -> None:
+        self.n = np.zeros(2)
+        self.s1 = np.zeros(2)
+        self.s2 = np.zeros(2)
+
+    def add(self, speed: np.ndarray, av: np.ndarray) -> None:
+        """One step's speeds (m/s) and AV mask."""
+        k = av.astype(np.intp)
+        self.n += np.bincount(k, minlength=2)
+        self.s1 += np.bincount(k, weights=speed, minlength=2)
+        self.s2 += np.bincount(k, weights=speed * speed, minlength=2)
+
+    def summary(self) -> dict[str, dict[str, float]]:
+        """``speed_mean_kmh``, ``speed_sd_kmh`` (sample sd, km/h; NaN with fewer than two
+        samples) and ``speed_samples`` (vehicle-steps), per class."""
+        out: dict[str, dict[str, float]] = {"speed_mean_kmh": {}, "speed_sd_kmh": {},
+                                            "speed_samples": {}}
+        for c, n, s1, s2 in zip(self.CLASSES, self.n, self.s1, self.s2, strict=True):
+            mean = s1 / n if n else math.nan
+            var = max(s2 - s1 * s1 / n, 0.0) / (n - 1) if n > 1 else math.nan
+            out["speed_mean_kmh"][c] = float(ms_to_kmh(mean))
+            out["speed_sd_kmh"][c] = float(ms_to_kmh(math.sqrt(var)))
+            out["speed_samples"][c] = int(n)
+        return out
+
+
 class SumoSensor:
     """Reads an open libsumo run every step; yields one measurement per control period.
 
@@ -61,14 +101,29 @@ class SumoSensor:
         Length L of the measured section, m.
     cfg : SumoConfig
         Cell length, step length and control period.
+    window : bool
+        Keep the warm-up ledger and the section's speed moments for a control window
+        (:meth:`start_window`; the co-simulation does).
     """
 
-    def __init__(self, lib: ModuleType, length: float, cfg: SumoConfig) -> None:
+    def __init__(self, lib: ModuleType, length: float, cfg: SumoConfig,
+                 window: bool = False) -> None:
         self.lib = lib
         self.mainline = MainlineSensor(lib, length, cfg.cell_length, cfg.step_length,
                                        cfg.steps_per_period)
         self.queue = 0
         self._occupancy_sum, self._steps = 0.0, 0
+        self.ledger = WarmupLedger(lib, cfg.step_length) if window else None
+        self.window_open = False
+        self.speeds = SpeedMoments()
+
+    def start_window(self, t: float) -> WindowStart:
+        """Open the control window at ``t`` (s): the system's state now (for the window's
+        network measures); from now on speeds are accumulated, fuel no longer."""
+        if self.ledger is None or self.window_open:
+            raise RuntimeError("start_window needs a sensor made with window=True, once")
+        self.window_open = True
+        return self.ledger.close(t)
 
     def observe(self, t: float) -> PeriodMeasurement | None:
         """Sample the step that ended at ``t`` (s); return the period's measurement when
@@ -77,6 +132,10 @@ class SumoSensor:
         self._occupancy_sum += self.lib.lane.getLastStepOccupancy(OCCUPANCY_LANE)
         self._steps += 1
         cells = self.mainline.collect(t)
+        if self.window_open:
+            self.speeds.add(self.mainline.last_speed, self.mainline.last_av)
+        elif self.ledger is not None:
+            self.ledger.add()
         if cells is None:
             return None
         occupancy = self._occupancy_sum / self._steps

@@ -239,7 +239,8 @@ def default_workers() -> int:
 def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
               scheduler: str | None = None, progress: bool = True,
               plots: bool = True,
-              paper: Mapping[str, Mapping[float, float]] | None = None) -> SweepReport:
+              paper: Mapping[str, Mapping[float, float]] | None = None,
+              kind: str = "sweep") -> SweepReport:
     """Execute the runs of ``spec`` that have no current result under ``out``; then write
     the table, plots and manifest.
 
@@ -256,12 +257,15 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
     paper : mapping, optional
         Reference points drawn on ``study.png``: metric -> {axis value: value} (the CLI
         passes :func:`arzsumo.studies.paper.values.paper_points` of ``spec.paper``).
+    kind : str
+        The kind of result ``out`` holds (its marker): ``sweep``, or ``evaluation`` for
+        ``arzsumo evaluate``; a directory of another kind is refused.
     """
     t0 = time.perf_counter()
     runs = spec.runs()
     if workers is not None and workers < 1:
         raise SweepError(f"--workers = {workers} is not allowed: an integer >= 1")
-    with resumable_dir(out, "sweep") as target:
+    with resumable_dir(out, kind) as target:
         return _run(spec, target, runs, workers, scheduler, progress, plots, paper, t0)
 
 

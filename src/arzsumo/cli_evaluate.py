@@ -1,0 +1,82 @@
+"""``arzsumo evaluate SCENARIO --controllers LIST --seeds N``: controllers on the same seeds
+in SUMO, compared with the open loop seed by seed.
+
+Checks the scenario for every controller (as ``arzsumo run`` would) before any run,
+then calls :func:`arzsumo.sweep.evaluate.run_evaluation` and prints where the report is.
+Exit codes: 0 every run finished, 4 some runs were invalid, failed or crashed (the
+report uses the seeds that finished for both members of a pair), 2 a user error.
+"""
+
+from __future__ import annotations
+
+import argparse
+import shlex
+import sys
+from pathlib import Path
+
+from arzsumo.cli_args import positive_float, positive_int, seed_int
+
+EXIT_SOME_FAILED = 4
+
+
+def cmd_evaluate(args: argparse.Namespace) -> int:
+    from arzsumo.sweep.evaluate import BASELINE, run_evaluation
+
+    scenario = Path(args.scenario)
+    seeds = list(range(args.seed_start, args.seed_start + args.seeds))
+    controllers = [c.strip() for c in args.controllers.split(",") if c.strip()]
+    out = Path(args.out) if args.out else Path("results") / "evaluate" / scenario.stem
+    command = "arzsumo " + " ".join(shlex.quote(a) for a in sys.argv[1:]) \
+        if sys.argv[1:2] == ["evaluate"] else ""
+    res = run_evaluation(scenario, controllers, seeds, out=out, horizon=args.horizon,
+                         workers=args.workers, scheduler=args.scheduler,
+                         overwrite=args.overwrite, progress=not args.quiet,
+                         plots=not args.no_plots, command=command)
+    rep = res.sweep
+    print(f"evaluate {scenario.name}: {rep.total} runs, {rep.skipped} already finished, "
+          f"{rep.executed} executed on {rep.backend} in {rep.wall_time:.1f} s")
+    bad = rep.table[~rep.table["status"].isin(["ok"])] if rep.table is not None else None
+    if bad is not None:
+        for _, row in bad.iterrows():
+            print(f"  {row['run_id']}: {row['status']}: {str(row['error']).splitlines()[0]}")
+    main = res.table[res.table["measure"].isin(["network.time_loss_s.total",
+                                                "network.depart_delay_s.ramp"])]
+    for r in main.itertuples(index=False):
+        if r.controller != BASELINE:
+            print(f"  {r.label} ({r.unit}), {r.controller} minus {BASELINE}: "
+                  f"{r.diff_mean:.3g} [{r.diff_ci_low:.3g}, {r.diff_ci_high:.3g}]")
+    print("  report: " + ", ".join(str(p) for p in res.files))
+    return 0 if bad is None or bad.empty else EXIT_SOME_FAILED
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add ``evaluate`` to the top-level parser."""
+    p = sub.add_parser("evaluate", help="controllers on the same seeds, paired against the "
+                                        "open loop (CSV, Markdown, figure)",
+                       description="Run every controller on the same SUMO seeds through the "
+                                   "sweep engine (parallel, resumable, Dask-capable) and "
+                                   "report per measure the mean with its 95 %% CI and the "
+                                   "paired difference against the open loop with its 95 %% "
+                                   "CI, wins and losses.")
+    p.add_argument("scenario", metavar="SCENARIO.toml", help="scenario file")
+    p.add_argument("--controllers", default="open,alinea,backstepping,etc,observer-etc",
+                   help="comma-separated controllers; open (the baseline) is added first "
+                        "when missing")
+    p.add_argument("--seeds", type=positive_int, default=10, help="number of seeds N")
+    p.add_argument("--seed-start", type=seed_int, default=1,
+                   help="first seed S: the seeds are S, S+1, ..., S+N-1")
+    p.add_argument("--horizon", type=positive_float,
+                   help="control horizon after the warm-up, s (default: [sumo] horizon_s)")
+    p.add_argument("--workers", type=positive_int,
+                   help="local processes (default: one per core); ignored with --scheduler")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="Dask scheduler address, e.g. tcp://10.0.0.5:8786")
+    p.add_argument("--out", metavar="DIR",
+                   help="output directory (default results/evaluate/<scenario file name>); "
+                        "a restart with the same directory runs only what is missing")
+    p.add_argument("--overwrite", action="store_true",
+                   help="discard the runs and report of a previous evaluation in --out and "
+                        "run everything again")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--no-plots", action="store_true", help="skip the figure")
+    p.set_defaults(func=cmd_evaluate)

@@ -1,0 +1,168 @@
+"""The evaluation of controllers over seeds: per measure, mean with its CI per controller
+and the paired difference against a baseline (the open loop) over the same seeds.
+
+Pure: takes a table with one row per run (columns ``controller``, ``seed`` and the
+measures as dotted summary keys in SI, as the sweep table has them) and returns tables
+and text; writes nothing (:mod:`arzsumo.outputs.evaluation` writes them).
+
+Values in the results are in the human units of :data:`MEASURES` (veh h, veh/h, kg, km/h,
+counts). Intervals: 95 % Student t for means and paired differences; the bootstrap (BCa,
+seeded) interval of the paired difference is given too (:mod:`~arzsumo.evaluation.stats`).
+Seeds where either run lacks a value are dropped pair-wise.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from arzsumo.evaluation.stats import StatisticsError, mean_ci, paired_difference
+
+S_PER_H = 3600.0
+
+
+@dataclass(frozen=True)
+class Measure:
+    """One measure of the evaluation.
+
+    ``key``: dotted summary key (SI); ``scale``: factor from the summary's unit to
+    ``unit``; ``lower_is_better``: direction used for wins and losses.
+    """
+
+    key: str
+    label: str
+    unit: str
+    scale: float = 1.0
+    lower_is_better: bool = True
+
+
+def _split(key: str, label: str, unit: str, scale: float) -> tuple[Measure, ...]:
+    return tuple(Measure(f"{key}.{part}", f"{label}, {part}", unit, scale)
+                 for part in ("mainline", "ramp", "total"))
+
+
+#: the measures, in report order
+MEASURES: tuple[Measure, ...] = (
+    *_split("network.time_spent_s", "network time spent", "veh h", 1 / S_PER_H),
+    *_split("network.time_loss_s", "network time loss", "veh h", 1 / S_PER_H),
+    *_split("network.depart_delay_s", "network depart delay", "veh h", 1 / S_PER_H),
+    Measure("network.throughput_veh_h.section_outlet", "throughput, section outlet", "veh/h",
+            1.0, lower_is_better=False),
+    Measure("network.throughput_veh_h.network_exit", "throughput, network exit", "veh/h",
+            1.0, lower_is_better=False),
+    Measure("network.fuel_g.total", "network fuel", "kg", 1e-3),
+    Measure("network.co2_g.total", "network CO2", "kg", 1e-3),
+    Measure("section.speed_sd_kmh.h", "section speed sd, HV", "km/h"),
+    Measure("section.speed_sd_kmh.a", "section speed sd, AV", "km/h"),
+    Measure("section.TTT.total", "section TTT", "veh h", 1 / S_PER_H),
+    Measure("section.total_delay.total", "section delay", "veh h", 1 / S_PER_H),
+    Measure("plan_changes", "meter plan changes", "count"),
+    Measure("light_changes", "ramp-light changes", "count"),
+    Measure("triggers", "controller updates (triggers)", "count"),
+)
+
+#: columns of the long table, in order (``evaluation.csv``)
+COLUMNS = ("measure", "label", "unit", "lower_is_better", "controller", "n", "mean",
+           "ci_low", "ci_high", "diff_mean", "diff_ci_low", "diff_ci_high",
+           "diff_boot_low", "diff_boot_high", "wins", "losses", "ties")
+
+
+def per_seed(runs: pd.DataFrame, measure: Measure, controllers: Sequence[str]) -> pd.DataFrame:
+    """Seeds x controllers table of ``measure`` in its human unit (NaN where missing)."""
+    if measure.key not in runs:
+        values = pd.Series(math.nan, index=runs.index)
+    else:
+        values = pd.to_numeric(runs[measure.key], errors="coerce") * measure.scale
+    wide = pd.DataFrame({"seed": runs["seed"], "controller": runs["controller"],
+                         "value": values}).pivot(index="seed", columns="controller",
+                                                 values="value")
+    return wide.reindex(columns=list(controllers)).sort_index()
+
+
+def _row(measure: Measure, controller: str, values: np.ndarray,
+         base: np.ndarray) -> dict[str, object]:
+    row: dict[str, object] = {"measure": measure.key, "label": measure.label,
+                              "unit": measure.unit, "lower_is_better": measure.lower_is_better,
+                              "controller": controller}
+    row.update(dict.fromkeys(COLUMNS[5:], math.nan))
+    row.update(n=0, wins=0, losses=0, ties=0)
+    try:
+        m = mean_ci(values)
+    except StatisticsError:          # no value for this controller
+        return row
+    row.update(n=m.n, mean=m.mean, ci_low=m.low, ci_high=m.high)
+    try:
+        d = paired_difference(values, base, lower_is_better=measure.lower_is_better)
+    except StatisticsError:          # no seed with both values
+        return row
+    row.update(diff_mean=d.mean_diff, diff_ci_low=d.t.low, diff_ci_high=d.t.high,
+               diff_boot_low=d.bootstrap.low, diff_boot_high=d.bootstrap.high,
+               wins=d.wins, losses=d.losses, ties=d.ties)
+    return row
+
+
+def evaluate(runs: pd.DataFrame, controllers: Sequence[str], baseline: str = "open",
+             measures: Sequence[Measure] = MEASURES) -> pd.DataFrame:
+    """The long table (:data:`COLUMNS`): one row per measure and controller.
+
+    Parameters
+    ----------
+    runs : pandas.DataFrame
+        One row per finished run: ``controller``, ``seed`` and the measures' keys (SI).
+    controllers : sequence of str
+        Controllers in report order; must contain ``baseline``.
+    baseline : str
+        The controller every other is compared with, seed by seed (its own row has a
+        difference of 0 with a zero-width interval).
+    """
+    if baseline not in controllers:
+        raise StatisticsError(f"baseline = {baseline!r} is not among the controllers "
+                              f"{list(controllers)}; allowed: one of them")
+    rows = []
+    for measure in measures:
+        wide = per_seed(runs, measure, controllers)
+        base = wide[baseline].to_numpy(float)
+        rows += [_row(measure, c, wide[c].to_numpy(float), base) for c in controllers]
+    return pd.DataFrame(rows, columns=list(COLUMNS))
+
+
+def paired_differences(runs: pd.DataFrame, measure: Measure, controllers: Sequence[str],
+                       baseline: str = "open") -> dict[str, np.ndarray]:
+    """Per controller (baseline excluded), the per-seed differences against the baseline
+    in the measure's human unit, seeds where either value is missing left out."""
+    wide = per_seed(runs, measure, controllers)
+    out = {}
+    for c in controllers:
+        if c != baseline:
+            d = (wide[c] - wide[baseline]).to_numpy(float)
+            out[c] = d[np.isfinite(d)]
+    return out
+
+
+def _fmt(value: float, digits: int = 3) -> str:
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "n/a"
+    return f"{value:.{digits}g}" if abs(value) < 10 ** digits else f"{value:.0f}"
+
+
+def markdown(long: pd.DataFrame, baseline: str = "open") -> str:
+    """A readable Markdown table of the long table: per measure and controller, the mean
+    [95 % CI], the paired difference against ``baseline`` [95 % CI, t] and wins/losses/ties
+    over seeds (a win: better than the baseline on that seed)."""
+    lines = [f"| measure | unit | controller | n | mean [95 % CI] | minus {baseline} "
+             "[95 % CI] | wins / losses / ties |", "|---|---|---|---|---|---|---|"]
+    for r in long.itertuples(index=False):
+        mean = f"{_fmt(r.mean)} [{_fmt(r.ci_low)}, {_fmt(r.ci_high)}]"
+        if r.controller == baseline:
+            diff, wlt = "(baseline)", ""
+        else:
+            diff = f"{_fmt(r.diff_mean)} [{_fmt(r.diff_ci_low)}, {_fmt(r.diff_ci_high)}]"
+            wlt = f"{r.wins} / {r.losses} / {r.ties}"
+        better = "lower" if r.lower_is_better else "higher"
+        lines.append(f"| {r.label} ({better} is better) | {r.unit} | {r.controller} | {r.n} "
+                     f"| {mean} | {diff} | {wlt} |")
+    return "\n".join(lines)

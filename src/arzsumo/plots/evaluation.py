@@ -1,0 +1,51 @@
+"""The figure of ``arzsumo evaluate``: per-seed paired differences against the baseline."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from arzsumo.plots import plt
+
+
+@dataclass(frozen=True)
+class DiffPanel:
+    """One measure: its title (with unit) and, per controller, the per-seed differences
+    and the mean difference with its 95 % CI (low, high), in the measure's unit."""
+
+    title: str
+    diffs: Mapping[str, np.ndarray]
+    ci: Mapping[str, tuple[float, float, float]]
+
+
+def paired_differences_figure(panels: Sequence[DiffPanel], title: str,
+                              columns: int = 4) -> Figure:
+    """A grid of panels: per controller, dots for the seeds' differences (slightly spread
+    sideways), a bar for the mean and its CI, and a line at 0 (no difference)."""
+    rows = max(1, math.ceil(len(panels) / columns))
+    fig, axes = plt.subplots(rows, columns, figsize=(3.4 * columns, 2.6 * rows),
+                             layout="constrained", squeeze=False)
+    rng = np.random.default_rng(0)           # the same jitter every time
+    for ax, panel in zip(axes.flat, panels, strict=False):
+        names = list(panel.diffs)
+        for k, name in enumerate(names):
+            d = np.asarray(panel.diffs[name], float)
+            ax.plot(k + rng.uniform(-0.12, 0.12, d.size), d, "o", ms=3, alpha=0.6,
+                    color=f"C{k}")
+            mean, low, high = panel.ci[name]
+            if math.isfinite(mean):
+                err = [[mean - low], [high - mean]] if math.isfinite(low) else None
+                ax.errorbar(k + 0.3, mean, yerr=err, fmt="s", color="k", ms=4, capsize=3)
+        ax.axhline(0.0, color="0.5", lw=0.8)
+        ax.set_xticks(range(len(names)), names, rotation=30, fontsize=8)
+        ax.set_xlim(-0.6, len(names) - 0.2)
+        ax.set_title(panel.title, fontsize=8)
+        ax.tick_params(axis="y", labelsize=7)
+    for ax in axes.flat[len(panels):]:
+        ax.set_visible(False)
+    fig.suptitle(title, fontsize=10)
+    return fig

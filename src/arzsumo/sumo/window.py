@@ -1,0 +1,170 @@
+"""Network measures over the control window: every vehicle's time clipped to [t_w, T].
+
+Controllers are judged on the control window (from the end of the warm-up t_w to the end
+of the run T), not on the warm-up they did not act in. SUMO's tripinfo output
+(:mod:`arzsumo.sumo.network_measures`) holds each vehicle's totals since its wanted
+departure; the control window's part is
+
+* times (time in the system, depart delay): the vehicle's interval clipped to [t_w, T]
+  (exact: the intervals are known from ``depart``, ``departDelay`` and ``arrival``);
+* accumulated quantities (SUMO's time loss, waiting time, distance, fuel, CO2): the
+  tripinfo total minus the value the vehicle had at t_w. :class:`WarmupLedger` reads the
+  vehicles on the network at t_w with libsumo (``getTimeLoss``, ``getDistance``, the
+  tripinfo device's ``waitingTime``: equal to SUMO's tripinfo within its 2 decimals).
+  SUMO's emissions device cannot be read while running, so fuel and CO2 up to t_w are
+  summed every warm-up step from libsumo's ``getFuelConsumption`` and ``getCO2Emission``
+  (the same HBEFA model; measured within 0.3 % of the device's own totals).
+
+A vehicle counts in the window when it is in the system at some time in (t_w, T]: not
+arrived by t_w. Vehicles in the system at t_w (on the network or waiting to be inserted)
+are counted under ``vehicles.in_system_at_start``.
+"""
+
+from __future__ import annotations
+
+import gzip
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import ModuleType
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from arzsumo.sumo.network_measures import (
+    ORIGINS,
+    TRIPINFO_FILE,
+    aggregate,
+    network_summary,
+    read_trips,
+)
+
+MG_PER_G = 1000.0
+#: accumulated per-vehicle columns of :func:`~arzsumo.sumo.network_measures.read_trips`
+#: whose value at t_w is subtracted
+ACCUMULATED = ("sumo_time_loss_s", "waiting_time_s", "distance_m", "fuel_g", "co2_g")
+
+
+@dataclass(frozen=True)
+class WindowStart:
+    """The system at the start of the control window ``t_s`` (s of simulation time).
+
+    ``on_network``: per vehicle on the network then, the :data:`ACCUMULATED` values so far
+    (index: vehicle id; s, m, g); ``waiting``: ids of vehicles waiting to be inserted.
+    """
+
+    t_s: float
+    on_network: pd.DataFrame
+    waiting: tuple[str, ...] = field(default=())
+
+
+class WarmupLedger:
+    """Fuel and CO2 of every vehicle (mg) summed each step until :meth:`close`.
+
+    Parameters
+    ----------
+    lib : module
+        The libsumo module of the open run.
+    dt : float
+        Step length, s.
+    """
+
+    def __init__(self, lib: ModuleType, dt: float) -> None:
+        self.lib, self.dt = lib, dt
+        self.fuel_mg: dict[str, float] = {}
+        self.co2_mg: dict[str, float] = {}
+
+    def add(self) -> None:
+        """Add the step just simulated (libsumo rates in mg/s times dt)."""
+        v = self.lib.vehicle
+        ids = v.getIDList()
+        fuel, co2 = self.fuel_mg, self.co2_mg
+        for i, f, c in zip(ids, map(v.getFuelConsumption, ids), map(v.getCO2Emission, ids),
+                           strict=True):
+            fuel[i] = fuel.get(i, 0.0) + f * self.dt
+            co2[i] = co2.get(i, 0.0) + c * self.dt
+
+    def close(self, t: float) -> WindowStart:
+        """The :class:`WindowStart` at time ``t`` (s): read the vehicles now in the system."""
+        v = self.lib.vehicle
+        ids = list(v.getIDList())
+        rows = {
+            "sumo_time_loss_s": [v.getTimeLoss(i) for i in ids],
+            "waiting_time_s": [float(v.getParameter(i, "device.tripinfo.waitingTime"))
+                               for i in ids],
+            "distance_m": [v.getDistance(i) for i in ids],
+            "fuel_g": [self.fuel_mg.get(i, 0.0) / MG_PER_G for i in ids],
+            "co2_g": [self.co2_mg.get(i, 0.0) / MG_PER_G for i in ids],
+        }
+        frame = pd.DataFrame(rows, index=pd.Index(ids, name="id"), dtype=float)
+        waiting = tuple(self.lib.simulation.getPendingVehicles())
+        return WindowStart(float(t), frame, waiting)
+
+
+def window_trips(trips: pd.DataFrame, start: WindowStart, end: float) -> pd.DataFrame:
+    """The per-vehicle rows of ``trips`` (:func:`read_trips`) restricted to the control
+    window [start.t_s, end]: vehicles not arrived by t_w, their times clipped and their
+    accumulated values net of those at t_w (module docstring). Same columns, plus
+    ``due_s`` (wanted departure, s) and ``in_system_at_start`` (bool)."""
+    t_w = start.t_s
+    df = trips.copy()
+    inserted_at = np.where(df["depart_s"] >= 0, df["depart_s"], end)
+    df["due_s"] = inserted_at - df["depart_delay_s"]
+    stop = np.where(df["arrival_s"] >= 0, df["arrival_s"], end)
+    keep = (stop > t_w + 1e-9) & (df["due_s"] < end + 1e-9)
+    df, inserted_at, stop = df[keep].copy(), inserted_at[keep], stop[keep]
+    begin = np.maximum(df["due_s"].to_numpy(), t_w)
+    df["time_spent_s"] = np.clip(stop - begin, 0.0, None)
+    df["depart_delay_s"] = np.clip(inserted_at - begin, 0.0, None)
+    before = start.on_network.reindex(df["id"]).fillna(0.0)
+    for col in ACCUMULATED:
+        df[col] = df[col].to_numpy() - before[col].to_numpy()
+    df["time_loss_s"] = df["sumo_time_loss_s"] + df["depart_delay_s"]
+    df["in_system_at_start"] = df["id"].isin(start.on_network.index) | \
+        df["id"].isin(start.waiting)
+    return df.reset_index(drop=True)
+
+
+def window_summary(trips: pd.DataFrame, start: WindowStart, end: float,
+                   outlet_left: int) -> dict[str, Any]:
+    """The ``network`` dict of the control window (same layout as
+    :func:`~arzsumo.sumo.network_measures.aggregate`), with ``window`` and
+    ``vehicles.in_system_at_start``.
+
+    ``outlet_left``: vehicles that crossed the section outlet x = L in the window.
+    """
+    df = window_trips(trips, start, end)
+    out = aggregate(df, start.t_s, end, outlet_left)
+    at = df[df["in_system_at_start"]]
+    out["vehicles"]["in_system_at_start"] = {
+        **{o: int((at["origin"] == o).sum()) for o in ORIGINS}, "total": len(at)}
+    out = {"window": "control window: each vehicle's time inside [begin_s, end_s] "
+                     "(end of warm-up to end of run)", **out}
+    return out
+
+
+
+@dataclass(frozen=True)
+class NetworkMeasures:
+    """A run's network measures: control window, whole run, and SUMO's tripinfo file
+    (gzip-compressed bytes, to keep with the results)."""
+
+    window: dict[str, Any]
+    whole_run: dict[str, Any]
+    tripinfo_gz: bytes = field(repr=False)
+
+
+def measure_network(out_dir: Path, start: WindowStart, end: float,
+                    outlet_left_window: int) -> NetworkMeasures:
+    """Read the outputs of a run started with
+    :func:`~arzsumo.sumo.network_measures.network_options` into ``out_dir`` and ended at
+    ``end`` (s); ``outlet_left_window``: vehicles that crossed x = L in the control window.
+    """
+    out_dir = Path(out_dir)
+    whole = {"window": "whole run: each vehicle's time inside [begin_s, end_s] (from t = 0 "
+                       "of SUMO, warm-up included)",
+             **network_summary(out_dir, end_time=end)}
+    trips = read_trips(out_dir / TRIPINFO_FILE)
+    window = window_summary(trips, start, end, outlet_left_window)
+    blob = gzip.compress((out_dir / TRIPINFO_FILE).read_bytes(), compresslevel=6, mtime=0)
+    return NetworkMeasures(window, whole, blob)

@@ -1,0 +1,103 @@
+"""``arzsumo evaluate`` with real SUMO: 2 controllers x 3 seeds, short runs; the report's
+paired differences are those of the runs' own summaries; a restart runs nothing again."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from arzsumo.cli import main
+from arzsumo.evaluation.report import MEASURES
+
+ROOT = Path(__file__).resolve().parents[2]
+SEEDS = (5, 6, 7)
+pytestmark = pytest.mark.sumo
+
+
+def _scenario(tmp: Path) -> Path:
+    text = (ROOT / "scenarios" / "default.toml").read_text(encoding="utf-8")
+    text = text.replace("warmup_s = 150", "warmup_s = 30").replace(
+        "kernel_cells = 100", "kernel_cells = 40").replace("twin_cells = 100", "twin_cells = 40")
+    path = tmp / "short.toml"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def _evaluate(scenario: Path, out: Path, *extra: str) -> int:
+    return main(["evaluate", str(scenario), "--controllers", "alinea", "--seeds", "3",
+                 "--seed-start", str(SEEDS[0]), "--horizon", "30", "--workers", "2",
+                 "--quiet", "--out", str(out), *extra])
+
+
+@pytest.fixture(scope="module")
+def evaluation(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("evaluate")
+    scenario, out = _scenario(tmp), tmp / "out"
+    assert _evaluate(scenario, out) == 0           # open is added as the baseline
+    return scenario, out
+
+
+def _value(summary: dict, dotted: str) -> float:
+    for part in dotted.split("."):
+        summary = summary[part]
+    return float(summary)
+
+
+def test_paired_differences_are_those_of_the_runs(evaluation):
+    _, out = evaluation
+    csv = pd.read_csv(out / "evaluation.csv")
+    assert set(csv["controller"]) == {"open", "alinea"}
+    assert len(csv) == 2 * len(MEASURES)
+    runs = {(c, s): json.loads((out / "runs" / f"controller={c},seed={s}" /
+                                "summary.json").read_text())
+            for c in ("open", "alinea") for s in SEEDS}
+    for m in MEASURES:
+        row = csv[(csv.measure == m.key) & (csv.controller == "alinea")].iloc[0]
+        d = np.array([_value(runs["alinea", s], m.key) - _value(runs["open", s], m.key)
+                      for s in SEEDS]) * m.scale
+        mean = np.array([_value(runs["alinea", s], m.key) for s in SEEDS]) * m.scale
+        assert row["n"] == 3, m.key
+        assert row["diff_mean"] == pytest.approx(d.mean(), abs=1e-9), m.key
+        assert row["mean"] == pytest.approx(mean.mean(), abs=1e-9), m.key
+        better = -d if m.lower_is_better else d
+        assert row["wins"] == int((better > 0).sum()), m.key
+        assert row["wins"] + row["losses"] + row["ties"] == 3
+        if np.ptp(d) > 1e-9 * max(1.0, np.abs(d).max()):
+            half = 4.302652729911275 * d.std(ddof=1) / np.sqrt(3)   # t(0.975, 2)
+            assert row["diff_ci_high"] - row["diff_mean"] == pytest.approx(half, rel=1e-6)
+    # the open loop against itself: 0 with a zero-width interval, all ties
+    base = csv[csv.controller == "open"]
+    assert (base["diff_mean"] == 0).all() and (base["diff_ci_low"] == 0).all()
+    assert (base["diff_ci_high"] == 0).all() and (base["ties"] == 3).all()
+    assert (out / "paired_differences.png").stat().st_size > 10_000
+    text = (out / "evaluation.md").read_text()
+    assert "| network time loss, total (lower is better) | veh h | alinea | 3 |" in text
+
+
+def test_a_restart_runs_nothing_again(evaluation, capsys):
+    scenario, out = evaluation
+    before = (out / "executions.jsonl").read_text().splitlines()
+    assert len(before) == 6
+    csv = (out / "evaluation.csv").read_text()
+    capsys.readouterr()
+    assert _evaluate(scenario, out) == 0
+    assert "6 runs, 6 already finished, 0 executed" in capsys.readouterr().out
+    assert (out / "executions.jsonl").read_text().splitlines() == before
+    assert (out / "evaluation.csv").read_text() == csv
+
+
+def test_user_mistakes_are_one_line_and_start_nothing(evaluation, tmp_path, capsys):
+    scenario, _ = evaluation
+    assert main(["evaluate", str(scenario), "--controllers", "open,pid", "--quiet",
+                 "--out", str(tmp_path / "x")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--controllers = 'open,pid' is not allowed" in err
+    assert not (tmp_path / "x").exists()
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine" / "notes.txt").write_text("keep")
+    assert main(["evaluate", str(scenario), "--controllers", "open", "--seeds", "1",
+                 "--quiet", "--out", str(tmp_path / "mine"), "--overwrite"]) == 2
+    assert "not an arzsumo result" in capsys.readouterr().err
+    assert (tmp_path / "mine" / "notes.txt").read_text() == "keep"
