@@ -55,8 +55,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                                         "open loop (CSV, Markdown, figure)",
                        description="Run every controller on the same SUMO seeds through the "
                                    "sweep engine (parallel, resumable, Dask-capable) and "
-                                   "report per measure the mean with its 95 %% CI and the "
-                                   "paired difference against the open loop with its 95 %% "
+                                   "report per measure the mean with its 95 % CI and the "
+                                   "paired difference against the open loop with its 95 % "
                                    "CI, wins and losses.")
     p.add_argument("scenario", metavar="SCENARIO.toml", help="scenario file")
     p.add_argument("--controllers", default="open,alinea,backstepping,etc,observer-etc",
@@ -70,7 +70,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--workers", type=positive_int,
                    help="local processes (default: one per core); ignored with --scheduler")
     p.add_argument("--scheduler", metavar="ADDRESS",
-                   help="Dask scheduler address, e.g. tcp://10.0.0.5:8786")
+                   help="Dask scheduler address, e.g. tcp://SCHEDULER-HOST:8786")
     p.add_argument("--out", metavar="DIR",
                    help="output directory (default results/evaluate/<scenario file name>); "
                         "a restart with the same directory runs only what is missing")

@@ -52,7 +52,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--workers", type=positive_int,
                    help="local processes (default: one per core); ignored with --scheduler")
     p.add_argument("--scheduler", metavar="ADDRESS",
-                   help="Dask scheduler address, e.g. tcp://10.0.0.5:8786")
+                   help="Dask scheduler address, e.g. tcp://SCHEDULER-HOST:8786")
     p.add_argument("--out", metavar="DIR",
                    help="output directory (default results/sweeps/<name>); a restart with "
                         "the same directory runs only what is missing")
