@@ -15,7 +15,8 @@ from arzsumo.scenario import load_scenario
 pytestmark = pytest.mark.sumo
 
 DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "default.toml"
-#: recorded by /work/pins/record.py on the code before issue 13's typed scenario
+#: recorded with run_in_sumo on the code before the restructure (TTT and delay equal to the
+#: numbers before issue 12 too; the counts are per control window since issue 12)
 PINNED = {
     "etc": {"plan_changes": 11, "light_changes": 14, "triggers": 13, "max_ramp_queue": 6,
             "TTT": {"h": 3915.450000000001, "a": 2477.1500000000005,
