@@ -75,6 +75,9 @@ class SumoConfig:
         Meter-curve file (``meter_curve.toml`` of ``arzsumo calibrate``: mainline outflow
         against green share) that the actuator inverts; "" keeps the built-in
         :data:`arzsumo.sumo.meter.DEFAULT_CURVE`. :func:`sumo_config_of` makes it absolute.
+    approach_length : float
+        Length of the ``approach`` edge before x = 0 where mainline vehicles are inserted
+        and may queue, m; 0 (default) inserts them at x = 0 on the shipped network.
     """
 
     step_length: float = 0.1
@@ -100,6 +103,7 @@ class SumoConfig:
     av_model: str = "ACC"
     min_gap_lat: float = 0.15
     meter_curve: str = ""
+    approach_length: float = 0.0
 
     def __post_init__(self) -> None:
         def pos(name: str) -> None:
@@ -115,7 +119,8 @@ class SumoConfig:
         for name in ("step_length", "lateral_resolution", "horizon", "cell_length",
                      "control_period", "meter_cycle", "min_gap_lat"):
             pos(name)
-        for name in ("demand_h", "demand_a", "ramp_demand", "min_green", "min_red"):
+        for name in ("demand_h", "demand_a", "ramp_demand", "min_green", "min_red",
+                     "approach_length"):
             v = getattr(self, name)
             require(isinstance(v, int | float) and math.isfinite(v) and v >= 0, name, v,
                     "a finite number of at least 0", ScenarioError)
@@ -197,6 +202,7 @@ SUMO_KEYS: dict[str, Key] = {
     "av_model": Key("av_model", "string", choices=AV_MODELS),
     "min_gap_lat_m": Key("min_gap_lat"),
     "meter_curve": Key("meter_curve", "string"),
+    "approach_length_m": Key("approach_length"),
 }
 
 
