@@ -60,9 +60,12 @@ def test_routes_start_on_the_approach_only_when_there_is_one():
     assert '<route id="r_main" edges="approach main merge down"/>' in text
     assert '<route id="r_section" edges="main merge down"/>' in text
     assert 'id="hv_init.0" type="hv" route="r_section" depart="0"' in text
-    # the flows themselves are the same lines
+    # the same flows, but mainline vehicles enter behind a queue at the highest safe speed
     flows = lambda t: [ln for ln in t.splitlines() if "<flow " in ln]  # noqa: E731
-    assert flows(text) == flows(plain) and len(flows(plain)) == 4
+    assert len(flows(plain)) == len(flows(text)) == 4
+    assert [ln.replace('departSpeed="max"', 'departSpeed="desired"') if "r_main" in ln
+            else ln for ln in flows(text)] == flows(plain)
+    assert sum('route="r_main"' in ln and 'departSpeed="max"' in ln for ln in flows(text)) == 3
 
 
 def test_sumo_key_and_its_errors_name_the_key_in_metres():

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
@@ -43,6 +43,8 @@ class Flow:
     begin: float
     end: float
     lat: str = "center"
+    #: departSpeed; None: "desired" on the mainline (free road at x = 0), "max" on the ramp
+    depart_speed: str | None = None
 
     @property
     def period(self) -> float:
@@ -58,7 +60,7 @@ class Flow:
 
     def to_xml(self) -> str:
         lat = self.lat
-        speed = "desired" if self.route == ROUTE_MAIN else "max"
+        speed = self.depart_speed or ("desired" if self.route == ROUTE_MAIN else "max")
         attrs = {"id": self.id, "type": self.type, "route": self.route,
                  "begin": f"{self.begin:.6g}", "end": f"{self.end:.6g}",
                  "period": f"{self.period:.9g}", "departLane": "0", "departPos": "base",
@@ -157,6 +159,12 @@ def route_file_text(params: ModelParameters, cfg: SumoConfig,
     init_route = ROUTE_SECTION if cfg.approach_length > 0 else ROUTE_MAIN
     lines += [v.to_xml(init_route) for v in initial]
     flows = demand_flows(cfg, params.road_width, params.vehicle_width)
+    if cfg.approach_length > 0:
+        # a queue may reach back to the insertion point on the approach: "desired" would
+        # hold a vehicle until the road ahead is free at that speed, "max" enters it at
+        # the highest safe speed behind the queue
+        flows = [replace(f, depart_speed="max") if f.route == ROUTE_MAIN else f
+                 for f in flows]
     # SUMO drops departures listed out of time order: sort the flows by their begin
     lines += [f.to_xml() for f in sorted(flows, key=lambda f: f.begin)]
     body = "\n".join(f"    {ln}" for ln in lines)
