@@ -40,7 +40,7 @@ from scipy import stats
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENARIO = ROOT / "scenarios" / "default.toml"
-AV_SHARE = 1560.0 / 5664.0          # the default scenario's mainline AV share
+AV_SHARE = 1560.0 / 5664.0          # the default scenario's mainline AV share (0.275)
 BLOCK_S = 30.0                      # block length for the trend test, s
 CONGESTED_KMH = 40.0                # a cell-period slower than this counts as congested
 #: initial congested section (veh/km, km/h): near the merge's discharge state measured at
@@ -48,7 +48,8 @@ CONGESTED_KMH = 40.0                # a cell-period slower than this counts as c
 #: excess needs to fill the section from free flow
 INIT_RHO_H, INIT_RHO_A, INIT_V_KMH = 85.0, 45.0, 20.0
 FIELDS = ["demand_veh_h", "green_share", "hv_sigma", "seed", "approach_m", "step_s",
-          "initial", "warmup_s", "measured_s", "wall_s", "n_mean", "slope_veh_min", "slope_lo",
+          "initial", "av_share", "warmup_s", "measured_s", "wall_s", "n_mean",
+          "slope_veh_min", "slope_lo",
           "slope_hi", "kendall_p", "drift_rel", "stationary", "rho_h_veh_km",
           "rho_a_veh_km", "v_h_kmh", "v_a_kmh", "sd_v_h_kmh", "sd_v_a_kmh",
           "congested_share", "inflow_veh_h", "outflow_veh_h", "inserted_main",
@@ -110,7 +111,8 @@ def initial_vehicles(params: Any, cfg: Any) -> list[Any]:
 
 
 def run_point(demand: float, green: float, sigma: float, seed: int, approach: float,
-              warmup: float, measured: float, step: float, initial: bool) -> dict[str, Any]:
+              warmup: float, measured: float, step: float, initial: bool,
+              av_share: float = AV_SHARE) -> dict[str, Any]:
     """One open-loop run; returns the CSV row (units in the column names)."""
     from arzsumo.scenarios import load_scenario
     from arzsumo.sumo.config import sumo_config_of
@@ -121,7 +123,7 @@ def run_point(demand: float, green: float, sigma: float, seed: int, approach: fl
     t0 = time.perf_counter()
     sc = load_scenario(SCENARIO)
     cfg = sumo_config_of(sc).with_(
-        demand_h=demand * (1 - AV_SHARE) / 3600, demand_a=demand * AV_SHARE / 3600,
+        demand_h=demand * (1 - av_share) / 3600, demand_a=demand * av_share / 3600,
         green_share=green, hv_sigma=sigma, seed=seed, approach_length=approach,
         horizon=warmup + measured, step_length=step)
     cells, n_app = [], []
@@ -140,6 +142,7 @@ def run_point(demand: float, green: float, sigma: float, seed: int, approach: fl
     rep = sim.report
     row = {"demand_veh_h": demand, "green_share": green, "hv_sigma": sigma, "seed": seed,
            "approach_m": approach, "step_s": step, "initial": int(initial),
+           "av_share": av_share,
            "warmup_s": warmup, "measured_s": measured}
     row.update(summarise(cells, cfg.cell_length))
     row["inserted_main"] = rep.delivered_main
@@ -175,7 +178,8 @@ def summarise(cells: list[Any], dx: float) -> dict[str, float]:
 def _key(row: dict[str, Any]) -> tuple:
     return (float(row["demand_veh_h"]), float(row["green_share"]), float(row["hv_sigma"]),
             int(row["seed"]), float(row["approach_m"]), float(row["step_s"]),
-            int(row["initial"]), float(row["warmup_s"]), float(row["measured_s"]))
+            int(row["initial"]), float(row["warmup_s"]), float(row["measured_s"]),
+            round(float(row.get("av_share") or AV_SHARE), 6))
 
 
 def sweep(args: argparse.Namespace) -> None:
@@ -186,9 +190,9 @@ def sweep(args: argparse.Namespace) -> None:
         with out.open() as f:
             done = {_key(r) for r in csv.DictReader(f)}
     names = ["demand_veh_h", "green_share", "hv_sigma", "seed", "approach_m", "warmup_s",
-             "measured_s", "step_s", "initial"]
+             "measured_s", "step_s", "initial", "av_share"]
     todo = [(d, g, s, seed, args.approach, args.warmup, args.measured, args.step,
-             not args.empty_start)
+             not args.empty_start, args.av_share)
             for s in args.sigmas for seed in args.seeds for d in args.demands
             for g in args.greens]
     todo = [p for p in todo if _key(dict(zip(names, p, strict=True))) not in done]
@@ -221,6 +225,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--empty-start", action="store_true",
                    help="start with an empty section (default: a congested one)")
     p.add_argument("--warmup", type=float, default=150.0)
+    p.add_argument("--av-share", type=float, default=AV_SHARE,
+                   help="AV share of the mainline demand (default: the default scenario's)")
     p.add_argument("--measured", type=float, default=450.0)
     p.add_argument("--step", type=float, default=0.1)
     p.add_argument("--jobs", type=int, default=1)
