@@ -37,6 +37,14 @@ def positive_float(text: str) -> float:
     return value
 
 
+def non_negative_float(text: str) -> float:
+    """A finite number >= 0 (lengths that may be absent)."""
+    value = _number(text, float)
+    if not (math.isfinite(value) and value >= 0):
+        raise argparse.ArgumentTypeError(f"{text} is not allowed: a finite number >= 0")
+    return value
+
+
 def positive_int(text: str) -> int:
     """An integer >= 1 (workers, jobs)."""
     value = _number(text, int)

@@ -10,7 +10,7 @@ import argparse
 import logging
 import os
 
-from arzsumo.cli_args import positive_float, positive_int, seed_int
+from arzsumo.cli_args import non_negative_float, positive_float, positive_int, seed_int
 from arzsumo.units import ms_to_kmh, veh_m_to_veh_km, veh_s_to_veh_h
 
 log = logging.getLogger("arzsumo")
@@ -24,9 +24,10 @@ def cmd_build_net(args: argparse.Namespace) -> int:
     from arzsumo.sumo.paths import CONFIG_FILE, NET_FILE, ROUTE_FILE, build_nets_dir
 
     out = build_nets_dir(args.out)
-    spec = NetworkSpec()
+    spec = NetworkSpec(approach_length=args.approach_length)
     net, changed = rebuild_network(out, spec, write=not args.keep_sources)
-    write_gui_files(out, get_preset("paper_base").params, SumoConfig(), NET_FILE, ROUTE_FILE,
+    write_gui_files(out, get_preset("paper_base").params,
+                    SumoConfig(approach_length=args.approach_length), NET_FILE, ROUTE_FILE,
                     CONFIG_FILE)
     lengths = edge_lengths(net)
     print(f"network: {net} ({'written' if changed else 'unchanged'})")
@@ -92,6 +93,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "a source checkout)")
     p.add_argument("--keep-sources", action="store_true",
                    help="rebuild from the XML sources in DIR instead of rewriting them")
+    p.add_argument("--approach-length-m", dest="approach_length", type=non_negative_float,
+                   default=0.0, metavar="M",
+                   help="length of the approach edge before x = 0 where mainline vehicles "
+                        "are inserted (default 0: none, the shipped network)")
     p.set_defaults(func=cmd_build_net)
 
     p = sub.add_parser("calibrate", help="fit the AO fundamental diagram and the meter curve "

@@ -64,6 +64,10 @@ SUMO_KEYS: dict[str, Key] = {
     "meter_curve": Key("meter_curve", "string",
                        doc="meter_curve.toml of `arzsumo calibrate`, relative to the scenario "
                            "file; \"\" keeps the built-in curve"),
+    "approach_length_m": Key("approach_length", unit="m",
+                             doc="approach (buffer) edge before x = 0 where mainline vehicles "
+                                 "are inserted and may queue; 0 inserts them at x = 0 on the "
+                                 "shipped network"),
 }
 
 

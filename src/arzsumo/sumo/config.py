@@ -62,6 +62,9 @@ class SumoConfig:
         Meter-curve file (``meter_curve.toml`` of ``arzsumo calibrate``: mainline outflow
         against green share) that the actuator inverts; "" keeps the built-in
         :data:`arzsumo.sumo.meter.DEFAULT_CURVE`. :mod:`arzsumo.scenario.sumo` makes it absolute.
+    approach_length : float
+        Length of the ``approach`` edge before x = 0 where mainline vehicles are inserted
+        and may queue, m; 0 (default) inserts them at x = 0 on the shipped network.
     """
 
     step_length: float = 0.1
@@ -87,6 +90,7 @@ class SumoConfig:
     av_model: str = "ACC"
     min_gap_lat: float = 0.15
     meter_curve: str = ""
+    approach_length: float = 0.0
 
     def __post_init__(self) -> None:
         def pos(name: str) -> None:
@@ -102,7 +106,8 @@ class SumoConfig:
         for name in ("step_length", "lateral_resolution", "horizon", "cell_length",
                      "control_period", "meter_cycle", "min_gap_lat"):
             pos(name)
-        for name in ("demand_h", "demand_a", "ramp_demand", "min_green", "min_red"):
+        for name in ("demand_h", "demand_a", "ramp_demand", "min_green", "min_red",
+                     "approach_length"):
             v = getattr(self, name)
             require(isinstance(v, int | float) and math.isfinite(v) and v >= 0, name, v,
                     "a finite number of at least 0", ScenarioError)

@@ -6,13 +6,17 @@ HVs alternate between the two outer columns (``hv_0``, ``hv_1``), AVs use the ce
 right edge and delivered only about 70 % of 4104 + 1560 veh/h; the columns deliver all of
 it. Ramp flows ``ramp_hv`` and ``ramp_av`` enter at the start of ``ramp_up``. Flows are
 evenly spaced (``period``), so the requested number by time t is known exactly.
+
+With ``cfg.approach_length > 0`` the mainline route ``r_main`` starts on ``approach``
+(upstream of x = 0, where vehicles may queue); initial vehicles, placed on ``main``, then
+follow ``r_section`` (``main`` onwards).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
@@ -22,10 +26,10 @@ from arzsumo.errors import ScenarioError
 from arzsumo.io import atomic_file
 from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.network import DOWN, MAIN, MERGE, RAMP_DN, RAMP_UP
+from arzsumo.sumo.network import APPROACH, DOWN, MAIN, MERGE, RAMP_DN, RAMP_UP
 from arzsumo.sumo.vtypes import AV_TYPE, HV_TYPE, vehicle_types
 
-ROUTE_MAIN, ROUTE_RAMP = "r_main", "r_ramp"
+ROUTE_MAIN, ROUTE_RAMP, ROUTE_SECTION = "r_main", "r_ramp", "r_section"
 
 
 @dataclass(frozen=True)
@@ -39,6 +43,8 @@ class Flow:
     begin: float
     end: float
     lat: str = "center"
+    #: departSpeed; None: "desired" on the mainline (free road at x = 0), "max" on the ramp
+    depart_speed: str | None = None
 
     @property
     def period(self) -> float:
@@ -54,7 +60,7 @@ class Flow:
 
     def to_xml(self) -> str:
         lat = self.lat
-        speed = "desired" if self.route == ROUTE_MAIN else "max"
+        speed = self.depart_speed or ("desired" if self.route == ROUTE_MAIN else "max")
         attrs = {"id": self.id, "type": self.type, "route": self.route,
                  "begin": f"{self.begin:.6g}", "end": f"{self.end:.6g}",
                  "period": f"{self.period:.9g}", "departLane": "0", "departPos": "base",
@@ -72,8 +78,8 @@ class InitialVehicle:
     speed: float
     lat: float
 
-    def to_xml(self) -> str:
-        attrs = {"id": self.id, "type": self.type, "route": ROUTE_MAIN, "depart": "0",
+    def to_xml(self, route: str = ROUTE_MAIN) -> str:
+        attrs = {"id": self.id, "type": self.type, "route": route, "depart": "0",
                  "departLane": "0", "departPos": f"{self.pos:.3f}",
                  "departSpeed": f"{self.speed:.3f}", "departPosLat": f"{self.lat:.3f}",
                  "insertionChecks": "none"}
@@ -134,15 +140,31 @@ def check_columns(road_width: float, vehicle_width: float, resolution: float,
 
 def route_file_text(params: ModelParameters, cfg: SumoConfig,
                     initial: Sequence[InitialVehicle] = ()) -> str:
-    """The route file: vTypes, the two routes, initial vehicles, then the flows."""
+    """The route file: vTypes, the routes, initial vehicles, then the flows.
+
+    Mainline flows start on ``approach`` when ``cfg.approach_length > 0`` (the network
+    must have that edge), else on ``main`` at x = 0.
+    """
     check_columns(params.road_width, params.vehicle_width, cfg.lateral_resolution,
                   insertion_columns(params.road_width, params.vehicle_width, 3))
     hv, av = vehicle_types(params, cfg)
-    lines = [hv.to_xml(), av.to_xml(),
-             f'<route id="{ROUTE_MAIN}" edges="{MAIN} {MERGE} {DOWN}"/>',
-             f'<route id="{ROUTE_RAMP}" edges="{RAMP_UP} {RAMP_DN} {MERGE} {DOWN}"/>']
-    lines += [v.to_xml() for v in initial]
+    section = f"{MAIN} {MERGE} {DOWN}"
+    lines = [hv.to_xml(), av.to_xml()]
+    if cfg.approach_length > 0:
+        lines += [f'<route id="{ROUTE_MAIN}" edges="{APPROACH} {section}"/>',
+                  f'<route id="{ROUTE_SECTION}" edges="{section}"/>']
+    else:
+        lines.append(f'<route id="{ROUTE_MAIN}" edges="{section}"/>')
+    lines.append(f'<route id="{ROUTE_RAMP}" edges="{RAMP_UP} {RAMP_DN} {MERGE} {DOWN}"/>')
+    init_route = ROUTE_SECTION if cfg.approach_length > 0 else ROUTE_MAIN
+    lines += [v.to_xml(init_route) for v in initial]
     flows = demand_flows(cfg, params.road_width, params.vehicle_width)
+    if cfg.approach_length > 0:
+        # a queue may reach back to the insertion point on the approach: "desired" would
+        # hold a vehicle until the road ahead is free at that speed, "max" enters it at
+        # the highest safe speed behind the queue
+        flows = [replace(f, depart_speed="max") if f.route == ROUTE_MAIN else f
+                 for f in flows]
     # SUMO drops departures listed out of time order: sort the flows by their begin
     lines += [f.to_xml() for f in sorted(flows, key=lambda f: f.begin)]
     body = "\n".join(f"    {ln}" for ln in lines)

@@ -11,6 +11,11 @@ of ``merge`` at x = L; that lane ends, so ramp vehicles must merge into the 6.5 
 before C. ``down`` is slower than ``main``: a capacity bottleneck, so ramp inflow takes
 mainline capacity and the meter sets the mainline outflow q(L, t). The traffic light
 ``meter`` at node M has one signal (link index 0) on the ramp.
+
+With ``approach_length`` La > 0 an ``approach`` edge Q(-La) -> A(0) (same lane, speed
+and priority as ``main``) comes first: mainline vehicles are inserted there and may queue,
+so a queue from the merge that reaches x = 0 no longer blocks insertion and the inflow at
+x = 0 is set by traffic. With La = 0 (default) the network is the shipped one.
 """
 
 from __future__ import annotations
@@ -31,6 +36,7 @@ from arzsumo.sumo.paths import NET_FILE, SumoError, sumo_binary
 log = logging.getLogger(__name__)
 
 MAIN, MERGE, DOWN, RAMP_UP, RAMP_DN = "main", "merge", "down", "ramp_up", "ramp_dn"
+APPROACH = "approach"
 METER_TL = "meter"
 SOURCE_FILES = ("ramp.nod.xml", "ramp.edg.xml", "ramp.con.xml", "ramp.tll.xml")
 
@@ -54,6 +60,8 @@ class NetworkSpec:
     ramp_length, ramp_dn_length, ramp_speed : float
         Queue storage upstream of the meter (m), ramp length from meter to merge (m),
         ramp speed limit (m/s).
+    approach_length : float
+        Length of the ``approach`` edge before x = 0, m (0: no approach edge).
     """
 
     length: float = 1000.0
@@ -66,10 +74,15 @@ class NetworkSpec:
     ramp_length: float = 300.0
     ramp_dn_length: float = 120.0
     ramp_speed: float = 50.0 / 3.6
+    approach_length: float = 0.0
 
     def __post_init__(self) -> None:
         for f in fields(self):
             value = getattr(self, f.name)
+            if f.name == "approach_length":
+                require(isinstance(value, int | float) and 0 <= value < 1e6, f.name, value,
+                        "a length in [0, 1e6) m (0: no approach edge)")
+                continue
             require(isinstance(value, int | float) and value > 0, f.name, value,
                     "a number greater than 0")
         require(self.lane_width <= 20.0, "lane_width", self.lane_width, "at most 20 m")
@@ -116,6 +129,8 @@ def network_sources(spec: NetworkSpec) -> dict[str, str]:
         f'<connection {_attrs(**{"from": MERGE}, to=DOWN, fromLane=1, toLane=0)}/>',
         f'<connection {_attrs(**{"from": RAMP_UP}, to=RAMP_DN, fromLane=0, toLane=0)}/>',
     ]
+    if spec.approach_length > 0:
+        _add_approach(spec, nodes, edges, cons)
     tll = [
         f'<tlLogic {_attrs(id=METER_TL, type="static", programID="0", offset=0)}>',
         f'    <phase {_attrs(duration=3, state="G")}/>',
@@ -130,6 +145,14 @@ def network_sources(spec: NetworkSpec) -> dict[str, str]:
         "ramp.con.xml": _xml("connections", cons),
         "ramp.tll.xml": _xml("tlLogics", tll),
     }
+
+
+def _add_approach(spec: NetworkSpec, nodes: list[str], edges: list[str],
+                  cons: list[str]) -> None:
+    """Append node Q, edge ``approach`` (Q -> A, explicit length) and its connection."""
+    nodes.append(f'<node {_attrs(id="Q", x=-spec.approach_length, y=0.0)}/>')
+    edges.insert(0, f'<edge {_attrs(id=APPROACH, **{"from": "Q"}, to="A", numLanes=1, speed=spec.main_speed, priority=3, length=spec.approach_length, width=spec.lane_width)}/>')  # noqa: E501
+    cons.insert(0, f'<connection {_attrs(**{"from": APPROACH}, to=MAIN, fromLane=0, toLane=0)}/>')
 
 
 def write_if_changed(path: Path, data: bytes) -> bool:
@@ -207,7 +230,8 @@ def build_network(out_dir: Path, spec: NetworkSpec | None = None, *,
                   write: bool = True) -> Path:
     """Write the sources of ``spec`` (unless ``write`` is False) and build the network.
 
-    Checks that the mainline is exactly ``spec.length`` long in the built network.
+    Checks that the mainline (and the approach) is exactly as long as ``spec`` says in the
+    built network.
     See :func:`rebuild_network` for whether anything changed.
     """
     return rebuild_network(out_dir, spec, write=write)[0]
@@ -225,8 +249,17 @@ def rebuild_network(out_dir: Path, spec: NetworkSpec | None = None, *,
     except OSError as exc:
         raise SumoError(f"out = {str(out_dir)!r} cannot be written: {exc.strerror}; allowed: "
                         "a writable directory") from None
-    main_length = edge_lengths(net)[MAIN]
-    if abs(main_length - spec.length) > 1e-6:
-        raise SumoError(f"main edge length = {main_length} m differs from the requested "
-                        f"{spec.length} m")
+    lengths = edge_lengths(net)
+    wanted = {MAIN: spec.length}
+    if spec.approach_length > 0:
+        wanted[APPROACH] = spec.approach_length
+    for edge, length in wanted.items():
+        if abs(lengths.get(edge, -1.0) - length) > 1e-6:
+            raise SumoError(f"{edge} edge length = {lengths.get(edge)} m differs from the "
+                            f"requested {length} m")
     return net, changed
+
+
+def approach_length_of(net_file: Path) -> float:
+    """Length (m) of the ``approach`` edge of a built network; 0 without one."""
+    return edge_lengths(net_file).get(APPROACH, 0.0)

@@ -16,6 +16,7 @@ from __future__ import annotations
 import contextlib
 import io
 import logging
+import os
 import shutil
 import tempfile
 import xml.etree.ElementTree as ET
@@ -27,7 +28,15 @@ from types import ModuleType, TracebackType
 from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.demand import InitialVehicle, demand_flows, write_route_file
-from arzsumo.sumo.paths import NET_FILE, SumoError, nets_dir, scratch_dir, sumo_binary
+from arzsumo.sumo.network import NetworkSpec, approach_length_of, build_network
+from arzsumo.sumo.paths import (
+    NET_FILE,
+    NETS_ENV,
+    SumoError,
+    nets_dir,
+    scratch_dir,
+    sumo_binary,
+)
 
 log = logging.getLogger(__name__)
 
@@ -279,27 +288,49 @@ class SumoSimulation:
         self.close(warn=exc_type is None)
 
 
+def network_file(cfg: SumoConfig, net_dir: Path | None, workdir: Path) -> Path:
+    """The network of a run with ``cfg``.
+
+    An explicit ``net_dir`` (or ``$ARZSUMO_SUMO_NETS``) is used as it is and must have an
+    ``approach`` edge of ``cfg.approach_length`` (none for 0). Otherwise the shipped
+    network serves ``approach_length = 0``, and a network with the approach is built with
+    netconvert into ``workdir`` (about 0.5 s; it goes with the run's temporary files).
+    """
+    if cfg.approach_length > 0 and net_dir is None and not os.environ.get(NETS_ENV):
+        spec = NetworkSpec(approach_length=cfg.approach_length)
+        return build_network(workdir / "net", spec)
+    net = nets_dir(net_dir) / NET_FILE
+    have = approach_length_of(net)
+    if abs(have - cfg.approach_length) > 1e-6:
+        raise SumoError(f"approach_length = {cfg.approach_length:g} m does not match the "
+                        f"network {str(net)!r}, whose approach edge is {have:g} m long; "
+                        "allowed: the same length (`arzsumo build-net --approach-length-m "
+                        "LEN --out DIR`), or no network directory so that the run builds it")
+    return net
+
+
 def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
                     initial: Sequence[InitialVehicle] = (), net_dir: Path | None = None,
                     extra_args: Sequence[str] = (), e2_chain: bool = False,
                     output_dir: Path | None = None) -> SumoSimulation:
-    """A started simulation of the default network with the demand of ``cfg``.
+    """A started simulation of the network of :func:`network_file` with the demand of
+    ``cfg``.
 
     The route file (and, with ``e2_chain``, an E2 detector per measurement cell, see
     :mod:`arzsumo.sumo.detectors`) goes to a temporary directory (under
     :func:`~arzsumo.sumo.paths.scratch_dir`) removed when the run closes. With
     ``output_dir``, SUMO's statistics output is written there and kept.
     """
-    net = nets_dir(net_dir) / NET_FILE
     workdir = Path(tempfile.mkdtemp(prefix="arzsumo-", dir=scratch_dir()))
     try:
+        net = network_file(cfg, net_dir, workdir)
         route = write_route_file(workdir / "run.rou.xml", params, cfg, initial)
         if e2_chain:
             from arzsumo.sumo.detectors import write_e2_chain
 
             add = write_e2_chain(workdir / "e2.add.xml", params.length, cfg.cell_length)
             extra_args = ("--additional-files", str(add), *extra_args)
-    except BaseException:  # a bad demand or Ctrl-C: leave no temporary files
+    except BaseException:  # a bad demand or network, or Ctrl-C: leave no temporary files
         shutil.rmtree(workdir, ignore_errors=True)
         raise
     sim = SumoSimulation(net, route, cfg, requested_initial=len(initial), workdir=workdir,
