@@ -6,7 +6,8 @@ import pytest
 from arzsumo.cli import main
 from arzsumo.errors import ScenarioError
 from arzsumo.model import get_preset
-from arzsumo.sumo.config import SumoConfig, sumo_config_from_table
+from arzsumo.scenario import scenario_from_dict
+from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.demand import InitialVehicle, route_file_text
 from arzsumo.sumo.measure import MainlineSensor
 from arzsumo.sumo.network import (
@@ -69,10 +70,11 @@ def test_routes_start_on_the_approach_only_when_there_is_one():
 
 
 def test_sumo_key_and_its_errors_name_the_key_in_metres():
-    assert sumo_config_from_table({"approach_length_m": 1500}).approach_length == 1500.0
+    sc = scenario_from_dict({"sumo": {"approach_length_m": 1500}}, "s.toml")
+    assert sc.sumo.approach_length == 1500.0
     assert SumoConfig().approach_length == 0.0
     with pytest.raises(ScenarioError, match=r"\[sumo\] approach_length_m = -5 .*at least 0"):
-        sumo_config_from_table({"approach_length_m": -5})
+        scenario_from_dict({"sumo": {"approach_length_m": -5}}, "s.toml")
 
 
 @pytest.mark.sumo
