@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import math
 import re
+from collections.abc import Callable
 from typing import Any, NoReturn
 
 #: exit code of a user error (argparse's own, and the CLI's for ArzsumoError)
@@ -29,44 +30,33 @@ def _number(text: str, kind: type) -> Any:
     return value
 
 
-def positive_float(text: str) -> float:
-    """A finite number > 0 (times, periods, design constants)."""
-    value = _number(text, float)
-    if not (math.isfinite(value) and value > 0):
-        raise argparse.ArgumentTypeError(f"{text} is not allowed: a finite number > 0")
-    return value
+def _checked(name: str, kind: type, ok: Callable[[Any], bool], allowed: str,
+             doc: str) -> Callable[[str], Any]:
+    """An argparse ``type=``: ``text`` read as ``kind`` and kept when ``ok``; otherwise
+    refused as "TEXT is not allowed: ALLOWED"."""
+    def parse(text: str) -> Any:
+        value = _number(text, kind)
+        if not ok(value):
+            raise argparse.ArgumentTypeError(f"{text} is not allowed: {allowed}")
+        return value
+
+    parse.__name__ = parse.__qualname__ = name
+    parse.__doc__ = doc
+    return parse
 
 
-def non_negative_float(text: str) -> float:
-    """A finite number >= 0 (lengths that may be absent)."""
-    value = _number(text, float)
-    if not (math.isfinite(value) and value >= 0):
-        raise argparse.ArgumentTypeError(f"{text} is not allowed: a finite number >= 0")
-    return value
-
-
-def positive_int(text: str) -> int:
-    """An integer >= 1 (workers, jobs)."""
-    value = _number(text, int)
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{text} is not allowed: an integer >= 1")
-    return value
-
-
-def seed_int(text: str) -> int:
-    """A random seed: an integer in [0, 2^31) (SUMO's range)."""
-    value = _number(text, int)
-    if not 0 <= value < SEED_LIMIT:
-        raise argparse.ArgumentTypeError(f"{text} is not allowed: an integer in [0, 2^31)")
-    return value
-
-
-def cells_int(text: str) -> int:
-    """A grid size: an integer >= 4."""
-    value = _number(text, int)
-    if value < 4:
-        raise argparse.ArgumentTypeError(f"{text} is not allowed: an integer >= 4")
-    return value
+positive_float = _checked("positive_float", float, lambda v: math.isfinite(v) and v > 0,
+                          "a finite number > 0",
+                          "A finite number > 0 (times, periods, design constants).")
+non_negative_float = _checked("non_negative_float", float,
+                              lambda v: math.isfinite(v) and v >= 0, "a finite number >= 0",
+                              "A finite number >= 0 (lengths that may be absent).")
+positive_int = _checked("positive_int", int, lambda v: v >= 1, "an integer >= 1",
+                        "An integer >= 1 (workers, jobs).")
+seed_int = _checked("seed_int", int, lambda v: 0 <= v < SEED_LIMIT, "an integer in [0, 2^31)",
+                    "A random seed: an integer in [0, 2^31) (SUMO's range).")
+cells_int = _checked("cells_int", int, lambda v: v >= 4, "an integer >= 4",
+                     "A grid size: an integer >= 4.")
 
 
 class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter,
