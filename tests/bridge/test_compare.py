@@ -21,7 +21,7 @@ from arzsumo.outputs.bridge import write_results
 from arzsumo.outputs.compare import compare_runs
 from arzsumo.scenario import load_scenario
 
-DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "default.toml"
+DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "legacy_default.toml"
 SRC = str(Path(__file__).resolve().parents[2] / "src")
 pytestmark = pytest.mark.sumo
 
@@ -84,7 +84,7 @@ def test_comparable_runs_give_a_table_csv_with_identity_and_mean_bars(dirs, tmp_
     df = pd.read_csv(csv)
     assert list(df.columns[:6]) == ["scenario", "horizon_s", "warmup_s", "controller", "seed",
                                     "kind"]
-    assert df["scenario"].tolist() == ["default"] * 4 and df["kind"].tolist() == ["run"] * 4
+    assert df["scenario"].tolist() == ["legacy_default"] * 4 and df["kind"].tolist() == ["run"] * 4
     assert df["horizon_s"].tolist() == [12.0] * 4 and df["warmup_s"].tolist() == [12.0] * 4
     assert df["controller"].tolist() == ["open", "open", "alinea", "alinea"]
     assert df["seed"].tolist() == [1, 2, 1, 2]

@@ -21,7 +21,7 @@ from arzsumo.io import dump_toml
 from arzsumo.scenario import load_scenario, scenario_from_dict
 from arzsumo.sweep.spec import scenario_fields
 
-DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "default.toml"
+DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "legacy_default.toml"
 BASE = tomllib.loads(DEFAULT.read_text(encoding="utf-8"))
 
 
