@@ -23,7 +23,7 @@ congestion weight: a congestion wave is a property of the whole stream. Loop sta
 give densities and class speeds at the middle of their period; probes give class speeds.
 
 Kernels are truncated at |t - t_i| > :attr:`AsmParameters.window` (data further away
-weigh < e^-4 of a near one). ``causal=True`` uses only data with t_i <= t, for real
+weigh < e^-3 of a near one). ``causal=True`` uses only data with t_i <= t, for real
 time; :class:`CausalSmoother` keeps that window of data and returns one row per period.
 """
 
@@ -82,8 +82,8 @@ class AsmParameters:
 
     @property
     def window(self) -> float:
-        """Largest |t - t_i| (s) that enters a kernel sum: 5 tau + 4 sigma / |c_cong|."""
-        return 5.0 * self.tau + 4.0 * self.sigma / abs(self.c_cong)
+        """Largest |t - t_i| (s) that enters a kernel sum: 3 (tau + sigma / |c_cong|)."""
+        return 3.0 * (self.tau + self.sigma / abs(self.c_cong))
 
 
 @dataclass(frozen=True)
@@ -118,16 +118,36 @@ def _points(x: np.ndarray, t: float, value: np.ndarray, sd: float, kind: int) ->
                       np.full(n, kind, int))
 
 
+def _binned(pr: ProbeObservation, width: float) -> DataPoints:
+    """Probe speeds averaged in bins of ``width`` m: one point per occupied bin, at the
+    mean position of its probes, weighted by count / sd^2."""
+    b = np.floor(pr.x / width).astype(int)
+    b -= b.min(initial=0)
+    n = np.bincount(b)
+    occ = n > 0
+    x = np.bincount(b, pr.x)[occ] / n[occ]
+    v = np.bincount(b, pr.v)[occ] / n[occ]
+    return DataPoints(x, np.full(x.size, pr.t), v, n[occ] / pr.noise.speed ** 2,
+                      np.full(x.size, 2 * pr.index + 1, int))
+
+
 def data_points(loops: Sequence[LoopObservation] = (),
-                probes: Sequence[ProbeObservation] = ()) -> DataPoints:
-    """Flatten loop densities and speeds, and probe speeds, into :class:`DataPoints`."""
+                probes: Sequence[ProbeObservation] = (),
+                probe_bin: float = 50.0) -> DataPoints:
+    """Flatten loop densities and speeds, and probe speeds, into :class:`DataPoints`.
+
+    Probe speeds of one snapshot are first averaged in bins of ``probe_bin`` m (0: every
+    probe is a point); the bin's weight is its count over sd^2, so the sums are nearly
+    unchanged while their cost no longer grows with the number of probes.
+    """
     parts = []
     for obs in loops:
         for i in range(2):
             parts.append(_points(obs.x, obs.t_mid, obs.density[i], obs.noise.density, 2 * i))
             parts.append(_points(obs.x, obs.t_mid, obs.speed[i], obs.noise.speed, 2 * i + 1))
     for pr in probes:
-        parts.append(_points(pr.x, pr.t, pr.v, pr.noise.speed, 2 * pr.index + 1))
+        parts.append(_binned(pr, probe_bin) if probe_bin > 0 and pr.x.size else
+                     _points(pr.x, pr.t, pr.v, pr.noise.speed, 2 * pr.index + 1))
     return DataPoints.join(parts)
 
 
