@@ -17,7 +17,7 @@ import pytest
 from arzsumo.model.characteristic import linearize
 from arzsumo.model.equilibrium import Equilibrium
 from arzsumo.scenario import load_scenario
-from arzsumo.twin import Inlet, InitialCondition, SolverOptions, TwinStepper, initial_fields
+from arzsumo.twin import InitialCondition, Inlet, SolverOptions, TwinStepper, initial_fields
 from arzsumo.twin.state import cell_centres
 
 ROOT = Path(__file__).resolve().parents[2]

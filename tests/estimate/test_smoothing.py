@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from arzsumo.errors import ModelError
 from arzsumo.estimate.observations import LoopNoise, ProbeNoise, ProbeObservation
 from arzsumo.estimate.smoothing import (
     AsmParameters,
@@ -13,7 +14,6 @@ from arzsumo.estimate.smoothing import (
     smooth,
 )
 from arzsumo.estimate.synthetic import sample_loops, sample_probes
-from arzsumo.errors import ModelError
 from arzsumo.units import kmh_to_ms
 from tests.estimate.sensors import LOOPS_X, sample
 

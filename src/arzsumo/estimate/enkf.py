@@ -75,7 +75,7 @@ class EnkfOptions:
     flux: str = "hll"
     cfl: float = 0.9
     inflation: float = 1.05
-    localisation: float = 250.0
+    localisation: float = 150.0
     initial_sd: tuple[float, float, float, float] = (0.1, 0.1, 0.1, 0.1)
     initial_length: float = 150.0
     rho_min: float = 1e-4

@@ -88,47 +88,54 @@ class AsmParameters:
 
 @dataclass(frozen=True)
 class DataPoints:
-    """Scalar data: positions x (m), times t (s), values, weights 1/sd^2 and the index
-    of their quantity in :data:`QUANTITIES` (all arrays (N,))."""
+    """Data at N space-time points: positions x (m) and times t (s), (N,); values and
+    weights 1/sd^2 of the quantities of :data:`QUANTITIES`, (N, 4), weight 0 (value 0)
+    where a point has no datum of that quantity. A loop station's period is one point
+    with all four quantities, so the kernels are evaluated once for them."""
 
     x: np.ndarray
     t: np.ndarray
     value: np.ndarray
     weight: np.ndarray
-    kind: np.ndarray
 
     def select(self, keep: np.ndarray) -> DataPoints:
         """The points where ``keep`` is True."""
-        return DataPoints(self.x[keep], self.t[keep], self.value[keep], self.weight[keep],
-                          self.kind[keep])
+        return DataPoints(self.x[keep], self.t[keep], self.value[keep], self.weight[keep])
 
     @staticmethod
     def join(parts: Sequence[DataPoints]) -> DataPoints:
         """All points of ``parts``, in order."""
         if not parts:
-            return DataPoints(*(np.empty(0) for _ in range(4)), np.empty(0, int))
+            return DataPoints(np.empty(0), np.empty(0), np.empty((0, 4)), np.empty((0, 4)))
         return DataPoints(*(np.concatenate([getattr(p, f) for p in parts])
-                            for f in ("x", "t", "value", "weight", "kind")))
+                            for f in ("x", "t", "value", "weight")))
 
 
-def _points(x: np.ndarray, t: float, value: np.ndarray, sd: float, kind: int) -> DataPoints:
-    ok = np.isfinite(value)
-    n = int(ok.sum())
-    return DataPoints(x[ok], np.full(n, t), value[ok], np.full(n, sd ** -2),
-                      np.full(n, kind, int))
+def _loop_points(obs: LoopObservation) -> DataPoints:
+    """One point per station: densities and speeds of both classes (NaN speeds: weight 0)."""
+    n = obs.noise
+    value = np.stack([obs.density[0], obs.speed[0], obs.density[1], obs.speed[1]], axis=1)
+    sd = np.array([n.density, n.speed, n.density, n.speed])
+    weight = np.where(np.isfinite(value), sd ** -2.0, 0.0)
+    return DataPoints(obs.x, np.full(obs.x.size, obs.t_mid), np.nan_to_num(value), weight)
 
 
-def _binned(pr: ProbeObservation, width: float) -> DataPoints:
-    """Probe speeds averaged in bins of ``width`` m: one point per occupied bin, at the
-    mean position of its probes, weighted by count / sd^2."""
-    b = np.floor(pr.x / width).astype(int)
-    b -= b.min(initial=0)
-    n = np.bincount(b)
-    occ = n > 0
-    x = np.bincount(b, pr.x)[occ] / n[occ]
-    v = np.bincount(b, pr.v)[occ] / n[occ]
-    return DataPoints(x, np.full(x.size, pr.t), v, n[occ] / pr.noise.speed ** 2,
-                      np.full(x.size, 2 * pr.index + 1, int))
+def _probe_points(pr: ProbeObservation, width: float) -> DataPoints:
+    """Probe speeds averaged in bins of ``width`` m (0: one point per probe): one point
+    per occupied bin, at the mean position of its probes, weighted by count / sd^2."""
+    if width > 0:
+        b = np.floor(pr.x / width).astype(int)
+        b -= b.min(initial=0)
+        n = np.bincount(b)
+        occ = n > 0
+        x, count = np.bincount(b, pr.x)[occ] / n[occ], n[occ]
+        v = np.bincount(b, pr.v)[occ] / count
+    else:
+        x, v, count = pr.x, pr.v, np.ones(pr.x.size)
+    value, weight = np.zeros((x.size, 4)), np.zeros((x.size, 4))
+    k = 2 * pr.index + 1
+    value[:, k], weight[:, k] = v, count / pr.noise.speed ** 2
+    return DataPoints(x, np.full(x.size, pr.t), value, weight)
 
 
 def data_points(loops: Sequence[LoopObservation] = (),
@@ -140,15 +147,8 @@ def data_points(loops: Sequence[LoopObservation] = (),
     probe is a point); the bin's weight is its count over sd^2, so the sums are nearly
     unchanged while their cost no longer grows with the number of probes.
     """
-    parts = []
-    for obs in loops:
-        for i in range(2):
-            parts.append(_points(obs.x, obs.t_mid, obs.density[i], obs.noise.density, 2 * i))
-            parts.append(_points(obs.x, obs.t_mid, obs.speed[i], obs.noise.speed, 2 * i + 1))
-    for pr in probes:
-        parts.append(_binned(pr, probe_bin) if probe_bin > 0 and pr.x.size else
-                     _points(pr.x, pr.t, pr.v, pr.noise.speed, 2 * pr.index + 1))
-    return DataPoints.join(parts)
+    return DataPoints.join([_loop_points(obs) for obs in loops]
+                           + [_probe_points(pr, probe_bin) for pr in probes if pr.x.size])
 
 
 def _sums(pts: DataPoints, xg: np.ndarray, tg: np.ndarray, c: float,
@@ -159,9 +159,7 @@ def _sums(pts: DataPoints, xg: np.ndarray, tg: np.ndarray, c: float,
     phi = np.exp(-np.abs(dx) / par.sigma - np.abs(dt - dx / c) / par.tau)
     if causal:
         phi[dt < 0.0] = 0.0
-    onehot = np.zeros((pts.x.size, 4))
-    onehot[np.arange(pts.x.size), pts.kind] = pts.weight
-    return phi @ (onehot * pts.value[:, None]), phi @ onehot
+    return phi @ (pts.weight * pts.value), phi @ pts.weight
 
 
 def _mixed_speed(z: np.ndarray) -> np.ndarray:
