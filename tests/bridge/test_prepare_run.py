@@ -99,7 +99,7 @@ def test_dry_run_validates_and_writes_nothing(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     code, out, err = _run_cli("run", str(DEFAULT), "--dry-run", "--seed", "3")
     assert code == 0 and err == ""
-    assert "scenario default" in out and "SUMO seed 3" in out and "lambda_4 = -17.92" in out
+    assert "scenario legacy_default" in out and "SUMO seed 3" in out and "lambda_4 = -17.92" in out
     assert list(tmp_path.iterdir()) == []            # no results directory
     code, _, err = _run_cli("run", str(DEFAULT), "--dry-run", "--horizon", "0.5")
     assert code == 2 and err.count("\n") == 1
