@@ -132,7 +132,8 @@ def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None
 
     Applies the caller's overrides to the ``run`` and ``sumo`` sections of ``sc``
     (``--controller``, ``--seed`` in [0, 2^31), ``--horizon`` of at least one control
-    period, s; ``--warmup``, s >= 0; validated again by :meth:`~arzsumo.scenario.Scenario.with_`), checks that
+    period, s; ``--warmup``, s >= 0; validated again by
+    :meth:`~arzsumo.scenario.Scenario.with_`), checks that
     ``[sumo] cell_length_m`` divides the road and that the characteristic speeds are
     finite, refuses a PDE controller at a free-flow scenario equilibrium, and draws the
     placement profile of ``start = "placement"``. Raises an
