@@ -8,15 +8,17 @@ from the per-step sample the closed loop's sensor already takes
 with :meth:`AvProbes.read`.
 
 Which AVs report is drawn once per vehicle, from its id and a seed: an AV reports when
-``crc32(f"{seed}:{id}") / 2^32 < share`` (a fleet in which a share of the AVs is
+``blake2b(f"{seed}:{id}") / 2^64 < share`` (a fleet in which a share of the AVs is
 equipped; an equipped AV reports on every period of its trip). The draw depends on
-nothing else, so it is reproducible for a seed and independent of SUMO's own seed.
+nothing else, so it is reproducible for a seed and independent of SUMO's own seed; two
+seeds draw independent fleets (crc32 did not: it is linear, and two seeds drew disjoint
+fleets).
 """
 
 from __future__ import annotations
 
+import hashlib
 import math
-import zlib
 from collections.abc import Sequence
 from types import ModuleType
 
@@ -32,7 +34,8 @@ def reports(vid: str, share: float, seed: int) -> bool:
     """Whether the AV ``vid`` is a probe at ``share`` under ``seed``."""
     if share >= 1.0:
         return True
-    return zlib.crc32(f"{seed}:{vid}".encode()) < share * 2.0**32
+    digest = hashlib.blake2b(f"{seed}:{vid}".encode(), digest_size=8).digest()
+    return int.from_bytes(digest, "big") < share * 2.0**64
 
 
 class AvProbes:
