@@ -1,6 +1,6 @@
 """Synthetic truth for the estimators: the twin on the default scenario's model.
 
-A congested equilibrium (scenarios/default.toml, lambda_4 = -17.9 km/h) with an 8 %
+A congested equilibrium (scenarios/legacy_default.toml, lambda_4 = -17.9 km/h) with an 8 %
 stop-and-go perturbation (1.5 periods over the road), a slightly varying inlet demand and
 an outlet flow swinging by +-12 % of q* with a 100 s period; MUSCL on 100 cells (10 m),
 fields kept every second for 300 s. The perturbation grows to about +-30 %.
@@ -38,7 +38,7 @@ class Truth:
 
 
 def default_eq() -> Equilibrium:
-    return load_scenario(ROOT / "scenarios" / "default.toml").equilibrium
+    return load_scenario(ROOT / "scenarios" / "legacy_default.toml").equilibrium
 
 
 @pytest.fixture(scope="session")

@@ -88,6 +88,8 @@ def test_a_fill_phase_requests_the_fill_demand_then_the_hold_demand():
     assert sum(f.requested(1200) for f in by["av"]) == pytest.approx(240 + 120, abs=2)
     assert len({f.id for f in flows}) == len(flows)
     assert min(f.begin for f in flows if f.rate == pytest.approx(0.5)) >= 600
+    short = [f for f in demand_flows(cfg.with_(horizon=300)) if f.route == "r_main"]
+    assert short and all(f.end == 300 and f.begin < f.end for f in short)
     assert demand_flows(cfg.with_(fill_duration=0)) == demand_flows(
         SumoConfig(horizon=1200, demand_h=1.0, demand_a=0.2))
 

@@ -113,8 +113,10 @@ def _mainline(fid: str, vtype: str, lats: list[float], hold: float, fill: float,
     if cfg.fill_duration <= 0:
         return _columns(fid, vtype, hold, lats, cfg.horizon)
     until = min(cfg.fill_duration, cfg.horizon)
-    return [*_columns(f"{fid}_fill", vtype, fill, lats, until),
-            *_columns(fid, vtype, hold, lats, cfg.horizon, begin=until)]
+    fill_flows = _columns(f"{fid}_fill", vtype, fill, lats, until)
+    if until >= cfg.horizon:          # a run shorter than the fill phase has no hold flows
+        return fill_flows
+    return [*fill_flows, *_columns(fid, vtype, hold, lats, cfg.horizon, begin=until)]
 
 
 def demand_flows(cfg: SumoConfig, road_width: float = 6.5,
@@ -131,7 +133,7 @@ def demand_flows(cfg: SumoConfig, road_width: float = 6.5,
                         cfg),
              Flow("ramp_hv", HV_TYPE, ROUTE_RAMP, cfg.ramp_demand - ramp_a, 0.0, cfg.horizon),
              Flow("ramp_av", AV_TYPE, ROUTE_RAMP, ramp_a, 0.0, cfg.horizon)]
-    return [f for f in flows if f.rate > 1e-12]
+    return [f for f in flows if f.rate > 1e-12 and f.begin < f.end]   # SUMO refuses empty flows
 
 
 def check_columns(road_width: float, vehicle_width: float, resolution: float,
