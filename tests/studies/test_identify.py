@@ -121,3 +121,25 @@ def test_an_existing_result_is_kept_without_overwrite(result, capsys):
     out, _ = result
     err = _refused([*ARGS, "--out", str(out)], capsys)
     assert "identify" in err and "--overwrite" in err
+
+
+def test_vary_plans_every_seed_at_every_point_of_the_product():
+    from arzsumo.scenario import scenario_from_dict
+    from arzsumo.studies.identify import make_setup, plan
+
+    setup = make_setup(load_scenario(DEFAULT), [1, 2], [7], horizon=60.0, warmup=30.0,
+                       vary=["sumo.green_share=0.4,0.6", "sumo.ramp_demand_veh_h=900,1200"],
+                       which="tau_a,gamma_h", workers=1)
+    assert [p.label for p in setup.points] == [
+        "sumo.green_share=0.4, sumo.ramp_demand_veh_h=900",
+        "sumo.green_share=0.4, sumo.ramp_demand_veh_h=1200",
+        "sumo.green_share=0.6, sumo.ramp_demand_veh_h=900",
+        "sumo.green_share=0.6, sumo.ramp_demand_veh_h=1200"]
+    tasks = plan(setup)
+    assert len(tasks) == 12
+    assert [t.role for t in tasks] == ["training"] * 8 + ["validation"] * 4
+    assert tasks[3].run_id == "p1-seed2" and tasks[-1].run_id == "p3-seed7"
+    run = scenario_from_dict(tasks[5].tables, tasks[5].source)
+    assert run.sumo.green_share == 0.6 and run.sumo.ramp_demand == pytest.approx(900 / 3600)
+    assert run.run.controller == "open" and run.run.warmup == 30.0 and run.sumo.horizon == 60.0
+    assert setup.which == ("tau_a", "gamma_h") and setup.options.cells == run.run.twin_cells
