@@ -79,9 +79,8 @@ def trend(n: np.ndarray, dt: float) -> dict[str, float]:
 
 def regime(rho_h: float, rho_a: float) -> tuple[float, str]:
     """lambda_4 (km/h) and regime of the calibrated model at densities in veh/km."""
-    from arzsumo.scenarios import load_scenario
-
     from arzsumo.model import Equilibrium, linearize
+    from arzsumo.scenario import load_scenario
 
     params = load_scenario(SCENARIO).params
     try:
@@ -115,16 +114,14 @@ def run_point(demand: float, green: float, sigma: float, seed: int, approach: fl
               warmup: float, measured: float, step: float, initial: bool,
               av_share: float = AV_SHARE) -> dict[str, Any]:
     """One open-loop run; returns the CSV row (units in the column names)."""
-    from arzsumo.scenarios import load_scenario
-
-    from arzsumo.sumo.config import sumo_config_of
+    from arzsumo.scenario import load_scenario
     from arzsumo.sumo.meter import RampMeter
     from arzsumo.sumo.sensor import SumoSensor
     from arzsumo.sumo.simulation import open_simulation
 
     t0 = time.perf_counter()
     sc = load_scenario(SCENARIO)
-    cfg = sumo_config_of(sc).with_(
+    cfg = sc.sumo.with_(
         demand_h=demand * (1 - av_share) / 3600, demand_a=demand * av_share / 3600,
         green_share=green, hv_sigma=sigma, seed=seed, approach_length=approach,
         horizon=warmup + measured, step_length=step)

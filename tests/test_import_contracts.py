@@ -39,9 +39,12 @@ def test_the_package_keeps_every_contract(tmp_path):
 @pytest.mark.parametrize(("where", "line", "contract"), [
     # the math reaching for SUMO, and the twin numerics for a file writer
     ("model/_wrong.py", "import arzsumo.sumo.simulation\n",
-     "The math (model, control, twin numerics) imports no SUMO"),
+     "The math (model, control, twin numerics, estimation) imports no SUMO"),
     ("twin/flux.py", "from arzsumo.io import json_safe\n",
-     "The math (model, control, twin numerics) imports no SUMO"),
+     "The math (model, control, twin numerics, estimation) imports no SUMO"),
+    # the estimator reaching for the SUMO bridge's measurements
+    ("estimate/_wrong.py", "import arzsumo.bridge.estimator\n",
+     "The math (model, control, twin numerics, estimation) imports no SUMO"),
     # a library room drawing a figure itself (lazily, as twin/output.py once did)
     ("bridge/_wrong.py", "def f():\n    import arzsumo.plots.bridge\n",
      "Only the output layer imports plots"),

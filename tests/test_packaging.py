@@ -98,8 +98,9 @@ def test_installed_wheel_runs_from_another_directory(wheel, tmp_path):
                             "import arzsumo; print(arzsumo.__file__)"], cwd=elsewhere, env=env,
                            capture_output=True, text=True, check=True).stdout.strip()
     assert Path(where).is_relative_to(venv)
-    proc = subprocess.run([str(venv / "bin" / "arzsumo"), "run", "--horizon", "30", "--quiet",
-                           "--no-plots", "--out", "r"], cwd=elsewhere, env=env,
+    proc = subprocess.run([str(venv / "bin" / "arzsumo"), "run", "--horizon", "30",
+                           "--warmup", "30", "--quiet", "--no-plots", "--out", "r"],
+                          cwd=elsewhere, env=env,
                           capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr[-2000:]
     summ = json.loads((elsewhere / "r" / "summary.json").read_text())

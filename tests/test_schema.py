@@ -55,7 +55,7 @@ def run_dir(tmp_path_factory):
 
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv("ARZSUMO_CACHE", str(tmp_path_factory.mktemp("cache")))
-        sc = load_scenario(ROOT / "scenarios" / "default.toml")
+        sc = load_scenario(ROOT / "scenarios" / "legacy_default.toml")
         settings = replace(sc.run, controller="etc", warmup=20.0,
                            kernel_cells=40, twin_cells=40)
         cfg = sc.sumo.with_(horizon=20.0, seed=3)

@@ -7,7 +7,7 @@ import json
 import logging
 from pathlib import Path
 
-from arzsumo.cli_args import positive_float, seed_int
+from arzsumo.cli_args import non_negative_float, positive_float, seed_int
 from arzsumo.control.registry import controller_names
 
 log = logging.getLogger("arzsumo")
@@ -24,7 +24,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     path = Path(args.scenario) if args.scenario else default_scenario()
     sc = load_scenario(path)
     prepared = prepare_run(sc, controller=args.controller, seed=args.seed,
-                           horizon=args.horizon)
+                           horizon=args.horizon, warmup=args.warmup)
     if args.dry_run:
         print(prepared.describe())
         return 0
@@ -33,7 +33,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     # the output is checked and claimed before SUMO starts; Ctrl-C or an error removes it
     with OutputDir(out, "run", overwrite=args.overwrite) as target:
         session = run_in_sumo(sc, controller=args.controller, seed=args.seed,
-                              horizon=args.horizon, progress=not args.quiet)
+                              horizon=args.horizon, warmup=args.warmup,
+                              progress=not args.quiet)
         text = path.read_text(encoding="utf-8") + session.resolved_comment()
         _, summ = write_results(session.result, target, text, plots=not args.no_plots)
     if args.json:
@@ -77,6 +78,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--horizon", type=positive_float,
                    help="control horizon after the warm-up, s; at least one control period "
                         "(default: [sumo] horizon_s)")
+    p.add_argument("--warmup", type=non_negative_float,
+                   help="warm-up under the nominal meter before control, s (default: [run] "
+                        "warmup_s; the name of the default --out then ends in -wWs)")
     p.add_argument("--dry-run", action="store_true",
                    help="check the scenario and the options as the run would, print what "
                         "it would do, and exit without starting SUMO")

@@ -22,7 +22,8 @@ from arzsumo.io import toml_value
 
 #: what a value of each kind must be (the type part of error messages)
 KIND_TEXT = {"number": "a finite number", "integer": "an integer", "string": "a string",
-             "bool": "true or false", "numbers": "a list of numbers"}
+             "bool": "true or false", "numbers": "a list of numbers",
+             "strings": "a list of strings"}
 
 
 @dataclass(frozen=True)
@@ -35,14 +36,15 @@ class Key:
         The SI field it sets (of the dataclass behind the table).
     kind : str
         ``"number"`` (finite int or float), ``"integer"``, ``"string"``, ``"bool"`` or
-        ``"numbers"`` (a non-empty list of finite numbers, read as a tuple).
+        ``"numbers"`` (a non-empty list of finite numbers, read as a tuple) or
+        ``"strings"`` (a non-empty list of strings, each among ``choices``, read as a tuple).
     factor : float
         User units per SI unit: 3.6 for km/h, 3600 for veh/h, 1000 for veh/km, 1 for SI.
     allowed : str, optional
         What is allowed, in the key's units; replaces the SI check's text when that
         would mislead (numbers in veh/s, m/s or veh/m).
     choices : tuple of str
-        The allowed strings of a ``"string"`` key (empty: any string).
+        The allowed strings of a ``"string"`` or ``"strings"`` key (empty: any string).
     unit : str
         The key's unit as written in files ("km/h", "veh/h", "s", "m"; "" for none):
         what ``docs/scenarios.md`` states.
@@ -120,10 +122,16 @@ def checked(value: Any, kind: str, at: str, key: str,
         ok = isinstance(value, list) and bool(value) and all(
             isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
             for v in value)
+    elif kind == "strings":
+        ok = isinstance(value, list) and bool(value) and all(
+            isinstance(v, str) and (not choices or v in choices) for v in value)
     else:
         ok = isinstance(value, str) and (not choices or value in choices)
     if not ok:
-        text = f"one of {', '.join(choices)}" if choices else KIND_TEXT[kind]
+        text = KIND_TEXT[kind]
+        if choices:
+            text = (f"a list of {', '.join(choices)}" if kind == "strings"
+                    else f"one of {', '.join(choices)}")
         raise not_allowed(at, key, value, text)
     return value
 
@@ -138,6 +146,8 @@ def read_keys(table: Mapping[str, Any], keys: Mapping[str, Key], at: str) -> dic
         value = checked(value, spec.kind, at, key, spec.choices)
         if spec.kind == "numbers":
             value = tuple(float(v) / spec.factor for v in value)
+        elif spec.kind == "strings":
+            value = tuple(value)
         elif spec.kind == "number":
             value = value / spec.factor
         out[spec.field] = value

@@ -21,7 +21,7 @@ from arzsumo.outputs.bridge import write_results
 from arzsumo.outputs.compare import compare_runs
 from arzsumo.scenario import load_scenario
 
-DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "default.toml"
+DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "legacy_default.toml"
 SRC = str(Path(__file__).resolve().parents[2] / "src")
 pytestmark = pytest.mark.sumo
 
@@ -79,12 +79,12 @@ def compare(capsys, *args) -> subprocess.CompletedProcess:
 def test_comparable_runs_give_a_table_csv_with_identity_and_mean_bars(dirs, tmp_path):
     runs = [dirs[k] for k in ("o1", "o2", "a1", "a2")]
     text, csv, png = compare_runs(runs, tmp_path / "cmp")
-    assert text.splitlines()[0] == ("scenario default, horizon 12 s, warm-up 12 s: arzsumo "
+    assert text.splitlines()[0] == ("scenario legacy_default, horizon 12 s, warm-up 12 s: arzsumo "
                                     "run result (meter counts over the control window)")
     df = pd.read_csv(csv)
     assert list(df.columns[:6]) == ["scenario", "horizon_s", "warmup_s", "controller", "seed",
                                     "kind"]
-    assert df["scenario"].tolist() == ["default"] * 4 and df["kind"].tolist() == ["run"] * 4
+    assert df["scenario"].tolist() == ["legacy_default"] * 4 and df["kind"].tolist() == ["run"] * 4
     assert df["horizon_s"].tolist() == [12.0] * 4 and df["warmup_s"].tolist() == [12.0] * 4
     assert df["controller"].tolist() == ["open", "open", "alinea", "alinea"]
     assert df["seed"].tolist() == [1, 2, 1, 2]
@@ -130,7 +130,7 @@ def test_twin_result_refused_then_labelled_as_twin(dirs, tmp_path, capsys):
     proc = compare(capsys, dirs["o1"], dirs["twin"], "--out", out, "--allow-mixed")
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.startswith("MIXED RESULTS (--allow-mixed), not comparable row to "
-                                  "row: kind run, twin; scenario default, short; "
+                                  "row: kind run, twin; scenario legacy_default, short; "
                                   "warmup_s 12, none")
     df = pd.read_csv(out / "comparison.csv")
     assert df["kind"].tolist() == ["run", "twin"]

@@ -20,7 +20,7 @@ from arzsumo.outputs.bridge import write_results
 from arzsumo.scenario import load_scenario
 from arzsumo.scenario.run import RunSettings
 
-DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "default.toml"
+DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "legacy_default.toml"
 pytestmark = pytest.mark.sumo
 
 

@@ -12,7 +12,7 @@ from arzsumo.sumo.network_measures import read_trips
 from arzsumo.sumo.simulation import SumoSimulation
 
 ROOT = Path(__file__).resolve().parents[2]
-DEFAULT = ROOT / "scenarios" / "default.toml"
+DEFAULT = ROOT / "scenarios" / "legacy_default.toml"
 WARMUP, HORIZON, STEP = 40.0, 60.0, 0.1
 pytestmark = pytest.mark.sumo
 

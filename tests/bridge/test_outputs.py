@@ -21,7 +21,7 @@ from arzsumo.outputs.bridge import write_results
 from arzsumo.scenario import load_scenario
 from arzsumo.sumo.meter import plan_green_steps
 
-DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "default.toml"
+DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "legacy_default.toml"
 WARMUP, HORIZON = 30.0, 30.0
 pytestmark = pytest.mark.sumo
 

@@ -14,14 +14,14 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from arzsumo.bridge.session import prepare_run
+from arzsumo.bridge.session import default_run_name, prepare_run
 from arzsumo.cli import main
 from arzsumo.errors import ScenarioError
 from arzsumo.io import dump_toml
 from arzsumo.scenario import load_scenario, scenario_from_dict
 from arzsumo.sweep.spec import scenario_fields
 
-DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "default.toml"
+DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "legacy_default.toml"
 BASE = tomllib.loads(DEFAULT.read_text(encoding="utf-8"))
 
 
@@ -99,11 +99,25 @@ def test_dry_run_validates_and_writes_nothing(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     code, out, err = _run_cli("run", str(DEFAULT), "--dry-run", "--seed", "3")
     assert code == 0 and err == ""
-    assert "scenario default" in out and "SUMO seed 3" in out and "lambda_4 = -17.92" in out
+    assert "scenario legacy_default" in out and "SUMO seed 3" in out
+    assert "lambda_4 = -17.92" in out
     assert list(tmp_path.iterdir()) == []            # no results directory
     code, _, err = _run_cli("run", str(DEFAULT), "--dry-run", "--horizon", "0.5")
     assert code == 2 and err.count("\n") == 1
     assert err.startswith("arzsumo: error: --horizon = 0.5 is not allowed")
+
+
+def test_warmup_option_overrides_the_scenario_and_names_the_output():
+    sc = load_scenario(DEFAULT)
+    run = prepare_run(sc, warmup=20.0)
+    assert run.settings.warmup == 20.0 and sc.run.warmup == 150.0
+    assert default_run_name(sc, run.settings, run.sumo).endswith("-h450s-w20s")
+    same = prepare_run(sc, warmup=150.0)
+    assert default_run_name(sc, same.settings, same.sumo).endswith("-h450s")
+    code, out, err = _run_cli("run", str(DEFAULT), "--dry-run", "--warmup", "20")
+    assert code == 0 and "warm-up 20 s + control horizon 450 s" in out
+    code, _, err = _run_cli("run", str(DEFAULT), "--dry-run", "--warmup", "nan")
+    assert code == 2 and err.startswith("arzsumo: error: --warmup = nan is not allowed")
 
 
 # --- property-based: any mutation of the default scenario is accepted or refused in one line

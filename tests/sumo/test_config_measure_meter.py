@@ -76,6 +76,24 @@ def test_flows_request_exactly_and_are_sorted():
     assert begins == sorted(begins)
 
 
+def test_a_fill_phase_requests_the_fill_demand_then_the_hold_demand():
+    cfg = SumoConfig(horizon=1200, demand_h=3600 / 3600, demand_a=720 / 3600,
+                     fill_duration=600, fill_demand_h=7200 / 3600, fill_demand_a=1440 / 3600)
+    flows = [f for f in demand_flows(cfg) if f.route == "r_main"]
+    by = {c: [f for f in flows if f.type == c] for c in ("hv", "av")}
+    # 10 min at the fill rate, then 10 min at the hold rate, per class (+- one per column)
+    assert sum(f.requested(600) for f in by["hv"]) == pytest.approx(1200, abs=2)
+    assert sum(f.requested(1200) for f in by["hv"]) == pytest.approx(1200 + 600, abs=2)
+    assert sum(f.requested(600) for f in by["av"]) == pytest.approx(240, abs=2)
+    assert sum(f.requested(1200) for f in by["av"]) == pytest.approx(240 + 120, abs=2)
+    assert len({f.id for f in flows}) == len(flows)
+    assert min(f.begin for f in flows if f.rate == pytest.approx(0.5)) >= 600
+    short = [f for f in demand_flows(cfg.with_(horizon=300)) if f.route == "r_main"]
+    assert short and all(f.end == 300 and f.begin < f.end for f in short)
+    assert demand_flows(cfg.with_(fill_duration=0)) == demand_flows(
+        SumoConfig(horizon=1200, demand_h=1.0, demand_a=0.2))
+
+
 def test_sublane_grid_must_separate_insertion_columns():
     with pytest.raises(ScenarioError, match=r"lateral_resolution = 0\.65 is not allowed"):
         route_file_text(PARAMS, SumoConfig(lateral_resolution=0.65))

@@ -17,7 +17,7 @@ pytestmark = pytest.mark.sumo
 
 
 def _scenario(tmp: Path) -> Path:
-    text = (ROOT / "scenarios" / "default.toml").read_text(encoding="utf-8")
+    text = (ROOT / "scenarios" / "legacy_default.toml").read_text(encoding="utf-8")
     text = text.replace("warmup_s = 150", "warmup_s = 30").replace(
         "kernel_cells = 100", "kernel_cells = 40").replace("twin_cells = 100", "twin_cells = 40")
     path = tmp / "short.toml"

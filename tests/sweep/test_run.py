@@ -175,7 +175,7 @@ def test_an_edited_sweep_reruns_only_what_changed(tmp_path):
 
 @pytest.mark.sumo
 def test_a_sumo_sweep_runs_the_closed_loop(tmp_path):
-    data = {"name": "sumo_small", "base": "scenarios/default.toml", "engine": "sumo",
+    data = {"name": "sumo_small", "base": "scenarios/legacy_default.toml", "engine": "sumo",
             "seeds": [5],
             "set": {"sumo": {"horizon_s": 30}, "run": {"warmup_s": 30, "kernel_cells": 40,
                                                        "twin_cells": 40}},

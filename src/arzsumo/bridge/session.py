@@ -127,12 +127,13 @@ def _check_regime(sc: Scenario, settings: RunSettings, from_cli: bool) -> None:
 
 
 def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None = None,
-                horizon: float | None = None) -> PreparedRun:
+                horizon: float | None = None, warmup: float | None = None) -> PreparedRun:
     """Everything ``arzsumo run`` checks before SUMO starts, without starting it.
 
     Applies the caller's overrides to the ``run`` and ``sumo`` sections of ``sc``
     (``--controller``, ``--seed`` in [0, 2^31), ``--horizon`` of at least one control
-    period, s; validated again by :meth:`~arzsumo.scenario.Scenario.with_`), checks that
+    period, s; ``--warmup``, s >= 0; validated again by
+    :meth:`~arzsumo.scenario.Scenario.with_`), checks that
     ``[sumo] cell_length_m`` divides the road and that the characteristic speeds are
     finite, refuses a PDE controller at a free-flow scenario equilibrium, and draws the
     placement profile of ``start = "placement"``. Raises an
@@ -144,6 +145,8 @@ def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None
         sc = _override(sc, "sumo.seed", _seed(seed), "--seed")
     if horizon is not None:
         sc = _override(sc, "sumo.horizon_s", _horizon(horizon, sc.sumo), "--horizon")
+    if warmup is not None:
+        sc = _override(sc, "run.warmup_s", warmup, "--warmup")
     settings, cfg, design = sc.run, sc.sumo, sc.design
     ic = seeded(sc.initial, cfg.seed)  # one seed draws all randomness
     _check_model(sc, cfg)
@@ -159,12 +162,17 @@ def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None
 
 
 def default_run_name(sc: Scenario, settings: RunSettings, cfg: SumoConfig) -> str:
-    """``NAME-CONTROLLER-seedN-hTs``: unique per scenario, controller, seed and horizon (s)."""
-    return f"{sc.name}-{settings.controller}-seed{cfg.seed}-h{cfg.horizon:g}s"
+    """``NAME-CONTROLLER-seedN-hTs``: unique per scenario, controller, seed and horizon (s);
+    ``-wWs`` is added when the warm-up differs from the scenario's (``--warmup``)."""
+    name = f"{sc.name}-{settings.controller}-seed{cfg.seed}-h{cfg.horizon:g}s"
+    if settings.warmup != sc.run.warmup:
+        name += f"-w{settings.warmup:g}s"
+    return name
 
 
 def run_in_sumo(sc: Scenario, *, controller: str | None = None, seed: int | None = None,
-                horizon: float | None = None, progress: bool = False) -> SumoSession:
+                horizon: float | None = None, warmup: float | None = None,
+                progress: bool = False) -> SumoSession:
     """Run the closed loop of ``sc`` in SUMO (overrides win over the scenario's tables).
 
     Parameters
@@ -179,12 +187,14 @@ def run_in_sumo(sc: Scenario, *, controller: str | None = None, seed: int | None
         "placement"``).
     horizon : float, optional
         Overrides ``[sumo] horizon_s``, s; at least one control period.
+    warmup : float, optional
+        Overrides ``[run] warmup_s``, s.
     progress : bool
         Draw a progress bar on stderr.
 
     All checks happen in :func:`prepare_run` before SUMO starts.
     """
-    run = prepare_run(sc, controller=controller, seed=seed, horizon=horizon)
+    run = prepare_run(sc, controller=controller, seed=seed, horizon=horizon, warmup=warmup)
     res = run_cosimulation(run.scenario, run.settings, run.sumo, run.design,
                            initial_fields=run.initial, curve=run.curve, progress=progress)
     return SumoSession(res, run.settings, run.sumo)

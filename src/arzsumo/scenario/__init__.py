@@ -16,6 +16,7 @@ section                   record                                     keys (units
 ``[twin]``                ``twin``: TwinConfig (``arzsumo twin``)    :mod:`.twin`
 ``[sumo]``                ``sumo``: SumoConfig (``arzsumo run``)     :mod:`.sumo`
 ``[run]``                 ``run``: RunSettings (``arzsumo run``)     :mod:`.run`
+``[sensing]``             ``sensing``: SensorLayout (``run``)        :mod:`.sensing`
 ``[sweep]``               ``sweep``: DesignSweep (``reproduce``)     here
 ========================  =========================================  ====================
 
@@ -47,6 +48,7 @@ from arzsumo.scenario.model import (
     model_section,
 )
 from arzsumo.scenario.run import RUN_KEYS, RUN_RENAMED, RunSettings, run_section
+from arzsumo.scenario.sensing import SENSING_KEYS, sensing_section
 from arzsumo.scenario.sumo import SUMO_KEYS, sumo_section
 from arzsumo.scenario.twin import (
     INITIAL_KEYS,
@@ -56,6 +58,7 @@ from arzsumo.scenario.twin import (
     twin_section,
 )
 from arzsumo.sumo.config import SumoConfig
+from arzsumo.sumo.sensing import SensorLayout
 from arzsumo.tables import Key, check_keys, check_renamed, checked, not_allowed, where
 from arzsumo.twin.initial import InitialCondition
 
@@ -72,7 +75,7 @@ SWEEP_KEYS: dict[str, Key] = {
 KEYS: dict[str, dict[str, Key]] = {
     "model": MODEL_KEYS, "equilibrium": EQUILIBRIUM_KEYS, "design": DESIGN_KEYS,
     "initial": INITIAL_KEYS, "twin": TWIN_KEYS, "sumo": SUMO_KEYS, "run": RUN_KEYS,
-    "sweep": SWEEP_KEYS,
+    "sensing": SENSING_KEYS, "sweep": SWEEP_KEYS,
 }
 #: table -> {old key: new key}: keys renamed since earlier versions (a one-line hint)
 RENAMED: dict[str, dict[str, str]] = {"run": RUN_RENAMED}
@@ -108,6 +111,7 @@ class Scenario:
     sweep: DesignSweep | None = None
     source: str = "<dict>"
     tables: Mapping[str, Any] = field(default_factory=dict, repr=False, compare=False)
+    sensing: SensorLayout = field(default_factory=SensorLayout)
 
     def with_(self, changes: Mapping[str, Any]) -> Scenario:
         """A new scenario with keys changed, parsed and validated again.
@@ -170,12 +174,13 @@ def scenario_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scena
     twin = twin_section(t["twin"], at["twin"], initial, design)
     sumo = sumo_section(t["sumo"], at["sumo"], source)
     run = run_section(t["run"], at["run"])
+    sensing = sensing_section(t["sensing"], at["sensing"], params.length)
     sweep = _sweep_section(t["sweep"], at["sweep"])
     default_name = Path(source).stem if source != "<dict>" else preset.name
     return Scenario(_text(data, "name", source, default_name),
                     _text(data, "description", source, preset.description), params, eq,
                     design, initial, twin, sumo, run, sweep, source,
-                    copy.deepcopy(dict(data)))
+                    copy.deepcopy(dict(data)), sensing=sensing)
 
 
 def load_scenario(path: str | Path) -> Scenario:

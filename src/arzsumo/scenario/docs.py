@@ -17,6 +17,7 @@ from arzsumo.scenario import KEYS, RENAMED
 from arzsumo.scenario.run import RunSettings
 from arzsumo.scenario.twin import DEFAULT_AMPLITUDE, TwinConfig
 from arzsumo.sumo.config import SumoConfig
+from arzsumo.sumo.sensing import SensorLayout
 from arzsumo.tables import Key, written
 
 _TWIN = TwinConfig()
@@ -39,6 +40,8 @@ SECTIONS: dict[str, tuple[str, Callable[[str], Any] | None]] = {
              lambda f: getattr(_TWIN.solver, f, getattr(_TWIN, f, None))),
     "sumo": ("`arzsumo run` (and `arzsumo calibrate`) only", lambda f: getattr(SumoConfig(), f)),
     "run": ("`arzsumo run` only", lambda f: getattr(RunSettings(), f)),
+    "sensing": ("the sensors `arzsumo run` reads in SUMO (issue 16); default: `probe`, "
+                "every vehicle binned into cells", lambda f: getattr(SensorLayout(), f)),
     "sweep": ("`arzsumo reproduce` only: one ETC run per value of a [design] parameter", None),
 }
 
@@ -62,7 +65,7 @@ typed, [twin] defaulted to 200: the shipped [twin] tables state 200).
 
 
 def _default(key: Key, value: Any) -> str:
-    if value is None:
+    if value is None or value == ():
         return ""
     if key.kind == "number" and isinstance(value, float) and key.factor != 1.0:
         value = round(value * key.factor, 9)
@@ -75,6 +78,8 @@ def _rows(table: str) -> list[str]:
             "|---|---|---|---|---|"]
     for name, key in KEYS[table].items():
         kind = key.kind if not key.choices else " \\| ".join(key.choices)
+        if key.kind == "strings" and key.choices:
+            kind = f"list of {kind}"
         factor = f" / {key.factor:g}" if key.factor != 1.0 else ""
         value = _INITIAL.get(name) if table == "initial" else getter(key.field) if getter \
             else None

@@ -68,6 +68,14 @@ SUMO_KEYS: dict[str, Key] = {
                              doc="approach (buffer) edge before x = 0 where mainline vehicles "
                                  "are inserted and may queue; 0 inserts them at x = 0 on the "
                                  "shipped network"),
+    "fill_s": Key("fill_duration", unit="s",
+                  doc="fill phase from t = 0 of SUMO with the fill demands below; 0: none"),
+    "fill_demand_h_veh_h": Key("fill_demand_h", factor=VEH_H_PER_VEH_S, allowed=_DEMAND,
+                               unit="veh/h", doc="HV flow requested at the mainline "
+                                                 "entrance during the fill phase"),
+    "fill_demand_a_veh_h": Key("fill_demand_a", factor=VEH_H_PER_VEH_S, allowed=_DEMAND,
+                               unit="veh/h", doc="AV flow requested at the mainline "
+                                                 "entrance during the fill phase"),
 }
 
 

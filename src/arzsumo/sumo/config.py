@@ -65,6 +65,13 @@ class SumoConfig:
     approach_length : float
         Length of the ``approach`` edge before x = 0 where mainline vehicles are inserted
         and may queue, m; 0 (default) inserts them at x = 0 on the shipped network.
+    fill_duration : float
+        Length of the fill phase from t = 0 of SUMO, s; 0 (default) has none.
+    fill_demand_h, fill_demand_a : float
+        Class flows requested at the mainline entrance during the fill phase, veh/s; the
+        demand above then holds from ``fill_duration`` to the end. A fill above the
+        bottleneck's discharge builds the congested section fast (issue 15); the hold
+        demand, a little above the discharge, keeps it without filling the approach.
     """
 
     step_length: float = 0.1
@@ -91,6 +98,9 @@ class SumoConfig:
     min_gap_lat: float = 0.15
     meter_curve: str = ""
     approach_length: float = 0.0
+    fill_duration: float = 0.0
+    fill_demand_h: float = 0.0
+    fill_demand_a: float = 0.0
 
     def __post_init__(self) -> None:
         def pos(name: str) -> None:
@@ -107,7 +117,7 @@ class SumoConfig:
                      "control_period", "meter_cycle", "min_gap_lat"):
             pos(name)
         for name in ("demand_h", "demand_a", "ramp_demand", "min_green", "min_red",
-                     "approach_length"):
+                     "approach_length", "fill_duration", "fill_demand_h", "fill_demand_a"):
             v = getattr(self, name)
             require(isinstance(v, int | float) and math.isfinite(v) and v >= 0, name, v,
                     "a finite number of at least 0", ScenarioError)

@@ -163,7 +163,8 @@ class MainlineSensor:
     def collect(self, t: float) -> CellData | None:
         """Sample the current step (time ``t``, s); return a finished window or None."""
         ids, pos, speed, av = self.sample()
-        self.last_speed, self.last_av = speed, av   # for the sensor's speed moments
+        # for the sensor's speed moments and AV probes
+        self.last_ids, self.last_pos, self.last_speed, self.last_av = ids, pos, speed, av
         self.grid.add(pos, speed, av)
         cur = set(ids)
         entered = cur - self._prev

@@ -7,6 +7,10 @@ One :class:`SumoSensor` per run. After each SUMO step :meth:`SumoSensor.observe`
 * the lane occupancy downstream of the merge (ALINEA's measurement), and
 * the ramp queue (halted vehicles on ``ramp_up`` plus ramp vehicles still waiting to be
   inserted), which the meter's spillback override needs every step,
+* with a :class:`~arzsumo.sumo.sensing.SensorLayout` holding them, the E1 loop stations
+  (:class:`~arzsumo.sumo.loops.LoopSensor`; the run must be opened with their positions,
+  ``open_simulation(..., loops=layout.loop_x(L))``) and, at a period's last step, the
+  reporting AVs (:class:`~arzsumo.sumo.probes.AvProbes`, from the sample above),
 * until the control window opens (:meth:`SumoSensor.start_window`), every vehicle's fuel
   and CO2 (:class:`~arzsumo.sumo.window.WarmupLedger`); after, the speed moments per class
   of the vehicles on ``main`` (:class:`SpeedMoments`, from the samples above),
@@ -23,9 +27,13 @@ from types import ModuleType
 
 import numpy as np
 
+from arzsumo.estimate.observations import LoopObservation, ProbeObservation
 from arzsumo.sumo.config import SumoConfig
+from arzsumo.sumo.loops import LoopSensor
 from arzsumo.sumo.measure import CellData, MainlineSensor
 from arzsumo.sumo.network import DOWN, RAMP_UP
+from arzsumo.sumo.probes import AvProbes
+from arzsumo.sumo.sensing import SensorLayout
 from arzsumo.sumo.window import WarmupLedger, WindowStart
 from arzsumo.units import ms_to_kmh
 
@@ -45,12 +53,16 @@ class PeriodMeasurement:
 
     ``cells`` are the Edie aggregates of the mainline; ``occupancy_out`` the mean lane
     occupancy downstream of the merge over the period (fraction, SUMO's definition);
-    ``ramp_queue`` the ramp queue at the period's last step, vehicles.
+    ``ramp_queue`` the ramp queue at the period's last step, vehicles; ``loops`` the loop
+    stations' record of the period and ``probes`` the AV probes at its last step (None
+    when the layout has none).
     """
 
     cells: CellData
     occupancy_out: float
     ramp_queue: int
+    loops: LoopObservation | None = None
+    probes: ProbeObservation | None = None
 
     @property
     def t(self) -> float:
@@ -104,13 +116,20 @@ class SumoSensor:
     window : bool
         Keep the warm-up ledger and the section's speed moments for a control window
         (:meth:`start_window`; the co-simulation does).
+    layout : SensorLayout, optional
+        Loop stations and AV probes read besides the cells (default: none).
     """
 
     def __init__(self, lib: ModuleType, length: float, cfg: SumoConfig,
-                 window: bool = False) -> None:
+                 window: bool = False, layout: SensorLayout | None = None) -> None:
         self.lib = lib
         self.mainline = MainlineSensor(lib, length, cfg.cell_length, cfg.step_length,
                                        cfg.steps_per_period)
+        layout = layout or SensorLayout()
+        self.loops = LoopSensor(lib, layout.loop_x(length), length, cfg.step_length,
+                                cfg.steps_per_period) if layout.loops else None
+        self.probes = AvProbes(layout.av_probe_share, layout.av_probe_seed) \
+            if layout.av_probes else None
         self.queue = 0
         self._occupancy_sum, self._steps = 0.0, 0
         self.ledger = WarmupLedger(lib, cfg.step_length) if window else None
@@ -132,6 +151,7 @@ class SumoSensor:
         self._occupancy_sum += self.lib.lane.getLastStepOccupancy(OCCUPANCY_LANE)
         self._steps += 1
         cells = self.mainline.collect(t)
+        loops = self.loops.observe(t) if self.loops is not None else None
         if self.window_open:
             self.speeds.add(self.mainline.last_speed, self.mainline.last_av)
         elif self.ledger is not None:
@@ -140,4 +160,7 @@ class SumoSensor:
             return None
         occupancy = self._occupancy_sum / self._steps
         self._occupancy_sum, self._steps = 0.0, 0
-        return PeriodMeasurement(cells, occupancy, self.queue)
+        m = self.mainline
+        probes = self.probes.observe(t, m.last_ids, m.last_pos, m.last_speed, m.last_av) \
+            if self.probes is not None else None
+        return PeriodMeasurement(cells, occupancy, self.queue, loops, probes)

@@ -312,12 +312,15 @@ def network_file(cfg: SumoConfig, net_dir: Path | None, workdir: Path) -> Path:
 def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
                     initial: Sequence[InitialVehicle] = (), net_dir: Path | None = None,
                     extra_args: Sequence[str] = (), e2_chain: bool = False,
+                    loops: Sequence[float] = (),
                     output_dir: Path | None = None) -> SumoSimulation:
     """A started simulation of the network of :func:`network_file` with the demand of
     ``cfg``.
 
     The route file (and, with ``e2_chain``, an E2 detector per measurement cell, see
-    :mod:`arzsumo.sumo.detectors`) goes to a temporary directory (under
+    :mod:`arzsumo.sumo.detectors`; with ``loops``, an E1 loop station at each of those
+    positions on ``main``, m in [0, L], see :mod:`arzsumo.sumo.loops`) goes to a
+    temporary directory (under
     :func:`~arzsumo.sumo.paths.scratch_dir`) removed when the run closes. With
     ``output_dir``, SUMO's statistics output is written there and kept.
     """
@@ -325,11 +328,18 @@ def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
     try:
         net = network_file(cfg, net_dir, workdir)
         route = write_route_file(workdir / "run.rou.xml", params, cfg, initial)
+        adds = []
         if e2_chain:
             from arzsumo.sumo.detectors import write_e2_chain
 
-            add = write_e2_chain(workdir / "e2.add.xml", params.length, cfg.cell_length)
-            extra_args = ("--additional-files", str(add), *extra_args)
+            adds.append(write_e2_chain(workdir / "e2.add.xml", params.length,
+                                       cfg.cell_length))
+        if len(loops):
+            from arzsumo.sumo.loops import write_loops
+
+            adds.append(write_loops(workdir / "e1.add.xml", loops, params.length))
+        if adds:
+            extra_args = ("--additional-files", ",".join(map(str, adds)), *extra_args)
     except BaseException:  # a bad demand or network, or Ctrl-C: leave no temporary files
         shutil.rmtree(workdir, ignore_errors=True)
         raise
