@@ -24,7 +24,7 @@ from arzsumo.identify import run_replay
 from arzsumo.model.fd import equilibrium_speeds
 from arzsumo.scenario import load_scenario
 
-DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "default.toml"
+DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "legacy_default.toml"
 #: bit-identical in practice (same functions, same order of operations); the only
 #: rounding that may differ is q* + (outflow - q*) with another q*, hence a tolerance
 TOLERANCE = 1e-9
@@ -32,8 +32,8 @@ TOLERANCE = 1e-9
 
 @pytest.fixture(scope="module")
 def run():
-    """60 s of open loop after the scenario's warm-up (seed 5: no re-sync on the default
-    scenario of issue 15; the test compares up to the first re-sync if there is one)."""
+    """60 s of open loop after the scenario's warm-up (seed 5: no re-sync on legacy_default,
+    the default before issue 15; the test compares up to the first re-sync if any)."""
     sc = load_scenario(DEFAULT)
     settings = replace(sc.run, controller="open")
     return run_cosimulation(sc, settings, sc.sumo.with_(horizon=60.0, seed=5), PAPER_DESIGN)

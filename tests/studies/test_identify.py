@@ -12,7 +12,7 @@ from arzsumo.cli import main
 from arzsumo.scenario import load_scenario
 
 ROOT = Path(__file__).resolve().parents[2]
-DEFAULT = ROOT / "scenarios" / "default.toml"
+DEFAULT = ROOT / "scenarios" / "legacy_default.toml"
 #: 2 training + 1 validation seed, 60 s of open loop after 60 s of warm-up (the road is
 #: full by then), the two relaxation times, 3 least-squares steps
 ARGS = ["identify", str(DEFAULT), "--train-seeds", "1,2", "--validate-seeds", "3",
@@ -48,7 +48,7 @@ def test_writes_the_files_and_a_scenario_that_loads_with_the_identified_values(r
     runs = doc["runs"]
     means = [runs[r]["mean_rho_h"] for r in ("seed1", "seed2")]
     assert eq["rho_h"] == pytest.approx(sum(means) / 2, rel=1e-12)
-    assert sc.sumo == base.sumo and sc.name == "default_identified"
+    assert sc.sumo == base.sumo and sc.name == "legacy_default_identified"
 
 
 @pytest.mark.sumo
@@ -82,7 +82,7 @@ def test_the_fit_does_not_increase_the_training_error_and_reports_both_sets(resu
 def test_the_identified_scenario_is_valid_for_run(result, capsys):
     out, _ = result
     assert main(["run", str(out / "identified.toml"), "--dry-run"]) == 0
-    assert "default_identified" in capsys.readouterr().out
+    assert "legacy_default_identified" in capsys.readouterr().out
 
 
 def _refused(args: list[str], capsys: pytest.CaptureFixture[str]) -> str:
