@@ -17,6 +17,7 @@ from arzsumo import __version__
 from arzsumo.cli import main
 from arzsumo.schema import (
     CELLS,
+    IDENTIFY_SUMMARY,
     PERIODS,
     RUN_SUMMARY,
     SWEEP_FIXED,
@@ -141,7 +142,7 @@ def test_docs_list_every_column_with_the_schema_units(name, columns):
     assert block.group(1) == markdown(columns)
 
 
-@pytest.mark.parametrize("table", [RUN_SUMMARY, TWIN_SUMMARY])
+@pytest.mark.parametrize("table", [RUN_SUMMARY, TWIN_SUMMARY, IDENTIFY_SUMMARY])
 def test_docs_give_every_summary_key(table):
     text = DOC.read_text(encoding="utf-8")
     for pattern, unit in table.items():

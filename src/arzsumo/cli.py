@@ -22,6 +22,7 @@ from arzsumo import (
     cli_bridge,
     cli_control,
     cli_evaluate,
+    cli_identify,
     cli_list,
     cli_sumo,
     cli_sweep,
@@ -134,6 +135,7 @@ def build_parser() -> argparse.ArgumentParser:
     cli_bridge.register(sub)
     cli_sweep.register(sub)
     cli_evaluate.register(sub)
+    cli_identify.register(sub)
     cli_list.register(sub)
     return parser
 

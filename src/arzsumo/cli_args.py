@@ -53,6 +53,8 @@ non_negative_float = _checked("non_negative_float", float,
                               "A finite number >= 0 (lengths that may be absent).")
 positive_int = _checked("positive_int", int, lambda v: v >= 1, "an integer >= 1",
                         "An integer >= 1 (workers, jobs).")
+non_negative_int = _checked("non_negative_int", int, lambda v: v >= 0, "an integer >= 0",
+                            "An integer >= 0 (counts that may be zero).")
 seed_int = _checked("seed_int", int, lambda v: 0 <= v < SEED_LIMIT, "an integer in [0, 2^31)",
                     "A random seed: an integer in [0, 2^31) (SUMO's range).")
 cells_int = _checked("cells_int", int, lambda v: v >= 4, "an integer >= 4",

@@ -175,6 +175,32 @@ TWIN_SUMMARY: dict[str, str] = {
     "numerics.wall_time_s": "s", "numerics.speed_up": "1", "conservation.*": "veh",
 }
 
+#: units of the keys of ``arzsumo identify``'s identification.json (first match wins)
+IDENTIFY_SUMMARY: dict[str, str] = {
+    "kind": TEXT, "version": TEXT, "scenario": TEXT, "source": TEXT, "units": TEXT,
+    "units_by_key": TEXT, "settings.train_seeds": TEXT, "settings.validate_seeds": TEXT,
+    "settings.points": TEXT, "settings.which": TEXT, "settings.replay_scheme": TEXT,
+    "settings.horizon_s": "s", "settings.warmup_s": "s", "settings.max_nfev": "count",
+    "settings.bootstrap": "count", "settings.workers": "count",
+    "settings.replay_cells": "count", "settings.ao_limit": "1", "settings.penalty": "1",
+    "parameters.*.at_bound": TEXT, "parameters.v_free_*.*": "m/s",
+    "parameters.ao_max_*.*": "1", "parameters.gamma_*.*": "1", "parameters.tau_*.*": "s",
+    "parameters.spacing_*.*": "m", "correlation.*": "1",
+    "fit.nfev": "count", "fit.evaluations": "count", "fit.failures": "count",
+    "fit.cost": "1", "fit.residuals": "count", "fit.success": TEXT, "fit.message": TEXT,
+    "equilibrium.rho_*": "veh/m", "equilibrium.v_*": "m/s", "equilibrium.ao": "1",
+    "equilibrium.lambda_4": "m/s", "equilibrium.regime": TEXT,
+    "equilibrium.admissible": TEXT, "rmse.*.total": "1",
+    "rmse.*.rho_*.absolute": "veh/m", "rmse.*.v_*.absolute": "m/s",
+    "rmse.*.relative": "1", "rmse.*.penalised": "1", "rmse.*.samples": "count",
+    "replay_failures.*.stopped_s": "s", "replay_failures.*.periods_not_predicted": "count",
+    "replay_failures.*.reason": TEXT, "beyond_ao_max.*": "count",
+    "runs.*.role": TEXT, "runs.*.seed": TEXT, "runs.*.point": TEXT,
+    "runs.*.wall_time_s": "s", "runs.*.bridge_resyncs": "count",
+    "runs.*.inserted_fraction_main": "1", "runs.*.mean_rho_*": "veh/m",
+    "wall_time.*": "s", "resolved_scenario.*": TEXT,
+}
+
 #: scenario-file key suffixes and their units (scenario files name their units)
 _SUFFIXES = (("_veh_h_per_pct", "veh/h per %"), ("_veh_km", "veh/km"), ("_veh_h", "veh/h"),
              ("_kmh", "km/h"), ("_veh", "veh"), ("_rad", "rad"), ("_m", "m"), ("_s", "s"))

@@ -63,6 +63,7 @@ from arzsumo.progress import Progress
 from arzsumo.scenario import Scenario
 from arzsumo.scenario.run import RunSettings
 from arzsumo.sumo.config import SumoConfig
+from arzsumo.sumo.measure import CellData
 from arzsumo.sumo.meter import DEFAULT_CURVE, GreenShareCurve, RampMeter
 from arzsumo.sumo.network_measures import network_options
 from arzsumo.sumo.paths import scratch_dir
@@ -96,7 +97,9 @@ class CoSimResult:
 
     ``t[k]`` is the end of period k and ``micro``/``replay``/``reference`` (periods, 4,
     cells) the fields then; ``periods`` holds the :class:`PeriodRecord` columns, whose
-    ``t`` is the check that started period k.
+    ``t`` is the check that started period k. ``start`` (4, cells) is the micro state at
+    t = 0 (the last warm-up period, from which the twins start), as ``micro``:
+    (rho_h, v_h, rho_a, v_a), NaN speeds in empty cells.
     """
 
     scenario: Scenario
@@ -125,6 +128,13 @@ class CoSimResult:
     #: per-vehicle speed moments on the section over the control window, per class
     #: (``speed_mean_kmh``, ``speed_sd_kmh``, ``speed_samples``)
     section_speed: dict[str, dict[str, float]] = field(default_factory=dict)
+    #: micro state at the start of control (4, cells), as ``micro``
+    start: np.ndarray | None = None
+
+
+def micro_fields(c: CellData) -> np.ndarray:
+    """Edie cells as (rho_h, v_h, rho_a, v_a) rows (4, cells), SI; NaN speed where empty."""
+    return np.vstack([c.rho_h, c.v_h, c.rho_a, c.v_a])
 
 
 class SumoPlant:
@@ -211,6 +221,7 @@ class Trace:
     """The control window as it happened: records and fields per period."""
 
     x: np.ndarray
+    start: np.ndarray
     records: list[PeriodRecord] = field(default_factory=list)
     t: list[float] = field(default_factory=list)
     micro: list[np.ndarray] = field(default_factory=list)
@@ -265,7 +276,7 @@ class ClosedLoop:
 
     def run(self, start: PeriodMeasurement, horizon: float, bar: Progress) -> Trace:
         """Control from the measurement ``start`` (t = 0) until ``horizon`` seconds."""
-        t0, trace = start.t, Trace(start.cells.x)
+        t0, trace = start.t, Trace(start.cells.x, micro_fields(start.cells))
         state = self.estimator.estimate(start, 0.0)
         while True:
             final = state.t >= horizon - 1e-9
@@ -280,7 +291,7 @@ class ClosedLoop:
             c = m.cells
             trace.records.append(self.record(decision, m))
             trace.t.append(t)
-            trace.micro.append(np.vstack([c.rho_h, c.v_h, c.rho_a, c.v_a]))
+            trace.micro.append(micro_fields(c))
             trace.replay.append(self.twins.replay.sample(trace.x))
             trace.reference.append(self.twins.reference.sample(trace.x))
             state = self.estimator.estimate(m, t)
@@ -351,7 +362,7 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
                        c.ref_ctrl.log, meter_summary, sim.report, loop.twins.status(),
                        placement, time.perf_counter() - wall0,
                        {**loop.plant.timings, **loop.timings}, c.warmup_meter, network,
-                       loop.plant.sensor.speeds.summary())
+                       loop.plant.sensor.speeds.summary(), trace.start)
 
 
 def control(sim: SumoSimulation, scenario: Scenario, settings: RunSettings, cfg: SumoConfig,

@@ -18,18 +18,17 @@ happens in is excluded from the fidelity measures (NaN fields).
 from __future__ import annotations
 
 import logging
-import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from arzsumo.bridge.estimator import fill_speeds
+from arzsumo.bridge.boundary_data import measured_state, smooth_step
 from arzsumo.control.base import Controller
+from arzsumo.identify.replay import admissible, on_grid
 from arzsumo.model.characteristic import Linearization
 from arzsumo.model.equilibrium import Equilibrium
-from arzsumo.model.fd import area_occupancy
 from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.measure import CellData
 from arzsumo.twin.boundary import Inlet
@@ -38,28 +37,31 @@ from arzsumo.twin.solver import SolverOptions, TwinStepper, TwinStoppedError
 log = logging.getLogger(__name__)
 
 
+#: the twins' densities are scaled down to AO <= TWIN_AO_LIMIT AO_max where SUMO holds more
+#: than the model can (the start state, a re-synchronisation and the inlet state)
+TWIN_AO_LIMIT = 0.9
+
+
 def to_twin_grid(params: ModelParameters, data: CellData, x_twin: np.ndarray,
-                 ao_limit: float = 0.9) -> tuple[np.ndarray, float]:
+                 ao_limit: float = TWIN_AO_LIMIT) -> tuple[np.ndarray, float]:
     """Micro cell data interpolated to the twin's cells, made admissible for the model.
 
-    Densities are scaled down where the calibrated model could not hold them (AO above
-    ``ao_limit`` of its maximum); returns the fields (4, n) and the vehicles removed (veh).
+    The measured state (:func:`~arzsumo.bridge.boundary_data.measured_state`) is
+    interpolated linearly to ``x_twin`` and its densities are scaled down where the model
+    could not hold them (AO above ``ao_limit`` of its maximum), as the identification's
+    replay twin starts (:func:`arzsumo.identify.replay.run_replay`); returns the fields
+    (4, n) and the vehicles removed (veh).
     """
-    v_h, v_a = fill_speeds(params, data.rho_h, data.v_h, data.rho_a, data.v_a)
-    rho_h = np.maximum(np.interp(x_twin, data.x, data.rho_h), 1e-4)
-    rho_a = np.maximum(np.interp(x_twin, data.x, data.rho_a), 1e-4)
-    ao = area_occupancy(params, rho_h, rho_a)
-    scale = np.minimum(1.0, ao_limit * params.ao_max / ao)
+    measured = on_grid(measured_state(params, data.rho_h, data.v_h, data.rho_a, data.v_a),
+                       data.x, x_twin)
+    fields = admissible(params, measured, ao_limit)
     dx = x_twin[1] - x_twin[0]
-    removed = float(np.sum((rho_h + rho_a) * (1 - scale)) * dx)
-    rho_h, rho_a = rho_h * scale, rho_a * scale
-    fields = np.vstack([rho_h, np.interp(x_twin, data.x, v_h), rho_a,
-                        np.interp(x_twin, data.x, v_a)])
+    removed = float(np.sum(measured[[0, 2]] - fields[[0, 2]]) * dx)
     return fields, removed
 
 
 class _InletState:
-    """Mutable holder of the smoothed inlet state (rho_h, v_h, rho_a, v_a), SI."""
+    """Mutable holder of the inlet state (rho_h, v_h, rho_a, v_a) the ghost cell holds, SI."""
 
     def __init__(self, values: np.ndarray) -> None:
         self.values = np.array(values, float)
@@ -83,27 +85,36 @@ class _GhostInlet(Inlet):
 class MeasuredInlet:
     """Exponentially smoothed inlet state measured in SUMO's first cell, for the twins.
 
-    The densities and speeds of the first micro cell (and, where a class is absent, its
-    equilibrium speed) are smoothed with time constant ``tau`` (s).
+    The measured first cell (:func:`~arzsumo.bridge.boundary_data.measured_state`) is
+    smoothed with time constant ``tau`` (s) (:func:`~arzsumo.bridge.boundary_data.smooth_step`,
+    as :func:`~arzsumo.bridge.boundary_data.inlet_series` does for a whole run); the
+    ghost cell holds it with densities scaled to AO <= ``ao_limit`` AO_max, as the
+    identification's replay twin holds its inlet data.
     """
 
-    def __init__(self, eq: Equilibrium, lin: Linearization, tau: float) -> None:
-        self.params, self.tau = eq.params, tau
-        self.state = _InletState(np.array([eq.rho_h, eq.v_h, eq.rho_a, eq.v_a]))
+    def __init__(self, eq: Equilibrium, lin: Linearization, tau: float,
+                 ao_limit: float = TWIN_AO_LIMIT) -> None:
+        self.params, self.tau, self.ao_limit = eq.params, tau, ao_limit
+        self.smoothed = np.array([eq.rho_h, eq.v_h, eq.rho_a, eq.v_a])
+        self.state = _InletState(self.smoothed)
         self.inlet = _GhostInlet(eq.rho_h, eq.rho_a, eq.q, lin.T[3], self.state)
+
+    def _first(self, data: CellData) -> np.ndarray:
+        return measured_state(self.params, data.rho_h[:1], data.v_h[:1], data.rho_a[:1],
+                              data.v_a[:1])[:, 0]
+
+    def _hold(self) -> None:
+        self.state.values = admissible(self.params, self.smoothed[:, None], self.ao_limit)[:, 0]
 
     def update(self, data: CellData, dt: float) -> None:
         """Smooth in the first cell of ``data`` over ``dt`` seconds."""
-        a = 1.0 - math.exp(-dt / self.tau)
-        v_h, v_a = fill_speeds(self.params, data.rho_h[:1], data.v_h[:1], data.rho_a[:1],
-                               data.v_a[:1])
-        new = np.array([max(data.rho_h[0], 1e-4), v_h[0], max(data.rho_a[0], 1e-4), v_a[0]])
-        self.state.values = self.state.values + a * (new - self.state.values)
+        self.smoothed = smooth_step(self.smoothed, self._first(data), dt, self.tau)
+        self._hold()
 
     def start(self, data: CellData) -> None:
         """Start from the measured first cell (no smoothing history)."""
-        self.state.values = self.state.values * 0
-        self.update(data, 1e9)
+        self.smoothed = self._first(data)
+        self._hold()
 
 
 @dataclass
@@ -187,8 +198,8 @@ class TwinPair:
         """Advance both twins to ``t`` (s) after a period of ``period`` s that SUMO
         measured as ``data``; the reference twin under ``u_reference`` (veh/s)."""
         self.inlet.update(data, period)
-        self.q_out += (1.0 - math.exp(-period / self.smoothing)) * (
-            data.outflow_h + data.outflow_a - self.q_out)
+        self.q_out = smooth_step(self.q_out, data.outflow_h + data.outflow_a, period,
+                                 self.smoothing)
 
         def resync() -> np.ndarray:
             return to_twin_grid(self.params, data, self.x)[0]

@@ -46,14 +46,17 @@ def _array(name: str, value: ArrayLike, shape: tuple[int, ...], nan_ok: bool = F
     return arr
 
 
-def _positive_densities(name: str, arr: np.ndarray, axis: int) -> None:
-    """Densities (rows 0 and 2 along ``axis``) must be > 0 where given."""
+def _positive_densities(name: str, arr: np.ndarray, axis: int, strict: bool = True) -> None:
+    """Densities (rows 0 and 2 along ``axis``) must be > 0 where given (>= 0 unless
+    ``strict``: an observed empty cell has density 0)."""
     rho = np.take(arr, [0, 2], axis=axis)
-    bad = rho <= 0.0                       # NaN compares False: unobserved is fine
+    bad = rho <= 0.0 if strict else rho < 0.0   # NaN compares False: unobserved is fine
     if bad.any():
         idx = tuple(int(i) for i in np.argwhere(bad)[0])
+        allowed = ("densities > 0 (the twin divides by them)" if strict else
+                   "densities >= 0")
         raise IdentifyError(f"{name} has density {rho[idx]} veh/m at index {list(idx)}; "
-                            "allowed: densities > 0 (the twin divides by them)")
+                            f"allowed: {allowed}")
 
 
 @dataclass(frozen=True)
@@ -68,7 +71,7 @@ class ReplayData:
         Observation positions (cell centres), m, strictly increasing, >= 0.
     fields : ndarray (T, 4, N)
         Observed (rho_h veh/m, v_h m/s, rho_a veh/m, v_a m/s) at (t[k], x); NaN where
-        unobserved (e.g. the speed of an empty cell).
+        unobserved (e.g. the speed of an empty cell); densities >= 0.
     initial : ndarray (4, N)
         State at t = 0 on ``x``, complete (no NaN), densities > 0.
     inlet : ndarray (T, 4)
@@ -111,7 +114,7 @@ class ReplayData:
         outflow = _array(f"{self.name}: outflow", self.outflow, (n_t,))
         for label, arr, axis in (("fields", fields_, 1), ("initial", initial, 0),
                                  ("inlet", inlet, 1)):
-            _positive_densities(f"{self.name}: {label}", arr, axis)
+            _positive_densities(f"{self.name}: {label}", arr, axis, strict=label != "fields")
         if outflow.min() < 0.0:
             raise IdentifyError(f"{self.name}: outflow = {outflow.min()} veh/s is not "
                                 "allowed: a flow >= 0 veh/s")

@@ -14,7 +14,9 @@ finite-difference step mean the same for every parameter.
 
 from __future__ import annotations
 
+import logging
 import math
+import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
@@ -37,6 +39,10 @@ DEFAULT_WHICH = ("v_free_h", "v_free_a", "ao_max_h", "ao_max_a", "gamma_h", "gam
                  "tau_h", "tau_a")
 #: Residual of a value the replay could not predict (the twin stopped), in scale units.
 DEFAULT_PENALTY = 10.0
+#: seconds between progress lines of a long fit (logged at INFO)
+PROGRESS_EVERY = 60.0
+
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -141,7 +147,8 @@ class Objective:
     """Residual vector over all runs, for :func:`scipy.optimize.least_squares`.
 
     Calling it with z runs the replay of every dataset; it counts evaluations and the
-    replays that stopped (``failures``).
+    replays that stopped (``failures``), keeps the smallest cost seen, and logs progress
+    at most every :data:`PROGRESS_EVERY` seconds.
     """
 
     def __init__(self, space: ParameterSpace, datasets: Sequence[ReplayData],
@@ -150,6 +157,8 @@ class Objective:
         self.sqrt_w = np.sqrt(weights)[None, :, None]
         self.options, self.penalty = options, penalty
         self.evaluations = self.failures = 0
+        self.best = math.inf
+        self._started = self._logged = time.perf_counter()
 
     def residuals_at(self, params: ModelParameters) -> np.ndarray:
         """Stacked weighted relative residuals of the observed values, for ``params``."""
@@ -160,7 +169,14 @@ class Objective:
             err = relative_errors(data, run.fields, self.penalty) * self.sqrt_w
             parts.append(err[data.mask])
         self.evaluations += 1
-        return np.concatenate(parts)
+        r = np.concatenate(parts)
+        self.best = min(self.best, 0.5 * float(r @ r))
+        now = time.perf_counter()
+        if now - self._logged >= PROGRESS_EVERY:
+            self._logged = now
+            log.info("fit: %d evaluations in %.0f s, %d replays stopped, smallest cost %.6g",
+                     self.evaluations, now - self._started, self.failures, self.best)
+        return r
 
     def __call__(self, z: np.ndarray) -> np.ndarray:
         return self.residuals_at(self.space.params(self.space.to_p(z)))

@@ -161,7 +161,7 @@ def admissible(params: ModelParameters, z: np.ndarray, ao_limit: float) -> np.nd
     return out
 
 
-def _on_grid(values: np.ndarray, x_from: np.ndarray, x_to: np.ndarray) -> np.ndarray:
+def on_grid(values: np.ndarray, x_from: np.ndarray, x_to: np.ndarray) -> np.ndarray:
     """Rows of ``values`` (4, len(x_from)) linearly interpolated to ``x_to`` (held at ends)."""
     if x_from.shape == x_to.shape and np.array_equal(x_from, x_to):
         return values
@@ -170,7 +170,7 @@ def _on_grid(values: np.ndarray, x_from: np.ndarray, x_to: np.ndarray) -> np.nda
 
 def _stepper(params: ModelParameters, data: ReplayData, options: ReplayOptions,
              x_twin: np.ndarray) -> tuple[TwinStepper, HeldInlet]:
-    init = admissible(params, _on_grid(data.initial, data.x, x_twin), options.ao_limit)
+    init = admissible(params, on_grid(data.initial, data.x, x_twin), options.ao_limit)
     eq = Equilibrium(params, float(init[0].mean()), float(init[2].mean()))
     inlet = HeldInlet(eq.rho_h, eq.rho_a, eq.q, np.zeros(4))
     with _quiet_regime():
@@ -212,7 +212,7 @@ def run_replay(params: ModelParameters, data: ReplayData,
         except TwinStoppedError as exc:
             return ReplayRun(out, exc.t, str(exc), stepper.steps, stepper.outflow,
                              stepper.outlet_limited_time)
-        out[k] = _on_grid(stepper.primitive(), x_twin, data.x)
+        out[k] = on_grid(stepper.primitive(), x_twin, data.x)
     return ReplayRun(out, None, "", stepper.steps, stepper.outflow, stepper.outlet_limited_time)
 
 

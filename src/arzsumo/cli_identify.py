@@ -1,0 +1,106 @@
+"""``arzsumo identify SCENARIO --train-seeds ... --validate-seeds ...``: the macroscopic
+model identified from open-loop SUMO runs (issue 15, point 2).
+
+Checks the seeds, the ``--vary`` points, the ``--which`` names and the output directory
+before any run, then calls :func:`arzsumo.studies.identify.run_identification` and writes
+the results (:func:`arzsumo.studies.identify_report.write_study`). Exit codes: 0 done,
+2 a user error (one line).
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+from pathlib import Path
+
+from arzsumo.cli_args import non_negative_int, positive_float, positive_int, seed_int
+
+log = logging.getLogger("arzsumo")
+
+
+def seed_list(text: str) -> list[int]:
+    """Comma-separated seeds; ``A-B`` for a range (inclusive)."""
+    seeds: list[int] = []
+    for part in (p.strip() for p in text.split(",")):
+        first, sep, last = part.partition("-")
+        try:
+            lo = seed_int(first)
+            hi = seed_int(last) if sep else lo
+        except argparse.ArgumentTypeError:
+            raise argparse.ArgumentTypeError(f"{text} is not allowed: seeds in [0, 2^31), "
+                                             "comma-separated, A-B for a range") from None
+        seeds += list(range(lo, hi + 1))
+    return seeds
+
+
+def cmd_identify(args: argparse.Namespace) -> int:
+    from arzsumo.identify import FitSettings
+    from arzsumo.outdir import OutputDir
+    from arzsumo.scenario import load_scenario
+    from arzsumo.studies.identify import make_setup, run_identification
+    from arzsumo.studies.identify_report import write_study
+
+    path = Path(args.scenario)
+    sc = load_scenario(path)
+    setup = make_setup(sc, args.train_seeds, args.validate_seeds, vary=args.vary or (),
+                       which=args.which, horizon=args.horizon, warmup=args.warmup,
+                       fit=FitSettings(max_nfev=args.max_nfev, bootstrap=args.bootstrap),
+                       workers=args.workers)
+    out = Path(args.out) if args.out else Path("results") / "identify" / path.stem
+    runs = len(setup.points) * (len(setup.train_seeds) + len(setup.validate_seeds))
+    log.info("identify %s: %d SUMO runs on %d workers, fitting %s", sc.name, runs,
+             setup.workers, ", ".join(setup.which))
+    with OutputDir(out, "identify", overwrite=args.overwrite) as target:
+        study = run_identification(setup)
+        write_study(target, study)
+    fit = study.fit
+    print(f"identify {sc.name}: {runs} runs, SUMO {study.wall['sumo']:.1f} s, fit "
+          f"{study.wall['fit']:.1f} s ({fit.nfev} steps, {fit.evaluations} evaluations)")
+    for i, name in enumerate(fit.which):
+        print(f"  {name:<10} = {fit.values[i]:.4g} +- {fit.sigma[i]:.2g} (SI)")
+    for role, score in (("start, training", study.start), ("training", study.training),
+                        ("validation", study.validation)):
+        rel = ", ".join(f"{v} {e['relative']:.1%}" for v, e in score.pooled.items())
+        print(f"  relative RMSE, {role}: {rel}; objective {score.total:.3g}")
+    print(f"results: {out}")
+    return 0
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add ``identify`` to the top-level parser."""
+    p = sub.add_parser("identify", help="the macroscopic model identified from open-loop "
+                                        "SUMO runs (fit, uncertainties, validation)",
+                       description="Run the open loop in SUMO for training and held-out "
+                                   "validation seeds (at several operating points with "
+                                   "--vary), fit the model's parameters by minimising the "
+                                   "replay twin's error on the training runs (bounded "
+                                   "least squares, Jacobian and bootstrap uncertainties), "
+                                   "validate on both sets, and write a ready-to-run "
+                                   "scenario with the identified model.")
+    p.add_argument("scenario", metavar="SCENARIO.toml", help="scenario file")
+    p.add_argument("--train-seeds", type=seed_list, required=True, metavar="SEEDS",
+                   help="training seeds, e.g. 1,2,3 or 1-3")
+    p.add_argument("--validate-seeds", type=seed_list, required=True, metavar="SEEDS",
+                   help="held-out validation seeds (none of the training seeds)")
+    p.add_argument("--vary", action="append", metavar="TABLE.KEY=V1,V2",
+                   help="operating points: a scenario key and its values (file units), "
+                        "e.g. sumo.green_share=0.4,0.5,0.6; repeat for a product")
+    p.add_argument("--which", metavar="NAMES",
+                   help="parameters to fit, comma-separated (default: v_free_h, v_free_a, "
+                        "ao_max_h, ao_max_a, gamma_h, gamma_a, tau_h, tau_a; also "
+                        "spacing_h, spacing_a)")
+    p.add_argument("--bootstrap", type=non_negative_int, default=0, metavar="N",
+                   help="bootstrap refits over training runs drawn with replacement")
+    p.add_argument("--max-nfev", type=positive_int, default=40, metavar="N",
+                   help="largest number of least-squares steps (scipy's max_nfev)")
+    p.add_argument("--workers", type=positive_int,
+                   help="SUMO runs in parallel (default: one per core)")
+    p.add_argument("--horizon", type=positive_float,
+                   help="control horizon of each run, s (default: [sumo] horizon_s)")
+    p.add_argument("--warmup", type=positive_float,
+                   help="warm-up of each run, s (default: [run] warmup_s)")
+    p.add_argument("--out", metavar="DIR",
+                   help="output directory (default results/identify/<scenario file name>)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace a previous identification in --out")
+    p.set_defaults(func=cmd_identify)

@@ -1,0 +1,59 @@
+"""Write an identification (``arzsumo identify --out DIR``) atomically as one directory:
+``identified.toml``, ``identification.json``, ``fields.png`` and ``scatter.png``.
+
+Their content is made by :mod:`arzsumo.studies.identify_report`; here the texts are
+written and the figures (:mod:`arzsumo.plots.identify`) drawn from arrays.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from arzsumo.outdir import OutputDir, atomic_dir, target_of
+from arzsumo.plots import save_png
+from arzsumo.plots.identify import fields_figure, scatter_figure
+
+#: the marker kind of an identification's directory
+KIND = "identify"
+
+
+@dataclass(frozen=True)
+class FieldsPanel:
+    """``fields.png``: times t (s), cell centres x (m), observed and predicted fields
+    (T, 4, N) in SI, and a title."""
+
+    t: np.ndarray
+    x: np.ndarray
+    observed: np.ndarray
+    predicted: np.ndarray
+    title: str
+
+
+@dataclass(frozen=True)
+class ScatterPanel:
+    """``scatter.png``: paired observed and predicted values per variable (SI), the
+    relative RMSE per variable, and a title."""
+
+    observed: tuple[np.ndarray, ...]
+    predicted: tuple[np.ndarray, ...]
+    rmse: tuple[float, ...]
+    title: str
+
+
+def write_identification(out: str | os.PathLike[str] | OutputDir, toml_text: str,
+                         json_text: str, fields: FieldsPanel, scatter: ScatterPanel, *,
+                         overwrite: bool = False) -> Path:
+    """Write the four files into ``out`` (a path, or an :class:`~arzsumo.outdir.OutputDir`
+    of kind ``identify`` claimed before the runs) and put the directory in place."""
+    with atomic_dir(out, KIND, overwrite=overwrite) as tmp:
+        (tmp / "identified.toml").write_text(toml_text, encoding="utf-8")
+        (tmp / "identification.json").write_text(json_text, encoding="utf-8")
+        save_png(fields_figure(fields.t, fields.x, fields.observed, fields.predicted,
+                               fields.title), tmp / "fields.png", dpi=90)
+        save_png(scatter_figure(scatter.observed, scatter.predicted, scatter.rmse,
+                                scatter.title), tmp / "scatter.png", dpi=90)
+    return target_of(out)

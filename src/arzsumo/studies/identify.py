@@ -1,0 +1,372 @@
+"""Identify the macroscopic model from open-loop SUMO runs (``arzsumo identify``, issue 15).
+
+1. Plan: every operating point (``--vary table.key=v1,v2``: the scenario with that key
+   changed, via :meth:`~arzsumo.scenario.Scenario.with_`; the product of several) times
+   every training and validation seed is one SUMO run of the open loop (controller
+   ``open``, the scenario's warm-up and control horizon unless overridden).
+2. Simulate: the runs go through the sweep engine (:func:`arzsumo.sweep.driver.map_runs`,
+   one SUMO per process); each returns its :class:`~arzsumo.identify.ReplayData`
+   (:func:`~arzsumo.bridge.replay_data.replay_data_of`).
+3. Fit: :func:`arzsumo.identify.identify` on the training runs, starting from the
+   scenario's ``[model]``, with the bridge's twin numerics
+   (:func:`~arzsumo.bridge.replay_data.replay_options_of`) and
+   :data:`~arzsumo.identify.DEFAULT_BOUNDS`.
+4. Validate: :func:`arzsumo.identify.validate` and :func:`replay_metrics` on the
+   training runs and, separately, on the held-out validation runs, at the identified
+   parameters (and on the training runs at the start parameters, for comparison).
+
+Nothing is written here: :mod:`arzsumo.outputs.identify` writes the results.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from arzsumo.bridge.replay_data import replay_data_of, replay_options_of
+from arzsumo.bridge.session import run_in_sumo
+from arzsumo.errors import ArzsumoError, ScenarioError
+from arzsumo.identify import (
+    DEFAULT_BOUNDS,
+    DEFAULT_WHICH,
+    VARIABLES,
+    FitSettings,
+    IdentificationResult,
+    ReplayData,
+    ReplayOptions,
+    ValidationReport,
+    identify,
+    run_replay,
+    validate,
+)
+from arzsumo.identify.objective import DEFAULT_PENALTY
+from arzsumo.model.equilibrium import Equilibrium
+from arzsumo.model.fd import area_occupancy
+from arzsumo.model.params import ModelParameters
+from arzsumo.scenario import Scenario, scenario_from_dict
+from arzsumo.sweep.driver import default_workers, map_runs
+
+ROLES = ("training", "validation")
+
+
+@dataclass(frozen=True)
+class Point:
+    """An operating point: scenario keys changed (``table.key`` -> value, file units)."""
+
+    changes: tuple[tuple[str, Any], ...] = ()
+
+    @property
+    def label(self) -> str:
+        """``table.key=value`` pairs, or ``scenario`` for the scenario as it is."""
+        return ", ".join(f"{k}={v}" for k, v in self.changes) or "scenario"
+
+
+@dataclass(frozen=True)
+class RunTask:
+    """One open-loop SUMO run: the scenario's tables at its point, seed and role."""
+
+    run_id: str
+    role: str
+    seed: int
+    point: Point
+    tables: dict[str, Any]
+    source: str
+
+
+@dataclass(frozen=True)
+class SumoRun:
+    """What one run returns: its identification data and how it went."""
+
+    task: RunTask
+    data: ReplayData
+    wall_time: float
+    resyncs: int
+    delivered: float
+
+
+@dataclass(frozen=True)
+class IdentifySetup:
+    """A checked identification: the scenario, the runs and the fit's settings.
+
+    ``base`` is the scenario as given; ``scenario`` the one the runs use (controller
+    ``open``, horizon and warm-up overridden where asked).
+    """
+
+    base: Scenario
+    scenario: Scenario
+    train_seeds: tuple[int, ...]
+    validate_seeds: tuple[int, ...]
+    points: tuple[Point, ...]
+    which: tuple[str, ...]
+    fit: FitSettings
+    workers: int
+
+    @property
+    def options(self) -> ReplayOptions:
+        """The replay twin's numerics: the bridge's (``[run]`` twin_cells, twin_scheme)."""
+        return replay_options_of(self.scenario.run)
+
+
+def _value(text: str) -> Any:
+    """A ``--vary`` value as TOML would read it: integer, number, boolean or string."""
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    return {"true": True, "false": False}.get(text, text)
+
+
+def parse_vary(specs: Sequence[str], sc: Scenario) -> tuple[Point, ...]:
+    """Operating points of ``--vary table.key=v1,v2`` options (their product), each
+    checked by applying it to ``sc``; one-line errors naming the option."""
+    axes = []
+    for spec in specs:
+        key, sep, values = spec.partition("=")
+        vals = [v.strip() for v in values.split(",") if v.strip()]
+        if not sep or "." not in key or not vals:
+            raise ScenarioError(f"--vary = {spec} is not allowed: table.key=v1,v2,... "
+                                "(a scenario key and its values in the file's units)")
+        key = key.strip()
+        if key in ("sumo.seed", "run.controller"):
+            raise ScenarioError(f"--vary = {spec} is not allowed: seeds come from "
+                                "--train-seeds/--validate-seeds and the controller is open")
+        axes.append([(key, _value(v)) for v in vals])
+    points = tuple(Point(tuple(combo)) for combo in itertools.product(*axes))
+    for point in points:
+        try:
+            sc.with_(dict(point.changes))
+        except ScenarioError as exc:
+            raise ScenarioError(f"--vary {point.label}: {exc}") from None
+    return points
+
+
+def parse_which(text: str | None) -> tuple[str, ...]:
+    """``--which`` names (comma-separated), checked against DEFAULT_BOUNDS."""
+    if text is None:
+        return DEFAULT_WHICH
+    names = tuple(n.strip() for n in text.split(",") if n.strip())
+    bad = [n for n in names if n not in DEFAULT_BOUNDS]
+    if not names or bad or len(set(names)) != len(names):
+        raise ScenarioError(f"--which = {text} is not allowed: distinct names from "
+                            f"{', '.join(DEFAULT_BOUNDS)}")
+    return names
+
+
+def check_seeds(train: Sequence[int], held_out: Sequence[int]) -> None:
+    """Distinct training seeds, distinct validation seeds, none in both."""
+    for flag, seeds in (("--train-seeds", train), ("--validate-seeds", held_out)):
+        if not seeds or len(set(seeds)) != len(seeds):
+            raise ScenarioError(f"{flag} = {','.join(map(str, seeds))} is not allowed: one "
+                                "or more distinct seeds")
+    both = sorted(set(train) & set(held_out))
+    if both:
+        raise ScenarioError(f"--validate-seeds = {','.join(map(str, held_out))} is not "
+                            f"allowed: seeds {both} are also training seeds; allowed: "
+                            "held-out seeds not in --train-seeds")
+
+
+def make_setup(sc: Scenario, train: Sequence[int], held_out: Sequence[int], *,
+               vary: Sequence[str] = (), which: str | None = None,
+               horizon: float | None = None, warmup: float | None = None,
+               fit: FitSettings | None = None, workers: int | None = None) -> IdentifySetup:
+    """Check everything before SUMO starts: seeds, points, parameter names and bounds."""
+    check_seeds(train, held_out)
+    changes: dict[str, Any] = {"run.controller": "open"}
+    if horizon is not None:
+        changes["sumo.horizon_s"] = horizon
+    if warmup is not None:
+        changes["run.warmup_s"] = warmup
+    base, sc = sc, sc.with_(changes)
+    names = parse_which(which)
+    for name in names:
+        low, high = DEFAULT_BOUNDS[name]
+        value = getattr(sc.params, name)
+        if not low <= value <= high:
+            raise ScenarioError(f"{sc.source}: [model] {name} = {value:g} (SI) is outside "
+                                f"the bounds [{low:g}, {high:g}] of the fit; allowed: a start "
+                                "value within them")
+    points = parse_vary(vary, sc) or (Point(),)
+    return IdentifySetup(base, sc, tuple(train), tuple(held_out), points, names,
+                         fit or FitSettings(), workers or default_workers())
+
+
+def plan(setup: IdentifySetup) -> list[RunTask]:
+    """Every (point, seed) run, training runs first."""
+    tasks = []
+    for role, seeds in zip(ROLES, (setup.train_seeds, setup.validate_seeds), strict=True):
+        for i, point in enumerate(setup.points):
+            sc = setup.scenario.with_(dict(point.changes))
+            for seed in seeds:
+                rid = f"seed{seed}" if len(setup.points) == 1 else f"p{i}-seed{seed}"
+                tasks.append(RunTask(rid, role, seed, point, dict(sc.tables), sc.source))
+    return tasks
+
+
+def simulate(task: RunTask) -> SumoRun:
+    """One open-loop SUMO run as identification data (the sweep engine's worker)."""
+    start = time.perf_counter()
+    session = run_in_sumo(scenario_from_dict(task.tables, task.source), seed=task.seed)
+    res = session.result
+    data = replay_data_of(res, name=task.run_id)
+    delivered = res.report.delivered_main if res.report is not None else math.nan
+    return SumoRun(task, data, time.perf_counter() - start,
+                   int(res.twin_status["replay"]["resyncs"]), float(delivered))
+
+
+@dataclass(frozen=True)
+class RunScore:
+    """The replay of one run under one parameter set, against the run.
+
+    ``rmse[var]`` holds ``absolute`` (SI, over the values the replay predicted),
+    ``relative`` (the same over the run's equilibrium value), ``penalised`` (relative,
+    values the replay could not predict counted with the fit's penalty: what the fit
+    minimises) and ``samples``. ``stopped`` is when the replay twin left the physical
+    domain (None if it completed), ``periods_not_predicted`` the periods from there on.
+    ``beyond_ao_max`` counts observed cells (period x cell) whose AO exceeds the model's
+    AO_max (``model``: the smaller of the classes', where the model cannot go) and each
+    class's (``h``, ``a``), out of ``observed``.
+    """
+
+    name: str
+    rmse: dict[str, dict[str, float]]
+    stopped: float | None
+    reason: str
+    periods_not_predicted: int
+    beyond_ao_max: dict[str, int]
+    predicted: np.ndarray
+    sums: np.ndarray          # (3, 4): squared absolute and relative errors, counts
+
+
+def _beyond(params: ModelParameters, data: ReplayData) -> dict[str, int]:
+    rho = data.fields[:, [0, 2]]
+    seen = np.isfinite(rho).all(axis=1)
+    ao = area_occupancy(params, np.where(seen, rho[:, 0], 0.0), np.where(seen, rho[:, 1], 0.0))
+    return {"model": int((ao[seen] > params.ao_max).sum()),
+            "h": int((ao[seen] > params.ao_max_h).sum()),
+            "a": int((ao[seen] > params.ao_max_a).sum()), "observed": int(seen.sum())}
+
+
+def score_run(params: ModelParameters, data: ReplayData, options: ReplayOptions,
+              penalised: np.ndarray) -> RunScore:
+    """:class:`RunScore` of ``data`` under ``params``; ``penalised`` (4,) from
+    :func:`arzsumo.identify.validate`."""
+    run = run_replay(params, data, options)
+    both = data.mask & np.isfinite(run.fields)
+    err = np.where(both, run.fields - np.where(data.mask, data.fields, 0.0), 0.0)
+    sums = np.vstack([(err ** 2).sum(axis=(0, 2)),
+                      ((err / data.scale[None, :, None]) ** 2).sum(axis=(0, 2)),
+                      both.sum(axis=(0, 2))])
+    rmse = {}
+    for j, var in enumerate(VARIABLES):
+        n = sums[2, j]
+        rmse[var] = {"absolute": math.sqrt(sums[0, j] / n) if n else math.nan,
+                     "relative": math.sqrt(sums[1, j] / n) if n else math.nan,
+                     "penalised": float(penalised[j]), "samples": int(n)}
+    lost = int(np.isnan(run.fields).all(axis=(1, 2)).sum())
+    return RunScore(data.name, rmse, run.stopped, run.reason, lost, _beyond(params, data),
+                    run.fields, sums)
+
+
+@dataclass(frozen=True)
+class SetScore:
+    """Scores of a set of runs (training or validation) under one parameter set.
+
+    ``pooled[var]``: ``absolute``, ``relative`` and ``penalised`` RMSE over all runs'
+    values; ``total``: the penalised relative RMSE over every variable and value (the
+    fit's objective as an RMSE: sqrt(2 cost / residuals)).
+    """
+
+    runs: tuple[RunScore, ...]
+    report: ValidationReport
+    pooled: dict[str, dict[str, float]]
+    total: float
+
+
+def score_set(params: ModelParameters, datasets: Sequence[ReplayData],
+              options: ReplayOptions) -> SetScore:
+    """Validate ``params`` on ``datasets`` (:func:`arzsumo.identify.validate`) and score
+    each run (:func:`score_run`)."""
+    report = validate(params, datasets, options, DEFAULT_PENALTY)
+    runs = tuple(score_run(params, d, options, report.rmse[i])
+                 for i, d in enumerate(datasets))
+    sums = sum(r.sums for r in runs)
+    observed = np.array([d.mask.sum(axis=(0, 2)) for d in datasets], float)
+    pooled = {}
+    for j, var in enumerate(VARIABLES):
+        n = sums[2, j]
+        pooled[var] = {"absolute": math.sqrt(sums[0, j] / n) if n else math.nan,
+                       "relative": math.sqrt(sums[1, j] / n) if n else math.nan,
+                       "penalised": float(report.pooled[j])}
+    total = math.sqrt(float((report.rmse ** 2 * observed).sum() / observed.sum()))
+    return SetScore(runs, report, pooled, total)
+
+
+@dataclass(frozen=True)
+class IdentifyStudy:
+    """Everything an identification produced (SI).
+
+    ``measured`` is the mean (rho_h, rho_a) of the training runs' cells and periods, veh/m;
+    ``equilibrium`` the identified model's equilibrium there (None where the identified
+    model cannot hold it: AO >= AO_max). ``wall`` holds wall times, s: ``sumo`` (the batch
+    of runs), ``sumo_runs`` (their sum), ``fit``, ``bootstrap``, ``validate``, ``total``.
+    """
+
+    setup: IdentifySetup
+    runs: tuple[SumoRun, ...]
+    fit: IdentificationResult
+    start: SetScore
+    training: SetScore
+    validation: SetScore
+    measured: tuple[float, float]
+    equilibrium: Equilibrium | None
+    wall: dict[str, float]
+
+    def data(self, role: str) -> list[ReplayData]:
+        """The ReplayData of the ``training`` or ``validation`` runs."""
+        return [r.data for r in self.runs if r.task.role == role]
+
+
+def measured_densities(datasets: Sequence[ReplayData]) -> tuple[float, float]:
+    """Mean (rho_h, rho_a) over the runs' observed cells and periods, veh/m."""
+    rho_h = np.concatenate([d.fields[:, 0].ravel() for d in datasets])
+    rho_a = np.concatenate([d.fields[:, 2].ravel() for d in datasets])
+    return float(np.nanmean(rho_h)), float(np.nanmean(rho_a))
+
+
+def _equilibrium(params: ModelParameters, rho: tuple[float, float]) -> Equilibrium | None:
+    try:
+        return Equilibrium(params, *rho)
+    except ArzsumoError:
+        return None
+
+
+def run_identification(setup: IdentifySetup) -> IdentifyStudy:
+    """Plan, simulate, fit and validate (module docstring)."""
+    t0 = time.perf_counter()
+    tasks = plan(setup)
+    here = setup.workers <= 1 or len(tasks) <= 1
+    runs = tuple(map_runs(simulate, tasks, workers=setup.workers, in_process=here))
+    t1 = time.perf_counter()
+    train = [r.data for r in runs if r.task.role == "training"]
+    held_out = [r.data for r in runs if r.task.role == "validation"]
+    opts, guess = setup.options, setup.scenario.params
+    start = score_set(guess, train, opts)
+    t2 = time.perf_counter()
+    fit = identify(train, guess, which=setup.which, options=opts, settings=setup.fit)
+    t3 = time.perf_counter()
+    training = score_set(fit.params, train, opts)
+    validation = score_set(fit.params, held_out, opts)
+    t4 = time.perf_counter()
+    rho = measured_densities(train)
+    wall = {"sumo": t1 - t0, "sumo_runs": float(sum(r.wall_time for r in runs)),
+            "fit": fit.wall_time, "bootstrap": t3 - t2 - fit.wall_time,
+            "validate": (t4 - t3) + (t2 - t1), "total": t4 - t0}
+    return IdentifyStudy(setup, runs, fit, start, training, validation, rho,
+                         _equilibrium(fit.params, rho), wall)
