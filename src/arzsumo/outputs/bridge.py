@@ -43,6 +43,7 @@ from arzsumo.bridge.estimator import fill_speeds
 from arzsumo.control.base import ControlLog
 from arzsumo.control.events import release_time
 from arzsumo.evaluation.fields import field_rmse
+from arzsumo.evaluation.stationarity import count_trend
 from arzsumo.io import json_safe
 from arzsumo.model.characteristic import linearize
 from arzsumo.outdir import OutputDir, atomic_dir, target_of
@@ -98,6 +99,17 @@ def rmse_blocks(res: CoSimResult) -> dict[str, Any]:
             "block_s": periods * res.sumo.control_period,
             "replay": rmse(res, res.replay, periods, cells),
             "reference": rmse(res, res.reference, periods, cells)}
+
+
+def section_trend(res: CoSimResult) -> dict[str, Any] | None:
+    """Trend of the section's vehicle count over the control window
+    (:func:`arzsumo.evaluation.stationarity.count_trend`); None when too short."""
+    dx = float(res.x[1] - res.x[0]) if res.x.size > 1 else float(res.sumo.cell_length)
+    count = np.nansum(res.micro[:, 0] + res.micro[:, 2], axis=1) * dx
+    try:
+        return count_trend(count, res.sumo.control_period).as_dict()
+    except ValueError:
+        return None
 
 
 #: ``summary.json["kind"]`` of a closed-loop run in SUMO (``arzsumo run``)
@@ -163,8 +175,10 @@ def summary(res: CoSimResult) -> dict[str, Any]:
         "twin_replay": _indices(res, res.replay), "twin_reference": _indices(res, res.reference),
         "rmse": {"replay": rmse(res, res.replay), "reference": rmse(res, res.reference)},
         "rmse_blocks": rmse_blocks(res),
+        "section_trend": section_trend(res),
         "twin_status": res.twin_status,
         "inserted": rep.inserted if rep else None, "requested": rep.requested if rep else None,
+        "inserted_fraction_main": rep.delivered_main if rep else None,
         "waiting": rep.waiting if rep else None, "arrived": rep.arrived if rep else None,
         "teleports": rep.teleports if rep else None,
         "collisions": rep.collisions if rep else None,
