@@ -21,10 +21,32 @@ ARGS = ["identify", str(DEFAULT), "--train-seeds", "1,2", "--validate-seeds", "3
 
 
 @pytest.fixture(scope="module")
-def result(tmp_path_factory):
+def cache(tmp_path_factory):
+    """A fresh run cache (and kernel cache) for this module."""
+    path = tmp_path_factory.mktemp("cache")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("ARZSUMO_CACHE", str(path))
+        yield path
+
+
+@pytest.fixture(scope="module")
+def result(tmp_path_factory, cache):
     out = tmp_path_factory.mktemp("identify") / "out"
     assert main([*ARGS, "--out", str(out)]) == 0
     return out, json.loads((out / "identification.json").read_text())
+
+
+@pytest.mark.sumo
+def test_a_second_identification_reuses_the_cached_runs_and_gives_the_same_fit(
+        result, cache, tmp_path):
+    _, first = result
+    assert len(list((cache / "identify-runs").glob("*.npz"))) == 3
+    again = tmp_path / "again"
+    assert main([*ARGS, "--out", str(again)]) == 0
+    second = json.loads((again / "identification.json").read_text())
+    # no SUMO this time: the whole identification takes a fraction of the runs' time
+    assert second["wall_time"]["sumo_s"] < 0.2 * first["wall_time"]["sumo_s"]
+    assert second["parameters"] == first["parameters"]
 
 
 @pytest.mark.sumo

@@ -21,10 +21,11 @@ Nothing is written here: :mod:`arzsumo.outputs.identify` writes the results.
 from __future__ import annotations
 
 import itertools
+import logging
 import math
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -50,8 +51,10 @@ from arzsumo.model.equilibrium import Equilibrium
 from arzsumo.model.fd import area_occupancy
 from arzsumo.model.params import ModelParameters
 from arzsumo.scenario import Scenario, scenario_from_dict
+from arzsumo.studies.identify_cache import load_run, run_key, save_run
 from arzsumo.sweep.driver import default_workers, map_runs
 
+log = logging.getLogger(__name__)
 ROLES = ("training", "validation")
 
 
@@ -210,14 +213,44 @@ def plan(setup: IdentifySetup) -> list[RunTask]:
 
 
 def simulate(task: RunTask) -> SumoRun:
-    """One open-loop SUMO run as identification data (the sweep engine's worker)."""
+    """One open-loop SUMO run as identification data (the sweep engine's worker); taken
+    from the run cache (:mod:`.identify_cache`) when the same run was made before."""
+    key = run_key(task.tables, task.seed)
+    cached = load_run(key, task.run_id)
+    if cached is not None:
+        data, info = cached
+        return SumoRun(task, data, float(info["wall_time"]), int(info["resyncs"]),
+                       float(info["delivered"]))
     start = time.perf_counter()
     session = run_in_sumo(scenario_from_dict(task.tables, task.source), seed=task.seed)
     res = session.result
     data = replay_data_of(res, name=task.run_id)
     delivered = res.report.delivered_main if res.report is not None else math.nan
-    return SumoRun(task, data, time.perf_counter() - start,
-                   int(res.twin_status["replay"]["resyncs"]), float(delivered))
+    run = SumoRun(task, data, time.perf_counter() - start,
+                  int(res.twin_status["replay"]["resyncs"]), float(delivered))
+    save_run(key, data, {"wall_time": run.wall_time, "resyncs": run.resyncs,
+                         "delivered": run.delivered})
+    return run
+
+
+#: the start's AO_max holds the 99.5th percentile of the observed AO within the replay's
+#: AO limit: a start below the data stops every replay and leaves the fit a flat penalty
+START_AO_QUANTILE = 99.5
+
+
+def start_params(params: ModelParameters, datasets: Sequence[ReplayData],
+                 ao_limit: float) -> ModelParameters:
+    """``params`` with each class's AO_max raised, where needed, so that the observed
+    area occupancies (percentile START_AO_QUANTILE) lie below ``ao_limit`` AO_max."""
+    ao = []
+    for d in datasets:
+        seen = np.isfinite(d.fields[:, 0]) & np.isfinite(d.fields[:, 2])
+        ao.append(area_occupancy(params, d.fields[:, 0][seen], d.fields[:, 2][seen]))
+        ao.append(area_occupancy(params, d.inlet[:, 0], d.inlet[:, 2]))
+    need = min(float(np.percentile(np.concatenate(ao), START_AO_QUANTILE)) / ao_limit,
+               DEFAULT_BOUNDS["ao_max_h"][1])
+    return replace(params, ao_max_h=max(params.ao_max_h, need),
+                   ao_max_a=max(params.ao_max_a, need))
 
 
 @dataclass(frozen=True)
@@ -356,7 +389,11 @@ def run_identification(setup: IdentifySetup) -> IdentifyStudy:
     t1 = time.perf_counter()
     train = [r.data for r in runs if r.task.role == "training"]
     held_out = [r.data for r in runs if r.task.role == "validation"]
-    opts, guess = setup.options, setup.scenario.params
+    opts = setup.options
+    guess = start_params(setup.scenario.params, train, opts.ao_limit)
+    if guess != setup.scenario.params:
+        log.info("fit starts from AO_max_h = %.3f, AO_max_a = %.3f (the data's AO)",
+                 guess.ao_max_h, guess.ao_max_a)
     start = score_set(guess, train, opts)
     t2 = time.perf_counter()
     fit = identify(train, guess, which=setup.which, options=opts, settings=setup.fit)
