@@ -165,3 +165,22 @@ def test_vary_plans_every_seed_at_every_point_of_the_product():
     assert run.sumo.green_share == 0.6 and run.sumo.ramp_demand == pytest.approx(900 / 3600)
     assert run.run.controller == "open" and run.run.warmup == 30.0 and run.sumo.horizon == 60.0
     assert setup.which == ("tau_a", "gamma_h") and setup.options.cells == run.run.twin_cells
+
+
+def test_the_fit_starts_from_an_ao_max_that_holds_the_observed_occupancy():
+    import numpy as np
+
+    from arzsumo.identify import ReplayData
+    from arzsumo.model.fd import area_occupancy
+    from arzsumo.studies.identify import start_params
+
+    params = load_scenario(DEFAULT).params                   # AO_max_a 0.56
+    rho = np.array([0.120, 8.0, 0.065, 4.0])                 # AO above 0.56
+    ao = float(area_occupancy(params, rho[0], rho[2]))
+    fields = np.tile(rho[None, :, None], (2, 1, 3))
+    data = ReplayData.from_arrays([1.0, 2.0], [10.0, 20.0, 30.0], fields, fields[0],
+                                  np.tile(rho, (2, 1)), [1.0, 1.0])
+    start = start_params(params, [data], 0.9)
+    assert ao > params.ao_max_a
+    assert start.ao_max_a == pytest.approx(ao / 0.9) and start.ao_max_h >= params.ao_max_h
+    assert start_params(start, [data], 0.9) == start             # already holds it
