@@ -228,7 +228,7 @@ class ClosedLoop:
                  actuator: MeterActuator, twins: TwinPair, period: float) -> None:
         self.plant, self.estimator, self.controller = plant, estimator, controller
         self.actuator, self.twins, self.period = actuator, twins, period
-        self.timings = {"controller": 0.0, "twins": 0.0}
+        self.timings = {"controller": 0.0, "twins": 0.0, "estimator": 0.0}
 
     def decide(self, state: MacroState, final: bool) -> Decision:
         """Check the controller and the reference twin's; command the meter unless this
@@ -273,7 +273,9 @@ class ClosedLoop:
             trace.micro.append(micro_fields(c))
             trace.replay.append(self.twins.replay.sample(trace.x))
             trace.reference.append(self.twins.reference.sample(trace.x))
+            e0 = time.perf_counter()
             state = self.estimator.estimate(m, t)
+            self.timings["estimator"] += time.perf_counter() - e0
             bar.update(m.t)
 
 
