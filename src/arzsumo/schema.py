@@ -155,6 +155,11 @@ RUN_SUMMARY: dict[str, str] = {
     "rmse_blocks.block_m": "m", "rmse_blocks.block_s": "s",
     "rmse_blocks.*.rho_*.absolute": "veh/m", "rmse_blocks.*.v_*.absolute": "m/s",
     "rmse_blocks.*.*.relative": "1", "rmse_blocks.*.*.samples": "count",
+    "estimation": TEXT, "estimation.method": TEXT, "estimation.sensors": TEXT,
+    "estimation.spread": TEXT, "estimation.interpolation": TEXT,     # null: not available
+    "estimation.rho_*.absolute": "veh/m", "estimation.v_*.absolute": "m/s",
+    "estimation.*.rho_*.absolute": "veh/m", "estimation.*.v_*.absolute": "m/s",
+    "estimation.*.relative": "1", "estimation.*.samples": "count",
     "twin_status.*.resyncs": "count", "twin_status.*.first_resync_s": "s",
     "twin_status.*.first_reason": TEXT,
     "inserted": "veh", "requested": "veh", "waiting": "veh", "arrived": "veh",

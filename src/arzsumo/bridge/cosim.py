@@ -12,7 +12,9 @@ Sequence of :func:`run_cosimulation` (``arzsumo run``):
 5. Build the controller (kernels solved or loaded), ALINEA's occupancy target, the
    actuator and both twins from the measured state at the start of control.
 6. Every control period: the controller is checked on the estimate of the last period
-   (:mod:`~arzsumo.bridge.estimator`) and its U goes to the meter
+   (:mod:`~arzsumo.bridge.estimator`; with ``[estimation] method`` "smoothing" or "enkf"
+   built from the ``[sensing]`` loops and AV probes, fed the warm-up's records first:
+   :mod:`~arzsumo.bridge.estimators`) and its U goes to the meter
    (:mod:`~arzsumo.bridge.actuator`); SUMO runs one period, read by the sensor
    (:mod:`arzsumo.sumo.sensor`); the twins (:mod:`~arzsumo.bridge.twins`) advance; one
    :class:`~arzsumo.bridge.records.PeriodRecord` is kept. No command follows the last
@@ -49,8 +51,9 @@ from typing import Any
 import numpy as np
 
 from arzsumo.bridge.actuator import MeterActuator
-from arzsumo.bridge.estimator import Estimator, FundamentalDiagramFill
-from arzsumo.bridge.records import PeriodRecord, columns
+from arzsumo.bridge.estimator import Estimator
+from arzsumo.bridge.estimators import RecordedEstimator, estimation_stage
+from arzsumo.bridge.records import Decision, PeriodRecord, Trace, columns, micro_fields
 from arzsumo.bridge.twins import TwinPair
 from arzsumo.control.base import Controller, ControlLog, MacroState
 from arzsumo.control.etc import EtcDesign
@@ -63,7 +66,6 @@ from arzsumo.progress import Progress
 from arzsumo.scenario import Scenario
 from arzsumo.scenario.run import RunSettings
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.measure import CellData
 from arzsumo.sumo.meter import DEFAULT_CURVE, GreenShareCurve, RampMeter
 from arzsumo.sumo.network_measures import network_options
 from arzsumo.sumo.paths import scratch_dir
@@ -130,21 +132,24 @@ class CoSimResult:
     section_speed: dict[str, dict[str, float]] = field(default_factory=dict)
     #: micro state at the start of control (4, cells), as ``micro``
     start: np.ndarray | None = None
-
-
-def micro_fields(c: CellData) -> np.ndarray:
-    """Edie cells as (rho_h, v_h, rho_a, v_a) rows (4, cells), SI; NaN speed where empty."""
-    return np.vstack([c.rho_h, c.v_h, c.rho_a, c.v_a])
+    #: what the controller acted on, aligned with ``micro`` (periods, 4, cells), and the
+    #: estimator's record (:class:`~arzsumo.bridge.estimators.RecordedEstimator`)
+    estimate: np.ndarray | None = None
+    estimator: RecordedEstimator | None = None
 
 
 class SumoPlant:
     """SUMO with its sensor and meter, advanced one control period at a time."""
 
     def __init__(self, sim: SumoSimulation, length: float, cfg: SumoConfig,
-                 curve: GreenShareCurve) -> None:
+                 curve: GreenShareCurve, scenario: Scenario | None = None) -> None:
         self.sim = sim
         self.meter = RampMeter(sim.lib, cfg, curve)
-        self.sensor = SumoSensor(sim.lib, length, cfg, window=True)
+        est = scenario.estimation if scenario else None
+        self.sensor = SumoSensor(sim.lib, length, cfg, window=True,
+                                 layout=scenario.sensing if scenario else None,
+                                 loop_noise=est.loop_noise if est else None,
+                                 probe_noise=est.probe_noise if est else None)
         self.timings = {"sumo_step": 0.0, "measure_actuate": 0.0}
 
     def advance(self) -> PeriodMeasurement:
@@ -216,32 +221,6 @@ def build_controller(name: str, lin: Linearization, kernels: Any, design: EtcDes
     return ctrl
 
 
-@dataclass
-class Trace:
-    """The control window as it happened: records and fields per period."""
-
-    x: np.ndarray
-    start: np.ndarray
-    records: list[PeriodRecord] = field(default_factory=list)
-    t: list[float] = field(default_factory=list)
-    micro: list[np.ndarray] = field(default_factory=list)
-    replay: list[np.ndarray] = field(default_factory=list)
-    reference: list[np.ndarray] = field(default_factory=list)
-
-
-@dataclass(frozen=True)
-class Decision:
-    """One check: U held (veh/s), its continuous value, event flag, meter command."""
-
-    t: float
-    u: float
-    u_continuous: float
-    triggered: float
-    green_commanded: float
-    u_reference: float
-    controller_s: float
-
-
 class ClosedLoop:
     """The stages of the control window, wired together (see the module docstring)."""
 
@@ -249,7 +228,7 @@ class ClosedLoop:
                  actuator: MeterActuator, twins: TwinPair, period: float) -> None:
         self.plant, self.estimator, self.controller = plant, estimator, controller
         self.actuator, self.twins, self.period = actuator, twins, period
-        self.timings = {"controller": 0.0, "twins": 0.0}
+        self.timings = {"controller": 0.0, "twins": 0.0, "estimator": 0.0}
 
     def decide(self, state: MacroState, final: bool) -> Decision:
         """Check the controller and the reference twin's; command the meter unless this
@@ -294,7 +273,9 @@ class ClosedLoop:
             trace.micro.append(micro_fields(c))
             trace.replay.append(self.twins.replay.sample(trace.x))
             trace.reference.append(self.twins.reference.sample(trace.x))
+            e0 = time.perf_counter()
             state = self.estimator.estimate(m, t)
+            self.timings["estimator"] += time.perf_counter() - e0
             bar.update(m.t)
 
 
@@ -325,6 +306,7 @@ class Controlled:
     q_nom: float
     warmup_meter: dict[str, float]
     start: WindowStart
+    estimator: RecordedEstimator
 
 
 def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
@@ -346,7 +328,8 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
     net_dir = Path(tempfile.mkdtemp(prefix="arzsumo-net-", dir=scratch_dir()))
     try:
         with open_simulation(scenario.params, run_cfg, initial=initial,
-                             extra_args=network_options(net_dir), output_dir=net_dir) as sim:
+                             extra_args=network_options(net_dir), output_dir=net_dir,
+                             loops=scenario.sensing.loop_x(scenario.params.length)) as sim:
             c = control(sim, scenario, settings, cfg, design, curve, bar)
             meter_summary = c.loop.plant.meter.summary()
         records = c.trace.records
@@ -362,7 +345,8 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
                        c.ref_ctrl.log, meter_summary, sim.report, loop.twins.status(),
                        placement, time.perf_counter() - wall0,
                        {**loop.plant.timings, **loop.timings}, c.warmup_meter, network,
-                       loop.plant.sensor.speeds.summary(), trace.start)
+                       loop.plant.sensor.speeds.summary(), trace.start,
+                       np.asarray(c.estimator.fields[1:]), c.estimator)
 
 
 def control(sim: SumoSimulation, scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
@@ -372,7 +356,7 @@ def control(sim: SumoSimulation, scenario: Scenario, settings: RunSettings, cfg:
     from arzsumo.kernel_cache import cached_kernels
 
     params, period = scenario.params, cfg.control_period
-    plant = SumoPlant(sim, params.length, cfg, curve)
+    plant = SumoPlant(sim, params.length, cfg, curve, scenario)
     warm = warm_up(plant, settings.warmup, period, bar)
     plant.timings = dict.fromkeys(plant.timings, 0.0)   # time the control window only
     warmup_meter = {**plant.meter.start_window(), "duration_s": float(warm[-1].t)}
@@ -382,8 +366,10 @@ def control(sim: SumoSimulation, scenario: Scenario, settings: RunSettings, cfg:
     kernels = (cached_kernels(lin.system, settings.kernel_cells)
                if is_pde(settings.controller) else None)
     target = occupancy_target(settings, warm, period)
-    ctrl = build_controller(settings.controller, lin, kernels, design, settings, curve,
-                            cfg, target)
+    estimator, acting = estimation_stage(scenario.estimation, scenario.sensing,
+                                         settings.controller, eq, warm[-1].cells.x)
+    estimator.prime(warm[:-1], warm[-1].t)
+    ctrl = build_controller(acting, lin, kernels, design, settings, curve, cfg, target)
     ref_name = settings.controller if is_pde(settings.controller) else "open"
     ref_ctrl = build_controller(ref_name, lin, kernels, design, settings, curve, cfg, target)
     q_nom = curve.outflow_at(cfg.green_share)
@@ -391,6 +377,6 @@ def control(sim: SumoSimulation, scenario: Scenario, settings: RunSettings, cfg:
                          horizon=cfg.horizon, control_period=period)
     twins = TwinPair(eq, lin, warm[-1].cells, opts, settings.smoothing, ref_ctrl, q_nom)
     actuator = MeterActuator(plant.meter, q_nom, settings.controller == "open")
-    loop = ClosedLoop(plant, FundamentalDiagramFill(params), ctrl, actuator, twins, period)
+    loop = ClosedLoop(plant, estimator, ctrl, actuator, twins, period)
     trace = loop.run(warm[-1], cfg.horizon, bar)
-    return Controlled(loop, trace, ref_ctrl, eq, q_nom, warmup_meter, start)
+    return Controlled(loop, trace, ref_ctrl, eq, q_nom, warmup_meter, start, estimator)

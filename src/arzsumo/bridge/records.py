@@ -7,9 +7,11 @@ that period's end are stored beside (see :class:`~arzsumo.bridge.cosim.CoSimResu
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 
 import numpy as np
+
+from arzsumo.sumo.measure import CellData
 
 
 @dataclass(frozen=True)
@@ -48,3 +50,34 @@ def columns(records: list[PeriodRecord]) -> dict[str, np.ndarray]:
     """The records as one float array per field (the ``periods`` table's columns)."""
     return {f.name: np.array([getattr(r, f.name) for r in records], float)
             for f in fields(PeriodRecord)}
+
+
+def micro_fields(c: CellData) -> np.ndarray:
+    """Edie cells as (rho_h, v_h, rho_a, v_a) rows (4, cells), SI; NaN speed where empty."""
+    return np.vstack([c.rho_h, c.v_h, c.rho_a, c.v_a])
+
+
+@dataclass
+class Trace:
+    """The control window as it happened: records and fields per period."""
+
+    x: np.ndarray
+    start: np.ndarray
+    records: list[PeriodRecord] = field(default_factory=list)
+    t: list[float] = field(default_factory=list)
+    micro: list[np.ndarray] = field(default_factory=list)
+    replay: list[np.ndarray] = field(default_factory=list)
+    reference: list[np.ndarray] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class Decision:
+    """One check: U held (veh/s), its continuous value, event flag, meter command."""
+
+    t: float
+    u: float
+    u_continuous: float
+    triggered: float
+    green_commanded: float
+    u_reference: float
+    controller_s: float

@@ -63,7 +63,9 @@ class PreparedRun:
         return (f"scenario {self.scenario.name} ({self.scenario.source}): valid\n"
                 f"  controller {s.controller}, start {s.start}, warm-up {s.warmup:g} s + "
                 f"control horizon {c.horizon:g} s, SUMO seed {c.seed}, step {c.step_length:g} s"
-                f"\n  equilibrium {s.equilibrium} (scenario lambda_4 = {lam4:.2f} km/h)")
+                f"\n  equilibrium {s.equilibrium} (scenario lambda_4 = {lam4:.2f} km/h)"
+                f"\n  estimation {self.scenario.estimation.method} from sensors "
+                f"{', '.join(self.scenario.sensing.kinds)}")
 
 
 def _seed(seed: int) -> int:
@@ -126,6 +128,17 @@ def _check_regime(sc: Scenario, settings: RunSettings, from_cli: bool) -> None:
                             f"[equilibrium] of {sc.source}: {reason}") from None
 
 
+def _check_estimation(sc: Scenario, settings: RunSettings, from_cli: bool) -> None:
+    """observer-etc with an estimator acts on the boundary stations: it needs loops."""
+    method = sc.estimation.method
+    if settings.controller == "observer-etc" and method != "none" and not sc.sensing.loops:
+        at = (f"--controller = {settings.controller}" if from_cli else
+              f"{sc.source}: [run] controller = {written(settings.controller)}")
+        raise ScenarioError(f"{at} is not allowed with [estimation] method = "
+                            f"{written(method)} and no loops: it acts on the estimate from "
+                            "the boundary stations; add \"loops\" to [sensing] kinds")
+
+
 def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None = None,
                 horizon: float | None = None, warmup: float | None = None) -> PreparedRun:
     """Everything ``arzsumo run`` checks before SUMO starts, without starting it.
@@ -152,6 +165,7 @@ def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None
     _check_model(sc, cfg)
     if settings.equilibrium == "scenario":
         _check_regime(sc, settings, controller is not None)
+    _check_estimation(sc, settings, controller is not None)
     initial = None
     if settings.start == "placement":
         n = round(sc.params.length / cfg.cell_length)

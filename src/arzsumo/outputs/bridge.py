@@ -112,6 +112,31 @@ def section_trend(res: CoSimResult) -> dict[str, Any] | None:
         return None
 
 
+def estimation_summary(res: CoSimResult) -> dict[str, Any] | None:
+    """How well the state the controller acted on matched the full probe's cells.
+
+    ``method`` and ``sensors``; per variable the RMSE against ``res.micro`` over the
+    control window's periods (:func:`rmse`: absolute SI, relative to the equilibrium,
+    samples); ``spread``: the EnKF's mean ensemble sd per variable (absolute, relative;
+    None for other methods); ``interpolation``: the RMSE of linear interpolation between
+    the loop stations of the same periods (None without loops).
+    """
+    est = res.estimator
+    if est is None or res.estimate is None or not res.estimate.size:
+        return None
+    eq = res.equilibrium
+    ref = (eq.rho_h, eq.v_h, eq.rho_a, eq.v_a)
+    spread = None
+    if len(est.sd) > 1:
+        sd = np.asarray(est.sd[1:]).mean(axis=(0, 2))
+        spread = {name: {"absolute": float(sd[k]), "relative": float(sd[k] / ref[k])}
+                  for k, name in enumerate(VARIABLES)}
+    interp = (rmse(res, np.asarray(est.interpolation[1:]))
+              if len(est.interpolation) > 1 else None)
+    return {"method": est.method, "sensors": list(est.sensors),
+            **rmse(res, res.estimate), "spread": spread, "interpolation": interp}
+
+
 #: ``summary.json["kind"]`` of a closed-loop run in SUMO (``arzsumo run``)
 KIND = "run"
 
@@ -176,6 +201,7 @@ def summary(res: CoSimResult) -> dict[str, Any]:
         "rmse": {"replay": rmse(res, res.replay), "reference": rmse(res, res.reference)},
         "rmse_blocks": rmse_blocks(res),
         "section_trend": section_trend(res),
+        "estimation": estimation_summary(res),
         "twin_status": res.twin_status,
         "inserted": rep.inserted if rep else None, "requested": rep.requested if rep else None,
         "inserted_fraction_main": rep.delivered_main if rep else None,

@@ -17,6 +17,7 @@ section                   record                                     keys (units
 ``[sumo]``                ``sumo``: SumoConfig (``arzsumo run``)     :mod:`.sumo`
 ``[run]``                 ``run``: RunSettings (``arzsumo run``)     :mod:`.run`
 ``[sensing]``             ``sensing``: SensorLayout (``run``)        :mod:`.sensing`
+``[estimation]``          ``estimation``: EstimationSettings         :mod:`.estimation`
 ``[sweep]``               ``sweep``: DesignSweep (``reproduce``)     here
 ========================  =========================================  ====================
 
@@ -39,6 +40,12 @@ from arzsumo.errors import ScenarioError
 from arzsumo.io import read_toml
 from arzsumo.model.equilibrium import Equilibrium
 from arzsumo.model.params import ModelParameters, get_preset
+from arzsumo.scenario.estimation import (
+    ESTIMATION_KEYS,
+    EstimationSettings,
+    check_sensors,
+    estimation_section,
+)
 from arzsumo.scenario.model import (
     DESIGN_KEYS,
     EQUILIBRIUM_KEYS,
@@ -75,7 +82,7 @@ SWEEP_KEYS: dict[str, Key] = {
 KEYS: dict[str, dict[str, Key]] = {
     "model": MODEL_KEYS, "equilibrium": EQUILIBRIUM_KEYS, "design": DESIGN_KEYS,
     "initial": INITIAL_KEYS, "twin": TWIN_KEYS, "sumo": SUMO_KEYS, "run": RUN_KEYS,
-    "sensing": SENSING_KEYS, "sweep": SWEEP_KEYS,
+    "sensing": SENSING_KEYS, "estimation": ESTIMATION_KEYS, "sweep": SWEEP_KEYS,
 }
 #: table -> {old key: new key}: keys renamed since earlier versions (a one-line hint)
 RENAMED: dict[str, dict[str, str]] = {"run": RUN_RENAMED}
@@ -112,6 +119,7 @@ class Scenario:
     source: str = "<dict>"
     tables: Mapping[str, Any] = field(default_factory=dict, repr=False, compare=False)
     sensing: SensorLayout = field(default_factory=SensorLayout)
+    estimation: EstimationSettings = field(default_factory=EstimationSettings)
 
     def with_(self, changes: Mapping[str, Any]) -> Scenario:
         """A new scenario with keys changed, parsed and validated again.
@@ -175,12 +183,15 @@ def scenario_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scena
     sumo = sumo_section(t["sumo"], at["sumo"], source)
     run = run_section(t["run"], at["run"])
     sensing = sensing_section(t["sensing"], at["sensing"], params.length)
+    estimation = estimation_section(t["estimation"], at["estimation"])
+    check_sensors(estimation, sensing, params.length, at["estimation"])
     sweep = _sweep_section(t["sweep"], at["sweep"])
     default_name = Path(source).stem if source != "<dict>" else preset.name
     return Scenario(_text(data, "name", source, default_name),
                     _text(data, "description", source, preset.description), params, eq,
                     design, initial, twin, sumo, run, sweep, source,
-                    copy.deepcopy(dict(data)), sensing=sensing)
+                    copy.deepcopy(dict(data)), sensing=sensing,
+                    estimation=estimation)
 
 
 def load_scenario(path: str | Path) -> Scenario:

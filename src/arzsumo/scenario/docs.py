@@ -14,6 +14,7 @@ from arzsumo.control.etc import PAPER_DESIGN
 from arzsumo.control.registry import REGISTRY
 from arzsumo.model.params import get_preset
 from arzsumo.scenario import KEYS, RENAMED
+from arzsumo.scenario.estimation import EstimationSettings
 from arzsumo.scenario.run import RunSettings
 from arzsumo.scenario.twin import DEFAULT_AMPLITUDE, TwinConfig
 from arzsumo.sumo.config import SumoConfig
@@ -42,6 +43,10 @@ SECTIONS: dict[str, tuple[str, Callable[[str], Any] | None]] = {
     "run": ("`arzsumo run` only", lambda f: getattr(RunSettings(), f)),
     "sensing": ("the sensors `arzsumo run` reads in SUMO (issue 16); default: `probe`, "
                 "every vehicle binned into cells", lambda f: getattr(SensorLayout(), f)),
+    "estimation": ("the state the controller of `arzsumo run` acts on (issue 16); default: "
+                   "`none`, the probe's cells; noise levels are the estimators' assumed "
+                   "errors, not added to SUMO's readings",
+                   lambda f: getattr(EstimationSettings(), f)),
     "sweep": ("`arzsumo reproduce` only: one ETC run per value of a [design] parameter", None),
 }
 

@@ -107,7 +107,8 @@ class RunSettings:
 def run_section(table: dict[str, Any], at: str) -> RunSettings:
     """The RunSettings of a ``[run]`` table (keys already checked); errors name the key
     and the value as written."""
+    si = read_keys(table, RUN_KEYS, at)       # its own errors name key and value
     try:
-        return RunSettings(**read_keys(table, RUN_KEYS, at))
+        return RunSettings(**si)
     except ArzsumoError as exc:
         raise in_user_terms(exc, at, table, RUN_KEYS) from None

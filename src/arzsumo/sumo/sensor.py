@@ -27,7 +27,12 @@ from types import ModuleType
 
 import numpy as np
 
-from arzsumo.estimate.observations import LoopObservation, ProbeObservation
+from arzsumo.estimate.observations import (
+    LoopNoise,
+    LoopObservation,
+    ProbeNoise,
+    ProbeObservation,
+)
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.loops import LoopSensor
 from arzsumo.sumo.measure import CellData, MainlineSensor
@@ -118,17 +123,21 @@ class SumoSensor:
         (:meth:`start_window`; the co-simulation does).
     layout : SensorLayout, optional
         Loop stations and AV probes read besides the cells (default: none).
+    loop_noise, probe_noise : LoopNoise, ProbeNoise, optional
+        Noise models attached to their records (the estimators' assumed errors).
     """
 
     def __init__(self, lib: ModuleType, length: float, cfg: SumoConfig,
-                 window: bool = False, layout: SensorLayout | None = None) -> None:
+                 window: bool = False, layout: SensorLayout | None = None,
+                 loop_noise: LoopNoise | None = None,
+                 probe_noise: ProbeNoise | None = None) -> None:
         self.lib = lib
         self.mainline = MainlineSensor(lib, length, cfg.cell_length, cfg.step_length,
                                        cfg.steps_per_period)
         layout = layout or SensorLayout()
         self.loops = LoopSensor(lib, layout.loop_x(length), length, cfg.step_length,
-                                cfg.steps_per_period) if layout.loops else None
-        self.probes = AvProbes(layout.av_probe_share, layout.av_probe_seed) \
+                                cfg.steps_per_period, loop_noise) if layout.loops else None
+        self.probes = AvProbes(layout.av_probe_share, layout.av_probe_seed, probe_noise) \
             if layout.av_probes else None
         self.queue = 0
         self._occupancy_sum, self._steps = 0.0, 0

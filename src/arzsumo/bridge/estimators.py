@@ -1,0 +1,188 @@
+"""Estimators of the closed loop on sparse sensors: ASM smoothing and the EnKF (issue 16).
+
+The ``[estimation] method`` of a scenario picks what the controller acts on:
+
+* ``"none"``: :class:`~arzsumo.bridge.estimator.FundamentalDiagramFill`, the full
+  probe's cells (today's rule, unchanged);
+* ``"smoothing"``: :class:`SmoothingEstimator`, the causal adaptive smoothing method
+  (:class:`arzsumo.estimate.smoothing.CausalSmoother`) of the period's loop records and
+  AV probes, evaluated at the end of the period on the controller's cells;
+* ``"enkf"``: :class:`EnkfEstimator`, the ensemble Kalman filter on batched first-order
+  twins (:class:`arzsumo.estimate.enkf.EnsembleKalmanFilter`): every period each member
+  is advanced with the inflow state of the station at x = 0 and the outflow of the
+  station at x = L (:meth:`~arzsumo.estimate.enkf.BoundaryInput.from_loops`), then
+  assimilates the loop and probe records.
+
+Both read only the sparse sensors (``PeriodMeasurement.loops`` and ``.probes``), never
+the full probe's cells, which stay the ground truth of the scoring. Where a method has no
+datum of a quantity in reach, a density is the design equilibrium's and a speed Ve at
+the cell's densities (paper, eq. ``Ve``): the controller needs a value everywhere.
+
+``observer-etc`` in SUMO with an estimator is the ETC (the paper's full-state mechanism,
+defdynamic) on the estimate from the two boundary stations only (:func:`boundary_only`),
+instead of the paper's boundary observer, which has no output injection for this model
+(P = 0) and hardly acts in SUMO. With ``method = "none"`` it keeps the paper's observer.
+
+:class:`RecordedEstimator` wraps any of them and keeps, per control period, the fields
+the controller got, the EnKF's spread and the linear interpolation between the loop
+stations (the baseline an estimator must beat), for ``summary.json["estimation"]``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from arzsumo.bridge.estimator import Estimator, FundamentalDiagramFill, fill_speeds
+from arzsumo.control.base import MacroState
+from arzsumo.estimate.enkf import BoundaryInput, EnsembleKalmanFilter
+from arzsumo.estimate.observations import LoopObservation, ProbeObservation
+from arzsumo.estimate.smoothing import CausalSmoother
+from arzsumo.estimate.synthetic import interpolate_loops
+from arzsumo.model.equilibrium import Equilibrium
+from arzsumo.scenario.estimation import EstimationSettings
+from arzsumo.sumo.sensing import SensorLayout
+from arzsumo.sumo.sensor import PeriodMeasurement
+
+
+def filled(eq: Equilibrium, z: np.ndarray) -> np.ndarray:
+    """Fields (4, n) with NaN densities at the equilibrium's (veh/m) and NaN speeds at Ve
+    of the cell's densities (m/s)."""
+    z = np.array(z, float)
+    z[0] = np.where(np.isfinite(z[0]), z[0], eq.rho_h)
+    z[2] = np.where(np.isfinite(z[2]), z[2], eq.rho_a)
+    z[1], z[3] = fill_speeds(eq.params, z[0], z[1], z[2], z[3])
+    return z
+
+
+def boundary_only(obs: LoopObservation) -> LoopObservation:
+    """The record of the first and last stations of ``obs`` (x = 0+ and x = L-)."""
+    k = [0, obs.x.size - 1]
+    return LoopObservation(obs.t, obs.period, obs.x[k], obs.flow[:, k], obs.speed[:, k],
+                           obs.density[:, k], obs.noise)
+
+
+def _state(t: float, x: np.ndarray, z: np.ndarray, m: PeriodMeasurement) -> MacroState:
+    return MacroState(t, x, z[0], z[1], z[2], z[3], m.occupancy_out)
+
+
+class SparseData:
+    """The sparse records of a measurement an estimator uses (all, or boundary loops)."""
+
+    def __init__(self, boundary: bool) -> None:
+        self.boundary = boundary
+
+    def __call__(self, m: PeriodMeasurement
+                 ) -> tuple[list[LoopObservation], list[ProbeObservation]]:
+        loops = [] if m.loops is None else [boundary_only(m.loops) if self.boundary
+                                            else m.loops]
+        probes = [] if m.probes is None or self.boundary else [m.probes]
+        return loops, probes
+
+
+class SmoothingEstimator:
+    """Causal ASM of the loop and probe records on the cells ``x`` (m); see the module."""
+
+    def __init__(self, eq: Equilibrium, x: np.ndarray, settings: EstimationSettings,
+                 boundary: bool = False) -> None:
+        self.eq, self.x = eq, np.asarray(x, float)
+        self.smoother = CausalSmoother(self.x, settings.asm)
+        self.data = SparseData(boundary)
+        self.sd: np.ndarray | None = None
+
+    def estimate(self, measurement: PeriodMeasurement, t: float) -> MacroState:
+        self.smoother.add(*self.data(measurement))
+        z = filled(self.eq, self.smoother.estimate(measurement.t))
+        return _state(t, self.x, z, measurement)
+
+
+class EnkfEstimator:
+    """EnKF on the cells ``x`` (m), started at the first measurement; see the module.
+
+    The first guess is the linear interpolation between the loop stations of the first
+    record (:func:`filled`); the ensemble spreads around it by the filter's initial
+    spread. :attr:`sd` is the ensemble spread (4, n) of the last estimate.
+    """
+
+    def __init__(self, eq: Equilibrium, x: np.ndarray, settings: EstimationSettings,
+                 boundary: bool = False) -> None:
+        self.eq, self.x = eq, np.asarray(x, float)
+        self.options = settings.enkf(self.x.size)
+        self.data = SparseData(boundary)
+        self.filter: EnsembleKalmanFilter | None = None
+        self.sd: np.ndarray | None = None
+
+    def estimate(self, measurement: PeriodMeasurement, t: float) -> MacroState:
+        m = measurement
+        if m.loops is None:
+            raise RuntimeError("the EnKF needs loop records (open SUMO with the loops)")
+        loops, probes = self.data(m)
+        p = self.eq.params
+        if self.filter is None:
+            first = filled(self.eq, interpolate_loops(loops[0], self.x))
+            self.filter = EnsembleKalmanFilter(p, first, self.options, t0=m.t)
+            if not np.allclose(self.filter.x, self.x):
+                raise RuntimeError("the EnKF grid differs from the controller's cells")
+            self.filter.analyse(loops, probes)
+            est = self.filter.estimate()
+        else:
+            est = self.filter.step(m.t, BoundaryInput.from_loops(p, m.loops), loops, probes)
+        self.sd = est.sd
+        return _state(t, self.x, est.mean, m)
+
+
+@dataclass
+class RecordedEstimator:
+    """An estimator and what it gave in the control window (t >= 0), per period.
+
+    ``fields`` (4, n) per check, as the controller got them; ``sd`` the EnKF's spread
+    (None otherwise); ``interpolation`` the linear interpolation between the period's
+    loop stations, speeds filled with Ve (when there are loops).
+    """
+
+    inner: Estimator
+    method: str
+    sensors: tuple[str, ...]
+    eq: Equilibrium
+    fields: list[np.ndarray] = field(default_factory=list)
+    sd: list[np.ndarray] = field(default_factory=list)
+    interpolation: list[np.ndarray] = field(default_factory=list)
+
+    def estimate(self, measurement: PeriodMeasurement, t: float) -> MacroState:
+        s = self.inner.estimate(measurement, t)
+        if t >= 0.0:
+            self.fields.append(np.vstack([s.rho_h, s.v_h, s.rho_a, s.v_a]))
+            sd = getattr(self.inner, "sd", None)
+            if sd is not None:
+                self.sd.append(np.asarray(sd))
+            if measurement.loops is not None:
+                self.interpolation.append(filled(self.eq, interpolate_loops(
+                    measurement.loops, s.x)))
+        return s
+
+    def prime(self, warm: list[PeriodMeasurement], t0: float) -> None:
+        """Feed the warm-up's measurements (times before ``t0``, s) to a stateful method."""
+        if self.method != "none":
+            for m in warm:
+                self.inner.estimate(m, m.t - t0)
+
+
+def estimation_stage(settings: EstimationSettings, layout: SensorLayout, controller: str,
+                     eq: Equilibrium, x: np.ndarray) -> tuple[RecordedEstimator, str]:
+    """The estimator of a run and the controller that acts on it.
+
+    ``controller`` is the run's; ``observer-etc`` with a method other than ``none``
+    becomes ``etc`` on the boundary stations' estimate (module docstring).
+    """
+    boundary = controller == "observer-etc" and settings.method != "none"
+    inner: Estimator
+    if settings.method == "smoothing":
+        inner = SmoothingEstimator(eq, x, settings, boundary)
+    elif settings.method == "enkf":
+        inner = EnkfEstimator(eq, x, settings, boundary)
+    else:
+        inner = FundamentalDiagramFill(eq.params)
+    sensors = ("loops (boundaries)",) if boundary else layout.kinds
+    return (RecordedEstimator(inner, settings.method, sensors, eq),
+            "etc" if boundary else controller)

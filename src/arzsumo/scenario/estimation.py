@@ -1,0 +1,175 @@
+"""The ``[estimation]`` section: what the controller of ``arzsumo run`` acts on (issue 16).
+
+Every key, its unit and the field of :class:`EstimationSettings` it sets::
+
+    [estimation]
+    method = "enkf"                 # "none" (raw cells), "smoothing" (ASM) or "enkf"
+    members = 32                    # EnKF ensemble size
+    inflation = 1.05                # EnKF multiplicative inflation per analysis
+    localisation_m = 150            # EnKF Gaspari-Cohn half-width
+    seed = 0                        # EnKF random draws
+    loop_density_sd_veh_km = 8      # assumed error sd of a loop's density, per period
+    asm_sigma_m = 75                # ASM kernel width in space
+
+Without the table (``method = "none"``) the controller acts on the cells of the full
+probe, as before issue 16. ``smoothing`` and ``enkf`` read the ``[sensing]`` loops and AV
+probes (``enkf`` needs loop stations at both boundaries: its twins' inflow and outflow).
+The noise levels are the estimators' assumed measurement errors (the weights of the data
+and the EnKF's R); nothing is added to SUMO's readings.
+
+The ASM defaults are not the published ones (sigma 150 m, tau 15 s, crossover 60 km/h):
+fitted to this model's waves (3 of its 4 characteristic families travel downstream even
+in congestion), sigma 75 m, tau 10 s and a 30 km/h crossover won on HV density
+(``tests/estimate/test_smoothing.py``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass
+from typing import Any
+
+from arzsumo.errors import ArzsumoError, ScenarioError, require
+from arzsumo.estimate.enkf import EnkfOptions
+from arzsumo.estimate.observations import LoopNoise, ProbeNoise
+from arzsumo.estimate.smoothing import AsmParameters
+from arzsumo.sumo.loops import BOUNDARY_GAP, INLET_GAP, placed_positions
+from arzsumo.sumo.sensing import SensorLayout
+from arzsumo.tables import Key, in_user_terms, read_keys
+from arzsumo.units import KMH_PER_MS, VEH_H_PER_VEH_S, kmh_to_ms
+
+METHODS = ("none", "smoothing", "enkf")
+
+#: [estimation] key -> EstimationSettings field (SI)
+ESTIMATION_KEYS: dict[str, Key] = {
+    "method": Key("method", "string", choices=METHODS,
+                  doc="what the controller acts on: \"none\" (the probe's cells, empty "
+                      "cells at Ve), \"smoothing\" (causal adaptive smoothing of loops and "
+                      "AV probes), \"enkf\" (ensemble Kalman filter on batched twins)"),
+    "members": Key("members", "integer", doc="EnKF ensemble size (>= 2)"),
+    "inflation": Key("inflation", doc="EnKF multiplicative inflation per analysis (>= 1)"),
+    "localisation_m": Key("localisation", unit="m",
+                          doc="EnKF Gaspari-Cohn half-width (correlations vanish beyond "
+                              "twice this)"),
+    "seed": Key("seed", "integer", doc="seed of the EnKF's draws (>= 0)"),
+    "loop_flow_sd_veh_h": Key("loop_flow_sd", factor=VEH_H_PER_VEH_S, unit="veh/h",
+                              allowed="a standard deviation > 0 veh/h",
+                              doc="assumed error sd of a loop's class flow per period"),
+    "loop_speed_sd_kmh": Key("loop_speed_sd", factor=KMH_PER_MS, unit="km/h",
+                             allowed="a standard deviation > 0 km/h",
+                             doc="assumed error sd of a loop's time-mean speed"),
+    "loop_density_sd_veh_km": Key("loop_density_sd", factor=1000.0, unit="veh/km",
+                                  allowed="a standard deviation > 0 veh/km",
+                                  doc="assumed error sd of a loop's class density"),
+    "probe_speed_sd_kmh": Key("probe_speed_sd", factor=KMH_PER_MS, unit="km/h",
+                              allowed="a standard deviation > 0 km/h",
+                              doc="assumed error sd of an AV probe's speed"),
+    "asm_sigma_m": Key("asm_sigma", unit="m", doc="ASM kernel width in space"),
+    "asm_tau_s": Key("asm_tau", unit="s", doc="ASM kernel width in time"),
+    "asm_crossover_kmh": Key("asm_v_crit", factor=KMH_PER_MS, unit="km/h",
+                             allowed="a speed > 0 km/h",
+                             doc="ASM speed between its free and congested kernels"),
+    "asm_crossover_width_kmh": Key("asm_dv", factor=KMH_PER_MS, unit="km/h",
+                                   allowed="a speed > 0 km/h", doc="ASM crossover width"),
+    "asm_c_free_kmh": Key("asm_c_free", factor=KMH_PER_MS, unit="km/h",
+                          allowed="a speed > 0 km/h",
+                          doc="ASM wave speed in free flow (downstream)"),
+    "asm_c_cong_kmh": Key("asm_c_cong", factor=KMH_PER_MS, unit="km/h",
+                          allowed="a negative speed in km/h (waves travel upstream)",
+                          doc="ASM wave speed in congestion"),
+}
+
+
+@dataclass(frozen=True)
+class EstimationSettings:
+    """The estimator of a run (SI: veh/s, m/s, veh/m, m, s).
+
+    ``method`` is one of :data:`METHODS`; the EnKF's ``members``, ``inflation``,
+    ``localisation`` (m) and ``seed``; the assumed sensor errors (standard deviations,
+    per period: loop flow veh/s, loop speed m/s, loop density veh/m, probe speed m/s);
+    the ASM kernels (widths ``asm_sigma`` m and ``asm_tau`` s, crossover ``asm_v_crit``
+    and width ``asm_dv`` m/s, wave speeds ``asm_c_free`` > 0 and ``asm_c_cong`` < 0 m/s).
+    """
+
+    method: str = "none"
+    members: int = 32
+    inflation: float = 1.05
+    localisation: float = 150.0
+    seed: int = 0
+    loop_flow_sd: float = LoopNoise().flow
+    loop_speed_sd: float = LoopNoise().speed
+    loop_density_sd: float = LoopNoise().density
+    probe_speed_sd: float = ProbeNoise().speed
+    asm_sigma: float = 75.0
+    asm_tau: float = 10.0
+    asm_v_crit: float = float(kmh_to_ms(30.0))
+    asm_dv: float = float(kmh_to_ms(20.0))
+    asm_c_free: float = float(kmh_to_ms(80.0))
+    asm_c_cong: float = float(kmh_to_ms(-15.0))
+
+    def __post_init__(self) -> None:
+        def check(ok: bool, name: str, allowed: str) -> None:
+            require(ok, name, getattr(self, name), allowed, ScenarioError)
+
+        check(self.method in METHODS, "method", f"one of {', '.join(METHODS)}")
+        check(isinstance(self.members, int) and self.members >= 2, "members",
+              "an integer >= 2")
+        check(math.isfinite(self.inflation) and self.inflation >= 1, "inflation",
+              "a factor >= 1")
+        check(self.localisation > 0, "localisation", "a distance > 0 m")
+        check(isinstance(self.seed, int) and self.seed >= 0, "seed", "an integer >= 0")
+        for name in ("loop_flow_sd", "loop_speed_sd", "loop_density_sd", "probe_speed_sd",
+                     "asm_sigma", "asm_tau", "asm_v_crit", "asm_dv", "asm_c_free"):
+            check(math.isfinite(getattr(self, name)) and getattr(self, name) > 0, name,
+                  "a number > 0")
+        check(self.asm_c_cong < 0, "asm_c_cong", "a negative speed")
+
+    @property
+    def loop_noise(self) -> LoopNoise:
+        return LoopNoise(self.loop_flow_sd, self.loop_speed_sd, self.loop_density_sd)
+
+    @property
+    def probe_noise(self) -> ProbeNoise:
+        return ProbeNoise(self.probe_speed_sd)
+
+    @property
+    def asm(self) -> AsmParameters:
+        return AsmParameters(self.asm_c_free, self.asm_c_cong, self.asm_sigma, self.asm_tau,
+                             self.asm_v_crit, self.asm_dv)
+
+    def enkf(self, cells: int) -> EnkfOptions:
+        """The EnKF's options on ``cells`` cells (the controller's grid)."""
+        return EnkfOptions(members=self.members, cells=cells, inflation=self.inflation,
+                           localisation=self.localisation, seed=self.seed)
+
+    def as_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def check_sensors(est: EstimationSettings, layout: SensorLayout, length: float,
+                  at: str) -> None:
+    """Refuse a method the ``[sensing]`` layout cannot feed (one line naming both)."""
+    kinds = ", ".join(f'"{k}"' for k in layout.kinds)
+    if est.method == "smoothing" and not (layout.loops or layout.av_probes):
+        raise ScenarioError(f"{at} method = \"smoothing\" is not allowed with [sensing] "
+                            f"kinds = [{kinds}]: it needs \"loops\" or \"av_probes\"")
+    if est.method == "enkf":
+        if not layout.loops:
+            raise ScenarioError(f"{at} method = \"enkf\" is not allowed with [sensing] "
+                                f"kinds = [{kinds}]: it needs \"loops\" (stations at both "
+                                "boundaries)")
+        x = placed_positions(layout.loop_x(length), length)
+        if x.size < 2 or x[0] > INLET_GAP or x[-1] < length - BOUNDARY_GAP:
+            raise ScenarioError(f"{at} method = \"enkf\" is not allowed with [sensing] "
+                                f"loop_positions_m without 0 and {length:g}: its twins "
+                                "take their inflow and outflow from the boundary stations")
+
+
+def estimation_section(table: Mapping[str, Any], at: str) -> EstimationSettings:
+    """The EstimationSettings of an ``[estimation]`` table (keys already checked)."""
+    si = read_keys(table, ESTIMATION_KEYS, at)       # its own errors name key and value
+    try:
+        return EstimationSettings(**si)
+    except ArzsumoError as exc:
+        raise in_user_terms(exc, at, table, ESTIMATION_KEYS) from None
