@@ -105,7 +105,7 @@ def test_list_shows_shipped_scenarios_and_sweeps(capsys, monkeypatch):
     assert main(["list"]) == 0
     out = capsys.readouterr().out
     assert "scenarios/default.toml" in out
-    assert "Calibrated model at medium demand in SUMO; dynamic ETC on the ramp meter" in out
+    assert "Stationary congested section in SUMO (fill, then hold" in out
     assert "scenarios/sweeps/penetration_twin.toml" in out
     assert main(["list", "--json"]) == 0
     files = json.loads(capsys.readouterr().out)

@@ -20,8 +20,8 @@ CURVE = GreenShareCurve((0.0, 0.5, 1.0), tuple(veh_h_to_veh_s(q) for q in (5000,
 
 
 def _scenario(tmp_path: Path, meter_curve: str | None, curve: bool = True) -> Path:
-    """The default scenario, short, in ``tmp_path/sc/``, with its curve in ``sc/cal/``."""
-    text = default_scenario().read_text(encoding="utf-8")
+    """legacy_default, short, in ``tmp_path/sc/``, with its curve in ``sc/cal/``."""
+    text = (default_scenario().parent / "legacy_default.toml").read_text(encoding="utf-8")
     text = text.replace("warmup_s = 150", "warmup_s = 20")
     text = text.replace("kernel_cells = 100", "kernel_cells = 50")
     text = text.replace("twin_cells = 100", "twin_cells = 50")
