@@ -209,6 +209,11 @@ IDENTIFY_SUMMARY: dict[str, str] = {
     "runs.*.role": TEXT, "runs.*.seed": TEXT, "runs.*.point": TEXT,
     "runs.*.wall_time_s": "s", "runs.*.bridge_resyncs": "count",
     "runs.*.inserted_fraction_main": "1", "runs.*.mean_rho_*": "veh/m",
+    "rmse.*.blocks_relative": "1", "rmse.*.blocks": "count",
+    "runs.*.section_trend": TEXT, "runs.*.section_trend.slope_*": "veh/min",
+    "runs.*.section_trend.kendall_p": "1", "runs.*.section_trend.drift": "1",
+    "runs.*.section_trend.mean_veh": "veh", "runs.*.section_trend.blocks": "count",
+    "runs.*.section_trend.block_s": "s", "runs.*.section_trend.stationary": "bool",
     "wall_time.*": "s", "resolved_scenario.*": TEXT,
 }
 

@@ -33,6 +33,7 @@ import numpy as np
 from arzsumo.bridge.replay_data import replay_data_of, replay_options_of
 from arzsumo.bridge.session import run_in_sumo
 from arzsumo.errors import ArzsumoError, ScenarioError
+from arzsumo.evaluation.fields import field_rmse
 from arzsumo.identify import (
     DEFAULT_BOUNDS,
     DEFAULT_WHICH,
@@ -302,9 +303,24 @@ def score_run(params: ModelParameters, data: ReplayData, options: ReplayOptions,
         rmse[var] = {"absolute": math.sqrt(sums[0, j] / n) if n else math.nan,
                      "relative": math.sqrt(sums[1, j] / n) if n else math.nan,
                      "penalised": float(penalised[j]), "samples": int(n)}
+    blocks, n_blocks = field_rmse(data.fields, run.fields, *_block_shape(data))
+    for j, var in enumerate(VARIABLES):
+        rmse[var]["blocks_relative"] = float(blocks[j] / data.scale[j])
+        rmse[var]["blocks"] = int(n_blocks[j])
     lost = int(np.isnan(run.fields).all(axis=(1, 2)).sum())
     return RunScore(data.name, rmse, run.stopped, run.reason, lost, _beyond(params, data),
                     run.fields, sums)
+
+
+#: block of the RMSE at a macroscopic resolution (as ``rmse_blocks`` of ``arzsumo run``)
+BLOCK_M, BLOCK_S = 100.0, 10.0
+
+
+def _block_shape(data: ReplayData) -> tuple[int, int]:
+    """(periods, cells) per BLOCK_S x BLOCK_M block on the data's grid."""
+    dt = float(data.t[1] - data.t[0]) if data.t.size > 1 else float(data.t[0])
+    dx = float(data.x[1] - data.x[0])
+    return max(1, round(BLOCK_S / dt)), max(1, round(BLOCK_M / dx))
 
 
 @dataclass(frozen=True)

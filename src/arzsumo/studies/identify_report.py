@@ -28,7 +28,8 @@ import numpy as np
 
 from arzsumo import __version__
 from arzsumo.control.registry import is_pde
-from arzsumo.identify import VARIABLES
+from arzsumo.evaluation.stationarity import count_trend
+from arzsumo.identify import VARIABLES, ReplayData
 from arzsumo.identify.objective import DEFAULT_PENALTY as PENALTY
 from arzsumo.io import dump_toml, json_safe
 from arzsumo.model.characteristic import linearize
@@ -146,11 +147,23 @@ def _equilibrium(study: IdentifyStudy) -> dict[str, Any]:
     return out
 
 
+def _trend(data: ReplayData) -> dict[str, Any] | None:
+    """The section-count trend of a run's control window (``section_trend`` of a run)."""
+    dx = float(data.x[1] - data.x[0])
+    dt = float(data.t[1] - data.t[0]) if data.t.size > 1 else float(data.t[0])
+    count = np.nansum(data.fields[:, 0] + data.fields[:, 2], axis=1) * dx
+    try:
+        return count_trend(count, dt).as_dict()
+    except ValueError:
+        return None
+
+
 def _runs(study: IdentifyStudy) -> dict[str, Any]:
     return {r.task.run_id: {"role": r.task.role, "seed": r.task.seed,
                             "point": r.task.point.label, "wall_time_s": r.wall_time,
                             "bridge_resyncs": r.resyncs,
                             "inserted_fraction_main": r.delivered,
+                            "section_trend": _trend(r.data),
                             "mean_rho_h": float(np.nanmean(r.data.fields[:, 0])),
                             "mean_rho_a": float(np.nanmean(r.data.fields[:, 2]))}
             for r in study.runs}
