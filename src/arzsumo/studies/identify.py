@@ -234,22 +234,28 @@ def simulate(task: RunTask) -> SumoRun:
     return run
 
 
-#: the start's AO_max holds the 99.5th percentile of the observed AO within the replay's
-#: AO limit: a start below the data stops every replay and leaves the fit a flat penalty
-START_AO_QUANTILE = 99.5
+def ao_floor(params: ModelParameters, datasets: Sequence[ReplayData],
+             ao_limit: float) -> float:
+    """The smallest AO_max that holds every observed area occupancy (cells and inlet)
+    within the replay's AO limit ``ao_limit``: max AO / ao_limit (at most the bound 1).
 
-
-def start_params(params: ModelParameters, datasets: Sequence[ReplayData],
-                 ao_limit: float) -> ModelParameters:
-    """``params`` with each class's AO_max raised, where needed, so that the observed
-    area occupancies (percentile START_AO_QUANTILE) lie below ``ao_limit`` AO_max."""
+    Below it a replay stops where SUMO holds a state the model cannot (in practice in the
+    inlet cell, where the ghost-cell inlet compresses traffic), and the fit's objective
+    turns into a flat penalty; so it is the lower bound of AO_max in the fit, and the
+    start is raised to it.
+    """
     ao = []
     for d in datasets:
         seen = np.isfinite(d.fields[:, 0]) & np.isfinite(d.fields[:, 2])
         ao.append(area_occupancy(params, d.fields[:, 0][seen], d.fields[:, 2][seen]))
         ao.append(area_occupancy(params, d.inlet[:, 0], d.inlet[:, 2]))
-    need = min(float(np.percentile(np.concatenate(ao), START_AO_QUANTILE)) / ao_limit,
-               DEFAULT_BOUNDS["ao_max_h"][1])
+    return min(float(np.max(np.concatenate(ao))) / ao_limit, DEFAULT_BOUNDS["ao_max_h"][1])
+
+
+def start_params(params: ModelParameters, datasets: Sequence[ReplayData],
+                 ao_limit: float) -> ModelParameters:
+    """``params`` with each class's AO_max raised to :func:`ao_floor` where below it."""
+    need = ao_floor(params, datasets, ao_limit)
     return replace(params, ao_max_h=max(params.ao_max_h, need),
                    ao_max_a=max(params.ao_max_a, need))
 
@@ -412,7 +418,11 @@ def run_identification(setup: IdentifySetup) -> IdentifyStudy:
                  guess.ao_max_h, guess.ao_max_a)
     start = score_set(guess, train, opts)
     t2 = time.perf_counter()
-    fit = identify(train, guess, which=setup.which, options=opts, settings=setup.fit)
+    floor = ao_floor(guess, train, opts.ao_limit)
+    bounds = {name: (floor, 1.0) if name.startswith("ao_max") else DEFAULT_BOUNDS[name]
+              for name in setup.which}
+    fit = identify(train, guess, bounds, which=setup.which, options=opts,
+                   settings=setup.fit)
     t3 = time.perf_counter()
     training = score_set(fit.params, train, opts)
     validation = score_set(fit.params, held_out, opts)
