@@ -70,7 +70,9 @@ def test_writes_the_files_and_a_scenario_that_loads_with_the_identified_values(r
     runs = doc["runs"]
     means = [runs[r]["mean_rho_h"] for r in ("seed1", "seed2")]
     assert eq["rho_h"] == pytest.approx(sum(means) / 2, rel=1e-12)
-    assert sc.sumo == base.sumo and sc.name == "legacy_default_identified"
+    # the same SUMO runs: only the vehicle speeds are now stated (as the runs had them)
+    assert sc.sumo.with_(hv_max_speed=0.0, av_max_speed=0.0) == base.sumo
+    assert sc.name == "legacy_default_identified"
 
 
 @pytest.mark.sumo
@@ -101,6 +103,15 @@ def test_the_fit_does_not_increase_the_training_error_and_reports_both_sets(resu
 
 
 @pytest.mark.sumo
+def test_the_identified_scenario_keeps_the_sumo_vehicles_of_the_runs(result):
+    out, _ = result
+    sc, base = load_scenario(out / "identified.toml"), load_scenario(DEFAULT)
+    from arzsumo.sumo.vtypes import vehicle_types
+
+    assert [v.max_speed for v in vehicle_types(sc.params, sc.sumo)] == pytest.approx(
+        [v.max_speed for v in vehicle_types(base.params, base.sumo)], rel=1e-6)
+
+
 def test_the_identified_scenario_is_valid_for_run(result, capsys):
     out, _ = result
     assert main(["run", str(out / "identified.toml"), "--dry-run"]) == 0

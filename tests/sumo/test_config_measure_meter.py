@@ -76,6 +76,14 @@ def test_flows_request_exactly_and_are_sorted():
     assert begins == sorted(begins)
 
 
+def test_vehicle_speeds_come_from_the_sumo_table_when_given():
+    hv, av = vehicle_types(PARAMS, SumoConfig(hv_max_speed=25.0, av_max_speed=15.0))
+    assert (hv.max_speed, av.max_speed) == (25.0, 15.0)
+    assert 'maxSpeed="25.000000"' in hv.to_xml()
+    hv, av = vehicle_types(PARAMS, SumoConfig())
+    assert (hv.max_speed, av.max_speed) == (PARAMS.v_free_h, PARAMS.v_free_a)
+
+
 def test_a_fill_phase_requests_the_fill_demand_then_the_hold_demand():
     cfg = SumoConfig(horizon=1200, demand_h=3600 / 3600, demand_a=720 / 3600,
                      fill_duration=600, fill_demand_h=7200 / 3600, fill_demand_a=1440 / 3600)

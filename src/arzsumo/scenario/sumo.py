@@ -22,7 +22,7 @@ from typing import Any
 from arzsumo.errors import ArzsumoError, ScenarioError
 from arzsumo.sumo.config import AV_MODELS, HV_MODELS, SumoConfig
 from arzsumo.tables import Key, in_user_terms, read_keys, written
-from arzsumo.units import VEH_H_PER_VEH_S
+from arzsumo.units import KMH_PER_MS, VEH_H_PER_VEH_S
 
 _DEMAND = "a demand >= 0 veh/h"
 #: [sumo] key -> SumoConfig field (SI), with its unit factor
@@ -68,6 +68,10 @@ SUMO_KEYS: dict[str, Key] = {
                              doc="approach (buffer) edge before x = 0 where mainline vehicles "
                                  "are inserted and may queue; 0 inserts them at x = 0 on the "
                                  "shipped network"),
+    "hv_max_speed_kmh": Key("hv_max_speed", factor=KMH_PER_MS, unit="km/h",
+                            doc="HV maxSpeed in SUMO; 0: the model's V_h"),
+    "av_max_speed_kmh": Key("av_max_speed", factor=KMH_PER_MS, unit="km/h",
+                            doc="AV maxSpeed in SUMO; 0: the model's V_a"),
     "fill_s": Key("fill_duration", unit="s",
                   doc="fill phase from t = 0 of SUMO with the fill demands below; 0: none"),
     "fill_demand_h_veh_h": Key("fill_demand_h", factor=VEH_H_PER_VEH_S, allowed=_DEMAND,

@@ -38,7 +38,8 @@ from arzsumo.outputs.identify import FieldsPanel, ScatterPanel
 from arzsumo.scenario.model import MODEL_KEYS
 from arzsumo.schema import IDENTIFY_SUMMARY, key_units
 from arzsumo.studies.identify import IdentifyStudy, SetScore
-from arzsumo.units import veh_m_to_veh_km
+from arzsumo.sumo.vtypes import vehicle_types
+from arzsumo.units import ms_to_kmh, veh_m_to_veh_km
 
 #: significant digits of the identified values in identified.toml
 DIGITS = 7
@@ -97,6 +98,11 @@ def identified_toml(study: IdentifyStudy) -> str:
                     f"{rho_a:.2f} veh/km are beyond the identified AO_max.")
     if base.sumo.meter_curve:
         data["sumo"] = {**data.get("sumo", {}), "meter_curve": str(base.sumo.meter_curve)}
+    # SUMO's vehicles keep the speeds the runs had: the identified V_i describe SUMO
+    vtypes = vehicle_types(study.setup.scenario.params, study.setup.scenario.sumo)
+    data["sumo"] = {**data.get("sumo", {}),
+                    "hv_max_speed_kmh": round(ms_to_kmh(vtypes[0].max_speed), 6),
+                    "av_max_speed_kmh": round(ms_to_kmh(vtypes[1].max_speed), 6)}
     lines, table = [], ""
     for line in dump_toml(data).splitlines():
         if line.startswith("["):

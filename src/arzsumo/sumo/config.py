@@ -65,6 +65,10 @@ class SumoConfig:
     approach_length : float
         Length of the ``approach`` edge before x = 0 where mainline vehicles are inserted
         and may queue, m; 0 (default) inserts them at x = 0 on the shipped network.
+    hv_max_speed, av_max_speed : float
+        The vehicle types' maxSpeed, m/s; 0 (default) takes the model's free-flow speed
+        V_i. A scenario whose model is identified from SUMO states the speeds its SUMO
+        runs used, so that the fitted V_i do not change the traffic they were fitted to.
     fill_duration : float
         Length of the fill phase from t = 0 of SUMO, s; 0 (default) has none.
     fill_demand_h, fill_demand_a : float
@@ -98,6 +102,8 @@ class SumoConfig:
     min_gap_lat: float = 0.15
     meter_curve: str = ""
     approach_length: float = 0.0
+    hv_max_speed: float = 0.0
+    av_max_speed: float = 0.0
     fill_duration: float = 0.0
     fill_demand_h: float = 0.0
     fill_demand_a: float = 0.0
@@ -117,7 +123,8 @@ class SumoConfig:
                      "control_period", "meter_cycle", "min_gap_lat"):
             pos(name)
         for name in ("demand_h", "demand_a", "ramp_demand", "min_green", "min_red",
-                     "approach_length", "fill_duration", "fill_demand_h", "fill_demand_a"):
+                     "approach_length", "fill_duration", "fill_demand_h", "fill_demand_a",
+                     "hv_max_speed", "av_max_speed"):
             v = getattr(self, name)
             require(isinstance(v, int | float) and math.isfinite(v) and v >= 0, name, v,
                     "a finite number of at least 0", ScenarioError)

@@ -63,13 +63,15 @@ def vehicle_types(params: ModelParameters, cfg: SumoConfig) -> tuple[VehicleType
         hv_model: tuple[tuple[str, str], ...] = (("sigma", f"{cfg.hv_sigma:.3f}"),)
     else:
         hv_model = (("speedDev", "0.1"),)
-    hv = VehicleType(HV_TYPE, length, gap, params.vehicle_width, params.v_free_h,
+    hv = VehicleType(HV_TYPE, length, gap, params.vehicle_width,
+                     cfg.hv_max_speed or params.v_free_h,
                      cfg.hv_model,
                      (("vClass", "passenger"), ("accel", "2.6"), ("decel", "4.5"),
                       ("emergencyDecel", "9.0"), ("tau", "1.0"), ("speedFactor", "1"),
                       ("speedDev", "0.05"), *hv_model, ("color", "0.2,0.4,1"), *sub))
     length, gap = _geometry(params.spacing_a)
-    av = VehicleType(AV_TYPE, length, gap, params.vehicle_width, params.v_free_a,
+    av = VehicleType(AV_TYPE, length, gap, params.vehicle_width,
+                     cfg.av_max_speed or params.v_free_a,
                      cfg.av_model,
                      (("vClass", "passenger"), ("accel", "2.0"), ("decel", "4.5"),
                       ("emergencyDecel", "9.0"), ("tau", "1.0"), ("speedFactor", "1"),
