@@ -214,7 +214,7 @@ def run_netconvert(src_dir: Path, out_dir: Path) -> tuple[Path, bool]:
             raise SumoError(f"netconvert failed: {lines[-1] if lines else proc.returncode}")
         data = deterministic_net((Path(work) / NET_FILE).read_bytes())
     changed = write_if_changed(out_dir / NET_FILE, data)
-    log.info("network %s %s", "written to" if changed else "unchanged in", out_dir / NET_FILE)
+    log.debug("network %s %s", "written to" if changed else "unchanged in", out_dir / NET_FILE)
     return out_dir / NET_FILE, changed
 
 
