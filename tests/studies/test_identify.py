@@ -183,7 +183,7 @@ def test_the_fit_starts_from_an_ao_max_that_holds_the_observed_occupancy():
 
     from arzsumo.identify import ReplayData
     from arzsumo.model.fd import area_occupancy
-    from arzsumo.studies.identify import start_params
+    from arzsumo.studies.identify_scores import start_params
 
     params = load_scenario(DEFAULT).params                   # AO_max_a 0.56
     rho = np.array([0.120, 8.0, 0.065, 4.0])                 # AO above 0.56

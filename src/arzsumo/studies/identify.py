@@ -25,7 +25,7 @@ import logging
 import math
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -33,26 +33,25 @@ import numpy as np
 from arzsumo.bridge.replay_data import replay_data_of, replay_options_of
 from arzsumo.bridge.session import run_in_sumo
 from arzsumo.errors import ArzsumoError, ScenarioError
-from arzsumo.evaluation.fields import field_rmse
 from arzsumo.identify import (
     DEFAULT_BOUNDS,
     DEFAULT_WHICH,
-    VARIABLES,
     FitSettings,
     IdentificationResult,
     ReplayData,
     ReplayOptions,
-    ValidationReport,
     identify,
-    run_replay,
-    validate,
 )
-from arzsumo.identify.objective import DEFAULT_PENALTY
 from arzsumo.model.equilibrium import Equilibrium
-from arzsumo.model.fd import area_occupancy
 from arzsumo.model.params import ModelParameters
 from arzsumo.scenario import Scenario, scenario_from_dict
 from arzsumo.studies.identify_cache import load_run, run_key, save_run
+from arzsumo.studies.identify_scores import (
+    SetScore,
+    ao_floor,
+    score_set,
+    start_params,
+)
 from arzsumo.sweep.driver import default_workers, map_runs
 
 log = logging.getLogger(__name__)
@@ -232,135 +231,6 @@ def simulate(task: RunTask) -> SumoRun:
     save_run(key, data, {"wall_time": run.wall_time, "resyncs": run.resyncs,
                          "delivered": run.delivered})
     return run
-
-
-def ao_floor(params: ModelParameters, datasets: Sequence[ReplayData],
-             ao_limit: float) -> float:
-    """The smallest AO_max that holds every observed area occupancy (cells and inlet)
-    within the replay's AO limit ``ao_limit``: max AO / ao_limit (at most the bound 1).
-
-    Below it a replay stops where SUMO holds a state the model cannot (in practice in the
-    inlet cell, where the ghost-cell inlet compresses traffic), and the fit's objective
-    turns into a flat penalty; so it is the lower bound of AO_max in the fit, and the
-    start is raised to it.
-    """
-    ao = []
-    for d in datasets:
-        seen = np.isfinite(d.fields[:, 0]) & np.isfinite(d.fields[:, 2])
-        ao.append(area_occupancy(params, d.fields[:, 0][seen], d.fields[:, 2][seen]))
-        ao.append(area_occupancy(params, d.inlet[:, 0], d.inlet[:, 2]))
-    return min(float(np.max(np.concatenate(ao))) / ao_limit, DEFAULT_BOUNDS["ao_max_h"][1])
-
-
-def start_params(params: ModelParameters, datasets: Sequence[ReplayData],
-                 ao_limit: float) -> ModelParameters:
-    """``params`` with each class's AO_max raised to :func:`ao_floor` where below it."""
-    need = ao_floor(params, datasets, ao_limit)
-    return replace(params, ao_max_h=max(params.ao_max_h, need),
-                   ao_max_a=max(params.ao_max_a, need))
-
-
-@dataclass(frozen=True)
-class RunScore:
-    """The replay of one run under one parameter set, against the run.
-
-    ``rmse[var]`` holds ``absolute`` (SI, over the values the replay predicted),
-    ``relative`` (the same over the run's equilibrium value), ``penalised`` (relative,
-    values the replay could not predict counted with the fit's penalty: what the fit
-    minimises) and ``samples``. ``stopped`` is when the replay twin left the physical
-    domain (None if it completed), ``periods_not_predicted`` the periods from there on.
-    ``beyond_ao_max`` counts observed cells (period x cell) whose AO exceeds the model's
-    AO_max (``model``: the smaller of the classes', where the model cannot go) and each
-    class's (``h``, ``a``), out of ``observed``.
-    """
-
-    name: str
-    rmse: dict[str, dict[str, float]]
-    stopped: float | None
-    reason: str
-    periods_not_predicted: int
-    beyond_ao_max: dict[str, int]
-    predicted: np.ndarray
-    sums: np.ndarray          # (3, 4): squared absolute and relative errors, counts
-
-
-def _beyond(params: ModelParameters, data: ReplayData) -> dict[str, int]:
-    rho = data.fields[:, [0, 2]]
-    seen = np.isfinite(rho).all(axis=1)
-    ao = area_occupancy(params, np.where(seen, rho[:, 0], 0.0), np.where(seen, rho[:, 1], 0.0))
-    return {"model": int((ao[seen] > params.ao_max).sum()),
-            "h": int((ao[seen] > params.ao_max_h).sum()),
-            "a": int((ao[seen] > params.ao_max_a).sum()), "observed": int(seen.sum())}
-
-
-def score_run(params: ModelParameters, data: ReplayData, options: ReplayOptions,
-              penalised: np.ndarray) -> RunScore:
-    """:class:`RunScore` of ``data`` under ``params``; ``penalised`` (4,) from
-    :func:`arzsumo.identify.validate`."""
-    run = run_replay(params, data, options)
-    both = data.mask & np.isfinite(run.fields)
-    err = np.where(both, run.fields - np.where(data.mask, data.fields, 0.0), 0.0)
-    sums = np.vstack([(err ** 2).sum(axis=(0, 2)),
-                      ((err / data.scale[None, :, None]) ** 2).sum(axis=(0, 2)),
-                      both.sum(axis=(0, 2))])
-    rmse = {}
-    for j, var in enumerate(VARIABLES):
-        n = sums[2, j]
-        rmse[var] = {"absolute": math.sqrt(sums[0, j] / n) if n else math.nan,
-                     "relative": math.sqrt(sums[1, j] / n) if n else math.nan,
-                     "penalised": float(penalised[j]), "samples": int(n)}
-    blocks, n_blocks = field_rmse(data.fields, run.fields, *_block_shape(data))
-    for j, var in enumerate(VARIABLES):
-        rmse[var]["blocks_relative"] = float(blocks[j] / data.scale[j])
-        rmse[var]["blocks"] = int(n_blocks[j])
-    lost = int(np.isnan(run.fields).all(axis=(1, 2)).sum())
-    return RunScore(data.name, rmse, run.stopped, run.reason, lost, _beyond(params, data),
-                    run.fields, sums)
-
-
-#: block of the RMSE at a macroscopic resolution (as ``rmse_blocks`` of ``arzsumo run``)
-BLOCK_M, BLOCK_S = 100.0, 10.0
-
-
-def _block_shape(data: ReplayData) -> tuple[int, int]:
-    """(periods, cells) per BLOCK_S x BLOCK_M block on the data's grid."""
-    dt = float(data.t[1] - data.t[0]) if data.t.size > 1 else float(data.t[0])
-    dx = float(data.x[1] - data.x[0])
-    return max(1, round(BLOCK_S / dt)), max(1, round(BLOCK_M / dx))
-
-
-@dataclass(frozen=True)
-class SetScore:
-    """Scores of a set of runs (training or validation) under one parameter set.
-
-    ``pooled[var]``: ``absolute``, ``relative`` and ``penalised`` RMSE over all runs'
-    values; ``total``: the penalised relative RMSE over every variable and value (the
-    fit's objective as an RMSE: sqrt(2 cost / residuals)).
-    """
-
-    runs: tuple[RunScore, ...]
-    report: ValidationReport
-    pooled: dict[str, dict[str, float]]
-    total: float
-
-
-def score_set(params: ModelParameters, datasets: Sequence[ReplayData],
-              options: ReplayOptions) -> SetScore:
-    """Validate ``params`` on ``datasets`` (:func:`arzsumo.identify.validate`) and score
-    each run (:func:`score_run`)."""
-    report = validate(params, datasets, options, DEFAULT_PENALTY)
-    runs = tuple(score_run(params, d, options, report.rmse[i])
-                 for i, d in enumerate(datasets))
-    sums = sum(r.sums for r in runs)
-    observed = np.array([d.mask.sum(axis=(0, 2)) for d in datasets], float)
-    pooled = {}
-    for j, var in enumerate(VARIABLES):
-        n = sums[2, j]
-        pooled[var] = {"absolute": math.sqrt(sums[0, j] / n) if n else math.nan,
-                       "relative": math.sqrt(sums[1, j] / n) if n else math.nan,
-                       "penalised": float(report.pooled[j])}
-    total = math.sqrt(float((report.rmse ** 2 * observed).sum() / observed.sum()))
-    return SetScore(runs, report, pooled, total)
 
 
 @dataclass(frozen=True)

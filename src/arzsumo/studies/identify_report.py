@@ -37,7 +37,8 @@ from arzsumo.outdir import OutputDir
 from arzsumo.outputs.identify import FieldsPanel, ScatterPanel
 from arzsumo.scenario.model import MODEL_KEYS
 from arzsumo.schema import IDENTIFY_SUMMARY, key_units
-from arzsumo.studies.identify import IdentifyStudy, SetScore
+from arzsumo.studies.identify import IdentifyStudy
+from arzsumo.studies.identify_scores import SetScore
 from arzsumo.sumo.vtypes import vehicle_types
 from arzsumo.units import ms_to_kmh, veh_m_to_veh_km
 
