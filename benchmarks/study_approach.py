@@ -110,14 +110,35 @@ def initial_vehicles(params: Any, cfg: Any) -> list[Any]:
                           INIT_RHO_A / 1000 * one, v)[0]
 
 
+def open_loop(params: Any, cfg: Any, warmup: float, initial: list[Any] | None = None
+              ) -> tuple[list[Any], list[int], tuple[int, float], int, Any]:
+    """One open-loop run (nominal meter): the Edie cells and approach counts of every period
+    after ``warmup`` s, the approach's vehicles and queue (m) and the ramp queue at the end,
+    and SUMO's run report."""
+    from arzsumo.sumo.meter import RampMeter
+    from arzsumo.sumo.sensor import SumoSensor
+    from arzsumo.sumo.simulation import open_simulation
+
+    cells, n_app = [], []
+    with open_simulation(params, cfg, initial=initial or []) as sim:
+        meter = RampMeter(sim.lib, cfg)
+        sensor = SumoSensor(sim.lib, params.length, cfg)
+        while sim.time < cfg.horizon - 1e-9:
+            got = sensor.observe(sim.step())
+            meter.step(sensor.queue)
+            if got is not None and got.t > warmup + 1e-9:
+                cells.append(got.cells)
+                n_app.append(sim.lib.edge.getLastStepVehicleNumber("approach"))
+        end = queue_end(sim.lib, cfg.approach_length)
+        ramp_q = sensor.queue
+    return cells, n_app, end, ramp_q, sim.report
+
+
 def run_point(demand: float, green: float, sigma: float, seed: int, approach: float,
               warmup: float, measured: float, step: float, initial: bool,
               av_share: float = AV_SHARE) -> dict[str, Any]:
     """One open-loop run; returns the CSV row (units in the column names)."""
     from arzsumo.scenario import load_scenario
-    from arzsumo.sumo.meter import RampMeter
-    from arzsumo.sumo.sensor import SumoSensor
-    from arzsumo.sumo.simulation import open_simulation
 
     t0 = time.perf_counter()
     sc = load_scenario(SCENARIO)
@@ -125,20 +146,8 @@ def run_point(demand: float, green: float, sigma: float, seed: int, approach: fl
         demand_h=demand * (1 - av_share) / 3600, demand_a=demand * av_share / 3600,
         green_share=green, hv_sigma=sigma, seed=seed, approach_length=approach,
         horizon=warmup + measured, step_length=step)
-    cells, n_app = [], []
     init = initial_vehicles(sc.params, cfg) if initial else []
-    with open_simulation(sc.params, cfg, initial=init) as sim:
-        meter = RampMeter(sim.lib, cfg)
-        sensor = SumoSensor(sim.lib, sc.params.length, cfg)
-        while sim.time < cfg.horizon - 1e-9:
-            got = sensor.observe(sim.step())
-            meter.step(sensor.queue)
-            if got is not None and got.t > warmup + 1e-9:
-                cells.append(got.cells)
-                n_app.append(sim.lib.edge.getLastStepVehicleNumber("approach"))
-        app_veh, queue_m = queue_end(sim.lib, approach)
-        ramp_q = sensor.queue
-    rep = sim.report
+    cells, n_app, (app_veh, queue_m), ramp_q, rep = open_loop(sc.params, cfg, warmup, init)
     row = {"demand_veh_h": demand, "green_share": green, "hv_sigma": sigma, "seed": seed,
            "approach_m": approach, "step_s": step, "initial": int(initial),
            "av_share": av_share,

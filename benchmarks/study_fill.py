@@ -26,7 +26,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from study_approach import SCENARIO, queue_end, regime, summarise, trend
+from study_approach import SCENARIO, open_loop, regime, summarise, trend
 
 FIELDS = ["hold_h_veh_h", "hold_a_veh_h", "fill_h_veh_h", "fill_a_veh_h", "fill_s",
           "green_share", "hv_sigma", "seed", "approach_m", "step_s", "warmup_s",
@@ -42,9 +42,6 @@ KEY = FIELDS[:12]
 def run_point(p: dict[str, Any]) -> dict[str, Any]:
     """One open-loop run of point ``p`` (the KEY columns); returns the CSV row."""
     from arzsumo.scenario import load_scenario
-    from arzsumo.sumo.meter import RampMeter
-    from arzsumo.sumo.sensor import SumoSensor
-    from arzsumo.sumo.simulation import open_simulation
 
     t0 = time.perf_counter()
     sc = load_scenario(SCENARIO)
@@ -54,19 +51,7 @@ def run_point(p: dict[str, Any]) -> dict[str, Any]:
         fill_duration=p["fill_s"], green_share=p["green_share"], hv_sigma=p["hv_sigma"],
         seed=int(p["seed"]), approach_length=p["approach_m"], step_length=p["step_s"],
         horizon=p["warmup_s"] + p["measured_s"])
-    cells, n_app = [], []
-    with open_simulation(sc.params, cfg) as sim:
-        meter = RampMeter(sim.lib, cfg)
-        sensor = SumoSensor(sim.lib, sc.params.length, cfg)
-        while sim.time < cfg.horizon - 1e-9:
-            got = sensor.observe(sim.step())
-            meter.step(sensor.queue)
-            if got is not None and got.t > p["warmup_s"] + 1e-9:
-                cells.append(got.cells)
-                n_app.append(sim.lib.edge.getLastStepVehicleNumber("approach"))
-        app_veh, queue_m = queue_end(sim.lib, p["approach_m"])
-        ramp_q = sensor.queue
-    rep = sim.report
+    cells, n_app, (app_veh, queue_m), ramp_q, rep = open_loop(sc.params, cfg, p["warmup_s"])
     row = dict(p)
     row.update(summarise(cells, cfg.cell_length))
     for c in "ha":
