@@ -28,22 +28,26 @@ def detector_ids(n: int) -> list[str]:
     return [f"e2_{k:03d}" for k in range(n)]
 
 
+def write_additional(path: Path, tag: str, elements: list[dict[str, str]]) -> Path:
+    """Write a SUMO additional file of ``<tag .../>`` elements (attributes as given),
+    atomically, and return its path."""
+    lines = ["    <" + tag + " " + " ".join(f"{a}={quoteattr(v)}" for a, v in e.items()) + "/>"
+             for e in elements]
+    with atomic_file(path) as tmp:
+        tmp.write_text("<additional>\n" + "\n".join(lines) + "\n</additional>\n",
+                       encoding="utf-8")
+    return path
+
+
 def write_e2_chain(path: Path, length: float, cell_length: float, period: float = 60.0) -> Path:
     """Write an additional file with one E2 detector per cell of ``main_0``."""
     n = round(length / cell_length)
     require(abs(n * cell_length - length) < 1e-9, "cell_length", cell_length,
             f"a length dividing the road length {length} m")
-    lines = []
-    for k, det in enumerate(detector_ids(n)):
-        attrs = {"id": det, "lane": f"{MAIN}_0", "pos": f"{k * cell_length:.3f}",
+    elements = [{"id": det, "lane": f"{MAIN}_0", "pos": f"{k * cell_length:.3f}",
                  "endPos": f"{(k + 1) * cell_length:.3f}", "period": f"{period:g}",
-                 "file": "e2_output.xml"}
-        lines.append("    <laneAreaDetector "
-                     + " ".join(f"{a}={quoteattr(v)}" for a, v in attrs.items()) + "/>")
-    with atomic_file(path) as tmp:
-        tmp.write_text("<additional>\n" + "\n".join(lines) + "\n</additional>\n",
-                       encoding="utf-8")
-    return path
+                 "file": "e2_output.xml"} for k, det in enumerate(detector_ids(n))]
+    return write_additional(path, "laneAreaDetector", elements)
 
 
 class E2Sensor:

@@ -38,13 +38,12 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 from types import ModuleType
-from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
 from arzsumo.errors import ScenarioError, require
 from arzsumo.estimate.observations import LoopNoise, LoopObservation
-from arzsumo.io import atomic_file
+from arzsumo.sumo.detectors import write_additional
 from arzsumo.sumo.network import MAIN
 from arzsumo.sumo.vtypes import AV_TYPE
 
@@ -82,16 +81,9 @@ def placed_positions(x: Sequence[float], length: float) -> np.ndarray:
 def write_loops(path: Path, x: Sequence[float], length: float) -> Path:
     """Write an additional file with one E1 station per position of ``main_0``."""
     placed = placed_positions(x, length)
-    lines = []
-    for det, pos in zip(loop_ids(placed.size), placed, strict=True):
-        attrs = {"id": det, "lane": f"{MAIN}_0", "pos": f"{pos:.3f}", "period": "3600",
-                 "file": "NUL"}
-        lines.append("    <inductionLoop "
-                     + " ".join(f"{a}={quoteattr(v)}" for a, v in attrs.items()) + "/>")
-    with atomic_file(path) as tmp:
-        tmp.write_text("<additional>\n" + "\n".join(lines) + "\n</additional>\n",
-                       encoding="utf-8")
-    return path
+    elements = [{"id": det, "lane": f"{MAIN}_0", "pos": f"{pos:.3f}", "period": "3600",
+                 "file": "NUL"} for det, pos in zip(loop_ids(placed.size), placed, strict=True)]
+    return write_additional(path, "inductionLoop", elements)
 
 
 class LoopSensor:
