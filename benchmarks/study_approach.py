@@ -152,16 +152,23 @@ def run_point(demand: float, green: float, sigma: float, seed: int, approach: fl
            "approach_m": approach, "step_s": step, "initial": int(initial),
            "av_share": av_share,
            "warmup_s": warmup, "measured_s": measured}
-    row.update(summarise(cells, cfg.cell_length))
+    row.update(run_measures(cfg, cells, n_app, (app_veh, queue_m), ramp_q, rep))
+    row["wall_s"] = time.perf_counter() - t0
+    return row
+
+
+def run_measures(cfg: Any, cells: list[Any], n_app: list[int], end: tuple[int, float],
+                 ramp_q: int, rep: Any) -> dict[str, Any]:
+    """The CSV columns of one run from :func:`open_loop`'s results (units in the names)."""
+    row = summarise(cells, cfg.cell_length)
     row["inserted_main"] = rep.delivered_main
-    row["approach_veh_end"], row["queue_m_end"] = app_veh, queue_m
+    row["approach_veh_end"], row["queue_m_end"] = end
     row["approach_slope_veh_min"] = trend(np.asarray(n_app, float),
                                           cfg.control_period)["slope_veh_min"]
     row["ramp_queue_end"] = ramp_q
     row["lambda4_kmh"], row["regime"] = regime(row["rho_h_veh_km"], row["rho_a_veh_km"])
     row["collisions"], row["emergency_stops"] = rep.collisions, rep.emergency_stops
     row["stationary"] = int(row["kendall_p"] > 0.05 and abs(row["drift_rel"]) < 0.1)
-    row["wall_s"] = time.perf_counter() - t0
     return row
 
 

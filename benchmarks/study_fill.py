@@ -26,7 +26,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from study_approach import SCENARIO, open_loop, regime, summarise, trend
+from study_approach import SCENARIO, open_loop, run_measures
 
 FIELDS = ["hold_h_veh_h", "hold_a_veh_h", "fill_h_veh_h", "fill_a_veh_h", "fill_s",
           "green_share", "hv_sigma", "seed", "approach_m", "step_s", "warmup_s",
@@ -53,18 +53,10 @@ def run_point(p: dict[str, Any]) -> dict[str, Any]:
         horizon=p["warmup_s"] + p["measured_s"])
     cells, n_app, (app_veh, queue_m), ramp_q, rep = open_loop(sc.params, cfg, p["warmup_s"])
     row = dict(p)
-    row.update(summarise(cells, cfg.cell_length))
+    row.update(run_measures(cfg, cells, n_app, (app_veh, queue_m), ramp_q, rep))
     for c in "ha":
         row[f"outflow_{c}_veh_h"] = float(np.mean([getattr(d, f"outflow_{c}") for d in cells])
                                           * 3600)
-    row["inserted_main"] = rep.delivered_main
-    row["approach_veh_end"], row["queue_m_end"] = app_veh, queue_m
-    row["approach_slope_veh_min"] = trend(np.asarray(n_app, float),
-                                          cfg.control_period)["slope_veh_min"]
-    row["ramp_queue_end"] = ramp_q
-    row["lambda4_kmh"], row["regime"] = regime(row["rho_h_veh_km"], row["rho_a_veh_km"])
-    row["collisions"], row["emergency_stops"] = rep.collisions, rep.emergency_stops
-    row["stationary"] = int(row["kendall_p"] > 0.05 and abs(row["drift_rel"]) < 0.1)
     row["ok"] = int(row["stationary"] and row["lambda4_kmh"] < 0
                     and row["inserted_main"] >= 0.98)
     row["wall_s"] = time.perf_counter() - t0
