@@ -89,6 +89,12 @@ DESIGN_KEYS: dict[str, Key] = {
     "varsigma": Key("varsigma", "numbers", doc="weights varsigma (one per state: 4 numbers)"),
     "mu": Key("mu", doc="ETC weight mu of the triggering condition"),
     "m0": Key("m0", doc="initial value m(0) < 0 of the dynamic variable (not in the paper)"),
+    "noise_sd_kmh": Key("noise_sd", "numbers", factor=KMH_PER_MS, unit="km/h",
+                        allowed="4 standard deviations >= 0 km/h (one per state)",
+                        doc="noise sd of each scaled Riemann variable on the state the ETC "
+                            "sees (default: none, no dead band; not in the paper)"),
+    "noise_k": Key("noise_k", doc="trigger dead band in noise sds of the trigger error d "
+                                  "(with noise_sd_kmh; not in the paper)"),
 }
 
 
