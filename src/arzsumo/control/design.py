@@ -22,12 +22,13 @@ one that cannot is named with its reason. The constants are those of
    1/2: half of the nominal rate mu goes to the triggering threshold.
 4. **B, varsigma_4** (select2, select4): B = max(2 sum A_i q_i^2, c Lambda-), so that B
    does not lower p_3, and varsigma_4 = (B - sum A_i q_i^2) / 2: half of select4's slack.
-   select2's right side is then 0.
+   select2 then reads varsigma_4 >= 4 zeta mu varsigma_4, i.e. zeta mu <= 1/4 (step 6).
 5. **varsigma_1..n** (select3) = A_i e^(-mu L/lambda_i) / 2 = c lambda_i / 2: half of
    what select3 allows. Larger varsigma make m more negative (fewer events).
 6. **zeta** (select1) = the largest with margin two: min_i varsigma_i / (2 max(B e^(mu
-   L/Lambda-), mu) eps_i). tau* of Theorem minimalthm grows with zeta (varphi_1, varphi_2
-   fall), so zeta is as large as select1 allows.
+   L/Lambda-), mu) eps_i), and at most 1 / (8 mu) (select2 with margin two). tau* of
+   Theorem minimalthm grows with zeta (varphi_1, varphi_2 fall), so zeta is as large as
+   select1 and select2 allow.
 7. **eta** = mu (1 - sigma): m forgets at the nominal rate of V; it exceeds mu (1 - sigma)
    - gamma, so esthm #2 holds.
 8. **c**: the scale of V is free (every condition is homogeneous in A, B, varsigma); c
@@ -116,12 +117,13 @@ def _weights(system: CharacteristicSystem, mu: float) -> tuple[np.ndarray, float
 
 def _zeta(system: CharacteristicSystem, eps: np.ndarray, vs: np.ndarray, B: float,
           mu: float) -> float:
-    """The largest zeta select1 allows, with margin two (step 6); 1 without any eps_i > 0."""
+    """The largest zeta select1 and select2 allow, with margin two (step 6)."""
     b_exp = B * math.exp(mu * system.length / system.lam_minus)
     pos = eps > 0
+    cap = 1.0 / (4 * MARGIN * mu)
     if not np.any(pos):
-        return 1.0
-    return float(np.min(vs[pos] / (MARGIN * max(b_exp, mu) * eps[pos])))
+        return cap
+    return min(cap, float(np.min(vs[pos] / (MARGIN * max(b_exp, mu) * eps[pos]))))
 
 
 def design_for(system: CharacteristicSystem, kernels: Kernels,

@@ -64,7 +64,7 @@ class EtcDesign:
     mu: float = 5e-4
     m0: float = -1e-2
     noise_sd: tuple[float, ...] = ()
-    noise_k: float = 3.0
+    noise_k: float = 2.0
 
     def __post_init__(self) -> None:
         for name in ("A", "varsigma", "noise_sd"):
