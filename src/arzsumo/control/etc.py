@@ -33,7 +33,8 @@ delivers, d(t) = sat(U-bar(t_k)) - sat(U-bar(t)) (both projected on the range in
 V's forcing of mdyna and in defdynamic. A law that stays beyond a bound then gives d = 0:
 no event fires for a command that cannot arrive. Without a range (the default, infinite
 bounds) d is dt's exactly. The rate limit is left out of the projection: it only delays
-the held command (as the meter's cycle does), which then arrives; it is no windup.
+the held command (as the meter's cycle does), which then arrives; it is no windup. The
+noise dead band acts on the projected d.
 
 Lemma mbound guarantees m < 0 under continuous monitoring. With periodic checks the
 condition can be violated between checks unseen, so m may creep above zero: every such
