@@ -23,6 +23,19 @@ d_delta = sign(d) max(|d| - delta, 0) instead of d, with delta = noise_k sqrt(2)
 pure noise of that level (|d| <= delta) neither raises m nor triggers. With delta = 0
 this is the paper's mechanism.
 
+Anti-windup (issue 17). When the actuator limits U to a range [U_lo, U_hi] (saturation:
+:func:`arzsumo.bridge.actuator.limit_u`), the boundary input the plant receives is
+sat(U-bar(t_k)), not control law sam's U-bar(t_k), and a d of dt computed on the raw values
+misjudges what reaches the boundary: changes of the law inside the saturated region would
+fire events that change nothing at the meter. With the range handed to the controller
+(:meth:`EventTriggered.applied`), the mechanism uses the discrepancy of what the actuator
+delivers, d(t) = sat(U-bar(t_k)) - sat(U-bar(t)) (both projected on the range in force), in
+V's forcing of mdyna and in defdynamic. A law that stays beyond a bound then gives d = 0:
+no event fires for a command that cannot arrive. Without a range (the default, infinite
+bounds) d is dt's exactly. The rate limit is left out of the projection: it only delays
+the held command (as the meter's cycle does), which then arrives; it is no windup. The
+noise dead band acts on the projected d.
+
 Lemma mbound guarantees m < 0 under continuous monitoring. With periodic checks the
 condition can be violated between checks unseen, so m may creep above zero: every such
 check is counted in the log (``m_nonnegative``), never clamped.
@@ -132,6 +145,13 @@ def noise_dead_band(design: EtcDesign, gain: np.ndarray) -> float:
     return design.noise_k * math.sqrt(2.0 * float(np.sum((sd * gain) ** 2)))
 
 
+def u_bar_range(lower: float, upper: float, per: float) -> tuple[float, float]:
+    """The range ``[lower, upper]`` of U (veh/s) in U-bar units (``per`` = U-bar per U,
+    either sign), as ``(low, high)``."""
+    a, b = lower * per, upper * per
+    return (a, b) if a <= b else (b, a)
+
+
 @dataclass(frozen=True)
 class CheckResult:
     """Outcome of one check: the held U-bar, the continuous U-bar and diagnostics."""
@@ -163,6 +183,8 @@ class EventTrigger:
         self.t_last: float | None = None
         self.u_held: float | None = None
         self.g_last = 0.0
+        #: range of U-bar the actuator delivers (anti-windup); infinite: no limits known
+        self.bounds = (-math.inf, math.inf)
 
     def _forcing(self, d: float, V: float, alpha: np.ndarray, beta: np.ndarray) -> float:
         ds = self.design
@@ -180,7 +202,8 @@ class EventTrigger:
             self.u_held, self.t_last = u_cont, t
             self.g_last = self._forcing(0.0, V, alpha, beta)
             return CheckResult(u_cont, u_cont, True, V, 0.0, self.m)
-        d = self.u_held - u_cont
+        lo, hi = self.bounds                         # anti-windup: what can be delivered
+        d = min(max(self.u_held, lo), hi) - min(max(u_cont, lo), hi)
         d_db = math.copysign(max(abs(d) - self.dead_band, 0.0), d)
         g = self._forcing(d_db, V, alpha, beta)
         self.m = integrate_m(self.m, self.g_last, g, ds.eta, t - (self.t_last or t))
@@ -210,6 +233,11 @@ class EventTriggered(Controller):
     def reset(self) -> None:
         super().reset()
         self.trigger.reset()
+
+    def applied(self, u: float, lower: float = -math.inf, upper: float = math.inf) -> None:
+        """Anti-windup: the trigger compares what the actuator delivers in ``[lower,
+        upper]`` (veh/s) from the next check on (module docstring)."""
+        self.trigger.bounds = u_bar_range(lower, upper, self.lin.u_bar_per_u)
 
     def check_riemann(self, t: float, w_bar: np.ndarray) -> float:
         """Check on a scaled Riemann state at the kernel nodes; returns the held U-bar."""
