@@ -169,6 +169,8 @@ RUN_SUMMARY: dict[str, str] = {
     "estimation.rho_*.absolute": "veh/m", "estimation.v_*.absolute": "m/s",
     "estimation.*.rho_*.absolute": "veh/m", "estimation.*.v_*.absolute": "m/s",
     "estimation.*.relative": "1", "estimation.*.samples": "count",
+    "estimation.reference": TEXT, "estimation.reference_offset": TEXT,   # null: none
+    "estimation.reference_offset.rho_*": "veh/m", "estimation.reference_offset.v_*": "m/s",
     "actuation.u_max_fraction": "1", "actuation.u_max": "veh/s",
     "actuation.u_rate_max": "veh/s^2", "actuation.rate_step": "veh/s",
     "actuation.ramp_bound": "bool", "actuation.anti_windup": "bool", "actuation.applies": "bool",

@@ -55,6 +55,7 @@ from arzsumo.bridge.actuator import ActuationLimits, MeterActuator
 from arzsumo.bridge.estimator import Estimator
 from arzsumo.bridge.estimators import RecordedEstimator, estimation_stage
 from arzsumo.bridge.records import Decision, PeriodRecord, Trace, columns, micro_fields
+from arzsumo.bridge.reference import ReferenceShift, reference_shift
 from arzsumo.bridge.twins import TwinPair
 from arzsumo.control.base import Controller, ControlLog, MacroState
 from arzsumo.control.etc import EtcDesign
@@ -137,6 +138,9 @@ class CoSimResult:
     #: estimator's record (:class:`~arzsumo.bridge.estimators.RecordedEstimator`)
     estimate: np.ndarray | None = None
     estimator: RecordedEstimator | None = None
+    #: the offset subtracted from the controller's input (:mod:`~arzsumo.bridge.reference`),
+    #: None when its deviations are measured from the equilibrium
+    shift: ReferenceShift | None = None
 
 
 class SumoPlant:
@@ -227,17 +231,17 @@ class ClosedLoop:
 
     def __init__(self, plant: SumoPlant, estimator: Estimator, controller: Controller,
                  actuator: MeterActuator, twins: TwinPair, period: float,
-                 anti_windup: bool = True) -> None:
+                 anti_windup: bool = True, shift: ReferenceShift | None = None) -> None:
         self.plant, self.estimator, self.controller = plant, estimator, controller
         self.actuator, self.twins, self.period = actuator, twins, period
-        self.anti_windup = anti_windup
+        self.anti_windup, self.shift = anti_windup, shift
         self.timings = {"controller": 0.0, "twins": 0.0, "estimator": 0.0}
 
     def decide(self, state: MacroState, final: bool) -> Decision:
         """Check the controller and the reference twin's; command the meter unless this
         is the ``final`` check."""
         c0 = time.perf_counter()
-        u = self.controller.check(state)
+        u = self.controller.check(self.shift.apply(state) if self.shift else state)
         c1 = time.perf_counter()
         u_ref = self.twins.check_reference()
         self.timings["controller"] += c1 - c0
@@ -356,7 +360,8 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
                        placement, time.perf_counter() - wall0,
                        {**loop.plant.timings, **loop.timings}, c.warmup_meter, network,
                        loop.plant.sensor.speeds.summary(), trace.start,
-                       np.asarray(c.estimator.fields[1:]), c.estimator)
+                       np.asarray(c.estimator.fields[1:]), c.estimator,
+                       loop.shift)
 
 
 def control(sim: SumoSimulation, scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
@@ -378,7 +383,10 @@ def control(sim: SumoSimulation, scenario: Scenario, settings: RunSettings, cfg:
     target = occupancy_target(settings, warm, period)
     estimator, acting = estimation_stage(scenario.estimation, scenario.sensing,
                                          settings.controller, eq, warm[-1].cells.x)
-    estimator.prime(warm[:-1], warm[-1].t)
+    est = scenario.estimation
+    warm_fields = estimator.prime(warm[:-1], warm[-1].t)
+    shift = (reference_shift(est.reference, warm_fields, eq, est.reference_window, period)
+             if is_pde(acting) and est.reference != "equilibrium" and warm_fields else None)
     ctrl = build_controller(acting, lin, kernels, design, settings, curve, cfg, target)
     ref_name = settings.controller if is_pde(settings.controller) else "open"
     ref_ctrl = build_controller(ref_name, lin, kernels, design, settings, curve, cfg, target)
@@ -389,6 +397,7 @@ def control(sim: SumoSimulation, scenario: Scenario, settings: RunSettings, cfg:
     act = scenario.actuation
     actuator = MeterActuator(plant.meter, q_nom, settings.controller == "open",
                              ActuationLimits.of(act, q_nom, curve, cfg))
-    loop = ClosedLoop(plant, estimator, ctrl, actuator, twins, period, act.anti_windup)
+    loop = ClosedLoop(plant, estimator, ctrl, actuator, twins, period, act.anti_windup,
+                      shift)
     trace = loop.run(warm[-1], cfg.horizon, bar)
     return Controlled(loop, trace, ref_ctrl, eq, q_nom, warmup_meter, start, estimator)

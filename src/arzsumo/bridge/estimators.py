@@ -161,11 +161,14 @@ class RecordedEstimator:
                     measurement.loops, s.x)))
         return s
 
-    def prime(self, warm: list[PeriodMeasurement], t0: float) -> None:
-        """Feed the warm-up's measurements (times before ``t0``, s) to a stateful method."""
-        if self.method != "none":
-            for m in warm:
-                self.inner.estimate(m, m.t - t0)
+    def prime(self, warm: list[PeriodMeasurement], t0: float) -> list[np.ndarray]:
+        """Feed the warm-up's measurements (times before ``t0``, s) to the method; return
+        its estimate (4, n) of each (for the warm-up reference, :mod:`.reference`)."""
+        out = []
+        for m in warm:
+            s = self.inner.estimate(m, m.t - t0)
+            out.append(np.vstack([s.rho_h, s.v_h, s.rho_a, s.v_a]))
+        return out
 
 
 def estimation_stage(settings: EstimationSettings, layout: SensorLayout, controller: str,

@@ -119,7 +119,9 @@ def estimation_summary(res: CoSimResult) -> dict[str, Any] | None:
     control window's periods (:func:`rmse`: absolute SI, relative to the equilibrium,
     samples); ``spread``: the EnKF's mean ensemble sd per variable (absolute, relative;
     None for other methods); ``interpolation``: the RMSE of linear interpolation between
-    the loop stations of the same periods (None without loops).
+    the loop stations of the same periods (None without loops); ``reference`` and
+    ``reference_offset``: what a PDE controller's deviations were measured from and the
+    mean offset subtracted from its input (SI; None from the equilibrium).
     """
     est = res.estimator
     if est is None or res.estimate is None or not res.estimate.size:
@@ -134,7 +136,9 @@ def estimation_summary(res: CoSimResult) -> dict[str, Any] | None:
     interp = (rmse(res, np.asarray(est.interpolation[1:]))
               if len(est.interpolation) > 1 else None)
     return {"method": est.method, "sensors": list(est.sensors),
-            **rmse(res, res.estimate), "spread": spread, "interpolation": interp}
+            **rmse(res, res.estimate), "spread": spread, "interpolation": interp,
+            "reference": res.scenario.estimation.reference,
+            "reference_offset": res.shift.means() if res.shift else None}
 
 
 def actuation_summary(res: CoSimResult) -> dict[str, Any]:

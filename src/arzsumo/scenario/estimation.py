@@ -40,6 +40,8 @@ from arzsumo.tables import Key, in_user_terms, read_keys
 from arzsumo.units import KMH_PER_MS, VEH_H_PER_VEH_S, kmh_to_ms
 
 METHODS = ("none", "smoothing", "enkf")
+#: what a PDE controller's deviations are measured from (:mod:`arzsumo.bridge.reference`)
+REFERENCES = ("equilibrium", "warmup")
 
 #: [estimation] key -> EstimationSettings field (SI)
 ESTIMATION_KEYS: dict[str, Key] = {
@@ -78,6 +80,13 @@ ESTIMATION_KEYS: dict[str, Key] = {
     "asm_c_cong_kmh": Key("asm_c_cong", factor=KMH_PER_MS, unit="km/h",
                           allowed="a negative speed in km/h (waves travel upstream)",
                           doc="ASM wave speed in congestion"),
+    "reference": Key("reference", "string", choices=REFERENCES,
+                     doc="what a PDE controller's deviations are measured from: "
+                         "\"equilibrium\" (the model's, as in the paper) or \"warmup\" "
+                         "(the mean estimate over the warm-up's last reference_window_s: "
+                         "the state the nominal plan holds gets U = 0)"),
+    "reference_window_s": Key("reference_window", unit="s",
+                              doc="warm-up seconds averaged for reference = \"warmup\""),
 }
 
 
@@ -107,6 +116,8 @@ class EstimationSettings:
     asm_dv: float = float(kmh_to_ms(20.0))
     asm_c_free: float = float(kmh_to_ms(80.0))
     asm_c_cong: float = float(kmh_to_ms(-15.0))
+    reference: str = "equilibrium"
+    reference_window: float = 300.0
 
     def __post_init__(self) -> None:
         def check(ok: bool, name: str, allowed: str) -> None:
@@ -124,6 +135,9 @@ class EstimationSettings:
             check(math.isfinite(getattr(self, name)) and getattr(self, name) > 0, name,
                   "a number > 0")
         check(self.asm_c_cong < 0, "asm_c_cong", "a negative speed")
+        check(self.reference in REFERENCES, "reference", f"one of {', '.join(REFERENCES)}")
+        check(math.isfinite(self.reference_window) and self.reference_window > 0,
+              "reference_window", "a duration > 0 s")
 
     @property
     def loop_noise(self) -> LoopNoise:

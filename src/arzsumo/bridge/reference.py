@@ -1,0 +1,66 @@
+"""The state a PDE controller regulates to: the model's equilibrium, or the mean state SUMO
+held in the warm-up.
+
+The backstepping law (paper, eq. ``control_law``) and the ETC's trigger act on deviations
+from the equilibrium (rho*, v*) of the model. Where the model's fundamental diagram and
+SUMO disagree about the speed at the densities SUMO holds, a state SUMO holds for minutes
+under the nominal plan is a constant deviation to the law, and it answers with a constant
+U: on the default scenario's open-loop runs -610 veh/h, against q* = 4464 veh/h (the mean
+field of 450 s gives v_h 39.9 and v_a 14.5 km/h where the identified FD says 43.7 and
+19.2). ``reference = "warmup"`` measures the deviations from the mean of the estimate over
+the warm-up's last ``reference_window`` seconds instead: the state the nominal plan holds
+gets U = 0, and the law acts on what moves about it. The laws are linear in the fields
+(:class:`arzsumo.control.backstepping.StateMap`), so this is the same as subtracting the
+law's answer to the constant offset.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from arzsumo.control.base import MacroState
+from arzsumo.model.equilibrium import Equilibrium
+from arzsumo.scenario.estimation import REFERENCES
+
+#: the variables of an offset, in order (SI: veh/m, m/s, veh/m, m/s)
+VARIABLES = ("rho_h", "v_h", "rho_a", "v_a")
+
+
+@dataclass(frozen=True)
+class ReferenceShift:
+    """Per-cell offset (4, n) subtracted from the fields a controller is checked on."""
+
+    offset: np.ndarray
+
+    def apply(self, state: MacroState) -> MacroState:
+        """``state`` with the offset subtracted (occupancy and time unchanged)."""
+        o = self.offset
+        return replace(state, rho_h=state.rho_h - o[0], v_h=state.v_h - o[1],
+                       rho_a=state.rho_a - o[2], v_a=state.v_a - o[3])
+
+    def means(self) -> dict[str, float]:
+        """The offset's mean over the cells per variable (SI)."""
+        return {name: float(np.mean(self.offset[k])) for k, name in enumerate(VARIABLES)}
+
+
+def reference_shift(reference: str, warm_fields: Sequence[np.ndarray], eq: Equilibrium,
+                    window: float, period: float) -> ReferenceShift:
+    """The shift of ``reference`` (:data:`REFERENCES`).
+
+    ``warm_fields``: the estimate (4, n) of every warm-up period, oldest first; the mean of
+    the last ``window`` seconds (periods of ``period`` s, at least one) minus the
+    equilibrium is the offset of ``"warmup"``; ``"equilibrium"`` has a zero offset.
+    """
+    if reference not in REFERENCES:
+        raise ValueError(f"reference {reference!r}: one of {REFERENCES}")
+    n = np.asarray(warm_fields[-1]).shape[1]
+    if reference == "equilibrium":
+        return ReferenceShift(np.zeros((4, n)))
+    k = max(1, math.ceil(window / period - 1e-9))
+    mean = np.nanmean(np.asarray(warm_fields[-k:], float), axis=0)
+    star = np.array([eq.rho_h, eq.v_h, eq.rho_a, eq.v_a])[:, None]
+    return ReferenceShift(np.where(np.isfinite(mean), mean - star, 0.0))
