@@ -67,6 +67,8 @@ STEPS = (
     Step("estimator", "ASM estimate from loops every 250 m + AV probes (issue 16)",
          {"sensing": {"kinds": ["loops", "av_probes"], "loop_spacing_m": 250},
           "estimation": {"method": "smoothing"}}),
+    Step("reference", "deviations from the warm-up mean state, not the model's equilibrium",
+         {"estimation": {"reference": "warmup", "reference_window_s": 300.0}}),
     Step("saturation", "|U| <= 20 % of q*, rate <= 100 veh/h per s, ramp bound, anti-windup",
          {"actuation": {"u_max_fraction": 0.2, "u_rate_max_veh_h_s": 100.0,
                         "ramp_bound": True, "anti_windup": True}}),
