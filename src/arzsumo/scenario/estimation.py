@@ -40,6 +40,8 @@ from arzsumo.tables import Key, in_user_terms, read_keys
 from arzsumo.units import KMH_PER_MS, VEH_H_PER_VEH_S, kmh_to_ms
 
 METHODS = ("none", "smoothing", "enkf")
+#: default EnKF model-error sd per forecast (rho_h veh/m, v_h m/s, rho_a veh/m, v_a m/s)
+MODEL_SD = (0.0, 0.0, 0.0, 0.0)
 
 #: [estimation] key -> EstimationSettings field (SI)
 ESTIMATION_KEYS: dict[str, Key] = {
@@ -65,6 +67,21 @@ ESTIMATION_KEYS: dict[str, Key] = {
     "probe_speed_sd_kmh": Key("probe_speed_sd", factor=KMH_PER_MS, unit="km/h",
                               allowed="a standard deviation > 0 km/h",
                               doc="assumed error sd of an AV probe's speed"),
+    "model_sd_rho_h_veh_km": Key("model_sd_rho_h", factor=1000.0, unit="veh/km",
+                                 allowed="a standard deviation >= 0 veh/km",
+                                 doc="EnKF model-error noise added to each member's HV "
+                                     "density per forecast (control period)"),
+    "model_sd_v_h_kmh": Key("model_sd_v_h", factor=KMH_PER_MS, unit="km/h",
+                            allowed="a standard deviation >= 0 km/h",
+                            doc="EnKF model-error noise of the HV speed per forecast"),
+    "model_sd_rho_a_veh_km": Key("model_sd_rho_a", factor=1000.0, unit="veh/km",
+                                 allowed="a standard deviation >= 0 veh/km",
+                                 doc="EnKF model-error noise of the AV density per forecast"),
+    "model_sd_v_a_kmh": Key("model_sd_v_a", factor=KMH_PER_MS, unit="km/h",
+                            allowed="a standard deviation >= 0 km/h",
+                            doc="EnKF model-error noise of the AV speed per forecast"),
+    "model_length_m": Key("model_length", unit="m",
+                          doc="EnKF model-error noise: correlation length in space"),
     "asm_sigma_m": Key("asm_sigma", unit="m", doc="ASM kernel width in space"),
     "asm_tau_s": Key("asm_tau", unit="s", doc="ASM kernel width in time"),
     "asm_crossover_kmh": Key("asm_v_crit", factor=KMH_PER_MS, unit="km/h",
@@ -101,6 +118,11 @@ class EstimationSettings:
     loop_speed_sd: float = LoopNoise().speed
     loop_density_sd: float = LoopNoise().density
     probe_speed_sd: float = ProbeNoise().speed
+    model_sd_rho_h: float = MODEL_SD[0]
+    model_sd_v_h: float = MODEL_SD[1]
+    model_sd_rho_a: float = MODEL_SD[2]
+    model_sd_v_a: float = MODEL_SD[3]
+    model_length: float = 150.0
     asm_sigma: float = 75.0
     asm_tau: float = 10.0
     asm_v_crit: float = float(kmh_to_ms(30.0))
@@ -124,6 +146,11 @@ class EstimationSettings:
             check(math.isfinite(getattr(self, name)) and getattr(self, name) > 0, name,
                   "a number > 0")
         check(self.asm_c_cong < 0, "asm_c_cong", "a negative speed")
+        for name in ("model_sd_rho_h", "model_sd_v_h", "model_sd_rho_a", "model_sd_v_a"):
+            check(math.isfinite(getattr(self, name)) and getattr(self, name) >= 0, name,
+                  "a standard deviation >= 0")
+        check(math.isfinite(self.model_length) and self.model_length > 0, "model_length",
+              "a length > 0 m")
 
     @property
     def loop_noise(self) -> LoopNoise:
@@ -141,7 +168,10 @@ class EstimationSettings:
     def enkf(self, cells: int) -> EnkfOptions:
         """The EnKF's options on ``cells`` cells (the controller's grid)."""
         return EnkfOptions(members=self.members, cells=cells, inflation=self.inflation,
-                           localisation=self.localisation, seed=self.seed)
+                           localisation=self.localisation, seed=self.seed,
+                           model_sd=(self.model_sd_rho_h, self.model_sd_v_h,
+                                     self.model_sd_rho_a, self.model_sd_v_a),
+                           model_length=self.model_length)
 
     def as_dict(self) -> dict[str, Any]:
         return asdict(self)
