@@ -34,10 +34,10 @@ KEYS = ("estimation.model_sd_rho_h_veh_km", "estimation.model_sd_v_h_kmh",
         "estimation.model_sd_rho_a_veh_km", "estimation.model_sd_v_a_kmh")
 
 
-def settings(sd: np.ndarray, inflation: float) -> dict[str, Any]:
-    """Scenario keys of one setting (sd in veh/km and km/h)."""
+def settings(sd: np.ndarray, inflation: float, length: float = 150.0) -> dict[str, Any]:
+    """Scenario keys of one setting (sd in veh/km and km/h, correlation length m)."""
     return {**{k: float(v) for k, v in zip(KEYS, sd, strict=True)},
-            "estimation.inflation": float(inflation)}
+            "estimation.inflation": float(inflation), "estimation.model_length_m": length}
 
 
 def score(job: tuple[str, str, int, str, dict[str, Any]]) -> dict[str, Any]:
@@ -85,6 +85,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--start", type=float, nargs=4, default=[2.0, 1.0, 1.0, 1.0],
                    help="starting sd: rho_h veh/km, v_h km/h, rho_a veh/km, v_a km/h")
     p.add_argument("--inflation", type=float, default=1.05)
+    p.add_argument("--length", type=float, default=150.0,
+                   help="correlation length of the model noise, m")
     p.add_argument("--rounds", type=int, default=6, help="0: report --start as it is")
     p.add_argument("--inflation-only", type=float, nargs="*", default=[1.05, 1.3, 2.0],
                    help="inflations tried without model noise on the tuning seeds")
@@ -114,14 +116,14 @@ def main(argv: list[str] | None = None) -> int:
         sd = np.array(args.start, float)
         for k in range(args.rounds):
             rows = evaluate(pool, paths, scen, args.tune_seeds, [args.layout],
-                            settings(sd, args.inflation))
+                            settings(sd, args.inflation, args.length))
             lines.append(fmt(rows, f"tune round {k}: sd " + ", ".join(f"{v:.3g}" for v in sd)))
             print(lines[-1], flush=True)
             sd = sd * np.clip(normalised(rows), 0.25, 4.0) ** args.gain
         sd = np.array([float(f"{v:.2g}") for v in sd]) if args.rounds else sd
         for lay in [name for name, keys in LAYOUTS.items() if keys and args.report_seeds]:
             for label, extra in (("perfect model", settings(np.zeros(4), 1.05)),
-                                 ("model noise", settings(sd, args.inflation))):
+                                 ("model noise", settings(sd, args.inflation, args.length))):
                 rows = evaluate(pool, paths, scen, args.report_seeds, [lay], extra)
                 lines.append(fmt(rows, f"report {lay}: {label}"))
                 out_rows += [{**r, "setting": label} for r in rows]

@@ -9,6 +9,8 @@ Every key, its unit and the field of :class:`EstimationSettings` it sets::
     localisation_m = 150            # EnKF Gaspari-Cohn half-width
     seed = 0                        # EnKF random draws
     loop_density_sd_veh_km = 8      # assumed error sd of a loop's density, per period
+    model_sd_rho_h_veh_km = 2       # EnKF model-error noise per forecast (also _v_h_kmh,
+                                    # _rho_a_veh_km, _v_a_kmh; defaults 2, 1, 1, 1)
     asm_sigma_m = 75                # ASM kernel width in space
 
 Without the table (``method = "none"``) the controller acts on the cells of the full
@@ -40,8 +42,13 @@ from arzsumo.tables import Key, in_user_terms, read_keys
 from arzsumo.units import KMH_PER_MS, VEH_H_PER_VEH_S, kmh_to_ms
 
 METHODS = ("none", "smoothing", "enkf")
-#: default EnKF model-error sd per forecast (rho_h veh/m, v_h m/s, rho_a veh/m, v_a m/s)
-MODEL_SD = (0.0, 0.0, 0.0, 0.0)
+#: default EnKF model-error sd per forecast (rho_h veh/m, v_h m/s, rho_a veh/m, v_a m/s):
+#: 2 veh/km, 1 km/h, 1 veh/km, 1 km/h, chosen offline on SUMO records of the default
+#: scenario (seeds 1-2, loops every 250 m + AV probes; ``benchmarks/tune_enkf_noise.py``,
+#: docs/sumo.md): RMSE / spread fell from 5.1, 7.5, 7.9, 8.1 to 3.0, 3.4, 4.2, 1.8 at
+#: RMSE +12 %, -1 %, +8 %, -48 %; larger noise or inflation raised the spread and the
+#: error together (density RMSE x 1.5-3 for RMSE / spread 2-3).
+MODEL_SD = (2e-3, float(kmh_to_ms(1.0)), 1e-3, float(kmh_to_ms(1.0)))
 
 #: [estimation] key -> EstimationSettings field (SI)
 ESTIMATION_KEYS: dict[str, Key] = {
