@@ -138,6 +138,8 @@ def _cli(tmp_path, text, controller="etc"):
     ('\n[estimation]\nloop_speed_sd_kmh = 0\n',
      "loop_speed_sd_kmh = 0 is not allowed: a standard deviation > 0 km/h"),
     ('\n[estimation]\nmembrs = 8\n', "[estimation] unknown key 'membrs'"),
+    ('\n[estimation]\nmodel_sd_v_h_kmh = -1\n',
+     "[estimation] model_sd_v_h_kmh = -1 is not allowed: a standard deviation >= 0 km/h"),
     ('\n[estimation]\nmethod = "enkf"\n',
      '[estimation] method = "enkf" is not allowed with [sensing] kinds = ["probe"]'),
     ('\n[sensing]\nkinds = ["av_probes"]\n[estimation]\nmethod = "enkf"\n',
