@@ -1,6 +1,7 @@
 """Co-simulation wall time with each estimator (issue 16): none, smoothing, enkf (32).
 
-``scenarios/legacy_default.toml`` (150 s warm-up), a short control horizon (120 s by
+``scenarios/legacy_default.toml`` (150 s warm-up; ``--scenario`` another, e.g. the
+default with its 600 s fill, ``--warmup`` to override), a short control horizon (120 s by
 default), the ETC: ``none`` on today's sensor (the full probe's cells), ``smoothing``
 and ``enkf`` on loops every 250 m and every AV as a probe (the sensors are loaded in all
 three so the ratio is the estimator's alone; loading the loops moves no vehicle,
@@ -44,10 +45,13 @@ def main() -> None:
     ap.add_argument("--horizon", type=float, default=120.0)
     ap.add_argument("--repeats", type=int, default=2)
     ap.add_argument("--controller", default="etc")
+    ap.add_argument("--scenario", type=Path, default=LEGACY)
+    ap.add_argument("--warmup", type=float, default=None, help="s (default: the scenario's)")
     args = ap.parse_args()
-    base = load_scenario(LEGACY).with_(SENSORS)
+    base = load_scenario(args.scenario).with_(SENSORS)
     runs = {name: base.with_(ch) if ch else base for name, ch in METHODS.items()}
-    settings = replace(base.run, controller=args.controller)
+    settings = replace(base.run, controller=args.controller,
+                       warmup=base.run.warmup if args.warmup is None else args.warmup)
     cfg = base.sumo.with_(horizon=args.horizon)
     run_cosimulation(base, settings, cfg.with_(horizon=5.0), PAPER_DESIGN)  # kernels cached
     wall: dict[str, list[float]] = {name: [] for name in runs}

@@ -2,10 +2,11 @@
 ``scenarios/legacy_default.toml`` (40 s warm-up, seed 42).
 
 Measured when written (60 s of control, loops every 250 m and every AV a probe):
-backstepping made 49 plan changes on the raw cells, 28 on the ASM estimate and 44 on the
-EnKF's; the EnKF's RMSE relative to the equilibrium was rho_h 0.22, v_h 0.22, rho_a 0.21,
-v_a 0.23 against linear interpolation between the loops' 0.37, 0.10, 0.77, 0.68 (the
-loops' time-mean HV speeds interpolate better than the filter's v_h).
+backstepping made 49 plan changes on the raw cells, 28 on the ASM estimate and 52 on the
+EnKF's (44 before the EnKF had model-error noise); the ETC 16, 4 and 8. The EnKF's RMSE
+relative to the equilibrium (backstepping) was rho_h 0.17, v_h 0.12, rho_a 0.19, v_a 0.08
+against linear interpolation between the loops' 0.35, 0.12, 0.70, 0.71; its spread 0.04,
+0.04, 0.06, 0.04.
 """
 
 from __future__ import annotations
@@ -44,10 +45,13 @@ def runs(tmp_path_factory):
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv("ARZSUMO_CACHE", str(tmp_path_factory.mktemp("cache")))
         mp.setenv("OPENBLAS_NUM_THREADS", "1")
-        return {"raw": _run({}, "backstepping"),
-                "raw+loops": _run(LOOPS, "backstepping"),
-                "smoothing": _run({**LOOPS, "estimation.method": "smoothing"}, "backstepping"),
-                "enkf": _run({**LOOPS, "estimation.method": "enkf"}, "backstepping")}
+        out = {"raw": _run({}, "backstepping"),
+               "raw+loops": _run(LOOPS, "backstepping"),
+               "smoothing": _run({**LOOPS, "estimation.method": "smoothing"}, "backstepping"),
+               "enkf": _run({**LOOPS, "estimation.method": "enkf"}, "backstepping")}
+        for method in ("smoothing", "enkf"):
+            out[f"etc {method}"] = _run({**LOOPS, "estimation.method": method}, "etc")
+        return out | {"etc raw": _run({}, "etc")}
 
 
 def test_method_none_acts_on_the_raw_cells_and_loops_change_nothing(runs):
@@ -72,17 +76,36 @@ def test_enkf_estimate_beats_interpolation_between_the_loops(runs):
     for name in VARIABLES:
         assert math.isfinite(est[name]["absolute"]) and est[name]["samples"] > 1000
         assert 0 < est["spread"][name]["absolute"] < est[name]["absolute"]
-    for name in ("rho_h", "rho_a", "v_a"):
+    for name in VARIABLES:
         assert est[name]["absolute"] < est["interpolation"][name]["absolute"], name
-    assert est["v_h"]["relative"] < 0.3            # interpolation wins here (0.10 vs 0.22)
 
 
-def test_backstepping_changes_the_plan_less_often_on_an_estimate(runs):
-    raw = summary(runs["raw"])["plan_changes"]
-    smooth = summary(runs["smoothing"])["plan_changes"]
-    enkf = summary(runs["enkf"])["plan_changes"]
-    assert (raw, smooth, enkf) == (49, 28, 44)      # measured; below, the claim itself
-    assert smooth < raw and enkf < raw
+def _plan_changes(runs, controller):
+    key = "" if controller == "backstepping" else "etc "
+    return tuple(summary(runs[f"{key}{m}"])["plan_changes"]
+                 for m in ("raw", "smoothing", "enkf"))
+
+
+@pytest.mark.parametrize(("controller", "measured"), [("backstepping", (49, 28, 52)),
+                                                      ("etc", (16, 4, 8))])
+def test_controllers_change_the_plan_less_often_on_the_asm_estimate(runs, controller,
+                                                                    measured):
+    """Same seed, same traffic until the first command: plan changes on the raw cells,
+    the ASM estimate and the EnKF's (loops every 250 m + every AV a probe)."""
+    raw, smooth, enkf = _plan_changes(runs, controller)
+    assert (raw, smooth, enkf) == measured            # measured; below, the claim itself
+    assert smooth < raw
+
+
+@pytest.mark.parametrize("controller", [
+    pytest.param("backstepping", marks=pytest.mark.xfail(
+        strict=True, reason="with the model-error noise (issue 16) the EnKF's mean follows "
+                            "the loops more closely and backstepping's U on it is rougher: "
+                            "52 plan changes against 49 on raw cells (44 without the noise)")),
+    "etc"])
+def test_controllers_change_the_plan_less_often_on_the_enkf_estimate(runs, controller):
+    raw, _, enkf = _plan_changes(runs, controller)
+    assert enkf < raw
 
 
 @pytest.mark.parametrize(("method", "paper_observer"), [("none", True), ("enkf", False)])
@@ -115,6 +138,8 @@ def _cli(tmp_path, text, controller="etc"):
     ('\n[estimation]\nloop_speed_sd_kmh = 0\n',
      "loop_speed_sd_kmh = 0 is not allowed: a standard deviation > 0 km/h"),
     ('\n[estimation]\nmembrs = 8\n', "[estimation] unknown key 'membrs'"),
+    ('\n[estimation]\nmodel_sd_v_h_kmh = -1\n',
+     "[estimation] model_sd_v_h_kmh = -1 is not allowed: a standard deviation >= 0 km/h"),
     ('\n[estimation]\nmethod = "enkf"\n',
      '[estimation] method = "enkf" is not allowed with [sensing] kinds = ["probe"]'),
     ('\n[sensing]\nkinds = ["av_probes"]\n[estimation]\nmethod = "enkf"\n',

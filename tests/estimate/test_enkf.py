@@ -68,6 +68,21 @@ def test_without_inflation_the_spread_collapses(truth):
     assert np.all(_normalised_error(s, means, sds) > 2.0)
 
 
+def test_model_noise_widens_the_spread_and_keeps_it_consistent(truth):
+    """Additive model-error noise (the SUMO setting's order: 1 veh/km, 0.5 km/h per
+    forecast) on the perfect-model synthetic case: the spread grows, the error a little,
+    and the normalised error stays near 1. Measured (rho_h, v_h, rho_a, v_a): normalised
+    error 0.97, 1.06, 0.77, 0.97 (without: 1.24, 1.38, 1.02, 1.34); RMSE x 1.09, 1.12,
+    1.36, 1.12 (the model is perfect here: the noise only costs)."""
+    s, m0, sd0, _ = _run(truth, EnkfOptions(members=32))
+    noise = (1e-3, 0.5 / 3.6, 1e-3, 0.5 / 3.6)
+    _, m1, sd1, _ = _run(truth, EnkfOptions(members=32, model_sd=noise))
+    assert np.all(sd1[SCORED_FROM:].mean(axis=(0, 2)) > sd0[SCORED_FROM:].mean(axis=(0, 2)))
+    assert np.all(s.rmse(m1) < 1.5 * s.rmse(m0))
+    nerr = _normalised_error(s, m1, sd1)
+    assert np.all((nerr > 0.5) & (nerr < 2.0)), nerr
+
+
 def test_analysis_pulls_the_mean_to_an_exact_observation():
     from arzsumo.estimate.observations import LoopNoise, LoopObservation
     from tests.estimate.conftest import default_eq
@@ -100,7 +115,9 @@ def test_gaspari_cohn_taper():
 @pytest.mark.parametrize(("kw", "name"), [({"members": 1}, "members"),
                                           ({"inflation": 0.9}, "inflation"),
                                           ({"flux": "roe"}, "flux"),
-                                          ({"localisation": 0.0}, "localisation")])
+                                          ({"localisation": 0.0}, "localisation"),
+                                          ({"model_sd": (0, -1, 0, 0)}, "model_sd"),
+                                          ({"model_length": 0.0}, "model_length")])
 def test_bad_options_are_refused_by_name(kw, name):
     with pytest.raises(ModelError, match=name):
         EnkfOptions(**kw)

@@ -326,11 +326,14 @@ class Controlled:
 def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
                      design: EtcDesign, *, initial_fields: np.ndarray | None = None,
                      curve: GreenShareCurve = DEFAULT_CURVE,
-                     progress: bool = False) -> CoSimResult:
+                     progress: bool = False, keep_measurements: bool = False
+                     ) -> CoSimResult:
     """Run SUMO with the controller of ``settings`` and both twins (module docstring).
 
     ``initial_fields`` (4, cells on the micro grid) places vehicles at t = 0 when
-    ``settings.start == "placement"``.
+    ``settings.start == "placement"``. ``keep_measurements``: keep every period's
+    measurement, warm-up included, in ``estimator.measurements`` (for offline estimation,
+    :mod:`arzsumo.bridge.sensor_record`).
     """
     wall0 = time.perf_counter()
     if settings.equilibrium == "scenario":
@@ -344,7 +347,7 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
         with open_simulation(scenario.params, run_cfg, initial=initial,
                              extra_args=network_options(net_dir), output_dir=net_dir,
                              loops=scenario.sensing.loop_x(scenario.params.length)) as sim:
-            c = control(sim, scenario, settings, cfg, design, curve, bar)
+            c = control(sim, scenario, settings, cfg, design, curve, bar, keep_measurements)
             meter_summary = c.loop.plant.meter.summary()
         records = c.trace.records
         outlet = round(sum((r.outflow_h + r.outflow_a) * cfg.control_period for r in records))
@@ -365,7 +368,8 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
 
 
 def control(sim: SumoSimulation, scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
-            design: EtcDesign, curve: GreenShareCurve, bar: Progress) -> Controlled:
+            design: EtcDesign, curve: GreenShareCurve, bar: Progress,
+            keep_measurements: bool = False) -> Controlled:
     """Warm-up, then the control window, in the open ``sim`` (steps 3-6 of the module
     docstring); ``cfg`` has the control horizon."""
     from arzsumo.kernel_cache import cached_kernels
@@ -382,7 +386,8 @@ def control(sim: SumoSimulation, scenario: Scenario, settings: RunSettings, cfg:
                if is_pde(settings.controller) else None)
     target = occupancy_target(settings, warm, period)
     estimator, acting = estimation_stage(scenario.estimation, scenario.sensing,
-                                         settings.controller, eq, warm[-1].cells.x)
+                                         settings.controller, eq, warm[-1].cells.x,
+                                         keep_measurements)
     est = scenario.estimation
     warm_fields = estimator.prime(warm[:-1], warm[-1].t)
     shift = (reference_shift(est.reference, warm_fields, eq, est.reference_window, period)

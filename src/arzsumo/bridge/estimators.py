@@ -138,7 +138,9 @@ class RecordedEstimator:
 
     ``fields`` (4, n) per check, as the controller got them; ``sd`` the EnKF's spread
     (None otherwise); ``interpolation`` the linear interpolation between the period's
-    loop stations, speeds filled with Ve (when there are loops).
+    loop stations, speeds filled with Ve (when there are loops); ``measurements``, when
+    not None, every measurement handed over (warm-up included: the record an offline pass
+    replays, :mod:`arzsumo.bridge.sensor_record`).
     """
 
     inner: Estimator
@@ -148,8 +150,11 @@ class RecordedEstimator:
     fields: list[np.ndarray] = field(default_factory=list)
     sd: list[np.ndarray] = field(default_factory=list)
     interpolation: list[np.ndarray] = field(default_factory=list)
+    measurements: list[PeriodMeasurement] | None = None
 
     def estimate(self, measurement: PeriodMeasurement, t: float) -> MacroState:
+        if self.measurements is not None:
+            self.measurements.append(measurement)
         s = self.inner.estimate(measurement, t)
         if t >= 0.0:
             self.fields.append(np.vstack([s.rho_h, s.v_h, s.rho_a, s.v_a]))
@@ -164,6 +169,8 @@ class RecordedEstimator:
     def prime(self, warm: list[PeriodMeasurement], t0: float) -> list[np.ndarray]:
         """Feed the warm-up's measurements (times before ``t0``, s) to the method; return
         its estimate (4, n) of each (for the warm-up reference, :mod:`.reference`)."""
+        if self.measurements is not None:
+            self.measurements.extend(warm)
         out = []
         for m in warm:
             s = self.inner.estimate(m, m.t - t0)
@@ -172,11 +179,13 @@ class RecordedEstimator:
 
 
 def estimation_stage(settings: EstimationSettings, layout: SensorLayout, controller: str,
-                     eq: Equilibrium, x: np.ndarray) -> tuple[RecordedEstimator, str]:
+                     eq: Equilibrium, x: np.ndarray, keep: bool = False
+                     ) -> tuple[RecordedEstimator, str]:
     """The estimator of a run and the controller that acts on it.
 
     ``controller`` is the run's; ``observer-etc`` with a method other than ``none``
-    becomes ``etc`` on the boundary stations' estimate (module docstring).
+    becomes ``etc`` on the boundary stations' estimate (module docstring). ``keep``:
+    the estimator keeps every measurement (:attr:`RecordedEstimator.measurements`).
     """
     boundary = controller == "observer-etc" and settings.method != "none"
     inner: Estimator
@@ -187,5 +196,6 @@ def estimation_stage(settings: EstimationSettings, layout: SensorLayout, control
     else:
         inner = FundamentalDiagramFill(eq.params)
     sensors = ("loops (boundaries)",) if boundary else layout.kinds
-    return (RecordedEstimator(inner, settings.method, sensors, eq),
+    return (RecordedEstimator(inner, settings.method, sensors, eq,
+                              measurements=[] if keep else None),
             "etc" if boundary else controller)

@@ -2,17 +2,22 @@
 
 Every control period the ensemble of M first-order twins (:class:`BatchStepper`, one
 vectorised step for all members) is advanced with the period's boundary data, each
-member with its own draw of the boundary noise, then updated with the period's loop and
-probe data (Evensen 1994; Burgers, van Leeuwen & Evensen 1998; Houtekamer & Mitchell
-2001)::
+member with its own draw of the boundary noise, given additive model-error noise, then
+updated with the period's loop and probe data (Evensen 1994; Burgers, van Leeuwen &
+Evensen 1998; Houtekamer & Mitchell 2001)::
 
+    X^f <- X^f + eta_k,  eta_k ~ N(0, diag(s)^2 C)         model error, per forecast
     X^f <- mean + lambda (X^f - mean)                     multiplicative inflation
     K   = (rho_xo o P H^T) (rho_oo o H P H^T + R)^-1      localised gain
     X^a = X^f + K (y + eps_k - h(X^f_k)),  eps_k ~ N(0, R)
 
 The analysed state is the primitive fields (rho_h, v_h, rho_a, v_a) on the cells,
 stacked; P H^T and H P H^T are ensemble covariances; h interpolates a member's fields (or
-its class flows rho_i v_i) linearly at the sensor positions; rho is the Gaspari & Cohn
+its class flows rho_i v_i) linearly at the sensor positions; s the per-variable model-error
+sd of one forecast (:attr:`EnkfOptions.model_sd`, SI) and C a Gaussian correlation in
+space over :attr:`EnkfOptions.model_length` (the twin's own error: without it the
+ensemble, driven by one model, is far more confident than it is right when the data come
+from SUMO rather than from the twin); rho is the Gaspari & Cohn
 (1999) taper of the distance between state cells and sensors, half-width
 :attr:`EnkfOptions.localisation`; R is diagonal from the records' noise models. After
 each analysis the members are projected onto the physical domain
@@ -68,6 +73,12 @@ class EnkfOptions:
         Largest AO kept, as a fraction of AO_max.
     seed : int
         Seed of the filter's random draws (initial ensemble, boundary and obs noise).
+    model_sd : tuple of 4 floats
+        Additive model-error noise per forecast (control period), absolute: standard
+        deviations of (rho_h veh/m, v_h m/s, rho_a veh/m, v_a m/s); 0: none (a perfect
+        model, as in the synthetic twin experiments).
+    model_length : float
+        Correlation length in space of the model-error noise, m.
     """
 
     members: int = 32
@@ -81,6 +92,8 @@ class EnkfOptions:
     rho_min: float = 1e-4
     ao_fraction: float = 0.98
     seed: int = 0
+    model_sd: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
+    model_length: float = 150.0
 
     def __post_init__(self) -> None:
         require(isinstance(self.members, int) and self.members >= 2, "members", self.members,
@@ -95,6 +108,11 @@ class EnkfOptions:
         require(len(self.initial_sd) == 4 and min(self.initial_sd) >= 0, "initial_sd",
                 self.initial_sd, "4 relative spreads >= 0")
         require(0 < self.ao_fraction < 1, "ao_fraction", self.ao_fraction, "a fraction in (0, 1)")
+        require(len(self.model_sd) == 4 and min(self.model_sd) >= 0
+                and all(math.isfinite(v) for v in self.model_sd), "model_sd", self.model_sd,
+                "4 standard deviations >= 0 (SI)")
+        require(math.isfinite(self.model_length) and self.model_length > 0, "model_length",
+                self.model_length, "a length > 0 m")
 
 
 @dataclass(frozen=True)
@@ -246,6 +264,11 @@ class EnsembleKalmanFilter:
                              * self.rng.standard_normal(m), 0.0)
         self.q, self.t, _ = self.stepper.advance(self.q, self.t, t_end, ghost, outflow,
                                                  self.stepper.last_speed)
+        sd = np.asarray(self.options.model_sd, float)
+        if sd.any():
+            z = self.primitive() + sd[:, None, None] * smooth_noise(
+                self.x, self.options.model_length, (4, m), self.rng)
+            self.q = self._conserved(z)
 
     def analyse(self, loops: Sequence[LoopObservation] = (),
                 probes: Sequence[ProbeObservation] = ()) -> None:

@@ -40,6 +40,7 @@ import pyarrow.parquet as pq
 from arzsumo import __version__
 from arzsumo.bridge.cosim import CoSimResult
 from arzsumo.bridge.estimator import fill_speeds
+from arzsumo.bridge.sensor_record import estimation_scores
 from arzsumo.control.base import ControlLog
 from arzsumo.control.events import release_time
 from arzsumo.evaluation.fields import field_rmse
@@ -113,30 +114,17 @@ def section_trend(res: CoSimResult) -> dict[str, Any] | None:
 
 
 def estimation_summary(res: CoSimResult) -> dict[str, Any] | None:
-    """How well the state the controller acted on matched the full probe's cells.
-
-    ``method`` and ``sensors``; per variable the RMSE against ``res.micro`` over the
-    control window's periods (:func:`rmse`: absolute SI, relative to the equilibrium,
-    samples); ``spread``: the EnKF's mean ensemble sd per variable (absolute, relative;
-    None for other methods); ``interpolation``: the RMSE of linear interpolation between
-    the loop stations of the same periods (None without loops); ``reference`` and
+    """How well the state the controller acted on matched the full probe's cells
+    (:func:`arzsumo.bridge.sensor_record.estimation_scores`: ``method``, ``sensors``, RMSE
+    per variable absolute SI and relative to the equilibrium, the EnKF's mean ``spread``,
+    the RMSE of ``interpolation`` between the loop stations); ``reference`` and
     ``reference_offset``: what a PDE controller's deviations were measured from and the
-    mean offset subtracted from its input (SI; None from the equilibrium).
-    """
+    mean offset subtracted from its input (SI; None from the equilibrium). None without
+    an estimate."""
     est = res.estimator
     if est is None or res.estimate is None or not res.estimate.size:
         return None
-    eq = res.equilibrium
-    ref = (eq.rho_h, eq.v_h, eq.rho_a, eq.v_a)
-    spread = None
-    if len(est.sd) > 1:
-        sd = np.asarray(est.sd[1:]).mean(axis=(0, 2))
-        spread = {name: {"absolute": float(sd[k]), "relative": float(sd[k] / ref[k])}
-                  for k, name in enumerate(VARIABLES)}
-    interp = (rmse(res, np.asarray(est.interpolation[1:]))
-              if len(est.interpolation) > 1 else None)
-    return {"method": est.method, "sensors": list(est.sensors),
-            **rmse(res, res.estimate), "spread": spread, "interpolation": interp,
+    return {**estimation_scores(res.micro, est, res.equilibrium),
             "reference": res.scenario.estimation.reference,
             "reference_offset": res.shift.means() if res.shift else None}
 

@@ -9,6 +9,8 @@ Every key, its unit and the field of :class:`EstimationSettings` it sets::
     localisation_m = 150            # EnKF Gaspari-Cohn half-width
     seed = 0                        # EnKF random draws
     loop_density_sd_veh_km = 8      # assumed error sd of a loop's density, per period
+    model_sd_rho_h_veh_km = 2       # EnKF model-error noise per forecast (also _v_h_kmh,
+                                    # _rho_a_veh_km, _v_a_kmh; defaults 2, 1, 1, 1)
     asm_sigma_m = 75                # ASM kernel width in space
 
 Without the table (``method = "none"``) the controller acts on the cells of the full
@@ -42,6 +44,13 @@ from arzsumo.units import KMH_PER_MS, VEH_H_PER_VEH_S, kmh_to_ms
 METHODS = ("none", "smoothing", "enkf")
 #: what a PDE controller's deviations are measured from (:mod:`arzsumo.bridge.reference`)
 REFERENCES = ("equilibrium", "warmup")
+#: default EnKF model-error sd per forecast (rho_h veh/m, v_h m/s, rho_a veh/m, v_a m/s):
+#: 2 veh/km, 1 km/h, 1 veh/km, 1 km/h, chosen offline on SUMO records of the default
+#: scenario (seeds 1-2, loops every 250 m + AV probes; ``benchmarks/tune_enkf_noise.py``,
+#: docs/sumo.md): RMSE / spread fell from 5.1, 7.5, 7.9, 8.1 to 3.0, 3.4, 4.2, 1.8 at
+#: RMSE +12 %, -1 %, +8 %, -48 %; larger noise or inflation raised the spread and the
+#: error together (density RMSE x 1.5-3 for RMSE / spread 2-3).
+MODEL_SD = (2e-3, float(kmh_to_ms(1.0)), 1e-3, float(kmh_to_ms(1.0)))
 
 #: [estimation] key -> EstimationSettings field (SI)
 ESTIMATION_KEYS: dict[str, Key] = {
@@ -67,6 +76,21 @@ ESTIMATION_KEYS: dict[str, Key] = {
     "probe_speed_sd_kmh": Key("probe_speed_sd", factor=KMH_PER_MS, unit="km/h",
                               allowed="a standard deviation > 0 km/h",
                               doc="assumed error sd of an AV probe's speed"),
+    "model_sd_rho_h_veh_km": Key("model_sd_rho_h", factor=1000.0, unit="veh/km",
+                                 allowed="a standard deviation >= 0 veh/km",
+                                 doc="EnKF model-error noise added to each member's HV "
+                                     "density per forecast (control period)"),
+    "model_sd_v_h_kmh": Key("model_sd_v_h", factor=KMH_PER_MS, unit="km/h",
+                            allowed="a standard deviation >= 0 km/h",
+                            doc="EnKF model-error noise of the HV speed per forecast"),
+    "model_sd_rho_a_veh_km": Key("model_sd_rho_a", factor=1000.0, unit="veh/km",
+                                 allowed="a standard deviation >= 0 veh/km",
+                                 doc="EnKF model-error noise of the AV density per forecast"),
+    "model_sd_v_a_kmh": Key("model_sd_v_a", factor=KMH_PER_MS, unit="km/h",
+                            allowed="a standard deviation >= 0 km/h",
+                            doc="EnKF model-error noise of the AV speed per forecast"),
+    "model_length_m": Key("model_length", unit="m",
+                          doc="EnKF model-error noise: correlation length in space"),
     "asm_sigma_m": Key("asm_sigma", unit="m", doc="ASM kernel width in space"),
     "asm_tau_s": Key("asm_tau", unit="s", doc="ASM kernel width in time"),
     "asm_crossover_kmh": Key("asm_v_crit", factor=KMH_PER_MS, unit="km/h",
@@ -110,6 +134,11 @@ class EstimationSettings:
     loop_speed_sd: float = LoopNoise().speed
     loop_density_sd: float = LoopNoise().density
     probe_speed_sd: float = ProbeNoise().speed
+    model_sd_rho_h: float = MODEL_SD[0]
+    model_sd_v_h: float = MODEL_SD[1]
+    model_sd_rho_a: float = MODEL_SD[2]
+    model_sd_v_a: float = MODEL_SD[3]
+    model_length: float = 150.0
     asm_sigma: float = 75.0
     asm_tau: float = 10.0
     asm_v_crit: float = float(kmh_to_ms(30.0))
@@ -138,6 +167,11 @@ class EstimationSettings:
         check(self.reference in REFERENCES, "reference", f"one of {', '.join(REFERENCES)}")
         check(math.isfinite(self.reference_window) and self.reference_window > 0,
               "reference_window", "a duration > 0 s")
+        for name in ("model_sd_rho_h", "model_sd_v_h", "model_sd_rho_a", "model_sd_v_a"):
+            check(math.isfinite(getattr(self, name)) and getattr(self, name) >= 0, name,
+                  "a standard deviation >= 0")
+        check(math.isfinite(self.model_length) and self.model_length > 0, "model_length",
+              "a length > 0 m")
 
     @property
     def loop_noise(self) -> LoopNoise:
@@ -155,7 +189,10 @@ class EstimationSettings:
     def enkf(self, cells: int) -> EnkfOptions:
         """The EnKF's options on ``cells`` cells (the controller's grid)."""
         return EnkfOptions(members=self.members, cells=cells, inflation=self.inflation,
-                           localisation=self.localisation, seed=self.seed)
+                           localisation=self.localisation, seed=self.seed,
+                           model_sd=(self.model_sd_rho_h, self.model_sd_v_h,
+                                     self.model_sd_rho_a, self.model_sd_v_a),
+                           model_length=self.model_length)
 
     def as_dict(self) -> dict[str, Any]:
         return asdict(self)

@@ -1,0 +1,69 @@
+"""Offline estimation on a recorded run equals the estimator inside the closed loop
+(issue 16): real SUMO, ``scenarios/legacy_default.toml``, 40 s warm-up + 30 s, seed 42."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from arzsumo.bridge.sensor_record import (
+    SensorRecord,
+    estimation_scores,
+    record_run,
+    replay_estimation,
+)
+from arzsumo.bridge.session import run_in_sumo
+from arzsumo.outputs.bridge import VARIABLES, summary
+from arzsumo.scenario import load_scenario
+
+pytestmark = pytest.mark.sumo
+
+LEGACY = Path(__file__).resolve().parents[2] / "scenarios" / "legacy_default.toml"
+LAYOUT = {"sensing.kinds": ["loops", "av_probes"], "sensing.loop_spacing_m": 250}
+
+
+@pytest.fixture(scope="module")
+def recorded(tmp_path_factory):
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("ARZSUMO_CACHE", str(tmp_path_factory.mktemp("cache")))
+        mp.setenv("OPENBLAS_NUM_THREADS", "1")
+        rec, info = record_run(load_scenario(LEGACY), 42, 40.0, 30.0)
+        path = tmp_path_factory.mktemp("rec") / "rec.npz"
+        rec.save(path, info)
+        return SensorRecord.load(path)[0], rec
+
+
+def test_the_record_holds_the_superset_and_survives_the_file(recorded):
+    loaded, rec = recorded
+    assert rec.start == 39 and rec.t.size == 70 and rec.truth().shape == (30, 4, 20)
+    np.testing.assert_allclose(rec.loop_x, [6.0, *range(50, 1000, 50), 999.9])
+    assert int(rec.probe_n.sum()) == rec.probe_x.size > 0
+    for name in ("t", "flow", "speed", "density", "probe_x", "samples_h"):
+        np.testing.assert_array_equal(getattr(loaded, name), getattr(rec, name))
+
+
+@pytest.mark.parametrize("method", ["smoothing", "enkf"])
+def test_offline_estimation_equals_the_closed_loop(recorded, method, tmp_path,
+                                                   monkeypatch):
+    monkeypatch.setenv("ARZSUMO_CACHE", str(tmp_path))
+    rec = recorded[0]
+    sc = load_scenario(LEGACY).with_({**LAYOUT, "estimation.method": method,
+                                      "run.controller": "open"})
+    online = summary(run_in_sumo(sc, seed=42, horizon=30.0, warmup=40.0).result)
+    offline = estimation_scores(rec.truth(), replay_estimation(rec, sc), sc.equilibrium)
+    on = online["estimation"]
+    for name in VARIABLES:
+        assert on[name]["samples"] == offline[name]["samples"] > 500
+        assert offline[name]["absolute"] == pytest.approx(on[name]["absolute"], abs=1e-9)
+        assert offline["interpolation"][name]["absolute"] == pytest.approx(
+            on["interpolation"][name]["absolute"], abs=1e-9)
+    assert (offline["spread"] is None) is (method == "smoothing")
+
+
+def test_a_layout_with_stations_not_recorded_is_refused(recorded):
+    sc = load_scenario(LEGACY).with_({"sensing.kinds": ["loops"],
+                                      "sensing.loop_spacing_m": 120})
+    with pytest.raises(ValueError, match="not all among the recorded"):
+        recorded[0].stations(sc.sensing, sc.params.length)
