@@ -10,7 +10,7 @@ then acts on the state it will meet.
 The prediction follows the characteristics of the linearised system (clpsys1-clpsys4)
 over theta: in scaled variables the diagonal of the source is absorbed, and the
 in-domain coupling Sigma(x) (zero diagonal) is neglected over the short horizon (error
-O(theta ||Sigma||), ||Sigma|| about 1e-3 1/s on the default). So
+O(theta ||Sigma||), ||Sigma|| below 0.02 1/s on paper_base and the default). So
 
 * w+_i(x, t + theta) = w+_i(x - lambda_i theta, t) where the foot lies in [0, L]; else
   the characteristic left x = 0 at t + s, s = theta - x / lambda_i, where
@@ -45,10 +45,12 @@ def held(u_bar: float) -> UBarAhead:
 
 def committed(times: np.ndarray, u_bar: np.ndarray, now: float, delay: float) -> UBarAhead:
     """U-bar that reaches the boundary after ``now``: commands issued at ``times`` (s,
-    ascending, zero-order hold) act ``delay`` s later."""
+    ascending, zero-order hold) act ``delay`` s later; 0 before the first command."""
     t_cmd, u = np.asarray(times, float), np.asarray(u_bar, float)
 
     def ahead(s: np.ndarray) -> np.ndarray:
+        if u.size == 0:
+            return np.zeros(np.shape(s))
         idx = np.searchsorted(t_cmd, now + np.asarray(s, float) - delay, side="right") - 1
         return np.where(idx >= 0, u[np.clip(idx, 0, None)], 0.0)
 
