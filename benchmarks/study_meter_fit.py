@@ -91,17 +91,23 @@ def row(signal: str, scope: str, seed: Any, step: str, du: Any, n: int, fit: Fop
             "samples": fit.n_samples}
 
 
-def fits(data: dict[int, dict[str, np.ndarray]], signal: str, pre: float
-         ) -> list[dict[str, Any]]:
-    """Per-step, pooled (direction, step type) and per-seed staircase fits of a signal."""
+STARTS = {"delay_starts": (2.0, 10.0), "tau_starts": (3.0, 15.0)}
+
+
+def fits(data: dict[int, dict[str, np.ndarray]], signal: str, pre: float,
+         detail: bool = True) -> list[dict[str, Any]]:
+    """Per-step, pooled (direction, step type) and per-seed staircase fits of a signal
+    (``detail=False``: only the pooled ones)."""
     rows, recs = [], []
     for seed, d in data.items():
         for (g0, g1), rec in step_records(d, signal, pre):
             recs.append(((g0, g1), rec))
-            rows.append(row(signal, "step", seed, f"{g0:g}->{g1:g}", g1 - g0, 1,
-                            fit_fopdt([rec])))
-        rows.append(row(signal, "staircase", seed, "all", "", len(plan_changes(d)),
-                        fit_fopdt([staircase(d, signal, pre)])))
+            if detail:
+                rows.append(row(signal, "step", seed, f"{g0:g}->{g1:g}", g1 - g0, 1,
+                                fit_fopdt([rec], **STARTS)))
+        if detail:
+            rows.append(row(signal, "staircase", seed, "all", "", len(plan_changes(d)),
+                            fit_fopdt([staircase(d, signal, pre)], **STARTS)))
     groups: dict[str, list[StepData]] = {"down (less ramp green)": [],
                                          "up (more ramp green)": []}
     for (g0, g1), rec in recs:
@@ -110,10 +116,14 @@ def fits(data: dict[int, dict[str, np.ndarray]], signal: str, pre: float
     for name, members in groups.items():
         if members:
             scope = "direction" if "ramp green" in name else "type"
+            if scope == "type" and not detail:
+                continue
             rows.append(row(signal, scope, "all", name, members[0].du[0]
-                            if scope == "type" else "", len(members), fit_fopdt(members)))
+                            if scope == "type" else "", len(members),
+                            fit_fopdt(members, **STARTS)))
     both = [rec for _, rec in recs]
-    rows.append(row(signal, "all steps", "all", "all", "", len(both), fit_fopdt(both)))
+    rows.append(row(signal, "all steps", "all", "all", "", len(both),
+                    fit_fopdt(both, **STARTS)))
     return rows
 
 
@@ -150,7 +160,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--settled", type=float, default=60.0, help="s averaged for levels")
     args = p.parse_args(argv)
     data = load(args.series)
-    rows = fits(data, "y", args.pre) + fits(data, "ramp", args.pre)
+    rows = fits(data, "y", args.pre) + fits(data, "ramp", args.pre, detail=False)
     with args.out.open("w", newline="") as f:
         w = csv.DictWriter(f, FIT_FIELDS)
         w.writeheader()
