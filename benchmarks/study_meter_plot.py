@@ -57,7 +57,7 @@ def print_tables(rows: list[dict[str, Any]], levels: dict[float, list[float]],
 def _ensemble(data: dict[int, dict[str, np.ndarray]], sign: int, span: float
               ) -> tuple[np.ndarray, np.ndarray]:
     """Mean of (y - level before) / du over the steps of one sign, against time since
-    the change (s)."""
+    the change (s), as a trailing 6 s (one cycle) mean."""
     from study_meter_fit import plan_changes
 
     lag = np.arange(-20.0, span + 1)
@@ -69,7 +69,9 @@ def _ensemble(data: dict[int, dict[str, np.ndarray]], sign: int, span: float
             base = d["y"][(d["t_s"] > t0 - 30) & (d["t_s"] <= t0)].mean()
             y = np.interp(t0 + lag, d["t_s"], d["y"], left=np.nan, right=np.nan)
             acc.append((y - base) / (g1 - g0))
-    return lag, np.nanmean(acc, axis=0)
+    mean = np.nanmean(acc, axis=0)
+    smooth = np.convolve(mean, np.ones(6) / 6, mode="full")[: mean.size]   # trailing 6 s
+    return lag, smooth
 
 
 def plot_steps(data: dict[int, dict[str, np.ndarray]],
@@ -108,10 +110,10 @@ def plot_steps(data: dict[int, dict[str, np.ndarray]],
     for sign, color, name in ((-1, "C0", "down (less ramp green)"),
                               (1, "C2", "up (more ramp green)")):
         lag, mean = _ensemble(data, sign, 90)
-        ax.plot(lag, mean * 3600, ".-", ms=3, color=color, lw=0.6, label=f"mean {name}")
+        ax.plot(lag, mean * 3600, ".-", ms=3, color=color, lw=0.6, label=f"mean {name}, 6 s means")
         r = next(r for r in rows if r["signal"] == "y" and r["step"] == name)
         fit = fopdt_response(lag, 0.0, r["gain_veh_s"], 1.0, 0.0, r["delay_s"],
-                             r["time_constant_s"], 1.0)
+                             r["time_constant_s"], 6.0)
         ax.plot(lag, fit * 3600, color=color, lw=2, alpha=0.6,
                 label=f"fit K={r['gain_veh_s'] * 3600:.0f} veh/h, theta={r['delay_s']:.1f} s,"
                       f" T={r['time_constant_s']:.1f} s")
