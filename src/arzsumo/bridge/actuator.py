@@ -9,7 +9,7 @@ plan, and no plan change is counted.
 
 from __future__ import annotations
 
-from arzsumo.sumo.meter import RampMeter
+from arzsumo.sumo.meter import MeterLight
 
 
 class MeterActuator:
@@ -17,19 +17,21 @@ class MeterActuator:
 
     Parameters
     ----------
-    meter : RampMeter
-        The meter of the open run.
+    meter : MeterLight
+        The meter of the open run (fixed cycle: the outflow ``q_nominal + U`` through its
+        curve; one per green: the release rate of
+        :func:`~arzsumo.sumo.meter_release.release_rate_for`).
     q_nominal : float
         Mainline outflow of the nominal plan, veh/s.
     hold_nominal : bool
         Keep the nominal plan whatever U is (the open loop).
     """
 
-    def __init__(self, meter: RampMeter, q_nominal: float, hold_nominal: bool) -> None:
+    def __init__(self, meter: MeterLight, q_nominal: float, hold_nominal: bool) -> None:
         self.meter, self.q_nominal, self.hold_nominal = meter, q_nominal, hold_nominal
 
     def apply(self, u: float) -> float:
         """Command U (veh/s); return the green share commanded (in [0, 1])."""
         if self.hold_nominal:
             return self.meter.green_share
-        return self.meter.command_outflow(self.q_nominal + u)
+        return self.meter.command(u, self.q_nominal)
