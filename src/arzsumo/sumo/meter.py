@@ -32,6 +32,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from types import ModuleType
+from typing import Any
 
 import numpy as np
 
@@ -144,11 +145,11 @@ class StopLine:
 class GreenRecord:
     """One green interval, from a green's start to the next green's start (steps)."""
 
-    start: int
-    queue: int
-    releases: int = 0
-    green: int = 0
-    length: int = 0
+    start: int           # SUMO steps since the start when the green began
+    queue: int           # ramp queue then, veh
+    releases: int = 0    # vehicles that crossed the stop line in the interval
+    green: int = 0       # steps shown green
+    length: int = 0      # steps so far (the whole interval once the next green began)
 
 
 class MeterLight:
@@ -231,7 +232,7 @@ class MeterLight:
         """Whether the queue override is on (queue at or above ``cfg.spillback_queue``)."""
         return bool(self.cfg.spillback_queue) and self.queue >= self.cfg.spillback_queue
 
-    def start_window(self) -> dict[str, float]:
+    def start_window(self) -> dict[str, Any]:
         """Close the current counting window: return its :meth:`summary`, then count anew.
 
         Plan and light changes, override steps and releases restart from 0; the queue
@@ -250,7 +251,7 @@ class MeterLight:
         """Green share of the running plan."""
         raise NotImplementedError
 
-    def summary(self) -> dict[str, float | str]:
+    def summary(self) -> dict[str, Any]:
         """Counts of the current window (see :meth:`start_window`): plan and light changes,
         queue maximum (veh), override steps, releases (veh), green intervals begun and the
         most releases in one, emergency stops and braking at the meter; the last queue and
