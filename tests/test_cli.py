@@ -116,3 +116,17 @@ def test_design_check_ends_with_an_overall_verdict(tmp_path, monkeypatch, capsys
     last = capsys.readouterr().out.strip().splitlines()[-1]
     assert last == (f"verdict: {len(failing)} of {len(out['conditions'])} conditions fail: "
                     + ", ".join(out["failing"]))
+
+
+def test_design_check_auto_prints_a_design_table_and_its_verdict(tmp_path, monkeypatch,
+                                                                 capsys):
+    import tomllib
+
+    monkeypatch.setenv("ARZSUMO_CACHE", str(tmp_path))
+    assert main(["design-check", "--cells", "40", "--auto"]) == 0
+    out = capsys.readouterr().out
+    table = out.split("\n\n")[0]
+    design = tomllib.loads(table)["design"]
+    assert {"mu", "sigma", "zeta", "eta", "A", "B", "varsigma"} <= set(design)
+    assert "cannot hold: esthm #1" in out
+    assert out.strip().splitlines()[-1] == "verdict: 1 of 10 conditions fail: esthm #1"

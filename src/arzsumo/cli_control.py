@@ -44,11 +44,10 @@ def cmd_kernels(args: argparse.Namespace) -> int:
 
 
 def _design(args: argparse.Namespace):
-    from arzsumo.control.etc import PAPER_DESIGN
-
+    """The scenario's [design] (the paper's for a preset) with --mu/--sigma/--zeta."""
     changes = {k: getattr(args, k) for k in ("mu", "sigma", "zeta")
                if getattr(args, k) is not None}
-    return PAPER_DESIGN.with_(**changes)
+    return scenario_of(args).design.with_(**changes)
 
 
 def cmd_verify(args: argparse.Namespace) -> int:
@@ -117,6 +116,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                                    "time tau*, and an overall verdict.")
     _add_common(p)
     _add_design(p)
+    p.add_argument("--auto", action="store_true",
+                   help="choose the design for this model (arzsumo.control.design."
+                        "design_for), print it as a [design] table, then check it")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(func=cmd_design_check)
 
@@ -137,13 +139,25 @@ def cmd_design_check(args: argparse.Namespace) -> int:
     kernels = cached_kernels(lin.system, args.cells)
     w0 = lin.to_riemann(sinusoidal_deviation(lin, kernels.x), kernels.x)
     alpha_x = (w0[:-1, -1] - w0[:-1, -2]) / kernels.h
-    report = check_design(lin.system, kernels, _design(args), alpha_x)
+    design, choice = _design(args), None
+    if args.auto:
+        from arzsumo.control.design import design_for
+
+        require(all(getattr(args, k) is None for k in ("mu", "sigma", "zeta")), "--auto",
+                True, "without --mu, --sigma, --zeta (it chooses them)")
+        choice = design_for(lin.system, kernels, base=design)
+        design = choice.design
+    report = check_design(lin.system, kernels, design, alpha_x)
     if args.json:
         print(json.dumps({"conditions": [asdict(c) for c in report.conditions],
                           "all_hold": report.all_hold, "failing": report.failing(),
-                          "tau_star": report.tau_star, "constants": report.constants},
+                          "tau_star": report.tau_star, "constants": report.constants,
+                          **({"design": asdict(design), "cannot_hold": list(
+                              choice.cannot_hold), "why": list(choice.why)} if choice else {})},
                          indent=2))
         return 0
+    if choice is not None:
+        _print_choice(choice, args.cells)
     print(f"{'condition':9s} {'holds':5s} {'lhs':>12s} {'rhs':>12s}  statement")
     for c in report.conditions:
         print(f"{c.label:9s} {'yes' if c.holds else 'NO':5s} {c.lhs:12.4e} {c.rhs:12.4e}  "
@@ -152,3 +166,14 @@ def cmd_design_check(args: argparse.Namespace) -> int:
           "the sinusoidal initial state)")
     print(f"verdict: {report.verdict()}")
     return 0
+
+
+def _print_choice(choice, cells: int) -> None:
+    """The designed [design] table (ready to paste) and what cannot hold."""
+    from arzsumo.scenario.model import design_toml
+
+    print(design_toml(choice.design, f"designed by arzsumo design-check --auto ({cells} "
+                                     "kernel cells; docs/design.md)"))
+    for line in choice.why:
+        print(f"cannot hold: {line}")
+    print()

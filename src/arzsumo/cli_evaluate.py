@@ -31,7 +31,8 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
     res = run_evaluation(scenario, controllers, seeds, out=out, horizon=args.horizon,
                          workers=args.workers, scheduler=args.scheduler,
                          overwrite=args.overwrite, progress=not args.quiet,
-                         plots=not args.no_plots, command=command)
+                         plots=not args.no_plots, command=command,
+                         baseline_from=Path(args.baseline_from) if args.baseline_from else None)
     rep = res.sweep
     print(f"evaluate {scenario.name}: {rep.total} runs, {rep.skipped} already finished, "
           f"{rep.executed} executed on {rep.backend} in {rep.wall_time:.1f} s")
@@ -77,6 +78,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--overwrite", action="store_true",
                    help="discard the runs and report of a previous evaluation in --out and "
                         "run everything again")
+    p.add_argument("--baseline-from", metavar="DIR",
+                   help="take the open-loop runs from the earlier evaluation in DIR instead "
+                        "of running them (same seeds and horizon; its scenario may differ "
+                        "only in what does not act on an open loop: [estimation], "
+                        "[sensing], [actuation], [design], [run] controller)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--no-plots", action="store_true", help="skip the figure")
     p.set_defaults(func=cmd_evaluate)

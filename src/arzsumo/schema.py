@@ -41,7 +41,8 @@ _PERIOD = "over the control period [t_s, t_s + control period]"
 PERIODS: dict[str, Column] = {
     "t_s": Column("s", "time of the controller check that opens the period, from the start "
                        "of control (end of warm-up)"),
-    "u": Column("veh/s", "U applied: commanded mainline outflow minus q_nominal (0: open loop)"),
+    "u": Column("veh/s", "U applied: commanded mainline outflow minus q_nominal (0: open "
+                         "loop); the same as u_applied"),
     "u_continuous": Column("veh/s", "the continuous control law at this check (before event "
                                     "triggering; equal to u for continuous controllers)"),
     "triggered": Column(TEXT, "true where the controller updated U at this check (an event)"),
@@ -63,6 +64,14 @@ PERIODS: dict[str, Column] = {
     "occupancy_out": Column("1", "SUMO lane occupancy of down_0 (downstream of the merge), "
                                  f"mean {_PERIOD}; ALINEA's measurement"),
     "u_reference": Column("veh/s", "U of the reference twin's own controller at this check"),
+    "u_raw": Column("veh/s", "U the controller held after this check (its law's), before "
+                             "the [actuation] limits"),
+    "u_applied": Column("veh/s", "U sent to the meter after the [actuation] limits (equal to "
+                                 "u_raw without limits)"),
+    "saturated": Column(TEXT, "true where the range of U (u_max_fraction, ramp_bound) cut "
+                              "the controller's U"),
+    "rate_limited": Column(TEXT, "true where the rate limit (u_rate_max_veh_h_s) cut the "
+                                 "change of U"),
 }
 
 _STATE = {
@@ -166,6 +175,12 @@ RUN_SUMMARY: dict[str, str] = {
     "estimation.rho_*.absolute": "veh/m", "estimation.v_*.absolute": "m/s",
     "estimation.*.rho_*.absolute": "veh/m", "estimation.*.v_*.absolute": "m/s",
     "estimation.*.relative": "1", "estimation.*.samples": "count",
+    "actuation.u_max_fraction": "1", "actuation.u_max": "veh/s",
+    "actuation.u_rate_max": "veh/s^2", "actuation.rate_step": "veh/s",
+    "actuation.ramp_bound": "bool", "actuation.anti_windup": "bool", "actuation.applies": "bool",
+    "actuation.periods": "count", "actuation.saturated_periods": "count",
+    "actuation.rate_limited_periods": "count", "actuation.saturated_share": "1",
+    "actuation.rate_limited_share": "1",
     "twin_status.*.resyncs": "count", "twin_status.*.first_resync_s": "s",
     "twin_status.*.first_reason": TEXT,
     "inserted": "veh", "requested": "veh", "waiting": "veh", "arrived": "veh",

@@ -101,3 +101,45 @@ def test_user_mistakes_are_one_line_and_start_nothing(evaluation, tmp_path, caps
                  "--quiet", "--out", str(tmp_path / "mine"), "--overwrite"]) == 2
     assert "not an arzsumo result" in capsys.readouterr().err
     assert (tmp_path / "mine" / "notes.txt").read_text() == "keep"
+
+
+def test_a_borrowed_baseline_is_the_same_open_loop(evaluation, tmp_path, capsys):
+    """An evaluation whose scenario differs only in [sensing], [estimation] takes the open-loop runs
+    of the first one (none run again) and pairs against them; sensors that only read do
+    not change the open loop (a fresh open run with them gives the same SUMO numbers)."""
+    scenario, out = evaluation
+    step = tmp_path / "step.toml"
+    step.write_text(scenario.read_text() + '\n[sensing]\nkinds = ["loops", "av_probes"]\n'
+                    '[estimation]\nmethod = "smoothing"\n')
+    out2 = tmp_path / "out2"
+    assert _evaluate(step, out2, "--baseline-from", str(out)) == 0
+    assert "3 runs, 0 already finished, 3 executed" in capsys.readouterr().out
+    assert not (out2 / "runs" / "controller=open,seed=5").exists()
+    csv = pd.read_csv(out2 / "evaluation.csv")
+    first = pd.read_csv(out / "evaluation.csv")
+    key = "network.time_loss_s.total"
+    for c in ("open", "alinea"):
+        a = csv[(csv.measure == key) & (csv.controller == c)].iloc[0]
+        b = first[(first.measure == key) & (first.controller == c)].iloc[0]
+        assert a["mean"] == pytest.approx(b["mean"], abs=1e-9)    # estimation is inert
+    # the premise: an open loop with the estimator gives the same SUMO numbers
+    assert main(["evaluate", str(step), "--controllers", "open", "--seeds", "1",
+                 "--seed-start", str(SEEDS[0]), "--horizon", "30", "--workers", "1",
+                 "--quiet", "--no-plots", "--out", str(tmp_path / "fresh")]) == 0
+    fresh = json.loads((tmp_path / "fresh" / "runs" / f"controller=open,seed={SEEDS[0]}" /
+                        "summary.json").read_text())
+    old = json.loads((out / "runs" / f"controller=open,seed={SEEDS[0]}" /
+                      "summary.json").read_text())
+    assert fresh["network"] == old["network"]
+    assert fresh["speed_variance"] == old["speed_variance"]
+
+
+def test_a_baseline_that_differs_in_sumo_is_refused(evaluation, tmp_path, capsys):
+    scenario, out = evaluation
+    step = tmp_path / "step.toml"
+    step.write_text(scenario.read_text().replace("ramp_demand_veh_h = 1200",
+                                                 "ramp_demand_veh_h = 900"))
+    assert _evaluate(step, tmp_path / "o", "--baseline-from", str(out)) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "differs in sumo.ramp_demand_veh_h" in err
+    assert not (tmp_path / "o").exists()

@@ -33,7 +33,8 @@ with the results.
 
 A detector sample's path: ``SumoSensor.observe`` (libsumo, every step) ->
 ``PeriodMeasurement`` -> ``Estimator.estimate`` -> ``MacroState`` -> ``Controller.check``
--> U -> ``MeterActuator.apply`` -> ``RampMeter.command_outflow`` (or a release rate,
+-> U -> ``MeterActuator.apply`` (the ``[actuation]`` limits; the U applied goes back to
+``Controller.applied``) -> ``RampMeter.command_outflow`` (or a release rate,
 ``OnePerGreenMeter.command_rate``) -> the light, set by ``step`` at the next cycle start.
 """
 
@@ -50,7 +51,7 @@ from typing import Any
 
 import numpy as np
 
-from arzsumo.bridge.actuator import MeterActuator
+from arzsumo.bridge.actuator import ActuationLimits, MeterActuator
 from arzsumo.bridge.estimator import Estimator
 from arzsumo.bridge.estimators import RecordedEstimator, estimation_stage
 from arzsumo.bridge.records import Decision, PeriodRecord, Trace, columns, micro_fields
@@ -226,9 +227,11 @@ class ClosedLoop:
     """The stages of the control window, wired together (see the module docstring)."""
 
     def __init__(self, plant: SumoPlant, estimator: Estimator, controller: Controller,
-                 actuator: MeterActuator, twins: TwinPair, period: float) -> None:
+                 actuator: MeterActuator, twins: TwinPair, period: float,
+                 anti_windup: bool = True) -> None:
         self.plant, self.estimator, self.controller = plant, estimator, controller
         self.actuator, self.twins, self.period = actuator, twins, period
+        self.anti_windup = anti_windup
         self.timings = {"controller": 0.0, "twins": 0.0, "estimator": 0.0}
 
     def decide(self, state: MacroState, final: bool) -> Decision:
@@ -240,19 +243,26 @@ class ClosedLoop:
         u_ref = self.twins.check_reference()
         self.timings["controller"] += c1 - c0
         self.timings["twins"] += time.perf_counter() - c1
-        green = self.plant.meter.green_share if final else self.actuator.apply(u)
         log_ = self.controller.log
-        return Decision(state.t, u, log_.u_continuous[-1] if log_.u_continuous else u,
-                        float(log_.triggered[-1]) if log_.triggered else 0.0, green, u_ref,
-                        c1 - c0)
+        u_cont = log_.u_continuous[-1] if log_.u_continuous else u
+        triggered = float(log_.triggered[-1]) if log_.triggered else 0.0
+        if final:
+            return Decision(state.t, u, u_cont, triggered, self.plant.meter.green_share,
+                            u_ref, c1 - c0)
+        act = self.actuator.apply(u)
+        if self.anti_windup:
+            self.controller.applied(act.u_applied, act.lower, act.upper)
+        return Decision(state.t, u, u_cont, triggered, act.green, u_ref, c1 - c0,
+                        act.u_applied, float(act.saturated), float(act.rate_limited))
 
     def record(self, d: Decision, m: PeriodMeasurement) -> PeriodRecord:
         meter, c = self.plant.meter, m.cells
-        return PeriodRecord(d.t, d.u, d.u_continuous, d.triggered, d.green_commanded,
-                            meter.green_share, meter.light_changes, meter.plan_changes,
-                            meter.queue, meter.max_queue, c.inflow_h, c.inflow_a,
-                            c.outflow_h, c.outflow_a, m.occupancy_out, d.u_reference,
-                            d.controller_s)
+        return PeriodRecord(d.t, d.u_applied, d.u_continuous, d.triggered,
+                            d.green_commanded, meter.green_share, meter.light_changes,
+                            meter.plan_changes, meter.queue, meter.max_queue, c.inflow_h,
+                            c.inflow_a, c.outflow_h, c.outflow_a, m.occupancy_out,
+                            d.u_reference, d.controller_s, d.u, d.u_applied, d.saturated,
+                            d.rate_limited)
 
     def run(self, start: PeriodMeasurement, horizon: float, bar: Progress) -> Trace:
         """Control from the measurement ``start`` (t = 0) until ``horizon`` seconds."""
@@ -377,7 +387,9 @@ def control(sim: SumoSimulation, scenario: Scenario, settings: RunSettings, cfg:
     opts = SolverOptions(cells=settings.twin_cells, scheme=settings.twin_scheme,
                          horizon=cfg.horizon, control_period=period)
     twins = TwinPair(eq, lin, warm[-1].cells, opts, settings.smoothing, ref_ctrl, q_nom)
-    actuator = MeterActuator(plant.meter, q_nom, settings.controller == "open")
-    loop = ClosedLoop(plant, estimator, ctrl, actuator, twins, period)
+    act = scenario.actuation
+    actuator = MeterActuator(plant.meter, q_nom, settings.controller == "open",
+                             ActuationLimits.of(act, q_nom, curve, cfg))
+    loop = ClosedLoop(plant, estimator, ctrl, actuator, twins, period, act.anti_windup)
     trace = loop.run(warm[-1], cfg.horizon, bar)
     return Controlled(loop, trace, ref_ctrl, eq, q_nom, warmup_meter, start, estimator)

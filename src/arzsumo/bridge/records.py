@@ -18,7 +18,10 @@ from arzsumo.sumo.measure import CellData
 class PeriodRecord:
     """One control period (SI; flows veh/s, counts since the start of control).
 
-    ``u`` is the U held after the check (veh/s), ``u_continuous`` what the continuous
+    ``u`` is the U applied after the check (veh/s; ``u_applied``, after the
+    ``[actuation]`` limits of :mod:`~arzsumo.bridge.actuator`), ``u_raw`` the U the
+    controller held (its law's, before the limits), ``saturated`` and ``rate_limited``
+    (1.0 or 0.0) which limits acted; ``u_continuous`` what the continuous
     law gave, ``triggered`` an update of the held U (1.0 or 0.0), ``green_commanded`` the
     green share asked of the meter, ``u_reference`` the reference twin's U,
     ``controller_s`` the wall time of the check. The rest is the period that followed:
@@ -44,6 +47,10 @@ class PeriodRecord:
     occupancy_out: float
     u_reference: float
     controller_s: float
+    u_raw: float = float("nan")
+    u_applied: float = float("nan")
+    saturated: float = 0.0
+    rate_limited: float = 0.0
 
 
 def columns(records: list[PeriodRecord]) -> dict[str, np.ndarray]:
@@ -72,7 +79,8 @@ class Trace:
 
 @dataclass(frozen=True)
 class Decision:
-    """One check: U held (veh/s), its continuous value, event flag, meter command."""
+    """One check: U held (veh/s), its continuous value, event flag, meter command, and
+    the U applied (veh/s) with the limit flags (1.0 or 0.0)."""
 
     t: float
     u: float
@@ -81,3 +89,6 @@ class Decision:
     green_commanded: float
     u_reference: float
     controller_s: float
+    u_applied: float = float("nan")
+    saturated: float = 0.0
+    rate_limited: float = 0.0

@@ -9,6 +9,7 @@ their equilibrium themselves, so callers hand over the nonlinear fields.
 
 from __future__ import annotations
 
+import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
 
@@ -92,6 +93,19 @@ class Controller(ABC):
     @abstractmethod
     def decide(self, state: MacroState) -> float:
         """Return U (veh/s); implementations append one record to :attr:`log`."""
+
+    def applied(self, u: float, lower: float = -math.inf, upper: float = math.inf) -> None:
+        """Anti-windup hook: the actuator applied ``u`` (veh/s) for the U of the last
+        :meth:`check`, and U is limited to ``[lower, upper]`` (veh/s) at present.
+
+        Called after every check whose U reaches the meter (``[actuation] anti_windup``).
+        The default does nothing: a static law (continuous backstepping, control_law,
+        computes U from the present state alone and keeps no state to wind up).
+        Controllers with state override it: the ETC's trigger
+        (:class:`arzsumo.control.etc.EventTriggered`) and the observer
+        (:class:`arzsumo.control.observer.ObserverEtc`).
+        """
+        return None
 
 
 class OpenLoop(Controller):

@@ -108,16 +108,34 @@ class _Constants:
     b_exp: float
 
 
+def inverse_p1(kernels: Kernels) -> float:
+    """p_1 = 1 / ||inverse transform||^2 (on at most about 60 cells; dimensionless)."""
+    coarse = kernels if kernels.n_cells <= 60 else _coarsen(kernels)
+    return 1.0 / _inverse_norm(coarse) ** 2
+
+
+def boundary_eps(system: CharacteristicSystem, kernels: Kernels) -> np.ndarray:
+    """epsilon_i of Lemma bounddt, one per positive-speed state (1/s^2)."""
+    n, lam, r_norm = system.n, system.lam_plus, float(np.linalg.norm(system.R))
+    j = np.linalg.norm(system.sigma(kernels.x)[-1, :n, :n], axis=0)
+    return 8 * kernels.L[:, -1, -1]**2 * lam**2 + 8 * j * r_norm**2
+
+
+def coupling_bound(system: CharacteristicSystem, kernels: Kernels, p1: float) -> float:
+    """max ||Sigma++|| + (1 + 1/p_1) max ||Sigma+-|| over [0, L], 1/s (the factor of gamma)."""
+    n, sig = system.n, system.sigma(kernels.x)
+    sig_pp_max = float(np.linalg.norm(sig[:, :n, :n], axis=(1, 2)).max())
+    sig_pm_max = float(np.linalg.norm(sig[:, :n, n], axis=1).max())
+    return sig_pp_max + (1 + 1 / p1) * sig_pm_max
+
+
 def _norm_equivalences(system: CharacteristicSystem, kernels: Kernels,
                        design: EtcDesign) -> tuple[float, float]:
-    """p_1 = 1 / ||inverse transform||^2 (on at most about 60 cells) and p_3 = the smallest
-    weight of V."""
+    """p_1 (:func:`inverse_p1`) and p_3 = the smallest weight of V."""
     lam, lm, A = system.lam_plus, system.lam_minus, np.array(design.A)
     p3 = float(min((A / lam * np.exp(-design.mu * system.length / lam)).min(),
                    design.B / lm))
-    p1 = 1.0 / _inverse_norm(kernels) ** 2 if kernels.n_cells <= 60 else 1.0 / _inverse_norm(
-        _coarsen(kernels)) ** 2
-    return p1, p3
+    return inverse_p1(kernels), p3
 
 
 def _inverse_kernel_bounds(system: CharacteristicSystem, kernels: Kernels,
@@ -146,16 +164,13 @@ def _constants(system: CharacteristicSystem, kernels: Kernels, design: EtcDesign
     sig = system.sigma(kernels.x)
     r_norm = float(np.linalg.norm(r))
     b_exp = design.B * math.exp(design.mu * system.length / lm)
-    j = np.linalg.norm(sig[-1, :n, :n], axis=0)
-    eps = 8 * kernels.L[:, -1, -1]**2 * lam**2 + 8 * j * r_norm**2
+    eps = boundary_eps(system, kernels)
     p1, p3 = _norm_equivalences(system, kernels, design)
     c1, c2, c3 = _inverse_kernel_bounds(system, kernels, sig)
     s_pm_l = sig[-1, :n, n]
     phi1 = (8 * kernels.N[-1, -1] ** 2 * lm**2 + 2 * float(r @ s_pm_l) ** 2) * r_norm**2
     phi2 = 8 / p3 * (c1 + c2 / p1) + 8 * c3 * r_norm**2 / p3
-    sig_pp_max = float(np.linalg.norm(sig[:, :n, :n], axis=(1, 2)).max())
-    sig_pm_max = float(np.linalg.norm(sig[:, :n, n], axis=1).max())
-    gamma = 2 * A.max() / (p3 * lam.min()) * (sig_pp_max + (1 + 1 / p1) * sig_pm_max)
+    gamma = 2 * A.max() / (p3 * lam.min()) * coupling_bound(system, kernels, p1)
     ax = np.zeros(n) if alpha_x_at_l is None else np.asarray(alpha_x_at_l)
     c4 = 2 * float(np.linalg.norm(r * lam)) ** 2 * float(ax @ ax)
     return _Constants(eps, p1, p3, gamma, c1, c2, c3, c4, phi1, phi2, b_exp)

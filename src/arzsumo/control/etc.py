@@ -14,6 +14,28 @@ as small as the plant time step for continuous monitoring) the mechanism
 4. triggers an event when zeta B e^{mu L/Lambda-} d^2 >= zeta mu sigma V - m (defdynamic;
    the paper's second bullet drops the first zeta, a typo: Lemma mbound uses it).
 
+Noise dead band (not in the paper; off by default). With ``noise_sd`` given (the sd of
+each scaled Riemann variable's noise on the state the controller sees, m/s, taken as
+independent between grid nodes and checks), U-bar carries noise of sd
+s_U = sqrt(sum_i noise_sd_i^2 ||gain_i||^2) (gain: the law's weights on w-bar), and the
+difference d of two noisy samples sd sqrt(2) s_U. Steps 3 and 4 then use
+d_delta = sign(d) max(|d| - delta, 0) instead of d, with delta = noise_k sqrt(2) s_U:
+pure noise of that level (|d| <= delta) neither raises m nor triggers. With delta = 0
+this is the paper's mechanism.
+
+Anti-windup (issue 17). When the actuator limits U to a range [U_lo, U_hi] (saturation:
+:func:`arzsumo.bridge.actuator.limit_u`), the boundary input the plant receives is
+sat(U-bar(t_k)), not control law sam's U-bar(t_k), and a d of dt computed on the raw values
+misjudges what reaches the boundary: changes of the law inside the saturated region would
+fire events that change nothing at the meter. With the range handed to the controller
+(:meth:`EventTriggered.applied`), the mechanism uses the discrepancy of what the actuator
+delivers, d(t) = sat(U-bar(t_k)) - sat(U-bar(t)) (both projected on the range in force), in
+V's forcing of mdyna and in defdynamic. A law that stays beyond a bound then gives d = 0:
+no event fires for a command that cannot arrive. Without a range (the default, infinite
+bounds) d is dt's exactly. The rate limit is left out of the projection: it only delays
+the held command (as the meter's cycle does), which then arrives; it is no windup. The
+noise dead band acts on the projected d.
+
 Lemma mbound guarantees m < 0 under continuous monitoring. With periodic checks the
 condition can be violated between checks unseen, so m may creep above zero: every such
 check is counted in the log (``m_nonnegative``), never clamped.
@@ -40,6 +62,10 @@ class EtcDesign:
 
     ``m0`` (m(0) < 0) is not given in the paper; -0.01 is our choice. m decays at rate eta,
     so it matters only for the first seconds.
+
+    ``noise_sd`` (m/s, one per scaled Riemann variable, or empty: no dead band) and
+    ``noise_k`` (dimensionless) set the noise dead band of the trigger (module docstring);
+    they are not part of the paper's design and the theorems do not see them.
     """
 
     zeta: float = 8e-3
@@ -50,11 +76,13 @@ class EtcDesign:
     varsigma: tuple[float, ...] = (2e-10, 2e-9, 1.2e-12, 0.01)
     mu: float = 5e-4
     m0: float = -1e-2
+    noise_sd: tuple[float, ...] = ()
+    noise_k: float = 2.0
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "A", tuple(float(a) for a in self.A))
-        object.__setattr__(self, "varsigma", tuple(float(v) for v in self.varsigma))
-        for name in ("zeta", "sigma", "eta", "B", "mu"):
+        for name in ("A", "varsigma", "noise_sd"):
+            object.__setattr__(self, name, tuple(float(a) for a in getattr(self, name)))
+        for name in ("zeta", "sigma", "eta", "B", "mu", "noise_k"):
             value = getattr(self, name)
             require(math.isfinite(value) and value > 0, name, value, "a number > 0")
         for name in ("A", "varsigma"):
@@ -65,6 +93,9 @@ class EtcDesign:
                 f"{len(self.A) + 1} values (one per state)")
         require(math.isfinite(self.m0) and self.m0 < 0, "m0", self.m0,
                 "a negative number (m(0) < 0)")
+        require(not self.noise_sd or (len(self.noise_sd) == len(self.varsigma) and all(
+            math.isfinite(v) and v >= 0 for v in self.noise_sd)), "noise_sd", self.noise_sd,
+                f"{len(self.varsigma)} numbers >= 0 (one per state) or none")
 
     def with_(self, **changes: object) -> EtcDesign:
         """A validated copy with some fields changed."""
@@ -103,6 +134,24 @@ def integrate_m(m: float, g0: float, g1: float, eta: float, tau: float) -> float
     return decay * m + g0 * a + (g1 - g0) * (1.0 - a / tau) / eta
 
 
+def noise_dead_band(design: EtcDesign, gain: np.ndarray) -> float:
+    """delta = noise_k sqrt(2) s_U (module docstring), in U-bar units (m/s); 0 without
+    ``noise_sd``."""
+    if not design.noise_sd:
+        return 0.0
+    require(len(design.noise_sd) == gain.shape[0], "noise_sd", design.noise_sd,
+            f"{gain.shape[0]} numbers (one per state)")
+    sd = np.asarray(design.noise_sd)[:, None]
+    return design.noise_k * math.sqrt(2.0 * float(np.sum((sd * gain) ** 2)))
+
+
+def u_bar_range(lower: float, upper: float, per: float) -> tuple[float, float]:
+    """The range ``[lower, upper]`` of U (veh/s) in U-bar units (``per`` = U-bar per U,
+    either sign), as ``(low, high)``."""
+    a, b = lower * per, upper * per
+    return (a, b) if a <= b else (b, a)
+
+
 @dataclass(frozen=True)
 class CheckResult:
     """Outcome of one check: the held U-bar, the continuous U-bar and diagnostics."""
@@ -126,6 +175,7 @@ class EventTrigger:
         self.transform = BacksteppingTransform(kernels)
         self.lyapunov = Lyapunov(system, kernels.x, design)
         self.b_exp = design.B * math.exp(design.mu * system.length / system.lam_minus)
+        self.dead_band = noise_dead_band(design, self.law.gain)
         self.reset()
 
     def reset(self) -> None:
@@ -133,6 +183,8 @@ class EventTrigger:
         self.t_last: float | None = None
         self.u_held: float | None = None
         self.g_last = 0.0
+        #: range of U-bar the actuator delivers (anti-windup); infinite: no limits known
+        self.bounds = (-math.inf, math.inf)
 
     def _forcing(self, d: float, V: float, alpha: np.ndarray, beta: np.ndarray) -> float:
         ds = self.design
@@ -150,14 +202,18 @@ class EventTrigger:
             self.u_held, self.t_last = u_cont, t
             self.g_last = self._forcing(0.0, V, alpha, beta)
             return CheckResult(u_cont, u_cont, True, V, 0.0, self.m)
-        d = self.u_held - u_cont
-        g = self._forcing(d, V, alpha, beta)
+        lo, hi = self.bounds                         # anti-windup: what can be delivered
+        d = min(max(self.u_held, lo), hi) - min(max(u_cont, lo), hi)
+        d_db = math.copysign(max(abs(d) - self.dead_band, 0.0), d)
+        g = self._forcing(d_db, V, alpha, beta)
         self.m = integrate_m(self.m, self.g_last, g, ds.eta, t - (self.t_last or t))
         self.t_last = t
-        triggered = ds.zeta * self.b_exp * d * d >= ds.zeta * ds.mu * ds.sigma * V - self.m
+        triggered = (ds.zeta * self.b_exp * d_db * d_db
+                     >= ds.zeta * ds.mu * ds.sigma * V - self.m) and (
+            self.dead_band == 0.0 or abs(d) > self.dead_band)
         if triggered:
             self.u_held = u_cont
-            g -= self.b_exp * d * d                  # d(t_k+) = 0
+            g -= self.b_exp * d_db * d_db            # d(t_k+) = 0
         self.g_last = g
         return CheckResult(self.u_held, u_cont, bool(triggered), V, d, self.m)
 
@@ -177,6 +233,11 @@ class EventTriggered(Controller):
     def reset(self) -> None:
         super().reset()
         self.trigger.reset()
+
+    def applied(self, u: float, lower: float = -math.inf, upper: float = math.inf) -> None:
+        """Anti-windup: the trigger compares what the actuator delivers in ``[lower,
+        upper]`` (veh/s) from the next check on (module docstring)."""
+        self.trigger.bounds = u_bar_range(lower, upper, self.lin.u_bar_per_u)
 
     def check_riemann(self, t: float, w_bar: np.ndarray) -> float:
         """Check on a scaled Riemann state at the kernel nodes; returns the held U-bar."""

@@ -25,14 +25,22 @@ converges in finite time by the inlet condition alone.
 
 Observer-based ETC. The law bs_control_of and its sampled version bs_control_of_etc are
 control_law and the mechanism of defdynamic applied to the estimate (discrepancy dtof).
+
+Anti-windup (issue 17). The observer's boundary condition ob-sys2-bd takes the U-bar the
+plant receives. When the actuator limits U, that is the U applied, not the held command:
+:meth:`ObserverEtc.applied` hands it over and the observer integrates the next interval
+with it (otherwise, as before, with the held command); the trigger projects dtof on the
+actuator's range as the full-state ETC does (:mod:`arzsumo.control.etc`).
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from arzsumo.control.base import Controller, MacroState
-from arzsumo.control.etc import PAPER_DESIGN, EtcDesign, EventTrigger
+from arzsumo.control.etc import PAPER_DESIGN, EtcDesign, EventTrigger, u_bar_range
 from arzsumo.control.kernels import Kernels, solve_kernels
 from arzsumo.control.plant import LinearPlant, step_dividing
 from arzsumo.model.characteristic import CharacteristicSystem, Linearization
@@ -119,6 +127,8 @@ class ObserverEtc(Controller):
         self.observer = BoundaryObserver(lin.system, kernels.n_cells)
         self.trigger = EventTrigger(lin.system, kernels, design)
         self.u_bar_held = 0.0
+        #: U-bar the observer integrates over the next interval: the applied one
+        self.u_bar_input = 0.0
         eq = lin.equilibrium
         self._y_weights = lin.T[3, [1, 3]]            # y = w_4(0) with rho~(0) = 0
         self._v_ref = np.array([eq.v_h, eq.v_a])
@@ -127,7 +137,7 @@ class ObserverEtc(Controller):
         super().reset()
         self.observer.reset()
         self.trigger.reset()
-        self.u_bar_held = 0.0
+        self.u_bar_held = self.u_bar_input = 0.0
 
     def measurement_of(self, state: MacroState) -> float:
         """y = w-(0) from the class speeds in the first cell (inlet densities at rho*)."""
@@ -136,13 +146,20 @@ class ObserverEtc(Controller):
 
     def check_measurement(self, t: float, y: float) -> float:
         """Advance the observer to t with y(t), run the mechanism on the estimate; U-bar."""
-        estimate = self.observer.advance(t, y, self.u_bar_held)
+        estimate = self.observer.advance(t, y, self.u_bar_input)
         r = self.trigger.check(t, estimate)
-        self.u_bar_held = r.u_bar_held
+        self.u_bar_held = self.u_bar_input = r.u_bar_held
         per = self.lin.u_bar_per_u
         self.log.record(t, r.u_bar_held / per, r.u_bar_continuous / per, r.triggered,
                         V=r.V, d=r.d, m=r.m, m_nonnegative=float(r.m >= 0), y=y)
         return r.u_bar_held
+
+    def applied(self, u: float, lower: float = -math.inf, upper: float = math.inf) -> None:
+        """Anti-windup: the observer integrates with the applied ``u`` (veh/s) until the
+        next check; the trigger compares what is deliverable in ``[lower, upper]``."""
+        per = self.lin.u_bar_per_u
+        self.u_bar_input = u * per
+        self.trigger.bounds = u_bar_range(lower, upper, per)
 
     def decide(self, state: MacroState) -> float:
         return self.check_measurement(state.t, self.measurement_of(state)) / self.lin.u_bar_per_u

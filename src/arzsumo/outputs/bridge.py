@@ -4,10 +4,10 @@ Every file, column (with units, stored in the Parquet field metadata from
 :mod:`arzsumo.schema`) and summary key is described in ``docs/outputs.md``. Layout of
 ``DIR``::
 
-    periods.parquet   per control period: t_s (check time), U commanded and continuous (veh/s),
+    periods.parquet   per control period: t_s (check time), U applied and continuous (veh/s),
                       event flag, green share commanded and running, light and plan changes,
                       ramp queue and its maximum (veh), class in/outflows (veh/s),
-                      downstream occupancy
+                      downstream occupancy; U of the law and applied, limit flags
     cells.parquet     per period and cell: source (micro, replay, reference), t_s, x_m,
                       rho_h, v_h, rho_a, v_a (SI; micro speeds NaN in empty cells)
     summary.json      see :func:`summary`
@@ -137,6 +137,23 @@ def estimation_summary(res: CoSimResult) -> dict[str, Any] | None:
             **rmse(res, res.estimate), "spread": spread, "interpolation": interp}
 
 
+def actuation_summary(res: CoSimResult) -> dict[str, Any]:
+    """The ``[actuation]`` limits used (SI; null: off) and how often they acted: periods
+    and shares of the control window's periods saturated and rate limited."""
+    act, per = res.scenario.actuation, res.periods
+    n = int(per["t"].size)
+    sat, rate = int(np.sum(per["saturated"] > 0)), int(np.sum(per["rate_limited"] > 0))
+    off = res.settings.controller == "open"
+    return {"u_max_fraction": act.u_max_fraction,
+            "u_max": act.u_max_fraction * res.q_nominal if act.u_max_fraction else None,
+            "u_rate_max": act.u_rate_max or None,
+            "rate_step": act.u_rate_max * res.sumo.control_period if act.u_rate_max else None,
+            "ramp_bound": act.ramp_bound, "anti_windup": act.anti_windup,
+            "applies": not off, "periods": n, "saturated_periods": sat,
+            "rate_limited_periods": rate, "saturated_share": sat / n if n else None,
+            "rate_limited_share": rate / n if n else None}
+
+
 #: ``summary.json["kind"]`` of a closed-loop run in SUMO (``arzsumo run``)
 KIND = "run"
 
@@ -218,6 +235,7 @@ def summary(res: CoSimResult) -> dict[str, Any]:
         "rmse_blocks": rmse_blocks(res),
         "section_trend": section_trend(res),
         "estimation": estimation_summary(res),
+        "actuation": actuation_summary(res),
         "twin_status": res.twin_status,
         "inserted": rep.inserted if rep else None, "requested": rep.requested if rep else None,
         "inserted_fraction_main": rep.delivered_main if rep else None,
@@ -237,7 +255,8 @@ def summary(res: CoSimResult) -> dict[str, Any]:
 def periods_table(res: CoSimResult) -> pa.Table:
     cols = {"t_s": res.periods["t"]}
     cols.update({k: v for k, v in res.periods.items() if k not in ("t", "controller_s")})
-    cols["triggered"] = res.periods["triggered"].astype(bool)
+    for flag in ("triggered", "saturated", "rate_limited"):
+        cols[flag] = res.periods[flag].astype(bool)
     return with_units(pa.table(cols), PERIODS, "periods")
 
 

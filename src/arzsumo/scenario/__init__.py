@@ -18,6 +18,7 @@ section                   record                                     keys (units
 ``[run]``                 ``run``: RunSettings (``arzsumo run``)     :mod:`.run`
 ``[sensing]``             ``sensing``: SensorLayout (``run``)        :mod:`.sensing`
 ``[estimation]``          ``estimation``: EstimationSettings         :mod:`.estimation`
+``[actuation]``           ``actuation``: ActuationSettings (``run``) :mod:`.actuation`
 ``[sweep]``               ``sweep``: DesignSweep (``reproduce``)     here
 ========================  =========================================  ====================
 
@@ -40,6 +41,7 @@ from arzsumo.errors import ScenarioError
 from arzsumo.io import read_toml
 from arzsumo.model.equilibrium import Equilibrium
 from arzsumo.model.params import ModelParameters, get_preset
+from arzsumo.scenario.actuation import ACTUATION_KEYS, ActuationSettings, actuation_section
 from arzsumo.scenario.estimation import (
     ESTIMATION_KEYS,
     EstimationSettings,
@@ -70,7 +72,7 @@ from arzsumo.tables import Key, check_keys, check_renamed, checked, not_allowed,
 from arzsumo.twin.initial import InitialCondition
 
 #: the ETC design parameters that a ``[sweep]`` table may vary (one number each)
-SWEEPABLE = tuple(sorted(set(DESIGN_KEYS) - {"A", "varsigma"}))
+SWEEPABLE = tuple(sorted(set(DESIGN_KEYS) - {"A", "varsigma", "noise_sd_kmh"}))
 #: [sweep] key -> DesignSweep field (``arzsumo reproduce``: one ETC run per value)
 SWEEP_KEYS: dict[str, Key] = {
     "parameter": Key("parameter", "string", choices=SWEEPABLE,
@@ -82,7 +84,8 @@ SWEEP_KEYS: dict[str, Key] = {
 KEYS: dict[str, dict[str, Key]] = {
     "model": MODEL_KEYS, "equilibrium": EQUILIBRIUM_KEYS, "design": DESIGN_KEYS,
     "initial": INITIAL_KEYS, "twin": TWIN_KEYS, "sumo": SUMO_KEYS, "run": RUN_KEYS,
-    "sensing": SENSING_KEYS, "estimation": ESTIMATION_KEYS, "sweep": SWEEP_KEYS,
+    "sensing": SENSING_KEYS, "estimation": ESTIMATION_KEYS, "actuation": ACTUATION_KEYS,
+    "sweep": SWEEP_KEYS,
 }
 #: table -> {old key: new key}: keys renamed since earlier versions (a one-line hint)
 RENAMED: dict[str, dict[str, str]] = {"run": RUN_RENAMED}
@@ -120,6 +123,7 @@ class Scenario:
     tables: Mapping[str, Any] = field(default_factory=dict, repr=False, compare=False)
     sensing: SensorLayout = field(default_factory=SensorLayout)
     estimation: EstimationSettings = field(default_factory=EstimationSettings)
+    actuation: ActuationSettings = field(default_factory=ActuationSettings)
 
     def with_(self, changes: Mapping[str, Any]) -> Scenario:
         """A new scenario with keys changed, parsed and validated again.
@@ -185,13 +189,14 @@ def scenario_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scena
     sensing = sensing_section(t["sensing"], at["sensing"], params.length)
     estimation = estimation_section(t["estimation"], at["estimation"])
     check_sensors(estimation, sensing, params.length, at["estimation"])
+    actuation = actuation_section(t["actuation"], at["actuation"])
     sweep = _sweep_section(t["sweep"], at["sweep"])
     default_name = Path(source).stem if source != "<dict>" else preset.name
     return Scenario(_text(data, "name", source, default_name),
                     _text(data, "description", source, preset.description), params, eq,
                     design, initial, twin, sumo, run, sweep, source,
                     copy.deepcopy(dict(data)), sensing=sensing,
-                    estimation=estimation)
+                    estimation=estimation, actuation=actuation)
 
 
 def load_scenario(path: str | Path) -> Scenario:

@@ -14,6 +14,7 @@ from arzsumo.control.etc import PAPER_DESIGN
 from arzsumo.control.registry import REGISTRY
 from arzsumo.model.params import get_preset
 from arzsumo.scenario import KEYS, RENAMED
+from arzsumo.scenario.actuation import ActuationSettings
 from arzsumo.scenario.estimation import EstimationSettings
 from arzsumo.scenario.run import RunSettings
 from arzsumo.scenario.twin import DEFAULT_AMPLITUDE, TwinConfig
@@ -47,6 +48,9 @@ SECTIONS: dict[str, tuple[str, Callable[[str], Any] | None]] = {
                    "`none`, the probe's cells; noise levels are the estimators' assumed "
                    "errors, not added to SUMO's readings",
                    lambda f: getattr(EstimationSettings(), f)),
+    "actuation": ("the limits between the controller's U and the ramp meter of `arzsumo "
+                  "run` (issue 17); default: every limit off, the meter receives the "
+                  "controller's U", lambda f: getattr(ActuationSettings(), f)),
     "sweep": ("`arzsumo reproduce` only: one ETC run per value of a [design] parameter", None),
 }
 

@@ -24,6 +24,7 @@ from typing import Any
 
 from arzsumo.control.etc import PAPER_DESIGN, EtcDesign
 from arzsumo.errors import ArzsumoError, ScenarioError
+from arzsumo.io import toml_value
 from arzsumo.model.equilibrium import (
     Equilibrium,
     equilibrium_at_penetration,
@@ -89,6 +90,12 @@ DESIGN_KEYS: dict[str, Key] = {
     "varsigma": Key("varsigma", "numbers", doc="weights varsigma (one per state: 4 numbers)"),
     "mu": Key("mu", doc="ETC weight mu of the triggering condition"),
     "m0": Key("m0", doc="initial value m(0) < 0 of the dynamic variable (not in the paper)"),
+    "noise_sd_kmh": Key("noise_sd", "numbers", factor=KMH_PER_MS, unit="km/h",
+                        allowed="4 standard deviations >= 0 km/h (one per state)",
+                        doc="noise sd of each scaled Riemann variable on the state the ETC "
+                            "sees (default: none, no dead band; not in the paper)"),
+    "noise_k": Key("noise_k", doc="trigger dead band in noise sds of the trigger error d "
+                                  "(with noise_sd_kmh; not in the paper)"),
 }
 
 
@@ -146,6 +153,20 @@ def equilibrium_section(params: ModelParameters, preset: Preset, eqt: Mapping[st
         # the model states a disagreeing speed in km/h already: name the key
         exc.args = (re.sub(r"^v_([ha]) = ", r"v_\1_kmh = ", str(exc)),)
         raise in_user_terms(exc, at, eqt, EQUILIBRIUM_KEYS) from None
+
+
+def design_toml(design: EtcDesign, comment: str = "") -> str:
+    """A ``[design]`` table (TOML text, 6 significant digits) that :func:`design_section`
+    reads back as ``design``; keys at the paper's default value are left out."""
+    lines = [f"# {line}" for line in comment.splitlines()] + ["[design]"]
+    for key, spec in DESIGN_KEYS.items():
+        value = getattr(design, spec.field)
+        if value == getattr(PAPER_DESIGN, spec.field) and key not in ("mu", "sigma", "zeta"):
+            continue
+        user = ([float(f"{v * spec.factor:.6g}") for v in value] if isinstance(value, tuple)
+                else float(f"{value * spec.factor:.6g}"))
+        lines.append(f"{key} = {toml_value(user)}")
+    return "\n".join(lines) + "\n"
 
 
 def design_section(table: Mapping[str, Any], at: str) -> EtcDesign:

@@ -12,12 +12,20 @@ mistaken for it) laid out like a sweep, plus the report of
     OUT/  runs/<controller=...,seed=...>/   summary.json, periods.parquet (each run)
           summaries.parquet, sweep.json, sweep.toml, executions.jsonl   (the sweep's)
           evaluation.csv, evaluation.md, paired_differences.png        (the report)
+
+With ``baseline_from`` (``--baseline-from DIR``) the open-loop runs are not run again but
+taken from an earlier evaluation in DIR (:func:`borrowed_baseline`), allowed only when
+their resolved scenarios differ from this evaluation's in nothing that acts on an open-loop
+SUMO run (:data:`OPEN_LOOP_INERT`): an ablation whose steps change only the controllers'
+side (estimation, sensing, actuation, design) pays for its baseline once.
 """
 
 from __future__ import annotations
 
+import copy
 import re
 import shutil
+import tomllib
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -25,10 +33,12 @@ from pathlib import Path
 import pandas as pd
 
 from arzsumo.evaluation.report import evaluate
+from arzsumo.io import dump_toml
 from arzsumo.outdir import judge, where
 from arzsumo.outputs.evaluation import write_evaluation
 from arzsumo.sweep.driver import SweepReport, run_sweep
-from arzsumo.sweep.spec import SweepError, SweepSpec, sweep_from_dict
+from arzsumo.sweep.spec import RunSpec, SweepError, SweepSpec, sweep_from_dict
+from arzsumo.sweep.table import run_dir, sweep_table
 from arzsumo.sweep.worker import FINISHED
 
 #: marker kind of an evaluation directory
@@ -49,6 +59,13 @@ class EvaluationResult:
     runs: pd.DataFrame
     table: pd.DataFrame
     files: list[Path] = field(default_factory=list)
+
+
+#: scenario tables and keys that do not act on an open-loop SUMO run (the open loop holds
+#: the nominal plan; sensors and estimators only read; no controller is built): two open
+#: runs whose resolved scenarios differ only here are the same SUMO run
+OPEN_LOOP_INERT = ("name", "description", "estimation", "sensing", "actuation", "design",
+                   "run.controller")
 
 
 def check_controllers(controllers: Sequence[str]) -> list[str]:
@@ -98,6 +115,55 @@ def check_runs(scenario: Path, controllers: Sequence[str], horizon: float | None
     return sc.name
 
 
+def _without_inert(data: dict) -> dict:
+    out = copy.deepcopy(data)
+    for name in OPEN_LOOP_INERT:
+        table, _, key = name.partition(".")
+        if key and isinstance(out.get(table), dict):
+            out[table].pop(key, None)
+        elif not key:
+            out.pop(table, None)
+    return out
+
+
+def _first_difference(a: dict, b: dict, prefix: str = "") -> str:
+    for key in sorted(set(a) | set(b)):
+        if a.get(key) != b.get(key):
+            if isinstance(a.get(key), dict) and isinstance(b.get(key), dict):
+                return _first_difference(a[key], b[key], f"{prefix}{key}.")
+            return f"{prefix}{key}"
+    return ""
+
+
+def _their_run(source: Path, mine: RunSpec, user: str) -> RunSpec:
+    """The open-loop run of the earlier evaluation in ``source`` matching ``mine``,
+    checked to be the same SUMO run."""
+    path = run_dir(source, mine) / "scenario.toml"
+    if not (path.parent / "summary.json").is_file():
+        raise SweepError(f"--baseline-from = {user} is not allowed: it has no finished run "
+                         f"{mine.run_id}; allowed: an evaluation of the same seeds and horizon")
+    theirs = tomllib.loads(path.read_text(encoding="utf-8"))
+    ours = tomllib.loads(dump_toml(dict(mine.scenario)))
+    differ = _first_difference(_without_inert(theirs), _without_inert(ours))
+    if differ:
+        raise SweepError(f"--baseline-from = {user} is not allowed: its run {mine.run_id} "
+                         f"differs in {differ}; allowed: open-loop runs whose scenarios "
+                         f"differ only in {', '.join(OPEN_LOOP_INERT)}")
+    return replace(mine, scenario=theirs)
+
+
+def borrowed_baseline(spec: SweepSpec, source: Path, user: str) -> pd.DataFrame:
+    """The sweep-table rows of the open-loop runs of ``spec`` taken from the earlier
+    evaluation in ``source`` (``user``: the directory as the user wrote it)."""
+    mine = [r for r in spec.runs() if r.columns.get("controller") == BASELINE]
+    theirs = [_their_run(source, r, user) for r in mine]
+    table = sweep_table(theirs, source)
+    if not table["status"].isin(FINISHED).all():
+        raise SweepError(f"--baseline-from = {user} is not allowed: its open-loop runs "
+                         "cannot be read back; allowed: a finished arzsumo evaluation")
+    return table
+
+
 def _forget_previous(out: Path, user: str) -> None:
     """--overwrite: remove the runs and report of a previous evaluation in ``out``."""
     target = out.expanduser().resolve()
@@ -115,27 +181,39 @@ def run_evaluation(scenario: Path, controllers: Sequence[str], seeds: Sequence[i
                    out: Path, horizon: float | None = None, workers: int | None = None,
                    scheduler: str | None = None, overwrite: bool = False,
                    progress: bool = True, plots: bool = True,
-                   command: str = "") -> EvaluationResult:
+                   command: str = "", baseline_from: Path | None = None) -> EvaluationResult:
     """Run ``controllers`` (the open loop added first when missing) on ``seeds`` and write
     the report into ``out`` (module docstring).
 
     ``out`` may be new, empty, or a previous evaluation: continued (runs already finished
     with the same resolved scenario are not run again), or started afresh with
     ``overwrite``. ``command`` is printed at the top of ``evaluation.md``.
+    ``baseline_from``: take the open-loop runs from this earlier evaluation (module
+    docstring) instead of running them.
     """
     controllers = check_controllers(controllers)
     name = check_runs(scenario, controllers, horizon)
-    spec = evaluation_spec(scenario, controllers, seeds, horizon)
+    borrowed = pd.DataFrame()
+    if baseline_from is not None:
+        borrowed = borrowed_baseline(evaluation_spec(scenario, [BASELINE], seeds, horizon),
+                                     Path(baseline_from), str(baseline_from))
+        if len(controllers) == 1:
+            raise SweepError("--controllers is not allowed to be only the open loop with "
+                             "--baseline-from: nothing would run")
+    spec = evaluation_spec(scenario, controllers[1:] if len(borrowed) else controllers,
+                           seeds, horizon)
     if overwrite:
         _forget_previous(Path(out), str(out))
     rep = run_sweep(spec, out, workers=workers, scheduler=scheduler, progress=progress,
                     plots=False, kind=KIND)
     df = rep.table if rep.table is not None else pd.DataFrame()
+    df = pd.concat([borrowed, df], ignore_index=True) if len(borrowed) else df
     ok = df[df["status"].isin(FINISHED)]
     table = evaluate(ok, controllers, BASELINE)
-    files = write_evaluation(rep.out, table, ok, controllers,
-                             _header(name, scenario, controllers, seeds, ok, len(df), command),
-                             BASELINE, plots=plots)
+    head = _header(name, scenario, controllers, seeds, ok, len(df), command)
+    if len(borrowed):
+        head += f"\n\nOpen-loop runs taken from the evaluation in `{baseline_from}`."
+    files = write_evaluation(rep.out, table, ok, controllers, head, BASELINE, plots=plots)
     return EvaluationResult(rep, ok, table, files)
 
 

@@ -1,0 +1,84 @@
+"""The ``[actuation]`` section: limits between the controller's U and the ramp meter (issue 17).
+
+Every key, its unit and the field of :class:`ActuationSettings` it sets::
+
+    [actuation]
+    u_max_fraction = 0.2          # |U| <= 0.2 q*          (0: off)
+    u_rate_max_veh_h_s = 100      # |U_k - U_k-1| <= 100 veh/h per s x control period (0: off)
+    ramp_bound = true             # U within what the meter and the ramp can deliver
+    anti_windup = true            # controllers with state see the U actually applied
+
+Without the table every limit is off and a run is today's: the meter receives the
+controller's U unchanged (the meter itself still saturates its green share to
+``[sumo] green_share_min .. green_share_max``). The limits act in
+:func:`arzsumo.bridge.actuator.limit_u`; the ramp bound's rule is in
+:func:`arzsumo.bridge.actuator.ramp_range`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass
+from typing import Any
+
+from arzsumo.errors import ArzsumoError, ScenarioError, require
+from arzsumo.tables import Key, in_user_terms, read_keys
+from arzsumo.units import VEH_H_PER_VEH_S
+
+#: [actuation] key -> ActuationSettings field (SI)
+ACTUATION_KEYS: dict[str, Key] = {
+    "u_max_fraction": Key("u_max_fraction",
+                          allowed="a fraction of q* in [0, 1] (0: no magnitude limit)",
+                          doc="abs(U) <= this fraction of q* (the nominal outflow); 0: off"),
+    "u_rate_max_veh_h_s": Key("u_rate_max", factor=VEH_H_PER_VEH_S, unit="veh/h/s",
+                              allowed="a rate >= 0 veh/h per s (0: no rate limit)",
+                              doc="abs(U_k - U_k-1) <= this rate x the control period; 0: off"),
+    "ramp_bound": Key("ramp_bound", "bool",
+                      doc="U limited to what the meter can deliver (the green-share curve "
+                          "between green_share_min and green_share_max) and no more ramp "
+                          "release than the ramp's arrivals and queue (docs/sumo.md)"),
+    "anti_windup": Key("anti_windup", "bool",
+                       doc="controllers with state (ETC trigger, observer) see the U "
+                           "actually applied and the limits; false: they are not told"),
+}
+
+
+@dataclass(frozen=True)
+class ActuationSettings:
+    """Limits on U between controller and meter (SI).
+
+    ``u_max_fraction`` bounds |U| by that fraction of q* (0: off); ``u_rate_max`` (veh/s
+    per s) bounds the change of U between control periods (0: off); ``ramp_bound`` limits
+    U to the meter's and the ramp's range; ``anti_windup`` tells the controller the U
+    applied (:meth:`arzsumo.control.base.Controller.applied`).
+    """
+
+    u_max_fraction: float = 0.0
+    u_rate_max: float = 0.0
+    ramp_bound: bool = False
+    anti_windup: bool = True
+
+    def __post_init__(self) -> None:
+        require(math.isfinite(self.u_max_fraction) and 0.0 <= self.u_max_fraction <= 1.0,
+                "u_max_fraction", self.u_max_fraction, "a fraction in [0, 1]", ScenarioError)
+        require(math.isfinite(self.u_rate_max) and self.u_rate_max >= 0.0, "u_rate_max",
+                self.u_rate_max, "a rate >= 0 veh/s per s", ScenarioError)
+
+    @property
+    def active(self) -> bool:
+        """True when any limit is on."""
+        return self.u_max_fraction > 0 or self.u_rate_max > 0 or self.ramp_bound
+
+    def as_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def actuation_section(table: Mapping[str, Any], at: str) -> ActuationSettings:
+    """The ActuationSettings of an ``[actuation]`` table (keys already checked); errors
+    name the key and the value as written."""
+    si = read_keys(table, ACTUATION_KEYS, at)
+    try:
+        return ActuationSettings(**si)
+    except ArzsumoError as exc:
+        raise in_user_terms(exc, at, table, ACTUATION_KEYS) from None

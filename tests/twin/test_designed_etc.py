@@ -1,0 +1,82 @@
+"""The designed ETC (design_for + noise dead band) in the nonlinear twin on the identified
+default model: it converges, and on a noisy state it triggers far less than the paper's."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from arzsumo.control.design import design_for
+from arzsumo.control.etc import PAPER_DESIGN, EventTriggered
+from arzsumo.control.kernels import solve_kernels
+from arzsumo.model import linearize
+from arzsumo.scenario import load_scenario
+from arzsumo.twin.initial import InitialCondition, initial_fields
+from arzsumo.twin.solver import SolverOptions, simulate
+
+ROOT = Path(__file__).resolve().parents[2]
+#: sd of the scaled Riemann variables' fast noise on the smoothed estimate in SUMO
+#: (legacy scenario, seed 1, residual about an 11 s moving mean; docs/design.md), m/s
+MEASURED_SMOOTHING = np.array([3.36, 0.67, 3.55, 0.13])
+NOISE = MEASURED_SMOOTHING / 8     # an eighth: a 10 % wave is then well above the noise
+
+
+class NoisyEtc(EventTriggered):
+    """The ETC fed w-bar plus white noise of sd ``noise`` per node and check (m/s)."""
+
+    def __init__(self, *args, noise: np.ndarray, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        self.noise = noise
+
+    def reset(self) -> None:
+        super().reset()
+        self.rng = np.random.default_rng(7)
+
+    def decide(self, state):
+        w = self.state_map.riemann(self.state_map.deviations(state))
+        w = w + self.noise[:, None] * self.rng.standard_normal(w.shape)
+        return self.check_riemann(state.t, w) / self.lin.u_bar_per_u
+
+
+@pytest.fixture(scope="module")
+def runs():
+    eq = load_scenario(ROOT / "scenarios/default.toml").equilibrium
+    lin = linearize(eq)
+    kernels = solve_kernels(lin.system, 50)
+    plain = design_for(lin.system, kernels).design
+    designed = plain.with_(noise_sd=tuple(NOISE))
+    opts = SolverOptions(cells=50, horizon=300.0, output_period=10.0)
+    x = (np.arange(50) + 0.5) * eq.params.length / 50
+    f0 = initial_fields(InitialCondition(kind="sinusoid", amplitude=0.1), eq, x)
+    star = np.array([eq.rho_h, eq.v_h, eq.rho_a, eq.v_a])[:, None]
+    out = {}
+    for name, design, noise in (("paper", PAPER_DESIGN, NOISE), ("designed", designed, NOISE),
+                                ("designed_clean", plain, 0 * NOISE)):
+        ctrl = NoisyEtc(lin, kernels, design, noise=noise)
+        res = simulate(eq, f0, controller=ctrl, options=opts)
+        norm = np.sqrt(np.mean(((res.fields - star) / star) ** 2, axis=(1, 2)))
+        out[name] = (res, ctrl.log.triggers, norm)
+    res = simulate(eq, f0, options=opts)
+    out["open"] = (res, 0, np.sqrt(np.mean(((res.fields - star) / star) ** 2, axis=(1, 2))))
+    return out
+
+
+def test_designed_etc_converges_on_the_clean_state(runs):
+    res, _, norm = runs["designed_clean"]
+    assert res.complete
+    assert norm[-1] < 0.5 * norm[0]             # the L2 deviation halves within 300 s
+    assert norm[-1] < 0.5 * runs["open"][2][-1]   # the open loop keeps its wave
+
+
+def test_with_the_dead_band_the_noisy_loop_stays_bounded(runs):
+    # known limit: the U held at the last event carries that check's noise, and an offset
+    # inside the dead band is never corrected, so the deviation need not halve (seeds 0-3:
+    # 0.46 to 1.02 of its start after 300 s); it must not grow beyond twice its start
+    res, _, norm = runs["designed"]
+    assert res.complete and norm.max() < 2 * norm[0]
+
+
+def test_designed_etc_triggers_far_less_than_the_papers_on_noise(runs):
+    paper, designed = runs["paper"][1], runs["designed"][1]
+    assert paper > 250                          # the paper's design triggers on noise
+    assert designed < paper / 3
