@@ -17,7 +17,7 @@ from pathlib import Path
 
 from arzsumo.model import get_preset
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.meter import RampMeter
+from arzsumo.sumo.meter_release import make_meter
 from arzsumo.sumo.network_measures import network_options, network_summary
 from arzsumo.sumo.sensor import ramp_queue
 from arzsumo.sumo.simulation import open_simulation
@@ -29,7 +29,7 @@ def run(cfg: SumoConfig, out: Path | None) -> tuple[float, float, float, int]:
     extra = network_options(out) if out is not None else []
     t0, c0 = time.perf_counter(), time.process_time()
     with open_simulation(params, cfg, extra_args=extra, output_dir=out) as sim:
-        meter = RampMeter(sim.lib, cfg)
+        meter = make_meter(sim.lib, cfg)
         while sim.time < cfg.horizon - 1e-9:
             sim.step()
             meter.step(ramp_queue(sim.lib))

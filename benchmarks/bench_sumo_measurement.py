@@ -17,7 +17,7 @@ import time
 
 from arzsumo.model import get_preset
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.meter import RampMeter
+from arzsumo.sumo.meter_release import make_meter
 from arzsumo.sumo.sensor import SumoSensor
 from arzsumo.sumo.simulation import open_simulation
 
@@ -35,7 +35,7 @@ def run(cfg: SumoConfig, measured: bool) -> tuple[float, float, float, int, floa
     with open_simulation(params, cfg) as sim:
         lib = sim.lib
         if measured:
-            meter = RampMeter(lib, cfg)
+            meter = make_meter(lib, cfg)
             sensor = SumoSensor(lib, params.length, cfg)
             q_star = meter.curve.outflow_at(cfg.green_share)
             while sim.time < cfg.horizon - 1e-9:

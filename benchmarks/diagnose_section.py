@@ -15,7 +15,7 @@ import sys
 import numpy as np
 
 from arzsumo.scenario import load_scenario
-from arzsumo.sumo.meter import RampMeter
+from arzsumo.sumo.meter_release import make_meter
 from arzsumo.sumo.sensor import SumoSensor
 from arzsumo.sumo.simulation import open_simulation
 
@@ -45,7 +45,7 @@ def main(argv: list[str]) -> int:
     sc = load_scenario(argv[0])
     cfg = sc.sumo.with_(seed=int(argv[1]), horizon=float(argv[2]))
     with open_simulation(sc.params, cfg) as sim:
-        meter = RampMeter(sim.lib, cfg)
+        meter = make_meter(sim.lib, cfg)
         sensor = SumoSensor(sim.lib, sc.params.length, cfg)
         cells: list = []
         while sim.time < cfg.horizon - 1e-9:

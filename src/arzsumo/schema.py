@@ -46,8 +46,10 @@ PERIODS: dict[str, Column] = {
     "u_continuous": Column("veh/s", "the continuous control law at this check (before event "
                                     "triggering; equal to u for continuous controllers)"),
     "triggered": Column(TEXT, "true where the controller updated U at this check (an event)"),
-    "green_commanded": Column("1", "green share commanded for the period (fraction of cycle)"),
-    "green_running": Column("1", "green share the meter runs at the end of the period"),
+    "green_commanded": Column("1", "green share commanded for the period (fraction of cycle; "
+                                   "one_per_green: minimum green over the commanded cycle)"),
+    "green_running": Column("1", "green share the meter runs at the end of the period "
+                                 "(one_per_green: minimum green over the running cycle)"),
     "light_changes": Column("count", "ramp-light changes so far, from SUMO start (warm-up "
                                      "included), cumulative"),
     "plan_changes": Column("count", "meter plan (green share) changes so far, from SUMO "
@@ -150,6 +152,10 @@ RUN_SUMMARY: dict[str, str] = {
     "warmup.window": TEXT, "warmup.duration_s": "s", "warmup.plan_changes": "count",
     "warmup.light_changes": "count", "warmup.max_ramp_queue": "veh",
     "plan_changes": "count", "light_changes": "count", "max_ramp_queue": "veh",
+    "meter.mode": TEXT, "meter.clearance_s": "s", "meter.release_rate": "veh/s",
+    "meter.releases": "veh", "meter.greens": "count", "meter.releases_per_green_max": "veh",
+    "meter.override_steps": "count", "meter.emergency_stops": "count",
+    "meter.emergency_braking": "count",
     "speed_variance.*": "m^2/s^2",
     **{f"{k}.*": u for k, u in _RUN_INDICES.items()}, "until_s": "s",
     **{f"twin_*.{k}.*": u for k, u in _RUN_INDICES.items()}, "twin_*.until_s": "s",

@@ -29,7 +29,7 @@ from typing import NamedTuple
 
 from arzsumo.scenario.actuation import ActuationSettings
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.meter import GreenShareCurve, RampMeter
+from arzsumo.sumo.meter import GreenShareCurve, MeterLight
 
 INF = math.inf
 
@@ -75,7 +75,12 @@ def limit_u(u_raw: float, u_prev: float, lower: float = -INF, upper: float = INF
 def meter_range(curve: GreenShareCurve, cfg: SumoConfig, q_nominal: float) -> tuple[float, float]:
     """The U (veh/s) the meter can command: the monotone curve's outflow between
     ``green_share_max`` (least mainline outflow) and ``green_share_min``, minus q*; widened
-    to include 0 (the nominal plan is always allowed)."""
+    to include 0 (the nominal plan is always allowed). One per green: U = r_nominal - r
+    for r in [``release_rate_min``, ``release_rate_max``]
+    (:func:`~arzsumo.sumo.meter_release.release_rate_for`)."""
+    if cfg.meter_mode == "one_per_green":
+        return (min(0.0, cfg.release_rate - cfg.release_rate_max),
+                max(0.0, cfg.release_rate - cfg.release_rate_min))
     m = curve.monotone()
     return (min(0.0, m.outflow_at(cfg.green_share_max) - q_nominal),
             max(0.0, m.outflow_at(cfg.green_share_min) - q_nominal))
@@ -91,7 +96,12 @@ def ramp_floor(curve: GreenShareCurve, cfg: SumoConfig, q_nominal: float, queue:
     ``[sumo] ramp_demand``), so more ramp green cannot bring the mainline outflow below
     ``q_open - r - queue / H``: U below that minus q* is not deliverable. Capped at 0 (the
     nominal plan is always allowed), so it only bounds U < 0 (more ramp release).
+    One per green, by the same rule (U = r_nominal - r): ``r_nominal - r - queue / H``,
+    with the nominal cycle 1 / r_nominal for the meter cycle.
     """
+    if cfg.meter_mode == "one_per_green":
+        horizon = max(1.0 / cfg.release_rate, cfg.control_period)
+        return min(0.0, cfg.release_rate - cfg.ramp_demand - queue / horizon)
     q_open = curve.monotone().outflow_at(0.0)
     horizon = max(cfg.meter_cycle, cfg.control_period)
     return min(0.0, q_open - cfg.ramp_demand - queue / horizon - q_nominal)
@@ -149,8 +159,10 @@ class MeterActuator:
 
     Parameters
     ----------
-    meter : RampMeter
-        The meter of the open run.
+    meter : MeterLight
+        The meter of the open run (fixed cycle: the outflow ``q_nominal + U`` through its
+        curve; one per green: the release rate of
+        :func:`~arzsumo.sumo.meter_release.release_rate_for`).
     q_nominal : float
         Mainline outflow of the nominal plan, veh/s.
     hold_nominal : bool
@@ -159,7 +171,7 @@ class MeterActuator:
         The ``[actuation]`` limits (default: none).
     """
 
-    def __init__(self, meter: RampMeter, q_nominal: float, hold_nominal: bool,
+    def __init__(self, meter: MeterLight, q_nominal: float, hold_nominal: bool,
                  limits: ActuationLimits | None = None) -> None:
         self.meter, self.q_nominal, self.hold_nominal = meter, q_nominal, hold_nominal
         self.limits = limits or ActuationLimits()
@@ -173,6 +185,6 @@ class MeterActuator:
         lower, upper = self.limits.range(self.meter.queue)
         lim = limit_u(u, self.u_prev, lower, upper, self.limits.rate_step)
         self.u_prev = lim.u_applied
-        green = self.meter.command_outflow(self.q_nominal + lim.u_applied)
+        green = self.meter.command(lim.u_applied, self.q_nominal)
         return Actuation(u, lim.u_applied, lim.saturated, lim.rate_limited, lower, upper,
                          green)

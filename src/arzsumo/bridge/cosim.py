@@ -34,8 +34,8 @@ with the results.
 A detector sample's path: ``SumoSensor.observe`` (libsumo, every step) ->
 ``PeriodMeasurement`` -> ``Estimator.estimate`` -> ``MacroState`` -> ``Controller.check``
 -> U -> ``MeterActuator.apply`` (the ``[actuation]`` limits; the U applied goes back to
-``Controller.applied``) -> ``RampMeter.command_outflow`` -> the light, set by
-``RampMeter.step`` at the next cycle start.
+``Controller.applied``) -> ``RampMeter.command_outflow`` (or a release rate,
+``OnePerGreenMeter.command_rate``) -> the light, set by ``step`` at the next cycle start.
 """
 
 from __future__ import annotations
@@ -68,7 +68,8 @@ from arzsumo.progress import Progress
 from arzsumo.scenario import Scenario
 from arzsumo.scenario.run import RunSettings
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.meter import DEFAULT_CURVE, GreenShareCurve, RampMeter
+from arzsumo.sumo.meter import DEFAULT_CURVE, GreenShareCurve
+from arzsumo.sumo.meter_release import make_meter
 from arzsumo.sumo.network_measures import network_options
 from arzsumo.sumo.paths import scratch_dir
 from arzsumo.sumo.sensor import PeriodMeasurement, SumoSensor
@@ -119,7 +120,7 @@ class CoSimResult:
     periods: dict[str, np.ndarray]
     controller_log: ControlLog
     reference_log: ControlLog
-    meter: dict[str, float]
+    meter: dict[str, Any]
     report: RunReport | None
     twin_status: dict[str, Any]
     placement: str
@@ -149,7 +150,7 @@ class SumoPlant:
     def __init__(self, sim: SumoSimulation, length: float, cfg: SumoConfig,
                  curve: GreenShareCurve, scenario: Scenario | None = None) -> None:
         self.sim = sim
-        self.meter = RampMeter(sim.lib, cfg, curve)
+        self.meter = make_meter(sim.lib, cfg, curve)
         est = scenario.estimation if scenario else None
         self.sensor = SumoSensor(sim.lib, length, cfg, window=True,
                                  layout=scenario.sensing if scenario else None,

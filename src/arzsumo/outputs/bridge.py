@@ -171,6 +171,21 @@ def section_summary(res: CoSimResult, micro: dict[str, Any]) -> dict[str, Any]:
     return {"window": SECTION_WINDOW, **res.section_speed, **micro}
 
 
+#: ``summary.json["meter"]``: keys of the meter's own summary kept there (control window)
+METER_KEYS = ("mode", "clearance_s", "release_rate", "releases", "greens",
+              "releases_per_green_max", "override_steps", "emergency_stops",
+              "emergency_braking")
+
+
+def meter_summary(res: CoSimResult) -> dict[str, Any]:
+    """The meter's realisation and its counts over the control window
+    (``summary.json["meter"]``): mode, clearance (s), last release rate (veh/s, null for
+    the fixed cycle), releases (vehicles crossing the stop line), green intervals begun
+    and the most releases in one, override steps, emergency stops and braking at the
+    meter."""
+    return {k: res.meter.get(k) for k in METER_KEYS}
+
+
 def summary(res: CoSimResult) -> dict[str, Any]:
     """The run's summary: meter counts, events, indices (micro and twins), fidelity, accounting.
 
@@ -201,6 +216,7 @@ def summary(res: CoSimResult) -> dict[str, Any]:
         "triggers": int(triggered.sum()),
         "release_time": release_time(clipped.t, clipped.triggered, horizon),
         "max_ramp_queue": int(res.meter["max_queue"]),
+        "meter": meter_summary(res),
         "speed_variance": {"h": float(np.nanvar(v[:, 0])), "a": float(np.nanvar(v[:, 1]))},
         **micro,
         "section": section_summary(res, micro),

@@ -20,11 +20,13 @@ from pathlib import Path
 from typing import Any
 
 from arzsumo.errors import ArzsumoError, ScenarioError
-from arzsumo.sumo.config import AV_MODELS, HV_MODELS, SumoConfig
+from arzsumo.sumo.config import AV_MODELS, HV_MODELS, METER_MODES, SumoConfig
 from arzsumo.tables import Key, in_user_terms, read_keys, written
 from arzsumo.units import KMH_PER_MS, VEH_H_PER_VEH_S
 
 _DEMAND = "a demand >= 0 veh/h"
+_RATE = ("a rate > 0 veh/h, with release_rate_min_veh_h <= release_rate_veh_h <= "
+         "release_rate_max_veh_h")
 #: [sumo] key -> SumoConfig field (SI), with its unit factor
 SUMO_KEYS: dict[str, Key] = {
     "step_length_s": Key("step_length", unit="s", doc="SUMO time step (ACC/CACC need small "
@@ -54,7 +56,25 @@ SUMO_KEYS: dict[str, Key] = {
     "green_share_min": Key("green_share_min", doc="lowest commanded green share"),
     "green_share_max": Key("green_share_max", doc="highest commanded green share"),
     "spillback_queue_veh": Key("spillback_queue", "integer", unit="veh",
-                               doc="ramp queue that forces green; 0 disables it"),
+                               doc="ramp queue that forces green (one_per_green: the "
+                                   "highest release rate); 0 disables it"),
+    "meter_mode": Key("meter_mode", "string", choices=METER_MODES,
+                      doc="ramp meter realisation: green share of a fixed cycle, or one "
+                          "vehicle per green at a release rate"),
+    "meter_clearance_s": Key("meter_clearance", unit="s",
+                             doc="yellow before every red of the meter; 0 switches green "
+                                 "to red"),
+    "max_green_s": Key("max_green", unit="s",
+                       doc="one_per_green: longest green (min_green_s extended until the "
+                           "head vehicle crosses the stop line)"),
+    "release_rate_veh_h": Key("release_rate", factor=VEH_H_PER_VEH_S, allowed=_RATE,
+                              unit="veh/h", doc="one_per_green: release rate of the nominal "
+                                                "plan (open loop); a command U sets rate - U"),
+    "release_rate_min_veh_h": Key("release_rate_min", factor=VEH_H_PER_VEH_S, allowed=_RATE,
+                                  unit="veh/h", doc="one_per_green: lowest release rate"),
+    "release_rate_max_veh_h": Key("release_rate_max", factor=VEH_H_PER_VEH_S, allowed=_RATE,
+                                  unit="veh/h", doc="one_per_green: highest release rate "
+                                                    "(also the queue override's)"),
     "time_to_teleport_s": Key("time_to_teleport", unit="s",
                               doc="SUMO's --time-to-teleport; -1 disables teleports"),
     "hv_model": Key("hv_model", "string", choices=HV_MODELS, doc="HV car-following model"),

@@ -11,7 +11,8 @@ when a run starts), so the math packages and the CLI stay light.
 * :mod:`~arzsumo.sumo.simulation`: the run lifecycle
 * :mod:`~arzsumo.sumo.measure`, :mod:`~arzsumo.sumo.detectors`: micro to macro
 * :mod:`~arzsumo.sumo.placement`: macro to micro
-* :mod:`~arzsumo.sumo.meter`: the ramp-meter actuator
+* :mod:`~arzsumo.sumo.meter`, :mod:`~arzsumo.sumo.meter_release`: the ramp-meter actuator
+  (fixed cycle; one vehicle per green)
 * :mod:`~arzsumo.sumo.runner`, :mod:`~arzsumo.sumo.calibrate`: open-loop runs, calibration
 
 May import ``kernel_cache``, ``control``, ``model``, ``io``, ``progress``, ``units``,

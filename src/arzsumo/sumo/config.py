@@ -16,6 +16,8 @@ HV_MODELS = ("Krauss", "IDM")
 #: Width of the mainline lane, m (the network's).
 LANE_WIDTH = 6.5
 AV_MODELS = ("ACC", "CACC")
+#: How the ramp meter is realised (:mod:`arzsumo.sumo.meter`, :mod:`arzsumo.sumo.meter_release`)
+METER_MODES = ("fixed_cycle", "one_per_green")
 
 
 @dataclass(frozen=True)
@@ -49,7 +51,19 @@ class SumoConfig:
     green_share_min, green_share_max : float
         Saturation limits of commanded green shares, 0 <= min <= max <= 1.
     spillback_queue : int
-        Ramp queue (veh) that forces green; 0 disables the override.
+        Ramp queue (veh) that forces green (fixed cycle) or the highest release rate
+        (one per green); 0 disables the override.
+    meter_mode : str
+        "fixed_cycle" (green share of a fixed cycle, default) or "one_per_green" (one
+        vehicle per green at a commanded release rate).
+    meter_clearance : float
+        Yellow shown before every red of the meter, s; 0 (default) switches green to red.
+    max_green : float
+        Longest green of "one_per_green", s: the green lasts ``min_green``, extended until
+        the head vehicle crosses the stop line, at most this.
+    release_rate, release_rate_min, release_rate_max : float
+        Release rate of "one_per_green" at the nominal plan (the open loop), and its
+        bounds, veh/s.
     time_to_teleport : float
         SUMO's --time-to-teleport, s; -1 disables teleports (default).
     hv_model, hv_sigma : str, float
@@ -95,6 +109,12 @@ class SumoConfig:
     green_share_min: float = 0.0
     green_share_max: float = 1.0
     spillback_queue: int = 0
+    meter_mode: str = "fixed_cycle"
+    meter_clearance: float = 0.0
+    max_green: float = 3.0
+    release_rate: float = 600.0 / 3600.0
+    release_rate_min: float = 240.0 / 3600.0
+    release_rate_max: float = 900.0 / 3600.0
     time_to_teleport: float = -1.0
     hv_model: str = "Krauss"
     hv_sigma: float = 0.5
@@ -120,11 +140,12 @@ class SumoConfig:
                     "a number in [0, 1]", ScenarioError)
 
         for name in ("step_length", "lateral_resolution", "horizon", "cell_length",
-                     "control_period", "meter_cycle", "min_gap_lat"):
+                     "control_period", "meter_cycle", "min_gap_lat", "max_green",
+                     "release_rate", "release_rate_min", "release_rate_max"):
             pos(name)
         for name in ("demand_h", "demand_a", "ramp_demand", "min_green", "min_red",
-                     "approach_length", "fill_duration", "fill_demand_h", "fill_demand_a",
-                     "hv_max_speed", "av_max_speed"):
+                     "approach_length", "meter_clearance", "fill_duration", "fill_demand_h",
+                     "fill_demand_a", "hv_max_speed", "av_max_speed"):
             v = getattr(self, name)
             require(isinstance(v, int | float) and math.isfinite(v) and v >= 0, name, v,
                     "a finite number of at least 0", ScenarioError)
@@ -153,6 +174,7 @@ class SumoConfig:
         require(self.min_green + self.min_red <= self.meter_cycle, "min_green + min_red",
                 self.min_green + self.min_red, f"at most meter_cycle = {self.meter_cycle} s",
                 ScenarioError)
+        self._check_meter()
         require(isinstance(self.seed, int) and not isinstance(self.seed, bool)
                 and 0 <= self.seed < 2**31, "seed", self.seed, "an integer in [0, 2^31)",
                 ScenarioError)
@@ -165,6 +187,27 @@ class SumoConfig:
                 " or ".join(HV_MODELS), ScenarioError)
         require(self.av_model in AV_MODELS, "av_model", self.av_model,
                 " or ".join(AV_MODELS), ScenarioError)
+
+    def _check_meter(self) -> None:
+        """The meter's mode and timings fit together (clearance inside the cycle, release
+        rates ordered, the fastest release cycle long enough for its phases)."""
+        require(self.meter_mode in METER_MODES, "meter_mode", self.meter_mode,
+                " or ".join(METER_MODES), ScenarioError)
+        phases = self.min_green + self.meter_clearance + self.min_red
+        if self.meter_clearance > 0:
+            require(phases <= self.meter_cycle + 1e-9, "min_green + meter_clearance + min_red",
+                    phases, f"at most meter_cycle = {self.meter_cycle} s", ScenarioError)
+        require(self.release_rate_min <= self.release_rate <= self.release_rate_max,
+                "release_rate", self.release_rate,
+                f"a rate in [release_rate_min, release_rate_max] = [{self.release_rate_min}, "
+                f"{self.release_rate_max}] veh/s", ScenarioError)
+        require(self.min_green <= self.max_green, "max_green", self.max_green,
+                f"at least min_green = {self.min_green} s", ScenarioError)
+        if self.meter_mode == "one_per_green":
+            require(phases <= 1.0 / self.release_rate_max + 1e-9,
+                    "min_green + meter_clearance + min_red", phases,
+                    f"at most the cycle 1 / release_rate_max = {1 / self.release_rate_max:.3g} "
+                    "s of one_per_green", ScenarioError)
 
     @property
     def steps_per_period(self) -> int:

@@ -6,17 +6,25 @@ more ramp green, less mainline outflow) is inverted to a green share g in [0, 1]
 becomes a fixed-cycle program: green for g C seconds, then red, with minimum green and
 red times (a shorter green becomes all-red or the minimum green, whichever is nearer; the
 same for red). A new timing is a *plan change* and takes effect at the next cycle start;
-each switch of the light (green to red or red to green) is a *light change*. The ramp
-queue (halted vehicles on ``ramp_up`` plus ramp vehicles waiting to be inserted), read by
-the sensor (:mod:`arzsumo.sumo.sensor`) and handed to :meth:`RampMeter.step` every step,
-and its maximum are tracked; an optional spillback override forces green while the queue
-is at or above ``spillback_queue``. The meter reads nothing from SUMO: it only sets the
-light.
+each start or end of a green is a *light change*. With a clearance ``meter_clearance``
+> 0 every red is preceded by a yellow of that length (inside the cycle: green, yellow,
+red; the yellow's end is not a light change), so that ramp vehicles at the line stop
+without an emergency stop. The ramp queue (halted vehicles on ``ramp_up`` plus ramp
+vehicles waiting to be inserted), read by the sensor (:mod:`arzsumo.sumo.sensor`) and
+handed to :meth:`RampMeter.step` every step, and its maximum are tracked; an optional
+spillback override forces green while the queue is at or above ``spillback_queue``.
 
-The counts (plan and light changes, override steps, queue maximum) run over a *window*:
-from the meter's creation until :meth:`RampMeter.start_window`, which returns them and
-starts a new window (the co-simulation opens one at the start of control, so the warm-up
-is counted apart).
+Besides setting the light the meter reads one thing from SUMO, its own stop-line
+detector (:class:`StopLine`): the vehicles leaving ``ramp_up`` (*releases*, counted per
+green interval, from one green's start to the next) and the emergency stops and braking
+of the vehicles at the head of the ramp. The other realisation, one vehicle per green at
+a commanded release rate, is :class:`arzsumo.sumo.meter_release.OnePerGreenMeter`;
+:func:`arzsumo.sumo.meter_release.make_meter` builds the one ``[sumo] meter_mode`` names.
+
+The counts (plan and light changes, override steps, releases, queue maximum) run over a
+*window*: from the meter's creation until :meth:`RampMeter.start_window`, which returns
+them and starts a new window (the co-simulation opens one at the start of control, so the
+warm-up is counted apart).
 """
 
 from __future__ import annotations
@@ -24,14 +32,20 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from types import ModuleType
+from typing import Any
 
 import numpy as np
 
 from arzsumo.errors import ArzsumoError, require
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.network import METER_TL
+from arzsumo.sumo.network import METER_TL, RAMP_UP
 
-GREEN, RED = "G", "r"
+GREEN, YELLOW, RED = "G", "y", "r"
+#: vehicles at the head of the ramp whose braking the stop-line detector watches
+HEAD_VEHICLES = 3
+#: braking beyond a vehicle type's ``decel`` by more than this counts as emergency braking
+#: at the meter, m/s^2 (SUMO's own count is network-wide)
+BRAKING_MARGIN = 0.1
 
 
 @dataclass(frozen=True)
@@ -95,36 +109,202 @@ def plan_green_steps(g: float, cycle: int, min_green: int, min_red: int) -> int:
     return green
 
 
-class RampMeter:
-    """Drives the ramp traffic light of an open libsumo run.
+class StopLine:
+    """The meter's detector at the stop line of ``ramp_up`` (libsumo, read every step).
+
+    A vehicle is *released* when its front leaves ``ramp_up`` (crosses the stop line).
+    Safety at the meter: SUMO's emergency stops of vehicles on ``ramp_up``, and emergency
+    braking episodes (deceleration beyond the vehicle type's ``decel`` by more than
+    :data:`BRAKING_MARGIN`, counted once per vehicle and episode) of the
+    :data:`HEAD_VEHICLES` vehicles nearest the line.
+    """
+
+    def __init__(self, lib: ModuleType, edge: str = RAMP_UP) -> None:
+        self.lib, self.edge = lib, edge
+        self._on: set[str] = set()
+        self._braking: set[str] = set()
+        self.emergency_stops = self.emergency_braking = 0
+
+    def read(self) -> int:
+        """Vehicles released since the last read; updates the safety counts."""
+        ids = self.lib.edge.getLastStepVehicleIDs(self.edge)   # upstream first
+        now = set(ids)
+        released = len(self._on - now)
+        self._on = now
+        veh = self.lib.vehicle
+        for v in self.lib.simulation.getEmergencyStoppingVehiclesIDList():
+            self.emergency_stops += v in now
+        braking = {v for v in ids[-HEAD_VEHICLES:]
+                   if veh.getAcceleration(v) < -veh.getDecel(v) - BRAKING_MARGIN}
+        self.emergency_braking += len(braking - self._braking)
+        self._braking = braking
+        return released
+
+
+@dataclass
+class GreenRecord:
+    """One green interval, from a green's start to the next green's start (steps)."""
+
+    start: int           # SUMO steps since the start when the green began
+    queue: int           # ramp queue then, veh
+    releases: int = 0    # vehicles that crossed the stop line in the interval
+    green: int = 0       # steps shown green
+    length: int = 0      # steps so far (the whole interval once the next green began)
+
+
+class MeterLight:
+    """The light, its clearance and the counts shared by both meter realisations.
+
+    Subclasses decide every step whether the plan wants green or red (:meth:`_plan`);
+    :meth:`step` reads the stop line, shows a yellow of ``cfg.meter_clearance`` before
+    every red, and counts light changes, releases per green interval and the queue.
+    """
+
+    mode = ""
+
+    def __init__(self, lib: ModuleType, cfg: SumoConfig, tl_id: str = METER_TL) -> None:
+        self.lib, self.cfg, self.tl_id = lib, cfg, tl_id
+        self.dt = cfg.step_length
+        self.clearance_steps = round(cfg.meter_clearance / self.dt)
+        self.stop_line = StopLine(lib)
+        self.plan_changes = self.light_changes = self.override_steps = 0
+        self.queue = self.max_queue = 0
+        self.releases = 0
+        self.greens: list[GreenRecord] = []   # every green interval since SUMO started
+        self._window_greens = 0               # index of the window's first green
+        self._steps = 0                       # steps since SUMO started
+        self._yellow_left = 0
+        self.light = ""
+
+    def _plan(self) -> str:
+        """GREEN or RED wanted by the plan at this step (called once per step)."""
+        raise NotImplementedError
+
+    def command(self, u: float, q_nominal: float) -> float:
+        """Command the outflow deviation U (veh/s) from the nominal outflow ``q_nominal``
+        (veh/s); return the green share of the requested plan."""
+        raise NotImplementedError
+
+    def _set(self, state: str) -> None:
+        self.lib.trafficlight.setRedYellowGreenState(self.tl_id, state)
+
+    def _show(self, wanted: str) -> None:
+        """Show ``wanted``, with the clearance yellow before a red; count light changes."""
+        state = wanted
+        if wanted == RED and self.clearance_steps:
+            if self.light == GREEN:
+                self._yellow_left, state = self.clearance_steps, YELLOW
+            elif self.light == YELLOW:
+                self._yellow_left -= 1
+                state = YELLOW if self._yellow_left > 0 else RED
+        if state == self.light:
+            return
+        if (state == GREEN) != (self.light == GREEN) and self.light:
+            self.light_changes += 1
+        if state == GREEN:
+            self.greens.append(GreenRecord(self._steps, self.queue))
+        self._set(state)
+        self.light = state
+
+    def step(self, queue: int) -> str:
+        """Call once after every SUMO step with the ramp queue the sensor read (vehicles,
+        :func:`arzsumo.sumo.sensor.ramp_queue`): read the stop line, update the plan and
+        the light; return the light."""
+        self.queue = queue
+        self.max_queue = max(self.max_queue, queue)
+        self._steps += 1
+        released = self.stop_line.read()
+        self.releases += released
+        if self.greens:
+            g = self.greens[-1]
+            g.releases += released
+            g.length = self._steps - g.start
+            g.green += self.light == GREEN
+        self._show(self._plan())
+        return self.light
+
+    @property
+    def released_this_green(self) -> int:
+        """Vehicles released since the current green interval began."""
+        return self.greens[-1].releases if self.greens else 0
+
+    def override(self) -> bool:
+        """Whether the queue override is on (queue at or above ``cfg.spillback_queue``)."""
+        return bool(self.cfg.spillback_queue) and self.queue >= self.cfg.spillback_queue
+
+    def start_window(self) -> dict[str, Any]:
+        """Close the current counting window: return its :meth:`summary`, then count anew.
+
+        Plan and light changes, override steps and releases restart from 0; the queue
+        maximum restarts from the next :meth:`step` (the light, the cycle and the pending
+        plan carry on unchanged).
+        """
+        closed = self.summary()
+        self.plan_changes = self.light_changes = self.override_steps = self.releases = 0
+        self.max_queue = 0
+        self._window_greens = len(self.greens)
+        self.stop_line.emergency_stops = self.stop_line.emergency_braking = 0
+        return closed
+
+    @property
+    def green_share(self) -> float:
+        """Green share of the running plan."""
+        raise NotImplementedError
+
+    def summary(self) -> dict[str, Any]:
+        """Counts of the current window (see :meth:`start_window`): plan and light changes,
+        queue maximum (veh), override steps, releases (veh), green intervals begun and the
+        most releases in one, emergency stops and braking at the meter; the last queue and
+        green share, the mode, clearance (s) and release rate (veh/s; None for the fixed
+        cycle)."""
+        greens = self.greens[self._window_greens:]
+        return {"plan_changes": self.plan_changes, "light_changes": self.light_changes,
+                "max_queue": self.max_queue, "queue": self.queue,
+                "override_steps": self.override_steps, "green_share": self.green_share,
+                "mode": self.mode, "clearance_s": self.cfg.meter_clearance,
+                "releases": self.releases, "greens": len(greens),
+                "releases_per_green_max": max((g.releases for g in greens), default=0),
+                "emergency_stops": self.stop_line.emergency_stops,
+                "emergency_braking": self.stop_line.emergency_braking,
+                "release_rate": self.release_rate}
+
+    @property
+    def release_rate(self) -> float | None:
+        """Release rate commanded last, veh/s (None: the meter runs a green share)."""
+        return None
+
+
+class RampMeter(MeterLight):
+    """Drives the ramp traffic light of an open libsumo run at a fixed cycle.
 
     Parameters
     ----------
     lib : module
         The libsumo module of the open run.
     cfg : SumoConfig
-        Cycle, minimum green and red, nominal green share, spillback threshold, step.
+        Cycle, minimum green and red, clearance, nominal green share, spillback
+        threshold, step.
     curve : GreenShareCurve
         Mainline outflow against green share, inverted by :meth:`command_outflow`.
     """
 
+    mode = "fixed_cycle"
+
     def __init__(self, lib: ModuleType, cfg: SumoConfig,
                  curve: GreenShareCurve = DEFAULT_CURVE, tl_id: str = METER_TL) -> None:
-        self.lib, self.cfg, self.curve, self.tl_id = lib, cfg, curve, tl_id
-        self.dt = cfg.step_length
+        super().__init__(lib, cfg, tl_id)
+        self.curve = curve
         self.cycle_steps = max(1, round(cfg.meter_cycle / self.dt))
-        self.plan_changes = self.light_changes = self.override_steps = 0
-        self.queue = self.max_queue = 0
         self._k = 0                       # steps since the current cycle began
         self.green_steps = self._timing(cfg.green_share)
         self._pending = self.green_steps
-        self.light = GREEN if self.green_steps > 0 else RED
-        self._set(self.light)
+        self._show(GREEN if self.green_steps > 0 else RED)
 
     # -- timing --------------------------------------------------------------------------
     def _timing(self, g: float) -> int:
+        """Green steps for share ``g``; the red holds the clearance and the minimum red."""
         return plan_green_steps(g, self.cycle_steps, round(self.cfg.min_green / self.dt),
-                           round(self.cfg.min_red / self.dt))
+                                round(self.cfg.min_red / self.dt) + self.clearance_steps)
 
     @property
     def green_share(self) -> float:
@@ -151,44 +331,19 @@ class RampMeter:
         self.set_green_share(g)
         return self._pending / self.cycle_steps
 
-    # -- per-step actuation --------------------------------------------------------------
-    def _set(self, state: str) -> None:
-        self.lib.trafficlight.setRedYellowGreenState(self.tl_id, state)
+    def command(self, u: float, q_nominal: float) -> float:
+        """Command U (veh/s) around the nominal outflow ``q_nominal``: the outflow
+        ``q_nominal + u`` (:meth:`command_outflow`); return the green share chosen."""
+        return self.command_outflow(q_nominal + u)
 
-    def step(self, queue: int) -> str:
-        """Call once after every SUMO step with the ramp queue the sensor read (vehicles,
-        :func:`arzsumo.sumo.sensor.ramp_queue`): update cycle and light; return the light."""
-        self.queue = queue
-        self.max_queue = max(self.max_queue, self.queue)
+    # -- per-step plan -------------------------------------------------------------------
+    def _plan(self) -> str:
         self._k += 1
         if self._k >= self.cycle_steps:
             self._k = 0
             self.green_steps = self._pending
         light = GREEN if self._k < self.green_steps else RED
-        if self.cfg.spillback_queue and self.queue >= self.cfg.spillback_queue:
+        if self.override():
             self.override_steps += light == RED
             light = GREEN
-        if light != self.light:
-            self._set(light)
-            self.light = light
-            self.light_changes += 1
         return light
-
-    def start_window(self) -> dict[str, float]:
-        """Close the current counting window: return its :meth:`summary`, then count anew.
-
-        Plan and light changes and override steps restart from 0; the queue maximum
-        restarts from the next :meth:`step` (the light, the cycle and the pending plan
-        carry on unchanged).
-        """
-        closed = self.summary()
-        self.plan_changes = self.light_changes = self.override_steps = 0
-        self.max_queue = 0
-        return closed
-
-    def summary(self) -> dict[str, float]:
-        """Counts of the current window (see :meth:`start_window`): plan and light
-        changes, queue maximum (veh), override steps; the last queue and green share."""
-        return {"plan_changes": self.plan_changes, "light_changes": self.light_changes,
-                "max_queue": self.max_queue, "queue": self.queue,
-                "override_steps": self.override_steps, "green_share": self.green_share}

@@ -10,12 +10,14 @@ import logging
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.demand import InitialVehicle
 from arzsumo.sumo.measure import MeasurementLog
-from arzsumo.sumo.meter import DEFAULT_CURVE, GreenShareCurve, RampMeter
+from arzsumo.sumo.meter import DEFAULT_CURVE, GreenShareCurve
+from arzsumo.sumo.meter_release import make_meter
 from arzsumo.sumo.network import RAMP_UP
 from arzsumo.sumo.paths import SumoError
 from arzsumo.sumo.sensor import SumoSensor, ramp_queue
@@ -32,7 +34,7 @@ class RunResult:
     green_share: float
     measurements: MeasurementLog
     report: RunReport
-    meter: dict[str, float]
+    meter: dict[str, Any]
     ramp_passed: int
 
 
@@ -57,7 +59,7 @@ def run_fixed_meter(params: ModelParameters, cfg: SumoConfig, green_share: float
     g = cfg.green_share if green_share is None else green_share
     cfg = cfg.with_(green_share=g)
     with open_simulation(params, cfg, initial=initial, net_dir=net_dir) as sim:
-        meter = RampMeter(sim.lib, cfg, curve)
+        meter = make_meter(sim.lib, cfg, curve)
         sensor = SumoSensor(sim.lib, params.length, cfg)
         measurements = MeasurementLog()
         while sim.time < cfg.horizon - 1e-9:

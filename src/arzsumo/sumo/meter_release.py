@@ -1,0 +1,135 @@
+"""One vehicle per green: the ramp meter at a commanded release rate, as the field runs it.
+
+The command is a release rate r (veh/s) in [``release_rate_min``, ``release_rate_max``];
+the cycle is 1 / r, rounded to whole SUMO steps. Each cycle begins with a green that
+lasts ``min_green``, extended until the head vehicle has crossed the stop line (read by
+the meter's :class:`~arzsumo.sumo.meter.StopLine`), at most ``max_green``; then the
+clearance (yellow, ``meter_clearance``) and red for the rest of the cycle. When green,
+clearance and ``min_red`` do not fit in 1 / r (a long green) the cycle is stretched to
+hold them. A new r is a *plan change* when its cycle differs by a step or more and takes
+effect at the next cycle start; light changes are counted as for the fixed cycle (starts
+and ends of greens). While the ramp queue is at or above ``spillback_queue`` (> 0) the
+queue override runs the cycles at ``release_rate_max``.
+
+The controller's command is an outflow deviation U (veh/s) from the nominal outflow;
+:func:`release_rate_for` maps it to r by one rule: a released ramp vehicle takes one
+mainline slot at the merge, so r = r_nominal - U (``release_rate`` is r_nominal, the
+open loop's rate), saturated to the rate bounds.
+"""
+
+from __future__ import annotations
+
+import math
+from types import ModuleType
+
+from arzsumo.errors import ArzsumoError, require
+from arzsumo.sumo.config import SumoConfig
+from arzsumo.sumo.meter import (
+    DEFAULT_CURVE,
+    GREEN,
+    RED,
+    GreenShareCurve,
+    MeterLight,
+    RampMeter,
+)
+from arzsumo.sumo.network import METER_TL
+
+
+def release_rate_for(u: float, cfg: SumoConfig) -> float:
+    """Release rate r (veh/s) for the outflow command U (veh/s): r = r_nominal - U.
+
+    One released ramp vehicle takes one mainline slot at the merge, so lowering the
+    mainline outflow by U more releases U more ramp vehicles; r_nominal is
+    ``cfg.release_rate``, saturated to [``cfg.release_rate_min``, ``cfg.release_rate_max``].
+    """
+    require(math.isfinite(u), "U", u, "a finite flow in veh/s", ArzsumoError)
+    return min(cfg.release_rate_max, max(cfg.release_rate_min, cfg.release_rate - u))
+
+
+class OnePerGreenMeter(MeterLight):
+    """Drives the ramp traffic light of an open libsumo run, one vehicle per green.
+
+    Parameters
+    ----------
+    lib : module
+        The libsumo module of the open run.
+    cfg : SumoConfig
+        Nominal release rate and its bounds, minimum and maximum green, clearance,
+        minimum red, spillback threshold, step.
+    """
+
+    mode = "one_per_green"
+
+    def __init__(self, lib: ModuleType, cfg: SumoConfig, tl_id: str = METER_TL) -> None:
+        super().__init__(lib, cfg, tl_id)
+        self.min_green_steps = max(1, round(cfg.min_green / self.dt))
+        self.max_green_steps = max(self.min_green_steps, round(cfg.max_green / self.dt))
+        self.min_red_steps = round(cfg.min_red / self.dt)
+        self.rate = cfg.release_rate         # commanded last, veh/s
+        self.cycle_steps = self._cycle(cfg.release_rate)
+        self._pending = self.cycle_steps
+        self._k = 0                          # steps since the current cycle began
+        self._length = self.cycle_steps      # length of the current cycle, steps
+        self._green = True                   # the current cycle's green is on
+        #: shortest length the current cycle's phases allow (green, clearance, min red)
+        self._phases = self.max_green_steps + self.clearance_steps + self.min_red_steps
+        self._show(GREEN)
+
+    def _cycle(self, r: float) -> int:
+        """Cycle of release rate ``r`` (veh/s), whole steps."""
+        return max(1, round(1.0 / (r * self.dt)))
+
+    @property
+    def green_share(self) -> float:
+        """Minimum green over the running cycle (the plan's green share when the head
+        vehicle crosses within the minimum green)."""
+        return self.min_green_steps / self.cycle_steps
+
+    @property
+    def release_rate(self) -> float | None:
+        """Release rate commanded last, veh/s (saturated to the bounds)."""
+        return self.rate
+
+    def command_rate(self, r: float) -> float:
+        """Request release rate ``r`` (veh/s), saturated to the bounds; return the green
+        share of the requested plan. A changed cycle (whole steps) is a plan change."""
+        require(math.isfinite(r), "release_rate", r, "a finite rate in veh/s", ArzsumoError)
+        self.rate = min(self.cfg.release_rate_max, max(self.cfg.release_rate_min, r))
+        new = self._cycle(self.rate)
+        if new != self._pending:
+            self._pending = new
+            self.plan_changes += 1
+        return self.min_green_steps / self._pending
+
+    def command(self, u: float, q_nominal: float) -> float:
+        """Command U (veh/s) (``q_nominal`` unused: the rule is relative,
+        :func:`release_rate_for`); return the green share of the requested plan."""
+        return self.command_rate(release_rate_for(u, self.cfg))
+
+    def _plan(self) -> str:
+        fastest = self._cycle(self.cfg.release_rate_max)
+        override = self.override()
+        if override:      # cut the running cycle to the fastest one its phases allow
+            self.override_steps += self.cycle_steps > fastest or self._pending > fastest
+            self._length = min(self._length, max(fastest, self._phases))
+        self._k += 1
+        if self._k >= self._length:
+            self.cycle_steps = min(self._pending, fastest) if override else self._pending
+            self._k, self._length, self._green = 0, self.cycle_steps, True
+            self._phases = self.max_green_steps + self.clearance_steps + self.min_red_steps
+            return GREEN
+        if self._green:
+            done = self.released_this_green > 0 and self._k >= self.min_green_steps
+            if done or self._k >= self.max_green_steps:
+                self._green = False
+                self._phases = self._k + self.clearance_steps + self.min_red_steps
+                self._length = max(self.cycle_steps, self._phases)
+        return GREEN if self._green else RED
+
+
+def make_meter(lib: ModuleType, cfg: SumoConfig,
+               curve: GreenShareCurve = DEFAULT_CURVE) -> RampMeter | OnePerGreenMeter:
+    """The meter ``cfg.meter_mode`` names, on the light of an open libsumo run."""
+    if cfg.meter_mode == "one_per_green":
+        return OnePerGreenMeter(lib, cfg)
+    return RampMeter(lib, cfg, curve)

@@ -1,0 +1,60 @@
+"""Meter realisation settings and the outflow-command-to-release-rate rule (no SUMO)."""
+
+import pytest
+
+from arzsumo.errors import ArzsumoError, ScenarioError
+from arzsumo.scenario import scenario_from_dict
+from arzsumo.sumo.config import SumoConfig
+from arzsumo.sumo.meter import plan_green_steps
+from arzsumo.sumo.meter_release import release_rate_for
+
+
+def test_meter_keys_convert_units_and_default_to_todays_meter():
+    cfg = SumoConfig()
+    assert (cfg.meter_mode, cfg.meter_clearance, cfg.spillback_queue) == ("fixed_cycle", 0, 0)
+    cfg = scenario_from_dict({"sumo": {"meter_mode": "one_per_green", "meter_clearance_s": 2,
+                                       "release_rate_veh_h": 720, "release_rate_min_veh_h": 360,
+                                       "release_rate_max_veh_h": 720,
+                                       "max_green_s": 2.5}}).sumo
+    assert cfg.meter_mode == "one_per_green" and cfg.meter_clearance == 2.0
+    assert cfg.release_rate == pytest.approx(0.2) and cfg.release_rate_min == pytest.approx(0.1)
+    assert cfg.max_green == 2.5
+
+
+@pytest.mark.parametrize(("table", "message"), [
+    ({"meter_mode": "ramp"}, 'meter_mode = "ramp" is not allowed: one of fixed_cycle, '
+                             "one_per_green"),
+    ({"meter_clearance_s": -1}, "meter_clearance_s = -1 is not allowed: a finite number of "
+                                "at least 0"),
+    ({"meter_clearance_s": 5}, "min_green_s + meter_clearance_s + min_red_s = 7.0 is not "
+                               "allowed: at most meter_cycle"),
+    ({"release_rate_veh_h": 1000}, "release_rate_veh_h = 1000 is not allowed: a rate > 0 "
+                                   "veh/h, with release_rate_min_veh_h <= release_rate_veh_h"),
+    ({"max_green_s": 0.5}, "max_green_s = 0.5 is not allowed: at least min_green_s = 1.0 s"),
+    ({"meter_mode": "one_per_green", "meter_clearance_s": 2.5},
+     "is not allowed: at most the cycle 1 / release_rate_max = 4 s"),
+])
+def test_bad_meter_keys_name_key_and_value(table, message):
+    with pytest.raises(ScenarioError) as info:
+        scenario_from_dict({"sumo": table}, "test")
+    assert message in str(info.value)
+    assert str(info.value).startswith("test: [sumo]")
+
+
+def test_release_rate_is_nominal_minus_u_within_bounds():
+    cfg = SumoConfig()                         # 600 veh/h nominal, in [240, 900] veh/h
+    assert release_rate_for(0.0, cfg) == pytest.approx(600 / 3600)
+    assert release_rate_for(-200 / 3600, cfg) == pytest.approx(800 / 3600)   # U < 0: more
+    assert release_rate_for(200 / 3600, cfg) == pytest.approx(400 / 3600)
+    assert release_rate_for(-1.0, cfg) == pytest.approx(900 / 3600)
+    assert release_rate_for(1.0, cfg) == pytest.approx(240 / 3600)
+    with pytest.raises(ArzsumoError, match="U = nan is not allowed"):
+        release_rate_for(float("nan"), cfg)
+
+
+def test_clearance_is_taken_from_the_red_of_the_cycle():
+    # 60-step cycle, 10-step minimum green and red; a 20-step clearance joins the red
+    assert plan_green_steps(0.5, 60, 10, 10) == 30
+    assert plan_green_steps(0.5, 60, 10, 10 + 20) == 30    # yellow 20, red 10
+    assert plan_green_steps(0.6, 60, 10, 10 + 20) == 30    # the red holds yellow + min red
+    assert plan_green_steps(0.8, 60, 10, 10 + 20) == 60    # nearer all green
