@@ -18,7 +18,8 @@ from tests.test_outdir import checksums, result
 
 ROOT = Path(__file__).resolve().parents[1]
 TWIN = str(ROOT / "scenarios" / "paper_base.toml")
-RUN = ("run", "--horizon", "60", "--no-plots", "--quiet")
+# a short warm-up: these tests are about where results go, not about the fill phase
+RUN = ("run", "--warmup", "30", "--horizon", "60", "--no-plots", "--quiet")
 
 
 def cli_cmd(*args: str) -> list[str]:
@@ -112,11 +113,11 @@ def test_impossible_out_is_refused_before_sumo(tmp_path, out, startup):
 
 def test_default_run_name_has_the_horizon_and_follows_the_rules(tmp_path, startup):
     # a foreign directory at the default name: refused before SUMO, naming that path
-    mine = tmp_path / "results" / "default-etc-seed7-h60s"
+    mine = tmp_path / "results" / "default-etc-seed7-h60s-w30s"
     mine.mkdir(parents=True)
     (mine / "notes.txt").write_text("x")
     proc, elapsed = cli(*RUN, "--seed", "7", cwd=tmp_path, tmpdir=tmp_path / "tmp")
-    one_error_line(proc, "results/default-etc-seed7-h60s")
+    one_error_line(proc, "results/default-etc-seed7-h60s-w30s")
     assert elapsed < 5.0 + 2 * startup and (mine / "notes.txt").read_text() == "x"
 
 
