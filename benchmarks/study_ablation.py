@@ -40,6 +40,10 @@ MEASURES = {"section.speed_sd_kmh.h": "HV speed sd (km/h)",
             "section.speed_sd_kmh.a": "AV speed sd (km/h)",
             "network.time_loss_s.total": "network time loss (veh h)",
             "plan_changes": "plan changes"}
+#: the evaluation of the configuration before issue 15 (scenarios/legacy_default.toml,
+#: 150 s warm-up, 10 seeds), the ablation's starting point
+RECORDED = {"legacy": ("old scenario and calibrated model, raw cells (before issue 15)",
+                       ROOT / "docs" / "evaluation_default.csv")}
 #: tables whose change leaves the open loop as it was (evaluate's --baseline-from rule)
 INERT = {"sensing", "estimation", "actuation", "design"}
 
@@ -117,14 +121,15 @@ def run_step(name: str, out: Path, seeds: int, workers: int) -> int:
 def report(out: Path) -> pd.DataFrame:
     """One row per (step, controller, measure): mean and paired difference with CIs."""
     rows = []
-    for s in STEPS:
-        csv = out / s.name / "evaluation.csv"
+    sources = [(name, change, csv) for name, (change, csv) in RECORDED.items()]
+    sources += [(s.name, s.change, out / s.name / "evaluation.csv") for s in STEPS]
+    for name, change, csv in sources:
         if not csv.is_file():
             continue
         df = pd.read_csv(csv)
         df = df[df["measure"].isin(list(MEASURES))]
         for r in df.itertuples(index=False):
-            rows.append({"step": s.name, "change": s.change, "controller": r.controller,
+            rows.append({"step": name, "change": change, "controller": r.controller,
                          "measure": r.measure, "label": MEASURES[r.measure], "n": r.n,
                          "mean": r.mean, "diff_mean": r.diff_mean,
                          "diff_ci_low": r.diff_ci_low, "diff_ci_high": r.diff_ci_high,
