@@ -143,3 +143,12 @@ def test_a_baseline_that_differs_in_sumo_is_refused(evaluation, tmp_path, capsys
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "differs in sumo.ramp_demand_veh_h" in err
     assert not (tmp_path / "o").exists()
+
+
+def test_a_borrowed_baseline_needs_a_controller_to_run(evaluation, tmp_path, capsys):
+    scenario, out = evaluation
+    assert main(["evaluate", str(scenario), "--controllers", "open", "--quiet",
+                 "--out", str(tmp_path / "o"), "--baseline-from", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--controllers = 'open' is not allowed with" in err
+    assert not (tmp_path / "o").exists()

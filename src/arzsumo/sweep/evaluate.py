@@ -195,23 +195,24 @@ def run_evaluation(scenario: Path, controllers: Sequence[str], seeds: Sequence[i
     name = check_runs(scenario, controllers, horizon)
     borrowed = pd.DataFrame()
     if baseline_from is not None:
+        if len(controllers) == 1:
+            raise SweepError(f"--controllers = {BASELINE!r} is not allowed with "
+                             "--baseline-from: nothing would run; allowed: at least one "
+                             "controller besides the open loop")
         borrowed = borrowed_baseline(evaluation_spec(scenario, [BASELINE], seeds, horizon),
                                      Path(baseline_from), str(baseline_from))
-        if len(controllers) == 1:
-            raise SweepError("--controllers is not allowed to be only the open loop with "
-                             "--baseline-from: nothing would run")
-    spec = evaluation_spec(scenario, controllers[1:] if len(borrowed) else controllers,
+    spec = evaluation_spec(scenario, controllers[1:] if baseline_from else controllers,
                            seeds, horizon)
     if overwrite:
         _forget_previous(Path(out), str(out))
     rep = run_sweep(spec, out, workers=workers, scheduler=scheduler, progress=progress,
                     plots=False, kind=KIND)
     df = rep.table if rep.table is not None else pd.DataFrame()
-    df = pd.concat([borrowed, df], ignore_index=True) if len(borrowed) else df
+    df = pd.concat([borrowed, df], ignore_index=True) if baseline_from else df
     ok = df[df["status"].isin(FINISHED)]
     table = evaluate(ok, controllers, BASELINE)
     head = _header(name, scenario, controllers, seeds, ok, len(df), command)
-    if len(borrowed):
+    if baseline_from:
         head += f"\n\nOpen-loop runs taken from the evaluation in `{baseline_from}`."
     files = write_evaluation(rep.out, table, ok, controllers, head, BASELINE, plots=plots)
     return EvaluationResult(rep, ok, table, files)
