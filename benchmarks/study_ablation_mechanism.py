@@ -1,0 +1,142 @@
+"""Issue 17: what the controllers did to the meter and the section, per run of the ablation.
+
+Reads every run of an ablation directory (``benchmarks/study_ablation.py --out DIR``) and
+writes one row per (step, controller, seed): the meter's mean green share over the control
+window, the section's outflow and the network exit (veh/h, SUMO's counts), the section's
+mean speed and speed sd per class (km/h), the network time loss (veh h) and the ramp's
+depart delay (veh h); and, paired with the open loop of the same seed, the differences.
+
+Two figures show the mechanism the ablation table summarises:
+
+* ``*_map.png``: section outflow against mean green share, every run, with the static
+  levels of ``docs/meter_dynamics.md``: what the green share actually bought;
+* ``*_shift.png``: the paired change of each class's speed sd against the change of its
+  mean speed: a speed sd that rises with the mean speed is a change of operating point
+  within the window (a transition), not more stop-and-go.
+
+    python benchmarks/study_ablation_mechanism.py --out /path/to/ablation \\
+        --csv docs/ablation/mechanism.csv --png docs/ablation/mechanism
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import pandas as pd
+
+#: static outflow levels (veh/h) at held green shares on the default, seeds 1-2
+#: (docs/meter_dynamics.md)
+STATIC_LEVELS = {0.2: 4395.0, 0.5: 4268.0, 0.8: 3180.0}
+BORROWED = "open loop borrowed (--baseline-from)"
+
+
+def run_row(step: str, run: Path) -> dict[str, object]:
+    """The measures of one run directory (``controller=C,seed=S``)."""
+    s = json.loads((run / "summary.json").read_text(encoding="utf-8"))
+    periods = pd.read_parquet(run / "periods.parquet", columns=["green_running"])
+    net, sec = s["network"], s["section"]
+    return {"step": step, "controller": s["controller"], "seed": s["seed"],
+            "green_mean": float(periods["green_running"].mean()),
+            "section_outflow_veh_h": net["throughput_veh_h"]["section_outlet"],
+            "network_exit_veh_h": net["throughput_veh_h"]["network_exit"],
+            "speed_mean_h_kmh": sec["speed_mean_kmh"]["h"],
+            "speed_mean_a_kmh": sec["speed_mean_kmh"]["a"],
+            "speed_sd_h_kmh": sec["speed_sd_kmh"]["h"],
+            "speed_sd_a_kmh": sec["speed_sd_kmh"]["a"],
+            "time_loss_veh_h": net["time_loss_s"]["total"] / 3600.0,
+            "ramp_depart_delay_veh_h": net["depart_delay_s"]["ramp"] / 3600.0,
+            "plan_changes": s["plan_changes"]}
+
+
+def collect(out: Path) -> pd.DataFrame:
+    """Rows of every run under ``out/<step>/runs``; open loops found in the step they ran."""
+    rows = [run_row(step.name, run) for step in sorted(out.iterdir())
+            if (step / "runs").is_dir()
+            for run in sorted((step / "runs").iterdir()) if (run / "summary.json").is_file()]
+    return pd.DataFrame(rows)
+
+
+def paired(df: pd.DataFrame) -> pd.DataFrame:
+    """Each controller run minus the open loop of the same seed (the open loop of any step:
+    borrowed baselines are the same SUMO runs)."""
+    measures = [c for c in df.columns if c not in ("step", "controller", "seed")]
+    open_loop = df[df["controller"] == "open"].drop_duplicates("seed").set_index("seed")
+    ctrl = df[df["controller"] != "open"].copy()
+    base = open_loop.loc[ctrl["seed"], measures].to_numpy()
+    for i, m in enumerate(measures):
+        ctrl[f"d_{m}"] = ctrl[m].to_numpy() - base[:, i]
+    return ctrl
+
+
+def plot_map(df: pd.DataFrame, path: Path) -> None:
+    """Section outflow against mean green share, every run."""
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for (step, ctrl), g in df.groupby(["step", "controller"]):
+        ax.scatter(g["green_mean"], g["section_outflow_veh_h"], s=14,
+                   label=f"{step} {ctrl}" if ctrl != "open" else "open loop")
+    ax.plot(list(STATIC_LEVELS), list(STATIC_LEVELS.values()), "k--", marker="s",
+            label="static levels, held plans (docs/meter_dynamics.md)")
+    ax.set(xlabel="mean green share over the control window", xlim=(-0.02, 1.02),
+           ylabel="section outflow (veh/h)",
+           title="What the green share bought (default, seeds 1-10)")
+    ax.legend(fontsize=7, ncol=2)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def plot_shift(d: pd.DataFrame, path: Path) -> None:
+    """Paired change of speed sd against change of mean speed, per class."""
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4.2))
+    for ax, c, name in zip(axes, ("h", "a"), ("HV", "AV"), strict=True):
+        for (step, ctrl), g in d.groupby(["step", "controller"]):
+            ax.scatter(g[f"d_speed_mean_{c}_kmh"], g[f"d_speed_sd_{c}_kmh"], s=14,
+                       label=f"{step} {ctrl}")
+        ax.axhline(0, color="k", lw=0.6)
+        ax.axvline(0, color="k", lw=0.6)
+        ax.set(xlabel=f"{name} mean speed minus open loop (km/h)",
+               ylabel=f"{name} speed sd minus open loop (km/h)", title=f"{name}, paired by seed")
+    axes[0].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", type=Path, required=True, help="the ablation directory")
+    ap.add_argument("--csv", type=Path, help="write the per-run table here")
+    ap.add_argument("--png", type=Path, help="figure prefix (writes PREFIX_map.png, "
+                    "PREFIX_shift.png)")
+    args = ap.parse_args()
+    df = collect(args.out)
+    d = paired(df)
+    if args.csv:
+        args.csv.parent.mkdir(parents=True, exist_ok=True)
+        d_all = pd.concat([df[df["controller"] == "open"].drop_duplicates("seed"), d])
+        d_all.to_csv(args.csv, index=False, float_format="%.6g")
+    if args.png:
+        args.png.parent.mkdir(parents=True, exist_ok=True)
+        plot_map(pd.concat([df[df["controller"] == "open"].drop_duplicates("seed"),
+                            df[df["controller"] != "open"]]), Path(f"{args.png}_map.png"))
+        plot_shift(d, Path(f"{args.png}_shift.png"))
+    cols = ["green_mean", "section_outflow_veh_h", "d_section_outflow_veh_h",
+            "d_speed_mean_h_kmh", "d_speed_sd_h_kmh", "d_speed_mean_a_kmh",
+            "d_speed_sd_a_kmh", "d_time_loss_veh_h"]
+    print(d.groupby(["step", "controller"], sort=False)[cols].mean().round(2).to_string())
+    for c in ("h", "a"):
+        r = d[f"d_speed_mean_{c}_kmh"].corr(d[f"d_speed_sd_{c}_kmh"])
+        print(f"corr(change of mean speed, change of speed sd), class {c}: {r:+.2f} "
+              f"over {len(d)} paired runs")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
