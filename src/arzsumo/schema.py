@@ -182,7 +182,7 @@ RUN_SUMMARY: dict[str, str] = {
     "actuation.ramp_bound": "bool", "actuation.anti_windup": "bool", "actuation.applies": "bool",
     "actuation.periods": "count", "actuation.saturated_periods": "count",
     "actuation.rate_limited_periods": "count", "actuation.saturated_share": "1",
-    "actuation.rate_limited_share": "1",
+    "actuation.rate_limited_share": "1", "actuation.delay_compensation": "s",
     "twin_status.*.resyncs": "count", "twin_status.*.first_resync_s": "s",
     "twin_status.*.first_reason": TEXT,
     "inserted": "veh", "requested": "veh", "waiting": "veh", "arrived": "veh",

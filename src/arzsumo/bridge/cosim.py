@@ -34,7 +34,8 @@ with the results.
 A detector sample's path: ``SumoSensor.observe`` (libsumo, every step) ->
 ``PeriodMeasurement`` -> ``Estimator.estimate`` -> ``MacroState`` -> ``Controller.check``
 -> U -> ``MeterActuator.apply`` (the ``[actuation]`` limits; the U applied goes back to
-``Controller.applied``) -> ``RampMeter.command_outflow`` (or a release rate,
+``Controller.applied``, and to a delay compensator, ``Controller.actuated``:
+:mod:`~arzsumo.bridge.delay`) -> ``RampMeter.command_outflow`` (or a release rate,
 ``OnePerGreenMeter.command_rate``) -> the light, set by ``step`` at the next cycle start.
 """
 
@@ -52,6 +53,7 @@ from typing import Any
 import numpy as np
 
 from arzsumo.bridge.actuator import ActuationLimits, MeterActuator
+from arzsumo.bridge.delay import check_delay, compensate
 from arzsumo.bridge.estimator import Estimator
 from arzsumo.bridge.estimators import RecordedEstimator, estimation_stage
 from arzsumo.bridge.records import Decision, PeriodRecord, Trace, columns, micro_fields
@@ -254,6 +256,7 @@ class ClosedLoop:
             return Decision(state.t, u, u_cont, triggered, self.plant.meter.green_share,
                             u_ref, c1 - c0)
         act = self.actuator.apply(u)
+        self.controller.actuated(act.u_applied)
         if self.anti_windup:
             self.controller.applied(act.u_applied, act.lower, act.upper)
         return Decision(state.t, u, u_cont, triggered, act.green, u_ref, c1 - c0,
@@ -393,7 +396,10 @@ def control(sim: SumoSimulation, scenario: Scenario, settings: RunSettings, cfg:
     warm_fields = estimator.prime(warm[:-1], warm[-1].t)
     shift = (reference_shift(est.reference, warm_fields, eq, est.reference_window, period)
              if is_pde(acting) and est.reference != "equilibrium" and warm_fields else None)
-    ctrl = build_controller(acting, lin, kernels, design, settings, curve, cfg, target)
+    check_delay(scenario, acting, lin.eigenvalues, "measured" if eq is not scenario.equilibrium
+                else "")
+    ctrl = compensate(build_controller(acting, lin, kernels, design, settings, curve, cfg,
+                                       target), acting, scenario)
     ref_name = settings.controller if is_pde(settings.controller) else "open"
     ref_ctrl = build_controller(ref_name, lin, kernels, design, settings, curve, cfg, target)
     q_nom = curve.outflow_at(cfg.green_share)

@@ -178,6 +178,13 @@ class RecordedEstimator:
         return out
 
 
+def acting_controller(method: str, controller: str) -> str:
+    """The controller that acts in a run of ``controller`` with ``[estimation] method``:
+    ``observer-etc`` with a method other than ``none`` becomes ``etc`` on the boundary
+    stations' estimate; any other is itself."""
+    return "etc" if controller == "observer-etc" and method != "none" else controller
+
+
 def estimation_stage(settings: EstimationSettings, layout: SensorLayout, controller: str,
                      eq: Equilibrium, x: np.ndarray, keep: bool = False
                      ) -> tuple[RecordedEstimator, str]:
@@ -198,4 +205,4 @@ def estimation_stage(settings: EstimationSettings, layout: SensorLayout, control
     sensors = ("loops (boundaries)",) if boundary else layout.kinds
     return (RecordedEstimator(inner, settings.method, sensors, eq,
                               measurements=[] if keep else None),
-            "etc" if boundary else controller)
+            acting_controller(settings.method, controller))

@@ -14,6 +14,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from arzsumo.bridge.cosim import CoSimResult, check_before_start, run_cosimulation
+from arzsumo.bridge.delay import check_delay
+from arzsumo.bridge.estimators import acting_controller
 from arzsumo.control.etc import EtcDesign
 from arzsumo.errors import ArzsumoError, ScenarioError
 from arzsumo.model import linearize
@@ -148,7 +150,9 @@ def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None
     period, s; ``--warmup``, s >= 0; validated again by
     :meth:`~arzsumo.scenario.Scenario.with_`), checks that
     ``[sumo] cell_length_m`` divides the road and that the characteristic speeds are
-    finite, refuses a PDE controller at a free-flow scenario equilibrium, and draws the
+    finite, refuses a PDE controller at a free-flow scenario equilibrium and a
+    ``[actuation] delay_compensation_s`` it cannot apply
+    (:func:`~arzsumo.bridge.delay.check_delay`), and draws the
     placement profile of ``start = "placement"``. Raises an
     :class:`arzsumo.errors.ArzsumoError` naming the key or option.
     """
@@ -166,6 +170,8 @@ def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None
     if settings.equilibrium == "scenario":
         _check_regime(sc, settings, controller is not None)
     _check_estimation(sc, settings, controller is not None)
+    check_delay(sc, acting_controller(sc.estimation.method, settings.controller),
+                linearize(sc.equilibrium).eigenvalues)
     initial = None
     if settings.start == "placement":
         n = round(sc.params.length / cfg.cell_length)

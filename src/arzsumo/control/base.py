@@ -107,6 +107,17 @@ class Controller(ABC):
         """
         return None
 
+    def actuated(self, u: float) -> None:
+        """The meter received ``u`` (veh/s) for the U of the last :meth:`check`.
+
+        Called after every check whose U reaches the meter, whatever ``[actuation]
+        anti_windup`` says: a history of what was applied, not a limit the law adapts to.
+        The default does nothing; the delay compensator
+        (:class:`arzsumo.control.compensation.DelayCompensated`) keeps the commands of the
+        last theta seconds for its prediction.
+        """
+        return None
+
 
 class OpenLoop(Controller):
     """U = 0: the outlet flow stays at q* (the paper's open-loop case)."""

@@ -39,6 +39,7 @@ import pyarrow.parquet as pq
 
 from arzsumo import __version__
 from arzsumo.bridge.cosim import CoSimResult
+from arzsumo.bridge.delay import compensated_delay
 from arzsumo.bridge.estimator import fill_speeds
 from arzsumo.bridge.sensor_record import estimation_scores
 from arzsumo.control.base import ControlLog
@@ -131,7 +132,9 @@ def estimation_summary(res: CoSimResult) -> dict[str, Any] | None:
 
 def actuation_summary(res: CoSimResult) -> dict[str, Any]:
     """The ``[actuation]`` limits used (SI; null: off) and how often they acted: periods
-    and shares of the control window's periods saturated and rate limited."""
+    and shares of the control window's periods saturated and rate limited;
+    ``delay_compensation``: the dead time theta (s) the acting law predicted over (0: off,
+    or a controller without a Riemann-state law, :mod:`arzsumo.bridge.delay`)."""
     act, per = res.scenario.actuation, res.periods
     n = int(per["t"].size)
     sat, rate = int(np.sum(per["saturated"] > 0)), int(np.sum(per["rate_limited"] > 0))
@@ -143,7 +146,8 @@ def actuation_summary(res: CoSimResult) -> dict[str, Any]:
             "ramp_bound": act.ramp_bound, "anti_windup": act.anti_windup,
             "applies": not off, "periods": n, "saturated_periods": sat,
             "rate_limited_periods": rate, "saturated_share": sat / n if n else None,
-            "rate_limited_share": rate / n if n else None}
+            "rate_limited_share": rate / n if n else None,
+            "delay_compensation": compensated_delay(res.scenario, res.settings.controller)}
 
 
 #: ``summary.json["kind"]`` of a closed-loop run in SUMO (``arzsumo run``)

@@ -39,9 +39,15 @@ from typing import Any
 from arzsumo.control.etc import EtcDesign
 from arzsumo.errors import ScenarioError
 from arzsumo.io import read_toml
+from arzsumo.model.characteristic import linearize
 from arzsumo.model.equilibrium import Equilibrium
 from arzsumo.model.params import ModelParameters, get_preset
-from arzsumo.scenario.actuation import ACTUATION_KEYS, ActuationSettings, actuation_section
+from arzsumo.scenario.actuation import (
+    ACTUATION_KEYS,
+    ActuationSettings,
+    actuation_section,
+    check_delay_horizon,
+)
 from arzsumo.scenario.estimation import (
     ESTIMATION_KEYS,
     EstimationSettings,
@@ -190,6 +196,9 @@ def scenario_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scena
     estimation = estimation_section(t["estimation"], at["estimation"])
     check_sensors(estimation, sensing, params.length, at["estimation"])
     actuation = actuation_section(t["actuation"], at["actuation"])
+    if actuation.delay_compensation > 0:
+        check_delay_horizon(actuation, linearize(eq).eigenvalues, params.length,
+                            at["actuation"], t["actuation"].get("delay_compensation_s"))
     sweep = _sweep_section(t["sweep"], at["sweep"])
     default_name = Path(source).stem if source != "<dict>" else preset.name
     return Scenario(_text(data, "name", source, default_name),

@@ -1,0 +1,115 @@
+"""Delay compensation: a PDE law evaluated on the state predicted theta seconds ahead.
+
+The ramp meter moves the section's outflow only a dead time theta after a command (10-14 s
+in SUMO, ``docs/meter_dynamics.md``; issue 17, point 1c): the U-bar issued at t enters the
+boundary condition clpsys4 at t + theta. :class:`DelayCompensated` wraps a law that takes
+scaled Riemann states (continuous backstepping, control_law; the full-state ETC, control
+law sam with defdynamic) and, at every check t,
+
+1. maps the controller's state to w-bar(t) = E(x) T z on the kernel grid (clpsys1),
+2. predicts w-bar(t + theta) by :func:`arzsumo.control.predictor.predict_riemann`, with
+   the U-bar that reaches the boundary in (t, t + theta]: the commands applied in
+   [t - theta, t) (:func:`arzsumo.control.predictor.committed`; after the actuator's
+   limits, told through :meth:`DelayCompensated.actuated`),
+3. evaluates the wrapped law on the prediction (its ``check_riemann``).
+
+So the command acts on the state it will meet (predictor feedback). The prediction and
+the law are one place for both laws. With theta = 0 the prediction is the identity and
+the command is the wrapped law's exactly; the closed loop does not wrap at theta = 0.
+
+The boundary observer of the observer-ETC is not wrapped: its boundary model ob-sys2-bd
+integrates the U-bar it is handed as the one acting now, which under a dead time is the
+command of theta seconds ago; predicting its estimate alone would compensate a state
+that already assumed no delay. Pure math: no SUMO, no files.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Protocol
+
+import numpy as np
+
+from arzsumo.control.backstepping import StateMap
+from arzsumo.control.base import Controller, ControlLog, MacroState
+from arzsumo.control.predictor import committed, predict_riemann
+from arzsumo.errors import ModelError, require
+from arzsumo.model.characteristic import Linearization
+
+
+class RiemannLaw(Protocol):
+    """A controller whose law takes scaled Riemann states on its kernel grid."""
+
+    name: str
+    lin: Linearization
+    state_map: StateMap
+    log: ControlLog
+
+    def check_riemann(self, t: float, w_bar: np.ndarray) -> float: ...
+
+    def reset(self) -> None: ...
+
+    def applied(self, u: float, lower: float = -math.inf, upper: float = math.inf) -> None: ...
+
+
+class DelayCompensated(Controller):
+    """``inner`` evaluated on the state predicted ``delay`` s ahead (module docstring).
+
+    Parameters
+    ----------
+    inner : Backstepping or EventTriggered
+        The law (anything with ``lin``, ``state_map`` and ``check_riemann``).
+    delay : float
+        Dead time theta, s, in [0, L / max |lambda|).
+
+    The log is the inner law's (same records as without compensation); the applied
+    commands are kept in :attr:`times` (s) and :attr:`u_bar` (scaled, clpsys4).
+    """
+
+    def __init__(self, inner: RiemannLaw, delay: float) -> None:
+        self.inner = inner
+        system = inner.lin.system
+        horizon = system.length / float(np.abs(system.lam).max())
+        require(math.isfinite(delay) and 0.0 <= delay < horizon, "delay", delay,
+                f"a dead time in [0, {horizon:.4g}) s", ModelError)
+        self.delay = float(delay)
+        self.name = inner.name
+        super().__init__()
+        self.times: list[float] = []
+        self.u_bar: list[float] = []
+
+    @property
+    def log(self) -> ControlLog:
+        return self.inner.log
+
+    @log.setter
+    def log(self, value: ControlLog) -> None:
+        self.inner.log = value
+
+    def reset(self) -> None:
+        self.inner.reset()
+        self.times, self.u_bar = [], []
+
+    def predicted(self, t: float, w_bar: np.ndarray) -> np.ndarray:
+        """w-bar(t + theta) from w-bar(t) on the kernel grid and the commands applied
+        before t (scaled Riemann variables, clpsys1)."""
+        ahead = committed(np.asarray(self.times), np.asarray(self.u_bar), t, self.delay)
+        return predict_riemann(self.inner.lin.system, self.inner.state_map.x, w_bar,
+                               self.delay, ahead)
+
+    def decide(self, state: MacroState) -> float:
+        sm = self.inner.state_map
+        w_bar = sm.riemann(sm.deviations(state))
+        u_bar = self.inner.check_riemann(state.t, self.predicted(state.t, w_bar))
+        self.times.append(float(state.t))        # the command, until the meter's is known
+        self.u_bar.append(float(u_bar))
+        return u_bar / self.inner.lin.u_bar_per_u
+
+    def actuated(self, u: float) -> None:
+        """The meter received ``u`` (veh/s) for the last check: the prediction uses it."""
+        if self.u_bar:
+            self.u_bar[-1] = u * self.inner.lin.u_bar_per_u
+
+    def applied(self, u: float, lower: float = -math.inf, upper: float = math.inf) -> None:
+        """Anti-windup: handed to the inner law (the ETC's trigger projects on the range)."""
+        self.inner.applied(u, lower, upper)
