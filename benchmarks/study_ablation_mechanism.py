@@ -76,21 +76,21 @@ def paired(df: pd.DataFrame) -> pd.DataFrame:
 
 
 def at_equal_mean_speed(d: pd.DataFrame) -> pd.DataFrame:
-    """Per class, the line d_sd = a + b d_mean through all paired runs, and per (step,
-    controller) the mean residual with its 95 % t interval: the change of speed sd a
-    controller made beyond what its change of mean speed explains (km/h)."""
+    """Per class, the common slope b of d_sd on d_mean over all paired runs, and per
+    (step, controller) the mean of d_sd - b d_mean with its 95 % t interval: the change of
+    speed sd a controller made at an unchanged mean speed (km/h), if all share the slope."""
     from scipy import stats
 
     rows = []
     for c in ("h", "a"):
         x, y = d[f"d_speed_mean_{c}_kmh"], d[f"d_speed_sd_{c}_kmh"]
         fit = stats.linregress(x, y)
-        resid = y - (fit.intercept + fit.slope * x)
-        for (step, ctrl), r in resid.groupby([d["step"], d["controller"]], sort=False):
+        at_equal = y - fit.slope * x
+        for (step, ctrl), r in at_equal.groupby([d["step"], d["controller"]], sort=False):
             half = stats.t.ppf(0.975, len(r) - 1) * r.std(ddof=1) / len(r) ** 0.5
-            rows.append({"class": c, "slope_sd_per_mean": fit.slope, "r": fit.rvalue,
-                         "step": step, "controller": ctrl, "n": len(r),
-                         "resid_mean_kmh": r.mean(), "ci_low": r.mean() - half,
+            rows.append({"class": c, "slope": fit.slope, "intercept": fit.intercept,
+                         "r": fit.rvalue, "step": step, "controller": ctrl, "n": len(r),
+                         "d_sd_at_equal_mean_kmh": r.mean(), "ci_low": r.mean() - half,
                          "ci_high": r.mean() + half})
     return pd.DataFrame(rows)
 
