@@ -95,6 +95,21 @@ def at_equal_mean_speed(d: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def equal_markdown(equal: pd.DataFrame) -> str:
+    """Steps x controllers: the sd change at an unchanged mean speed per class, km/h."""
+    lines = ["| step | controller | HV: sd change at equal mean speed (km/h) | "
+             "AV: sd change at equal mean speed (km/h) |", "|---|---|---|---|"]
+    for (step, ctrl), g in equal.groupby(["step", "controller"], sort=False):
+        cells = [f"{r.d_sd_at_equal_mean_kmh:+.2f} [{r.ci_low:+.2f}, {r.ci_high:+.2f}]"
+                 for r in g.sort_values("class", ascending=False).itertuples()]
+        lines.append(f"| {step} | {ctrl} | " + " | ".join(cells) + " |")
+    fits = equal.drop_duplicates("class").set_index("class")
+    lines.append("")
+    lines.append(" ".join(f"{c}: slope {fits.loc[c, 'slope']:+.3f}, r {fits.loc[c, 'r']:+.2f};"
+                          for c in ("h", "a")))
+    return "\n".join(lines)
+
+
 def plot_map(df: pd.DataFrame, path: Path) -> None:
     """Section outflow against mean green share, every run."""
     fig, ax = plt.subplots(figsize=(7, 4.5))
@@ -151,7 +166,9 @@ def main() -> int:
             "d_speed_mean_h_kmh", "d_speed_sd_h_kmh", "d_speed_mean_a_kmh",
             "d_speed_sd_a_kmh", "d_time_loss_veh_h"]
     print(d.groupby(["step", "controller"], sort=False)[cols].mean().round(2).to_string())
-    print(at_equal_mean_speed(d).round(3).to_string(index=False))
+    equal = at_equal_mean_speed(d)
+    print(equal.round(3).to_string(index=False))
+    print(equal_markdown(equal))
     return 0
 
 
