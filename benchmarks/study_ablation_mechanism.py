@@ -34,7 +34,8 @@ import pandas as pd
 #: static outflow levels (veh/h) at held green shares on the default, seeds 1-2
 #: (docs/meter_dynamics.md)
 STATIC_LEVELS = {0.2: 4395.0, 0.5: 4268.0, 0.8: 3180.0}
-BORROWED = "open loop borrowed (--baseline-from)"
+#: the ablation's steps in order (benchmarks/study_ablation.py)
+ORDER = ("scenario", "identified", "estimator", "reference", "saturation", "design", "delay")
 
 
 def run_row(step: str, run: Path) -> dict[str, object]:
@@ -60,7 +61,10 @@ def collect(out: Path) -> pd.DataFrame:
     rows = [run_row(step.name, run) for step in sorted(out.iterdir())
             if (step / "runs").is_dir()
             for run in sorted((step / "runs").iterdir()) if (run / "summary.json").is_file()]
-    return pd.DataFrame(rows)
+    df = pd.DataFrame(rows)
+    rank = {name: i for i, name in enumerate(ORDER)}
+    df["_rank"] = df["step"].map(lambda s: rank.get(s, len(ORDER)))
+    return df.sort_values(["_rank", "controller", "seed"]).drop(columns="_rank")
 
 
 def paired(df: pd.DataFrame) -> pd.DataFrame:
