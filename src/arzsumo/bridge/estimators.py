@@ -59,8 +59,9 @@ def filled(eq: Equilibrium, z: np.ndarray) -> np.ndarray:
 def boundary_only(obs: LoopObservation) -> LoopObservation:
     """The record of the first and last stations of ``obs`` (x = 0+ and x = L-)."""
     k = [0, obs.x.size - 1]
+    tm, hm = (None if a is None else a[:, k] for a in (obs.time_mean, obs.harmonic))
     return LoopObservation(obs.t, obs.period, obs.x[k], obs.flow[:, k], obs.speed[:, k],
-                           obs.density[:, k], obs.noise)
+                           obs.density[:, k], obs.noise, tm, hm)
 
 
 def _state(t: float, x: np.ndarray, z: np.ndarray, m: PeriodMeasurement) -> MacroState:
