@@ -86,6 +86,8 @@ def test_offline_estimation_equals_the_closed_loop(recorded, method, loop_speed,
         assert offline["interpolation"][name]["absolute"] == pytest.approx(
             on["interpolation"][name]["absolute"], abs=1e-9)
     assert (offline["spread"] is None) is (method == "smoothing")
+    loops = "loops (harmonic speed)" if loop_speed == "harmonic" else "loops"
+    assert on["sensors"] == offline["sensors"] == [loops, "av_probes"]
 
 
 def test_a_layout_with_stations_not_recorded_is_refused(recorded):

@@ -204,6 +204,10 @@ def estimation_stage(settings: EstimationSettings, layout: SensorLayout, control
     else:
         inner = FundamentalDiagramFill(eq.params)
     sensors = ("loops (boundaries)",) if boundary else layout.kinds
+    if layout.loop_speed == "harmonic":
+        named = {"loops": "loops (harmonic speed)",
+                 "loops (boundaries)": "loops (boundaries, harmonic speed)"}
+        sensors = tuple(named.get(k, k) for k in sensors)
     return (RecordedEstimator(inner, settings.method, sensors, eq,
                               measurements=[] if keep else None),
             acting_controller(settings.method, controller))
