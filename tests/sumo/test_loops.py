@@ -21,7 +21,7 @@ import pytest
 
 from arzsumo.errors import ScenarioError
 from arzsumo.scenario import load_scenario, scenario_from_dict
-from arzsumo.sumo.loops import INLET_GAP, placed_positions
+from arzsumo.sumo.loops import INLET_GAP, V_MIN, LoopSensor, placed_positions, speed_means
 from arzsumo.sumo.network import MAIN
 from arzsumo.sumo.placement import place_vehicles
 from arzsumo.sumo.probes import AvProbes
@@ -48,6 +48,9 @@ class Reference:
     records: list = field(default_factory=list)
     counts: list = field(default_factory=list)       # fronts that crossed x_j
     speeds: list = field(default_factory=list)       # mean speed at the crossing step
+    harmonic: list = field(default_factory=list)     # their harmonic mean (floored)
+    slow: list = field(default_factory=list)         # crossings at a speed below V_MIN
+    harmonic_records: list = field(default_factory=list)   # a loop_speed = "harmonic" sensor
     zone: list = field(default_factory=list)         # time front in [x_j, x_j + l) / l T
     probes: list = field(default_factory=list)       # (record, AVs on main then)
     abreast: int = 0                                 # same-step crossings of one station
@@ -102,8 +105,11 @@ def _run(params, cfg) -> Reference:
                          loops=LAYOUT.loop_x(params.length)) as sim:
         lib = sim.lib
         sensor = SumoSensor(lib, params.length, cfg, layout=LAYOUT)
+        harmonic = LoopSensor(lib, LAYOUT.loop_x(params.length), params.length,
+                              cfg.step_length, cfg.steps_per_period, speed="harmonic")
         tracks = Tracks(lib, params.length)
         cnt, vsum, zone = np.zeros((2, n)), np.zeros((2, n)), np.zeros((2, n))
+        vinv, slow = np.zeros((2, n)), np.zeros((2, n))
         while sim.time < cfg.horizon - 1e-9:
             t = sim.step()
             step = np.zeros((2, n))
@@ -112,21 +118,28 @@ def _run(params, cfg) -> Reference:
                 crossed = (x <= p1) & (x > (p1 - length if p0 is None else p0))
                 step[c] += crossed
                 vsum[c] += v * crossed
+                vinv[c] += crossed / max(v, V_MIN)
+                slow[c] += crossed * (v < V_MIN)
                 zone[c] += cfg.step_length / length * _covered(
                     p1 if p0 is None else p0, p1, x, length)
             ref.abreast += int((step >= 2).sum())
             cnt += step
             m = sensor.observe(t)
+            h = harmonic.observe(t)
             if m is None:
                 continue
             ref.records.append(m.loops)
+            ref.harmonic_records.append(h)
             ref.counts.append(cnt)
-            with np.errstate(invalid="ignore"):
+            with np.errstate(invalid="ignore", divide="ignore"):
                 ref.speeds.append(vsum / cnt)
+                ref.harmonic.append(np.where(cnt > 0, cnt / vinv, np.nan))
+            ref.slow.append(slow)
             ref.zone.append(zone / cfg.control_period)
             av_main = {v: s[1:3] for v, s in cur.items() if s[4] and s[5]}
             ref.probes.append((m.probes, av_main))
             cnt, vsum, zone = np.zeros((2, n)), np.zeros((2, n)), np.zeros((2, n))
+            vinv, slow = np.zeros((2, n)), np.zeros((2, n))
     return ref
 
 
@@ -157,6 +170,34 @@ def test_loop_speeds_are_the_crossing_vehicles_speeds(run):
     assert np.nanmin(speeds) < 7.0 < 14.0 < np.nanmax(speeds)   # slow and fast passages
 
 
+def test_time_mean_loop_speed_is_unchanged_and_kept_beside_the_harmonic(run):
+    # loop_speed = "time_mean" (the default): speed is the arithmetic mean, bit for bit the
+    # time_mean kept on the record; a "harmonic" sensor on the same run differs only in speed
+    for rec, h in zip(run.records, run.harmonic_records, strict=True):
+        np.testing.assert_array_equal(rec.speed, rec.time_mean)
+        np.testing.assert_array_equal(h.time_mean, rec.speed)
+        np.testing.assert_array_equal(h.harmonic, rec.harmonic)
+        np.testing.assert_array_equal(h.speed, h.harmonic)
+        for name in ("flow", "density"):
+            np.testing.assert_array_equal(getattr(h, name), getattr(rec, name))
+
+
+def test_harmonic_loop_speed_is_the_floored_harmonic_mean_below_the_time_mean(run):
+    # N / sum 1/max(v_k, V_MIN) of the crossing vehicles, against vehicle positions
+    hm = np.array([h.speed for h in run.harmonic_records])
+    tm = np.array([r.speed for r in run.records])
+    cnt, slow = np.array(run.counts), np.array(run.slow)
+    np.testing.assert_allclose(hm, np.array(run.harmonic), rtol=0, atol=1e-9, equal_nan=True)
+    np.testing.assert_array_equal(np.isfinite(hm), cnt > 0)          # NaN: no vehicle
+    clean = (cnt > 0) & (slow == 0)                                  # no floored speed
+    assert np.all(hm[clean] <= tm[clean] + 1e-9)                     # AM-HM inequality
+    np.testing.assert_allclose(hm[clean & (cnt == 1)], tm[clean & (cnt == 1)], rtol=1e-12)
+    assert np.all(hm[cnt > 0] >= V_MIN - 1e-12)
+    assert (clean & (cnt == 1)).sum() > 50 and (clean & (cnt >= 2)).sum() > 20
+    two = clean & (cnt >= 2)
+    assert (tm[two] - hm[two] > 1e-3).sum() > 5 and np.max(tm[two] - hm[two]) > 0.2   # m/s
+
+
 def test_loop_density_is_edie_density_over_one_vehicle_length(run):
     # summed occupancy time / vehicle length per period, against the time each body covers
     # x_j with fronts moving linearly within a step (SUMO's update): equal up to rounding
@@ -165,6 +206,19 @@ def test_loop_density_is_edie_density_over_one_vehicle_length(run):
     loop = np.mean([r.density for r in run.records], axis=0)
     assert loop.min() > 0.015 and loop[0].max() > 0.06     # veh/m: every station, queues
     assert np.array([r.density.sum(axis=0) for r in run.records]).max() > 0.2   # > 1 / l
+
+
+def test_speed_means_of_known_spot_speeds():
+    # 10 and 30 m/s: arithmetic 20, harmonic 2 / (1/10 + 1/30) = 15; a stopped vehicle
+    # counts at V_MIN in the harmonic mean only; no vehicle: NaN
+    v = [np.array([10.0, 30.0]), np.array([0.0, 5.0]), np.array([7.0]), np.array([])]
+    entered = np.array([s.size for s in v], float)
+    tm, hm = speed_means(entered, np.array([s.sum() for s in v]),
+                         np.array([(1.0 / np.maximum(s, V_MIN)).sum() for s in v]))
+    np.testing.assert_allclose(tm[:3], [20.0, 2.5, 7.0], rtol=1e-15)
+    np.testing.assert_allclose(hm[:3], [15.0, 2.0 / (1 / V_MIN + 1 / 5.0), 7.0],
+                               rtol=1e-15)
+    assert np.isnan(tm[3]) and np.isnan(hm[3])
 
 
 def test_av_probes_hold_every_av_on_main_and_nothing_else(run):
@@ -203,6 +257,10 @@ def test_inlet_station_lies_beyond_every_inserted_vehicle():
 
 def test_default_scenario_keeps_todays_probe_only():
     assert SCENARIO.sensing == SensorLayout() and SCENARIO.sensing.loop_x(1000.0) == ()
+    assert SCENARIO.sensing.loop_speed == "time_mean"
+    sc = scenario_from_dict({"sensing": {"kinds": ["loops"], "loop_speed": "harmonic"}},
+                            "s.toml")
+    assert sc.sensing.loop_speed == "harmonic"
     lay = SensorLayout(kinds=("loops",))
     assert lay.loop_x(1000.0) == (0.0, 1000.0)
     assert SensorLayout(kinds=("loops",), loop_spacing=300.0).loop_x(1000.0) == (
@@ -225,6 +283,10 @@ def test_default_scenario_keeps_todays_probe_only():
     ({"kinds": ["av_probes"], "av_probe_share": 1.5}, "av_probe_share = 1.5 is not allowed"),
     ({"kinds": ["loops"], "av_probe_share": 0.5}, "without \"av_probes\" in kinds"),
     ({"kinds": ["av_probes"], "unknown": 1}, "unknown key 'unknown'"),
+    ({"kinds": ["loops"], "loop_speed": "space_mean"},
+     "loop_speed = \"space_mean\" is not allowed: one of time_mean, harmonic"),
+    ({"kinds": ["loops"], "loop_speed": 1}, "loop_speed = 1 is not allowed"),
+    ({"kinds": ["av_probes"], "loop_speed": "harmonic"}, "without \"loops\" in kinds"),
 ])
 def test_bad_layouts_are_refused_in_one_line(table, message):
     with pytest.raises(ScenarioError) as err:

@@ -59,8 +59,9 @@ def filled(eq: Equilibrium, z: np.ndarray) -> np.ndarray:
 def boundary_only(obs: LoopObservation) -> LoopObservation:
     """The record of the first and last stations of ``obs`` (x = 0+ and x = L-)."""
     k = [0, obs.x.size - 1]
+    tm, hm = (None if a is None else a[:, k] for a in (obs.time_mean, obs.harmonic))
     return LoopObservation(obs.t, obs.period, obs.x[k], obs.flow[:, k], obs.speed[:, k],
-                           obs.density[:, k], obs.noise)
+                           obs.density[:, k], obs.noise, tm, hm)
 
 
 def _state(t: float, x: np.ndarray, z: np.ndarray, m: PeriodMeasurement) -> MacroState:
@@ -203,6 +204,10 @@ def estimation_stage(settings: EstimationSettings, layout: SensorLayout, control
     else:
         inner = FundamentalDiagramFill(eq.params)
     sensors = ("loops (boundaries)",) if boundary else layout.kinds
+    if layout.loop_speed == "harmonic":
+        named = {"loops": "loops (harmonic speed)",
+                 "loops (boundaries)": "loops (boundaries, harmonic speed)"}
+        sensors = tuple(named.get(k, k) for k in sensors)
     return (RecordedEstimator(inner, settings.method, sensors, eq,
                               measurements=[] if keep else None),
             acting_controller(settings.method, controller))

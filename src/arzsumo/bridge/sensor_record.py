@@ -12,6 +12,9 @@ control at t = 0, then one per period), and :func:`estimation_scores` scores wha
 against the full probe's cells as ``summary.json["estimation"]`` does. The numbers equal
 those of the same estimator inside a run (``tests/bridge/test_sensor_record.py``: 1e-9),
 because the stations read each vehicle independently and loading them moves no vehicle.
+The record holds both loop speeds, the time-mean (``speed``) and the harmonic
+(``speed_harmonic``), whatever the recorded scenario's ``[sensing] loop_speed``: the
+layout replayed chooses (:meth:`SensorRecord.measurements`).
 """
 
 from __future__ import annotations
@@ -52,9 +55,10 @@ class SensorRecord:
     ``start`` is the index of the start of control (t = 0; the periods before it are the
     warm-up's). Cells: ``t``, ``window`` (P,), ``x`` (n,), ``rho_h`` ... ``samples_a``
     (P, n), ``flows`` (P, 4) inflow h, a and outflow h, a (veh/s), ``occupancy`` and
-    ``queue`` (P,). Loops: ``loop_x`` (J,), ``loop_period`` (P,), ``flow``, ``speed``,
-    ``density`` (P, 2, J). Probes (every AV): ``probe_n`` (P,) per period, ``probe_x``,
-    ``probe_v`` (sum of probe_n,).
+    ``queue`` (P,). Loops: ``loop_x`` (J,), ``loop_period`` (P,), ``flow``, ``speed``
+    (time-mean), ``density``, ``speed_harmonic`` (P, 2, J; None in records saved before
+    it existed). Probes (every AV): ``probe_n`` (P,) per period, ``probe_x``, ``probe_v``
+    (sum of probe_n,).
     """
 
     start: int
@@ -78,12 +82,15 @@ class SensorRecord:
     probe_n: np.ndarray
     probe_x: np.ndarray
     probe_v: np.ndarray
+    speed_harmonic: np.ndarray | None = None
 
     @classmethod
     def from_measurements(cls, ms: list[PeriodMeasurement], start: int) -> SensorRecord:
         """From a run's measurements (each with loops and probes) and the start index."""
-        if any(m.loops is None or m.probes is None for m in ms):
-            raise ValueError("a sensor record needs loops and AV probes in every period")
+        if any(m.loops is None or m.probes is None or m.loops.time_mean is None
+               or m.loops.harmonic is None for m in ms):
+            raise ValueError("a sensor record needs SUMO's loops (both speeds) and AV "
+                             "probes in every period")
         cells = {k: np.array([getattr(m.cells, k) for m in ms], float) for k in _CELLS}
         loops = [m.loops for m in ms if m.loops is not None]
         probes = [m.probes for m in ms if m.probes is not None]
@@ -95,7 +102,8 @@ class SensorRecord:
                    loop_x=np.asarray(loops[0].x, float),
                    loop_period=np.array([o.period for o in loops]),
                    flow=np.array([o.flow for o in loops]),
-                   speed=np.array([o.speed for o in loops]),
+                   speed=np.array([o.time_mean for o in loops]),
+                   speed_harmonic=np.array([o.harmonic for o in loops]),
                    density=np.array([o.density for o in loops]),
                    probe_n=np.array([p.x.size for p in probes], int),
                    probe_x=np.concatenate([p.x for p in probes]),
@@ -125,9 +133,16 @@ class SensorRecord:
     def measurements(self, layout: SensorLayout, est: EstimationSettings,
                      length: float) -> list[PeriodMeasurement]:
         """The measurements a run with ``layout`` would have had, with the noise models
-        of ``est`` attached (AV probes only with ``av_probe_share = 1``, as recorded)."""
+        of ``est`` attached (AV probes only with ``av_probe_share = 1``, as recorded); the
+        loops' ``speed`` is the layout's ``loop_speed``."""
         if layout.av_probes and layout.av_probe_share != 1.0:
             raise ValueError("the record holds every AV: av_probe_share must be 1")
+        harmonic = self.speed_harmonic
+        if harmonic is None and layout.loops and layout.loop_speed == "harmonic":
+            raise ValueError("the record has no harmonic loop speeds (saved before they "
+                             "were recorded): record the run again")
+        speed = harmonic if layout.loop_speed == "harmonic" and harmonic is not None \
+            else self.speed
         idx = self.stations(layout, length)
         ends = np.cumsum(self.probe_n)
         out = []
@@ -136,8 +151,10 @@ class SensorRecord:
                              *(getattr(self, c)[k] for c in _CELLS),
                              *(float(f) for f in self.flows[k]))
             loops = LoopObservation(float(t), float(self.loop_period[k]), self.loop_x[idx],
-                                    self.flow[k][:, idx], self.speed[k][:, idx],
-                                    self.density[k][:, idx], est.loop_noise) \
+                                    self.flow[k][:, idx], speed[k][:, idx],
+                                    self.density[k][:, idx], est.loop_noise,
+                                    self.speed[k][:, idx],
+                                    None if harmonic is None else harmonic[k][:, idx]) \
                 if layout.loops else None
             p = slice(ends[k] - self.probe_n[k], ends[k])
             probes = ProbeObservation(float(t), "a", self.probe_x[p], self.probe_v[p], 1.0,
@@ -149,7 +166,8 @@ class SensorRecord:
     def save(self, path: Path, info: dict[str, Any] | None = None) -> None:
         """Write the arrays (and ``info``, JSON) to ``path`` (.npz, atomically)."""
         path.parent.mkdir(parents=True, exist_ok=True)
-        arrays = {f.name: getattr(self, f.name) for f in fields(self)}
+        arrays = {f.name: getattr(self, f.name) for f in fields(self)
+                  if getattr(self, f.name) is not None}
         with atomic_file(path) as tmp, open(tmp, "wb") as fh:
             np.savez(fh, **arrays, info=json.dumps(info or {}))
 
@@ -157,7 +175,7 @@ class SensorRecord:
     def load(cls, path: Path) -> tuple[SensorRecord, dict[str, Any]]:
         """The record and info of :meth:`save`."""
         with np.load(path) as z:
-            arrays = {f.name: z[f.name] for f in fields(cls)}
+            arrays = {f.name: z[f.name] for f in fields(cls) if f.name in z.files}
             info = json.loads(str(z["info"]))
         arrays["start"] = int(arrays["start"])
         return cls(**arrays), info

@@ -5,9 +5,10 @@ Two kinds of record, each frozen, validated on construction, with its own noise 
 independent between quantities, stations, vehicles and periods):
 
 * :class:`LoopObservation`: induction-loop stations at fixed positions x_j reporting, once
-  per period and per class i in (h, a), the count-based flow q_i (veh/s), the time-mean
-  speed v_i (m/s; NaN where no vehicle of the class passed) and the density rho_i (veh/m,
-  from the occupancy: :func:`density_from_occupancy`).
+  per period and per class i in (h, a), the count-based flow q_i (veh/s), a speed v_i
+  (m/s; NaN where no vehicle of the class passed: the time-mean or the harmonic mean of
+  the spot speeds, per ``[sensing] loop_speed``) and the density rho_i (veh/m, from the
+  occupancy: :func:`density_from_occupancy`).
 * :class:`ProbeObservation`: positions (m) and speeds (m/s) of individual vehicles of one
   class at one instant (e.g. the AVs as mobile sensors), with the share of that class's
   vehicles that report.
@@ -51,7 +52,7 @@ class LoopNoise:
     flow : float
         Count-based flow, veh/s.
     speed : float
-        Time-mean speed, m/s.
+        Loop speed (time-mean or harmonic), m/s.
     density : float
         Density (from occupancy), veh/m.
     """
@@ -88,9 +89,13 @@ class LoopObservation:
     x : array (n_j,)
         Station positions, m, increasing.
     flow, speed, density : array (2, n_j)
-        Per class (h, a): flow veh/s, time-mean speed m/s (NaN: no vehicle of the class
-        passed), density veh/m.
+        Per class (h, a): flow veh/s, speed m/s (NaN: no vehicle of the class passed),
+        density veh/m. ``speed`` is what the estimators use.
     noise : LoopNoise
+    time_mean, harmonic : array (2, n_j), optional
+        Both means of the same spot speeds, m/s, when the reader has them (SUMO's loops,
+        :mod:`arzsumo.sumo.loops`; ``speed`` is one of them): an offline pass over a
+        recorded run can use either (:mod:`arzsumo.bridge.sensor_record`).
     """
 
     t: float
@@ -100,6 +105,8 @@ class LoopObservation:
     speed: np.ndarray
     density: np.ndarray
     noise: LoopNoise = LoopNoise()
+    time_mean: np.ndarray | None = None
+    harmonic: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         require(math.isfinite(self.t), "t", self.t, "a finite time in s")
@@ -110,7 +117,9 @@ class LoopObservation:
                 and bool(np.all(np.diff(x) > 0)), "x", self.x,
                 "station positions in m, finite and increasing")
         object.__setattr__(self, "x", x)
-        for name in ("flow", "speed", "density"):
+        for name in ("flow", "speed", "density", "time_mean", "harmonic"):
+            if getattr(self, name) is None:
+                continue
             arr = _frozen(getattr(self, name))
             require(arr.shape == (2, x.size), name, arr.shape,
                     f"shape (2, {x.size}): classes (h, a) by station")

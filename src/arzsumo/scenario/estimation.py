@@ -69,7 +69,8 @@ ESTIMATION_KEYS: dict[str, Key] = {
                               doc="assumed error sd of a loop's class flow per period"),
     "loop_speed_sd_kmh": Key("loop_speed_sd", factor=KMH_PER_MS, unit="km/h",
                              allowed="a standard deviation > 0 km/h",
-                             doc="assumed error sd of a loop's time-mean speed"),
+                             doc="assumed error sd of a loop's speed (time-mean or "
+                                 "harmonic, [sensing] loop_speed)"),
     "loop_density_sd_veh_km": Key("loop_density_sd", factor=1000.0, unit="veh/km",
                                   allowed="a standard deviation > 0 veh/km",
                                   doc="assumed error sd of a loop's class density"),

@@ -5,6 +5,7 @@ Every key, its unit and the field of :class:`arzsumo.sumo.sensing.SensorLayout` 
     [sensing]
     kinds = ["loops", "av_probes"]   # any of "probe", "loops", "av_probes"
     loop_spacing_m = 250             # stations at 0, 250, ..., L (or loop_positions_m)
+    loop_speed = "harmonic"          # loops report the harmonic mean speed (default time_mean)
     av_probe_share = 0.5             # half of the AVs report
     av_probe_seed = 1                # which half
 
@@ -18,7 +19,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from arzsumo.errors import ArzsumoError, ScenarioError
-from arzsumo.sumo.sensing import KINDS, SensorLayout
+from arzsumo.sumo.sensing import KINDS, LOOP_SPEEDS, SensorLayout
 from arzsumo.tables import Key, in_user_terms, read_keys, written
 
 #: [sensing] key -> SensorLayout field (SI)
@@ -32,11 +33,15 @@ SENSING_KEYS: dict[str, Key] = {
     "loop_positions_m": Key("loop_positions", "numbers", unit="m",
                             doc="loop positions in [0, L] instead of a spacing (x = 0 is "
                                 "placed at 6 m, x = L at L - 0.1 m)"),
+    "loop_speed": Key("loop_speed", "string", choices=LOOP_SPEEDS,
+                      doc="the loops' speed per class: \"time_mean\" (arithmetic mean of "
+                          "the crossing vehicles' spot speeds) or \"harmonic\" (their "
+                          "harmonic mean: the space-mean speed of q = rho v)"),
     "av_probe_share": Key("av_probe_share", doc="share of the AVs that report, in (0, 1]"),
     "av_probe_seed": Key("av_probe_seed", "integer",
                          doc="seed of the draw of reporting AVs (>= 0)"),
 }
-_NEEDS = {"loop_spacing_m": "loops", "loop_positions_m": "loops",
+_NEEDS = {"loop_spacing_m": "loops", "loop_positions_m": "loops", "loop_speed": "loops",
           "av_probe_share": "av_probes", "av_probe_seed": "av_probes"}
 
 

@@ -1,4 +1,4 @@
-"""Induction loops (E1) on ``main``: per-class counts, time-mean speeds and occupancy.
+"""Induction loops (E1) on ``main``: per-class counts, mean spot speeds and occupancy.
 
 A loop station at x_j is one SUMO E1 detector across the whole 6.5 m lane (an E1 sees
 every vehicle whose body passes its position, whatever its sublane: measured against
@@ -18,9 +18,13 @@ returns a :class:`~arzsumo.estimate.observations.LoopObservation` per class i (h
 
 * flow q_i = N_i / T, veh/s, with N_i the vehicles whose front reached x_j in the period
   (SUMO's entry; a vehicle inserted across the loop enters at its departure);
-* time-mean speed v_i, m/s: arithmetic mean of the spot speeds of those N_i vehicles at
-  the end of the step their front reached x_j (a speed trap's reading; NaN when N_i = 0;
-  the same vehicles as the flow);
+* speed v_i, m/s, from the spot speeds v_k of those N_i vehicles at the end of the step
+  their front reached x_j (a speed trap's reading; NaN when N_i = 0; the same vehicles as
+  the flow), per ``[sensing] loop_speed``: the *time-mean* speed sum v_k / N_i (the
+  default), or the *harmonic* mean N_i / sum 1/max(v_k, :data:`V_MIN`), Wardrop's
+  estimate of the *space-mean* speed that q = rho v and the model use (in stop-and-go
+  traffic the time-mean speed exceeds it: fast vehicles cross a point more often per
+  unit time). Both are kept on every record (``time_mean``, ``harmonic``);
 * density rho_i = (1/T) sum_k tau_k / l_k, veh/m, with tau_k the time vehicle k spent on
   the loop within the period and l_k its length: occupancy over the effective length
   (:func:`~arzsumo.estimate.observations.density_from_occupancy`), summed per vehicle.
@@ -52,6 +56,17 @@ BOUNDARY_GAP = 0.1
 #: Position of the upstream boundary station, m: beyond the front of any vehicle inserted
 #: at x = 0 (vtypes.MAX_LENGTH + 0.1 m; a test checks it).
 INLET_GAP = 6.0
+#: Floor of the spot speeds in the harmonic mean, m/s. A vehicle can reach the loop and
+#: stop within the same step, so its reading (the speed at the step's end) may be 0 and
+#: 1/v infinite: one such vehicle would make the period's mean 0. 0.5 m/s (1.8 km/h) is
+#: 5x SUMO's halting threshold (0.1 m/s) and far below the class means the estimators
+#: work with (14-40 km/h on the default), so it only caps the weight of a vehicle that
+#: crawls over the loop at 1/V_MIN = 2 s/m (the time a stopped queue takes to advance
+#: one metre); the time-mean speed is not floored.
+V_MIN = 0.5
+#: what a loop reports as a class's speed: the arithmetic (time-mean) or the harmonic
+#: mean of the spot speeds of the vehicles that crossed it in the period
+LOOP_SPEEDS = ("time_mean", "harmonic")
 
 
 def loop_ids(n: int) -> list[str]:
@@ -86,6 +101,31 @@ def write_loops(path: Path, x: Sequence[float], length: float) -> Path:
     return write_additional(path, "inductionLoop", elements)
 
 
+def speed_means(entered: np.ndarray, speed_sum: np.ndarray, inverse_sum: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """Time-mean and harmonic speeds, m/s, from per-loop sums of N spot speeds.
+
+    Parameters
+    ----------
+    entered : array
+        N, vehicles counted.
+    speed_sum : array
+        Sum of their spot speeds v_k, m/s.
+    inverse_sum : array
+        Sum of 1 / max(v_k, :data:`V_MIN`), s/m.
+
+    Returns
+    -------
+    time_mean, harmonic : array
+        sum v_k / N and N / sum 1/max(v_k, V_MIN), m/s; NaN where N = 0. By the AM-HM
+        inequality harmonic <= time-mean wherever no v_k < V_MIN (equal for N = 1).
+    """
+    with np.errstate(invalid="ignore", divide="ignore"):
+        time_mean = np.where(entered > 0, speed_sum / entered, np.nan)
+        harmonic = np.where(entered > 0, entered / inverse_sum, np.nan)
+    return time_mean, harmonic
+
+
 class LoopSensor:
     """Reads the stations of :func:`write_loops` every step; one record per period.
 
@@ -103,12 +143,17 @@ class LoopSensor:
         Steps per counting period (the control period).
     noise : LoopNoise
         Noise model attached to the records (for the estimators).
+    speed : {"time_mean", "harmonic"}
+        Which mean of the spot speeds the records' ``speed`` is (both are kept on them).
     """
 
     def __init__(self, lib: ModuleType, x: Sequence[float], length: float, dt: float,
-                 steps_per_period: int, noise: LoopNoise | None = None) -> None:
+                 steps_per_period: int, noise: LoopNoise | None = None,
+                 speed: str = "time_mean") -> None:
         require(steps_per_period >= 1, "steps_per_period", steps_per_period, "at least 1")
+        require(speed in LOOP_SPEEDS, "loop_speed", speed, f"one of {', '.join(LOOP_SPEEDS)}")
         self.lib, self.dt, self.steps_per_period = lib, dt, steps_per_period
+        self.speed = speed
         self.x = placed_positions(x, length)
         self.ids = loop_ids(self.x.size)
         self.noise = noise or LoopNoise()
@@ -120,6 +165,7 @@ class LoopSensor:
         n = self.x.size
         self.entered = np.zeros((2, n))      # vehicles whose front reached the loop
         self.speed_sum = np.zeros((2, n))    # their speeds then, m/s
+        self.inverse_sum = np.zeros((2, n))  # 1 / max(speed, V_MIN), s/m
         self.dwell = np.zeros((2, n))        # sum of time on loop / length, s/m
         self.steps = 0
 
@@ -132,8 +178,10 @@ class LoopSensor:
             c = 1 if vtype == AV_TYPE else 0
             on.add(vid)
             if vid not in self._on[j]:
+                v = self.lib.vehicle.getSpeed(vid)
                 self.entered[c, j] += 1
-                self.speed_sum[c, j] += self.lib.vehicle.getSpeed(vid)
+                self.speed_sum[c, j] += v
+                self.inverse_sum[c, j] += 1.0 / max(v, V_MIN)
             end = t if t_out < 0 else min(t_out, t)
             self.dwell[c, j] += max(end - max(t_in, t0), 0.0) / length
         self._on[j] = on
@@ -146,10 +194,10 @@ class LoopSensor:
         if self.steps < self.steps_per_period:
             return None
         span = self.steps * self.dt
-        with np.errstate(invalid="ignore", divide="ignore"):
-            speed = np.where(self.entered > 0, self.speed_sum / self.entered, np.nan)
+        time_mean, harmonic = speed_means(self.entered, self.speed_sum, self.inverse_sum)
+        speed = harmonic if self.speed == "harmonic" else time_mean
         obs = LoopObservation(float(t), span, self.x, self.entered / span, speed,
-                              self.dwell / span, self.noise)
+                              self.dwell / span, self.noise, time_mean, harmonic)
         self.records.append(obs)
         self._reset()
         return obs

@@ -6,7 +6,8 @@ Kinds, combinable:
   (:class:`~arzsumo.sumo.measure.MainlineSensor`; the closed loop's sensor until issue 16);
 * ``"loops"``: E1 loop stations at given positions, or every ``loop_spacing`` m from
   x = 0, always with both boundaries (:mod:`arzsumo.sumo.loops`); with neither given,
-  the two boundary stations only;
+  the two boundary stations only; their speed is the time-mean or the harmonic mean of
+  the crossing vehicles' spot speeds (``loop_speed``, :data:`~arzsumo.sumo.loops.LOOP_SPEEDS`);
 * ``"av_probes"``: the positions and speeds of a share of the AVs on ``main``
   (:mod:`arzsumo.sumo.probes`).
 
@@ -21,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from arzsumo.errors import ScenarioError, require
-from arzsumo.sumo.loops import placed_positions
+from arzsumo.sumo.loops import LOOP_SPEEDS, placed_positions
 
 KINDS = ("probe", "loops", "av_probes")
 
@@ -46,6 +47,10 @@ class SensorLayout:
         Share of the AVs that report, in (0, 1].
     av_probe_seed : int
         Seed of the draw of reporting AVs (>= 0).
+    loop_speed : {"time_mean", "harmonic"}
+        The loops' speed: the arithmetic mean of the crossing vehicles' spot speeds
+        (time-mean speed) or their harmonic mean (Wardrop's estimate of the space-mean
+        speed, the model's v in q = rho v; :mod:`arzsumo.sumo.loops`).
     """
 
     kinds: tuple[str, ...] = ("probe",)
@@ -53,6 +58,7 @@ class SensorLayout:
     loop_positions: tuple[float, ...] = ()
     av_probe_share: float = 1.0
     av_probe_seed: int = 1
+    loop_speed: str = "time_mean"
 
     def __post_init__(self) -> None:
         kinds = self.kinds
@@ -79,6 +85,8 @@ class SensorLayout:
         _check(isinstance(self.av_probe_seed, int) and not isinstance(self.av_probe_seed, bool)
                and self.av_probe_seed >= 0, "av_probe_seed", self.av_probe_seed,
                "an integer >= 0")
+        _check(self.loop_speed in LOOP_SPEEDS, "loop_speed", self.loop_speed,
+               f"one of {', '.join(LOOP_SPEEDS)}")
 
     @property
     def probe(self) -> bool:

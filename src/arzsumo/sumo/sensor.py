@@ -136,7 +136,8 @@ class SumoSensor:
                                        cfg.steps_per_period)
         layout = layout or SensorLayout()
         self.loops = LoopSensor(lib, layout.loop_x(length), length, cfg.step_length,
-                                cfg.steps_per_period, loop_noise) if layout.loops else None
+                                cfg.steps_per_period, loop_noise, layout.loop_speed) \
+            if layout.loops else None
         self.probes = AvProbes(layout.av_probe_share, layout.av_probe_seed, probe_noise) \
             if layout.av_probes else None
         self.queue = 0
