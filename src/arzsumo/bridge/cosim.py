@@ -46,7 +46,7 @@ import math
 import shutil
 import tempfile
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -58,8 +58,9 @@ from arzsumo.bridge.estimator import Estimator
 from arzsumo.bridge.estimators import RecordedEstimator, estimation_stage
 from arzsumo.bridge.records import Decision, PeriodRecord, Trace, columns, micro_fields
 from arzsumo.bridge.reference import ReferenceShift, reference_shift
+from arzsumo.bridge.result import CoSimResult
 from arzsumo.bridge.twins import TwinPair
-from arzsumo.control.base import Controller, ControlLog, MacroState
+from arzsumo.control.base import Controller, MacroState
 from arzsumo.control.etc import EtcDesign
 from arzsumo.control.registry import ControllerInputs, controller_spec, is_pde
 from arzsumo.errors import ArzsumoError, ScenarioError
@@ -75,8 +76,8 @@ from arzsumo.sumo.meter_release import make_meter
 from arzsumo.sumo.network_measures import network_options
 from arzsumo.sumo.paths import scratch_dir
 from arzsumo.sumo.sensor import PeriodMeasurement, SumoSensor
-from arzsumo.sumo.simulation import RunReport, SumoSimulation, open_simulation
-from arzsumo.sumo.window import NetworkMeasures, WindowStart, measure_network
+from arzsumo.sumo.simulation import SumoSimulation, open_simulation
+from arzsumo.sumo.window import WindowStart, measure_network
 from arzsumo.twin.solver import SolverOptions
 
 log = logging.getLogger(__name__)
@@ -96,54 +97,6 @@ def check_before_start(settings: RunSettings, eq: Equilibrium) -> Linearization:
             f"lambda_4 = {lin.eigenvalues[3] * 3.6:.2f} km/h >= 0 (free flow); PDE "
             "boundary control needs congestion (lambda_4 < 0); use 'open' or 'alinea'")
     return lin
-
-
-@dataclass
-class CoSimResult:
-    """Everything a run produced; arrays are per control period (SI, times from control start).
-
-    ``t[k]`` is the end of period k and ``micro``/``replay``/``reference`` (periods, 4,
-    cells) the fields then; ``periods`` holds the :class:`PeriodRecord` columns, whose
-    ``t`` is the check that started period k. ``start`` (4, cells) is the micro state at
-    t = 0 (the last warm-up period, from which the twins start), as ``micro``:
-    (rho_h, v_h, rho_a, v_a), NaN speeds in empty cells.
-    """
-
-    scenario: Scenario
-    settings: RunSettings
-    sumo: SumoConfig
-    equilibrium: Equilibrium
-    q_nominal: float
-    t: np.ndarray
-    x: np.ndarray
-    micro: np.ndarray
-    replay: np.ndarray
-    reference: np.ndarray
-    periods: dict[str, np.ndarray]
-    controller_log: ControlLog
-    reference_log: ControlLog
-    meter: dict[str, Any]
-    report: RunReport | None
-    twin_status: dict[str, Any]
-    placement: str
-    wall_time: float
-    timings: dict[str, float]
-    #: meter counts from t = 0 to the start of control, and that time (``duration_s``, s)
-    warmup_meter: dict[str, float] = field(default_factory=dict)
-    #: SUMO's network measures (control window, whole run) and its tripinfo file
-    network: NetworkMeasures | None = None
-    #: per-vehicle speed moments on the section over the control window, per class
-    #: (``speed_mean_kmh``, ``speed_sd_kmh``, ``speed_samples``)
-    section_speed: dict[str, dict[str, float]] = field(default_factory=dict)
-    #: micro state at the start of control (4, cells), as ``micro``
-    start: np.ndarray | None = None
-    #: what the controller acted on, aligned with ``micro`` (periods, 4, cells), and the
-    #: estimator's record (:class:`~arzsumo.bridge.estimators.RecordedEstimator`)
-    estimate: np.ndarray | None = None
-    estimator: RecordedEstimator | None = None
-    #: the offset subtracted from the controller's input (:mod:`~arzsumo.bridge.reference`),
-    #: None when its deviations are measured from the equilibrium
-    shift: ReferenceShift | None = None
 
 
 class SumoPlant:

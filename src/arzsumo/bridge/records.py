@@ -2,7 +2,7 @@
 
 Record k pairs the check at ``t`` (s from the start of control) with the SUMO period that
 followed it under that check's command, ending at ``t + control_period``; the fields of
-that period's end are stored beside (see :class:`~arzsumo.bridge.cosim.CoSimResult`).
+that period's end are stored beside (see :class:`~arzsumo.bridge.result.CoSimResult`).
 """
 
 from __future__ import annotations

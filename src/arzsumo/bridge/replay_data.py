@@ -1,6 +1,6 @@
 """One SUMO run as identification data: :func:`replay_data_of` (issue 15, point 2).
 
-A :class:`~arzsumo.bridge.cosim.CoSimResult` becomes an
+A :class:`~arzsumo.bridge.result.CoSimResult` becomes an
 :class:`arzsumo.identify.ReplayData` holding what the bridge's *replay* twin was given and
 what it was compared with:
 
@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from arzsumo.bridge.boundary_data import inlet_series, measured_state, outflow_series
-from arzsumo.bridge.cosim import CoSimResult
+from arzsumo.bridge.result import CoSimResult
 from arzsumo.bridge.twins import TWIN_AO_LIMIT
 from arzsumo.errors import ArzsumoError
 from arzsumo.identify import ReplayData, ReplayOptions

@@ -13,9 +13,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from arzsumo.bridge.cosim import CoSimResult, check_before_start, run_cosimulation
+from arzsumo.bridge.cosim import check_before_start, run_cosimulation
 from arzsumo.bridge.delay import check_delay
 from arzsumo.bridge.estimators import acting_controller
+from arzsumo.bridge.result import CoSimResult
 from arzsumo.control.etc import EtcDesign
 from arzsumo.errors import ArzsumoError, ScenarioError
 from arzsumo.model import linearize

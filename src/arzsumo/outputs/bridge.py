@@ -38,9 +38,9 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from arzsumo import __version__
-from arzsumo.bridge.cosim import CoSimResult
 from arzsumo.bridge.delay import compensated_delay
 from arzsumo.bridge.estimator import fill_speeds
+from arzsumo.bridge.result import CoSimResult
 from arzsumo.bridge.sensor_record import estimation_scores
 from arzsumo.control.base import ControlLog
 from arzsumo.control.events import release_time

@@ -2,7 +2,7 @@
 control and meter signals with release instants.
 
 ``*_figure`` functions take arrays and return a Figure; :func:`write_bridge_plots` takes a
-:class:`arzsumo.bridge.cosim.CoSimResult` and saves PNGs atomically.
+:class:`arzsumo.bridge.result.CoSimResult` and saves PNGs atomically.
 """
 
 from __future__ import annotations
