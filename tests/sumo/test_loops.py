@@ -255,8 +255,11 @@ def test_inlet_station_lies_beyond_every_inserted_vehicle():
     np.testing.assert_allclose(placed_positions([0, 500, 1000], 1000.0), [6.0, 500, 999.9])
 
 
-def test_default_scenario_keeps_todays_probe_only():
-    assert SCENARIO.sensing == SensorLayout() and SCENARIO.sensing.loop_x(1000.0) == ()
+def test_default_scenario_senses_loops_every_250_m_and_av_probes():
+    # issue 17's best configuration; the built-in layout stays the probe alone
+    assert SensorLayout().kinds == ("probe",) and SensorLayout().loop_x(1000.0) == ()
+    assert SCENARIO.sensing.kinds == ("loops", "av_probes")
+    np.testing.assert_allclose(SCENARIO.sensing.loop_x(1000.0), [0, 250, 500, 750, 1000])
     assert SCENARIO.sensing.loop_speed == "time_mean"
     sc = scenario_from_dict({"sensing": {"kinds": ["loops"], "loop_speed": "harmonic"}},
                             "s.toml")

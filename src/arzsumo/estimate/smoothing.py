@@ -164,9 +164,13 @@ def _sums(pts: DataPoints, xg: np.ndarray, tg: np.ndarray, c: float,
 
 def _mixed_speed(z: np.ndarray) -> np.ndarray:
     """(q_h + q_a) / (rho_h + rho_a) of fields z (G, 4); class-speed mean where no density."""
+    speeds = z[:, [1, 3]]
+    known = np.isfinite(speeds).sum(axis=1)
+    # NaN where neither class has a speed (np.nanmean would warn on such rows)
+    class_mean = np.where(known > 0, np.nansum(speeds, axis=1) / np.maximum(known, 1), np.nan)
     with np.errstate(invalid="ignore", divide="ignore"):
         v = (z[:, 0] * z[:, 1] + z[:, 2] * z[:, 3]) / (z[:, 0] + z[:, 2])
-        return np.where(np.isfinite(v), v, np.nanmean(z[:, [1, 3]], axis=1))
+    return np.where(np.isfinite(v), v, class_mean)
 
 
 def _blend(free: np.ndarray, cong: np.ndarray, par: AsmParameters) -> np.ndarray:
