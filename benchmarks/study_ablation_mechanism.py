@@ -117,6 +117,7 @@ def equal_markdown(equal: pd.DataFrame) -> str:
 def plot_map(df: pd.DataFrame, path: Path) -> None:
     """Section outflow against mean green share, every run."""
     fig, ax = plt.subplots(figsize=(7, 4.5))
+    ax.set_prop_cycle(color=plt.cm.tab20.colors)
     for (step, ctrl), g in df.groupby(["step", "controller"]):
         ax.scatter(g["green_mean"], g["section_outflow_veh_h"], s=14,
                    label=f"{step} {ctrl}" if ctrl != "open" else "open loop")
@@ -135,6 +136,7 @@ def plot_shift(d: pd.DataFrame, path: Path) -> None:
     """Paired change of speed sd against change of mean speed, per class."""
     fig, axes = plt.subplots(1, 2, figsize=(10, 4.2))
     for ax, c, name in zip(axes, ("h", "a"), ("HV", "AV"), strict=True):
+        ax.set_prop_cycle(color=plt.cm.tab20.colors)
         for (step, ctrl), g in d.groupby(["step", "controller"]):
             ax.scatter(g[f"d_speed_mean_{c}_kmh"], g[f"d_speed_sd_{c}_kmh"], s=14,
                        label=f"{step} {ctrl}")
