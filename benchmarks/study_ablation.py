@@ -69,6 +69,8 @@ class Step:
     tables: dict[str, dict[str, Any]] = field(default_factory=dict)
     #: the controllers evaluated (the open loop is borrowed where the step allows it)
     controllers: str = "open,backstepping,etc"
+    #: the step it builds on when not the one listed before it (a side branch)
+    after: str | None = None
 
 
 def _legacy_model() -> dict[str, dict[str, Any]]:
@@ -95,6 +97,10 @@ STEPS = (
          {"design": dict(DESIGNED)}, controllers="open,etc"),
     Step("delay", f"laws on the state predicted {PREDICTION_S:g} s ahead (delay predictor)",
          {"actuation": {"delay_compensation_s": PREDICTION_S}}),
+    Step("meter", "one vehicle per green at a release rate, 2 s yellow (on `design`, the "
+         "default; its own open loop)",
+         {"sumo": {"meter_mode": "one_per_green", "meter_clearance_s": 2.0}},
+         after="design"),
 )
 
 
@@ -112,13 +118,15 @@ def step_scenario(name: str) -> tuple[dict[str, Any], str | None]:
         data.update(copy.deepcopy(STEPS[0].tables))
         data["name"] = "ablation-scenario"
         return data, None
+    step = STEPS[names.index(name)]
+    chain = [x for x in STEPS[names.index("identified") + 1:names.index(step.after or name) + 1]
+             if x.after is None] + ([step] if step.after else [])
     data, before = copy.deepcopy(base), "identified"
-    for s in STEPS[names.index("identified") + 1:names.index(name) + 1]:
+    for s in chain:
         for table, keys in s.tables.items():
             data.setdefault(table, {}).update(copy.deepcopy(keys))
     data["name"] = f"ablation-{name}"
-    inert = all(set(s.tables) <= INERT
-                for s in STEPS[names.index("identified") + 1:names.index(name) + 1])
+    inert = all(set(s.tables) <= INERT for s in chain)
     return data, before if inert else None
 
 

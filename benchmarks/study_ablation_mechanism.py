@@ -29,13 +29,15 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+import numpy as np
 import pandas as pd
 
 #: static outflow levels (veh/h) at held green shares on the default, seeds 1-2
 #: (docs/meter_dynamics.md)
 STATIC_LEVELS = {0.2: 4395.0, 0.5: 4268.0, 0.8: 3180.0}
 #: the ablation's steps in order (benchmarks/study_ablation.py)
-ORDER = ("scenario", "identified", "estimator", "reference", "saturation", "design", "delay")
+ORDER = ("scenario", "identified", "estimator", "reference", "saturation", "design", "delay",
+         "meter")
 
 
 def run_row(step: str, run: Path) -> dict[str, object]:
@@ -68,12 +70,16 @@ def collect(out: Path) -> pd.DataFrame:
 
 
 def paired(df: pd.DataFrame) -> pd.DataFrame:
-    """Each controller run minus the open loop of the same seed (the open loop of any step:
-    borrowed baselines are the same SUMO runs)."""
+    """Each controller run minus the open loop of the same seed: the step's own open loop
+    where it ran one (a step that changes SUMO's side), else the first step's (borrowed
+    baselines are the same SUMO runs)."""
     measures = [c for c in df.columns if c not in ("step", "controller", "seed")]
-    open_loop = df[df["controller"] == "open"].drop_duplicates("seed").set_index("seed")
+    loops = df[df["controller"] == "open"].set_index(["step", "seed"])
+    shared = loops.reset_index().drop_duplicates("seed").set_index("seed")
     ctrl = df[df["controller"] != "open"].copy()
-    base = open_loop.loc[ctrl["seed"], measures].to_numpy()
+    base = np.array([loops.loc[(st, sd), measures].to_numpy(float) if (st, sd) in loops.index
+                     else shared.loc[sd, measures].to_numpy(float)
+                     for st, sd in zip(ctrl["step"], ctrl["seed"], strict=True)])
     for i, m in enumerate(measures):
         ctrl[f"d_{m}"] = ctrl[m].to_numpy() - base[:, i]
     return ctrl
