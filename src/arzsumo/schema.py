@@ -143,6 +143,8 @@ _NETWORK = {"network*.window": TEXT, "network*.begin_s": "s", "network*.end_s": 
 #: the measured section over the control window
 _SECTION = {"section.window": TEXT, "section.speed_mean_kmh.*": "km/h",
             "section.speed_sd_kmh.*": "km/h", "section.speed_samples.*": "count",
+            "section.speed_oscillation_kmh.*": "km/h", "section.oscillation_block_m": "m",
+            "section.oscillation_block_s": "s",
             **{f"section.{k}.*": u for k, u in _RUN_INDICES.items()},
             "section.until_s": "s"}
 

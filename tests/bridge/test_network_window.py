@@ -5,6 +5,8 @@ import gzip
 import json
 from pathlib import Path
 
+import numpy as np
+import pandas as pd
 import pytest
 
 from arzsumo.cli import main
@@ -132,3 +134,26 @@ def test_section_speed_sd_and_the_kept_tripinfo(runs):
     whole = summ["network_whole_run"]
     assert len(trips) == whole["vehicles"]["loaded"]["total"]
     assert trips["time_spent_s"].sum() == pytest.approx(whole["time_spent_s"]["total"])
+
+
+def test_speed_oscillation_recomputed_from_the_written_cells(runs):
+    """The summary's oscillation equals one recomputed with pandas from cells.parquet:
+    100 m x 10 s block means of the micro speed, sd over time per block column (ddof 1),
+    RMS over columns, in km/h; it leaves out the profile, so it lies below the pooled sd."""
+    summ, _, out = runs["green"]
+    sec = summ["section"]
+    assert (sec["oscillation_block_m"], sec["oscillation_block_s"]) == (100.0, 10.0)
+    cells = pd.read_parquet(out / "cells.parquet")
+    micro = cells[cells["source"] == "micro"].copy()
+    periods, places = np.unique(micro["t_s"]), np.unique(micro["x_m"])
+    micro["bt"] = np.searchsorted(periods, micro["t_s"]) // 10      # 1 s periods
+    micro["bx"] = np.searchsorted(places, micro["x_m"]) // 2        # 50 m cells
+    # incomplete trailing blocks are left out
+    micro = micro[(micro["bt"] < periods.size // 10) & (micro["bx"] < places.size // 2)]
+    for c in ("h", "a"):
+        blocks = micro.groupby(["bt", "bx"])[f"v_{c}"].mean()
+        sd = blocks.groupby(level="bx").std(ddof=1)
+        expected = float(np.sqrt(np.mean(sd.dropna() ** 2))) * 3.6
+        assert sec["speed_oscillation_kmh"][c] == pytest.approx(expected, rel=1e-9)
+        assert 0.0 < sec["speed_oscillation_kmh"][c] < sec["speed_sd_kmh"][c]
+    assert summ["units_by_key"]["section.speed_oscillation_kmh.a"] == "km/h"

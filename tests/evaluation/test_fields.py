@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from arzsumo.evaluation.fields import block_means, field_rmse
+from arzsumo.evaluation.fields import block_means, field_rmse, oscillation
 
 
 def test_block_means_average_over_blocks_and_skip_nan():
@@ -38,3 +38,30 @@ def test_pairs_missing_in_either_field_are_left_out_of_both():
     assert n[0] == 1
     with pytest.raises(ValueError, match="expected >= 1"):
         block_means(obs, 0, 1)
+
+
+def test_oscillation_ignores_the_profile_and_measures_the_wave():
+    t = np.arange(1200.0)[:, None, None]
+    x = np.arange(20.0)[None, None, :]
+    profile = 10.0 + 2.0 * x                       # a mean profile: pooled sd about 11.5
+    steady = np.broadcast_to(profile, (1200, 1, 20))
+    assert oscillation(steady)[0] == pytest.approx(0.0, abs=1e-12)
+    assert np.nanstd(steady) > 11.0
+    wave = profile + 3.0 * np.sin(2 * np.pi * (t / 120.0 - x / 10.0))
+    assert oscillation(wave)[0] == pytest.approx(3.0 / np.sqrt(2) * np.sqrt(1200 / 1199))
+    # 10-period blocks keep a 120 s wave: the mean of 10 samples scales its amplitude by
+    # the discrete sinc sin(pi 10/120) / (10 sin(pi/120)) only
+    # (times sqrt(120 / 119): the sample sd of 120 blocks over exactly 10 wave periods)
+    damped = 3.0 / np.sqrt(2) * np.sin(np.pi * 10 / 120) / (10 * np.sin(np.pi / 120))
+    damped *= np.sqrt(120 / 119)
+    assert oscillation(wave, periods=10)[0] == pytest.approx(damped, rel=1e-3)
+
+
+def test_oscillation_skips_empty_places_and_needs_two_blocks():
+    rng = np.random.default_rng(5)
+    f = rng.normal(0.0, 2.0, (4000, 2, 3))
+    f[:, 0, 0] = np.nan                            # a place never observed
+    f[1:, 1, :] = np.nan                           # one period only: no sd
+    value = oscillation(f)
+    assert value[0] == pytest.approx(2.0, rel=0.03)
+    assert np.isnan(value[1])

@@ -6,6 +6,11 @@ describes means over a few hundred metres and tens of seconds (detector data for
 calibration are commonly aggregated to 30 s to 1 min). :func:`block_means` averages a
 (periods, variables, cells) field over blocks of ``periods`` x ``cells`` (NaN skipped),
 and :func:`field_rmse` compares two fields at that resolution.
+
+:func:`oscillation` measures what the paper's controllers act on, the oscillation of a
+field about its own mean at each place: a pooled sd over space and time also counts the
+mean profile along the section (slow at the merge, free upstream), which moves with the
+operating point, not with the waves.
 """
 
 from __future__ import annotations
@@ -57,3 +62,27 @@ def field_rmse(observed: np.ndarray, predicted: np.ndarray, periods: int = 1,
     n = ok.sum(axis=(0, 2))
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(n > 0, np.sqrt(sq / np.maximum(n, 1)), np.nan), n
+
+
+def oscillation(field: np.ndarray, periods: int = 1, cells: int = 1) -> np.ndarray:
+    """Root mean square over places of each place's temporal sd, per variable.
+
+    ``field`` (T, V, N) is block-averaged first (:func:`block_means`); at each block column
+    the sample sd over time (ddof 1, NaN skipped, at least two blocks) measures the
+    oscillation about that place's own mean; the columns are then pooled as an RMS. A
+    field steady in time has 0 whatever its profile; ``a(x) + A sin(wt)`` has A / sqrt(2).
+
+    Returns
+    -------
+    ndarray (V,)
+        In the field's unit; NaN for a variable with no column of two finite blocks.
+    """
+    blocks = block_means(field, periods, cells)
+    n = np.isfinite(blocks).sum(axis=0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean = np.nansum(blocks, axis=0) / n
+        var = np.nansum((blocks - mean) ** 2, axis=0) / (n - 1)
+    var = np.where(n >= 2, var, np.nan)
+    used = np.isfinite(var).sum(axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(used > 0, np.sqrt(np.nansum(var, axis=1) / used), np.nan)

@@ -58,6 +58,8 @@ MEASURES: tuple[Measure, ...] = (
     Measure("network.co2_g.total", "network CO2", "kg", 1e-3),
     Measure("section.speed_sd_kmh.h", "section speed sd, HV", "km/h"),
     Measure("section.speed_sd_kmh.a", "section speed sd, AV", "km/h"),
+    Measure("section.speed_oscillation_kmh.h", "section speed oscillation, HV", "km/h"),
+    Measure("section.speed_oscillation_kmh.a", "section speed oscillation, AV", "km/h"),
     Measure("section.TTT.total", "section TTT", "veh h", 1 / S_PER_H),
     Measure("section.total_delay.total", "section delay", "veh h", 1 / S_PER_H),
     Measure("plan_changes", "meter plan changes", "count"),

@@ -44,13 +44,14 @@ from arzsumo.bridge.result import CoSimResult
 from arzsumo.bridge.sensor_record import estimation_scores
 from arzsumo.control.base import ControlLog
 from arzsumo.control.events import release_time
-from arzsumo.evaluation.fields import field_rmse
+from arzsumo.evaluation.fields import field_rmse, oscillation
 from arzsumo.evaluation.stationarity import count_trend
 from arzsumo.io import json_safe
 from arzsumo.model.characteristic import linearize
 from arzsumo.outdir import OutputDir, atomic_dir, target_of
 from arzsumo.schema import CELLS, PERIODS, RUN_SUMMARY, key_units, with_units
 from arzsumo.twin.metrics import performance
+from arzsumo.units import ms_to_kmh
 
 VARIABLES = ("rho_h", "v_h", "rho_a", "v_a")
 #: SUMO's tripinfo output of the run (every loaded vehicle), gzip-compressed
@@ -95,8 +96,7 @@ def rmse(res: CoSimResult, twin: np.ndarray, periods: int = 1,
 
 def rmse_blocks(res: CoSimResult) -> dict[str, Any]:
     """Both twins' RMSE on RMSE_BLOCK_M x RMSE_BLOCK_S block means (``summary["rmse_blocks"]``)."""
-    cells = max(1, round(RMSE_BLOCK_M / res.sumo.cell_length))
-    periods = max(1, round(RMSE_BLOCK_S / res.sumo.control_period))
+    periods, cells = _blocks(res)
     return {"block_m": cells * res.sumo.cell_length,
             "block_s": periods * res.sumo.control_period,
             "replay": rmse(res, res.replay, periods, cells),
@@ -168,11 +168,29 @@ SECTION_WINDOW = ("measured section x in [0, L] over the control window: indices
                   "Edie cells, speed moments from every vehicle on main every step")
 
 
+def _blocks(res: CoSimResult) -> tuple[int, int]:
+    """Periods and cells of a RMSE_BLOCK_S x RMSE_BLOCK_M block."""
+    return (max(1, round(RMSE_BLOCK_S / res.sumo.control_period)),
+            max(1, round(RMSE_BLOCK_M / res.sumo.cell_length)))
+
+
+def speed_oscillation(res: CoSimResult) -> dict[str, Any]:
+    """Per class, the RMS over places of the temporal sd of the micro speed (km/h) on
+    RMSE_BLOCK_M x RMSE_BLOCK_S blocks (:func:`arzsumo.evaluation.fields.oscillation`): the
+    waves, without the mean speed profile that the pooled ``speed_sd_kmh`` also counts."""
+    periods, cells = _blocks(res)
+    sd = oscillation(res.micro[:, [1, 3]], periods, cells)
+    return {"speed_oscillation_kmh": {"h": float(ms_to_kmh(sd[0])),
+                                      "a": float(ms_to_kmh(sd[1]))},
+            "oscillation_block_m": cells * res.sumo.cell_length,
+            "oscillation_block_s": periods * res.sumo.control_period}
+
+
 def section_summary(res: CoSimResult, micro: dict[str, Any]) -> dict[str, Any]:
-    """The section's measures, labelled as such: per-vehicle speed moments per class (km/h)
-    and the micro indices ``micro`` (:func:`_indices`; also at the top level, kept for
-    compatibility)."""
-    return {"window": SECTION_WINDOW, **res.section_speed, **micro}
+    """The section's measures, labelled as such: per-vehicle speed moments per class (km/h),
+    the speed oscillation (:func:`speed_oscillation`) and the micro indices ``micro``
+    (:func:`_indices`; also at the top level, kept for compatibility)."""
+    return {"window": SECTION_WINDOW, **res.section_speed, **speed_oscillation(res), **micro}
 
 
 #: ``summary.json["meter"]``: keys of the meter's own summary kept there (control window)
