@@ -40,6 +40,8 @@ ARZSUMO = Path(sys.executable).with_name("arzsumo")
 #: the measures of the ablation table: summary key -> short label
 MEASURES = {"section.speed_sd_kmh.h": "HV speed sd (km/h)",
             "section.speed_sd_kmh.a": "AV speed sd (km/h)",
+            "section.speed_oscillation_kmh.h": "HV speed oscillation (km/h)",
+            "section.speed_oscillation_kmh.a": "AV speed oscillation (km/h)",
             "network.time_loss_s.total": "network time loss (veh h)",
             "plan_changes": "plan changes"}
 #: the evaluation of the configuration before issue 15 (scenarios/legacy_default.toml,
