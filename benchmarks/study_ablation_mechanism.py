@@ -38,6 +38,8 @@ STATIC_LEVELS = {0.2: 4395.0, 0.5: 4268.0, 0.8: 3180.0}
 #: the ablation's steps in order (benchmarks/study_ablation.py)
 ORDER = ("scenario", "identified", "estimator", "reference", "saturation", "design", "delay",
          "meter")
+#: the step whose open loop the controller-side steps borrow (evaluate --baseline-from)
+SHARED_OPEN_LOOP = "identified"
 
 
 def run_row(step: str, run: Path) -> dict[str, object]:
@@ -53,6 +55,9 @@ def run_row(step: str, run: Path) -> dict[str, object]:
             "speed_mean_a_kmh": sec["speed_mean_kmh"]["a"],
             "speed_sd_h_kmh": sec["speed_sd_kmh"]["h"],
             "speed_sd_a_kmh": sec["speed_sd_kmh"]["a"],
+            # the waves without the mean profile (runs made before it: NaN)
+            "speed_osc_h_kmh": sec.get("speed_oscillation_kmh", {}).get("h", np.nan),
+            "speed_osc_a_kmh": sec.get("speed_oscillation_kmh", {}).get("a", np.nan),
             "time_loss_veh_h": net["time_loss_s"]["total"] / 3600.0,
             "ramp_depart_delay_veh_h": net["depart_delay_s"]["ramp"] / 3600.0,
             "plan_changes": s["plan_changes"]}
@@ -71,11 +76,11 @@ def collect(out: Path) -> pd.DataFrame:
 
 def paired(df: pd.DataFrame) -> pd.DataFrame:
     """Each controller run minus the open loop of the same seed: the step's own open loop
-    where it ran one (a step that changes SUMO's side), else the first step's (borrowed
-    baselines are the same SUMO runs)."""
+    where it ran one (a step that changes SUMO's side), else that of SHARED_OPEN_LOOP (the
+    baseline the controller-side steps borrow: the same SUMO runs)."""
     measures = [c for c in df.columns if c not in ("step", "controller", "seed")]
     loops = df[df["controller"] == "open"].set_index(["step", "seed"])
-    shared = loops.reset_index().drop_duplicates("seed").set_index("seed")
+    shared = loops.loc[SHARED_OPEN_LOOP]
     ctrl = df[df["controller"] != "open"].copy()
     base = np.array([loops.loc[(st, sd), measures].to_numpy(float) if (st, sd) in loops.index
                      else shared.loc[sd, measures].to_numpy(float)
@@ -126,7 +131,7 @@ def plot_map(df: pd.DataFrame, path: Path) -> None:
     ax.set_prop_cycle(color=plt.cm.tab20.colors)
     for (step, ctrl), g in df.groupby(["step", "controller"]):
         ax.scatter(g["green_mean"], g["section_outflow_veh_h"], s=14,
-                   label=f"{step} {ctrl}" if ctrl != "open" else "open loop")
+                   label=f"{step} " + ("open loop" if ctrl == "open" else ctrl))
     ax.plot(list(STATIC_LEVELS), list(STATIC_LEVELS.values()), "k--", marker="s",
             label="static levels, held plans (docs/meter_dynamics.md)")
     ax.set(xlabel="mean green share over the control window", xlim=(-0.02, 1.02),
@@ -167,12 +172,11 @@ def main() -> int:
     d = paired(df)
     if args.csv:
         args.csv.parent.mkdir(parents=True, exist_ok=True)
-        d_all = pd.concat([df[df["controller"] == "open"].drop_duplicates("seed"), d])
+        d_all = pd.concat([df[df["controller"] == "open"], d])
         d_all.to_csv(args.csv, index=False, float_format="%.6g")
     if args.png:
         args.png.parent.mkdir(parents=True, exist_ok=True)
-        plot_map(pd.concat([df[df["controller"] == "open"].drop_duplicates("seed"),
-                            df[df["controller"] != "open"]]), Path(f"{args.png}_map.png"))
+        plot_map(df, Path(f"{args.png}_map.png"))
         plot_shift(d, Path(f"{args.png}_shift.png"))
     cols = ["green_mean", "section_outflow_veh_h", "d_section_outflow_veh_h",
             "d_speed_mean_h_kmh", "d_speed_sd_h_kmh", "d_speed_mean_a_kmh",
