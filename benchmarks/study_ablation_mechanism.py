@@ -58,6 +58,8 @@ def run_row(step: str, run: Path) -> dict[str, object]:
             # the waves without the mean profile (runs made before it: NaN)
             "speed_osc_h_kmh": sec.get("speed_oscillation_kmh", {}).get("h", np.nan),
             "speed_osc_a_kmh": sec.get("speed_oscillation_kmh", {}).get("a", np.nan),
+            "wave_speed_h_kmh": sec.get("speed_wave", {}).get("h", {}).get("speed_kmh", np.nan),
+            "wave_speed_a_kmh": sec.get("speed_wave", {}).get("a", {}).get("speed_kmh", np.nan),
             "time_loss_veh_h": net["time_loss_s"]["total"] / 3600.0,
             "ramp_depart_delay_veh_h": net["depart_delay_s"]["ramp"] / 3600.0,
             "plan_changes": s["plan_changes"]}

@@ -145,6 +145,9 @@ _SECTION = {"section.window": TEXT, "section.speed_mean_kmh.*": "km/h",
             "section.speed_sd_kmh.*": "km/h", "section.speed_samples.*": "count",
             "section.speed_oscillation_kmh.*": "km/h", "section.oscillation_block_m": "m",
             "section.oscillation_block_s": "s",
+            "section.speed_wave.gap_m": "m", "section.speed_wave.max_lag_s": "s",
+            "section.speed_wave.*.speed_kmh": "km/h", "section.speed_wave.*.lag_s": "s",
+            "section.speed_wave.*.peak_corr": "1", "section.speed_wave.*.pairs": "count",
             **{f"section.{k}.*": u for k, u in _RUN_INDICES.items()},
             "section.until_s": "s"}
 

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from arzsumo.evaluation.fields import block_means, field_rmse, oscillation
+from arzsumo.evaluation.fields import block_means, field_rmse, oscillation, wave_travel
 
 
 def test_block_means_average_over_blocks_and_skip_nan():
@@ -65,3 +65,27 @@ def test_oscillation_skips_empty_places_and_needs_two_blocks():
     value = oscillation(f)
     assert value[0] == pytest.approx(2.0, rel=0.03)
     assert np.isnan(value[1])
+
+
+@pytest.mark.parametrize("c", [20.8, -13.9])           # 75 km/h downstream, 50 upstream
+def test_wave_travel_recovers_the_speed_of_a_travelling_field(c):
+    rng = np.random.default_rng(7)
+    t = np.arange(600.0)[:, None]
+    x = 25.0 + 50.0 * np.arange(20)[None, :]
+    # a random profile carried at speed c, plus a place-dependent mean and some noise
+    base = np.cumsum(rng.normal(0.0, 1.0, 4000))
+    phase = (t - (x / c) + 2000.0).astype(float)
+    f = np.interp(phase, np.arange(4000.0), base) + 0.01 * x
+    f += rng.normal(0.0, 0.05, f.shape)
+    f[100:110, 3] = np.nan                               # an empty cell for a while
+    out = wave_travel(f, dt=1.0, dx=50.0, gap=5, max_lag_s=60.0)
+    assert out["lag_s"] == pytest.approx(250.0 / c, abs=0.5)
+    assert np.sign(out["speed"]) == np.sign(c)
+    assert abs(out["speed"] - c) / abs(c) < 0.05
+    assert out["peak_corr"] > 0.95 and out["pairs"] == 15
+
+
+def test_wave_travel_of_unrelated_noise_is_weakly_correlated():
+    rng = np.random.default_rng(8)
+    out = wave_travel(rng.normal(size=(600, 20)), dt=1.0, dx=50.0, gap=5, max_lag_s=60.0)
+    assert out["peak_corr"] < 0.25

@@ -86,3 +86,52 @@ def oscillation(field: np.ndarray, periods: int = 1, cells: int = 1) -> np.ndarr
     used = np.isfinite(var).sum(axis=1)
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(used > 0, np.sqrt(np.nansum(var, axis=1) / used), np.nan)
+
+
+def _fill_in_time(field: np.ndarray) -> np.ndarray:
+    """(T, N) with each column's NaN filled linearly in time (ends held); all-NaN stays."""
+    out = np.array(field, float)
+    t = np.arange(out.shape[0])
+    for j in range(out.shape[1]):
+        ok = np.isfinite(out[:, j])
+        if ok.any():
+            out[:, j] = np.interp(t, t[ok], out[ok, j])
+    return out
+
+
+def _peak_lag(up: np.ndarray, down: np.ndarray, max_lag: int) -> tuple[int, float]:
+    """Lag k in [-max_lag, max_lag] (samples) maximising corr(up(t), down(t + k)), and it."""
+    n = up.size
+    best = (0, -np.inf)
+    for k in range(-max_lag, max_lag + 1):
+        a, b = (up[:n - k], down[k:]) if k >= 0 else (up[-k:], down[:n + k])
+        if a.size > 2 and a.std() > 0 and b.std() > 0:
+            c = float(np.corrcoef(a, b)[0, 1])
+            if c > best[1]:
+                best = (k, c)
+    return best
+
+
+def wave_travel(field: np.ndarray, dt: float, dx: float, gap: int,
+                max_lag_s: float) -> dict[str, float]:
+    """Which way, and how fast, the fluctuations of a (T, N) field travel.
+
+    For every pair of places ``gap`` cells apart the fluctuations (each place's series
+    minus its mean, NaN filled in time) are cross-correlated; the lag of the peak (> 0:
+    the downstream place follows) gives a travel time. Returned: the median lag (s), the
+    speed ``gap dx`` / median lag (m/s; > 0 downstream, NaN at lag 0), the median peak
+    correlation and the pairs used. A field f(x - c t) gives c to the grid's resolution.
+    """
+    f = _fill_in_time(field)
+    seen = np.isfinite(f).all(axis=0)
+    f[:, seen] -= f[:, seen].mean(axis=0)
+    # at least half of the series overlaps at every lag
+    max_lag = min(max(1, round(max_lag_s / dt)), f.shape[0] // 2)
+    peaks = [_peak_lag(f[:, j], f[:, j + gap], max_lag) for j in range(f.shape[1] - gap)
+             if seen[j] and seen[j + gap]]
+    peaks = [p for p in peaks if np.isfinite(p[1])]
+    if not peaks:
+        return {"lag_s": np.nan, "speed": np.nan, "peak_corr": np.nan, "pairs": 0}
+    lag = float(np.median([k for k, _ in peaks])) * dt
+    return {"lag_s": lag, "speed": gap * dx / lag if lag else np.nan,
+            "peak_corr": float(np.median([c for _, c in peaks])), "pairs": len(peaks)}

@@ -44,7 +44,7 @@ from arzsumo.bridge.result import CoSimResult
 from arzsumo.bridge.sensor_record import estimation_scores
 from arzsumo.control.base import ControlLog
 from arzsumo.control.events import release_time
-from arzsumo.evaluation.fields import field_rmse, oscillation
+from arzsumo.evaluation.fields import field_rmse, oscillation, wave_travel
 from arzsumo.evaluation.stationarity import count_trend
 from arzsumo.io import json_safe
 from arzsumo.model.characteristic import linearize
@@ -186,11 +186,32 @@ def speed_oscillation(res: CoSimResult) -> dict[str, Any]:
             "oscillation_block_s": periods * res.sumo.control_period}
 
 
+#: the cross-correlation of ``speed_wave``: places this far apart (m), lags up to (s)
+WAVE_GAP_M, WAVE_MAX_LAG_S = 250.0, 60.0
+
+
+def speed_wave(res: CoSimResult) -> dict[str, Any]:
+    """Per class, which way the micro speed fluctuations travel
+    (:func:`arzsumo.evaluation.fields.wave_travel` over places WAVE_GAP_M apart): median
+    lag (s), speed (km/h; > 0 downstream, the way the meter cannot reach), median peak
+    correlation, pairs. The paper's actuator acts through what travels upstream."""
+    dx = float(res.x[1] - res.x[0]) if res.x.size > 1 else float(res.sumo.cell_length)
+    gap = max(1, round(WAVE_GAP_M / dx))
+    out: dict[str, Any] = {"gap_m": gap * dx, "max_lag_s": WAVE_MAX_LAG_S}
+    for c, k in (("h", 1), ("a", 3)):
+        w = wave_travel(res.micro[:, k], res.sumo.control_period, dx, gap, WAVE_MAX_LAG_S)
+        out[c] = {"speed_kmh": float(ms_to_kmh(w["speed"])), "lag_s": w["lag_s"],
+                  "peak_corr": w["peak_corr"], "pairs": w["pairs"]}
+    return out
+
+
 def section_summary(res: CoSimResult, micro: dict[str, Any]) -> dict[str, Any]:
     """The section's measures, labelled as such: per-vehicle speed moments per class (km/h),
-    the speed oscillation (:func:`speed_oscillation`) and the micro indices ``micro``
+    the speed oscillation (:func:`speed_oscillation`), the waves' direction
+    (:func:`speed_wave`) and the micro indices ``micro``
     (:func:`_indices`; also at the top level, kept for compatibility)."""
-    return {"window": SECTION_WINDOW, **res.section_speed, **speed_oscillation(res), **micro}
+    return {"window": SECTION_WINDOW, **res.section_speed, **speed_oscillation(res),
+            "speed_wave": speed_wave(res), **micro}
 
 
 #: ``summary.json["meter"]``: keys of the meter's own summary kept there (control window)
