@@ -17,7 +17,9 @@ so the baseline is paid once. The step scenarios are written next to the evaluat
 17), i.e. the congested SUMO scenario of issue 15 and the model identified from it;
 ``scenario`` is that SUMO scenario under the model of ``scenarios/legacy_default.toml``
 (the paper's FD calibrated on the old network), to separate the scenario from the
-identification.
+identification. It borrows the open loop of ``identified``: SUMO fills the road itself
+(``[run] start = "warmup"``), so the model drives only the twins and the laws
+(``arzsumo evaluate``'s PLACEMENT_ONLY rule, tested with SUMO).
 """
 
 from __future__ import annotations
@@ -119,7 +121,7 @@ def step_scenario(name: str) -> tuple[dict[str, Any], str | None]:
         data = copy.deepcopy(base)
         data.update(copy.deepcopy(STEPS[0].tables))
         data["name"] = "ablation-scenario"
-        return data, None
+        return data, "identified"
     step = STEPS[names.index(name)]
     chain = [x for x in STEPS[names.index("identified") + 1:names.index(step.after or name) + 1]
              if x.after is None] + ([step] if step.after else [])

@@ -152,3 +152,41 @@ def test_a_borrowed_baseline_needs_a_controller_to_run(evaluation, tmp_path, cap
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--controllers = 'open' is not allowed with" in err
     assert not (tmp_path / "o").exists()
+
+
+def test_a_baseline_under_another_model_is_borrowed_when_sumo_fills_the_road(
+        evaluation, tmp_path, capsys):
+    """With [run] start = "warmup" the model reaches SUMO's open loop nowhere (it drives
+    the twins only), so a step that changes [model] and [equilibrium] borrows the baseline;
+    the premise: a fresh open run under the other model gives the same SUMO numbers."""
+    scenario, out = evaluation
+    step = tmp_path / "model.toml"
+    text = scenario.read_text().replace("tau_h_s = 30", "tau_h_s = 20").replace(
+        "rho_a_veh_km = 41.2363", "rho_a_veh_km = 38")
+    assert "tau_h_s = 20" in text and "rho_a_veh_km = 38" in text
+    step.write_text(text)
+    assert _evaluate(step, tmp_path / "o", "--baseline-from", str(out)) == 0
+    assert "3 runs, 0 already finished, 3 executed" in capsys.readouterr().out
+    assert main(["evaluate", str(step), "--controllers", "open", "--seeds", "1",
+                 "--seed-start", str(SEEDS[0]), "--horizon", "30", "--workers", "1",
+                 "--quiet", "--no-plots", "--out", str(tmp_path / "fresh")]) == 0
+    run = f"controller=open,seed={SEEDS[0]}"
+    fresh = json.loads((tmp_path / "fresh" / "runs" / run / "summary.json").read_text())
+    old = json.loads((out / "runs" / run / "summary.json").read_text())
+    assert fresh["network"] == old["network"]
+    for key in ("speed_sd_kmh", "speed_mean_kmh", "speed_oscillation_kmh"):
+        assert fresh["section"][key] == old["section"][key]
+    assert fresh["equilibrium"] != old["equilibrium"]      # the twins did see the model
+
+
+def test_the_model_is_not_inert_when_vehicles_are_placed_from_it():
+    from arzsumo.sweep.evaluate import _first_difference, _without_inert
+
+    warm = {"run": {"start": "warmup"}, "model": {"tau_h_s": 30}, "sumo": {"seed": 1}}
+    other = {"run": {"start": "warmup"}, "model": {"tau_h_s": 20}, "sumo": {"seed": 1}}
+    assert _first_difference(_without_inert(warm), _without_inert(other)) == ""
+    placed = {**warm, "run": {"start": "placement"}}
+    placed_other = {**other, "run": {"start": "placement"}}
+    assert _first_difference(_without_inert(placed),
+                             _without_inert(placed_other)) == "model.tau_h_s"
+    assert _first_difference(_without_inert(warm), _without_inert(placed_other)) != ""

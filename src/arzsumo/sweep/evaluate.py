@@ -16,8 +16,9 @@ mistaken for it) laid out like a sweep, plus the report of
 With ``baseline_from`` (``--baseline-from DIR``) the open-loop runs are not run again but
 taken from an earlier evaluation in DIR (:func:`borrowed_baseline`), allowed only when
 their resolved scenarios differ from this evaluation's in nothing that acts on an open-loop
-SUMO run (:data:`OPEN_LOOP_INERT`): an ablation whose steps change only the controllers'
-side (estimation, sensing, actuation, design) pays for its baseline once.
+SUMO run (:data:`OPEN_LOOP_INERT`; and :data:`PLACEMENT_ONLY` when SUMO fills the road
+itself): an ablation whose steps change only the controllers' side (estimation, sensing,
+actuation, design, or the model the laws are designed on) pays for its baseline once.
 """
 
 from __future__ import annotations
@@ -66,6 +67,11 @@ class EvaluationResult:
 #: runs whose resolved scenarios differ only here are the same SUMO run
 OPEN_LOOP_INERT = ("name", "description", "estimation", "sensing", "actuation", "design",
                    "run.controller")
+#: tables that act on an open-loop SUMO run only through the vehicles placed at t = 0
+#: (``[run] start = "placement"``): the model, its equilibrium and the initial profile.
+#: With ``start = "warmup"`` (the default) SUMO fills the road itself and the model only
+#: drives the twins, which no evaluation measure reads (:data:`~arzsumo.evaluation.report.MEASURES`)
+PLACEMENT_ONLY = ("model", "equilibrium", "initial")
 
 
 def check_controllers(controllers: Sequence[str]) -> list[str]:
@@ -117,7 +123,8 @@ def check_runs(scenario: Path, controllers: Sequence[str], horizon: float | None
 
 def _without_inert(data: dict) -> dict:
     out = copy.deepcopy(data)
-    for name in OPEN_LOOP_INERT:
+    start = out.get("run", {}).get("start", "warmup")
+    for name in OPEN_LOOP_INERT + (PLACEMENT_ONLY if start == "warmup" else ()):
         table, _, key = name.partition(".")
         if key and isinstance(out.get(table), dict):
             out[table].pop(key, None)
@@ -148,7 +155,8 @@ def _their_run(source: Path, mine: RunSpec, user: str) -> RunSpec:
     if differ:
         raise SweepError(f"--baseline-from = {user} is not allowed: its run {mine.run_id} "
                          f"differs in {differ}; allowed: open-loop runs whose scenarios "
-                         f"differ only in {', '.join(OPEN_LOOP_INERT)}")
+                         f"differ only in {', '.join(OPEN_LOOP_INERT)} (and, with [run] "
+                         f"start = 'warmup', in {', '.join(PLACEMENT_ONLY)})")
     return replace(mine, scenario=theirs)
 
 
