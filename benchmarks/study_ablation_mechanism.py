@@ -58,8 +58,9 @@ def run_row(step: str, run: Path) -> dict[str, object]:
             # the waves without the mean profile (runs made before it: NaN)
             "speed_osc_h_kmh": sec.get("speed_oscillation_kmh", {}).get("h", np.nan),
             "speed_osc_a_kmh": sec.get("speed_oscillation_kmh", {}).get("a", np.nan),
-            "wave_speed_h_kmh": sec.get("speed_wave", {}).get("h", {}).get("speed_kmh", np.nan),
-            "wave_speed_a_kmh": sec.get("speed_wave", {}).get("a", {}).get("speed_kmh", np.nan),
+            # lag (s, > 0 downstream) rather than its inverse, which blows up near 0
+            "wave_lag_h_s": sec.get("speed_wave", {}).get("h", {}).get("lag_s", np.nan),
+            "wave_lag_a_s": sec.get("speed_wave", {}).get("a", {}).get("lag_s", np.nan),
             "time_loss_veh_h": net["time_loss_s"]["total"] / 3600.0,
             "ramp_depart_delay_veh_h": net["depart_delay_s"]["ramp"] / 3600.0,
             "plan_changes": s["plan_changes"]}
@@ -82,6 +83,9 @@ def paired(df: pd.DataFrame) -> pd.DataFrame:
     baseline the controller-side steps borrow: the same SUMO runs)."""
     measures = [c for c in df.columns if c not in ("step", "controller", "seed")]
     loops = df[df["controller"] == "open"].set_index(["step", "seed"])
+    if SHARED_OPEN_LOOP not in loops.index.get_level_values("step"):
+        raise SystemExit(f"no open loop of step {SHARED_OPEN_LOOP!r} under the ablation "
+                         "directory: the controller-side steps pair with it")
     shared = loops.loc[SHARED_OPEN_LOOP]
     ctrl = df[df["controller"] != "open"].copy()
     base = np.array([loops.loc[(st, sd), measures].to_numpy(float) if (st, sd) in loops.index

@@ -154,11 +154,13 @@ def test_a_borrowed_baseline_needs_a_controller_to_run(evaluation, tmp_path, cap
     assert not (tmp_path / "o").exists()
 
 
-def test_a_baseline_under_another_model_is_borrowed_when_sumo_fills_the_road(
+def test_a_baseline_under_another_model_is_borrowed_when_sumo_is_given_the_same(
         evaluation, tmp_path, capsys):
-    """With [run] start = "warmup" the model reaches SUMO's open loop nowhere (it drives
-    the twins only), so a step that changes [model] and [equilibrium] borrows the baseline;
-    the premise: a fresh open run under the other model gives the same SUMO numbers."""
+    """With [run] start = "warmup", a model that changes neither the vehicle types nor the
+    insertion columns of SUMO's route file reaches the open loop nowhere (it drives the
+    twins), so the step borrows the baseline; the premise: a fresh open run under the other
+    model gives the same SUMO numbers. The section delay, computed with the model's free
+    speeds, is blanked in the borrowed baseline rather than paired across two models."""
     scenario, out = evaluation
     step = tmp_path / "model.toml"
     text = scenario.read_text().replace("tau_h_s = 30", "tau_h_s = 20").replace(
@@ -167,6 +169,11 @@ def test_a_baseline_under_another_model_is_borrowed_when_sumo_fills_the_road(
     step.write_text(text)
     assert _evaluate(step, tmp_path / "o", "--baseline-from", str(out)) == 0
     assert "3 runs, 0 already finished, 3 executed" in capsys.readouterr().out
+    csv = pd.read_csv(tmp_path / "o" / "evaluation.csv").set_index(["measure", "controller"])
+    assert csv.loc[("section.total_delay.total", "open"), "n"] == 0
+    assert csv.loc[("section.total_delay.total", "alinea"), "diff_mean"] != \
+        csv.loc[("section.total_delay.total", "alinea"), "diff_mean"]          # NaN
+    assert csv.loc[("network.time_loss_s.total", "open"), "n"] == 3
     assert main(["evaluate", str(step), "--controllers", "open", "--seeds", "1",
                  "--seed-start", str(SEEDS[0]), "--horizon", "30", "--workers", "1",
                  "--quiet", "--no-plots", "--out", str(tmp_path / "fresh")]) == 0
@@ -179,14 +186,25 @@ def test_a_baseline_under_another_model_is_borrowed_when_sumo_fills_the_road(
     assert fresh["equilibrium"] != old["equilibrium"]      # the twins did see the model
 
 
-def test_the_model_is_not_inert_when_vehicles_are_placed_from_it():
-    from arzsumo.sweep.evaluate import _first_difference, _without_inert
+def test_a_model_that_changes_the_vehicles_is_not_borrowed(evaluation, tmp_path, capsys):
+    scenario, out = evaluation
+    step = tmp_path / "longer.toml"
+    step.write_text(scenario.read_text().replace("spacing_h_m = 8", "spacing_h_m = 9"))
+    assert _evaluate(step, tmp_path / "o", "--baseline-from", str(out)) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "differs in model.spacing_h_m" in err
+    assert not (tmp_path / "o").exists()
 
-    warm = {"run": {"start": "warmup"}, "model": {"tau_h_s": 30}, "sumo": {"seed": 1}}
-    other = {"run": {"start": "warmup"}, "model": {"tau_h_s": 20}, "sumo": {"seed": 1}}
-    assert _first_difference(_without_inert(warm), _without_inert(other)) == ""
-    placed = {**warm, "run": {"start": "placement"}}
-    placed_other = {**other, "run": {"start": "placement"}}
-    assert _first_difference(_without_inert(placed),
-                             _without_inert(placed_other)) == "model.tau_h_s"
-    assert _first_difference(_without_inert(warm), _without_inert(placed_other)) != ""
+
+def test_the_model_is_not_inert_when_vehicles_are_placed_from_it():
+    import tomllib
+
+    from arzsumo.sweep.evaluate import _model_inert
+
+    base = tomllib.loads((ROOT / "scenarios" / "legacy_default.toml").read_text())
+    other = {**base, "model": {**base["model"], "tau_h_s": 20}}
+    assert _model_inert(base, other)
+    placed = {**other, "run": {**base["run"], "start": "placement"}}
+    assert not _model_inert(base, placed)
+    wider = {**base, "model": {**base["model"], "vehicle_width_m": 1.8}}
+    assert not _model_inert(base, wider)

@@ -71,6 +71,14 @@ def oscillation(field: np.ndarray, periods: int = 1, cells: int = 1) -> np.ndarr
     the sample sd over time (ddof 1, NaN skipped, at least two blocks) measures the
     oscillation about that place's own mean; the columns are then pooled as an RMS. A
     field steady in time has 0 whatever its profile; ``a(x) + A sin(wt)`` has A / sqrt(2).
+    A slow drift within the window (a transient after control starts) counts too.
+
+    Parameters
+    ----------
+    field : ndarray (T, V, N)
+        Periods x variables x places, any unit; NaN where not observed.
+    periods, cells : int
+        Block size in periods and in places (>= 1).
 
     Returns
     -------
@@ -99,39 +107,61 @@ def _fill_in_time(field: np.ndarray) -> np.ndarray:
     return out
 
 
-def _peak_lag(up: np.ndarray, down: np.ndarray, max_lag: int) -> tuple[int, float]:
-    """Lag k in [-max_lag, max_lag] (samples) maximising corr(up(t), down(t + k)), and it."""
+def _lagged_corr(up: np.ndarray, down: np.ndarray, k: int) -> float:
+    """corr(up(t), down(t + k)) over the overlap (k in samples, either sign); NaN when a
+    side is constant there."""
     n = up.size
-    best = (0, -np.inf)
-    for k in range(-max_lag, max_lag + 1):
-        a, b = (up[:n - k], down[k:]) if k >= 0 else (up[-k:], down[:n + k])
-        if a.size > 2 and a.std() > 0 and b.std() > 0:
-            c = float(np.corrcoef(a, b)[0, 1])
-            if c > best[1]:
-                best = (k, c)
-    return best
+    a, b = (up[:n - k], down[k:]) if k >= 0 else (up[-k:], down[:n + k])
+    if a.size < 3 or a.std() == 0 or b.std() == 0:
+        return float("nan")
+    return float(np.corrcoef(a, b)[0, 1])
 
 
 def wave_travel(field: np.ndarray, dt: float, dx: float, gap: int,
                 max_lag_s: float) -> dict[str, float]:
     """Which way, and how fast, the fluctuations of a (T, N) field travel.
 
-    For every pair of places ``gap`` cells apart the fluctuations (each place's series
-    minus its mean, NaN filled in time) are cross-correlated; the lag of the peak (> 0:
-    the downstream place follows) gives a travel time. Returned: the median lag (s), the
-    speed ``gap dx`` / median lag (m/s; > 0 downstream, NaN at lag 0), the median peak
-    correlation and the pairs used. A field f(x - c t) gives c to the grid's resolution.
+    For every pair of places ``gap`` cells apart the fluctuations (each place's series,
+    NaN filled in time) are cross-correlated at lags k = -K..K; the correlations are
+    averaged over the pairs and the lag of the peak (> 0: the downstream place follows)
+    is the travel time of ``gap dx``. A peak at the edge of the search (|k| = K: slower
+    than ``gap dx / max_lag_s``) or within two samples of 0 (faster than the grid
+    resolves) gives no speed. A field f(x - c t) gives c when |c| lies between those.
+
+    Parameters
+    ----------
+    field : ndarray (T, N)
+        Periods x places (e.g. a class speed, m/s); NaN where not observed.
+    dt : float
+        Period, s.
+    dx : float
+        Distance between neighbouring places, m.
+    gap : int
+        Places between the two of a pair (>= 1).
+    max_lag_s : float
+        Largest lag searched, s (held to half the series).
+
+    Returns
+    -------
+    dict
+        ``lag_s`` (s), ``speed`` (m/s; > 0 downstream; NaN when unresolved), ``peak_corr``
+        (pair-averaged correlation at the peak) and ``pairs`` (pairs used).
     """
     f = _fill_in_time(field)
     seen = np.isfinite(f).all(axis=0)
-    f[:, seen] -= f[:, seen].mean(axis=0)
-    # at least half of the series overlaps at every lag
+    pairs = [j for j in range(f.shape[1] - gap) if seen[j] and seen[j + gap]]
     max_lag = min(max(1, round(max_lag_s / dt)), f.shape[0] // 2)
-    peaks = [_peak_lag(f[:, j], f[:, j + gap], max_lag) for j in range(f.shape[1] - gap)
-             if seen[j] and seen[j + gap]]
-    peaks = [p for p in peaks if np.isfinite(p[1])]
-    if not peaks:
+    lags = np.arange(-max_lag, max_lag + 1)
+    with np.errstate(invalid="ignore"):
+        corr = np.array([[_lagged_corr(f[:, j], f[:, j + gap], int(k)) for k in lags]
+                         for j in pairs]).reshape(len(pairs), lags.size)
+    used = np.isfinite(corr).any(axis=1)
+    if not used.any():
         return {"lag_s": np.nan, "speed": np.nan, "peak_corr": np.nan, "pairs": 0}
-    lag = float(np.median([k for k, _ in peaks])) * dt
-    return {"lag_s": lag, "speed": gap * dx / lag if lag else np.nan,
-            "peak_corr": float(np.median([c for _, c in peaks])), "pairs": len(peaks)}
+    ok = np.isfinite(corr[used])
+    mean = np.where(ok, corr[used], 0.0).sum(axis=0) / np.maximum(ok.sum(axis=0), 1)
+    mean[~ok.any(axis=0)] = np.nan
+    k = int(lags[np.nanargmax(mean)])
+    resolved = 2 <= abs(k) < max_lag
+    return {"lag_s": k * dt, "speed": gap * dx / (k * dt) if resolved else np.nan,
+            "peak_corr": float(np.nanmax(mean)), "pairs": int(used.sum())}

@@ -186,15 +186,17 @@ def speed_oscillation(res: CoSimResult) -> dict[str, Any]:
             "oscillation_block_s": periods * res.sumo.control_period}
 
 
-#: the cross-correlation of ``speed_wave``: places this far apart (m), lags up to (s)
-WAVE_GAP_M, WAVE_MAX_LAG_S = 250.0, 60.0
+#: the cross-correlation of ``speed_wave``: places this far apart (m), lags up to (s);
+#: 150 s resolves waves down to 6 km/h (a congested lambda_4 is about -11 km/h)
+WAVE_GAP_M, WAVE_MAX_LAG_S = 250.0, 150.0
 
 
 def speed_wave(res: CoSimResult) -> dict[str, Any]:
     """Per class, which way the micro speed fluctuations travel
-    (:func:`arzsumo.evaluation.fields.wave_travel` over places WAVE_GAP_M apart): median
-    lag (s), speed (km/h; > 0 downstream, the way the meter cannot reach), median peak
-    correlation, pairs. The paper's actuator acts through what travels upstream."""
+    (:func:`arzsumo.evaluation.fields.wave_travel` over places WAVE_GAP_M apart): lag of
+    the pair-averaged peak (s), speed (km/h; > 0 downstream, the way the meter cannot
+    reach; NaN when unresolved), peak correlation, pairs. The paper's actuator acts
+    through what travels upstream."""
     dx = float(res.x[1] - res.x[0]) if res.x.size > 1 else float(res.sumo.cell_length)
     gap = max(1, round(WAVE_GAP_M / dx))
     out: dict[str, Any] = {"gap_m": gap * dx, "max_lag_s": WAVE_MAX_LAG_S}

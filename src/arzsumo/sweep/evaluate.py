@@ -33,6 +33,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from arzsumo.errors import ArzsumoError
 from arzsumo.evaluation.report import evaluate
 from arzsumo.io import dump_toml
 from arzsumo.outdir import judge, where
@@ -67,11 +68,14 @@ class EvaluationResult:
 #: runs whose resolved scenarios differ only here are the same SUMO run
 OPEN_LOOP_INERT = ("name", "description", "estimation", "sensing", "actuation", "design",
                    "run.controller")
-#: tables that act on an open-loop SUMO run only through the vehicles placed at t = 0
-#: (``[run] start = "placement"``): the model, its equilibrium and the initial profile.
-#: With ``start = "warmup"`` (the default) SUMO fills the road itself and the model only
-#: drives the twins, which no evaluation measure reads (:data:`~arzsumo.evaluation.report.MEASURES`)
+#: tables that reach an open-loop SUMO run only through what it is given to simulate: the
+#: vehicles placed at t = 0 (``[run] start = "placement"``) and, from the model, the
+#: vehicle types and insertion columns of the route file (:func:`_sumo_input`). With
+#: ``start = "warmup"`` (the default) and the same route file, they drive only the twins
 PLACEMENT_ONLY = ("model", "equilibrium", "initial")
+#: evaluation measures computed with the model's parameters (section delay: TTT - TMT /
+#: v_free): a baseline borrowed under another [model] has them blanked (NaN)
+MODEL_DEPENDENT = ("section.total_delay.",)
 
 
 def check_controllers(controllers: Sequence[str]) -> list[str]:
@@ -121,10 +125,32 @@ def check_runs(scenario: Path, controllers: Sequence[str], horizon: float | None
     return sc.name
 
 
-def _without_inert(data: dict) -> dict:
+def _sumo_input(data: dict) -> tuple[str, float] | None:
+    """The route file and road length SUMO is given for the scenario ``data`` (without
+    placed vehicles); None when it does not load."""
+    from arzsumo.scenario import scenario_from_dict
+    from arzsumo.sumo.demand import route_file_text
+
+    try:
+        sc = scenario_from_dict(data)
+        return route_file_text(sc.params, sc.sumo), sc.params.length
+    except ArzsumoError:
+        return None
+
+
+def _model_inert(a: dict, b: dict) -> bool:
+    """Whether [model], [equilibrium] and [initial] leave the open loop of ``a`` and ``b``
+    alone: SUMO fills the road itself in both and is given the same route file."""
+    starts = {d.get("run", {}).get("start", "warmup") for d in (a, b)}
+    if starts != {"warmup"}:
+        return False
+    ours = _sumo_input(a)
+    return ours is not None and ours == _sumo_input(b)
+
+
+def _without_inert(data: dict, model_inert: bool = False) -> dict:
     out = copy.deepcopy(data)
-    start = out.get("run", {}).get("start", "warmup")
-    for name in OPEN_LOOP_INERT + (PLACEMENT_ONLY if start == "warmup" else ()):
+    for name in OPEN_LOOP_INERT + (PLACEMENT_ONLY if model_inert else ()):
         table, _, key = name.partition(".")
         if key and isinstance(out.get(table), dict):
             out[table].pop(key, None)
@@ -151,12 +177,14 @@ def _their_run(source: Path, mine: RunSpec, user: str) -> RunSpec:
                          f"{mine.run_id}; allowed: an evaluation of the same seeds and horizon")
     theirs = tomllib.loads(path.read_text(encoding="utf-8"))
     ours = tomllib.loads(dump_toml(dict(mine.scenario)))
-    differ = _first_difference(_without_inert(theirs), _without_inert(ours))
+    inert = _model_inert(theirs, ours)
+    differ = _first_difference(_without_inert(theirs, inert), _without_inert(ours, inert))
     if differ:
         raise SweepError(f"--baseline-from = {user} is not allowed: its run {mine.run_id} "
                          f"differs in {differ}; allowed: open-loop runs whose scenarios "
-                         f"differ only in {', '.join(OPEN_LOOP_INERT)} (and, with [run] "
-                         f"start = 'warmup', in {', '.join(PLACEMENT_ONLY)})")
+                         f"differ only in {', '.join(OPEN_LOOP_INERT)} (and in "
+                         f"{', '.join(PLACEMENT_ONLY)} when [run] start = 'warmup' and "
+                         "SUMO's route file is the same)")
     return replace(mine, scenario=theirs)
 
 
@@ -169,6 +197,10 @@ def borrowed_baseline(spec: SweepSpec, source: Path, user: str) -> pd.DataFrame:
     if not table["status"].isin(FINISHED).all():
         raise SweepError(f"--baseline-from = {user} is not allowed: its open-loop runs "
                          "cannot be read back; allowed: a finished arzsumo evaluation")
+    if any(t.scenario.get("model") != tomllib.loads(dump_toml(dict(m.scenario))).get("model")
+           for t, m in zip(theirs, mine, strict=True)):
+        blank = [c for c in table.columns if c.startswith(MODEL_DEPENDENT)]
+        table[blank] = float("nan")
     return table
 
 
