@@ -107,14 +107,17 @@ def _fill_in_time(field: np.ndarray) -> np.ndarray:
     return out
 
 
-def _lagged_corr(up: np.ndarray, down: np.ndarray, k: int) -> float:
-    """corr(up(t), down(t + k)) over the overlap (k in samples, either sign); NaN when a
-    side is constant there."""
-    n = up.size
+def _lagged_corr(up: np.ndarray, down: np.ndarray, k: int) -> np.ndarray:
+    """Per column, corr(up(t), down(t + k)) over the overlap of (T, P) series (k in
+    samples, either sign); NaN where a side is constant there."""
+    n = up.shape[0]
     a, b = (up[:n - k], down[k:]) if k >= 0 else (up[-k:], down[:n + k])
-    if a.size < 3 or a.std() == 0 or b.std() == 0:
-        return float("nan")
-    return float(np.corrcoef(a, b)[0, 1])
+    if a.shape[0] < 3:
+        return np.full(up.shape[1], np.nan)
+    a, b = a - a.mean(axis=0), b - b.mean(axis=0)
+    norm = np.sqrt((a * a).sum(axis=0) * (b * b).sum(axis=0))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(norm > 0, (a * b).sum(axis=0) / norm, np.nan)
 
 
 def wave_travel(field: np.ndarray, dt: float, dx: float, gap: int,
@@ -152,9 +155,9 @@ def wave_travel(field: np.ndarray, dt: float, dx: float, gap: int,
     pairs = [j for j in range(f.shape[1] - gap) if seen[j] and seen[j + gap]]
     max_lag = min(max(1, round(max_lag_s / dt)), f.shape[0] // 2)
     lags = np.arange(-max_lag, max_lag + 1)
-    with np.errstate(invalid="ignore"):
-        corr = np.array([[_lagged_corr(f[:, j], f[:, j + gap], int(k)) for k in lags]
-                         for j in pairs]).reshape(len(pairs), lags.size)
+    up, down = f[:, pairs], f[:, [j + gap for j in pairs]]
+    corr = np.array([_lagged_corr(up, down, int(k)) for k in lags]).T.reshape(len(pairs),
+                                                                                lags.size)
     used = np.isfinite(corr).any(axis=1)
     if not used.any():
         return {"lag_s": np.nan, "speed": np.nan, "peak_corr": np.nan, "pairs": 0}
