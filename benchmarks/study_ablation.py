@@ -61,6 +61,8 @@ DESIGNED = {"zeta": 0.00797514, "sigma": 0.5, "eta": 0.00391508,
 #: prediction horizon of the delay step, s: the measured dead time from a new plan to the
 #: section's outflow (10-14 s) plus the mean wait for the next cycle (docs/meter_dynamics.md)
 PREDICTION_S = 14.0
+#: [sumo] keys of the meter realisation: the `meter` step's change, shipped in the default
+METER_KEYS = ("meter_mode", "meter_clearance_s")
 #: tables whose change leaves the open loop as it was (evaluate's --baseline-from rule)
 INERT = {"sensing", "estimation", "actuation", "design"}
 
@@ -115,6 +117,10 @@ def step_scenario(name: str) -> tuple[dict[str, Any], str | None]:
     # the shipped default carries the ablation's best controller side since issue 17: the
     # steps start from its scenario and model alone (raw cells, paper's ETC, no limits)
     base = {k: v for k, v in base.items() if k not in INERT}
+    # ... and its meter realisation (the `meter` step, one vehicle per green): the steps
+    # start from the fixed cycle
+    for key in METER_KEYS:
+        base["sumo"].pop(key, None)
     if name == "identified":
         return base, None
     names = [s.name for s in STEPS]
