@@ -38,6 +38,8 @@ STATIC_LEVELS = {0.2: 4395.0, 0.5: 4268.0, 0.8: 3180.0}
 #: the ablation's steps in order (benchmarks/study_ablation.py)
 ORDER = ("scenario", "identified", "estimator", "reference", "saturation", "design", "delay",
          "meter")
+#: steps whose meter releases one vehicle per green (left out of the green-share map)
+RELEASE_STEPS = ("meter",)
 #: the step whose open loop the controller-side steps borrow (evaluate --baseline-from)
 SHARED_OPEN_LOOP = "identified"
 
@@ -182,7 +184,9 @@ def main() -> int:
         d_all.to_csv(args.csv, index=False, float_format="%.6g")
     if args.png:
         args.png.parent.mkdir(parents=True, exist_ok=True)
-        plot_map(df, Path(f"{args.png}_map.png"))
+        # one vehicle per green: its green share is a release per cycle, not a point on
+        # the fixed cycle's curve
+        plot_map(df[~df["step"].isin(RELEASE_STEPS)], Path(f"{args.png}_map.png"))
         plot_shift(d, Path(f"{args.png}_shift.png"))
     cols = ["green_mean", "section_outflow_veh_h", "d_section_outflow_veh_h",
             "d_speed_mean_h_kmh", "d_speed_sd_h_kmh", "d_speed_mean_a_kmh",
