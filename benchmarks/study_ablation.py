@@ -190,9 +190,13 @@ def markdown(table: pd.DataFrame) -> str:
                 cells.append("")
                 continue
             r = r.iloc[0]
-            cells.append(f"{r['mean']:.3g}" if ctrl == "open" else
-                         f"{r['mean']:.3g} ({r['diff_mean']:+.3g} "
-                         f"[{r['diff_ci_low']:+.3g}, {r['diff_ci_high']:+.3g}])")
+            if pd.isna(r["mean"]):           # a measure the runs did not report yet
+                cells.append("")
+            elif ctrl == "open" or pd.isna(r["diff_mean"]):   # no paired open loop
+                cells.append(f"{r['mean']:.3g}")
+            else:
+                cells.append(f"{r['mean']:.3g} ({r['diff_mean']:+.3g} "
+                             f"[{r['diff_ci_low']:+.3g}, {r['diff_ci_high']:+.3g}])")
         lines.append(f"| {step} | {ctrl} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
