@@ -17,8 +17,9 @@ With ``baseline_from`` (``--baseline-from DIR``) the open-loop runs are not run 
 taken from an earlier evaluation in DIR (:func:`borrowed_baseline`), allowed only when
 their resolved scenarios differ from this evaluation's in nothing that acts on an open-loop
 SUMO run (:data:`OPEN_LOOP_INERT`; and :data:`PLACEMENT_ONLY` when SUMO fills the road
-itself and is given the same route file): an ablation whose steps change only the controllers' side (estimation, sensing,
-actuation, design, or the model the laws are designed on) pays for its baseline once.
+itself and is given the same route file): an ablation whose steps change only the
+controllers' side (estimation, sensing, actuation, design, or the model the laws are
+designed on) pays for its baseline once.
 """
 
 from __future__ import annotations
