@@ -4,8 +4,10 @@ In the ablation's `meter` step (one vehicle per green, on the default's controll
 the PDE laws lower the network time loss, and they spend much of the window at the upper
 bound of U, where the meter releases at ``release_rate_min``. This script runs the open
 loop of the same scenario with the nominal release rate set to that bound (a fixed,
-restrictive meter: no feedback) on the same seeds, and pairs every controller of the
-`meter` step against it as well as against the step's own open loop.
+restrictive meter: no feedback, held from t = 0, the warm-up included) on the same seeds,
+and pairs every run set of the `meter` step (its open loop and both laws) against it.
+Because the held meter also holds during the warm-up, this compares two policies over the
+same window; it does not separate feedback from holding within the window.
 
     python benchmarks/study_held_ramp.py --out ABLATION_DIR --seeds 10 --workers 2
     python benchmarks/study_held_ramp.py --out ABLATION_DIR --report   # only the table
@@ -17,16 +19,17 @@ the held-ramp open loop goes to ``ABLATION_DIR/held``.
 from __future__ import annotations
 
 import argparse
-import json
 import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import study_ablation
 
+from arzsumo.evaluation.report import Measure, per_seed
 from arzsumo.evaluation.stats import StatisticsError, paired_difference
 from arzsumo.io import dump_toml
 
@@ -60,36 +63,28 @@ def run_held(out: Path, seeds: int, workers: int) -> int:
     return subprocess.call(cmd)
 
 
-def _value(summary: dict, dotted: str) -> float:
-    for part in dotted.split("."):
-        summary = summary[part]
-    return float(summary)
-
-
-def values(runs: Path, controller: str, seeds: int, key: str) -> np.ndarray:
-    """Per seed 1..seeds the measure ``key`` of ``controller``'s runs (NaN: missing)."""
-    out = np.full(seeds, np.nan)
-    for s in range(1, seeds + 1):
-        f = runs / f"controller={controller},seed={s}" / "summary.json"
-        if f.is_file():
-            out[s - 1] = _value(json.loads(f.read_text(encoding="utf-8")), key)
-    return out
+def per_seed_values(runs: pd.DataFrame, controller: str, key: str, scale: float,
+                    seeds: int) -> np.ndarray:
+    """Seeds 1..seeds of ``controller``'s measure ``key`` times ``scale`` from an
+    evaluation's sweep table (``summaries.parquet``; NaN where a run is missing)."""
+    wide = per_seed(runs, Measure(key, key, "", scale), [controller])
+    return wide[controller].reindex(range(1, seeds + 1)).to_numpy(float)
 
 
 def report(out: Path, seeds: int) -> str:
     """Markdown: per measure, each run set minus the held-ramp open loop, paired by seed
     (mean [95 % t], and in brackets the seeds lower / higher than the held ramp)."""
-    meter, held = out / "meter" / "runs", out / "held" / "runs"
+    meter, held = (pd.read_parquet(out / d / "summaries.parquet") for d in ("meter", "held"))
     sets = [("open loop, nominal rate", meter, "open"), ("backstepping", meter, "backstepping"),
             ("ETC", meter, "etc")]
     lines = ["| measure | held ramp (mean) | " + " | ".join(f"{n} minus held" for n, _, _ in sets)
              + " |", "|---" * (2 + len(sets)) + "|"]
     for key, (label, scale) in MEASURES.items():
-        base = values(held, "open", seeds, key) * scale
+        base = per_seed_values(held, "open", key, scale, seeds)
         cells = []
         for _, runs, ctrl in sets:
             try:
-                d = paired_difference(values(runs, ctrl, seeds, key) * scale, base)
+                d = paired_difference(per_seed_values(runs, ctrl, key, scale, seeds), base)
                 cells.append(f"{d.mean_diff:+.3g} [{d.t.low:+.3g}, {d.t.high:+.3g}] "
                              f"({d.wins}/{d.losses})")
             except StatisticsError:
