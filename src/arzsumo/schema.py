@@ -72,6 +72,8 @@ PERIODS: dict[str, Column] = {
                               "the controller's U"),
     "rate_limited": Column(TEXT, "true where the rate limit (u_rate_max_veh_h_s) cut the "
                                  "change of U"),
+    "override": Column(TEXT, "true where the meter's queue override was on at the period's "
+                             "end (ramp queue above ramp_storage_veh: the largest release)"),
 }
 
 _STATE = {
@@ -159,7 +161,16 @@ RUN_SUMMARY: dict[str, str] = {
     "plan_changes": "count", "light_changes": "count", "max_ramp_queue": "veh",
     "meter.mode": TEXT, "meter.clearance_s": "s", "meter.release_rate": "veh/s",
     "meter.releases": "veh", "meter.greens": "count", "meter.releases_per_green_max": "veh",
-    "meter.override_steps": "count", "meter.emergency_stops": "count",
+    "meter.override_steps": "count", "meter.override_s": "s", "meter.ramp_storage": "veh",
+    "meter.emergency_stops": "count",
+    "network_whole_demand": TEXT,      # null without a drain
+    "network_whole_demand.complete": "bool", "network_whole_demand.drain.duration_s": "s",
+    "network_whole_demand.drain.max_s": "s", "network_whole_demand.drain.hit_limit": "bool",
+    "network_whole_demand.in_system_integral_s": "veh*s",
+    "network_whole_demand.ramp_wait_s.vehicles": "veh",
+    "network_whole_demand.ramp_wait_s.over_limit": "veh",
+    "network_whole_demand.ramp_wait_s.not_crossed": "veh",
+    "network_whole_demand.ramp_wait_s.*": "s",
     "meter.emergency_braking": "count",
     "speed_variance.*": "m^2/s^2",
     **{f"{k}.*": u for k, u in _RUN_INDICES.items()}, "until_s": "s",

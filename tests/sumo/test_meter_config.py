@@ -4,14 +4,18 @@ import pytest
 
 from arzsumo.errors import ArzsumoError, ScenarioError
 from arzsumo.scenario import scenario_from_dict
-from arzsumo.sumo.config import SumoConfig
+from arzsumo.sumo.config import SumoConfig, ramp_capacity
 from arzsumo.sumo.meter import plan_green_steps
 from arzsumo.sumo.meter_release import release_rate_for
 
 
 def test_meter_keys_convert_units_and_default_to_todays_meter():
     cfg = SumoConfig()
-    assert (cfg.meter_mode, cfg.meter_clearance, cfg.spillback_queue) == ("fixed_cycle", 0, 0)
+    assert (cfg.meter_mode, cfg.meter_clearance, cfg.drain_max) == ("fixed_cycle", 0, 0)
+    # the ramp stores what its 300 m hold at 8 m per vehicle unless told otherwise
+    assert cfg.ramp_storage == ramp_capacity() == 37
+    assert ramp_capacity(100.0, 7.5) == 13
+    assert SumoConfig(ramp_storage=0).ramp_storage == 0
     cfg = scenario_from_dict({"sumo": {"meter_mode": "one_per_green", "meter_clearance_s": 2,
                                        "release_rate_veh_h": 720, "release_rate_min_veh_h": 360,
                                        "release_rate_max_veh_h": 720,

@@ -83,7 +83,7 @@ def test_one_per_green_cycles_follow_the_commanded_rate():
 def test_queue_override_forces_releases_in_both_modes():
     slow = [(0.0, 240.0)]                                   # release_rate_min: 15 s cycles
     plain, _ = run_meter(ONE, 120.0, slow)
-    over, _ = run_meter(ONE.with_(spillback_queue=3), 120.0, slow)
+    over, _ = run_meter(ONE.with_(ramp_storage=3), 120.0, slow)
     assert plain.summary()["override_steps"] == 0 and over.summary()["override_steps"] > 0
     assert plain.releases <= 120 / 15 + 1
     assert over.releases >= plain.releases + 5
@@ -91,7 +91,7 @@ def test_queue_override_forces_releases_in_both_modes():
     # the fixed cycle at all red releases only under the override (green forced)
     red = BASE.with_(green_share=0.0, meter_clearance=2.0)
     held, _ = run_meter(red, 90.0)
-    forced, shown = run_meter(red.with_(spillback_queue=3), 90.0)
+    forced, shown = run_meter(red.with_(ramp_storage=3), 90.0)
     assert held.releases == 0 and held.summary()["override_steps"] == 0
     assert forced.releases > 0 and forced.summary()["override_steps"] > 0
     assert "y" in shown and forced.summary()["emergency_stops"] == 0

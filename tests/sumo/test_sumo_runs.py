@@ -191,7 +191,7 @@ def test_e2_chain_counts_each_vehicle_once_like_the_position_sensor():
 
 
 def test_spillback_override_releases_a_long_queue():
-    cfg = FAST.with_(horizon=50.0, ramp_demand=1200 / 3600, spillback_queue=4)
+    cfg = FAST.with_(horizon=50.0, ramp_demand=1200 / 3600, ramp_storage=4)
     res = run_fixed_meter(PARAMS, cfg, 0.0, measure=False)
     assert res.meter["override_steps"] > 0 and res.ramp_passed > 0
     assert res.meter["max_queue"] >= 4

@@ -16,9 +16,12 @@ Between the controller and the meter, the ``[actuation]`` limits
 3. the range again, so the output always lies in it: the range wins over the rate when
    the range moved away from the previous U (the ramp bound moves with the queue).
 
-Every limit off (the default) returns the law's U unchanged: today's closed loop. The
-U applied goes back to the controller (:meth:`arzsumo.control.base.Controller.applied`,
-with the range) unless ``anti_windup = false``.
+Every limit off (the default) returns the law's U unchanged. While the meter's queue
+override is on (the ramp queue beyond its storage,
+:meth:`~arzsumo.sumo.meter.MeterLight.override`) the range collapses to the override's U,
+whatever the limits: the law sees a saturated actuator. The U applied goes back to the
+controller (:meth:`arzsumo.control.base.Controller.applied`, with the range) unless
+``anti_windup = false``.
 """
 
 from __future__ import annotations
@@ -183,7 +186,12 @@ class MeterActuator:
         if self.hold_nominal:
             return Actuation(u, 0.0, False, False, -INF, INF, self.meter.green_share)
         lower, upper = self.limits.range(self.meter.queue)
-        lim = limit_u(u, self.u_prev, lower, upper, self.limits.rate_step)
+        if self.meter.override():
+            # the queue override runs the meter at its largest release whatever is
+            # commanded: to the law, a saturation of its actuator (anti-windup sees it)
+            lower = upper = self.meter.override_u(self.q_nominal)
+        lim = limit_u(u, self.u_prev, lower, upper, INF if self.meter.override()
+                      else self.limits.rate_step)
         self.u_prev = lim.u_applied
         green = self.meter.command(lim.u_applied, self.q_nominal)
         return Actuation(u, lim.u_applied, lim.saturated, lim.rate_limited, lower, upper,

@@ -46,7 +46,7 @@ import math
 import shutil
 import tempfile
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -54,6 +54,7 @@ import numpy as np
 
 from arzsumo.bridge.actuator import ActuationLimits, MeterActuator
 from arzsumo.bridge.delay import check_delay, compensate
+from arzsumo.bridge.drain import Drained, drain
 from arzsumo.bridge.estimator import Estimator
 from arzsumo.bridge.estimators import RecordedEstimator, estimation_stage
 from arzsumo.bridge.records import Decision, PeriodRecord, Trace, columns, micro_fields
@@ -73,11 +74,13 @@ from arzsumo.scenario.run import RunSettings
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.meter import DEFAULT_CURVE, GreenShareCurve
 from arzsumo.sumo.meter_release import make_meter
+from arzsumo.sumo.network import NetworkSpec
 from arzsumo.sumo.network_measures import network_options
 from arzsumo.sumo.paths import scratch_dir
 from arzsumo.sumo.sensor import PeriodMeasurement, SumoSensor
 from arzsumo.sumo.simulation import SumoSimulation, open_simulation
-from arzsumo.sumo.window import WindowStart, measure_network
+from arzsumo.sumo.whole_demand import ramp_waits, whole_demand_summary
+from arzsumo.sumo.window import NetworkMeasures, WindowStart, measure_network
 from arzsumo.twin.solver import SolverOptions
 
 log = logging.getLogger(__name__)
@@ -222,7 +225,7 @@ class ClosedLoop:
                             meter.plan_changes, meter.queue, meter.max_queue, c.inflow_h,
                             c.inflow_a, c.outflow_h, c.outflow_a, m.occupancy_out,
                             d.u_reference, d.controller_s, d.u, d.u_applied, d.saturated,
-                            d.rate_limited)
+                            d.rate_limited, float(meter.override()))
 
     def run(self, start: PeriodMeasurement, horizon: float, bar: Progress) -> Trace:
         """Control from the measurement ``start`` (t = 0) until ``horizon`` seconds."""
@@ -305,10 +308,16 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
                              extra_args=network_options(net_dir), output_dir=net_dir,
                              loops=scenario.sensing.loop_x(scenario.params.length)) as sim:
             c = control(sim, scenario, settings, cfg, design, curve, bar, keep_measurements)
-            meter_summary = c.loop.plant.meter.summary()
+            meter = c.loop.plant.meter
+            meter_summary = {**meter.summary(), "ramp_storage": cfg.ramp_storage}
+            t_end = sim.time
+            drained = drain(sim, meter, cfg.drain_max) if cfg.drain_max > 0 else None
         records = c.trace.records
         outlet = round(sum((r.outflow_h + r.outflow_a) * cfg.control_period for r in records))
-        network = measure_network(net_dir, c.start, sim.time, outlet)
+        network, trips = measure_network(net_dir, c.start, t_end, outlet,
+                                         drained.end if drained else None, sim.time)
+        if drained is not None:
+            network = whole_demand(network, trips, meter, sim, drained)
     finally:
         shutil.rmtree(net_dir, ignore_errors=True)
     bar.close()
@@ -322,6 +331,19 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
                        loop.plant.sensor.speeds.summary(), trace.start,
                        np.asarray(c.estimator.fields[1:]), c.estimator,
                        loop.shift)
+
+
+def whole_demand(network: NetworkMeasures, trips: Any, meter: Any, sim: SumoSimulation,
+                 drained: Drained) -> NetworkMeasures:
+    """``network`` with its ``whole_demand`` block (:mod:`arzsumo.sumo.whole_demand`):
+    the whole run after the drain, the per-step integral of vehicles in the system and
+    the ramp vehicles' waits at the meter."""
+    spec = NetworkSpec()
+    waits = ramp_waits(trips, meter.stop_line.crossings, sim.cfg.step_length,
+                       spec.ramp_length / spec.ramp_speed)
+    block = whole_demand_summary(network.whole_run, waits, sim.in_system_s,
+                                 drained.duration_s, drained.max_s)
+    return replace(network, whole_demand=block)
 
 
 def control(sim: SumoSimulation, scenario: Scenario, settings: RunSettings, cfg: SumoConfig,

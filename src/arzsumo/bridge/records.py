@@ -26,8 +26,9 @@ class PeriodRecord:
     green share asked of the meter, ``u_reference`` the reference twin's U,
     ``controller_s`` the wall time of the check. The rest is the period that followed:
     the running green share, cumulative light and plan changes, the ramp queue at its end
-    and its maximum so far (veh), class in- and outflows of the section, and the mean
-    occupancy downstream of the merge (fraction).
+    and its maximum so far (veh), class in- and outflows of the section, the mean
+    occupancy downstream of the merge (fraction), and whether the meter's queue override
+    was on at the period's end (1.0 or 0.0).
     """
 
     t: float
@@ -51,6 +52,7 @@ class PeriodRecord:
     u_applied: float = float("nan")
     saturated: float = 0.0
     rate_limited: float = 0.0
+    override: float = 0.0
 
 
 def columns(records: list[PeriodRecord]) -> dict[str, np.ndarray]:

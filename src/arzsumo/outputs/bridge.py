@@ -218,8 +218,8 @@ def section_summary(res: CoSimResult, micro: dict[str, Any]) -> dict[str, Any]:
 
 #: ``summary.json["meter"]``: keys of the meter's own summary kept there (control window)
 METER_KEYS = ("mode", "clearance_s", "release_rate", "releases", "greens",
-              "releases_per_green_max", "override_steps", "emergency_stops",
-              "emergency_braking")
+              "releases_per_green_max", "override_steps", "override_s", "ramp_storage",
+              "emergency_stops", "emergency_braking")
 
 
 def meter_summary(res: CoSimResult) -> dict[str, Any]:
@@ -267,6 +267,7 @@ def summary(res: CoSimResult) -> dict[str, Any]:
         "section": section_summary(res, micro),
         "network": net.window if net else None,
         "network_whole_run": net.whole_run if net else None,
+        "network_whole_demand": net.whole_demand if net else None,
         "twin_replay": _indices(res, res.replay), "twin_reference": _indices(res, res.reference),
         "rmse": {"replay": rmse(res, res.replay), "reference": rmse(res, res.reference)},
         "rmse_blocks": rmse_blocks(res),
@@ -292,7 +293,7 @@ def summary(res: CoSimResult) -> dict[str, Any]:
 def periods_table(res: CoSimResult) -> pa.Table:
     cols = {"t_s": res.periods["t"]}
     cols.update({k: v for k, v in res.periods.items() if k not in ("t", "controller_s")})
-    for flag in ("triggered", "saturated", "rate_limited"):
+    for flag in ("triggered", "saturated", "rate_limited", "override"):
         cols[flag] = res.periods[flag].astype(bool)
     return with_units(pa.table(cols), PERIODS, "periods")
 

@@ -55,9 +55,16 @@ SUMO_KEYS: dict[str, Key] = {
     "green_share": Key("green_share", doc="nominal green share of the cycle (open loop)"),
     "green_share_min": Key("green_share_min", doc="lowest commanded green share"),
     "green_share_max": Key("green_share_max", doc="highest commanded green share"),
-    "spillback_queue_veh": Key("spillback_queue", "integer", unit="veh",
-                               doc="ramp queue that forces green (one_per_green: the "
-                                   "highest release rate); 0 disables it"),
+    "ramp_storage_veh": Key("ramp_storage", "integer", unit="veh",
+                            doc="vehicles the ramp stores: while the ramp queue exceeds it "
+                                "the meter releases at its largest rate (fixed_cycle: "
+                                "green), for every controller; 0 disables the override; "
+                                "default: what ramp_up holds at jam spacing (37)"),
+    "drain_max_s": Key("drain_max", unit="s",
+                       doc="after the control window no vehicle is requested and the run "
+                           "goes on, the meter at its largest rate, until every loaded "
+                           "vehicle has left (network_whole_demand), at most this long; "
+                           "0 ends the run with the window"),
     "meter_mode": Key("meter_mode", "string", choices=METER_MODES,
                       doc="ramp meter realisation: green share of a fixed cycle, or one "
                           "vehicle per green at a release rate"),

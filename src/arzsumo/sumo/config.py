@@ -11,6 +11,7 @@ from dataclasses import dataclass, fields, replace
 from typing import Any
 
 from arzsumo.errors import ScenarioError, require
+from arzsumo.sumo.network import NetworkSpec
 
 HV_MODELS = ("Krauss", "IDM")
 #: Width of the mainline lane, m (the network's).
@@ -18,6 +19,18 @@ LANE_WIDTH = 6.5
 AV_MODELS = ("ACC", "CACC")
 #: How the ramp meter is realised (:mod:`arzsumo.sumo.meter`, :mod:`arzsumo.sumo.meter_release`)
 METER_MODES = ("fixed_cycle", "one_per_green")
+
+
+#: jam spacing of a stored ramp vehicle, m: an HV's length + minGap at the model's default
+#: spacing s_h = 8 m (:mod:`arzsumo.sumo.vtypes`)
+RAMP_JAM_SPACING = 8.0
+
+
+def ramp_capacity(length: float | None = None, spacing: float = RAMP_JAM_SPACING) -> int:
+    """Vehicles a ramp of ``length`` (m; default: ``ramp_up`` of the network, 300 m) holds
+    at jam spacing ``spacing`` (m): 37 on the shipped network."""
+    ramp = NetworkSpec().ramp_length if length is None else length
+    return int(ramp // spacing)
 
 
 @dataclass(frozen=True)
@@ -50,9 +63,16 @@ class SumoConfig:
         Nominal green share of the meter cycle, in [0, 1].
     green_share_min, green_share_max : float
         Saturation limits of commanded green shares, 0 <= min <= max <= 1.
-    spillback_queue : int
-        Ramp queue (veh) that forces green (fixed cycle) or the highest release rate
-        (one per green); 0 disables the override.
+    ramp_storage : int
+        Vehicles the ramp stores (veh): while the ramp queue exceeds it, the queue override
+        forces green (fixed cycle) or the highest release rate (one per green), as field
+        meters do; 0 disables the override. Default (-1): what ``ramp_up`` holds at jam
+        spacing, :func:`ramp_capacity`.
+    drain_max : float
+        After the control window no vehicles are requested and the run goes on, the meter
+        at its drain policy (the queue override held on: the highest release rate), until
+        every loaded vehicle has left the network, at most this long, s; 0 (default) ends
+        the run with the control window.
     meter_mode : str
         "fixed_cycle" (green share of a fixed cycle, default) or "one_per_green" (one
         vehicle per green at a commanded release rate).
@@ -108,7 +128,8 @@ class SumoConfig:
     green_share: float = 0.5
     green_share_min: float = 0.0
     green_share_max: float = 1.0
-    spillback_queue: int = 0
+    ramp_storage: int = -1
+    drain_max: float = 0.0
     meter_mode: str = "fixed_cycle"
     meter_clearance: float = 0.0
     max_green: float = 3.0
@@ -144,8 +165,8 @@ class SumoConfig:
                      "release_rate", "release_rate_min", "release_rate_max"):
             pos(name)
         for name in ("demand_h", "demand_a", "ramp_demand", "min_green", "min_red",
-                     "approach_length", "meter_clearance", "fill_duration", "fill_demand_h",
-                     "fill_demand_a", "hv_max_speed", "av_max_speed"):
+                     "approach_length", "meter_clearance", "fill_duration", "drain_max",
+                     "fill_demand_h", "fill_demand_a", "hv_max_speed", "av_max_speed"):
             v = getattr(self, name)
             require(isinstance(v, int | float) and math.isfinite(v) and v >= 0, name, v,
                     "a finite number of at least 0", ScenarioError)
@@ -178,9 +199,12 @@ class SumoConfig:
         require(isinstance(self.seed, int) and not isinstance(self.seed, bool)
                 and 0 <= self.seed < 2**31, "seed", self.seed, "an integer in [0, 2^31)",
                 ScenarioError)
-        require(isinstance(self.spillback_queue, int) and self.spillback_queue >= 0,
-                "spillback_queue", self.spillback_queue, "an integer >= 0 (0 = off)",
+        require(isinstance(self.ramp_storage, int) and self.ramp_storage >= -1,
+                "ramp_storage", self.ramp_storage,
+                "an integer >= 0 (0 = no queue override; -1: what the ramp holds)",
                 ScenarioError)
+        if self.ramp_storage == -1:
+            object.__setattr__(self, "ramp_storage", ramp_capacity())
         require(self.time_to_teleport == -1 or self.time_to_teleport > 0, "time_to_teleport",
                 self.time_to_teleport, "-1 (off) or a time > 0 s", ScenarioError)
         require(self.hv_model in HV_MODELS, "hv_model", self.hv_model,

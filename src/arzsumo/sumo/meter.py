@@ -12,7 +12,9 @@ red; the yellow's end is not a light change), so that ramp vehicles at the line 
 without an emergency stop. The ramp queue (halted vehicles on ``ramp_up`` plus ramp
 vehicles waiting to be inserted), read by the sensor (:mod:`arzsumo.sumo.sensor`) and
 handed to :meth:`RampMeter.step` every step, and its maximum are tracked; an optional
-spillback override forces green while the queue is at or above ``spillback_queue``.
+queue override forces green while the queue exceeds the ramp's storage
+(``ramp_storage``), and for good once :meth:`MeterLight.drain` hands the meter to the drain
+policy after the control window.
 
 Besides setting the light the meter reads one thing from SUMO, its own stop-line
 detector (:class:`StopLine`): the vehicles leaving ``ramp_up`` (*releases*, counted per
@@ -43,6 +45,9 @@ from arzsumo.sumo.network import METER_TL, RAMP_UP
 GREEN, YELLOW, RED = "G", "y", "r"
 #: vehicles at the head of the ramp whose braking the stop-line detector watches
 HEAD_VEHICLES = 3
+#: the queue override, on above the ramp's storage, stays on until the queue is back at this
+#: share of the storage (rounded down)
+OVERRIDE_OFF = 0.8
 #: braking beyond a vehicle type's ``decel`` by more than this counts as emergency braking
 #: at the meter, m/s^2 (SUMO's own count is network-wide)
 BRAKING_MARGIN = 0.1
@@ -121,6 +126,9 @@ class StopLine:
 
     def __init__(self, lib: ModuleType, edge: str = RAMP_UP) -> None:
         self.lib, self.edge = lib, edge
+        #: every release: (vehicle id, steps since SUMO started when its front had left)
+        self.crossings: list[tuple[str, int]] = []
+        self._steps = 0
         self._on: set[str] = set()
         self._braking: set[str] = set()
         self.emergency_stops = self.emergency_braking = 0
@@ -129,7 +137,10 @@ class StopLine:
         """Vehicles released since the last read; updates the safety counts."""
         ids = self.lib.edge.getLastStepVehicleIDs(self.edge)   # upstream first
         now = set(ids)
-        released = len(self._on - now)
+        self._steps += 1
+        gone = self._on - now
+        self.crossings += [(v, self._steps) for v in sorted(gone)]
+        released = len(gone)
         self._on = now
         veh = self.lib.vehicle
         for v in self.lib.simulation.getEmergencyStoppingVehiclesIDList():
@@ -169,6 +180,9 @@ class MeterLight:
         self.stop_line = StopLine(lib)
         self.plan_changes = self.light_changes = self.override_steps = 0
         self.queue = self.max_queue = 0
+        self.draining = False                 # handed to the drain policy (:meth:`drain`)
+        self.override_on_steps = 0            # steps the queue override was on
+        self._overriding = False
         self.releases = 0
         self.greens: list[GreenRecord] = []   # every green interval since SUMO started
         self._window_greens = 0               # index of the window's first green
@@ -212,6 +226,7 @@ class MeterLight:
         the light; return the light."""
         self.queue = queue
         self.max_queue = max(self.max_queue, queue)
+        self._update_override()
         self._steps += 1
         released = self.stop_line.read()
         self.releases += released
@@ -221,6 +236,7 @@ class MeterLight:
             g.length = self._steps - g.start
             g.green += self.light == GREEN
         self._show(self._plan())
+        self.override_on_steps += self.override() and not self.draining
         return self.light
 
     @property
@@ -229,8 +245,32 @@ class MeterLight:
         return self.greens[-1].releases if self.greens else 0
 
     def override(self) -> bool:
-        """Whether the queue override is on (queue at or above ``cfg.spillback_queue``)."""
-        return bool(self.cfg.spillback_queue) and self.queue >= self.cfg.spillback_queue
+        """Whether the queue override is on: from the step the queue exceeds
+        ``cfg.ramp_storage`` (> 0) until it is back at :data:`OVERRIDE_OFF` of it, or the
+        meter is draining."""
+        return self.draining or self._overriding
+
+    def _update_override(self) -> None:
+        # hysteresis: switched on and off at one threshold the override flickers with the
+        # halted count (a released queue starts moving, is no longer halted, the light
+        # turns red, the queue halts again), every step
+        storage = self.cfg.ramp_storage
+        if storage <= 0:
+            self._overriding = False
+        elif self.queue > storage:
+            self._overriding = True
+        elif self.queue <= math.floor(OVERRIDE_OFF * storage):
+            self._overriding = False
+
+    def override_u(self, q_nominal: float) -> float:
+        """The U (veh/s) the override realises, relative to ``q_nominal`` (veh/s)."""
+        raise NotImplementedError
+
+    def drain(self) -> None:
+        """Hand the meter to the drain policy for the rest of the run: the queue override
+        held on (the highest release rate; the fixed cycle: green), whatever was
+        commanded. Every controller leaves its queue to be discharged the same way."""
+        self.draining = True
 
     def start_window(self) -> dict[str, Any]:
         """Close the current counting window: return its :meth:`summary`, then count anew.
@@ -241,7 +281,7 @@ class MeterLight:
         """
         closed = self.summary()
         self.plan_changes = self.light_changes = self.override_steps = self.releases = 0
-        self.max_queue = 0
+        self.max_queue = self.override_on_steps = 0
         self._window_greens = len(self.greens)
         self.stop_line.emergency_stops = self.stop_line.emergency_braking = 0
         return closed
@@ -260,7 +300,9 @@ class MeterLight:
         greens = self.greens[self._window_greens:]
         return {"plan_changes": self.plan_changes, "light_changes": self.light_changes,
                 "max_queue": self.max_queue, "queue": self.queue,
-                "override_steps": self.override_steps, "green_share": self.green_share,
+                "override_steps": self.override_steps,
+                "override_s": self.override_on_steps * self.dt,
+                "green_share": self.green_share,
                 "mode": self.mode, "clearance_s": self.cfg.meter_clearance,
                 "releases": self.releases, "greens": len(greens),
                 "releases_per_green_max": max((g.releases for g in greens), default=0),
@@ -310,6 +352,11 @@ class RampMeter(MeterLight):
     def green_share(self) -> float:
         """Green share of the running plan."""
         return self.green_steps / self.cycle_steps
+
+    def override_u(self, q_nominal: float) -> float:
+        """U (veh/s) of the override's green (green share 1 on the curve) from
+        ``q_nominal`` (veh/s)."""
+        return self.curve.monotone().outflow_at(1.0) - q_nominal
 
     def set_green_share(self, g: float) -> bool:
         """Request green share ``g``; return True when this is a plan change."""

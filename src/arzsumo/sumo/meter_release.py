@@ -8,8 +8,9 @@ clearance (yellow, ``meter_clearance``) and red for the rest of the cycle. When 
 clearance and ``min_red`` do not fit in 1 / r (a long green) the cycle is stretched to
 hold them. A new r is a *plan change* when its cycle differs by a step or more and takes
 effect at the next cycle start; light changes are counted as for the fixed cycle (starts
-and ends of greens). While the ramp queue is at or above ``spillback_queue`` (> 0) the
-queue override runs the cycles at ``release_rate_max``.
+and ends of greens). While the ramp queue exceeds ``ramp_storage`` (> 0), and while the meter
+drains after the control window, the queue override runs the cycles at
+``release_rate_max``.
 
 The controller's command is an outflow deviation U (veh/s) from the nominal outflow;
 :func:`release_rate_for` maps it to r by one rule: a released ramp vehicle takes one
@@ -55,7 +56,7 @@ class OnePerGreenMeter(MeterLight):
         The libsumo module of the open run.
     cfg : SumoConfig
         Nominal release rate and its bounds, minimum and maximum green, clearance,
-        minimum red, spillback threshold, step.
+        minimum red, ramp storage (the override's threshold), step.
     """
 
     mode = "one_per_green"
@@ -100,6 +101,11 @@ class OnePerGreenMeter(MeterLight):
             self._pending = new
             self.plan_changes += 1
         return self.min_green_steps / self._pending
+
+    def override_u(self, q_nominal: float) -> float:
+        """U (veh/s) of the override's rate: r_nominal - ``release_rate_max``
+        (``q_nominal`` unused, as in :meth:`command`)."""
+        return self.cfg.release_rate - self.cfg.release_rate_max
 
     def command(self, u: float, q_nominal: float) -> float:
         """Command U (veh/s) (``q_nominal`` unused: the rule is relative,

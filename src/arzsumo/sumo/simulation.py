@@ -141,6 +141,9 @@ class SumoSimulation:
         self.collisions = self.teleports = self.emergency_stops = 0
         self.emergency_braking = -1
         self.time = 0.0
+        #: integral of the vehicles in the system (on the network or waiting to be
+        #: inserted) over the run, veh s: counted every step, independently of tripinfo
+        self.in_system_s = 0.0
         self.report: RunReport | None = None
 
     # -- command line --------------------------------------------------------------------
@@ -208,6 +211,8 @@ class SumoSimulation:
         if departed:
             self.inserted_ramp += sum(1 for v in departed if v.startswith("ramp"))
         self.arrived += sim.getArrivedNumber()
+        self.in_system_s += (lib.vehicle.getIDCount() + len(sim.getPendingVehicles())) \
+            * self.cfg.step_length
         self.collisions += sim.getCollidingVehiclesNumber()
         self.emergency_stops += sim.getEmergencyStoppingVehiclesNumber()
         if self.cfg.time_to_teleport > 0:

@@ -101,16 +101,75 @@ class WarmupLedger:
         return WindowStart(float(t), frame, waiting)
 
 
-def window_trips(trips: pd.DataFrame, start: WindowStart, end: float) -> pd.DataFrame:
+@dataclass(frozen=True)
+class WindowEnd:
+    """The system at the end of the control window ``t_s`` when the run goes on (a drain).
+
+    ``on_network``: per vehicle on the network then, SUMO's time loss, waiting time and
+    distance so far (s, m); ``after_g``: per vehicle, fuel and CO2 from ``t_s`` to its
+    arrival (g; summed every drain step, so that its value at ``t_s`` is the tripinfo
+    total minus this).
+    """
+
+    t_s: float
+    on_network: pd.DataFrame
+    after_g: pd.DataFrame
+
+
+def window_end(lib: ModuleType, t: float) -> tuple[pd.DataFrame, WarmupLedger]:
+    """At the end of the window ``t`` (s): the values so far of the vehicles on the
+    network, and a ledger that sums fuel and CO2 from now on (call its ``add`` every
+    drain step; :func:`finish_window` makes the :class:`WindowEnd`)."""
+    ledger = WarmupLedger(lib, lib.simulation.getDeltaT())
+    return ledger.close(t).on_network, ledger
+
+
+def finish_window(t: float, on_network: pd.DataFrame, ledger: WarmupLedger) -> WindowEnd:
+    """The :class:`WindowEnd` of :func:`window_end` once the drain has run."""
+    ids = sorted(set(ledger.fuel_mg))
+    after = pd.DataFrame({"fuel_g": [ledger.fuel_mg[i] / MG_PER_G for i in ids],
+                          "co2_g": [ledger.co2_mg[i] / MG_PER_G for i in ids]},
+                         index=pd.Index(ids, name="id"), dtype=float)
+    return WindowEnd(float(t), on_network.drop(columns=["fuel_g", "co2_g"]), after)
+
+
+def _values_at_end(df: pd.DataFrame, finish: WindowEnd) -> None:
+    """Replace the tripinfo totals of vehicles still in the system at ``finish.t_s`` by
+    their values then (in place; vehicles not inserted by then have none yet)."""
+    t_e = finish.t_s
+    later = (df["arrival_s"] < 0) | (df["arrival_s"] > t_e + 1e-9)
+    inserted = (df["depart_s"] >= 0) & (df["depart_s"] <= t_e + 1e-9)
+    at = finish.on_network.reindex(df["id"]).fillna(0.0)
+    after = finish.after_g.reindex(df["id"]).fillna(0.0)
+    for col in ("sumo_time_loss_s", "waiting_time_s", "distance_m"):
+        df[col] = np.where(later, np.where(inserted, at[col].to_numpy(), 0.0), df[col])
+    for col in ("fuel_g", "co2_g"):
+        now = df[col].to_numpy() - after[col].to_numpy()
+        df[col] = np.where(later, np.where(inserted, now, 0.0), df[col])
+    state = np.where(later, np.where(inserted, "en_route", "waiting"), "completed")
+    df["state"] = np.where(df["depart_s"] < 0, "waiting", state)
+
+
+def window_trips(trips: pd.DataFrame, start: WindowStart, end: float,
+                 finish: WindowEnd | None = None, run_end: float | None = None
+                 ) -> pd.DataFrame:
     """The per-vehicle rows of ``trips`` (:func:`read_trips`) restricted to the control
     window [start.t_s, end]: vehicles not arrived by t_w, their times clipped and their
     accumulated values net of those at t_w (module docstring). Same columns, plus
-    ``due_s`` (wanted departure, s) and ``in_system_at_start`` (bool)."""
-    t_w = start.t_s
+    ``due_s`` (wanted departure, s) and ``in_system_at_start`` (bool).
+
+    When the run went on after ``end`` (a drain, ending at ``run_end``), ``finish`` holds
+    the values at ``end``: accumulated values are taken net of those after it and
+    ``state`` is each vehicle's at ``end``.
+    """
+    t_w, last = start.t_s, end if run_end is None else run_end
     df = trips.copy()
-    inserted_at = np.where(df["depart_s"] >= 0, df["depart_s"], end)
+    inserted_at = np.where(df["depart_s"] >= 0, df["depart_s"], last)
     df["due_s"] = inserted_at - df["depart_delay_s"]
-    stop = np.where(df["arrival_s"] >= 0, df["arrival_s"], end)
+    stop = np.where(df["arrival_s"] >= 0, df["arrival_s"], last)
+    if finish is not None:
+        _values_at_end(df, finish)
+    inserted_at, stop = np.minimum(inserted_at, end), np.minimum(stop, end)
     keep = (stop > t_w + 1e-9) & (df["due_s"] < end + 1e-9)
     df, inserted_at, stop = df[keep].copy(), inserted_at[keep], stop[keep]
     begin = np.maximum(df["due_s"].to_numpy(), t_w)
@@ -126,45 +185,53 @@ def window_trips(trips: pd.DataFrame, start: WindowStart, end: float) -> pd.Data
 
 
 def window_summary(trips: pd.DataFrame, start: WindowStart, end: float,
-                   outlet_left: int) -> dict[str, Any]:
+                   outlet_left: int, finish: WindowEnd | None = None,
+                   run_end: float | None = None) -> dict[str, Any]:
     """The ``network`` dict of the control window (same layout as
     :func:`~arzsumo.sumo.network_measures.aggregate`), with ``window`` and
     ``vehicles.in_system_at_start``.
 
-    ``outlet_left``: vehicles that crossed the section outlet x = L in the window.
+    ``outlet_left``: vehicles that crossed the section outlet x = L in the window;
+    ``finish``, ``run_end``: the values at ``end`` of a run that went on to ``run_end``
+    (s; :func:`window_trips`).
     """
-    df = window_trips(trips, start, end)
+    df = window_trips(trips, start, end, finish, run_end)
     out = aggregate(df, start.t_s, end, outlet_left)
     at = df[df["in_system_at_start"]]
     out["vehicles"]["in_system_at_start"] = {
         **{o: int((at["origin"] == o).sum()) for o in ORIGINS}, "total": len(at)}
     out = {"window": "control window: each vehicle's time inside [begin_s, end_s] "
-                     "(end of warm-up to end of run)", **out}
+                     "(end of warm-up to end of the control horizon)", **out}
     return out
-
 
 
 @dataclass(frozen=True)
 class NetworkMeasures:
-    """A run's network measures: control window, whole run, and SUMO's tripinfo file
-    (gzip-compressed bytes, to keep with the results)."""
+    """A run's network measures: control window, whole run, whole demand (None without a
+    drain), and SUMO's tripinfo file (gzip-compressed bytes, to keep with the results)."""
 
     window: dict[str, Any]
     whole_run: dict[str, Any]
     tripinfo_gz: bytes = field(repr=False)
+    whole_demand: dict[str, Any] | None = None
 
 
 def measure_network(out_dir: Path, start: WindowStart, end: float,
-                    outlet_left_window: int) -> NetworkMeasures:
+                    outlet_left_window: int, finish: WindowEnd | None = None,
+                    run_end: float | None = None) -> tuple[NetworkMeasures, pd.DataFrame]:
     """Read the outputs of a run started with
-    :func:`~arzsumo.sumo.network_measures.network_options` into ``out_dir`` and ended at
-    ``end`` (s); ``outlet_left_window``: vehicles that crossed x = L in the control window.
+    :func:`~arzsumo.sumo.network_measures.network_options` into ``out_dir``, whose control
+    window ended at ``end`` (s) and the run at ``run_end`` (s; ``end`` without a drain,
+    then ``finish`` holds the values at ``end``); ``outlet_left_window``: vehicles that
+    crossed x = L in the control window. Returns the measures and the per-vehicle rows
+    of the whole run (:func:`~arzsumo.sumo.network_measures.read_trips`).
     """
     out_dir = Path(out_dir)
+    last = end if run_end is None else run_end
     whole = {"window": "whole run: each vehicle's time inside [begin_s, end_s] (from t = 0 "
-                       "of SUMO, warm-up included)",
-             **network_summary(out_dir, end_time=end)}
+                       "of SUMO, warm-up and any drain included)",
+             **network_summary(out_dir, end_time=last)}
     trips = read_trips(out_dir / TRIPINFO_FILE)
-    window = window_summary(trips, start, end, outlet_left_window)
+    window = window_summary(trips, start, end, outlet_left_window, finish, run_end)
     blob = gzip.compress((out_dir / TRIPINFO_FILE).read_bytes(), compresslevel=6, mtime=0)
-    return NetworkMeasures(window, whole, blob)
+    return NetworkMeasures(window, whole, blob), trips

@@ -1,0 +1,48 @@
+"""The drain: after the control window, the run goes on until every loaded vehicle has left.
+
+The demand is finite (flows end with the control window, :mod:`arzsumo.sumo.demand`), so
+a controller that stored vehicles on the ramp or upstream leaves them in the system at
+the window's end. Every controller then hands the meter to the same *drain policy*: the
+queue override held on, so the meter releases at its largest rate (one per green:
+``release_rate_max``; the fixed cycle: green) until the network is empty, at most
+``[sumo] drain_max_s``. The policy is the one field meters fall back to when the queue
+reaches the ramp's storage, it needs no state of the controller, and it empties the ramp
+as fast as the meter can: what each controller left is charged the same way, at the
+least cost the meter allows. No controller, sensor or twin runs during the drain; fuel
+and CO2 are summed every step (SUMO's emissions device cannot be read while running) so
+that the control window's measures stay those of the window
+(:func:`arzsumo.sumo.window.finish_window`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from arzsumo.sumo.meter import MeterLight
+from arzsumo.sumo.sensor import ramp_queue
+from arzsumo.sumo.simulation import SumoSimulation
+from arzsumo.sumo.window import WindowEnd, finish_window, window_end
+
+
+@dataclass(frozen=True)
+class Drained:
+    """What the drain left: the window's end (its values then), and the drain's length
+    and limit (s)."""
+
+    end: WindowEnd
+    duration_s: float
+    max_s: float
+
+
+def drain(sim: SumoSimulation, meter: MeterLight, limit: float) -> Drained:
+    """Step ``sim`` after the control window under the drain policy (module docstring)
+    until no vehicle is in the system or expected, at most ``limit`` seconds."""
+    lib = sim.lib
+    t_end = sim.time
+    at_end, ledger = window_end(lib, t_end)
+    meter.drain()
+    while sim.time - t_end < limit - 1e-9 and lib.simulation.getMinExpectedNumber() > 0:
+        sim.step()
+        ledger.add()
+        meter.step(ramp_queue(lib))
+    return Drained(finish_window(t_end, at_end, ledger), sim.time - t_end, limit)
