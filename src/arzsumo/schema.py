@@ -142,14 +142,31 @@ _NETWORK = {"network*.window": TEXT, "network*.begin_s": "s", "network*.end_s": 
             "network*.fuel_g.*": "g", "network*.co2_g.*": "g",
             "network*.distance_m.*": "veh*m", "network*.vehicles.*": "veh",
             "network*.throughput_veh_h.*": "veh/h"}
+#: wave measures of the section per class and lateral file (``section.waves``)
+_WAVE_MEASURES = {"oscillation_kmh": "km/h", "band_power_kmh2": "(km/h)^2",
+                  "total_variance_kmh2": "(km/h)^2", "band_share": "1",
+                  "band_places": "count", "growth_per_km": "1/km",
+                  "amplitude.x_m": "m", "amplitude.sd_kmh": "km/h"}
+_WAVES = {"section.waves.block_m": "m", "section.waves.block_s": "s",
+          "section.waves.band_min_s": "s", "section.waves.band_max_s": "s",
+          "section.waves.window_s": "s", "section.waves.snapshots": "count",
+          "section.waves.lateral_samples": "count", "section.waves.*.file_count": "count",
+          "section.waves.*.files.*.centre_m": "m", "section.waves.*.files.*.share": "1",
+          "section.waves.*.files.*.samples": "count",
+          "section.waves.*.files.*.speed_mean_kmh": "km/h",
+          "section.waves.*.files.*.speed_spread_kmh": "km/h",
+          **{f"section.waves.*.files.*.{k}": u for k, u in _WAVE_MEASURES.items()},
+          **{f"section.waves.*.{k}": u for k, u in _WAVE_MEASURES.items()}}
 #: the measured section over the control window
 _SECTION = {"section.window": TEXT, "section.speed_mean_kmh.*": "km/h",
+            "section.speed_spread_kmh.*": "km/h",
             "section.speed_sd_kmh.*": "km/h", "section.speed_samples.*": "count",
             "section.speed_oscillation_kmh.*": "km/h", "section.oscillation_block_m": "m",
             "section.oscillation_block_s": "s",
             "section.speed_wave.gap_m": "m", "section.speed_wave.max_lag_s": "s",
             "section.speed_wave.*.speed_kmh": "km/h", "section.speed_wave.*.lag_s": "s",
             "section.speed_wave.*.peak_corr": "1", "section.speed_wave.*.pairs": "count",
+            **_WAVES,
             **{f"section.{k}.*": u for k, u in _RUN_INDICES.items()},
             "section.until_s": "s"}
 

@@ -42,3 +42,13 @@ def veh_h_to_veh_s(q: ArrayLike) -> np.ndarray | float:
 def veh_s_to_veh_h(q: ArrayLike) -> np.ndarray | float:
     """Flow from veh/s to veh/h."""
     return (np.asarray(q, dtype=float) if np.ndim(q) else float(q)) * VEH_H_PER_VEH_S
+
+
+def ms2_to_kmh2(p: ArrayLike) -> np.ndarray | float:
+    """A squared speed (a variance or spectral power) from (m/s)^2 to (km/h)^2."""
+    return (np.asarray(p, dtype=float) if np.ndim(p) else float(p)) * KMH_PER_MS ** 2
+
+
+def per_m_to_per_km(g: ArrayLike) -> np.ndarray | float:
+    """A rate along the road from 1/m to 1/km."""
+    return (np.asarray(g, dtype=float) if np.ndim(g) else float(g)) * 1000.0

@@ -82,3 +82,19 @@ def test_markdown_lists_every_measure_and_controller():
     assert "network time loss, total (lower is better) | veh h | alinea | 5 |" in text
     assert "-0.1 [-0.1, -0.1] | 5 / 0 / 0 |" in text
     assert all(math.isnan(v) for v in long[long.measure == "plan_changes"]["mean"])
+
+
+def test_a_renamed_key_reads_its_former_name_in_older_runs():
+    """``section.speed_spread_kmh`` was ``section.speed_sd_kmh``: a baseline borrowed from
+    runs made before the rename still pairs with the new runs."""
+    spread = next(m for m in MEASURES if m.key == "section.speed_spread_kmh.h")
+    assert spread.aliases == ("section.speed_sd_kmh.h",)
+    runs = pd.DataFrame([
+        {"controller": "open", "seed": 1, "section.speed_sd_kmh.h": 20.0},
+        {"controller": "open", "seed": 2, "section.speed_sd_kmh.h": 22.0},
+        {"controller": "alinea", "seed": 1, "section.speed_spread_kmh.h": 18.0},
+        {"controller": "alinea", "seed": 2, "section.speed_spread_kmh.h": 21.0}])
+    row = evaluate(runs, ["open", "alinea"], measures=[spread]).iloc[1]
+    assert row.n == 2 and row.diff_mean == pytest.approx(-1.5) and row.wins == 2
+    keys = {m.key for m in MEASURES}
+    assert {"section.waves.h.band_power_kmh2", "section.waves.a.growth_per_km"} <= keys

@@ -2,6 +2,7 @@
 paired differences are those of the runs' own summaries; a restart runs nothing again."""
 
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -42,7 +43,7 @@ def evaluation(tmp_path_factory):
 def _value(summary: dict, dotted: str) -> float:
     for part in dotted.split("."):
         summary = summary[part]
-    return float(summary)
+    return math.nan if summary is None else float(summary)
 
 
 def test_paired_differences_are_those_of_the_runs(evaluation):
@@ -58,6 +59,9 @@ def test_paired_differences_are_those_of_the_runs(evaluation):
         d = np.array([_value(runs["alinea", s], m.key) - _value(runs["open", s], m.key)
                       for s in SEEDS]) * m.scale
         mean = np.array([_value(runs["alinea", s], m.key) for s in SEEDS]) * m.scale
+        if np.isnan(mean).all():    # the 1-10 min band is not resolved in 30 s: no value
+            assert row["n"] == 0 and m.key.endswith("band_power_kmh2"), m.key
+            continue
         assert row["n"] == 3, m.key
         assert row["diff_mean"] == pytest.approx(d.mean(), abs=1e-9), m.key
         assert row["mean"] == pytest.approx(mean.mean(), abs=1e-9), m.key

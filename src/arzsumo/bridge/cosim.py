@@ -28,7 +28,8 @@ SUMO writes its own outputs (tripinfo of every loaded vehicle with emissions, ed
 statistics; :func:`~arzsumo.sumo.network_measures.network_options`) into a scratch
 directory; after the run they become the network measures of the control window and of
 the whole run (:mod:`arzsumo.sumo.window`, ``CoSimResult.network``), the sensor's speed
-moments of the section (``CoSimResult.section_speed``), and the compressed tripinfo kept
+moments of the section (``CoSimResult.section_speed``; its lateral snapshots:
+``CoSimResult.lateral``), and the compressed tripinfo kept
 with the results.
 
 A detector sample's path: ``SumoSensor.observe`` (libsumo, every step) ->
@@ -330,7 +331,7 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
                        {**loop.plant.timings, **loop.timings}, c.warmup_meter, network,
                        loop.plant.sensor.speeds.summary(), trace.start,
                        np.asarray(c.estimator.fields[1:]), c.estimator,
-                       loop.shift)
+                       loop.shift, loop.plant.sensor.lateral.record())
 
 
 def whole_demand(network: NetworkMeasures, trips: Any, meter: Any, sim: SumoSimulation,

@@ -14,6 +14,7 @@ from arzsumo.model.equilibrium import Equilibrium
 from arzsumo.scenario import Scenario
 from arzsumo.scenario.run import RunSettings
 from arzsumo.sumo.config import SumoConfig
+from arzsumo.sumo.lateral import LateralRecord
 from arzsumo.sumo.simulation import RunReport
 from arzsumo.sumo.window import NetworkMeasures
 
@@ -53,7 +54,8 @@ class CoSimResult:
     #: SUMO's network measures (control window, whole run) and its tripinfo file
     network: NetworkMeasures | None = None
     #: per-vehicle speed moments on the section over the control window, per class
-    #: (``speed_mean_kmh``, ``speed_sd_kmh``, ``speed_samples``)
+    #: (``speed_mean_kmh``, ``speed_spread_kmh`` and its former name ``speed_sd_kmh``,
+    #: ``speed_samples``)
     section_speed: dict[str, dict[str, float]] = field(default_factory=dict)
     #: micro state at the start of control (4, cells), as ``micro``
     start: np.ndarray | None = None
@@ -64,3 +66,6 @@ class CoSimResult:
     #: the offset subtracted from the controller's input (:mod:`~arzsumo.bridge.reference`),
     #: None when its deviations are measured from the equilibrium
     shift: ReferenceShift | None = None
+    #: one snapshot per control period of the window (the last step of period k with
+    #: ``micro[k]``): positions, speeds, lateral offsets and classes of the vehicles on main
+    lateral: LateralRecord | None = None

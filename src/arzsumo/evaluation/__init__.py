@@ -3,6 +3,9 @@ network-wide measures from SUMO's own outputs).
 
 * :mod:`~arzsumo.evaluation.stats`: mean with a 95 % t interval, paired differences
   treatment - baseline with t and bootstrap intervals, wins and losses per seed.
+* :mod:`~arzsumo.evaluation.fields` and :mod:`~arzsumo.evaluation.waves`: block means of
+  space-time fields, their oscillation, direction of travel, stop-and-go band power and
+  growth upstream, and the lateral files of a class.
 * :mod:`~arzsumo.evaluation.report`: the measures of ``arzsumo evaluate`` and their table
   (per controller: mean and CI; paired difference against the open loop, wins, losses).
 

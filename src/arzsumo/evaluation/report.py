@@ -30,7 +30,8 @@ class Measure:
     """One measure of the evaluation.
 
     ``key``: dotted summary key (SI); ``scale``: factor from the summary's unit to
-    ``unit``; ``lower_is_better``: direction used for wins and losses.
+    ``unit``; ``lower_is_better``: direction used for wins and losses; ``aliases``:
+    former names of the key, read where a run (an older summary) lacks ``key``.
     """
 
     key: str
@@ -38,12 +39,15 @@ class Measure:
     unit: str
     scale: float = 1.0
     lower_is_better: bool = True
+    aliases: tuple[str, ...] = ()
 
 
 def _split(key: str, label: str, unit: str, scale: float) -> tuple[Measure, ...]:
     return tuple(Measure(f"{key}.{part}", f"{label}, {part}", unit, scale)
                  for part in ("mainline", "ramp", "total"))
 
+
+_CLASSES = (("h", "HV"), ("a", "AV"))
 
 #: the measures, in report order
 MEASURES: tuple[Measure, ...] = (
@@ -56,10 +60,16 @@ MEASURES: tuple[Measure, ...] = (
             1.0, lower_is_better=False),
     Measure("network.fuel_g.total", "network fuel", "kg", 1e-3),
     Measure("network.co2_g.total", "network CO2", "kg", 1e-3),
-    Measure("section.speed_sd_kmh.h", "section speed sd, HV", "km/h"),
-    Measure("section.speed_sd_kmh.a", "section speed sd, AV", "km/h"),
-    Measure("section.speed_oscillation_kmh.h", "section speed oscillation, HV", "km/h"),
-    Measure("section.speed_oscillation_kmh.a", "section speed oscillation, AV", "km/h"),
+    *(Measure(f"section.speed_spread_kmh.{c}",
+              f"section speed spread across vehicles, {name}", "km/h",
+              aliases=(f"section.speed_sd_kmh.{c}",)) for c, name in _CLASSES),
+    *(Measure(f"section.speed_oscillation_kmh.{c}", f"section speed oscillation, {name}",
+              "km/h") for c, name in _CLASSES),
+    *(Measure(f"section.waves.{c}.band_power_kmh2",
+              f"section stop-and-go band power (1-10 min), {name}", "(km/h)^2")
+      for c, name in _CLASSES),
+    *(Measure(f"section.waves.{c}.growth_per_km", f"section wave growth upstream, {name}",
+              "1/km") for c, name in _CLASSES),
     Measure("section.TTT.total", "section TTT", "veh h", 1 / S_PER_H),
     Measure("section.total_delay.total", "section delay", "veh h", 1 / S_PER_H),
     Measure("plan_changes", "meter plan changes", "count"),
@@ -75,10 +85,11 @@ COLUMNS = ("measure", "label", "unit", "lower_is_better", "controller", "n", "me
 
 def per_seed(runs: pd.DataFrame, measure: Measure, controllers: Sequence[str]) -> pd.DataFrame:
     """Seeds x controllers table of ``measure`` in its human unit (NaN where missing)."""
-    if measure.key not in runs:
-        values = pd.Series(math.nan, index=runs.index)
-    else:
-        values = pd.to_numeric(runs[measure.key], errors="coerce") * measure.scale
+    values = pd.Series(math.nan, index=runs.index)
+    for key in (measure.key, *measure.aliases):     # a former name fills older runs
+        if key in runs:
+            values = values.fillna(pd.to_numeric(runs[key], errors="coerce"))
+    values = values * measure.scale
     wide = pd.DataFrame({"seed": runs["seed"], "controller": runs["controller"],
                          "value": values}).pivot(index="seed", columns="controller",
                                                  values="value")

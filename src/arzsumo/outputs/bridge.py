@@ -49,6 +49,7 @@ from arzsumo.evaluation.stationarity import count_trend
 from arzsumo.io import json_safe
 from arzsumo.model.characteristic import linearize
 from arzsumo.outdir import OutputDir, atomic_dir, target_of
+from arzsumo.outputs.waves import waves_summary
 from arzsumo.schema import CELLS, PERIODS, RUN_SUMMARY, key_units, with_units
 from arzsumo.twin.metrics import performance
 from arzsumo.units import ms_to_kmh
@@ -165,7 +166,9 @@ def warmup_summary(res: CoSimResult) -> dict[str, Any]:
 
 #: ``summary.json["section"]["window"]``
 SECTION_WINDOW = ("measured section x in [0, L] over the control window: indices from the "
-                  "Edie cells, speed moments from every vehicle on main every step")
+                  "Edie cells, speed moments from every vehicle on main every step, wave "
+                  "measures from block means of the Edie speeds and, per lateral file, "
+                  "of one snapshot of the vehicles per control period")
 
 
 def _blocks(res: CoSimResult) -> tuple[int, int]:
@@ -177,7 +180,8 @@ def _blocks(res: CoSimResult) -> tuple[int, int]:
 def speed_oscillation(res: CoSimResult) -> dict[str, Any]:
     """Per class, the RMS over places of the temporal sd of the micro speed (km/h) on
     RMSE_BLOCK_M x RMSE_BLOCK_S blocks (:func:`arzsumo.evaluation.fields.oscillation`): the
-    waves, without the mean speed profile that the pooled ``speed_sd_kmh`` also counts."""
+    waves, without the mean speed profile and the lateral files that the spread across
+    vehicles ``speed_spread_kmh`` also counts."""
     periods, cells = _blocks(res)
     sd = oscillation(res.micro[:, [1, 3]], periods, cells)
     return {"speed_oscillation_kmh": {"h": float(ms_to_kmh(sd[0])),
@@ -208,12 +212,15 @@ def speed_wave(res: CoSimResult) -> dict[str, Any]:
 
 
 def section_summary(res: CoSimResult, micro: dict[str, Any]) -> dict[str, Any]:
-    """The section's measures, labelled as such: per-vehicle speed moments per class (km/h),
-    the speed oscillation (:func:`speed_oscillation`), the waves' direction
-    (:func:`speed_wave`) and the micro indices ``micro``
+    """The section's measures, labelled as such: per-vehicle speed moments per class (km/h;
+    ``speed_spread_kmh``, the spread across vehicles, also under its former name
+    ``speed_sd_kmh``), the speed oscillation (:func:`speed_oscillation`), the waves'
+    direction (:func:`speed_wave`), the wave measures per class and lateral file
+    (:func:`arzsumo.outputs.waves.waves_summary`) and the micro indices ``micro``
     (:func:`_indices`; also at the top level, kept for compatibility)."""
     return {"window": SECTION_WINDOW, **res.section_speed, **speed_oscillation(res),
-            "speed_wave": speed_wave(res), **micro}
+            "speed_wave": speed_wave(res), "waves": waves_summary(res, *_blocks(res)),
+            **micro}
 
 
 #: ``summary.json["meter"]``: keys of the meter's own summary kept there (control window)

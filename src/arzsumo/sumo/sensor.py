@@ -13,7 +13,8 @@ One :class:`SumoSensor` per run. After each SUMO step :meth:`SumoSensor.observe`
   reporting AVs (:class:`~arzsumo.sumo.probes.AvProbes`, from the sample above),
 * until the control window opens (:meth:`SumoSensor.start_window`), every vehicle's fuel
   and CO2 (:class:`~arzsumo.sumo.window.WarmupLedger`); after, the speed moments per class
-  of the vehicles on ``main`` (:class:`SpeedMoments`, from the samples above),
+  of the vehicles on ``main`` (:class:`SpeedMoments`, from the samples above) and, at
+  a period's last step, their lateral offsets (:class:`~arzsumo.sumo.lateral.LateralSampler`),
 
 and when a control period is complete returns one :class:`PeriodMeasurement`. Nothing
 else in the closed loop reads SUMO; the meter only writes the traffic light.
@@ -34,6 +35,7 @@ from arzsumo.estimate.observations import (
     ProbeObservation,
 )
 from arzsumo.sumo.config import SumoConfig
+from arzsumo.sumo.lateral import LateralSampler
 from arzsumo.sumo.loops import LoopSensor
 from arzsumo.sumo.measure import CellData, MainlineSensor
 from arzsumo.sumo.network import DOWN, RAMP_UP
@@ -77,7 +79,11 @@ class PeriodMeasurement:
 
 class SpeedMoments:
     """Count, sum and sum of squares of per-vehicle speeds (m/s) per class (HV, AV),
-    accumulated over vehicle-steps."""
+    accumulated over vehicle-steps.
+
+    Their sd is the spread across vehicles: it pools lateral files riding at different
+    speeds, the mean speed profile along the section and waves alike; the waves alone
+    are measured on block speeds (:mod:`arzsumo.evaluation.waves`)."""
 
     CLASSES = ("h", "a")
 
@@ -94,15 +100,17 @@ class SpeedMoments:
         self.s2 += np.bincount(k, weights=speed * speed, minlength=2)
 
     def summary(self) -> dict[str, dict[str, float]]:
-        """``speed_mean_kmh``, ``speed_sd_kmh`` (sample sd, km/h; NaN with fewer than two
-        samples) and ``speed_samples`` (vehicle-steps), per class."""
-        out: dict[str, dict[str, float]] = {"speed_mean_kmh": {}, "speed_sd_kmh": {},
-                                            "speed_samples": {}}
+        """``speed_mean_kmh``, ``speed_spread_kmh`` (sample sd across vehicle-steps, km/h;
+        NaN with fewer than two samples), ``speed_sd_kmh`` (the same, its former name, kept
+        for reports that read it) and ``speed_samples`` (vehicle-steps), per class."""
+        out: dict[str, dict[str, float]] = {"speed_mean_kmh": {}, "speed_spread_kmh": {},
+                                            "speed_sd_kmh": {}, "speed_samples": {}}
         for c, n, s1, s2 in zip(self.CLASSES, self.n, self.s1, self.s2, strict=True):
             mean = s1 / n if n else math.nan
             var = max(s2 - s1 * s1 / n, 0.0) / (n - 1) if n > 1 else math.nan
             out["speed_mean_kmh"][c] = float(ms_to_kmh(mean))
-            out["speed_sd_kmh"][c] = float(ms_to_kmh(math.sqrt(var)))
+            out["speed_spread_kmh"][c] = float(ms_to_kmh(math.sqrt(var)))
+            out["speed_sd_kmh"][c] = out["speed_spread_kmh"][c]
             out["speed_samples"][c] = int(n)
         return out
 
@@ -145,6 +153,7 @@ class SumoSensor:
         self.ledger = WarmupLedger(lib, cfg.step_length) if window else None
         self.window_open = False
         self.speeds = SpeedMoments()
+        self.lateral = LateralSampler(lib)
 
     def start_window(self, t: float) -> WindowStart:
         """Open the control window at ``t`` (s): the system's state now (for the window's
@@ -171,6 +180,8 @@ class SumoSensor:
         occupancy = self._occupancy_sum / self._steps
         self._occupancy_sum, self._steps = 0.0, 0
         m = self.mainline
+        if self.window_open:     # once per period: a libsumo call per vehicle
+            self.lateral.sample(t, m.last_ids, m.last_pos, m.last_speed, m.last_av)
         probes = self.probes.observe(t, m.last_ids, m.last_pos, m.last_speed, m.last_av) \
             if self.probes is not None else None
         return PeriodMeasurement(cells, occupancy, self.queue, loops, probes)
