@@ -63,7 +63,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--controllers", default="open,alinea,backstepping,etc,observer-etc",
                    help="comma-separated controllers; open (the baseline) is added first "
                         "when missing")
-    p.add_argument("--seeds", type=positive_int, default=10, help="number of seeds N")
+    p.add_argument("--seeds", type=positive_int, default=20,
+                   help="number of seeds N (20: a headline needs 20 paired seeds)")
     p.add_argument("--seed-start", type=seed_int, default=1,
                    help="first seed S: the seeds are S, S+1, ..., S+N-1")
     p.add_argument("--horizon", type=positive_float,

@@ -79,7 +79,7 @@ def test_markdown_lists_every_measure_and_controller():
     text = markdown(long)
     assert text.count("\n") == 1 + 2 * len(MEASURES)
     assert "| time loss" not in text          # only the default measures
-    assert "network time loss, total (lower is better) | veh h | alinea | 5 |" in text
+    assert "window time loss, total (lower is better) | veh h | alinea | 5 |" in text
     assert "-0.1 [-0.1, -0.1] | 5 / 0 / 0 |" in text
     assert all(math.isnan(v) for v in long[long.measure == "plan_changes"]["mean"])
 

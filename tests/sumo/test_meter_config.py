@@ -1,5 +1,7 @@
 """Meter realisation settings and the outflow-command-to-release-rate rule (no SUMO)."""
 
+import re
+
 import pytest
 
 from arzsumo.errors import ArzsumoError, ScenarioError
@@ -62,3 +64,25 @@ def test_clearance_is_taken_from_the_red_of_the_cycle():
     assert plan_green_steps(0.5, 60, 10, 10 + 20) == 30    # yellow 20, red 10
     assert plan_green_steps(0.6, 60, 10, 10 + 20) == 30    # the red holds yellow + min red
     assert plan_green_steps(0.8, 60, 10, 10 + 20) == 60    # nearer all green
+
+
+@pytest.mark.parametrize(("table", "message"), [
+    ({"meter_mode": "one_per_green", "green_share": 0},
+     'green_share = 0 is not allowed with meter_mode = "one_per_green": it acts only under '
+     'meter_mode = "fixed_cycle"; allowed: remove it, or set meter_mode = "fixed_cycle"'),
+    ({"meter_mode": "one_per_green", "meter_cycle_s": 6}, "meter_cycle_s = 6 is not allowed"),
+    ({"release_rate_max_veh_h": 900}, 'release_rate_max_veh_h = 900 is not allowed with '
+                                      'meter_mode = "fixed_cycle"'),
+    ({"meter_mode": "fixed_cycle", "max_green_s": 3}, "max_green_s = 3 is not allowed"),
+])
+def test_a_key_the_meter_mode_ignores_is_refused(table, message):
+    with pytest.raises(ScenarioError, match=re.escape(message)):
+        scenario_from_dict({"sumo": table})
+
+
+def test_keys_of_the_chosen_meter_mode_are_accepted():
+    cfg = scenario_from_dict({"sumo": {"meter_mode": "one_per_green",
+                                       "release_rate_veh_h": 500, "max_green_s": 3}}).sumo
+    assert cfg.release_rate == pytest.approx(500 / 3600) and cfg.green_share == 0.5
+    cfg = scenario_from_dict({"sumo": {"green_share": 0.3, "meter_cycle_s": 8}}).sumo
+    assert (cfg.green_share, cfg.meter_cycle) == (0.3, 8.0)

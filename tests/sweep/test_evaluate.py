@@ -77,7 +77,7 @@ def test_paired_differences_are_those_of_the_runs(evaluation):
     assert (base["diff_ci_high"] == 0).all() and (base["ties"] == 3).all()
     assert (out / "paired_differences.png").stat().st_size > 10_000
     text = (out / "evaluation.md").read_text()
-    assert "| network time loss, total (lower is better) | veh h | alinea | 3 |" in text
+    assert "| window time loss, total (lower is better) | veh h | alinea | 3 |" in text
 
 
 def test_a_restart_runs_nothing_again(evaluation, capsys):

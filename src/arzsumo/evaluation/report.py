@@ -49,20 +49,26 @@ def _split(key: str, label: str, unit: str, scale: float) -> tuple[Measure, ...]
 
 _CLASSES = (("h", "HV"), ("a", "AV"))
 
-#: the measures, in report order
+_WHOLE = "network_whole_demand"
+_WAIT = f"{_WHOLE}.ramp_wait_s"
+
+#: the measures, in report order: the whole demand first (every loaded vehicle to its
+#: arrival: what a controller leaves behind is charged), then the waves, then the meter's
+#: counts, then the control window's own measures
 MEASURES: tuple[Measure, ...] = (
-    *_split("network.time_spent_s", "network time spent", "veh h", 1 / S_PER_H),
-    *_split("network.time_loss_s", "network time loss", "veh h", 1 / S_PER_H),
-    *_split("network.depart_delay_s", "network depart delay", "veh h", 1 / S_PER_H),
-    Measure("network.throughput_veh_h.section_outlet", "throughput, section outlet", "veh/h",
-            1.0, lower_is_better=False),
-    Measure("network.throughput_veh_h.network_exit", "throughput, network exit", "veh/h",
-            1.0, lower_is_better=False),
-    Measure("network.fuel_g.total", "network fuel", "kg", 1e-3),
-    Measure("network.co2_g.total", "network CO2", "kg", 1e-3),
-    *(Measure(f"section.speed_spread_kmh.{c}",
-              f"section speed spread across vehicles, {name}", "km/h",
-              aliases=(f"section.speed_sd_kmh.{c}",)) for c, name in _CLASSES),
+    Measure(f"{_WHOLE}.time_spent_s.total", "whole-demand time spent, total", "veh h",
+            1 / S_PER_H),
+    Measure(f"{_WHOLE}.time_spent_s.mainline", "whole-demand time spent, mainline", "veh h",
+            1 / S_PER_H),
+    Measure(f"{_WHOLE}.time_spent_s.ramp", "whole-demand time spent, ramp", "veh h",
+            1 / S_PER_H),
+    Measure(f"{_WHOLE}.time_loss_s.total", "whole-demand time loss, total", "veh h",
+            1 / S_PER_H),
+    Measure(f"{_WHOLE}.fuel_g.total", "whole-demand fuel", "kg", 1e-3),
+    Measure(f"{_WAIT}.p95", "ramp wait at the meter, 95th percentile", "s"),
+    Measure(f"{_WAIT}.max", "ramp wait at the meter, maximum", "s"),
+    Measure(f"{_WAIT}.over_limit", "ramp vehicles waiting over 240 s", "veh"),
+    Measure(f"{_WHOLE}.drain.duration_s", "drain after the window", "s"),
     *(Measure(f"section.speed_oscillation_kmh.{c}", f"section speed oscillation, {name}",
               "km/h") for c, name in _CLASSES),
     *(Measure(f"section.waves.{c}.band_power_kmh2",
@@ -70,11 +76,24 @@ MEASURES: tuple[Measure, ...] = (
       for c, name in _CLASSES),
     *(Measure(f"section.waves.{c}.growth_per_km", f"section wave growth upstream, {name}",
               "1/km") for c, name in _CLASSES),
-    Measure("section.TTT.total", "section TTT", "veh h", 1 / S_PER_H),
-    Measure("section.total_delay.total", "section delay", "veh h", 1 / S_PER_H),
     Measure("plan_changes", "meter plan changes", "count"),
     Measure("light_changes", "ramp-light changes", "count"),
     Measure("triggers", "controller updates (triggers)", "count"),
+    Measure("meter.override_s", "queue override on (window)", "s"),
+    *_split("network.time_spent_s", "window time spent", "veh h", 1 / S_PER_H),
+    *_split("network.time_loss_s", "window time loss", "veh h", 1 / S_PER_H),
+    *_split("network.depart_delay_s", "window depart delay", "veh h", 1 / S_PER_H),
+    Measure("network.throughput_veh_h.section_outlet", "throughput, section outlet", "veh/h",
+            1.0, lower_is_better=False),
+    Measure("network.throughput_veh_h.network_exit", "throughput, network exit", "veh/h",
+            1.0, lower_is_better=False),
+    Measure("network.fuel_g.total", "window fuel", "kg", 1e-3),
+    Measure("network.co2_g.total", "window CO2", "kg", 1e-3),
+    *(Measure(f"section.speed_spread_kmh.{c}",
+              f"section speed spread across vehicles, {name}", "km/h",
+              aliases=(f"section.speed_sd_kmh.{c}",)) for c, name in _CLASSES),
+    Measure("section.TTT.total", "section TTT", "veh h", 1 / S_PER_H),
+    Measure("section.total_delay.total", "section delay", "veh h", 1 / S_PER_H),
 )
 
 #: columns of the long table, in order (``evaluation.csv``)

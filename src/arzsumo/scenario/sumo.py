@@ -110,6 +110,28 @@ SUMO_KEYS: dict[str, Key] = {
 }
 
 
+#: [sumo] keys that act under one meter_mode only: under the other they would be ignored
+MODE_ONLY_KEYS: dict[str, tuple[str, ...]] = {
+    "fixed_cycle": ("green_share", "green_share_min", "green_share_max", "meter_cycle_s"),
+    "one_per_green": ("release_rate_veh_h", "release_rate_min_veh_h", "release_rate_max_veh_h",
+                      "max_green_s"),
+}
+
+
+def refuse_inert_meter_keys(table: Mapping[str, Any], at: str, mode: str) -> None:
+    """Refuse a key of ``table`` that the meter realisation ``mode`` would ignore (a user
+    who sets ``green_share = 0`` under one per green expecting a red meter would get the
+    nominal release rate)."""
+    for other, keys in MODE_ONLY_KEYS.items():
+        bad = [k for k in keys if k in table and other != mode]
+        if bad:
+            k = bad[0]
+            raise ScenarioError(
+                f"{at} {k} = {written(table[k])} is not allowed with meter_mode = "
+                f"{written(mode)}: it acts only under meter_mode = {written(other)}; "
+                f"allowed: remove it, or set meter_mode = {written(other)}")
+
+
 def sumo_section(table: Mapping[str, Any], at: str, source: str = "<dict>") -> SumoConfig:
     """The SumoConfig of a ``[sumo]`` table (keys already checked against SUMO_KEYS).
 
@@ -121,6 +143,7 @@ def sumo_section(table: Mapping[str, Any], at: str, source: str = "<dict>") -> S
         cfg = SumoConfig(**changes)
     except ArzsumoError as exc:
         raise in_user_terms(exc, at, table, SUMO_KEYS) from None
+    refuse_inert_meter_keys(table, at, cfg.meter_mode)
     if not cfg.meter_curve:
         return cfg
     path = Path(cfg.meter_curve).expanduser()

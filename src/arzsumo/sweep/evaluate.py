@@ -46,6 +46,8 @@ from arzsumo.sweep.worker import FINISHED
 
 #: marker kind of an evaluation directory
 KIND = "evaluation"
+#: the headline measure's column in the sweep table
+WHOLE_DEMAND_KEY = "network_whole_demand.time_spent_s.total"
 #: the controller every other one is compared with
 BASELINE = "open"
 #: what --overwrite removes from a previous evaluation directory (ours: it has our marker)
@@ -270,8 +272,20 @@ def _header(name: str, scenario: Path, controllers: Sequence[str], seeds: Sequen
              f"{len(ok)} of {total} runs finished. Control window: {one('horizon')} s after "
              f"a warm-up of {one('warmup.duration_s')} s. Differences: controller minus "
              f"{BASELINE} on the same seed; 95 % intervals (Student t; the CSV adds the "
-             "bootstrap). Network measures cover the control window and every vehicle "
-             "loaded (docs/outputs.md)."]
+             "bootstrap). The headline is the whole-demand time spent: every loaded "
+             "vehicle from its insertion request to its arrival, the drain after the "
+             "window included (docs/outputs.md); the window measures follow."]
+    if f"{WHOLE_DEMAND_KEY}" in ok and ok[WHOLE_DEMAND_KEY].isna().all():
+        lines += ["", "**No whole-demand measures**: the scenario has no drain "
+                      "(`[sumo] drain_max_s` = 0), so a queue left at the window's end is "
+                      "not charged; compare controllers on the window measures with care."]
+    elif WHOLE_DEMAND_KEY not in ok:
+        lines += ["", "**No whole-demand measures**: the scenario has no drain "
+                      "(`[sumo] drain_max_s` = 0)."]
+    incomplete = int((ok.get("network_whole_demand.complete") == False).sum())  # noqa: E712
+    if incomplete:
+        lines += ["", f"**{incomplete} run(s) hit the drain limit** (`[sumo] drain_max_s`): "
+                      "their whole-demand measures leave vehicles uncharged."]
     if command:
         lines += ["", f"Command: `{command}`"]
     return "\n".join(lines)
