@@ -14,6 +14,7 @@ from arzsumo.model.equilibrium import Equilibrium
 from arzsumo.scenario import Scenario
 from arzsumo.scenario.run import RunSettings
 from arzsumo.sumo.config import SumoConfig
+from arzsumo.sumo.run_files import RunFiles
 from arzsumo.sumo.simulation import RunReport
 from arzsumo.sumo.window import NetworkMeasures
 
@@ -64,3 +65,6 @@ class CoSimResult:
     #: the offset subtracted from the controller's input (:mod:`~arzsumo.bridge.reference`),
     #: None when its deviations are measured from the equilibrium
     shift: ReferenceShift | None = None
+    #: the SUMO configuration the run ran (``run.sumocfg``, ``sumo/``) and, with
+    #: ``[sumo] fcd``, its FCD output, to be placed into the results directory
+    files: RunFiles | None = None
