@@ -62,3 +62,15 @@ def test_gui_without_sumo_gui_is_one_line_and_exit_2(monkeypatch, tmp_path, caps
     err = capsys.readouterr().err.strip()
     assert "binary = 'sumo-gui-not-installed' is not in" in err and "\n" not in err
     assert not out.exists()
+
+
+@pytest.mark.sumo
+def test_gui_on_a_display_it_cannot_open_is_one_line_and_exit_2(monkeypatch, tmp_path, capsys):
+    monkeypatch.setenv("DISPLAY", ":99")            # no X server there: sumo-gui exits at once
+    out = tmp_path / "out"
+    assert main([*RUN, "--controller", "open", "--no-plots", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert err == ("arzsumo: error: SUMO did not start: Could not connect; allowed: --gui "
+                   "with a display sumo-gui can open (DISPLAY = ':99'), or the run without "
+                   "--gui")
+    assert not out.exists()

@@ -91,3 +91,25 @@ class Frontend:
         import traci
 
         return traci
+
+    def start(self, lib: ModuleType, cmd: list[str]) -> None:
+        """Start SUMO with ``cmd`` through ``lib`` (:meth:`load`).
+
+        TraCI gets a fixed port: without one, traci starts the binary again on a new port
+        after every failed start (a minute of retries when sumo-gui cannot open its
+        display). Its retry messages go to no one; SUMO's own output is left alone.
+        """
+        if self.module_name == "libsumo":
+            lib.start(cmd)
+            return
+        from sumolib.miscutils import getFreeSocketPort
+
+        with contextlib.redirect_stdout(io.StringIO()):
+            lib.start(cmd, port=getFreeSocketPort())
+
+    def failed_hint(self) -> str:
+        """What to try when the binary did not start ("" for plain SUMO)."""
+        if not self.gui:
+            return ""
+        return (f"; allowed: --gui with a display sumo-gui can open (DISPLAY = "
+                f"{os.environ.get('DISPLAY', '')!r}), or the run without --gui")

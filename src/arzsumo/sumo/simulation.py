@@ -173,10 +173,11 @@ class SumoSimulation:
             raise
         lib = self.frontend.load()
         try:
-            lib.start(self.command())
+            self.frontend.start(lib, self.command())
         except Exception as exc:
             self._remove_files()
-            raise SumoError(f"SUMO did not start: {_one_line(exc)}") from None
+            raise SumoError(f"SUMO did not start: {_one_line(exc).rstrip('.')}"
+                            f"{self.frontend.failed_hint()}") from None
         self._lib, self.started, _ACTIVE = lib, True, self
         self.time = float(lib.simulation.getTime())
         log.debug("SUMO started: seed %d, step %.3g s", self.cfg.seed, self.cfg.step_length)
