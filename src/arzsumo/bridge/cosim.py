@@ -29,7 +29,9 @@ statistics; :func:`~arzsumo.sumo.network_measures.network_options`) into a scrat
 directory; after the run they become the network measures of the control window and of
 the whole run (:mod:`arzsumo.sumo.window`, ``CoSimResult.network``), the sensor's speed
 moments of the section (``CoSimResult.section_speed``), and the compressed tripinfo kept
-with the results.
+with the results. The run's SUMO configuration (``run.sumocfg`` and its files) and, with
+``[sumo] fcd``, SUMO's FCD output are kept in ``CoSimResult.files``
+(:mod:`arzsumo.sumo.run_files`) for the results directory.
 
 A detector sample's path: ``SumoSensor.observe`` (libsumo, every step) ->
 ``PeriodMeasurement`` -> ``Estimator.estimate`` -> ``MacroState`` -> ``Controller.check``

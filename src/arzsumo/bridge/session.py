@@ -68,7 +68,8 @@ class PreparedRun:
                 f"control horizon {c.horizon:g} s, SUMO seed {c.seed}, step {c.step_length:g} s"
                 f"\n  equilibrium {s.equilibrium} (scenario lambda_4 = {lam4:.2f} km/h)"
                 f"\n  estimation {self.scenario.estimation.method} from sensors "
-                f"{', '.join(self.scenario.sensing.kinds)}")
+                f"{', '.join(self.scenario.sensing.kinds)}"
+                + ("\n  SUMO's FCD output kept (fcd.xml.gz)" if c.fcd else ""))
 
 
 def _seed(seed: int) -> int:
