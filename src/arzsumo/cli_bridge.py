@@ -19,12 +19,16 @@ def cmd_run(args: argparse.Namespace) -> int:
     from arzsumo.outputs.bridge import write_results
     from arzsumo.resources import default_scenario
     from arzsumo.scenario import load_scenario
+    from arzsumo.sumo.frontend import Frontend
 
     # the shipped default, found in the package so that any working directory will do
     path = Path(args.scenario) if args.scenario else default_scenario()
     sc = load_scenario(path)
+    fcd = True if args.fcd else None   # without --fcd the scenario's [sumo] fcd holds
     prepared = prepare_run(sc, controller=args.controller, seed=args.seed,
-                           horizon=args.horizon, warmup=args.warmup)
+                           horizon=args.horizon, warmup=args.warmup, fcd=fcd)
+    frontend = "gui" if args.gui else "libsumo"
+    Frontend(frontend).check()   # no display or no sumo-gui: one line, before any output
     if args.dry_run:
         print(prepared.describe())
         return 0
@@ -33,8 +37,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     # the output is checked and claimed before SUMO starts; Ctrl-C or an error removes it
     with OutputDir(out, "run", overwrite=args.overwrite) as target:
         session = run_in_sumo(sc, controller=args.controller, seed=args.seed,
-                              horizon=args.horizon, warmup=args.warmup,
-                              progress=not args.quiet)
+                              horizon=args.horizon, warmup=args.warmup, fcd=fcd,
+                              progress=not args.quiet, frontend=frontend)
         text = path.read_text(encoding="utf-8") + session.resolved_comment()
         _, summ = write_results(session.result, target, text, plots=not args.no_plots)
     if args.json:
@@ -84,6 +88,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--dry-run", action="store_true",
                    help="check the scenario and the options as the run would, print what "
                         "it would do, and exit without starting SUMO")
+    p.add_argument("--fcd", action="store_true",
+                   help="keep SUMO's trajectories of every vehicle every step in "
+                        "fcd.xml.gz (as [sumo] fcd = true)")
+    p.add_argument("--gui", action="store_true",
+                   help="watch the run in sumo-gui (driven through TraCI; slower; needs a "
+                        "display)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG figures")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")

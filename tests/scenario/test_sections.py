@@ -54,6 +54,7 @@ def test_every_shipped_sweep_loads_and_its_runs_parse(path):
                                          r"allowed: one of open, backstepping, etc"),
     ({"sumo": {"ramp_demand_veh_h": -1}}, r"^s.toml: \[sumo\] ramp_demand_veh_h = -1 is not "
                                           r"allowed: a demand >= 0 veh/h$"),
+    ({"sumo": {"fcd": "yes"}}, r'^s.toml: \[sumo\] fcd = "yes" is not allowed: true or false$'),
     ({"run": {"controller": "constant"}}, r'^s.toml: \[run\] controller = "constant" is not'),
     ({"run": {"smoothing_s": 0}}, r"^s.toml: \[run\] smoothing_s = 0 is not allowed"),
     ({"sweep": {"parameter": "mu", "values": ["a"]}}, r'^s.toml: \[sweep\] values = \["a"\]'),

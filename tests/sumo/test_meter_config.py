@@ -8,7 +8,8 @@ from arzsumo.errors import ArzsumoError, ScenarioError
 from arzsumo.scenario import scenario_from_dict
 from arzsumo.sumo.config import SumoConfig, ramp_capacity
 from arzsumo.sumo.meter import plan_green_steps
-from arzsumo.sumo.meter_release import release_rate_for
+from arzsumo.sumo.meter_release import nominal_phases, release_rate_for
+from arzsumo.sumo.run_files import meter_program_text
 
 
 def test_meter_keys_convert_units_and_default_to_todays_meter():
@@ -86,3 +87,25 @@ def test_keys_of_the_chosen_meter_mode_are_accepted():
     assert cfg.release_rate == pytest.approx(500 / 3600) and cfg.green_share == 0.5
     cfg = scenario_from_dict({"sumo": {"green_share": 0.3, "meter_cycle_s": 8}}).sumo
     assert (cfg.green_share, cfg.meter_cycle) == (0.3, 8.0)
+
+
+@pytest.mark.parametrize(("changes", "phases"), [
+    ({}, [("G", 30), ("r", 30)]),                                  # 6 s cycle, share 0.5
+    ({"meter_clearance": 2.0}, [("G", 30), ("y", 20), ("r", 10)]),
+    ({"green_share": 0.0}, [("r", 60)]), ({"green_share": 1.0}, [("G", 60)]),
+    ({"meter_mode": "one_per_green", "meter_clearance": 2.0},      # 600 veh/h: 6 s cycle
+     [("G", 10), ("y", 20), ("r", 30)]),
+    ({"meter_mode": "one_per_green", "release_rate": 900 / 3600},  # 4 s cycle, no yellow
+     [("G", 10), ("r", 30)]),
+])
+def test_the_nominal_plan_as_phases_of_whole_steps(changes, phases):
+    cfg = SumoConfig(**changes)
+    assert nominal_phases(cfg) == phases
+    assert sum(n for _, n in phases) * cfg.step_length == pytest.approx(
+        1 / cfg.release_rate if cfg.meter_mode == "one_per_green" else cfg.meter_cycle)
+
+
+def test_the_nominal_plan_becomes_a_static_program_of_the_meter_light():
+    text = meter_program_text(SumoConfig(meter_clearance=2.0))
+    assert '<tlLogic id="meter" type="static" programID="nominal" offset="0">' in text
+    assert '<phase duration="3" state="G"/>' in text and 'duration="2" state="y"' in text

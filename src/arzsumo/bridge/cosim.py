@@ -29,8 +29,10 @@ statistics; :func:`~arzsumo.sumo.network_measures.network_options`) into a scrat
 directory; after the run they become the network measures of the control window and of
 the whole run (:mod:`arzsumo.sumo.window`, ``CoSimResult.network``), the sensor's speed
 moments of the section (``CoSimResult.section_speed``; its lateral snapshots:
-``CoSimResult.lateral``), and the compressed tripinfo kept
-with the results.
+``CoSimResult.lateral``), and the compressed tripinfo kept with the results. The run's
+SUMO configuration (``run.sumocfg`` and its files) and, with ``[sumo] fcd``, SUMO's FCD
+output are kept in ``CoSimResult.files`` (:mod:`arzsumo.sumo.run_files`) for the results
+directory.
 
 A detector sample's path: ``SumoSensor.observe`` (libsumo, every step) ->
 ``PeriodMeasurement`` -> ``Estimator.estimate`` -> ``MacroState`` -> ``Controller.check``
@@ -78,6 +80,7 @@ from arzsumo.sumo.meter_release import make_meter
 from arzsumo.sumo.network import NetworkSpec
 from arzsumo.sumo.network_measures import network_options
 from arzsumo.sumo.paths import scratch_dir
+from arzsumo.sumo.run_files import FCD_FILE, RunFiles
 from arzsumo.sumo.sensor import PeriodMeasurement, SumoSensor
 from arzsumo.sumo.simulation import SumoSimulation, open_simulation
 from arzsumo.sumo.whole_demand import ramp_waits, whole_demand_summary
@@ -287,14 +290,17 @@ class Controlled:
 def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
                      design: EtcDesign, *, initial_fields: np.ndarray | None = None,
                      curve: GreenShareCurve = DEFAULT_CURVE,
-                     progress: bool = False, keep_measurements: bool = False
-                     ) -> CoSimResult:
+                     progress: bool = False, keep_measurements: bool = False,
+                     frontend: str = "libsumo") -> CoSimResult:
     """Run SUMO with the controller of ``settings`` and both twins (module docstring).
 
     ``initial_fields`` (4, cells on the micro grid) places vehicles at t = 0 when
     ``settings.start == "placement"``. ``keep_measurements``: keep every period's
     measurement, warm-up included, in ``estimator.measurements`` (for offline estimation,
-    :mod:`arzsumo.bridge.sensor_record`).
+    :mod:`arzsumo.bridge.sensor_record`). ``frontend``: "libsumo", "traci" or "gui"
+    (watch the run in sumo-gui; :mod:`arzsumo.sumo.frontend`). The run's SUMO
+    configuration, and with ``cfg.fcd`` its FCD output, are kept in ``files``
+    (:mod:`arzsumo.sumo.run_files`).
     """
     wall0 = time.perf_counter()
     if settings.equilibrium == "scenario":
@@ -304,9 +310,11 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
     bar = Progress(run_cfg.horizon, f"{settings.controller} seed {cfg.seed}",
                    enabled=progress)
     net_dir = Path(tempfile.mkdtemp(prefix="arzsumo-net-", dir=scratch_dir()))
+    files = RunFiles()
     try:
         with open_simulation(scenario.params, run_cfg, initial=initial,
-                             extra_args=network_options(net_dir), output_dir=net_dir,
+                             extra_args=network_options(net_dir, fcd=cfg.fcd),
+                             output_dir=net_dir, keep=files, frontend=frontend,
                              loops=scenario.sensing.loop_x(scenario.params.length)) as sim:
             c = control(sim, scenario, settings, cfg, design, curve, bar, keep_measurements)
             meter = c.loop.plant.meter
@@ -319,6 +327,11 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
                                          drained.end if drained else None, sim.time)
         if drained is not None:
             network = whole_demand(network, trips, meter, sim, drained)
+        if cfg.fcd:   # moved, not read: an FCD file is large
+            files.adopt(net_dir / FCD_FILE, FCD_FILE)
+    except BaseException:
+        files.remove()
+        raise
     finally:
         shutil.rmtree(net_dir, ignore_errors=True)
     bar.close()
@@ -331,7 +344,7 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
                        {**loop.plant.timings, **loop.timings}, c.warmup_meter, network,
                        loop.plant.sensor.speeds.summary(), trace.start,
                        np.asarray(c.estimator.fields[1:]), c.estimator,
-                       loop.shift, loop.plant.sensor.lateral.record())
+                       loop.shift, loop.plant.sensor.lateral.record(), files)
 
 
 def whole_demand(network: NetworkMeasures, trips: Any, meter: Any, sim: SumoSimulation,

@@ -15,6 +15,7 @@ from arzsumo.scenario import Scenario
 from arzsumo.scenario.run import RunSettings
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.lateral import LateralRecord
+from arzsumo.sumo.run_files import RunFiles
 from arzsumo.sumo.simulation import RunReport
 from arzsumo.sumo.window import NetworkMeasures
 
@@ -69,3 +70,6 @@ class CoSimResult:
     #: one snapshot per control period of the window (the last step of period k with
     #: ``micro[k]``): positions, speeds, lateral offsets and classes of the vehicles on main
     lateral: LateralRecord | None = None
+    #: the SUMO configuration the run ran (``run.sumocfg``, ``sumo/``) and, with
+    #: ``[sumo] fcd``, its FCD output, to be placed into the results directory
+    files: RunFiles | None = None

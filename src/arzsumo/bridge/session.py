@@ -68,7 +68,8 @@ class PreparedRun:
                 f"control horizon {c.horizon:g} s, SUMO seed {c.seed}, step {c.step_length:g} s"
                 f"\n  equilibrium {s.equilibrium} (scenario lambda_4 = {lam4:.2f} km/h)"
                 f"\n  estimation {self.scenario.estimation.method} from sensors "
-                f"{', '.join(self.scenario.sensing.kinds)}")
+                f"{', '.join(self.scenario.sensing.kinds)}"
+                + ("\n  SUMO's FCD output kept (fcd.xml.gz)" if c.fcd else ""))
 
 
 def _seed(seed: int) -> int:
@@ -143,12 +144,13 @@ def _check_estimation(sc: Scenario, settings: RunSettings, from_cli: bool) -> No
 
 
 def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None = None,
-                horizon: float | None = None, warmup: float | None = None) -> PreparedRun:
+                horizon: float | None = None, warmup: float | None = None,
+                fcd: bool | None = None) -> PreparedRun:
     """Everything ``arzsumo run`` checks before SUMO starts, without starting it.
 
     Applies the caller's overrides to the ``run`` and ``sumo`` sections of ``sc``
     (``--controller``, ``--seed`` in [0, 2^31), ``--horizon`` of at least one control
-    period, s; ``--warmup``, s >= 0; validated again by
+    period, s; ``--warmup``, s >= 0; ``--fcd``; validated again by
     :meth:`~arzsumo.scenario.Scenario.with_`), checks that
     ``[sumo] cell_length_m`` divides the road and that the characteristic speeds are
     finite, refuses a PDE controller at a free-flow scenario equilibrium and a
@@ -165,6 +167,8 @@ def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None
         sc = _override(sc, "sumo.horizon_s", _horizon(horizon, sc.sumo), "--horizon")
     if warmup is not None:
         sc = _override(sc, "run.warmup_s", warmup, "--warmup")
+    if fcd is not None:
+        sc = _override(sc, "sumo.fcd", fcd, "--fcd")
     settings, cfg, design = sc.run, sc.sumo, sc.design
     ic = seeded(sc.initial, cfg.seed)  # one seed draws all randomness
     _check_model(sc, cfg)
@@ -193,7 +197,8 @@ def default_run_name(sc: Scenario, settings: RunSettings, cfg: SumoConfig) -> st
 
 def run_in_sumo(sc: Scenario, *, controller: str | None = None, seed: int | None = None,
                 horizon: float | None = None, warmup: float | None = None,
-                progress: bool = False) -> SumoSession:
+                fcd: bool | None = None, progress: bool = False,
+                frontend: str = "libsumo") -> SumoSession:
     """Run the closed loop of ``sc`` in SUMO (overrides win over the scenario's tables).
 
     Parameters
@@ -210,14 +215,21 @@ def run_in_sumo(sc: Scenario, *, controller: str | None = None, seed: int | None
         Overrides ``[sumo] horizon_s``, s; at least one control period.
     warmup : float, optional
         Overrides ``[run] warmup_s``, s.
+    fcd : bool, optional
+        Overrides ``[sumo] fcd`` (SUMO's FCD output kept with the results).
     progress : bool
         Draw a progress bar on stderr.
+    frontend : str
+        What drives SUMO: "libsumo" (default), "traci", or "gui" to watch the run in
+        sumo-gui (:mod:`arzsumo.sumo.frontend`).
 
     All checks happen in :func:`prepare_run` before SUMO starts.
     """
-    run = prepare_run(sc, controller=controller, seed=seed, horizon=horizon, warmup=warmup)
+    run = prepare_run(sc, controller=controller, seed=seed, horizon=horizon, warmup=warmup,
+                      fcd=fcd)
     res = run_cosimulation(run.scenario, run.settings, run.sumo, run.design,
-                           initial_fields=run.initial, curve=run.curve, progress=progress)
+                           initial_fields=run.initial, curve=run.curve, progress=progress,
+                           frontend=frontend)
     return SumoSession(res, run.settings, run.sumo)
 
 

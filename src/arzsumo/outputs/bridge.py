@@ -13,6 +13,10 @@ Every file, column (with units, stored in the Parquet field metadata from
     summary.json      see :func:`summary`
     tripinfo.xml.gz   SUMO's tripinfo output (every loaded vehicle, with emissions),
                       compressed; ``arzsumo.sumo.network_measures.read_trips`` reads it
+    fcd.xml.gz        with ``[sumo] fcd`` (``--fcd``): SUMO's FCD output, every vehicle
+                      every step (type, speed, pos, lane, posLat)
+    run.sumocfg, sumo/   the SUMO configuration the run ran (network, routes, loops) and
+                      the meter's nominal plan as a static program: ``sumo-gui -c``
     scenario.toml     the resolved scenario (as loaded) and settings
     fields_h.png, fields_a.png   micro | replay twin | reference twin, per class
     control.png       U, green share, light, queue, release instants
@@ -332,6 +336,8 @@ def write_results(res: CoSimResult, out: str | Path | OutputDir, scenario_text: 
                                           encoding="utf-8")
         if res.network is not None:
             (tmp / TRIPINFO_GZ).write_bytes(res.network.tripinfo_gz)
+        if res.files is not None:   # linked or copied in chunks, never read into memory
+            res.files.place(tmp)
         if plots:
             write_bridge_plots(res, tmp)
     return target_of(out), summ

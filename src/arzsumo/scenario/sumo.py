@@ -107,6 +107,8 @@ SUMO_KEYS: dict[str, Key] = {
     "fill_demand_a_veh_h": Key("fill_demand_a", factor=VEH_H_PER_VEH_S, allowed=_DEMAND,
                                unit="veh/h", doc="AV flow requested at the mainline "
                                                  "entrance during the fill phase"),
+    "fcd": Key("fcd", "bool", doc="write SUMO's trajectories of every vehicle every step "
+                                  "(fcd.xml.gz in the run directory; `arzsumo run --fcd`)"),
 }
 
 

@@ -110,6 +110,9 @@ class SumoConfig:
         demand above then holds from ``fill_duration`` to the end. A fill above the
         bottleneck's discharge builds the congested section fast (issue 15); the hold
         demand, a little above the discharge, keeps it without filling the approach.
+    fcd : bool
+        Have SUMO write its floating-car data (every vehicle every step: position, lateral
+        position, speed, lane, type) into ``fcd.xml.gz`` of ``arzsumo run``'s directory.
     """
 
     step_length: float = 0.1
@@ -148,6 +151,7 @@ class SumoConfig:
     fill_duration: float = 0.0
     fill_demand_h: float = 0.0
     fill_demand_a: float = 0.0
+    fcd: bool = False
 
     def __post_init__(self) -> None:
         def pos(name: str) -> None:
@@ -211,6 +215,7 @@ class SumoConfig:
                 " or ".join(HV_MODELS), ScenarioError)
         require(self.av_model in AV_MODELS, "av_model", self.av_model,
                 " or ".join(AV_MODELS), ScenarioError)
+        require(isinstance(self.fcd, bool), "fcd", self.fcd, "true or false", ScenarioError)
 
     def _check_meter(self) -> None:
         """The meter's mode and timings fit together (clearance inside the cycle, release

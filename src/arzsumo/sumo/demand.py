@@ -198,15 +198,25 @@ def write_route_file(path: Path, params: ModelParameters, cfg: SumoConfig,
     return path
 
 
-def sumocfg_text(net_file: str, route_file: str, cfg: SumoConfig) -> str:
-    """A ``.sumocfg`` a user can open in sumo-gui (same options as arzsumo's runs)."""
+def sumocfg_text(net_file: str, route_file: str, cfg: SumoConfig,
+                 additional: Sequence[str] = ()) -> str:
+    """A ``.sumocfg`` a user can open in sumo-gui (same options as arzsumo's runs).
+
+    File names are written as given (SUMO reads relative ones from the config file's
+    directory); ``additional`` lists additional files (detectors, the meter's program).
+    The run ends at ``cfg.horizon`` (s).
+    """
+    inputs = {"net-file": net_file, "route-files": route_file}
+    if additional:
+        inputs["additional-files"] = ",".join(additional)
     opts = {
-        "input": {"net-file": net_file, "route-files": route_file},
+        "input": inputs,
         "time": {"begin": "0", "end": f"{cfg.horizon:.6g}",
                  "step-length": f"{cfg.step_length:.6g}"},
         "processing": {"lateral-resolution": f"{cfg.lateral_resolution:.6g}",
                        "time-to-teleport": f"{cfg.time_to_teleport:.6g}",
-                       "eager-insert": "true", "collision.action": "warn"},
+                       "eager-insert": "true", "collision.action": "warn",
+                       "collision.check-junctions": "true"},
         "random_number": {"seed": str(cfg.seed)},
     }
     lines = ['<?xml version="1.0" encoding="UTF-8"?>', "<configuration>"]

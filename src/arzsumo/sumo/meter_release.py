@@ -29,9 +29,11 @@ from arzsumo.sumo.meter import (
     DEFAULT_CURVE,
     GREEN,
     RED,
+    YELLOW,
     GreenShareCurve,
     MeterLight,
     RampMeter,
+    plan_green_steps,
 )
 from arzsumo.sumo.network import METER_TL
 
@@ -139,3 +141,30 @@ def make_meter(lib: ModuleType, cfg: SumoConfig,
     if cfg.meter_mode == "one_per_green":
         return OnePerGreenMeter(lib, cfg)
     return RampMeter(lib, cfg, curve)
+
+
+def nominal_phases(cfg: SumoConfig) -> list[tuple[str, int]]:
+    """One cycle of the nominal plan (the open loop's) as (state, SUMO steps) phases.
+
+    The fixed cycle: ``meter_cycle`` with the green of ``green_share``
+    (:func:`~arzsumo.sumo.meter.plan_green_steps`), the clearance yellow, red for the rest.
+    One per green: the cycle 1 / ``release_rate`` rounded to steps, green ``min_green``,
+    the clearance yellow, red for the rest (the head vehicle crossing within the minimum
+    green; the run extends a green up to ``max_green`` when it does not). The queue
+    override is left out: it depends on the traffic.
+    """
+    dt = cfg.step_length
+    clear = round(cfg.meter_clearance / dt)
+    if cfg.meter_mode == "one_per_green":
+        green = max(1, round(cfg.min_green / dt))
+        cycle = max(max(1, round(1.0 / (cfg.release_rate * dt))),
+                    green + clear + round(cfg.min_red / dt))
+    else:
+        cycle = max(1, round(cfg.meter_cycle / dt))
+        green = plan_green_steps(cfg.green_share, cycle, round(cfg.min_green / dt),
+                                 round(cfg.min_red / dt) + clear)
+    if green in (0, cycle):           # always red or always green: no clearance shown
+        return [(GREEN if green else RED, cycle)]
+    clear = min(clear, cycle - green)
+    phases = [(GREEN, green), (YELLOW, clear), (RED, cycle - green - clear)]
+    return [(state, n) for state, n in phases if n > 0]

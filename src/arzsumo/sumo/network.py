@@ -38,6 +38,8 @@ log = logging.getLogger(__name__)
 MAIN, MERGE, DOWN, RAMP_UP, RAMP_DN = "main", "merge", "down", "ramp_up", "ramp_dn"
 APPROACH = "approach"
 METER_TL = "meter"
+#: signals (links) of the light ``meter``: its state strings are this long
+METER_LINKS = 1
 SOURCE_FILES = ("ramp.nod.xml", "ramp.edg.xml", "ramp.con.xml", "ramp.tll.xml")
 
 

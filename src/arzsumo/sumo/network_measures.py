@@ -42,10 +42,15 @@ import pandas as pd
 
 from arzsumo.sumo.network import MAIN
 from arzsumo.sumo.paths import SumoError
+from arzsumo.sumo.run_files import FCD_FILE
 from arzsumo.units import veh_s_to_veh_h
 
 TRIPINFO_FILE, EDGEDATA_FILE, STATISTICS_FILE = "tripinfo.xml", "edgedata.xml", "statistics.xml"
-OUTPUT_FILES = (TRIPINFO_FILE, EDGEDATA_FILE, STATISTICS_FILE)
+#: what the FCD output (:data:`~arzsumo.sumo.run_files.FCD_FILE`, every vehicle every
+#: step) records per vehicle besides its id: vType id, speed in m/s, pos in m from the
+#: lane's start, lane id, posLat in m from the lane centre (left positive)
+FCD_ATTRIBUTES = ("type", "speed", "pos", "lane", "posLat")
+OUTPUT_FILES = (TRIPINFO_FILE, EDGEDATA_FILE, STATISTICS_FILE, FCD_FILE)
 ORIGINS = ("mainline", "ramp")
 STATES = ("completed", "en_route", "waiting")
 MG_PER_G = 1000.0
@@ -55,8 +60,10 @@ _TRIP_COLUMNS = {"depart": "depart_s", "arrival": "arrival_s", "duration": "dura
                  "waitingTime": "waiting_time_s", "routeLength": "distance_m"}
 
 
-def network_options(out_dir: Path) -> list[str]:
-    """SUMO options writing tripinfo (all vehicles, with emissions) and edge data to ``out_dir``.
+def network_options(out_dir: Path, fcd: bool = False) -> list[str]:
+    """SUMO options writing tripinfo (all vehicles, with emissions) and edge data to ``out_dir``;
+    with ``fcd`` also SUMO's FCD output, gzip-compressed (:data:`FCD_FILE`, attributes
+    :data:`FCD_ATTRIBUTES`).
 
     Pass ``output_dir=out_dir`` to :func:`~arzsumo.sumo.simulation.open_simulation` too,
     so that SUMO's statistics output lands beside them. ``out_dir`` is created; existing
@@ -72,11 +79,15 @@ def network_options(out_dir: Path) -> list[str]:
     except OSError as exc:
         raise SumoError(f"out_dir = {str(out_dir)!r} cannot be created: {exc.strerror}; "
                         "allowed: a writable directory") from None
-    return ["--tripinfo-output", str(out_dir / TRIPINFO_FILE),
+    opts = ["--tripinfo-output", str(out_dir / TRIPINFO_FILE),
             "--tripinfo-output.write-unfinished", "true",
             "--tripinfo-output.write-undeparted", "true",
             "--device.emissions.probability", "1",
             "--edgedata-output", str(out_dir / EDGEDATA_FILE)]
+    if fcd:   # SUMO compresses an output whose name ends in .gz
+        opts += ["--fcd-output", str(out_dir / FCD_FILE),
+                 "--fcd-output.attributes", ",".join(FCD_ATTRIBUTES)]
+    return opts
 
 
 def _need(path: Path) -> Path:

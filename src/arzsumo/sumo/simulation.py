@@ -13,8 +13,6 @@ SUMO's cause in one line. Use it as a context manager::
 
 from __future__ import annotations
 
-import contextlib
-import io
 import logging
 import os
 import shutil
@@ -28,6 +26,7 @@ from types import ModuleType, TracebackType
 from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.demand import InitialVehicle, demand_flows, write_route_file
+from arzsumo.sumo.frontend import Frontend
 from arzsumo.sumo.network import NetworkSpec, approach_length_of, build_network
 from arzsumo.sumo.paths import (
     NET_FILE,
@@ -35,22 +34,12 @@ from arzsumo.sumo.paths import (
     SumoError,
     nets_dir,
     scratch_dir,
-    sumo_binary,
 )
+from arzsumo.sumo.run_files import RunFiles
 
 log = logging.getLogger(__name__)
 
 _ACTIVE: SumoSimulation | None = None
-
-
-def libsumo_module() -> ModuleType:
-    """Import libsumo, keeping its import-time version chatter off stdout."""
-    buf = io.StringIO()
-    with contextlib.redirect_stdout(buf):
-        import libsumo
-    if buf.getvalue().strip():
-        log.debug("libsumo import: %s", buf.getvalue().strip())
-    return libsumo
 
 
 def _one_line(exc: BaseException) -> str:
@@ -103,7 +92,7 @@ class RunReport:
 
 
 class SumoSimulation:
-    """One libsumo run of ``net_file`` with ``route_file`` under ``cfg``.
+    """One run of ``net_file`` with ``route_file`` under ``cfg``, driven by libsumo or TraCI.
 
     Parameters
     ----------
@@ -120,12 +109,17 @@ class SumoSimulation:
     output_dir : Path, optional
         Where SUMO's statistics output goes instead, kept after the run (for
         :mod:`arzsumo.sumo.network_measures`).
+    frontend : str
+        What drives the run, one choice for module and binary
+        (:mod:`arzsumo.sumo.frontend`): "libsumo" (default), "traci" (traci to ``sumo``)
+        or "gui" (traci to ``sumo-gui``).
     """
 
     def __init__(self, net_file: Path, route_file: Path, cfg: SumoConfig, *,
                  requested_initial: int = 0, workdir: Path | None = None,
                  extra_args: Sequence[str] = (), cleanup: Sequence[Path] = (),
-                 output_dir: Path | None = None) -> None:
+                 output_dir: Path | None = None, frontend: str = "libsumo") -> None:
+        self.frontend = Frontend(frontend)
         self.net_file, self.route_file, self.cfg = Path(net_file), Path(route_file), cfg
         self.requested_initial = requested_initial
         self._own_workdir = workdir is None
@@ -154,7 +148,7 @@ class SumoSimulation:
     def command(self) -> list[str]:
         """The SUMO command line (the one place it is built)."""
         c = self.cfg
-        return [str(sumo_binary("sumo")), "--net-file", str(self.net_file),
+        return [self.frontend.binary(), "--net-file", str(self.net_file),
                 "--route-files", str(self.route_file),
                 "--step-length", f"{c.step_length:.6g}", "--seed", str(c.seed),
                 "--lateral-resolution", f"{c.lateral_resolution:.6g}",
@@ -163,7 +157,8 @@ class SumoSimulation:
                 "--collision.check-junctions", "true",
                 "--statistic-output", str(self.stats_file),
                 "--no-step-log", "true", "--no-warnings", "true",
-                "--duration-log.disable", "true", *self.extra_args]
+                "--duration-log.disable", "true", *self.frontend.extra_args(),
+                *self.extra_args]
 
     # -- lifecycle -----------------------------------------------------------------------
     def start(self) -> SumoSimulation:
@@ -174,12 +169,18 @@ class SumoSimulation:
         if _ACTIVE is not None:
             raise SumoError("another SUMO simulation is open in this process; allowed: one "
                             "at a time (close it first)")
-        lib = libsumo_module()
         try:
-            lib.start(self.command())
+            self.frontend.check()
+        except SumoError:
+            self._remove_files()
+            raise
+        lib = self.frontend.load()
+        try:
+            self.frontend.start(lib, self.command())
         except Exception as exc:
             self._remove_files()
-            raise SumoError(f"SUMO did not start: {_one_line(exc)}") from None
+            raise SumoError(f"SUMO did not start: {_one_line(exc).rstrip('.')}"
+                            f"{self.frontend.failed_hint()}") from None
         self._lib, self.started, _ACTIVE = lib, True, self
         self.time = float(lib.simulation.getTime())
         log.debug("SUMO started: seed %d, step %.3g s", self.cfg.seed, self.cfg.step_length)
@@ -187,7 +188,7 @@ class SumoSimulation:
 
     @property
     def lib(self) -> ModuleType:
-        """The libsumo module of the open run."""
+        """The module driving the open run (libsumo or traci: one API)."""
         if self._lib is None or self.closed:
             raise SumoError("the simulation is not running; allowed: use it between start() "
                             "and close()")
@@ -318,7 +319,8 @@ def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
                     initial: Sequence[InitialVehicle] = (), net_dir: Path | None = None,
                     extra_args: Sequence[str] = (), e2_chain: bool = False,
                     loops: Sequence[float] = (),
-                    output_dir: Path | None = None) -> SumoSimulation:
+                    output_dir: Path | None = None, keep: RunFiles | None = None,
+                    frontend: str = "libsumo") -> SumoSimulation:
     """A started simulation of the network of :func:`network_file` with the demand of
     ``cfg``.
 
@@ -327,8 +329,12 @@ def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
     positions on ``main``, m in [0, L], see :mod:`arzsumo.sumo.loops`) goes to a
     temporary directory (under
     :func:`~arzsumo.sumo.paths.scratch_dir`) removed when the run closes. With
-    ``output_dir``, SUMO's statistics output is written there and kept.
+    ``output_dir``, SUMO's statistics output is written there and kept. With ``keep``,
+    the network, route and additional files are copied there with a ``run.sumocfg``
+    (:meth:`~arzsumo.sumo.run_files.RunFiles.keep_config`). ``frontend``: what drives
+    the run (:mod:`arzsumo.sumo.frontend`).
     """
+    Frontend(frontend).check()   # no display for sumo-gui: refused before any file
     workdir = Path(tempfile.mkdtemp(prefix="arzsumo-", dir=scratch_dir()))
     try:
         net = network_file(cfg, net_dir, workdir)
@@ -345,9 +351,12 @@ def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
             adds.append(write_loops(workdir / "e1.add.xml", loops, params.length))
         if adds:
             extra_args = ("--additional-files", ",".join(map(str, adds)), *extra_args)
+        if keep is not None:
+            keep.keep_config(net, route, adds, cfg)
     except BaseException:  # a bad demand or network, or Ctrl-C: leave no temporary files
         shutil.rmtree(workdir, ignore_errors=True)
         raise
     sim = SumoSimulation(net, route, cfg, requested_initial=len(initial), workdir=workdir,
-                         extra_args=extra_args, cleanup=(workdir,), output_dir=output_dir)
+                         extra_args=extra_args, cleanup=(workdir,), output_dir=output_dir,
+                         frontend=frontend)
     return sim.start()

@@ -1,0 +1,106 @@
+"""What a run keeps of SUMO for its results directory: the configuration it ran, its FCD.
+
+The configuration: the network, the route file and the additional files (loops) the run
+loaded, copied into ``sumo/``, and ``run.sumocfg`` naming them relative to itself with
+the run's options (:func:`~arzsumo.sumo.demand.sumocfg_text`), so that ``sumo-gui -c
+RUN/run.sumocfg`` opens the same scenario. A run drives the meter's light every step
+through libsumo; the kept configuration runs the nominal plan instead, as a static
+program of the light (``sumo/meter.add.xml``, :func:`meter_program_text`): the open loop.
+With ``[sumo] fcd``, SUMO's FCD output (``fcd.xml.gz``) joins them.
+
+The files are gathered under :func:`~arzsumo.sumo.paths.scratch_dir` while the run lasts
+(:class:`RunFiles`) and placed into the results directory by :meth:`RunFiles.place`:
+hard-linked, or copied in chunks across file systems, never read into memory (an FCD
+file is large). The gathering directory goes when its :class:`RunFiles` does.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+import weakref
+from collections.abc import Sequence
+from pathlib import Path
+
+from arzsumo.sumo.config import SumoConfig
+from arzsumo.sumo.demand import sumocfg_text
+from arzsumo.sumo.meter_release import nominal_phases
+from arzsumo.sumo.network import METER_LINKS, METER_TL
+from arzsumo.sumo.paths import SumoError, scratch_dir
+
+#: names inside the results directory
+CONFIG_FILE, SUMO_DIR, METER_FILE, FCD_FILE = "run.sumocfg", "sumo", "meter.add.xml", "fcd.xml.gz"
+#: programID of the nominal plan in ``meter.add.xml`` (the network's own program is "0";
+#: SUMO runs the program loaded last)
+METER_PROGRAM = "nominal"
+
+
+def meter_program_text(cfg: SumoConfig) -> str:
+    """An additional file with the nominal plan of the meter as a static ``tlLogic``
+    (durations in s; :func:`~arzsumo.sumo.meter_release.nominal_phases`)."""
+    phases = [f'        <phase duration="{n * cfg.step_length:.6g}" '
+              f'state="{state * METER_LINKS}"/>' for state, n in nominal_phases(cfg)]
+    return "\n".join([
+        '<?xml version="1.0" encoding="UTF-8"?>', "<additional>",
+        f'    <tlLogic id="{METER_TL}" type="static" programID="{METER_PROGRAM}" offset="0">',
+        *phases, "    </tlLogic>", "</additional>"]) + "\n"
+
+
+class RunFiles:
+    """A directory laid out as the results directory will be, gathered during a run.
+
+    Created under :func:`~arzsumo.sumo.paths.scratch_dir` (inside the claimed output of
+    ``arzsumo run``), removed by :meth:`remove` or when the object is collected.
+    """
+
+    def __init__(self) -> None:
+        self.root = Path(tempfile.mkdtemp(prefix="arzsumo-keep-", dir=scratch_dir()))
+        self._finalizer = weakref.finalize(self, shutil.rmtree, str(self.root), True)
+
+    def keep_config(self, net: Path, route: Path, additional: Sequence[Path],
+                    cfg: SumoConfig) -> Path:
+        """Copy the run's network, route and additional files into ``sumo/``, add the
+        meter's nominal program and write ``run.sumocfg``; return its path."""
+        sub = self.root / SUMO_DIR
+        sub.mkdir(exist_ok=True)
+        names = []
+        for src in (net, route, *additional):
+            shutil.copyfile(src, sub / Path(src).name)
+            names.append(f"{SUMO_DIR}/{Path(src).name}")
+        (sub / METER_FILE).write_text(meter_program_text(cfg), encoding="utf-8")
+        config = self.root / CONFIG_FILE
+        config.write_text(sumocfg_text(names[0], names[1], cfg,
+                                       [*names[2:], f"{SUMO_DIR}/{METER_FILE}"]),
+                          encoding="utf-8")
+        return config
+
+    def adopt(self, src: Path, name: str) -> Path:
+        """Move ``src`` (a SUMO output of the run) in as ``name`` (a rename on one file
+        system); a missing ``src`` is a SumoError."""
+        if not Path(src).is_file():
+            raise SumoError(f"SUMO wrote no {Path(src).name} in {str(Path(src).parent)!r}; "
+                            "allowed: a run started with that output")
+        return Path(shutil.move(src, self.root / name))
+
+    def files(self) -> list[Path]:
+        """The kept files, relative to the root, sorted."""
+        return sorted(p.relative_to(self.root) for p in self.root.rglob("*") if p.is_file())
+
+    def place(self, dest: Path) -> list[Path]:
+        """Put every kept file under ``dest`` at its relative path (hard link, else a
+        chunked copy); return the paths written. The kept files stay (placeable again)."""
+        out = []
+        for rel in self.files():
+            target = Path(dest) / rel
+            target.parent.mkdir(parents=True, exist_ok=True)
+            try:
+                os.link(self.root / rel, target)
+            except OSError:   # another file system, or no hard links there
+                shutil.copyfile(self.root / rel, target)
+            out.append(target)
+        return out
+
+    def remove(self) -> None:
+        """Remove the gathered files now (safe to call twice)."""
+        self._finalizer()
