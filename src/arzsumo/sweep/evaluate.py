@@ -282,7 +282,8 @@ def _header(name: str, scenario: Path, controllers: Sequence[str], seeds: Sequen
     elif WHOLE_DEMAND_KEY not in ok:
         lines += ["", "**No whole-demand measures**: the scenario has no drain "
                       "(`[sumo] drain_max_s` = 0)."]
-    incomplete = int((ok.get("network_whole_demand.complete") == False).sum())  # noqa: E712
+    complete = ok.get("network_whole_demand.complete", pd.Series(dtype=object))
+    incomplete = int((complete.astype(str).str.lower() == "false").sum())
     if incomplete:
         lines += ["", f"**{incomplete} run(s) hit the drain limit** (`[sumo] drain_max_s`): "
                       "their whole-demand measures leave vehicles uncharged."]
