@@ -28,6 +28,7 @@ from types import ModuleType, TracebackType
 from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.demand import InitialVehicle, demand_flows, write_route_file
+from arzsumo.sumo.loops import DOWNSTREAM_DISTANCE, write_downstream_loop
 from arzsumo.sumo.network import NetworkSpec, approach_length_of, build_network
 from arzsumo.sumo.paths import (
     NET_FILE,
@@ -313,13 +314,16 @@ def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
                     initial: Sequence[InitialVehicle] = (), net_dir: Path | None = None,
                     extra_args: Sequence[str] = (), e2_chain: bool = False,
                     loops: Sequence[float] = (),
+                    downstream_loop: float = DOWNSTREAM_DISTANCE,
                     output_dir: Path | None = None) -> SumoSimulation:
     """A started simulation of the network of :func:`network_file` with the demand of
     ``cfg``.
 
     The route file (and, with ``e2_chain``, an E2 detector per measurement cell, see
     :mod:`arzsumo.sumo.detectors`; with ``loops``, an E1 loop station at each of those
-    positions on ``main``, m in [0, L], see :mod:`arzsumo.sumo.loops`) goes to a
+    positions on ``main``, m in [0, L], see :mod:`arzsumo.sumo.loops`; always, the E1
+    loop on ``down`` at ``downstream_loop`` m past the merge nose that the sensor reads,
+    :func:`~arzsumo.sumo.loops.write_downstream_loop`) goes to a
     temporary directory (under
     :func:`~arzsumo.sumo.paths.scratch_dir`) removed when the run closes. With
     ``output_dir``, SUMO's statistics output is written there and kept.
@@ -328,7 +332,7 @@ def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
     try:
         net = network_file(cfg, net_dir, workdir)
         route = write_route_file(workdir / "run.rou.xml", params, cfg, initial)
-        adds = []
+        adds = [write_downstream_loop(workdir / "e1_down.add.xml", downstream_loop)]
         if e2_chain:
             from arzsumo.sumo.detectors import write_e2_chain
 
@@ -338,8 +342,7 @@ def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
             from arzsumo.sumo.loops import write_loops
 
             adds.append(write_loops(workdir / "e1.add.xml", loops, params.length))
-        if adds:
-            extra_args = ("--additional-files", ",".join(map(str, adds)), *extra_args)
+        extra_args = ("--additional-files", ",".join(map(str, adds)), *extra_args)
     except BaseException:  # a bad demand or network, or Ctrl-C: leave no temporary files
         shutil.rmtree(workdir, ignore_errors=True)
         raise
