@@ -77,6 +77,12 @@ class TriangleFit:
     congested_slope: float
     rmse: float
 
+    def flow(self, occupancy: np.ndarray) -> np.ndarray:
+        """The fitted curve's flow (veh/s) at ``occupancy`` (fractions)."""
+        d = np.asarray(occupancy, float) - self.critical
+        return self.capacity + self.free_slope * np.minimum(d, 0) + \
+            self.congested_slope * np.maximum(d, 0)
+
 
 def fit_triangle(occupancy: np.ndarray, flow: np.ndarray, grid: int = 200) -> TriangleFit:
     """Fit q = q_c + s_f min(o - o_c, 0) + s_c max(o - o_c, 0) (module docstring) with
