@@ -125,7 +125,8 @@ def cmd_alinea_target(args: argparse.Namespace) -> int:
         write_alinea_target(target, means, crit, meta, title)
     print(f"critical occupancy {100 * crit.critical:.2f} % (capacity "
           f"{crit.fit.capacity * 3600:.0f} veh/h, {crit.samples} period means"
-          f"{'' if crit.saturated else '; flow never saturated: a lower bound'}); "
+          f"{'' if crit.saturated else '; flow never saturated: a lower bound, the 98th '}"
+          f"{'' if crit.saturated else 'percentile of the occupancies'}); "
           f"target {100 * crit.target:.2f} % = {crit.share:g} x critical")
     print(f"[alinea] target_pct = {100 * crit.target:.1f}")
     print(f"results: {args.out}")

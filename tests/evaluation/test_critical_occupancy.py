@@ -39,10 +39,12 @@ def test_a_plateau_downstream_of_a_bottleneck_gives_the_knee():
     assert crit.target == pytest.approx(0.95 * crit.critical)
 
 
-def test_free_flow_only_is_flagged_as_not_saturated():
-    o = np.linspace(0.02, 0.15, 50)
+def test_free_flow_only_gives_a_lower_bound_flagged_as_not_saturated():
+    o = np.linspace(0.02, 0.15, 51)
     crit = critical_occupancy(o, 2.5 * o)
     assert not crit.saturated
+    assert crit.critical == pytest.approx(np.percentile(o, 98))      # flow still rose there
+    assert crit.target == pytest.approx(0.9 * crit.critical)
 
 
 def test_period_means_and_bins():

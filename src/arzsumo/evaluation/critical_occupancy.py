@@ -18,8 +18,10 @@ Steps (all pure; SI: occupancy a fraction, flow veh/s, time s):
    occupancy of the highest bin, a model-free cross-check).
 
 :func:`critical_occupancy` chains them. When the congested branch still rises (s_c >
-half the free slope: the loop never saw flow saturate), o_c is only a lower bound and
-``saturated`` is False.
+half the free slope: the loop never saw flow saturate, as downstream of an active
+bottleneck that never spills past the loop), the curve has no peak in the data: o_c is
+then reported as the lower bound the data give, the 98th percentile of the occupancies
+(flow still rose there), and ``saturated`` is False.
 """
 
 from __future__ import annotations
@@ -110,8 +112,8 @@ class CriticalOccupancy:
 
     ``fit`` is the triangular fit, ``peak_bin`` the centre of the occupancy bin of the
     highest mean flow (bins of at least ``min_count`` samples), ``saturated`` whether the
-    data show flow saturating (otherwise o_c is a lower bound), ``samples`` the number
-    of period means used.
+    data show flow saturating (then ``critical`` is the fit's breakpoint; otherwise the
+    lower bound of the module docstring), ``samples`` the number of period means used.
     """
 
     critical: float
@@ -135,5 +137,6 @@ def critical_occupancy(occupancy: np.ndarray, flow: np.ndarray,
     ok = count >= min_count
     peak = float(centres[ok][np.argmax(mean[ok])]) if ok.any() else math.nan
     saturated = fit.free_slope > 0 and fit.congested_slope < 0.5 * fit.free_slope
-    return CriticalOccupancy(fit.critical, share * fit.critical, share, fit, peak,
-                             bool(saturated), int(np.asarray(occupancy).size))
+    critical = fit.critical if saturated else float(np.percentile(occupancy, 98.0))
+    return CriticalOccupancy(critical, share * critical, share, fit, peak, bool(saturated),
+                             int(np.asarray(occupancy).size))
