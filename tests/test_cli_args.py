@@ -79,7 +79,8 @@ def _subparsers(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentP
 def test_every_command_has_help_and_description():
     commands = _subparsers(build_parser())
     assert {"model", "kernels", "verify", "design-check", "twin", "reproduce", "build-net",
-            "calibrate", "run", "compare", "sweep", "evaluate", "identify", "list"} == set(commands)
+            "calibrate", "run", "compare", "alinea-target", "sweep", "evaluate", "identify",
+            "list"} == set(commands)
     for name, p in commands.items():
         assert p.description and len(p.description) > 30, name
 

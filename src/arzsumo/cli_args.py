@@ -92,3 +92,18 @@ class Parser(argparse.ArgumentParser):
         if m:  # "argument --horizon: -5 is not allowed: ..." -> "--horizon = -5 is ..."
             message = f"{m.group(1)} = {m.group(2)}"
         self.exit(EXIT_USAGE, f"arzsumo: error: {message} (see '{self.prog} --help')\n")
+
+
+def seed_list(text: str) -> list[int]:
+    """Comma-separated seeds; ``A-B`` for a range (inclusive)."""
+    seeds: list[int] = []
+    for part in (p.strip() for p in text.split(",")):
+        first, sep, last = part.partition("-")
+        try:
+            lo = seed_int(first)
+            hi = seed_int(last) if sep else lo
+        except argparse.ArgumentTypeError:
+            raise argparse.ArgumentTypeError(f"{text} is not allowed: seeds in [0, 2^31), "
+                                             "comma-separated, A-B for a range") from None
+        seeds += list(range(lo, hi + 1))
+    return seeds

@@ -1,4 +1,5 @@
-"""CLI commands of the closed loop: ``arzsumo run`` and ``arzsumo compare``."""
+"""CLI commands of the closed loop: ``arzsumo run``, ``arzsumo compare`` and
+``arzsumo alinea-target`` (ALINEA's target from open-loop runs)."""
 
 from __future__ import annotations
 
@@ -6,9 +7,15 @@ import argparse
 import json
 import logging
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from arzsumo.cli_args import non_negative_float, positive_float, seed_int
+from arzsumo.cli_args import non_negative_float, positive_float, seed_int, seed_list
 from arzsumo.control.registry import controller_names
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from arzsumo.scenario import Scenario
 
 log = logging.getLogger("arzsumo")
 
@@ -63,8 +70,75 @@ def cmd_compare(args: argparse.Namespace) -> int:
     return 0
 
 
+def _loop_samples(args: argparse.Namespace, sc: Scenario
+                  ) -> list[tuple[int, np.ndarray, np.ndarray]]:
+    """(seed, occupancy, flow) per open-loop run (1 s samples), SUMO runs or ``--runs``."""
+    import numpy as np
+    import pyarrow.parquet as pq
+
+    from arzsumo.bridge.session import meter_curve_of
+    from arzsumo.errors import ScenarioError
+    from arzsumo.sumo.loop_curve import record_downstream_loop
+
+    out = []
+    for run_dir in args.runs or ():
+        path = Path(run_dir) / "periods.parquet"
+        if not path.is_file():
+            raise ScenarioError(f"--runs {run_dir} is not allowed: no periods.parquet there")
+        table = pq.read_table(path).to_pandas()
+        if "flow_out_loop" not in table:
+            raise ScenarioError(f"--runs {run_dir} is not allowed: its periods table has no "
+                                "flow_out_loop (a run from before the ALINEA loop)")
+        seed = json.loads((Path(run_dir) / "summary.json").read_text()).get("seed", -1)
+        out.append((int(seed), np.asarray(table["occupancy_out"], float),
+                    np.asarray(table["flow_out_loop"], float)))
+    duration = args.duration or sc.run.warmup + sc.sumo.horizon
+    for seed in args.seeds or ():
+        cfg = sc.sumo.with_(seed=seed, horizon=duration)
+        log.info("open loop, seed %d, %g s", seed, duration)
+        series = record_downstream_loop(sc.params, cfg, sc.alinea.loop_distance,
+                                        meter_curve_of(cfg, sc.source))
+        out.append((seed, series.occupancy, series.flow))
+    return out
+
+
+def cmd_alinea_target(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from arzsumo.errors import ScenarioError
+    from arzsumo.evaluation.critical_occupancy import critical_occupancy, period_means
+    from arzsumo.outdir import OutputDir
+    from arzsumo.outputs.alinea import write_alinea_target
+    from arzsumo.scenario import load_scenario
+
+    sc = load_scenario(args.scenario)
+    if not args.seeds and not args.runs:
+        raise ScenarioError("--seeds or --runs is needed: open-loop runs to read the loop from")
+    period, dt = sc.alinea.period, sc.sumo.control_period
+    with OutputDir(args.out, "alinea-target", overwrite=args.overwrite) as target:
+        raw = _loop_samples(args, sc)
+        means = [(seed, *period_means(o, q, dt, period)) for seed, o, q in raw]
+        crit = critical_occupancy(np.concatenate([m[1] for m in means]),
+                                  np.concatenate([m[2] for m in means]), share=args.share)
+        meta = {"scenario": str(args.scenario), "seeds": [m[0] for m in means],
+                "period_s": period, "loop_distance_m": sc.alinea.loop_distance,
+                "duration_s": args.duration or sc.run.warmup + sc.sumo.horizon,
+                "runs": list(args.runs or ())}
+        title = (f"{sc.name}: loop {sc.alinea.loop_distance:g} m past the merge, "
+                 f"{period:g} s means")
+        write_alinea_target(target, means, crit, meta, title)
+    print(f"critical occupancy {100 * crit.critical:.2f} % (capacity "
+          f"{crit.fit.capacity * 3600:.0f} veh/h, {crit.samples} period means"
+          f"{'' if crit.saturated else '; flow never saturated: a lower bound, the 98th '}"
+          f"{'' if crit.saturated else 'percentile of the occupancies'}); "
+          f"target {100 * crit.target:.2f} % = {crit.share:g} x critical")
+    print(f"[alinea] target_pct = {100 * crit.target:.1f}")
+    print(f"results: {args.out}")
+    return 0
+
+
 def register(sub: argparse._SubParsersAction) -> None:
-    """Add ``run`` and ``compare`` to the top-level parser."""
+    """Add ``run``, ``compare`` and ``alinea-target`` to the top-level parser."""
     p = sub.add_parser("run", help="closed loop in SUMO with the PDE twin alongside",
                        description="Run a scenario's closed loop in SUMO: warm-up under the "
                                    "nominal meter, then the [run] controller on the ramp "
@@ -110,3 +184,29 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="tabulate results of different kinds (twin), scenarios, horizons or "
                         "warm-ups anyway; the table's header states the mix")
     p.set_defaults(func=cmd_compare)
+    _register_alinea_target(sub)
+
+
+def _register_alinea_target(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("alinea-target", help="ALINEA's target from the loop's flow-occupancy "
+                                             "curve in open-loop runs",
+                       description="Run open loops of a scenario (or read run directories), "
+                                   "average ALINEA's loop over the [alinea] period, fit the "
+                                   "triangular flow-occupancy curve, and print the critical "
+                                   "occupancy and the suggested target; write samples.csv, "
+                                   "curve.csv, target.json and curve.png to --out.")
+    p.add_argument("scenario", metavar="SCENARIO.toml", help="scenario file")
+    p.add_argument("--seeds", type=seed_list, metavar="SEEDS",
+                   help="SUMO seeds of open-loop runs, comma-separated, A-B for a range")
+    p.add_argument("--runs", nargs="+", metavar="RUN_DIR",
+                   help="results directories of arzsumo run to read instead of (or besides) "
+                        "running SUMO")
+    p.add_argument("--duration", type=positive_float,
+                   help="simulated time of each open-loop run from t = 0, s (default: "
+                        "[run] warmup_s + [sumo] horizon_s)")
+    p.add_argument("--share", type=positive_float, default=0.9,
+                   help="target as a share of the critical occupancy (in (0, 1])")
+    p.add_argument("--out", metavar="DIR", required=True, help="output directory")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace a previous alinea-target result in --out")
+    p.set_defaults(func=cmd_alinea_target)

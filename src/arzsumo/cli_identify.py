@@ -13,24 +13,9 @@ import argparse
 import logging
 from pathlib import Path
 
-from arzsumo.cli_args import non_negative_int, positive_float, positive_int, seed_int
+from arzsumo.cli_args import non_negative_int, positive_float, positive_int, seed_list
 
 log = logging.getLogger("arzsumo")
-
-
-def seed_list(text: str) -> list[int]:
-    """Comma-separated seeds; ``A-B`` for a range (inclusive)."""
-    seeds: list[int] = []
-    for part in (p.strip() for p in text.split(",")):
-        first, sep, last = part.partition("-")
-        try:
-            lo = seed_int(first)
-            hi = seed_int(last) if sep else lo
-        except argparse.ArgumentTypeError:
-            raise argparse.ArgumentTypeError(f"{text} is not allowed: seeds in [0, 2^31), "
-                                             "comma-separated, A-B for a range") from None
-        seeds += list(range(lo, hi + 1))
-    return seeds
 
 
 def cmd_identify(args: argparse.Namespace) -> int:

@@ -61,8 +61,9 @@ PERIODS: dict[str, Column] = {
     "inflow_a": Column("veh/s", f"AVs entering the mainline at x = 0 {_PERIOD}"),
     "outflow_h": Column("veh/s", f"HVs leaving the mainline at x = L {_PERIOD}"),
     "outflow_a": Column("veh/s", f"AVs leaving the mainline at x = L {_PERIOD}"),
-    "occupancy_out": Column("1", "SUMO lane occupancy of down_0 (downstream of the merge), "
-                                 f"mean {_PERIOD}; ALINEA's measurement"),
+    "occupancy_out": Column("1", "occupancy of the E1 loop on down [alinea] loop_distance_m "
+                                 f"past the merge nose (share of time occupied) {_PERIOD}; "
+                                 "ALINEA's measurement"),
     "u_reference": Column("veh/s", "U of the reference twin's own controller at this check"),
     "u_raw": Column("veh/s", "U the controller held after this check (its law's), before "
                              "the [actuation] limits"),
@@ -72,6 +73,9 @@ PERIODS: dict[str, Column] = {
                               "the controller's U"),
     "rate_limited": Column(TEXT, "true where the rate limit (u_rate_max_veh_h_s) cut the "
                                  "change of U"),
+    "flow_out_loop": Column("veh/s", f"vehicles crossing the loop of occupancy_out {_PERIOD}"),
+    "release_rate": Column("veh/s", "release rate the meter was asked for after this check "
+                                    "(one_per_green; NaN for fixed_cycle)"),
     "override": Column(TEXT, "true where the meter's queue override was on at the period's "
                              "end (ramp queue above ramp_storage_veh: the largest release)"),
 }
@@ -222,8 +226,7 @@ RUN_SUMMARY: dict[str, str] = {
     "teleports": "count", "collisions": "count", "emergency_braking": "count",
     "placement": TEXT, "wall_time": "s", "timings.*": "s",
     "controller_time_per_period": "s", **_NETWORK, **_SECTION,
-    "settings.warmup": "s", "settings.smoothing": "s", "settings.alinea_target": "1",
-    "settings.alinea_gain": "veh/s", "settings.alinea_saturation": "veh/s",
+    "settings.warmup": "s", "settings.smoothing": "s", "settings.constant_release": "veh/s",
     "settings.kernel_cells": "count", "settings.twin_cells": "count", "settings.*": TEXT,
 }
 #: units of the keys of ``arzsumo twin``'s summary.json

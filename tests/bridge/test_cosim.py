@@ -121,3 +121,28 @@ def test_a_run_killed_halfway_leaves_no_complete_results(tmp_path):
     proc.wait(timeout=30)
     assert not out.exists()
     assert not any((p / "summary.json").exists() for p in tmp_path.iterdir() if p.is_dir())
+
+
+def test_practitioner_alinea_holds_its_period_and_held_keeps_r_min(scenario):
+    """One-per-green meter, 20 s ALINEA period, 80 s of control: the law's command (and,
+    without [actuation] limits, the U applied) changes at most once per ALINEA period;
+    the held meter asks for r_min from the first check of the window."""
+    sc = scenario.with_({"sumo.meter_mode": "one_per_green", "alinea.period_s": 20,
+                         "alinea.target_pct": 20})
+    period = sc.alinea.period
+    cfg = sc.sumo
+    for name in ("alinea", "held"):
+        res = _short(sc, name, horizon=80.0)
+        per = res.periods
+        assert per["occupancy_out"].size == 80 and np.isfinite(per["occupancy_out"]).all()
+        assert np.nanmax(per["flow_out_loop"]) > 0          # the loop on `down` sees traffic
+        if name == "alinea":
+            for col in ("u_continuous", "u_raw", "u"):
+                changes = per["t"][1:][np.diff(per[col]) != 0]
+                counts = np.bincount((changes // period).astype(int), minlength=4)
+                assert counts.max() <= 1, (col, changes)
+            assert per["u"][0] == 0.0                        # nominal until a period ends
+            assert res.controller_log.triggers >= 1
+        else:
+            np.testing.assert_allclose(per["release_rate"], cfg.release_rate_min)
+            np.testing.assert_allclose(per["u"], cfg.release_rate - cfg.release_rate_min)

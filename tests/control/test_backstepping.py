@@ -86,7 +86,7 @@ def test_controller_applies_the_law_in_physical_units(lin, kernels):
 
 def test_registry_builds_every_controller(lin, kernels):
     from arzsumo.control import make_controller
-    from arzsumo.control.registry import Alinea as AlineaClass
+    from arzsumo.control.alinea import Alinea, HeldMeter, PiAlinea, ReleaseRates
     from arzsumo.control.registry import ControllerInputs, controller_names, controller_spec
     from arzsumo.errors import ModelError, ScenarioError
 
@@ -94,36 +94,21 @@ def test_registry_builds_every_controller(lin, kernels):
     x = kernels.x
     z = sinusoidal_deviation(lin, x)
     state = MacroState(0.0, x, eq.rho_h + z[0], eq.v_h + z[1], eq.rho_a + z[2], eq.v_a + z[3])
-    alinea = {"outflow_of_green": lambda g: 0.2 + 0.3 * g, "nominal_green": 0.5,
-              "target": 0.2}
-    inputs = ControllerInputs(lin, kernels, constant_u=0.125, alinea=alinea)
+    rates = ReleaseRates(600 / 3600, 240 / 3600, 900 / 3600)
+    inputs = ControllerInputs(lin, kernels, constant_u=0.125, rates=rates)
     us = {name: controller_spec(name).build(inputs).check(state)
           for name in controller_names()}
-    assert set(us) == {"open", "backstepping", "etc", "observer-etc", "constant", "alinea"}
+    assert set(us) == {"open", "backstepping", "etc", "observer-etc", "constant", "alinea",
+                       "pi-alinea", "held"}
     assert us["open"] == 0.0 and us["constant"] == 0.125
+    assert us["alinea"] == us["pi-alinea"] == 0.0              # nominal until a period ends
+    assert us["held"] == pytest.approx(360 / 3600)              # r_nominal - r_min
     assert us["backstepping"] == pytest.approx(us["etc"])        # first ETC check is an event
-    assert isinstance(controller_spec("alinea").build(inputs), AlineaClass)
+    for name, cls in (("alinea", Alinea), ("pi-alinea", PiAlinea), ("held", HeldMeter)):
+        assert type(controller_spec(name).build(inputs)) is cls
+    with pytest.raises(ModelError, match="needs the meter's release rates"):
+        controller_spec("held").build(ControllerInputs(lin))
     with pytest.raises(ScenarioError, match="controller = 'pid' is not allowed"):
         make_controller("pid", lin, kernels)
     with pytest.raises(ModelError, match="needs backstepping kernels"):
         make_controller("etc", lin, None)
-
-
-def test_alinea_integrates_occupancy_error():
-    from arzsumo.control.alinea import Alinea
-
-    def curve(g):                   # more ramp green, less mainline outflow (veh/s)
-        return 1.5 - 0.6 * g
-
-    ctrl = Alinea(curve, nominal_green=0.5, target=0.2)
-    x = np.array([25.0])
-    one = np.ones(1)
-    state = MacroState(0.0, x, one, one, one, one, occupancy_out=0.3)   # too dense
-    u1 = ctrl.check(state)
-    assert ctrl.green == pytest.approx(0.5 - 7000 / 1800 * 0.1)        # K_R / r_sat * error
-    assert u1 == pytest.approx(curve(ctrl.green) - curve(0.5)) and u1 > 0
-    for _ in range(20):
-        ctrl.check(state)
-    assert ctrl.green == 0.0                                              # saturated
-    ctrl.check(MacroState(1.0, x, one, one, one, one))                    # no measurement
-    assert ctrl.green == 0.0

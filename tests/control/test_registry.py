@@ -23,7 +23,7 @@ def test_cli_choices_are_the_registry_names():
     assert _choices(parser, "run", "--controller") == list(controller_names("sumo"))
     assert _choices(parser, "verify", "--controller") == ["theory", *pde_controller_names()]
     assert controller_names("sumo") == ("open", "backstepping", "etc", "observer-etc",
-                                        "alinea")
+                                        "constant", "alinea", "pi-alinea", "held")
     assert controller_names("twin") == ("open", "backstepping", "etc", "observer-etc",
                                         "constant")
     assert [n for n in controller_names() if is_pde(n)] == ["backstepping", "etc",

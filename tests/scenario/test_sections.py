@@ -55,7 +55,9 @@ def test_every_shipped_sweep_loads_and_its_runs_parse(path):
     ({"sumo": {"ramp_demand_veh_h": -1}}, r"^s.toml: \[sumo\] ramp_demand_veh_h = -1 is not "
                                           r"allowed: a demand >= 0 veh/h$"),
     ({"sumo": {"fcd": "yes"}}, r'^s.toml: \[sumo\] fcd = "yes" is not allowed: true or false$'),
-    ({"run": {"controller": "constant"}}, r'^s.toml: \[run\] controller = "constant" is not'),
+    ({"run": {"controller": "pid"}}, r'^s.toml: \[run\] controller = "pid" is not'),
+    ({"alinea": {"period_s": 61}}, r"^s.toml: \[alinea\] period_s = 61 is not allowed: a "
+                                   r"period in \[20, 60\] s$"),
     ({"run": {"smoothing_s": 0}}, r"^s.toml: \[run\] smoothing_s = 0 is not allowed"),
     ({"sweep": {"parameter": "mu", "values": ["a"]}}, r'^s.toml: \[sweep\] values = \["a"\]'),
     ({"sumo": {"meter_curve": "nowhere.toml"}}, r'^s.toml: \[sumo\] meter_curve = '

@@ -71,7 +71,7 @@ def test_one_at_a_time_group_and_multi_field_axis():
     ({"axis": [{"field": "equilibrium.penetrat", "values": [0.4]}]},
      r"field 'equilibrium.penetrat' is not allowed: \[equilibrium\] has branch"),
     ({"axis": [{"field": "traffic.x", "values": [1]}]},
-     r"field 'traffic.x' is not allowed: 'table.key' with table one of actuation, design"),
+     r"field 'traffic.x' is not allowed: 'table.key' with table one of actuation, alinea, design"),
     ({"axis": [{"field": "design.mu", "values": [1e-3, 0.001]}]}, "values repeat 0.001"),
     ({"axis": [{"field": "design.mu", "values": [1], "set": [{}]}]}, "give either field"),
     ({"axis": [{"name": "d", "values": [1, 2], "set": [{}]}]}, "set must be a list of 2"),

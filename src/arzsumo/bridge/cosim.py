@@ -9,8 +9,8 @@ Sequence of :func:`run_cosimulation` (``arzsumo run``):
    warm-up rounded up to whole control periods (at least one, to measure from).
 4. With ``equilibrium = "measured"``, take the mean Edie densities of the last 60 s of the
    warm-up as the equilibrium of the (calibrated) model, and check its regime.
-5. Build the controller (kernels solved or loaded), ALINEA's occupancy target, the
-   actuator and both twins from the measured state at the start of control.
+5. Build the controller (kernels solved or loaded; ALINEA's settings from ``[alinea]``),
+   the actuator and both twins from the measured state at the start of control.
 6. Every control period: the controller is checked on the estimate of the last period
    (:mod:`~arzsumo.bridge.estimator`; with ``[estimation] method`` "smoothing" or "enkf"
    built from the ``[sensing]`` loops and AV probes, fed the warm-up's records first:
@@ -64,6 +64,7 @@ from arzsumo.bridge.records import Decision, PeriodRecord, Trace, columns, micro
 from arzsumo.bridge.reference import ReferenceShift, reference_shift
 from arzsumo.bridge.result import CoSimResult
 from arzsumo.bridge.twins import TwinPair
+from arzsumo.control.alinea import AlineaSettings, ReleaseRates
 from arzsumo.control.base import Controller, MacroState
 from arzsumo.control.etc import EtcDesign
 from arzsumo.control.registry import ControllerInputs, controller_spec, is_pde
@@ -89,10 +90,8 @@ from arzsumo.twin.solver import SolverOptions
 
 log = logging.getLogger(__name__)
 
-#: seconds of warm-up averaged for a measured equilibrium (and ALINEA's target occupancy)
+#: seconds of warm-up averaged for a measured equilibrium
 MEASURE_WINDOW = 60.0
-#: ALINEA target when the warm-up measured no downstream occupancy (fraction)
-DEFAULT_OCCUPANCY_TARGET = 0.2
 
 
 def check_before_start(settings: RunSettings, eq: Equilibrium) -> Linearization:
@@ -162,29 +161,22 @@ def operating_point(settings: RunSettings, eq: Equilibrium,
     return measured
 
 
-def occupancy_target(settings: RunSettings, warm: list[PeriodMeasurement],
-                     period: float) -> float:
-    """ALINEA's target occupancy: the scenario's, else the warm-up's last 60 s."""
-    k = max(1, round(MEASURE_WINDOW / period))
-    target = settings.alinea_target or float(np.mean([w.occupancy_out for w in warm[-k:]]))
-    if target > 0.01:
-        return target
-    if settings.controller == "alinea":   # nothing reached the detector in the warm-up
-        log.warning("no downstream occupancy measured in the warm-up; ALINEA target %.2f",
-                    DEFAULT_OCCUPANCY_TARGET)
-    return DEFAULT_OCCUPANCY_TARGET
+def meter_rates(cfg: SumoConfig) -> ReleaseRates:
+    """The meter's nominal release rate and bounds (veh/s): ALINEA's and the held meter's
+    r_nominal, r_min, r_max (U = r_nominal - r)."""
+    return ReleaseRates(cfg.release_rate, cfg.release_rate_min, cfg.release_rate_max)
 
 
 def build_controller(name: str, lin: Linearization, kernels: Any, design: EtcDesign,
-                     settings: RunSettings, curve: GreenShareCurve, cfg: SumoConfig,
-                     alinea_target: float) -> Controller:
-    """A reset controller of ``name`` for the closed loop (the registry's builder)."""
-    alinea = {"outflow_of_green": curve.outflow_at, "nominal_green": cfg.green_share,
-              "target": alinea_target, "gain": settings.alinea_gain,
-              "saturation_flow": settings.alinea_saturation,
-              "green_min": cfg.green_share_min, "green_max": cfg.green_share_max}
-    ctrl = controller_spec(name, "sumo").build(ControllerInputs(lin, kernels, design,
-                                                                alinea=alinea))
+                     settings: RunSettings, cfg: SumoConfig,
+                     alinea: AlineaSettings) -> Controller:
+    """A reset controller of ``name`` for the closed loop (the registry's builder); the
+    ``constant`` controller holds the release rate ``[run] constant_release_veh_h``."""
+    inputs = ControllerInputs(lin, kernels, design,
+                              constant_u=cfg.release_rate - settings.constant_release,
+                              alinea=alinea, rates=meter_rates(cfg),
+                              check_period=cfg.control_period)
+    ctrl = controller_spec(name, "sumo").build(inputs)
     ctrl.reset()
     return ctrl
 
@@ -219,8 +211,10 @@ class ClosedLoop:
         self.controller.actuated(act.u_applied)
         if self.anti_windup:
             self.controller.applied(act.u_applied, act.lower, act.upper)
+        rate = self.plant.meter.release_rate
         return Decision(state.t, u, u_cont, triggered, act.green, u_ref, c1 - c0,
-                        act.u_applied, float(act.saturated), float(act.rate_limited))
+                        act.u_applied, float(act.saturated), float(act.rate_limited),
+                        math.nan if rate is None else rate)
 
     def record(self, d: Decision, m: PeriodMeasurement) -> PeriodRecord:
         meter, c = self.plant.meter, m.cells
@@ -229,7 +223,8 @@ class ClosedLoop:
                             meter.plan_changes, meter.queue, meter.max_queue, c.inflow_h,
                             c.inflow_a, c.outflow_h, c.outflow_a, m.occupancy_out,
                             d.u_reference, d.controller_s, d.u, d.u_applied, d.saturated,
-                            d.rate_limited, float(meter.override()))
+                            d.rate_limited, m.flow_out_loop, d.release_rate,
+                            float(meter.override()))
 
     def run(self, start: PeriodMeasurement, horizon: float, bar: Progress) -> Trace:
         """Control from the measurement ``start`` (t = 0) until ``horizon`` seconds."""
@@ -315,7 +310,8 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
         with open_simulation(scenario.params, run_cfg, initial=initial,
                              extra_args=network_options(net_dir, fcd=cfg.fcd),
                              output_dir=net_dir, keep=files, frontend=frontend,
-                             loops=scenario.sensing.loop_x(scenario.params.length)) as sim:
+                             loops=scenario.sensing.loop_x(scenario.params.length),
+                             downstream_loop=scenario.alinea.loop_distance) as sim:
             c = control(sim, scenario, settings, cfg, design, curve, bar, keep_measurements)
             meter = c.loop.plant.meter
             meter_summary = {**meter.summary(), "ramp_storage": cfg.ramp_storage}
@@ -377,7 +373,6 @@ def control(sim: SumoSimulation, scenario: Scenario, settings: RunSettings, cfg:
     lin = linearize(eq)
     kernels = (cached_kernels(lin.system, settings.kernel_cells)
                if is_pde(settings.controller) else None)
-    target = occupancy_target(settings, warm, period)
     estimator, acting = estimation_stage(scenario.estimation, scenario.sensing,
                                          settings.controller, eq, warm[-1].cells.x,
                                          keep_measurements)
@@ -387,10 +382,11 @@ def control(sim: SumoSimulation, scenario: Scenario, settings: RunSettings, cfg:
              if is_pde(acting) and est.reference != "equilibrium" and warm_fields else None)
     check_delay(scenario, acting, lin.eigenvalues, "measured" if eq is not scenario.equilibrium
                 else "")
-    ctrl = compensate(build_controller(acting, lin, kernels, design, settings, curve, cfg,
-                                       target), acting, scenario)
+    ctrl = compensate(build_controller(acting, lin, kernels, design, settings, cfg,
+                                       scenario.alinea), acting, scenario)
     ref_name = settings.controller if is_pde(settings.controller) else "open"
-    ref_ctrl = build_controller(ref_name, lin, kernels, design, settings, curve, cfg, target)
+    ref_ctrl = build_controller(ref_name, lin, kernels, design, settings, cfg,
+                                scenario.alinea)
     q_nom = curve.outflow_at(cfg.green_share)
     opts = SolverOptions(cells=settings.twin_cells, scheme=settings.twin_scheme,
                          horizon=cfg.horizon, control_period=period)

@@ -26,9 +26,10 @@ class PeriodRecord:
     green share asked of the meter, ``u_reference`` the reference twin's U,
     ``controller_s`` the wall time of the check. The rest is the period that followed:
     the running green share, cumulative light and plan changes, the ramp queue at its end
-    and its maximum so far (veh), class in- and outflows of the section, the mean
-    occupancy downstream of the merge (fraction), and whether the meter's queue override
-    was on at the period's end (1.0 or 0.0).
+    and its maximum so far (veh), class in- and outflows of the section, the occupancy
+    (fraction) and flow (veh/s) of the loop on ``down`` past the merge nose, the release
+    rate the meter was asked for (veh/s; NaN for a fixed-cycle meter), and whether the
+    meter's queue override was on at the period's end (1.0 or 0.0).
     """
 
     t: float
@@ -52,6 +53,8 @@ class PeriodRecord:
     u_applied: float = float("nan")
     saturated: float = 0.0
     rate_limited: float = 0.0
+    flow_out_loop: float = float("nan")
+    release_rate: float = float("nan")
     override: float = 0.0
 
 
@@ -81,8 +84,9 @@ class Trace:
 
 @dataclass(frozen=True)
 class Decision:
-    """One check: U held (veh/s), its continuous value, event flag, meter command, and
-    the U applied (veh/s) with the limit flags (1.0 or 0.0)."""
+    """One check: U held (veh/s), its continuous value, event flag, meter command, the
+    U applied (veh/s) with the limit flags (1.0 or 0.0), and the release rate asked of
+    the meter (veh/s; NaN for a fixed-cycle meter)."""
 
     t: float
     u: float
@@ -94,3 +98,4 @@ class Decision:
     u_applied: float = float("nan")
     saturated: float = 0.0
     rate_limited: float = 0.0
+    release_rate: float = float("nan")

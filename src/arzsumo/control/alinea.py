@@ -1,76 +1,231 @@
-"""ALINEA (Papageorgiou, Hadj-Salem and Blosseville, 1991): the traffic engineer's baseline.
+"""ALINEA and PI-ALINEA as practitioners run them: local occupancy feedback on the release rate.
 
-Local integral feedback on the occupancy o measured downstream of the merge:
+ALINEA (Papageorgiou, Hadj-Salem and Blosseville, Transp. Res. Rec. 1320, 1991) updates
+the ramp's release rate once per control period T (20-60 s in the field) from the
+occupancy o(k) of one loop 40-300 m downstream of the merge nose, averaged over the
+period:
 
-    r(k) = r(k-1) + K_R (o_target - o(k)),   r saturated to [r_min, r_max],
+    r(k) = r(k-1) + K_R (o_target - o(k)),
 
-with r the ramp metering rate. Our actuator takes a mainline outflow command (the same
-actuator as the PDE controllers): the rate is expressed as a green share g = r / r_sat of
-the meter, and the command is the mainline outflow the meter's calibrated curve gives at g,
-U = q(g) - q_nominal. The usual gain K_R = 70 veh/h per % occupancy becomes
-K_R / r_sat per unit occupancy in green share.
+PI-ALINEA (Wang, Kosmatopoulos, Papageorgiou and Papamichail, IEEE T-ITS 15(5), 2014)
+adds a proportional term for bottlenecks further downstream:
+
+    r(k) = r(k-1) - K_P (o(k) - o(k-1)) + K_I (o_target - o(k)).
+
+r is clamped to [r_min, r_max] after each update; clamping the *state* r(k) (not only the
+output) is ALINEA's anti-windup: the rate leaves a bound at the first update whose
+increment points back inside.
+
+Gains. K_R (and K_I) integrate the error once per period, so the integral action per
+unit time is K_R / T; practice quotes K_R = 70 veh/h per % of occupancy for T = 60 s.
+:class:`AlineaSettings` holds the gain at a reference period T_ref and uses
+K_R(T) = K_R(T_ref) T / T_ref, which keeps K_R / T, hence the loop's bandwidth, when
+the period changes (46.7 veh/h per % at 40 s). K_P multiplies a change of occupancy,
+not an accumulated error, and is not scaled.
+
+The closed loop checks every controller every control period of the co-simulation
+(1 s); these controllers average the occupancy samples of those checks over their own
+period and hold their command in between, so the command changes at most once per
+period. The command is the outflow deviation of every controller, U = r_nominal - r
+(veh/s): the meter maps it back to r (one vehicle per green,
+``arzsumo.sumo.meter_release.release_rate_for``).
+
+SI throughout: rates veh/s, occupancy a fraction (SUMO's loop occupancy, the share of
+time the loop is occupied; it can exceed 1 with vehicles side by side under the sublane
+model), gains veh/s per unit occupancy, times s.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from dataclasses import dataclass
 
 from arzsumo.control.base import Controller, MacroState
-from arzsumo.errors import ModelError, require
+from arzsumo.errors import ModelError, ScenarioError, require
+
+#: 70 veh/h per % of occupancy (the field's K_R at a 60 s period), veh/s per unit occupancy
+GAIN_70 = 70.0 * 100.0 / 3600.0
+#: allowed control periods (s) and loop distances downstream of the merge nose (m)
+PERIOD_RANGE = (20.0, 60.0)
+DISTANCE_RANGE = (40.0, 300.0)
 
 
-class Alinea(Controller):
-    """ALINEA on the green share of the ramp meter.
+@dataclass(frozen=True)
+class AlineaSettings:
+    """Parameters of ALINEA and PI-ALINEA (SI; the ``[alinea]`` table of a scenario).
 
     Parameters
     ----------
-    outflow_of_green : callable
-        Mainline outflow (veh/s) at a green share in [0, 1] (the meter's calibrated curve).
-    nominal_green : float
-        Green share of the nominal plan; U is relative to the outflow there.
+    period : float
+        Control period T of the controller, s, in [20, 60].
+    loop_distance : float
+        Distance of its loop downstream of the merge nose (the end of ``merge``), m,
+        in [40, 300].
     target : float
-        Target occupancy o_target (fraction); typically the critical occupancy.
-    gain : float, optional
-        K_R in veh/s per unit occupancy; default 70 veh/h per % = 7000 veh/h per unit.
-    saturation_flow : float, optional
-        Ramp flow (veh/s) of an always-green meter, r_sat; default 1800 veh/h.
-    green_min, green_max : float
-        Saturation of the green share.
+        Occupancy target o_target (fraction, > 0): just below the loop's critical
+        occupancy (``arzsumo alinea-target``).
+    gain : float
+        K_R at ``gain_period``, veh/s per unit occupancy (> 0).
+    gain_period : float
+        Reference period T_ref of ``gain`` and ``ki``, s (> 0).
+    kp : float
+        PI-ALINEA's K_P, veh/s per unit occupancy (>= 0; not scaled with the period).
+    ki : float
+        PI-ALINEA's K_I at ``gain_period``, veh/s per unit occupancy (>= 0).
+    """
+
+    period: float = 40.0
+    loop_distance: float = 100.0
+    target: float = 0.2
+    gain: float = GAIN_70
+    gain_period: float = 60.0
+    kp: float = 60.0 * 100.0 / 3600.0
+    ki: float = 5.0 * 100.0 / 3600.0
+
+    def __post_init__(self) -> None:
+        def check(ok: bool, name: str, allowed: str) -> None:
+            require(ok, name, getattr(self, name), allowed, ScenarioError)
+
+        lo, hi = PERIOD_RANGE
+        check(math.isfinite(self.period) and lo <= self.period <= hi, "period",
+              f"a period in [{lo:g}, {hi:g}] s")
+        lo, hi = DISTANCE_RANGE
+        check(math.isfinite(self.loop_distance) and lo <= self.loop_distance <= hi,
+              "loop_distance", f"a distance in [{lo:g}, {hi:g}] m downstream of the merge")
+        check(math.isfinite(self.target) and 0 < self.target < 10, "target",
+              "an occupancy fraction > 0")
+        check(math.isfinite(self.gain) and self.gain > 0, "gain", "a gain > 0")
+        check(math.isfinite(self.gain_period) and self.gain_period > 0, "gain_period",
+              "a period > 0 s")
+        check(math.isfinite(self.kp) and self.kp >= 0, "kp", "a gain >= 0")
+        check(math.isfinite(self.ki) and self.ki >= 0, "ki", "a gain >= 0")
+
+    def scaled(self, gain: float) -> float:
+        """An integral gain given at ``gain_period`` scaled to ``period``:
+        K(T) = K(T_ref) T / T_ref (the same integral action per second)."""
+        return gain * self.period / self.gain_period
+
+
+@dataclass(frozen=True)
+class ReleaseRates:
+    """The meter's release rates, veh/s: nominal (the open loop's, U = 0) and bounds."""
+
+    nominal: float
+    low: float
+    high: float
+
+    def __post_init__(self) -> None:
+        require(0 < self.low <= self.nominal <= self.high, "release_rate", self.nominal,
+                f"a rate in [{self.low}, {self.high}] veh/s", ModelError)
+
+    def clamp(self, r: float, low: float = -math.inf, high: float = math.inf) -> float:
+        """``r`` within the bounds (and within ``[low, high]`` where they are narrower)."""
+        return min(min(self.high, high), max(max(self.low, low), r))
+
+
+def alinea_step(r_prev: float, occupancy: float, target: float, gain: float,
+                low: float, high: float) -> float:
+    """ALINEA's update r(k) = clamp(r(k-1) + K_R (o_target - o(k))), veh/s."""
+    return min(high, max(low, r_prev + gain * (target - occupancy)))
+
+
+def pi_alinea_step(r_prev: float, occupancy: float, occupancy_prev: float, target: float,
+                   kp: float, ki: float, low: float, high: float) -> float:
+    """PI-ALINEA's update r(k) = clamp(r(k-1) - K_P (o(k) - o(k-1)) + K_I (o_target -
+    o(k))), veh/s."""
+    r = r_prev - kp * (occupancy - occupancy_prev) + ki * (target - occupancy)
+    return min(high, max(low, r))
+
+
+class Alinea(Controller):
+    """ALINEA on the release rate, updated once per its own period (module docstring).
+
+    Parameters
+    ----------
+    settings : AlineaSettings
+        Period, target and gains.
+    rates : ReleaseRates
+        Nominal release rate (the start, r(0)) and the clamp [r_min, r_max], veh/s.
+    check_period : float
+        Period of the closed loop's checks, s; ``settings.period`` must be a whole
+        multiple of it.
     """
 
     name = "alinea"
 
-    def __init__(self, outflow_of_green: Callable[[float], float], nominal_green: float,
-                 target: float, gain: float = 7000.0 / 3600.0,
-                 saturation_flow: float = 1800.0 / 3600.0, green_min: float = 0.0,
-                 green_max: float = 1.0) -> None:
+    def __init__(self, settings: AlineaSettings, rates: ReleaseRates,
+                 check_period: float = 1.0) -> None:
         super().__init__()
-        require(0.0 <= green_min <= nominal_green <= green_max <= 1.0, "nominal_green",
-                nominal_green, f"within [green_min, green_max] = [{green_min}, {green_max}]",
-                ModelError)
-        require(math.isfinite(target) and target > 0, "target", target,
-                "an occupancy > 0", ModelError)
-        require(gain > 0 and saturation_flow > 0, "gain", gain, "> 0 (and saturation_flow > 0)",
-                ModelError)
-        self.outflow_of_green = outflow_of_green
-        self.nominal_green, self.target = nominal_green, target
-        self.gain_green = gain / saturation_flow
-        self.green_min, self.green_max = green_min, green_max
-        self.q_nominal = outflow_of_green(nominal_green)
-        self.green = nominal_green
+        n = round(settings.period / check_period)
+        require(n >= 1 and abs(n * check_period - settings.period) < 1e-6, "period",
+                settings.period, f"a whole multiple of the control period {check_period:g} s",
+                ScenarioError)
+        self.settings, self.rates, self.checks_per_update = settings, rates, n
+        self.reset()
 
     def reset(self) -> None:
         super().reset()
-        self.green = self.nominal_green
+        self.rate = self.rates.nominal
+        self.occupancy_prev = math.nan     # o(k-1), PI-ALINEA
+        self._samples: list[float] = []
+        self._checks = 0
+        self._range = (-math.inf, math.inf)  # rates the actuator allowed last (anti-windup)
+
+    def update(self, occupancy: float) -> float:
+        """One ALINEA update with the period's mean occupancy; the new rate, veh/s."""
+        s = self.settings
+        lo, hi = self._range
+        return alinea_step(self.rate, occupancy, s.target, s.scaled(s.gain),
+                           max(self.rates.low, lo), min(self.rates.high, hi))
 
     def decide(self, state: MacroState) -> float:
         occ = state.occupancy_out
-        previous = self.green
         if math.isfinite(occ):
-            g = previous + self.gain_green * (self.target - occ)
-            self.green = min(self.green_max, max(self.green_min, g))
-        u = self.outflow_of_green(self.green) - self.q_nominal
-        self.log.record(state.t, u, u, self.green != previous, green_share=self.green,
-                        occupancy=occ)
+            self._samples.append(occ)
+        self._checks += 1
+        previous, mean = self.rate, math.nan
+        if self._checks >= self.checks_per_update:
+            if self._samples:
+                mean = sum(self._samples) / len(self._samples)
+                self.rate = self.update(mean)
+                self.occupancy_prev = mean
+            self._samples, self._checks = [], 0
+        u = self.rates.nominal - self.rate
+        self.log.record(state.t, u, u, self.rate != previous, release_rate=self.rate,
+                        occupancy=occ, occupancy_mean=mean)
         return u
+
+    def applied(self, u: float, lower: float = -math.inf, upper: float = math.inf) -> None:
+        """Anti-windup on the actuator's range: U in ``[lower, upper]`` is r in
+        ``[r_nominal - upper, r_nominal - lower]``; the next update clamps the state to
+        it (not this check: the command is held between updates)."""
+        self._range = (self.rates.nominal - upper, self.rates.nominal - lower)
+
+
+class PiAlinea(Alinea):
+    """PI-ALINEA (Wang et al. 2014): ALINEA with a proportional term on the change of the
+    period's occupancy; the first update, with no o(k-1), uses o(k-1) = o(k)."""
+
+    name = "pi-alinea"
+
+    def update(self, occupancy: float) -> float:
+        s = self.settings
+        prev = occupancy if math.isnan(self.occupancy_prev) else self.occupancy_prev
+        lo, hi = self._range
+        return pi_alinea_step(self.rate, occupancy, prev, s.target, s.kp, s.scaled(s.ki),
+                              max(self.rates.low, lo), min(self.rates.high, hi))
+
+
+class HeldMeter(Controller):
+    """The meter held at its least release rate from the start of control:
+    U = r_nominal - r_min (veh/s), constant."""
+
+    name = "held"
+
+    def __init__(self, rates: ReleaseRates) -> None:
+        super().__init__()
+        self.u = rates.nominal - rates.low
+
+    def decide(self, state: MacroState) -> float:
+        self.log.record(state.t, self.u, self.u, not self.log.t)
+        return self.u

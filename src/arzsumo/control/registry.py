@@ -22,7 +22,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from arzsumo.control.alinea import Alinea
+from arzsumo.control.alinea import Alinea, AlineaSettings, HeldMeter, PiAlinea, ReleaseRates
 from arzsumo.control.backstepping import Backstepping
 from arzsumo.control.base import ConstantControl, Controller, OpenLoop
 from arzsumo.control.etc import PAPER_DESIGN, EtcDesign, EventTriggered
@@ -45,16 +45,25 @@ class ControllerInputs:
     design : EtcDesign
         ETC design (paper section 5 by default).
     constant_u : float
-        U of the ``constant`` controller, veh/s.
-    alinea : dict
-        Keyword arguments of :class:`arzsumo.control.alinea.Alinea` (``alinea`` only).
+        U of the ``constant`` controller, veh/s (in SUMO: r_nominal minus ``[run]
+        constant_release_veh_h``; in the twin: ``[twin] constant_u_veh_h``).
+    alinea : AlineaSettings
+        Period, loop, target and gains of ``alinea`` and ``pi-alinea`` (``[alinea]``).
+    rates : ReleaseRates, optional
+        The meter's nominal release rate and bounds, veh/s (``alinea``, ``pi-alinea``,
+        ``held``).
+    check_period : float
+        Period of the closed loop's checks, s (ALINEA holds its command between its own
+        updates, a whole number of checks).
     """
 
     lin: Linearization | None = None
     kernels: Kernels | None = None
     design: EtcDesign = PAPER_DESIGN
     constant_u: float = 0.0
-    alinea: dict[str, Any] = field(default_factory=dict)
+    alinea: AlineaSettings = field(default_factory=AlineaSettings)
+    rates: ReleaseRates | None = None
+    check_period: float = 1.0
 
 
 Builder = Callable[[ControllerInputs], Controller]
@@ -69,6 +78,7 @@ class ControllerSpec:
     pde: bool = False       # needs kernels on a congested equilibrium (lambda_4 < 0)
     twin: bool = True       # available to ``arzsumo twin`` ([twin] controller)
     sumo: bool = True       # available to ``arzsumo run`` ([run] controller)
+    alinea: bool = False    # reads the [alinea] table (its own period and loop)
     description: str = ""
 
 
@@ -79,6 +89,19 @@ def _pde(cls: Any) -> Builder:
         if cls is Backstepping:
             return Backstepping(inp.lin, inp.kernels)
         return cls(inp.lin, inp.kernels, inp.design)
+
+    return build
+
+
+def _rates(inp: ControllerInputs, name: str) -> ReleaseRates:
+    if inp.rates is None:
+        raise ModelError(f"controller {name!r} needs the meter's release rates")
+    return inp.rates
+
+
+def _alinea(cls: type[Alinea]) -> Builder:
+    def build(inp: ControllerInputs) -> Controller:
+        return cls(inp.alinea, _rates(inp, cls.name), inp.check_period)
 
     return build
 
@@ -106,10 +129,17 @@ for _spec in (
                    description="dynamic event-triggered backstepping (the paper's)"),
     ControllerSpec("observer-etc", _pde(ObserverEtc), pde=True,
                    description="ETC on the state of a boundary observer"),
-    ControllerSpec("constant", lambda inp: ConstantControl(inp.constant_u), sumo=False,
-                   description="U held at [twin] constant_u_veh_h"),
-    ControllerSpec("alinea", lambda inp: Alinea(**inp.alinea), twin=False,
-                   description="ALINEA on the downstream occupancy (the engineer's baseline)"),
+    ControllerSpec("constant", lambda inp: ConstantControl(inp.constant_u),
+                   description="U held: [twin] constant_u_veh_h; in SUMO the release rate "
+                               "[run] constant_release_veh_h"),
+    ControllerSpec("alinea", _alinea(Alinea), twin=False, alinea=True,
+                   description="ALINEA on the release rate, one loop downstream of the "
+                               "merge, its own period ([alinea])"),
+    ControllerSpec("pi-alinea", _alinea(PiAlinea), twin=False, alinea=True,
+                   description="PI-ALINEA: ALINEA with a proportional term ([alinea])"),
+    ControllerSpec("held", lambda inp: HeldMeter(_rates(inp, "held")), twin=False,
+                   description="the meter held at its least release rate from the start "
+                               "of control"),
 ):
     register_controller(_spec)
 
@@ -130,6 +160,12 @@ def is_pde(name: str) -> bool:
     return spec is not None and spec.pde
 
 
+def uses_alinea(name: str) -> bool:
+    """Whether ``name`` reads the ``[alinea]`` table (False for an unknown name)."""
+    spec = REGISTRY.get(name)
+    return spec is not None and spec.alinea
+
+
 def controller_spec(name: str, engine: str | None = None) -> ControllerSpec:
     """The entry of ``name`` (available to ``engine``); the error lists the allowed names."""
     spec = REGISTRY.get(name)
@@ -141,6 +177,6 @@ def controller_spec(name: str, engine: str | None = None) -> ControllerSpec:
 
 def make_controller(name: str, lin: Linearization, kernels: Kernels | None = None,
                     design: EtcDesign = PAPER_DESIGN) -> Controller:
-    """A fresh controller called ``name`` for the equilibrium of ``lin`` (no ALINEA
-    arguments, no constant U: for those, build through :func:`controller_spec`)."""
+    """A fresh controller called ``name`` for the equilibrium of ``lin`` (no meter rates,
+    no constant U: for those, build through :func:`controller_spec`)."""
     return controller_spec(name).build(ControllerInputs(lin, kernels, design))

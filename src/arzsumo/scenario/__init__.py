@@ -19,6 +19,7 @@ section                   record                                     keys (units
 ``[sensing]``             ``sensing``: SensorLayout (``run``)        :mod:`.sensing`
 ``[estimation]``          ``estimation``: EstimationSettings         :mod:`.estimation`
 ``[actuation]``           ``actuation``: ActuationSettings (``run``) :mod:`.actuation`
+``[alinea]``              ``alinea``: AlineaSettings (``run``)       :mod:`.alinea`
 ``[sweep]``               ``sweep``: DesignSweep (``reproduce``)     here
 ========================  =========================================  ====================
 
@@ -36,7 +37,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from arzsumo.control.alinea import AlineaSettings
 from arzsumo.control.etc import EtcDesign
+from arzsumo.control.registry import uses_alinea
 from arzsumo.errors import ScenarioError
 from arzsumo.io import read_toml
 from arzsumo.model.characteristic import linearize
@@ -48,6 +51,7 @@ from arzsumo.scenario.actuation import (
     actuation_section,
     check_delay_horizon,
 )
+from arzsumo.scenario.alinea import ALINEA_KEYS, alinea_section, check_alinea_period
 from arzsumo.scenario.estimation import (
     ESTIMATION_KEYS,
     EstimationSettings,
@@ -62,7 +66,13 @@ from arzsumo.scenario.model import (
     equilibrium_section,
     model_section,
 )
-from arzsumo.scenario.run import RUN_KEYS, RUN_RENAMED, RunSettings, run_section
+from arzsumo.scenario.run import (
+    RUN_KEYS,
+    RUN_RENAMED,
+    RunSettings,
+    check_constant_release,
+    run_section,
+)
 from arzsumo.scenario.sensing import SENSING_KEYS, sensing_section
 from arzsumo.scenario.sumo import SUMO_KEYS, sumo_section
 from arzsumo.scenario.twin import (
@@ -91,7 +101,7 @@ KEYS: dict[str, dict[str, Key]] = {
     "model": MODEL_KEYS, "equilibrium": EQUILIBRIUM_KEYS, "design": DESIGN_KEYS,
     "initial": INITIAL_KEYS, "twin": TWIN_KEYS, "sumo": SUMO_KEYS, "run": RUN_KEYS,
     "sensing": SENSING_KEYS, "estimation": ESTIMATION_KEYS, "actuation": ACTUATION_KEYS,
-    "sweep": SWEEP_KEYS,
+    "alinea": ALINEA_KEYS, "sweep": SWEEP_KEYS,
 }
 #: table -> {old key: new key}: keys renamed since earlier versions (a one-line hint)
 RENAMED: dict[str, dict[str, str]] = {"run": RUN_RENAMED}
@@ -130,6 +140,7 @@ class Scenario:
     sensing: SensorLayout = field(default_factory=SensorLayout)
     estimation: EstimationSettings = field(default_factory=EstimationSettings)
     actuation: ActuationSettings = field(default_factory=ActuationSettings)
+    alinea: AlineaSettings = field(default_factory=AlineaSettings)
 
     def with_(self, changes: Mapping[str, Any]) -> Scenario:
         """A new scenario with keys changed, parsed and validated again.
@@ -192,6 +203,8 @@ def scenario_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scena
     twin = twin_section(t["twin"], at["twin"], initial, design)
     sumo = sumo_section(t["sumo"], at["sumo"], source)
     run = run_section(t["run"], at["run"])
+    check_constant_release(run, sumo.release_rate_min, sumo.release_rate_max, at["run"],
+                           t["run"].get("constant_release_veh_h"))
     sensing = sensing_section(t["sensing"], at["sensing"], params.length)
     estimation = estimation_section(t["estimation"], at["estimation"])
     check_sensors(estimation, sensing, params.length, at["estimation"])
@@ -199,13 +212,17 @@ def scenario_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scena
     if actuation.delay_compensation > 0:
         check_delay_horizon(actuation, linearize(eq).eigenvalues, params.length,
                             at["actuation"], t["actuation"].get("delay_compensation_s"))
+    alinea = alinea_section(t["alinea"], at["alinea"])
+    if uses_alinea(run.controller):
+        check_alinea_period(alinea, sumo.control_period, at["alinea"],
+                            t["alinea"].get("period_s"))
     sweep = _sweep_section(t["sweep"], at["sweep"])
     default_name = Path(source).stem if source != "<dict>" else preset.name
     return Scenario(_text(data, "name", source, default_name),
                     _text(data, "description", source, preset.description), params, eq,
                     design, initial, twin, sumo, run, sweep, source,
                     copy.deepcopy(dict(data)), sensing=sensing,
-                    estimation=estimation, actuation=actuation)
+                    estimation=estimation, actuation=actuation, alinea=alinea)
 
 
 def load_scenario(path: str | Path) -> Scenario:

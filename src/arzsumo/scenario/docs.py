@@ -10,6 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from arzsumo.control.alinea import AlineaSettings
 from arzsumo.control.etc import PAPER_DESIGN
 from arzsumo.control.registry import REGISTRY
 from arzsumo.model.params import get_preset
@@ -51,6 +52,9 @@ SECTIONS: dict[str, tuple[str, Callable[[str], Any] | None]] = {
     "actuation": ("the limits between the controller's U and the ramp meter of `arzsumo "
                   "run` (issue 17); default: every limit off, the meter receives the "
                   "controller's U", lambda f: getattr(ActuationSettings(), f)),
+    "alinea": ("ALINEA and PI-ALINEA in `arzsumo run` (`alinea`, `pi-alinea`): period, loop, "
+               "target and gains; the loop is read in every run (`occupancy_out`)",
+               lambda f: getattr(AlineaSettings(), f)),
     "sweep": ("`arzsumo reproduce` only: one ETC run per value of a [design] parameter", None),
 }
 

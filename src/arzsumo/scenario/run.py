@@ -11,9 +11,10 @@ Example::
     twin_cells = 100            # PDE twin grid (replay and reference)
     twin_scheme = "muscl"       # or "first"
     smoothing_s = 30            # time constant of the measured boundary data fed to the twins
-    alinea_target = 0.0         # occupancy target; 0: measured at the end of the warm-up
-    alinea_gain_veh_h_per_pct = 70
-    alinea_saturation_veh_h = 1800
+    constant_release_veh_h = 600  # release rate of the `constant` controller
+
+ALINEA's and PI-ALINEA's parameters are the ``[alinea]`` table
+(:mod:`arzsumo.scenario.alinea`).
 
 The control horizon, the control period and the seed are ``[sumo]`` keys.
 """
@@ -26,14 +27,13 @@ from typing import Any
 
 from arzsumo.control.registry import controller_names
 from arzsumo.errors import ArzsumoError, ScenarioError, require
-from arzsumo.tables import Key, in_user_terms, read_keys
+from arzsumo.tables import Key, in_user_terms, not_allowed, read_keys
 from arzsumo.units import VEH_H_PER_VEH_S
 
 #: backstepping kernel grid of both `arzsumo run` and `arzsumo twin` (one default)
 KERNEL_CELLS = 100
 
-#: [run] key -> RunSettings field (SI), with its unit factor; ALINEA's gain per % of
-#: occupancy in veh/h is 100/3600 veh/s per unit occupancy, hence the factor 36
+#: [run] key -> RunSettings field (SI), with its unit factor
 RUN_KEYS: dict[str, Key] = {
     "controller": Key("controller", "string", doc="controller on the ramp meter (a name of "
                                                   "the registry that runs in SUMO)"),
@@ -49,22 +49,21 @@ RUN_KEYS: dict[str, Key] = {
                        doc="scheme of the twins alongside SUMO"),
     "smoothing_s": Key("smoothing", unit="s",
                        doc="time constant of the measured boundary data fed to the twins"),
-    "alinea_target": Key("alinea_target", doc="ALINEA occupancy target (fraction); 0: "
-                                              "measured at the end of the warm-up"),
-    "alinea_gain_veh_h_per_pct": Key("alinea_gain", factor=VEH_H_PER_VEH_S / 100,
-                                     allowed="a gain > 0 veh/h per % of occupancy",
-                                     unit="veh/h per %", doc="ALINEA gain K_R"),
-    "alinea_saturation_veh_h": Key("alinea_saturation", factor=VEH_H_PER_VEH_S,
-                                   allowed="a flow > 0 veh/h", unit="veh/h",
-                                   doc="ramp flow of an always-green meter"),
+    "constant_release_veh_h": Key("constant_release", factor=VEH_H_PER_VEH_S,
+                                  allowed="a rate > 0 veh/h, within [sumo] "
+                                          "release_rate_min_veh_h .. release_rate_max_veh_h",
+                                  unit="veh/h", doc="release rate of the `constant` "
+                                                    "controller in SUMO (sweep it to find "
+                                                    "the best constant rate)"),
 }
 #: keys renamed since earlier versions: old -> new (refused with a one-line hint)
-RUN_RENAMED = {"equilibrium": "operating_point"}
+RUN_RENAMED = {"equilibrium": "operating_point",
+               "alinea_gain_veh_h_per_pct": "[alinea] gain_veh_h_per_pct"}
 
 
 @dataclass(frozen=True)
 class RunSettings:
-    """Settings of one co-simulation (SI; ALINEA gain in veh/s per unit occupancy)."""
+    """Settings of one co-simulation (SI; ``constant_release`` in veh/s)."""
 
     controller: str = "etc"
     warmup: float = 150.0
@@ -74,9 +73,7 @@ class RunSettings:
     twin_cells: int = 100
     twin_scheme: str = "muscl"
     smoothing: float = 30.0
-    alinea_target: float = 0.0
-    alinea_gain: float = 7000.0 / 3600.0
-    alinea_saturation: float = 1800.0 / 3600.0
+    constant_release: float = 600.0 / 3600.0
 
     def __post_init__(self) -> None:
         def check(ok: bool, name: str, allowed: str) -> None:
@@ -95,10 +92,8 @@ class RunSettings:
                   "an integer >= 10")
         check(self.twin_scheme in ("first", "muscl"), "twin_scheme", "'first' or 'muscl'")
         check(self.smoothing > 0, "smoothing", "a time > 0 s")
-        check(0 <= self.alinea_target < 10, "alinea_target",
-              "an occupancy fraction >= 0 (0: measured)")
-        check(self.alinea_gain > 0, "alinea_gain", "> 0")
-        check(self.alinea_saturation > 0, "alinea_saturation", "> 0")
+        check(math.isfinite(self.constant_release) and self.constant_release > 0,
+              "constant_release", "a rate > 0 veh/s")
 
     def as_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -112,3 +107,17 @@ def run_section(table: dict[str, Any], at: str) -> RunSettings:
         return RunSettings(**si)
     except ArzsumoError as exc:
         raise in_user_terms(exc, at, table, RUN_KEYS) from None
+
+
+def check_constant_release(settings: RunSettings, low: float, high: float, at: str,
+                           written_value: Any = None) -> None:
+    """Refuse a ``constant`` controller whose release rate lies outside the meter's
+    bounds ``[low, high]`` (veh/s), in one line naming ``at`` (``file: [run]``), the key
+    and the value as written."""
+    r = settings.constant_release
+    if settings.controller == "constant" and not low - 1e-12 <= r <= high + 1e-12:
+        value = written_value if written_value is not None else r * VEH_H_PER_VEH_S
+        raise not_allowed(at, "constant_release_veh_h", value,
+                          f"a rate in [{low * VEH_H_PER_VEH_S:g}, "
+                          f"{high * VEH_H_PER_VEH_S:g}] veh/h (the [sumo] release rate "
+                          "bounds)")

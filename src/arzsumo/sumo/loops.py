@@ -48,7 +48,7 @@ import numpy as np
 from arzsumo.errors import ScenarioError, require
 from arzsumo.estimate.observations import LoopNoise, LoopObservation
 from arzsumo.sumo.detectors import write_additional
-from arzsumo.sumo.network import MAIN
+from arzsumo.sumo.network import DOWN, MAIN
 from arzsumo.sumo.vtypes import AV_TYPE
 
 #: Distance of the downstream boundary station before x = L, m (a loop must lie on the lane).
@@ -201,3 +201,59 @@ class LoopSensor:
         self.records.append(obs)
         self._reset()
         return obs
+
+
+#: id of the E1 loop downstream of the merge (ALINEA's measurement)
+DOWNSTREAM_LOOP = "e1_down"
+#: its default distance past the merge nose (the start of ``down``), m
+DOWNSTREAM_DISTANCE = 100.0
+
+
+def write_downstream_loop(path: Path, distance: float = DOWNSTREAM_DISTANCE) -> Path:
+    """Write an additional file with one E1 loop on ``down_0`` at ``distance`` m past the
+    merge nose (the end of ``merge`` is the start of ``down``)."""
+    require(0 < distance < 500, "loop_distance", distance,
+            "a distance in (0, 500) m on the 500 m `down` edge", ScenarioError)
+    return write_additional(path, "inductionLoop", [
+        {"id": DOWNSTREAM_LOOP, "lane": f"{DOWN}_0", "pos": f"{distance:.3f}",
+         "period": "3600", "file": "NUL"}])
+
+
+class DownstreamLoop:
+    """Reads the loop of :func:`write_downstream_loop` every step; occupancy and flow per
+    control period.
+
+    Per period of T = ``steps_per_period`` steps of ``dt`` s: the occupancy o = (1/T) sum
+    tau_k (a fraction; tau_k the time vehicle k spent on the loop within the period;
+    vehicles side by side each count, so o may exceed 1 under the sublane model, as
+    SUMO's own E1 occupancy does) and the flow q = N / T (veh/s; N the vehicles whose
+    front reached the loop in the period).
+    """
+
+    def __init__(self, lib: ModuleType, dt: float, steps_per_period: int) -> None:
+        require(steps_per_period >= 1, "steps_per_period", steps_per_period, "at least 1")
+        self.lib, self.dt, self.steps_per_period = lib, dt, steps_per_period
+        self._on: set[str] = set()
+        self._reset()
+
+    def _reset(self) -> None:
+        self.occupied, self.entered, self.steps = 0.0, 0, 0
+
+    def observe(self, t: float) -> tuple[float, float] | None:
+        """Read the step that ended at ``t`` (s); ``(occupancy, flow)`` (fraction, veh/s)
+        of the period when it is complete, else None."""
+        on, t0 = set(), t - self.dt
+        for vid, _length, t_in, t_out, _vtype in self.lib.inductionloop.getVehicleData(
+                DOWNSTREAM_LOOP):
+            on.add(vid)
+            self.entered += vid not in self._on
+            end = t if t_out < 0 else min(t_out, t)
+            self.occupied += max(end - max(t_in, t0), 0.0)
+        self._on = on
+        self.steps += 1
+        if self.steps < self.steps_per_period:
+            return None
+        span = self.steps * self.dt
+        out = (self.occupied / span, self.entered / span)
+        self._reset()
+        return out

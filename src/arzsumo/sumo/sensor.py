@@ -4,7 +4,9 @@ One :class:`SumoSensor` per run. After each SUMO step :meth:`SumoSensor.observe`
 
 * the vehicles on ``main`` (Edie aggregates per class and cell, class flows at the
   section boundaries, :class:`~arzsumo.sumo.measure.MainlineSensor`),
-* the lane occupancy downstream of the merge (ALINEA's measurement), and
+* the occupancy and flow of the E1 loop on ``down`` past the merge nose (ALINEA's
+  measurement, :class:`~arzsumo.sumo.loops.DownstreamLoop`; every run has it,
+  ``open_simulation(..., downstream_loop=d)``), and
 * the ramp queue (halted vehicles on ``ramp_up`` plus ramp vehicles still waiting to be
   inserted), which the meter's spillback override needs every step,
 * with a :class:`~arzsumo.sumo.sensing.SensorLayout` holding them, the E1 loop stations
@@ -36,16 +38,13 @@ from arzsumo.estimate.observations import (
 )
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.lateral import LateralSampler
-from arzsumo.sumo.loops import LoopSensor
+from arzsumo.sumo.loops import DownstreamLoop, LoopSensor
 from arzsumo.sumo.measure import CellData, MainlineSensor
-from arzsumo.sumo.network import DOWN, RAMP_UP
+from arzsumo.sumo.network import RAMP_UP
 from arzsumo.sumo.probes import AvProbes
 from arzsumo.sumo.sensing import SensorLayout
 from arzsumo.sumo.window import WarmupLedger, WindowStart
 from arzsumo.units import ms_to_kmh
-
-#: the lane whose occupancy ALINEA regulates (downstream of the merge)
-OCCUPANCY_LANE = f"{DOWN}_0"
 
 
 def ramp_queue(lib: ModuleType) -> int:
@@ -58,8 +57,9 @@ def ramp_queue(lib: ModuleType) -> int:
 class PeriodMeasurement:
     """What the sensor read over one control period ending at ``cells.t`` (SI).
 
-    ``cells`` are the Edie aggregates of the mainline; ``occupancy_out`` the mean lane
-    occupancy downstream of the merge over the period (fraction, SUMO's definition);
+    ``cells`` are the Edie aggregates of the mainline; ``occupancy_out`` and
+    ``flow_out_loop`` the occupancy (fraction of the period) and the flow (veh/s) of the
+    loop on ``down`` past the merge nose over the period;
     ``ramp_queue`` the ramp queue at the period's last step, vehicles; ``loops`` the loop
     stations' record of the period and ``probes`` the AV probes at its last step (None
     when the layout has none).
@@ -70,6 +70,7 @@ class PeriodMeasurement:
     ramp_queue: int
     loops: LoopObservation | None = None
     probes: ProbeObservation | None = None
+    flow_out_loop: float = float("nan")
 
     @property
     def t(self) -> float:
@@ -149,7 +150,7 @@ class SumoSensor:
         self.probes = AvProbes(layout.av_probe_share, layout.av_probe_seed, probe_noise) \
             if layout.av_probes else None
         self.queue = 0
-        self._occupancy_sum, self._steps = 0.0, 0
+        self.downstream = DownstreamLoop(lib, cfg.step_length, cfg.steps_per_period)
         self.ledger = WarmupLedger(lib, cfg.step_length) if window else None
         self.window_open = False
         self.speeds = SpeedMoments()
@@ -167,8 +168,7 @@ class SumoSensor:
         """Sample the step that ended at ``t`` (s); return the period's measurement when
         the period is complete, else None. :attr:`queue` is the ramp queue now."""
         self.queue = ramp_queue(self.lib)
-        self._occupancy_sum += self.lib.lane.getLastStepOccupancy(OCCUPANCY_LANE)
-        self._steps += 1
+        down = self.downstream.observe(t)
         cells = self.mainline.collect(t)
         loops = self.loops.observe(t) if self.loops is not None else None
         if self.window_open:
@@ -177,11 +177,10 @@ class SumoSensor:
             self.ledger.add()
         if cells is None:
             return None
-        occupancy = self._occupancy_sum / self._steps
-        self._occupancy_sum, self._steps = 0.0, 0
+        occupancy, flow = down if down is not None else (float("nan"), float("nan"))
         m = self.mainline
         if self.window_open:     # once per period: a libsumo call per vehicle
             self.lateral.sample(t, m.last_ids, m.last_pos, m.last_speed, m.last_av)
         probes = self.probes.observe(t, m.last_ids, m.last_pos, m.last_speed, m.last_av) \
             if self.probes is not None else None
-        return PeriodMeasurement(cells, occupancy, self.queue, loops, probes)
+        return PeriodMeasurement(cells, occupancy, self.queue, loops, probes, flow)

@@ -27,6 +27,7 @@ from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.demand import InitialVehicle, demand_flows, write_route_file
 from arzsumo.sumo.frontend import Frontend
+from arzsumo.sumo.loops import DOWNSTREAM_DISTANCE, write_downstream_loop
 from arzsumo.sumo.network import NetworkSpec, approach_length_of, build_network
 from arzsumo.sumo.paths import (
     NET_FILE,
@@ -319,6 +320,7 @@ def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
                     initial: Sequence[InitialVehicle] = (), net_dir: Path | None = None,
                     extra_args: Sequence[str] = (), e2_chain: bool = False,
                     loops: Sequence[float] = (),
+                    downstream_loop: float = DOWNSTREAM_DISTANCE,
                     output_dir: Path | None = None, keep: RunFiles | None = None,
                     frontend: str = "libsumo") -> SumoSimulation:
     """A started simulation of the network of :func:`network_file` with the demand of
@@ -326,7 +328,9 @@ def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
 
     The route file (and, with ``e2_chain``, an E2 detector per measurement cell, see
     :mod:`arzsumo.sumo.detectors`; with ``loops``, an E1 loop station at each of those
-    positions on ``main``, m in [0, L], see :mod:`arzsumo.sumo.loops`) goes to a
+    positions on ``main``, m in [0, L], see :mod:`arzsumo.sumo.loops`; always, the E1
+    loop on ``down`` at ``downstream_loop`` m past the merge nose that the sensor reads,
+    :func:`~arzsumo.sumo.loops.write_downstream_loop`) goes to a
     temporary directory (under
     :func:`~arzsumo.sumo.paths.scratch_dir`) removed when the run closes. With
     ``output_dir``, SUMO's statistics output is written there and kept. With ``keep``,
@@ -339,7 +343,7 @@ def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
     try:
         net = network_file(cfg, net_dir, workdir)
         route = write_route_file(workdir / "run.rou.xml", params, cfg, initial)
-        adds = []
+        adds = [write_downstream_loop(workdir / "e1_down.add.xml", downstream_loop)]
         if e2_chain:
             from arzsumo.sumo.detectors import write_e2_chain
 
@@ -349,8 +353,7 @@ def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
             from arzsumo.sumo.loops import write_loops
 
             adds.append(write_loops(workdir / "e1.add.xml", loops, params.length))
-        if adds:
-            extra_args = ("--additional-files", ",".join(map(str, adds)), *extra_args)
+        extra_args = ("--additional-files", ",".join(map(str, adds)), *extra_args)
         if keep is not None:
             keep.keep_config(net, route, adds, cfg)
     except BaseException:  # a bad demand or network, or Ctrl-C: leave no temporary files

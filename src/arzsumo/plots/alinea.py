@@ -1,0 +1,41 @@
+"""ALINEA's loop: flow against occupancy, the triangular fit, the critical occupancy and
+the target (``arzsumo alinea-target``). Occupancy in %, flow in veh/h (a report)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.figure import Figure
+
+from arzsumo.io import atomic_file
+from arzsumo.units import veh_s_to_veh_h
+
+
+def loop_curve_figure(occupancy: np.ndarray, flow: np.ndarray, centres: np.ndarray,
+                      mean: np.ndarray, fit: tuple[np.ndarray, np.ndarray], critical: float,
+                      target: float, title: str) -> Figure:
+    """Period means (occupancy fraction, flow veh/s), the binned mean, the fitted curve
+    ``fit`` (occupancies, flows) and the critical occupancy and target (fractions)."""
+    fig, ax = plt.subplots(figsize=(7, 4.6), layout="constrained")
+    ax.plot(100 * occupancy, veh_s_to_veh_h(flow), ".", ms=4, alpha=0.4, color="0.45",
+            label="period means")
+    ax.plot(100 * centres, veh_s_to_veh_h(mean), "C0o-", ms=3, lw=1, label="bin mean")
+    ax.plot(100 * fit[0], veh_s_to_veh_h(fit[1]), "C3", lw=2, label="triangular fit")
+    ax.axvline(100 * critical, color="C3", ls="--", label=f"critical {100 * critical:.1f} %")
+    ax.axvline(100 * target, color="C2", ls="-.", label=f"target {100 * target:.1f} %")
+    ax.set_xlabel("loop occupancy (%)")
+    ax.set_ylabel("loop flow (veh/h)")
+    ax.set_title(title)
+    ax.legend(fontsize=8)
+    return fig
+
+
+def write_loop_curve_figure(path: str | Path, *args: object, **kwargs: object) -> Path:
+    """Draw :func:`loop_curve_figure` and save it as PNG at ``path`` (atomically)."""
+    fig = loop_curve_figure(*args, **kwargs)  # type: ignore[arg-type]
+    with atomic_file(path) as tmp:
+        fig.savefig(tmp, dpi=110, format="png")
+    plt.close(fig)
+    return Path(path)

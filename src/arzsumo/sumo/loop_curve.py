@@ -1,0 +1,55 @@
+"""Open-loop runs that record ALINEA's loop: the samples of its flow-occupancy curve.
+
+:func:`record_downstream_loop` runs SUMO with the meter at its nominal plan (the open
+loop) for ``cfg.horizon`` seconds from t = 0, fill included (the fill is where the loop
+sees the free branch of the curve), and returns the occupancy and flow of the E1 loop on
+``down`` at ``distance`` m past the merge nose per control period
+(:class:`~arzsumo.sumo.loops.DownstreamLoop`). The math on top (period means,
+triangular fit, target) is :mod:`arzsumo.evaluation.critical_occupancy`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from arzsumo.model.params import ModelParameters
+from arzsumo.sumo.config import SumoConfig
+from arzsumo.sumo.loops import DownstreamLoop
+from arzsumo.sumo.meter import DEFAULT_CURVE, GreenShareCurve
+from arzsumo.sumo.meter_release import make_meter
+from arzsumo.sumo.sensor import ramp_queue
+from arzsumo.sumo.simulation import open_simulation
+
+
+@dataclass(frozen=True)
+class LoopSeries:
+    """The loop's record of one run: period ends ``t`` (s from SUMO start), occupancy
+    (fraction) and flow (veh/s) per control period of ``dt`` s; the SUMO ``seed``."""
+
+    t: np.ndarray
+    occupancy: np.ndarray
+    flow: np.ndarray
+    dt: float
+    seed: int
+
+
+def record_downstream_loop(params: ModelParameters, cfg: SumoConfig, distance: float,
+                           curve: GreenShareCurve = DEFAULT_CURVE) -> LoopSeries:
+    """Run ``cfg.horizon`` s of open loop (nominal meter; ``curve`` for a fixed-cycle
+    meter); the loop's series (module docstring)."""
+    t_out, occ, flow = [], [], []
+    with open_simulation(params, cfg, downstream_loop=distance) as sim:
+        meter = make_meter(sim.lib, cfg, curve)
+        loop = DownstreamLoop(sim.lib, cfg.step_length, cfg.steps_per_period)
+        while sim.time < cfg.horizon - 1e-9:
+            t = sim.step()
+            got = loop.observe(t)
+            meter.step(ramp_queue(sim.lib))
+            if got is not None:
+                t_out.append(t)
+                occ.append(got[0])
+                flow.append(got[1])
+    return LoopSeries(np.asarray(t_out), np.asarray(occ), np.asarray(flow),
+                      cfg.control_period, cfg.seed)
