@@ -127,10 +127,10 @@ def cmd_alinea_target(args: argparse.Namespace) -> int:
         title = (f"{sc.name}: loop {sc.alinea.loop_distance:g} m past the merge, "
                  f"{period:g} s means")
         write_alinea_target(target, means, crit, meta, title)
-    print(f"critical occupancy {100 * crit.critical:.2f} % (capacity "
-          f"{crit.fit.capacity * 3600:.0f} veh/h, {crit.samples} period means"
-          f"{'' if crit.saturated else '; flow never saturated: a lower bound, the 98th '}"
-          f"{'' if crit.saturated else 'percentile of the occupancies'}); "
+    bound = ("" if crit.saturated else "; flow never saturated: a lower bound, the 98th "
+             "percentile of the occupancies")
+    print(f"critical occupancy {100 * crit.critical:.2f} % ({crit.samples} period means, "
+          f"fit capacity {crit.fit.capacity * 3600:.0f} veh/h{bound}); "
           f"target {100 * crit.target:.2f} % = {crit.share:g} x critical")
     print(f"[alinea] target_pct = {100 * crit.target:.1f}")
     print(f"results: {args.out}")

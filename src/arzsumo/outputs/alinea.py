@@ -62,5 +62,6 @@ def write_alinea_target(out: str | Path | OutputDir, samples: list[tuple[int, np
                                                     indent=2), encoding="utf-8")
         o = np.linspace(0.0, 1.05 * float(occ.max()), 200)
         write_loop_curve_figure(tmp / "curve.png", occ, flow, centres, mean,
-                                (o, crit.fit.flow(o)), crit.critical, crit.target, title)
+                                (o, crit.fit.flow(o)), crit.critical, crit.target, title,
+                                lower_bound=not crit.saturated)
     return target_of(out)
