@@ -21,6 +21,7 @@ EXIT_SOME_FAILED = 4
 
 def cmd_evaluate(args: argparse.Namespace) -> int:
     from arzsumo.sweep.evaluate import BASELINE, run_evaluation
+    from arzsumo.sweep.evaluate import WHOLE_DEMAND_KEY as HEADLINE
 
     scenario = Path(args.scenario)
     seeds = list(range(args.seed_start, args.seed_start + args.seeds))
@@ -32,16 +33,19 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
                          workers=args.workers, scheduler=args.scheduler,
                          overwrite=args.overwrite, progress=not args.quiet,
                          plots=not args.no_plots, command=command,
-                         baseline_from=Path(args.baseline_from) if args.baseline_from else None)
-    rep = res.sweep
-    print(f"evaluate {scenario.name}: {rep.total} runs, {rep.skipped} already finished, "
-          f"{rep.executed} executed on {rep.backend} in {rep.wall_time:.1f} s")
-    bad = rep.table[~rep.table["status"].isin(["ok"])] if rep.table is not None else None
+                         baseline_from=Path(args.baseline_from) if args.baseline_from else None,
+                         runs_from=[Path(d) for d in args.runs_from or ()])
+    rep, bad = res.sweep, None
+    if rep is None:
+        print(f"evaluate {scenario.name}: every run taken from --runs-from, none executed")
+    else:
+        print(f"evaluate {scenario.name}: {rep.total} runs, {rep.skipped} already finished, "
+              f"{rep.executed} executed on {rep.backend} in {rep.wall_time:.1f} s")
+        bad = rep.table[~rep.table["status"].isin(["ok"])] if rep.table is not None else None
     if bad is not None:
         for _, row in bad.iterrows():
             print(f"  {row['run_id']}: {row['status']}: {str(row['error']).splitlines()[0]}")
-    main = res.table[res.table["measure"].isin(["network.time_loss_s.total",
-                                                "network.depart_delay_s.ramp"])]
+    main = res.table[res.table["measure"].isin([HEADLINE, "network.time_loss_s.total"])]
     for r in main.itertuples(index=False):
         if r.controller != BASELINE:
             print(f"  {r.label} ({r.unit}), {r.controller} minus {BASELINE}: "
@@ -60,7 +64,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                                    "paired difference against the open loop with its 95 % "
                                    "CI, wins and losses.")
     p.add_argument("scenario", metavar="SCENARIO.toml", help="scenario file")
-    p.add_argument("--controllers", default="open,alinea,backstepping,etc,observer-etc",
+    p.add_argument("--controllers",
+                   default="open,held,alinea,pi-alinea,backstepping,etc,observer-etc",
                    help="comma-separated controllers; open (the baseline) is added first "
                         "when missing")
     p.add_argument("--seeds", type=positive_int, default=20,
@@ -84,6 +89,11 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "of running them (same seeds and horizon; its scenario may differ "
                         "only in what does not act on an open loop: [estimation], "
                         "[sensing], [actuation], [design], [run] controller)")
+    p.add_argument("--runs-from", metavar="DIR", action="append",
+                   help="an earlier evaluation or sweep (repeatable): a controller whose "
+                        "runs on all the seeds are there, the same SUMO runs (scenarios "
+                        "that differ only in what that controller does not read), is taken "
+                        "from there instead of run")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--no-plots", action="store_true", help="skip the figure")
     p.set_defaults(func=cmd_evaluate)

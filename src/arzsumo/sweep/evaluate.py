@@ -25,6 +25,7 @@ designed on) pays for its baseline once.
 from __future__ import annotations
 
 import copy
+import logging
 import re
 import shutil
 import tomllib
@@ -37,12 +38,14 @@ import pandas as pd
 from arzsumo.errors import ArzsumoError
 from arzsumo.evaluation.report import evaluate
 from arzsumo.io import dump_toml
-from arzsumo.outdir import judge, where
+from arzsumo.outdir import judge, resumable_dir, where
 from arzsumo.outputs.evaluation import write_evaluation
 from arzsumo.sweep.driver import SweepReport, run_sweep
 from arzsumo.sweep.spec import RunSpec, SweepError, SweepSpec, sweep_from_dict
 from arzsumo.sweep.table import run_dir, sweep_table
 from arzsumo.sweep.worker import FINISHED
+
+log = logging.getLogger(__name__)
 
 #: marker kind of an evaluation directory
 KIND = "evaluation"
@@ -60,7 +63,7 @@ class EvaluationResult:
     """What :func:`run_evaluation` did: the sweep's report, the finished runs (one row
     each, SI), the long table of the report (human units) and the files written."""
 
-    sweep: SweepReport
+    sweep: SweepReport | None      # None: every run was taken from elsewhere
     runs: pd.DataFrame
     table: pd.DataFrame
     files: list[Path] = field(default_factory=list)
@@ -71,6 +74,19 @@ class EvaluationResult:
 #: runs whose resolved scenarios differ only here are the same SUMO run
 OPEN_LOOP_INERT = ("name", "description", "estimation", "sensing", "actuation", "design",
                    "run.controller")
+#: tables and keys that only some controllers read: for every other controller (the open
+#: loop included) they are inert, so two runs that differ only there are the same run
+CONTROLLER_ONLY: dict[str, tuple[str, ...]] = {
+    "alinea": ("alinea", "pi-alinea"), "run.constant_release_veh_h": ("constant",)}
+
+
+def inert_for(controller: str) -> tuple[str, ...]:
+    """Scenario tables and keys that do not act on a SUMO run of ``controller``."""
+    own = tuple(k for k, users in CONTROLLER_ONLY.items() if controller not in users)
+    base = OPEN_LOOP_INERT if controller == BASELINE else ("name", "description")
+    return base + own
+
+
 #: tables that reach an open-loop SUMO run only through what it is given to simulate: the
 #: vehicles placed at t = 0 (``[run] start = "placement"``) and, from the model, the
 #: vehicle types and insertion columns of the route file (:func:`_sumo_input`). With
@@ -151,9 +167,10 @@ def _model_inert(a: dict, b: dict) -> bool:
     return ours is not None and ours == _sumo_input(b)
 
 
-def _without_inert(data: dict, model_inert: bool = False) -> dict:
+def _without_inert(data: dict, model_inert: bool = False,
+                   inert: Sequence[str] = inert_for(BASELINE)) -> dict:
     out = copy.deepcopy(data)
-    for name in OPEN_LOOP_INERT + (PLACEMENT_ONLY if model_inert else ()):
+    for name in tuple(inert) + (PLACEMENT_ONLY if model_inert else ()):
         table, _, key = name.partition(".")
         if key and isinstance(out.get(table), dict):
             out[table].pop(key, None)
@@ -180,14 +197,17 @@ def _their_run(source: Path, mine: RunSpec, user: str) -> RunSpec:
                          f"{mine.run_id}; allowed: an evaluation of the same seeds and horizon")
     theirs = tomllib.loads(path.read_text(encoding="utf-8"))
     ours = tomllib.loads(dump_toml(dict(mine.scenario)))
-    inert = _model_inert(theirs, ours)
-    differ = _first_difference(_without_inert(theirs, inert), _without_inert(ours, inert))
+    controller = str(mine.columns.get("controller", BASELINE))
+    inert = inert_for(controller)
+    model = controller == BASELINE and _model_inert(theirs, ours)
+    differ = _first_difference(_without_inert(theirs, model, inert),
+                               _without_inert(ours, model, inert))
     if differ:
-        raise SweepError(f"--baseline-from = {user} is not allowed: its run {mine.run_id} "
-                         f"differs in {differ}; allowed: open-loop runs whose scenarios "
-                         f"differ only in {', '.join(OPEN_LOOP_INERT)} (and in "
-                         f"{', '.join(PLACEMENT_ONLY)} when [run] start = 'warmup' and "
-                         "SUMO's route file is the same)")
+        also = (f" (and in {', '.join(PLACEMENT_ONLY)} when [run] start = 'warmup' and "
+                "SUMO's route file is the same)" if controller == BASELINE else "")
+        raise SweepError(f"{user} is not allowed: its run {mine.run_id} differs in "
+                         f"{differ}; allowed: runs whose scenarios differ only in "
+                         f"{', '.join(inert)}{also}")
     return replace(mine, scenario=theirs)
 
 
@@ -195,7 +215,7 @@ def borrowed_baseline(spec: SweepSpec, source: Path, user: str) -> pd.DataFrame:
     """The sweep-table rows of the open-loop runs of ``spec`` taken from the earlier
     evaluation in ``source`` (``user``: the directory as the user wrote it)."""
     mine = [r for r in spec.runs() if r.columns.get("controller") == BASELINE]
-    theirs = [_their_run(source, r, user) for r in mine]
+    theirs = [_their_run(source, r, f"--baseline-from = {user}") for r in mine]
     table = sweep_table(theirs, source)
     if not table["status"].isin(FINISHED).all():
         raise SweepError(f"--baseline-from = {user} is not allowed: its open-loop runs "
@@ -205,6 +225,36 @@ def borrowed_baseline(spec: SweepSpec, source: Path, user: str) -> pd.DataFrame:
         blank = [c for c in table.columns if c.startswith(MODEL_DEPENDENT)]
         table[blank] = float("nan")
     return table
+
+
+def borrowed_controller(spec: SweepSpec, source: Path) -> pd.DataFrame | None:
+    """The sweep-table rows of every run of ``spec`` (one controller, all seeds) taken
+    from the earlier evaluation or sweep in ``source`` (``--runs-from``), or None when
+    ``source`` lacks one of them or one there is not the same SUMO run (it is run here)."""
+    mine = list(spec.runs())
+    if not all((run_dir(source, r) / "summary.json").is_file() for r in mine):
+        return None
+    try:
+        theirs = [_their_run(source, r, f"--runs-from = {source}") for r in mine]
+    except SweepError as exc:
+        log.info("not taken: %s", exc)
+        return None
+    table = sweep_table(theirs, source)
+    return table if table["status"].isin(FINISHED).all() else None
+
+
+def _borrow(scenario: Path, controllers: Sequence[str], seeds: Sequence[int],
+            horizon: float | None, sources: Sequence[Path]) -> dict[str, pd.DataFrame]:
+    """Per controller found complete in one of ``sources``, its borrowed rows."""
+    out: dict[str, pd.DataFrame] = {}
+    for c in controllers:
+        for source in sources:
+            table = borrowed_controller(evaluation_spec(scenario, [c], seeds, horizon),
+                                        Path(source))
+            if table is not None:
+                out[c] = table.assign(borrowed_from=str(source))
+                break
+    return out
 
 
 def _forget_previous(out: Path, user: str) -> None:
@@ -224,7 +274,8 @@ def run_evaluation(scenario: Path, controllers: Sequence[str], seeds: Sequence[i
                    out: Path, horizon: float | None = None, workers: int | None = None,
                    scheduler: str | None = None, overwrite: bool = False,
                    progress: bool = True, plots: bool = True,
-                   command: str = "", baseline_from: Path | None = None) -> EvaluationResult:
+                   command: str = "", baseline_from: Path | None = None,
+                   runs_from: Sequence[Path] = ()) -> EvaluationResult:
     """Run ``controllers`` (the open loop added first when missing) on ``seeds`` and write
     the report into ``out`` (module docstring).
 
@@ -232,7 +283,10 @@ def run_evaluation(scenario: Path, controllers: Sequence[str], seeds: Sequence[i
     with the same resolved scenario are not run again), or started afresh with
     ``overwrite``. ``command`` is printed at the top of ``evaluation.md``.
     ``baseline_from``: take the open-loop runs from this earlier evaluation (module
-    docstring) instead of running them.
+    docstring) instead of running them. ``runs_from``: earlier evaluations or sweeps;
+    every controller whose runs on all ``seeds`` one of them holds (the same SUMO runs:
+    scenarios that differ only in what that controller does not read, :func:`inert_for`)
+    is taken from there instead of run.
     """
     controllers = check_controllers(controllers)
     name = check_runs(scenario, controllers, horizon)
@@ -244,20 +298,31 @@ def run_evaluation(scenario: Path, controllers: Sequence[str], seeds: Sequence[i
                              "controller besides the open loop")
         borrowed = borrowed_baseline(evaluation_spec(scenario, [BASELINE], seeds, horizon),
                                      Path(baseline_from), str(baseline_from))
-    spec = evaluation_spec(scenario, controllers[1:] if baseline_from else controllers,
-                           seeds, horizon)
+    taken = _borrow(scenario, controllers[1:] if baseline_from else controllers, seeds,
+                    horizon, runs_from)
+    to_run = [c for c in (controllers[1:] if baseline_from else controllers)
+              if c not in taken]
     if overwrite:
         _forget_previous(Path(out), str(out))
-    rep = run_sweep(spec, out, workers=workers, scheduler=scheduler, progress=progress,
-                    plots=False, kind=KIND)
-    df = rep.table if rep.table is not None else pd.DataFrame()
-    df = pd.concat([borrowed, df], ignore_index=True) if baseline_from else df
+    rep, target = None, Path(out)
+    if to_run:
+        rep = run_sweep(evaluation_spec(scenario, to_run, seeds, horizon), out,
+                        workers=workers, scheduler=scheduler, progress=progress,
+                        plots=False, kind=KIND)
+        target = rep.out
+    else:   # every run taken from elsewhere: only the report is written here
+        with resumable_dir(out, KIND) as claimed:
+            target = claimed
+    df = rep.table if rep is not None and rep.table is not None else pd.DataFrame()
+    df = pd.concat([borrowed, *taken.values(), df], ignore_index=True)
     ok = df[df["status"].isin(FINISHED)]
     table = evaluate(ok, controllers, BASELINE)
     head = _header(name, scenario, controllers, seeds, ok, len(df), command)
     if baseline_from:
         head += f"\n\nOpen-loop runs taken from the evaluation in `{baseline_from}`."
-    files = write_evaluation(rep.out, table, ok, controllers, head, BASELINE, plots=plots)
+    for c, rows in taken.items():
+        head += f"\n\nRuns of `{c}` taken from `{rows['borrowed_from'].iloc[0]}`."
+    files = write_evaluation(target, table, ok, controllers, head, BASELINE, plots=plots)
     return EvaluationResult(rep, ok, table, files)
 
 
