@@ -187,6 +187,7 @@ RUN_SUMMARY: dict[str, str] = {
     "network_whole_demand": TEXT,      # null without a drain
     "network_whole_demand.complete": "bool", "network_whole_demand.drain.duration_s": "s",
     "network_whole_demand.drain.max_s": "s", "network_whole_demand.drain.hit_limit": "bool",
+    "network_whole_demand.drain.gridlock": "bool",
     "network_whole_demand.in_system_integral_s": "veh*s",
     "network_whole_demand.ramp_wait_s.vehicles": "veh",
     "network_whole_demand.ramp_wait_s.over_limit": "veh",

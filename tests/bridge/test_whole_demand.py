@@ -117,3 +117,25 @@ def test_the_window_measures_do_not_move_with_the_drain(drained, undrained):
     for key in ("fuel_g", "co2_g"):    # per-step sums against the emissions device
         assert ours["network"][key] == pytest.approx(theirs["network"][key], rel=5e-3), key
     assert ours["TTT"] == theirs["TTT"] and ours["plan_changes"] == theirs["plan_changes"]
+
+
+def test_a_drain_without_arrivals_ends_as_a_gridlock(tmp_path, monkeypatch):
+    """Every vehicle stopped for good when the drain starts: no arrival for STALL_S, so the
+    drain ends there, flagged, instead of running to drain_max_s."""
+    import arzsumo.bridge.drain as drain_module
+    from arzsumo.sumo.meter import MeterLight
+
+    monkeypatch.setattr(drain_module, "STALL_S", 20.0)
+    hand_over = MeterLight.drain
+
+    def stop_everyone(meter: MeterLight) -> None:
+        hand_over(meter)
+        for v in meter.lib.vehicle.getIDList():
+            meter.lib.vehicle.setSpeed(v, 0.0)
+
+    monkeypatch.setattr(MeterLight, "drain", stop_everyone)
+    summary, _, _ = _run(tmp_path, 1800.0)
+    whole = summary["network_whole_demand"]
+    assert whole["drain"]["gridlock"] and not whole["drain"]["hit_limit"]
+    assert not whole["complete"]
+    assert whole["drain"]["duration_s"] == pytest.approx(20.0, abs=0.2)

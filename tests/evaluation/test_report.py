@@ -98,3 +98,18 @@ def test_a_renamed_key_reads_its_former_name_in_older_runs():
     assert row.n == 2 and row.diff_mean == pytest.approx(-1.5) and row.wins == 2
     keys = {m.key for m in MEASURES}
     assert {"section.waves.h.band_power_kmh2", "section.waves.a.growth_per_km"} <= keys
+
+
+def test_a_run_whose_drain_did_not_empty_the_network_has_no_whole_demand_value():
+    from arzsumo.evaluation.report import per_seed
+
+    whole = next(m for m in MEASURES if m.key == "network_whole_demand.time_spent_s.total")
+    rows = [{"controller": c, "seed": s, whole.key: 3600.0 * (100 + s + (c == "etc")),
+             "network_whole_demand.complete": not (c == "etc" and s == 2)}
+            for c in ("open", "etc") for s in (1, 2, 3)]
+    wide = per_seed(pd.DataFrame(rows), whole, ["open", "etc"])
+    assert wide.loc[2, "etc"] != wide.loc[2, "etc"]          # NaN: a gridlocked drain
+    assert list(wide["open"]) == [101.0, 102.0, 103.0] and wide.loc[3, "etc"] == 104.0
+    long = evaluate(pd.DataFrame(rows), ["open", "etc"], measures=[whole])
+    etc = long[long.controller == "etc"].iloc[0]
+    assert etc["n"] == 2 and etc["diff_mean"] == pytest.approx(1.0)

@@ -352,7 +352,7 @@ def whole_demand(network: NetworkMeasures, trips: Any, meter: Any, sim: SumoSimu
     waits = ramp_waits(trips, meter.stop_line.crossings, sim.cfg.step_length,
                        spec.ramp_length / spec.ramp_speed)
     block = whole_demand_summary(network.whole_run, waits, sim.in_system_s,
-                                 drained.duration_s, drained.max_s)
+                                 drained.duration_s, drained.max_s, drained.gridlock)
     return replace(network, whole_demand=block)
 
 

@@ -12,6 +12,12 @@ least cost the meter allows. No controller, sensor or twin runs during the drain
 and CO2 are summed every step (SUMO's emissions device cannot be read while running) so
 that the control window's measures stay those of the window
 (:func:`arzsumo.sumo.window.finish_window`).
+
+Teleports are off, so a gridlock (measured: vehicles at the merge that wait for each other
+for good, 1 drain in 5 on the default) would hold the run until ``drain_max_s``. A drain in
+which no vehicle arrives for :data:`STALL_S` while vehicles remain ends there as
+``gridlock``: the run is then incomplete (its whole-demand measures charge vehicles only to
+the end), which the summary and the evaluation report.
 """
 
 from __future__ import annotations
@@ -23,15 +29,19 @@ from arzsumo.sumo.sensor import ramp_queue
 from arzsumo.sumo.simulation import SumoSimulation
 from arzsumo.sumo.window import WindowEnd, finish_window, window_end
 
+#: a drain with no arrival for this long while vehicles remain is a gridlock, s
+STALL_S = 300.0
+
 
 @dataclass(frozen=True)
 class Drained:
-    """What the drain left: the window's end (its values then), and the drain's length
-    and limit (s)."""
+    """What the drain left: the window's end (its values then), the drain's length and
+    limit (s), and whether it ended on a gridlock (no arrival for :data:`STALL_S`)."""
 
     end: WindowEnd
     duration_s: float
     max_s: float
+    gridlock: bool = False
 
 
 def drain(sim: SumoSimulation, meter: MeterLight, limit: float) -> Drained:
@@ -41,8 +51,14 @@ def drain(sim: SumoSimulation, meter: MeterLight, limit: float) -> Drained:
     t_end = sim.time
     at_end, ledger = window_end(lib, t_end)
     meter.drain()
+    arrived, last_arrival, gridlock = sim.arrived, t_end, False
     while sim.time - t_end < limit - 1e-9 and lib.simulation.getMinExpectedNumber() > 0:
         sim.step()
         ledger.add()
         meter.step(ramp_queue(lib))
-    return Drained(finish_window(t_end, at_end, ledger), sim.time - t_end, limit)
+        if sim.arrived > arrived:
+            arrived, last_arrival = sim.arrived, sim.time
+        elif sim.time - last_arrival >= STALL_S:
+            gridlock = True
+            break
+    return Drained(finish_window(t_end, at_end, ledger), sim.time - t_end, limit, gridlock)

@@ -109,6 +109,11 @@ def per_seed(runs: pd.DataFrame, measure: Measure, controllers: Sequence[str]) -
         if key in runs:
             values = values.fillna(pd.to_numeric(runs[key], errors="coerce"))
     values = values * measure.scale
+    if measure.key.startswith(f"{_WHOLE}.") and f"{_WHOLE}.complete" in runs:
+        # a run whose drain did not empty the network (a gridlock, the drain limit) has
+        # not charged every vehicle: it has no whole-demand value
+        complete = runs[f"{_WHOLE}.complete"].astype(str).str.lower() == "true"
+        values = values.where(complete)
     wide = pd.DataFrame({"seed": runs["seed"], "controller": runs["controller"],
                          "value": values}).pivot(index="seed", columns="controller",
                                                  values="value")

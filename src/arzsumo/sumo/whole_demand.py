@@ -9,7 +9,8 @@ then holds SUMO's tripinfo measures of every vehicle (the keys of
 :func:`~arzsumo.sumo.network_measures.aggregate`), plus:
 
 * ``complete``: whether the drain emptied the network (completed = loaded), and
-  ``drain``: its length (s), its limit and whether the run hit it;
+  ``drain``: its length (s), its limit, whether the run hit it, and whether it ended on a
+  gridlock (no arrival for :data:`arzsumo.bridge.drain.STALL_S` with teleports off);
 * ``in_system_integral_s``: the per-step integral of the vehicles in the system (on the
   network or waiting to be inserted), counted by libsumo every step: an independent
   check of ``time_spent_s.total`` (equal within a step per vehicle);
@@ -77,15 +78,17 @@ def wait_summary(waits: pd.Series, limit: float = WAIT_LIMIT_S) -> dict[str, Any
 
 
 def whole_demand_summary(network: dict[str, Any], waits: pd.Series, integral_s: float,
-                         drain_s: float, drain_max: float) -> dict[str, Any]:
+                         drain_s: float, drain_max: float,
+                         gridlock: bool = False) -> dict[str, Any]:
     """The ``network_whole_demand`` block (module docstring) from the whole run's
     ``network`` dict (its end after the drain), the ramp ``waits`` (s), the per-step
-    integral of vehicles in the system (veh s) and the drain's length and limit (s)."""
+    integral of vehicles in the system (veh s), the drain's length and limit (s) and
+    whether it ended on a gridlock."""
     veh = network["vehicles"]
     complete = veh["completed"]["total"] == veh["loaded"]["total"]
     return {"window": "whole demand: every loaded vehicle from its insertion request to its "
                       "arrival (warm-up, control window and drain)",
             **network, "complete": bool(complete),
             "drain": {"duration_s": drain_s, "max_s": drain_max,
-                      "hit_limit": not complete},
+                      "hit_limit": not complete and not gridlock, "gridlock": gridlock},
             "in_system_integral_s": integral_s, "ramp_wait_s": wait_summary(waits)}
