@@ -33,6 +33,7 @@ class CompareError(ArzsumoError, ValueError):
 COLUMNS: tuple[tuple[str, str], ...] = (
     ("scenario", "scenario"), ("horizon_s", "horizon s"), ("warmup_s", "warm-up s"),
     ("controller", "controller"), ("seed", "seed"), ("kind", "kind"),
+    ("whole_tts_veh_h", "whole TTS veh.h"), ("ramp_wait_p95_s", "ramp wait p95 s"),
     ("plan_changes", "plan chg"),
     ("light_changes", "light chg"), ("triggers", "updates"), ("release_time", "release s"),
     ("TTT_veh_h", "TTT veh.h"), ("delay_veh_h", "delay veh.h"), ("J_fuel", "J_fuel"),
@@ -87,8 +88,13 @@ def row_of(summ: dict[str, Any]) -> dict[str, Any]:
         return sum(vals) / len(vals) if vals else float("nan")
 
     var = summ.get("speed_variance", {})
+    whole = summ.get("network_whole_demand") or {}
+    complete = bool(whole.get("complete"))   # a run that did not drain has no whole value
     return {
         **identity_of(summ, kind_of(summ) or "run"),
+        "whole_tts_veh_h": _total(whole, "time_spent_s") / 3600.0 if complete else math.nan,
+        "ramp_wait_p95_s": (whole.get("ramp_wait_s") or {}).get("p95", math.nan)
+        if complete else math.nan,
         "plan_changes": summ.get("plan_changes"), "light_changes": summ.get("light_changes"),
         "triggers": summ.get("triggers"), "release_time": summ.get("release_time"),
         "TTT_veh_h": _total(summ, "TTT", "J_TTT") / 3600.0,
