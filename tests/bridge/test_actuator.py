@@ -92,3 +92,37 @@ def test_limits_combine_fraction_meter_and_ramp():
                                cfg)
     assert tight.range(queue=0) == pytest.approx((-0.1 * q_nom, 0.1 * q_nom))
     assert tight.rate_step == math.inf
+
+
+class _Meter:
+    """A one-per-green meter's interface without SUMO: the override as told."""
+
+    def __init__(self, cfg: SumoConfig, override: bool) -> None:
+        self.cfg, self.on, self.queue, self.green_share = cfg, override, 50, 0.2
+        self.commanded: list[float] = []
+
+    def override(self) -> bool:
+        return self.on
+
+    def override_u(self, q_nominal: float) -> float:
+        return self.cfg.release_rate - self.cfg.release_rate_max
+
+    def command(self, u: float, q_nominal: float) -> float:
+        self.commanded.append(u)
+        return 0.2
+
+
+def test_the_queue_override_is_a_saturation_the_law_sees():
+    from arzsumo.bridge.actuator import MeterActuator
+
+    cfg = SumoConfig(meter_mode="one_per_green")
+    limits = ActuationLimits.of(ActuationSettings(u_max_fraction=0.2, u_rate_max=0.01,
+                                                  ramp_bound=True), 1.2, DEFAULT_CURVE, cfg)
+    forced = MeterActuator(_Meter(cfg, override=True), 1.2, False, limits)
+    act = forced.apply(0.05)                 # the law asks for less release
+    assert act.u_applied == pytest.approx((600 - 900) / 3600)   # the largest release
+    assert act.saturated and act.lower == act.upper == act.u_applied
+    assert not act.rate_limited             # the override is not slowed by the rate limit
+    free = MeterActuator(_Meter(cfg, override=False), 1.2, False, limits)
+    act = free.apply(0.05)
+    assert act.u_applied == pytest.approx(0.01) and act.rate_limited   # rate from U = 0
