@@ -127,8 +127,14 @@ def test_practitioner_alinea_holds_its_period_and_held_keeps_r_min(scenario):
     """One-per-green meter, 20 s ALINEA period, 80 s of control: the law's command (and,
     without [actuation] limits, the U applied) changes at most once per ALINEA period;
     the held meter asks for r_min from the first check of the window."""
-    sc = scenario.with_({"sumo.meter_mode": "one_per_green", "alinea.period_s": 20,
-                         "alinea.target_pct": 20})
+    from arzsumo.scenario import scenario_from_dict
+    from arzsumo.scenario.sumo import MODE_ONLY_KEYS
+
+    tables = dict(scenario.tables)       # the fixed cycle's keys would be refused
+    tables["sumo"] = {k: v for k, v in tables["sumo"].items()
+                      if k not in MODE_ONLY_KEYS["fixed_cycle"]}
+    sc = scenario_from_dict(tables, scenario.source).with_(
+        {"sumo.meter_mode": "one_per_green", "alinea.period_s": 20, "alinea.target_pct": 20})
     period = sc.alinea.period
     cfg = sc.sumo
     for name in ("alinea", "held"):

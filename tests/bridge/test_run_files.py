@@ -103,8 +103,9 @@ def test_the_kept_configuration_holds_the_files_the_run_read(run):
     assert (sumo / NET_FILE).read_bytes() == (shipped_nets_dir() / NET_FILE).read_bytes()
     root = ET.parse(out / "run.sumocfg").getroot()
     adds = root.find("input/additional-files").get("value").split(",")
-    assert adds == ["sumo/meter.add.xml"]            # the legacy scenario has no loops
-    program = ET.parse(out / adds[0]).getroot().find("tlLogic")
+    # the legacy scenario has no section loops: ALINEA's loop on down and the meter's plan
+    assert adds == ["sumo/e1_down.add.xml", "sumo/meter.add.xml"]
+    program = ET.parse(out / adds[-1]).getroot().find("tlLogic")
     assert [(p.get("duration"), p.get("state")) for p in program] == [("3", "G"), ("3", "r")]
 
 
