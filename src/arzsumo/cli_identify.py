@@ -1,5 +1,5 @@
 """``arzsumo identify SCENARIO --train-seeds ... --validate-seeds ...``: the macroscopic
-model identified from open-loop SUMO runs (issue 15, point 2).
+model identified from open-loop SUMO runs.
 
 Checks the seeds, the ``--vary`` points, the ``--which`` names and the output directory
 before any run, then calls :func:`arzsumo.studies.identify.run_identification` and writes

@@ -1,4 +1,4 @@
-"""Delay compensation in the closed loop (``[actuation] delay_compensation_s``; issue 17).
+"""Delay compensation in the closed loop (``[actuation] delay_compensation_s``).
 
 The PDE controller that acts (continuous backstepping or the full-state ETC, also the ETC
 that an ``observer-etc`` run becomes with an ``[estimation] method``) is wrapped in

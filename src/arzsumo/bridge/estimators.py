@@ -1,4 +1,4 @@
-"""Estimators of the closed loop on sparse sensors: ASM smoothing and the EnKF (issue 16).
+"""Estimators of the closed loop on sparse sensors: ASM smoothing and the EnKF.
 
 The ``[estimation] method`` of a scenario picks what the controller acts on:
 

@@ -1,4 +1,4 @@
-"""One SUMO run as identification data: :func:`replay_data_of` (issue 15, point 2).
+"""One SUMO run as identification data: :func:`replay_data_of`.
 
 A :class:`~arzsumo.bridge.result.CoSimResult` becomes an
 :class:`arzsumo.identify.ReplayData` holding what the bridge's *replay* twin was given and

@@ -8,7 +8,7 @@ equilibrium then map to U (veh/s) through one precomputed gain matrix:
 
 so one evaluation is a dot product of two (4, n_cells+1) arrays.
 
-Anti-windup (issue 17): none needed. control_law is a static state feedback: U(t) depends
+Anti-windup: none needed. control_law is a static state feedback: U(t) depends
 on the present state alone, the controller keeps no state (no integrator, no held value)
 that a saturated or rate-limited actuator could wind up, so it keeps the default
 :meth:`~arzsumo.control.base.Controller.applied` (nothing). The limited U still acts on

@@ -23,7 +23,7 @@ d_delta = sign(d) max(|d| - delta, 0) instead of d, with delta = noise_k sqrt(2)
 pure noise of that level (|d| <= delta) neither raises m nor triggers. With delta = 0
 this is the paper's mechanism.
 
-Anti-windup (issue 17). When the actuator limits U to a range [U_lo, U_hi] (saturation:
+Anti-windup. When the actuator limits U to a range [U_lo, U_hi] (saturation:
 :func:`arzsumo.bridge.actuator.limit_u`), the boundary input the plant receives is
 sat(U-bar(t_k)), not control law sam's U-bar(t_k), and a d of dt computed on the raw values
 misjudges what reaches the boundary: changes of the law inside the saturated region would

@@ -26,7 +26,7 @@ converges in finite time by the inlet condition alone.
 Observer-based ETC. The law bs_control_of and its sampled version bs_control_of_etc are
 control_law and the mechanism of defdynamic applied to the estimate (discrepancy dtof).
 
-Anti-windup (issue 17). The observer's boundary condition ob-sys2-bd takes the U-bar the
+Anti-windup. The observer's boundary condition ob-sys2-bd takes the U-bar the
 plant receives. When the actuator limits U, that is the U applied, not the held command:
 :meth:`ObserverEtc.applied` hands it over and the observer integrates the next interval
 with it (otherwise, as before, with the held command); the trigger projects dtof on the

@@ -1,4 +1,4 @@
-"""State estimation between the sensors and the controllers (issue 16): pure math.
+"""State estimation between the sensors and the controllers: pure math.
 
 * :mod:`observations`: typed records of loop-station and probe data with noise models;
 * :mod:`smoothing`: the adaptive smoothing method (Treiber & Helbing), per class;

@@ -9,7 +9,7 @@ enough to leave 15 blocks in a 450 s horizon). On the block means:
   normality; p-value two-sided),
 * the drift: the OLS slope times the window over the mean count.
 
-A window is called stationary when Kendall's p > 0.05 and |drift| < 10 % (issue 15).
+A window is called stationary when Kendall's p > 0.05 and |drift| < 10 %.
 """
 
 from __future__ import annotations

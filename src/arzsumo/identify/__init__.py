@@ -1,4 +1,4 @@
-"""Identification of the macroscopic model from replay data (issue 15, point 2).
+"""Identification of the macroscopic model from replay data.
 
 Pure math: numpy and scipy on top of :mod:`arzsumo.model` and :mod:`arzsumo.twin`; no SUMO,
 no files, no plots. The SUMO layer turns its runs into :class:`ReplayData` and calls

@@ -1,4 +1,4 @@
-"""First order plus dead time (FOPDT) fitted to step responses (issue 17, point 1c).
+"""First order plus dead time (FOPDT) fitted to step responses.
 
 The actuator map from the ramp meter's green share u to the section's mainline outflow
 y = q(L, t) (veh/s) is modelled, around an operating point, as

@@ -1,4 +1,4 @@
-"""The ``[actuation]`` section: limits between the controller's U and the ramp meter (issue 17).
+"""The ``[actuation]`` section: limits between the controller's U and the ramp meter.
 
 Every key, its unit and the field of :class:`ActuationSettings` it sets::
 

@@ -43,14 +43,14 @@ SECTIONS: dict[str, tuple[str, Callable[[str], Any] | None]] = {
              lambda f: getattr(_TWIN.solver, f, getattr(_TWIN, f, None))),
     "sumo": ("`arzsumo run` (and `arzsumo calibrate`) only", lambda f: getattr(SumoConfig(), f)),
     "run": ("`arzsumo run` only", lambda f: getattr(RunSettings(), f)),
-    "sensing": ("the sensors `arzsumo run` reads in SUMO (issue 16); default: `probe`, "
+    "sensing": ("the sensors `arzsumo run` reads in SUMO; default: `probe`, "
                 "every vehicle binned into cells", lambda f: getattr(SensorLayout(), f)),
-    "estimation": ("the state the controller of `arzsumo run` acts on (issue 16); default: "
+    "estimation": ("the state the controller of `arzsumo run` acts on; default: "
                    "`none`, the probe's cells; noise levels are the estimators' assumed "
                    "errors, not added to SUMO's readings",
                    lambda f: getattr(EstimationSettings(), f)),
     "actuation": ("the limits between the controller's U and the ramp meter of `arzsumo "
-                  "run` (issue 17); default: every limit off, the meter receives the "
+                  "run`; default: every limit off, the meter receives the "
                   "controller's U", lambda f: getattr(ActuationSettings(), f)),
     "alinea": ("ALINEA and PI-ALINEA in `arzsumo run` (`alinea`, `pi-alinea`): period, loop, "
                "target and gains; the loop is read in every run (`occupancy_out`)",

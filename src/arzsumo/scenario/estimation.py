@@ -1,4 +1,4 @@
-"""The ``[estimation]`` section: what the controller of ``arzsumo run`` acts on (issue 16).
+"""The ``[estimation]`` section: what the controller of ``arzsumo run`` acts on.
 
 Every key, its unit and the field of :class:`EstimationSettings` it sets::
 
@@ -14,7 +14,7 @@ Every key, its unit and the field of :class:`EstimationSettings` it sets::
     asm_sigma_m = 75                # ASM kernel width in space
 
 Without the table (``method = "none"``) the controller acts on the cells of the full
-probe, as before issue 16. ``smoothing`` and ``enkf`` read the ``[sensing]`` loops and AV
+probe. ``smoothing`` and ``enkf`` read the ``[sensing]`` loops and AV
 probes (``enkf`` needs loop stations at both boundaries: its twins' inflow and outflow).
 The noise levels are the estimators' assumed measurement errors (the weights of the data
 and the EnKF's R); nothing is added to SUMO's readings.

@@ -1,4 +1,4 @@
-"""The ``[sensing]`` section: which sensors ``arzsumo run`` reads in SUMO (issue 16).
+"""The ``[sensing]`` section: which sensors ``arzsumo run`` reads in SUMO.
 
 Every key, its unit and the field of :class:`arzsumo.sumo.sensing.SensorLayout` it sets::
 

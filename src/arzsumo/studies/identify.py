@@ -1,4 +1,4 @@
-"""Identify the macroscopic model from open-loop SUMO runs (``arzsumo identify``, issue 15).
+"""Identify the macroscopic model from open-loop SUMO runs (``arzsumo identify``).
 
 1. Plan: every operating point (``--vary table.key=v1,v2``: the scenario with that key
    changed, via :meth:`~arzsumo.scenario.Scenario.with_`; the product of several) times

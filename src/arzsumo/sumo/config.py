@@ -108,7 +108,7 @@ class SumoConfig:
     fill_demand_h, fill_demand_a : float
         Class flows requested at the mainline entrance during the fill phase, veh/s; the
         demand above then holds from ``fill_duration`` to the end. A fill above the
-        bottleneck's discharge builds the congested section fast (issue 15); the hold
+        bottleneck's discharge builds the congested section fast; the hold
         demand, a little above the discharge, keeps it without filling the approach.
     fcd : bool
         Have SUMO write its floating-car data (every vehicle every step: position, lateral

@@ -3,7 +3,7 @@
 Kinds, combinable:
 
 * ``"probe"``: every vehicle on ``main``, binned into cells and periods
-  (:class:`~arzsumo.sumo.measure.MainlineSensor`; the closed loop's sensor until issue 16);
+  (:class:`~arzsumo.sumo.measure.MainlineSensor`; the closed loop's sensor without [sensing]);
 * ``"loops"``: E1 loop stations at given positions, or every ``loop_spacing`` m from
   x = 0, always with both boundaries (:mod:`arzsumo.sumo.loops`); with neither given,
   the two boundary stations only; their speed is the time-mean or the harmonic mean of
