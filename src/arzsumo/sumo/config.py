@@ -203,12 +203,7 @@ class SumoConfig:
         require(isinstance(self.seed, int) and not isinstance(self.seed, bool)
                 and 0 <= self.seed < 2**31, "seed", self.seed, "an integer in [0, 2^31)",
                 ScenarioError)
-        require(isinstance(self.ramp_storage, int) and self.ramp_storage >= -1,
-                "ramp_storage", self.ramp_storage,
-                "an integer >= 0 (0 = no queue override; -1: what the ramp holds)",
-                ScenarioError)
-        if self.ramp_storage == -1:
-            object.__setattr__(self, "ramp_storage", ramp_capacity())
+        self._resolve_storage()
         require(self.time_to_teleport == -1 or self.time_to_teleport > 0, "time_to_teleport",
                 self.time_to_teleport, "-1 (off) or a time > 0 s", ScenarioError)
         require(self.hv_model in HV_MODELS, "hv_model", self.hv_model,
@@ -216,6 +211,15 @@ class SumoConfig:
         require(self.av_model in AV_MODELS, "av_model", self.av_model,
                 " or ".join(AV_MODELS), ScenarioError)
         require(isinstance(self.fcd, bool), "fcd", self.fcd, "true or false", ScenarioError)
+
+    def _resolve_storage(self) -> None:
+        """Check ``ramp_storage``; -1 becomes what the ramp holds (:func:`ramp_capacity`)."""
+        require(isinstance(self.ramp_storage, int) and self.ramp_storage >= -1,
+                "ramp_storage", self.ramp_storage,
+                "an integer >= 0 (0 = no queue override; -1: what the ramp holds)",
+                ScenarioError)
+        if self.ramp_storage == -1:
+            object.__setattr__(self, "ramp_storage", ramp_capacity())
 
     def _check_meter(self) -> None:
         """The meter's mode and timings fit together (clearance inside the cycle, release
