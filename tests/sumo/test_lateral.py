@@ -27,8 +27,8 @@ def run(tmp_path_factory):
     on_main: list[int] = []
     observe = SumoSensor.observe
 
-    def counting(sensor: SumoSensor, t: float):
-        got = observe(sensor, t)
+    def counting(sensor: SumoSensor, t: float, pending=None):
+        got = observe(sensor, t, pending)
         if got is not None and sensor.window_open:
             on_main.append(int(sensor.lib.edge.getLastStepVehicleNumber(MAIN)))
         return got

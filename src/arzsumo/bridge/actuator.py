@@ -186,12 +186,13 @@ class MeterActuator:
         if self.hold_nominal:
             return Actuation(u, 0.0, False, False, -INF, INF, self.meter.green_share)
         lower, upper = self.limits.range(self.meter.queue)
+        rate_step = self.limits.rate_step
         if self.meter.override():
             # the queue override runs the meter at its largest release whatever is
             # commanded: to the law, a saturation of its actuator (anti-windup sees it)
             lower = upper = self.meter.override_u(self.q_nominal)
-        lim = limit_u(u, self.u_prev, lower, upper, INF if self.meter.override()
-                      else self.limits.rate_step)
+            rate_step = INF
+        lim = limit_u(u, self.u_prev, lower, upper, rate_step)
         self.u_prev = lim.u_applied
         green = self.meter.command(lim.u_applied, self.q_nominal)
         return Actuation(u, lim.u_applied, lim.saturated, lim.rate_limited, lower, upper,

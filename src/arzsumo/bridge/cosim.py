@@ -49,7 +49,7 @@ import math
 import shutil
 import tempfile
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -57,7 +57,7 @@ import numpy as np
 
 from arzsumo.bridge.actuator import ActuationLimits, MeterActuator
 from arzsumo.bridge.delay import check_delay, compensate
-from arzsumo.bridge.drain import Drained, drain
+from arzsumo.bridge.drain import drain, whole_demand
 from arzsumo.bridge.estimator import Estimator
 from arzsumo.bridge.estimators import RecordedEstimator, estimation_stage
 from arzsumo.bridge.records import Decision, PeriodRecord, Trace, columns, micro_fields
@@ -78,14 +78,12 @@ from arzsumo.scenario.run import RunSettings
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.meter import DEFAULT_CURVE, GreenShareCurve
 from arzsumo.sumo.meter_release import make_meter
-from arzsumo.sumo.network import NetworkSpec
 from arzsumo.sumo.network_measures import network_options
 from arzsumo.sumo.paths import scratch_dir
 from arzsumo.sumo.run_files import FCD_FILE, RunFiles
 from arzsumo.sumo.sensor import PeriodMeasurement, SumoSensor
 from arzsumo.sumo.simulation import SumoSimulation, open_simulation
-from arzsumo.sumo.whole_demand import ramp_waits, whole_demand_summary
-from arzsumo.sumo.window import NetworkMeasures, WindowStart, measure_network
+from arzsumo.sumo.window import WindowStart, measure_network
 from arzsumo.twin.solver import SolverOptions
 
 log = logging.getLogger(__name__)
@@ -125,7 +123,7 @@ class SumoPlant:
             s0 = time.perf_counter()
             t = self.sim.step()
             s1 = time.perf_counter()
-            got = self.sensor.observe(t)
+            got = self.sensor.observe(t, self.sim.pending)
             self.meter.step(self.sensor.queue)
             s2 = time.perf_counter()
             self.timings["sumo_step"] += s1 - s0
@@ -341,19 +339,6 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
                        loop.plant.sensor.speeds.summary(), trace.start,
                        np.asarray(c.estimator.fields[1:]), c.estimator,
                        loop.shift, loop.plant.sensor.lateral.record(), files)
-
-
-def whole_demand(network: NetworkMeasures, trips: Any, meter: Any, sim: SumoSimulation,
-                 drained: Drained) -> NetworkMeasures:
-    """``network`` with its ``whole_demand`` block (:mod:`arzsumo.sumo.whole_demand`):
-    the whole run after the drain, the per-step integral of vehicles in the system and
-    the ramp vehicles' waits at the meter."""
-    spec = NetworkSpec()
-    waits = ramp_waits(trips, meter.stop_line.crossings, sim.cfg.step_length,
-                       spec.ramp_length / spec.ramp_speed)
-    block = whole_demand_summary(network.whole_run, waits, sim.in_system_s,
-                                 drained.duration_s, drained.max_s, drained.gridlock)
-    return replace(network, whole_demand=block)
 
 
 def control(sim: SumoSimulation, scenario: Scenario, settings: RunSettings, cfg: SumoConfig,

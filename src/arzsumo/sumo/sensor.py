@@ -14,7 +14,7 @@ One :class:`SumoSensor` per run. After each SUMO step :meth:`SumoSensor.observe`
   ``open_simulation(..., loops=layout.loop_x(L))``) and, at a period's last step, the
   reporting AVs (:class:`~arzsumo.sumo.probes.AvProbes`, from the sample above),
 * until the control window opens (:meth:`SumoSensor.start_window`), every vehicle's fuel
-  and CO2 (:class:`~arzsumo.sumo.window.WarmupLedger`); after, the speed moments per class
+  and CO2 (:class:`~arzsumo.sumo.window.EmissionsLedger`); after, the speed moments per class
   of the vehicles on ``main`` (:class:`SpeedMoments`, from the samples above) and, at
   a period's last step, their lateral offsets (:class:`~arzsumo.sumo.lateral.LateralSampler`),
 
@@ -25,6 +25,7 @@ else in the closed loop reads SUMO; the meter only writes the traffic light.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from types import ModuleType
 
@@ -43,13 +44,16 @@ from arzsumo.sumo.measure import CellData, MainlineSensor
 from arzsumo.sumo.network import RAMP_UP
 from arzsumo.sumo.probes import AvProbes
 from arzsumo.sumo.sensing import SensorLayout
-from arzsumo.sumo.window import WarmupLedger, WindowStart
+from arzsumo.sumo.window import EmissionsLedger, WindowStart
 from arzsumo.units import ms_to_kmh
 
 
-def ramp_queue(lib: ModuleType) -> int:
-    """Halted vehicles on ``ramp_up`` plus ramp vehicles still waiting to be inserted."""
-    waiting = sum(1 for v in lib.simulation.getPendingVehicles() if v.startswith("ramp"))
+def ramp_queue(lib: ModuleType, pending: Sequence[str] | None = None) -> int:
+    """Halted vehicles on ``ramp_up`` plus ramp vehicles still waiting to be inserted
+    (``pending``: the ids SUMO holds back this step, read here when not given)."""
+    if pending is None:
+        pending = lib.simulation.getPendingVehicles()
+    waiting = sum(1 for v in pending if v.startswith("ramp"))
     return int(lib.edge.getLastStepHaltingNumber(RAMP_UP)) + waiting
 
 
@@ -151,7 +155,7 @@ class SumoSensor:
             if layout.av_probes else None
         self.queue = 0
         self.downstream = DownstreamLoop(lib, cfg.step_length, cfg.steps_per_period)
-        self.ledger = WarmupLedger(lib, cfg.step_length) if window else None
+        self.ledger = EmissionsLedger(lib, cfg.step_length) if window else None
         self.window_open = False
         self.speeds = SpeedMoments()
         self.lateral = LateralSampler(lib)
@@ -164,10 +168,13 @@ class SumoSensor:
         self.window_open = True
         return self.ledger.close(t)
 
-    def observe(self, t: float) -> PeriodMeasurement | None:
-        """Sample the step that ended at ``t`` (s); return the period's measurement when
-        the period is complete, else None. :attr:`queue` is the ramp queue now."""
-        self.queue = ramp_queue(self.lib)
+    def observe(self, t: float, pending: Sequence[str] | None = None
+                ) -> PeriodMeasurement | None:
+        """Sample the step that ended at ``t`` (s; ``pending``: the vehicles SUMO holds
+        back now, :attr:`arzsumo.sumo.simulation.SumoSimulation.pending`); return the
+        period's measurement when the period is complete, else None. :attr:`queue` is the
+        ramp queue now."""
+        self.queue = ramp_queue(self.lib, pending)
         down = self.downstream.observe(t)
         cells = self.mainline.collect(t)
         loops = self.loops.observe(t) if self.loops is not None else None

@@ -139,6 +139,7 @@ class SumoSimulation:
         #: integral of the vehicles in the system (on the network or waiting to be
         #: inserted) over the run, veh s: counted every step, independently of tripinfo
         self.in_system_s = 0.0
+        self.pending: Sequence[str] = ()
         self.report: RunReport | None = None
 
     # -- command line --------------------------------------------------------------------
@@ -213,8 +214,9 @@ class SumoSimulation:
         if departed:
             self.inserted_ramp += sum(1 for v in departed if v.startswith("ramp"))
         self.arrived += sim.getArrivedNumber()
-        self.in_system_s += (lib.vehicle.getIDCount() + len(sim.getPendingVehicles())) \
-            * self.cfg.step_length
+        #: vehicles due but not yet inserted after this step (ids), read once per step
+        self.pending = sim.getPendingVehicles()
+        self.in_system_s += (lib.vehicle.getIDCount() + len(self.pending)) * self.cfg.step_length
         self.collisions += sim.getCollidingVehiclesNumber()
         self.emergency_stops += sim.getEmergencyStoppingVehiclesNumber()
         if self.cfg.time_to_teleport > 0:

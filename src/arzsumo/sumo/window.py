@@ -8,7 +8,7 @@ departure; the control window's part is
 * times (time in the system, depart delay): the vehicle's interval clipped to [t_w, T]
   (exact: the intervals are known from ``depart``, ``departDelay`` and ``arrival``);
 * accumulated quantities (SUMO's time loss, waiting time, distance, fuel, CO2): the
-  tripinfo total minus the value the vehicle had at t_w. :class:`WarmupLedger` reads the
+  tripinfo total minus the value the vehicle had at t_w. :class:`EmissionsLedger` reads the
   vehicles on the network at t_w with libsumo (``getTimeLoss``, ``getDistance``, the
   tripinfo device's ``waitingTime``: equal to SUMO's tripinfo within its 2 decimals).
   SUMO's emissions device cannot be read while running, so fuel and CO2 up to t_w are
@@ -58,8 +58,10 @@ class WindowStart:
     waiting: tuple[str, ...] = field(default=())
 
 
-class WarmupLedger:
-    """Fuel and CO2 of every vehicle (mg) summed each step until :meth:`close`.
+class EmissionsLedger:
+    """Fuel and CO2 of every vehicle (mg) summed each step it is told to (:meth:`add`):
+    the warm-up's until :meth:`close` reads the window's start, and the drain's after the
+    window's end (:func:`window_end`).
 
     Parameters
     ----------
@@ -116,15 +118,15 @@ class WindowEnd:
     after_g: pd.DataFrame
 
 
-def window_end(lib: ModuleType, t: float) -> tuple[pd.DataFrame, WarmupLedger]:
+def window_end(lib: ModuleType, t: float) -> tuple[pd.DataFrame, EmissionsLedger]:
     """At the end of the window ``t`` (s): the values so far of the vehicles on the
     network, and a ledger that sums fuel and CO2 from now on (call its ``add`` every
     drain step; :func:`finish_window` makes the :class:`WindowEnd`)."""
-    ledger = WarmupLedger(lib, lib.simulation.getDeltaT())
+    ledger = EmissionsLedger(lib, lib.simulation.getDeltaT())
     return ledger.close(t).on_network, ledger
 
 
-def finish_window(t: float, on_network: pd.DataFrame, ledger: WarmupLedger) -> WindowEnd:
+def finish_window(t: float, on_network: pd.DataFrame, ledger: EmissionsLedger) -> WindowEnd:
     """The :class:`WindowEnd` of :func:`window_end` once the drain has run."""
     ids = sorted(set(ledger.fuel_mg))
     after = pd.DataFrame({"fuel_g": [ledger.fuel_mg[i] / MG_PER_G for i in ids],

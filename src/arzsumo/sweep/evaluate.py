@@ -340,18 +340,15 @@ def _header(name: str, scenario: Path, controllers: Sequence[str], seeds: Sequen
              "bootstrap). The headline is the whole-demand time spent: every loaded "
              "vehicle from its insertion request to its arrival, the drain after the "
              "window included (docs/outputs.md); the window measures follow."]
-    if f"{WHOLE_DEMAND_KEY}" in ok and ok[WHOLE_DEMAND_KEY].isna().all():
+    if WHOLE_DEMAND_KEY not in ok or ok[WHOLE_DEMAND_KEY].isna().all():
         lines += ["", "**No whole-demand measures**: the scenario has no drain "
                       "(`[sumo] drain_max_s` = 0), so a queue left at the window's end is "
                       "not charged; compare controllers on the window measures with care."]
-    elif WHOLE_DEMAND_KEY not in ok:
-        lines += ["", "**No whole-demand measures**: the scenario has no drain "
-                      "(`[sumo] drain_max_s` = 0)."]
     complete = ok.get("network_whole_demand.complete", pd.Series(dtype=object))
     incomplete = int((complete.astype(str).str.lower() == "false").sum())
     if incomplete:
-        lines += ["", f"**{incomplete} run(s) hit the drain limit** (`[sumo] drain_max_s`): "
-                      "their whole-demand measures leave vehicles uncharged."]
+        lines += ["", f"**{incomplete} run(s) did not drain** (a gridlock, or `[sumo] "
+                      "drain_max_s`): their whole-demand values are left out."]
     if command:
         lines += ["", f"Command: `{command}`"]
     return "\n".join(lines)
