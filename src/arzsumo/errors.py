@@ -19,6 +19,9 @@ class ArzsumoError(Exception):
     field: str | None = None
     value: object = None
     allowed: str | None = None
+    #: where a scenario key's refusal was raised (``x.toml: [sumo]``) and the key
+    at: str | None = None
+    key: str | None = None
 
 
 class ModelError(ArzsumoError, ValueError):

@@ -76,8 +76,22 @@ def where(source: str, table: str) -> str:
 
 def not_allowed(at: str, key: str, value: Any, allowed: str,
                 error: type[ArzsumoError] = ScenarioError) -> ArzsumoError:
-    """``error``: ``{at} {key} = {value as written} is not allowed: {allowed}``."""
-    return error(f"{at} {key} = {written(value)} is not allowed: {allowed}")
+    """``error``: ``{at} {key} = {value as written} is not allowed: {allowed}``.
+
+    The error keeps ``at``, ``key`` and ``allowed`` as attributes, so that a caller who
+    set the value from elsewhere (a command-line option) can name it there
+    (:func:`restated`)."""
+    exc = error(f"{at} {key} = {written(value)} is not allowed: {allowed}")
+    exc.at, exc.key, exc.allowed = at, key, allowed
+    return exc
+
+
+def restated(exc: ArzsumoError, at: str, key: str, name: str, value: Any) -> ArzsumoError:
+    """``exc`` about ``{at} {key}`` (from :func:`not_allowed`) said of ``name = value``
+    instead (the option the user typed); any other error unchanged."""
+    if getattr(exc, "at", None) == at and getattr(exc, "key", None) == key:
+        return type(exc)(f"{name} = {value} is not allowed: {exc.allowed}")
+    return exc
 
 
 def check_keys(table: Mapping[str, Any], allowed: set[str] | Mapping[str, Any],

@@ -2,20 +2,19 @@
 
 import pytest
 
-from arzsumo.bridge.actuator import meter_range, ramp_floor
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.meter import DEFAULT_CURVE
+from arzsumo.sumo.meter_release import one_per_green_ramp_floor, one_per_green_u_range
 
 ONE = SumoConfig(meter_mode="one_per_green")      # 600 veh/h nominal, 240..900 veh/h
 
 
 def test_one_per_green_range_is_the_release_rate_bounds():
-    lo, hi = meter_range(DEFAULT_CURVE, ONE, q_nominal=1.24)
+    lo, hi = one_per_green_u_range(ONE)
     assert lo == pytest.approx((600 - 900) / 3600) and hi == pytest.approx((600 - 240) / 3600)
 
 
 def test_one_per_green_ramp_floor_counts_arrivals_and_queue():
     # ramp demand 1200 veh/h, nominal cycle 6 s: floor = (600 - 1200) / 3600 - queue / 6
-    assert ramp_floor(DEFAULT_CURVE, ONE, 1.24, 0) == pytest.approx(-600 / 3600)
-    assert ramp_floor(DEFAULT_CURVE, ONE, 1.24, 3) == pytest.approx(-600 / 3600 - 0.5)
-    assert ramp_floor(DEFAULT_CURVE, ONE.with_(ramp_demand=0.1), 1.24, 0) == 0.0
+    assert one_per_green_ramp_floor(ONE, 0) == pytest.approx(-600 / 3600)
+    assert one_per_green_ramp_floor(ONE, 3) == pytest.approx(-600 / 3600 - 0.5)
+    assert one_per_green_ramp_floor(ONE.with_(ramp_demand=0.1), 0) == 0.0

@@ -10,12 +10,11 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
-from arzsumo.bridge.actuator import meter_range, ramp_floor
 from arzsumo.bridge.cosim import run_cosimulation
 from arzsumo.control.etc import PAPER_DESIGN
 from arzsumo.outputs.bridge import write_results
 from arzsumo.scenario import load_scenario
-from arzsumo.sumo.meter import DEFAULT_CURVE
+from arzsumo.sumo.meter import DEFAULT_CURVE, fixed_cycle_ramp_floor, fixed_cycle_u_range
 
 pytestmark = pytest.mark.sumo
 DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "legacy_default.toml"
@@ -71,10 +70,10 @@ def test_saturated_etc_does_not_trigger_on_every_period(runs):
 def test_ramp_bound_keeps_u_within_meter_and_ramp(runs):
     res = runs["ramp"]
     p, q_nom, cfg = res.periods, res.q_nominal, res.sumo
-    lo, hi = meter_range(DEFAULT_CURVE, cfg, q_nom)
+    lo, hi = fixed_cycle_u_range(DEFAULT_CURVE, cfg, q_nom)
     assert np.all((p["u_applied"] >= lo - TOL) & (p["u_applied"] <= hi + TOL))
     # the meter's queue at check k is the queue at the end of period k - 1
-    floor = [ramp_floor(DEFAULT_CURVE, cfg, q_nom, q) for q in p["queue"][:-1]]
+    floor = [fixed_cycle_ramp_floor(DEFAULT_CURVE, cfg, q_nom, q) for q in p["queue"][:-1]]
     assert np.all(p["u_applied"][1:] >= np.asarray(floor) - TOL)
     assert p["saturated"].sum() > 0 and p["rate_limited"].sum() == 0
 

@@ -1,4 +1,5 @@
-"""limit_u and the actuator's ranges (issue 17): pure functions, known answers, properties."""
+"""limit_u, the actuator's ranges and its one saturation of the meter's plan: pure
+functions, known answers, properties (no SUMO: a meter of the realisations' pure rules)."""
 
 from __future__ import annotations
 
@@ -8,13 +9,65 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from arzsumo.bridge.actuator import ActuationLimits, limit_u, meter_range, ramp_floor
+from arzsumo.bridge.actuator import ActuationLimits, MeterActuator, command_meter, limit_u
 from arzsumo.scenario.actuation import ActuationSettings
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.meter import DEFAULT_CURVE
+from arzsumo.sumo.meter import DEFAULT_CURVE, fixed_cycle_ramp_floor, fixed_cycle_u_range
+from arzsumo.sumo.meter_release import (
+    one_per_green_ramp_floor,
+    one_per_green_u_range,
+    release_rate_for,
+)
 
 FLOW = st.floats(-10.0, 10.0, allow_nan=False)
 TOL = 1e-12
+
+
+class _Meter:
+    """A meter's interface without SUMO, from the realisations' pure rules; the queue
+    override as told."""
+
+    def __init__(self, cfg: SumoConfig, override: bool = False, queue: int = 50) -> None:
+        self.cfg, self.on, self.queue, self.green_share = cfg, override, queue, 0.2
+        self.release_rate = cfg.release_rate if self.one else None
+        self.planned: list[float] = []
+
+    @property
+    def one(self) -> bool:
+        return self.cfg.meter_mode == "one_per_green"
+
+    def override(self) -> bool:
+        return self.on
+
+    def override_u(self, q_nominal: float) -> float:
+        return self.cfg.release_rate - self.cfg.release_rate_max
+
+    def plan_for(self, u: float, q_nominal: float) -> float:
+        if self.one:
+            return release_rate_for(u, self.cfg)
+        return DEFAULT_CURVE.green_share_for(q_nominal + u)
+
+    @property
+    def plan_bounds(self) -> tuple[float, float]:
+        if self.one:
+            return self.cfg.release_rate_min, self.cfg.release_rate_max
+        return self.cfg.green_share_min, self.cfg.green_share_max
+
+    def set_plan(self, plan: float) -> float:
+        lo, hi = self.plan_bounds
+        assert lo <= plan <= hi
+        self.planned.append(plan)
+        return 0.2
+
+    def u_range(self, q_nominal: float) -> tuple[float, float]:
+        if self.one:
+            return one_per_green_u_range(self.cfg)
+        return fixed_cycle_u_range(DEFAULT_CURVE, self.cfg, q_nominal)
+
+    def ramp_floor(self, queue: float, q_nominal: float) -> float:
+        if self.one:
+            return one_per_green_ramp_floor(self.cfg, queue)
+        return fixed_cycle_ramp_floor(DEFAULT_CURVE, self.cfg, q_nominal, queue)
 
 
 @settings(max_examples=400, deadline=None)
@@ -38,8 +91,8 @@ def test_output_lies_in_the_range_and_within_the_rate(u_raw, u_prev, lo, hi, rat
        u_prev=st.floats(allow_nan=False, allow_infinity=False))
 def test_every_limit_off_is_the_identity(u_raw, u_prev):
     assert limit_u(u_raw, u_prev) == (u_raw, False, False)
-    lim = ActuationLimits.of(ActuationSettings(), 1.24, DEFAULT_CURVE, SumoConfig())
-    lower, upper = lim.range(queue=7)
+    lim = ActuationLimits.of(ActuationSettings(), 1.24, SumoConfig().control_period)
+    lower, upper = lim.range(_Meter(SumoConfig(), queue=7), 1.24)
     assert limit_u(u_raw, u_prev, lower, upper, lim.rate_step).u_applied == u_raw
 
 
@@ -58,66 +111,47 @@ def test_known_answers(args, want):
 
 def test_meter_range_is_the_curve_between_the_green_share_limits():
     q_nom = DEFAULT_CURVE.outflow_at(0.5)                    # 4464 veh/h
-    lo, hi = meter_range(DEFAULT_CURVE, SumoConfig(), q_nom)
+    lo, hi = fixed_cycle_u_range(DEFAULT_CURVE, SumoConfig(), q_nom)
     assert (lo * 3600, hi * 3600) == pytest.approx((3240 - 4464, 5664 - 4464))
     cfg = SumoConfig(green_share_min=0.25, green_share_max=0.75)
-    lo, hi = meter_range(DEFAULT_CURVE, cfg, q_nom)
+    lo, hi = fixed_cycle_u_range(DEFAULT_CURVE, cfg, q_nom)
     assert (lo * 3600, hi * 3600) == pytest.approx((3300 - 4464, 4512 - 4464))
 
 
 def test_ramp_floor_allows_no_more_release_than_arrivals_and_queue():
     q_nom = DEFAULT_CURVE.outflow_at(0.5)
     # 5664 - 1200 - 4464 = 0 veh/h: with an empty queue U < 0 is not deliverable
-    assert ramp_floor(DEFAULT_CURVE, SumoConfig(), q_nom, queue=0) == pytest.approx(0.0,
-                                                                                   abs=1e-12)
+    floor = fixed_cycle_ramp_floor
+    assert floor(DEFAULT_CURVE, SumoConfig(), q_nom, queue=0) == pytest.approx(0.0, abs=1e-12)
     # 3 vehicles over one 6 s cycle: 0.5 veh/s more release, U >= -0.5 veh/s
-    assert ramp_floor(DEFAULT_CURVE, SumoConfig(), q_nom, queue=3) == pytest.approx(-0.5)
+    assert floor(DEFAULT_CURVE, SumoConfig(), q_nom, queue=3) == pytest.approx(-0.5)
     # a light ramp demand: the floor is capped at 0 (the nominal plan is always allowed)
     light = SumoConfig(ramp_demand=600 / 3600)
-    assert ramp_floor(DEFAULT_CURVE, light, q_nom, queue=0) == 0.0
+    assert floor(DEFAULT_CURVE, light, q_nom, queue=0) == 0.0
 
 
 def test_limits_combine_fraction_meter_and_ramp():
     q_nom = DEFAULT_CURVE.outflow_at(0.5)
     cfg = SumoConfig()
     lim = ActuationLimits.of(ActuationSettings(u_max_fraction=0.5, u_rate_max=0.01,
-                                               ramp_bound=True), q_nom, DEFAULT_CURVE, cfg)
+                                               ramp_bound=True), q_nom, cfg.control_period)
     assert lim.rate_step == pytest.approx(0.01 * cfg.control_period)
-    lo, hi = lim.range(queue=3)
+    lo, hi = lim.range(_Meter(cfg, queue=3), q_nom)
     assert lo == pytest.approx(-(4464 - 3240) / 3600)       # meter: all green
     assert hi == pytest.approx((5664 - 4464) / 3600)        # meter: all red
-    lo, hi = lim.range(queue=0)
+    lo, hi = lim.range(_Meter(cfg, queue=0), q_nom)
     assert lo == pytest.approx(0.0, abs=1e-12) and math.isfinite(hi)
-    tight = ActuationLimits.of(ActuationSettings(u_max_fraction=0.1), q_nom, DEFAULT_CURVE,
-                               cfg)
-    assert tight.range(queue=0) == pytest.approx((-0.1 * q_nom, 0.1 * q_nom))
+    tight = ActuationLimits.of(ActuationSettings(u_max_fraction=0.1), q_nom,
+                               cfg.control_period)
+    assert tight.range(_Meter(cfg, queue=0), q_nom) == pytest.approx((-0.1 * q_nom,
+                                                                      0.1 * q_nom))
     assert tight.rate_step == math.inf
 
 
-class _Meter:
-    """A one-per-green meter's interface without SUMO: the override as told."""
-
-    def __init__(self, cfg: SumoConfig, override: bool) -> None:
-        self.cfg, self.on, self.queue, self.green_share = cfg, override, 50, 0.2
-        self.commanded: list[float] = []
-
-    def override(self) -> bool:
-        return self.on
-
-    def override_u(self, q_nominal: float) -> float:
-        return self.cfg.release_rate - self.cfg.release_rate_max
-
-    def command(self, u: float, q_nominal: float) -> float:
-        self.commanded.append(u)
-        return 0.2
-
-
 def test_the_queue_override_is_a_saturation_the_law_sees():
-    from arzsumo.bridge.actuator import MeterActuator
-
     cfg = SumoConfig(meter_mode="one_per_green")
     limits = ActuationLimits.of(ActuationSettings(u_max_fraction=0.2, u_rate_max=0.01,
-                                                  ramp_bound=True), 1.2, DEFAULT_CURVE, cfg)
+                                                  ramp_bound=True), 1.2, cfg.control_period)
     forced = MeterActuator(_Meter(cfg, override=True), 1.2, False, limits)
     act = forced.apply(0.05)                 # the law asks for less release
     assert act.u_applied == pytest.approx((600 - 900) / 3600)   # the largest release
@@ -126,3 +160,18 @@ def test_the_queue_override_is_a_saturation_the_law_sees():
     free = MeterActuator(_Meter(cfg, override=False), 1.2, False, limits)
     act = free.apply(0.05)
     assert act.u_applied == pytest.approx(0.01) and act.rate_limited   # rate from U = 0
+
+
+@pytest.mark.parametrize(("mode", "u", "plan"), [
+    ("one_per_green", 0.0, 600 / 3600),
+    ("one_per_green", -1.0, 900 / 3600),        # more release than the meter has: its max
+    ("one_per_green", 1.0, 240 / 3600),         # less: its least rate
+    ("fixed_cycle", 0.0, 0.5),
+    ("fixed_cycle", 10.0, 0.25),                # more outflow than the curve: least green
+    ("fixed_cycle", -10.0, 0.75),
+])
+def test_the_meter_plan_is_saturated_once_to_its_bounds(mode, u, plan):
+    cfg = SumoConfig(meter_mode=mode, green_share_min=0.25, green_share_max=0.75)
+    meter = _Meter(cfg)
+    command_meter(meter, u, DEFAULT_CURVE.outflow_at(0.5))
+    assert meter.planned == [pytest.approx(plan)]

@@ -10,9 +10,8 @@ import pytest
 
 from arzsumo.model import get_preset
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.meter import MeterLight
-from arzsumo.sumo.meter_release import OnePerGreenMeter, make_meter
-from arzsumo.sumo.sensor import ramp_queue
+from arzsumo.sumo.meter_release import OnePerGreenMeter
+from arzsumo.sumo.plant import SumoPlant
 from arzsumo.sumo.simulation import open_simulation
 
 pytestmark = pytest.mark.sumo
@@ -22,20 +21,33 @@ BASE = SumoConfig()
 ONE = BASE.with_(meter_mode="one_per_green", meter_clearance=2.0)
 
 
-def run_meter(cfg: SumoConfig, horizon: float, commands=()) -> tuple[MeterLight, set[str]]:
+class Metered:
+    """A finished run's meter, with :meth:`summary` the meter's and its stop line's."""
+
+    def __init__(self, plant: SumoPlant) -> None:
+        self.plant = plant
+
+    def summary(self) -> dict:
+        return self.plant.meter_summary()
+
+    def __getattr__(self, name: str):
+        return getattr(self.plant.meter, name)
+
+
+def run_meter(cfg: SumoConfig, horizon: float, commands=()) -> tuple[Metered, set[str]]:
     """Run ``horizon`` s with the meter of ``cfg``; ``commands``: (time s, rate veh/h)
     given to a one-per-green meter. Returns the meter and the light states SUMO showed."""
     todo = sorted(commands)
     with open_simulation(PARAMS, cfg.with_(horizon=horizon)) as sim:
-        meter = make_meter(sim.lib, cfg)
+        plant = SumoPlant(sim, PARAMS.length, cfg, measure=False)
+        meter = plant.meter
         shown = set()
         while sim.time < horizon - 1e-9:
             while todo and sim.time >= todo[0][0] - 1e-9:
-                meter.command_rate(todo.pop(0)[1] / 3600)
-            sim.step()
-            meter.step(ramp_queue(sim.lib))
+                meter.set_plan(todo.pop(0)[1] / 3600)
+            plant.step()
             shown.add(sim.lib.trafficlight.getRedYellowGreenState("meter"))
-    return meter, shown
+    return Metered(plant), shown
 
 
 def test_clearance_removes_the_emergency_stops_at_the_meter():
@@ -67,7 +79,7 @@ def test_one_per_green_releases_one_vehicle_per_green_without_emergency():
 
 def test_one_per_green_cycles_follow_the_commanded_rate():
     meter, _ = run_meter(ONE, 140.0, [(30.0, 900.0), (70.0, 240.0)])
-    assert isinstance(meter, OnePerGreenMeter)
+    assert isinstance(meter.plant.meter, OnePerGreenMeter)
     assert meter.plan_changes == 2
     dt = ONE.step_length
     for lo, hi, rate in ((33.0, 70.0, 900.0), (72.0, 140.0, 240.0)):

@@ -8,7 +8,6 @@ import pytest
 from arzsumo.errors import ArzsumoError
 from arzsumo.model import get_preset
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.meter import RampMeter
 from arzsumo.sumo.network_measures import (
     EDGEDATA_FILE,
     STATISTICS_FILE,
@@ -18,7 +17,7 @@ from arzsumo.sumo.network_measures import (
     read_trips,
 )
 from arzsumo.sumo.paths import SumoError
-from arzsumo.sumo.sensor import ramp_queue
+from arzsumo.sumo.plant import SumoPlant
 from arzsumo.sumo.simulation import open_simulation
 
 PARAMS = get_preset("paper_base").params
@@ -40,10 +39,9 @@ def _run(out: Path, green_share: float) -> Run:
     integral = {"mainline": 0.0, "ramp": 0.0}
     with open_simulation(PARAMS, cfg, extra_args=network_options(out), output_dir=out) as sim:
         lib = sim.lib
-        meter = RampMeter(lib, cfg)
+        plant = SumoPlant(sim, PARAMS.length, cfg, measure=False)
         while sim.time < cfg.horizon - 1e-9:
-            sim.step()
-            meter.step(ramp_queue(sim.lib))
+            plant.step()
             ids = [*lib.vehicle.getIDList(), *lib.simulation.getPendingVehicles()]
             ramp = sum(1 for v in ids if v.startswith("ramp"))
             integral["ramp"] += ramp * cfg.step_length

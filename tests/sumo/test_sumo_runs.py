@@ -3,15 +3,15 @@
 import numpy as np
 import pytest
 
+from arzsumo.bridge.actuator import command_meter
 from arzsumo.model import get_preset
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.measure import MainlineSensor
-from arzsumo.sumo.meter import RampMeter
 from arzsumo.sumo.network import MAIN, RAMP_UP
 from arzsumo.sumo.paths import SumoError
 from arzsumo.sumo.placement import place_vehicles
+from arzsumo.sumo.plant import SumoPlant
 from arzsumo.sumo.runner import run_fixed_meter
-from arzsumo.sumo.sensor import ramp_queue
 from arzsumo.sumo.simulation import open_simulation
 
 pytestmark = pytest.mark.sumo
@@ -24,10 +24,9 @@ def test_vehicles_are_conserved():
     cfg = FAST.with_(horizon=100.0, ramp_demand=1500 / 3600)
     checked = 0
     with open_simulation(PARAMS, cfg) as sim:
-        meter = RampMeter(sim.lib, cfg)
+        plant = SumoPlant(sim, PARAMS.length, cfg, measure=False)
         while sim.time < cfg.horizon:
-            sim.step()
-            meter.step(ramp_queue(sim.lib))
+            plant.step()
             if round(sim.time / cfg.step_length) % 50 == 0:
                 r = sim.take_report()
                 assert r.requested == r.inserted + r.waiting
@@ -74,21 +73,21 @@ def test_always_red_holds_ramp_and_always_green_releases_it():
 def test_meter_counts_plan_and_light_changes():
     cfg = FAST.with_(horizon=30.0, meter_cycle=6.0, min_green=1.0, min_red=1.0)
     with open_simulation(PARAMS, cfg) as sim:
-        meter = RampMeter(sim.lib, cfg)               # nominal green share 0.5
+        plant = SumoPlant(sim, PARAMS.length, cfg, measure=False)
+        meter = plant.meter                           # nominal green share 0.5
         assert meter.set_green_share(0.5) is False    # same timing: no plan change
         for _ in range(round(12.0 / cfg.step_length)):
-            sim.step()
-            meter.step(ramp_queue(sim.lib))
+            plant.step()
             states = sim.lib.trafficlight.getRedYellowGreenState("meter")
             assert states == meter.light
         assert meter.light_changes == 4               # two cycles: G->r, r->G, G->r, r->G
-        assert meter.command_outflow(1e6) == 0.0      # more outflow than possible: all red
+        assert command_meter(meter, 1e6, 0.0) == 0.0  # more outflow than possible: all red
         assert meter.plan_changes == 1
     sat = cfg.with_(green_share_min=0.2, green_share_max=0.8)
     with open_simulation(PARAMS, sat) as sim:
-        meter = RampMeter(sim.lib, sat)
-        assert meter.command_outflow(1e6) == pytest.approx(0.2, abs=0.02)
-        assert meter.command_outflow(0.0) == pytest.approx(0.8, abs=0.02)
+        meter = SumoPlant(sim, PARAMS.length, sat, measure=False).meter
+        assert command_meter(meter, 1e6, 0.0) == pytest.approx(0.2, abs=0.02)
+        assert command_meter(meter, 0.0, 0.0) == pytest.approx(0.8, abs=0.02)
         assert meter.plan_changes == 2
         sim.run_until(30.0)
 
@@ -96,20 +95,19 @@ def test_meter_counts_plan_and_light_changes():
 def test_meter_window_restarts_the_counts_but_not_the_light():
     cfg = FAST.with_(horizon=30.0, meter_cycle=6.0, min_green=1.0, min_red=1.0)
     with open_simulation(PARAMS, cfg) as sim:
-        meter = RampMeter(sim.lib, cfg)
-        meter.command_outflow(1e6)                    # all red from the next cycle on
+        plant = SumoPlant(sim, PARAMS.length, cfg, measure=False)
+        meter = plant.meter
+        command_meter(meter, 1e6, 0.0)                # all red from the next cycle on
         for _ in range(round(12.0 / cfg.step_length)):
-            sim.step()
-            meter.step(ramp_queue(sim.lib))
+            plant.step()
         light, plan = meter.light, meter.green_share
         closed = meter.start_window()
         assert closed["plan_changes"] == 1 and closed["light_changes"] == 1   # G->r once
         assert (meter.plan_changes, meter.light_changes, meter.max_queue) == (0, 0, 0)
         assert (meter.light, meter.green_share) == (light, plan)
-        assert meter.command_outflow(0.0) == 1.0      # all green from the next cycle on
+        assert command_meter(meter, 0.0, 0.0) == 1.0  # all green from the next cycle on
         for _ in range(round(7.0 / cfg.step_length)):
-            sim.step()
-            meter.step(ramp_queue(sim.lib))
+            plant.step()
         assert meter.plan_changes == 1 and meter.light_changes == 1          # r->G once
         assert meter.max_queue >= meter.queue              # the window's own maximum
 

@@ -19,9 +19,14 @@ Between the controller and the meter, the ``[actuation]`` limits
 Every limit off (the default) returns the law's U unchanged. While the meter's queue
 override is on (the ramp queue beyond its storage,
 :meth:`~arzsumo.sumo.meter.MeterLight.override`) the range collapses to the override's U,
-whatever the limits: the law sees a saturated actuator. The U applied goes back to the
-controller (:meth:`arzsumo.control.base.Controller.applied`, with the range) unless
-``anti_windup = false``.
+whatever the limits: the law sees a saturated actuator. The U applied, with the range in
+force, is what the controller is told at its next check
+(:class:`~arzsumo.control.base.Applied`; the range only with ``anti_windup``).
+
+Last, the meter's own bounds: the U applied becomes the realisation's plan variable
+(green share or release rate, :meth:`~arzsumo.sumo.meter.MeterLight.plan_for`), saturated
+to the plan's bounds here (:func:`command_meter`), the one place the meter's command is
+clamped. The realisation is chosen once per run; nothing here asks which it is.
 """
 
 from __future__ import annotations
@@ -30,9 +35,9 @@ import math
 from dataclasses import dataclass
 from typing import NamedTuple
 
+from arzsumo.control.base import Applied
 from arzsumo.scenario.actuation import ActuationSettings
-from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.meter import GreenShareCurve, MeterLight
+from arzsumo.sumo.meter import MeterLight
 
 INF = math.inf
 
@@ -75,70 +80,41 @@ def limit_u(u_raw: float, u_prev: float, lower: float = -INF, upper: float = INF
     return Limited(w, saturated or w != v, rate_limited)
 
 
-def meter_range(curve: GreenShareCurve, cfg: SumoConfig, q_nominal: float) -> tuple[float, float]:
-    """The U (veh/s) the meter can command: the monotone curve's outflow between
-    ``green_share_max`` (least mainline outflow) and ``green_share_min``, minus q*; widened
-    to include 0 (the nominal plan is always allowed). One per green: U = r_nominal - r
-    for r in [``release_rate_min``, ``release_rate_max``]
-    (:func:`~arzsumo.sumo.meter_release.release_rate_for`)."""
-    if cfg.meter_mode == "one_per_green":
-        return (min(0.0, cfg.release_rate - cfg.release_rate_max),
-                max(0.0, cfg.release_rate - cfg.release_rate_min))
-    m = curve.monotone()
-    return (min(0.0, m.outflow_at(cfg.green_share_max) - q_nominal),
-            max(0.0, m.outflow_at(cfg.green_share_min) - q_nominal))
+def command_meter(meter: MeterLight, u: float, q_nominal: float) -> float:
+    """Command ``meter`` with the outflow deviation ``u`` (veh/s) from ``q_nominal``
+    (veh/s): its plan variable for ``u``, saturated to the plan's bounds. Returns the
+    green share of the plan requested."""
+    lo, hi = meter.plan_bounds
+    return meter.set_plan(min(hi, max(lo, meter.plan_for(u, q_nominal))))
 
 
-def ramp_floor(curve: GreenShareCurve, cfg: SumoConfig, q_nominal: float, queue: float) -> float:
-    """Least U (veh/s) the ramp can deliver with ``queue`` vehicles waiting.
-
-    The rule: the merge passes ``q_open`` = the curve's mainline outflow at green share 0
-    (mainline alone, ramp closed) in all, so each ramp vehicle released takes one from the
-    mainline. Over the next plan, ``H = max(meter cycle, control period)`` seconds, the
-    ramp can release at most its arrivals and its queue, ``r + queue / H`` veh/s (``r``:
-    ``[sumo] ramp_demand``), so more ramp green cannot bring the mainline outflow below
-    ``q_open - r - queue / H``: U below that minus q* is not deliverable. Capped at 0 (the
-    nominal plan is always allowed), so it only bounds U < 0 (more ramp release).
-    One per green, by the same rule (U = r_nominal - r): ``r_nominal - r - queue / H``,
-    with the nominal cycle 1 / r_nominal for the meter cycle.
-    """
-    if cfg.meter_mode == "one_per_green":
-        horizon = max(1.0 / cfg.release_rate, cfg.control_period)
-        return min(0.0, cfg.release_rate - cfg.ramp_demand - queue / horizon)
-    q_open = curve.monotone().outflow_at(0.0)
-    horizon = max(cfg.meter_cycle, cfg.control_period)
-    return min(0.0, q_open - cfg.ramp_demand - queue / horizon - q_nominal)
-
-
-@dataclass
+@dataclass(frozen=True)
 class ActuationLimits:
     """The ``[actuation]`` limits in SI for one run (see the module docstring).
 
     ``u_max`` (veh/s, inf: off), ``rate_step`` (veh/s per control period, inf: off), and
-    with ``ramp_bound`` the meter's range and the ramp's floor from ``curve`` and ``cfg``.
+    ``ramp_bound``: U within the meter's range and above the ramp's floor.
     """
 
     u_max: float = INF
     rate_step: float = INF
     ramp_bound: bool = False
-    curve: GreenShareCurve | None = None
-    cfg: SumoConfig | None = None
-    q_nominal: float = 0.0
 
     @classmethod
-    def of(cls, settings: ActuationSettings, q_nominal: float, curve: GreenShareCurve,
-           cfg: SumoConfig) -> ActuationLimits:
-        """The limits of ``settings`` (0: off) around ``q_nominal`` (veh/s)."""
+    def of(cls, settings: ActuationSettings, q_nominal: float,
+           control_period: float) -> ActuationLimits:
+        """The limits of ``settings`` (0: off) around ``q_nominal`` (veh/s), for a control
+        period of ``control_period`` s."""
         return cls(settings.u_max_fraction * q_nominal if settings.u_max_fraction else INF,
-                   settings.u_rate_max * cfg.control_period if settings.u_rate_max else INF,
-                   settings.ramp_bound, curve, cfg, q_nominal)
+                   settings.u_rate_max * control_period if settings.u_rate_max else INF,
+                   settings.ramp_bound)
 
-    def range(self, queue: float) -> tuple[float, float]:
-        """``(lower, upper)`` of U (veh/s) with ``queue`` vehicles on the ramp."""
+    def range(self, meter: MeterLight, q_nominal: float) -> tuple[float, float]:
+        """``(lower, upper)`` of U (veh/s) for ``meter`` with its present ramp queue."""
         lower, upper = -self.u_max, self.u_max
-        if self.ramp_bound and self.curve is not None and self.cfg is not None:
-            lo, hi = meter_range(self.curve, self.cfg, self.q_nominal)
-            lower = max(lower, lo, ramp_floor(self.curve, self.cfg, self.q_nominal, queue))
+        if self.ramp_bound:
+            lo, hi = meter.u_range(q_nominal)
+            lower = max(lower, lo, meter.ramp_floor(meter.queue, q_nominal))
             upper = min(upper, hi)
         return lower, upper
 
@@ -146,7 +122,9 @@ class ActuationLimits:
 @dataclass(frozen=True)
 class Actuation:
     """One command: the law's U and the U applied (veh/s), the limit flags, the range
-    ``[lower, upper]`` (veh/s) in force, and the green share commanded."""
+    ``[lower, upper]`` (veh/s) in force, the green share commanded, the release rate
+    asked of the meter (veh/s; NaN for a fixed cycle) and whether the queue override
+    held the meter."""
 
     u_raw: float
     u_applied: float
@@ -155,6 +133,15 @@ class Actuation:
     lower: float
     upper: float
     green: float
+    release_rate: float = math.nan
+    override: bool = False
+
+    def told(self, anti_windup: bool) -> Applied:
+        """What the controller is told at its next check: the U applied and, with
+        ``anti_windup``, the range in force."""
+        if anti_windup:
+            return Applied(self.u_applied, self.lower, self.upper)
+        return Applied(self.u_applied, anti_windup=False)
 
 
 class MeterActuator:
@@ -183,17 +170,25 @@ class MeterActuator:
     def apply(self, u: float) -> Actuation:
         """Command U (veh/s), limited; return what was applied and the green share
         commanded (in [0, 1])."""
+        meter = self.meter
+        override = meter.override()
         if self.hold_nominal:
-            return Actuation(u, 0.0, False, False, -INF, INF, self.meter.green_share)
-        lower, upper = self.limits.range(self.meter.queue)
+            return Actuation(u, 0.0, False, False, -INF, INF, meter.green_share,
+                             _rate(meter), override)
+        lower, upper = self.limits.range(meter, self.q_nominal)
         rate_step = self.limits.rate_step
-        if self.meter.override():
+        if override:
             # the queue override runs the meter at its largest release whatever is
             # commanded: to the law, a saturation of its actuator (anti-windup sees it)
-            lower = upper = self.meter.override_u(self.q_nominal)
+            lower = upper = meter.override_u(self.q_nominal)
             rate_step = INF
         lim = limit_u(u, self.u_prev, lower, upper, rate_step)
         self.u_prev = lim.u_applied
-        green = self.meter.command(lim.u_applied, self.q_nominal)
+        green = command_meter(meter, lim.u_applied, self.q_nominal)
         return Actuation(u, lim.u_applied, lim.saturated, lim.rate_limited, lower, upper,
-                         green)
+                         green, _rate(meter), override)
+
+
+def _rate(meter: MeterLight) -> float:
+    rate = meter.release_rate
+    return math.nan if rate is None else rate

@@ -1,24 +1,24 @@
 """The closed loop in SUMO: sense, estimate, decide, actuate; two PDE twins alongside.
 
-Sequence of :func:`run_cosimulation` (``arzsumo run``):
+Sequence of :func:`run_cosimulation` (``arzsumo run``), on a run that
+:func:`arzsumo.bridge.session.prepare_run` checked once (among others: no PDE controller
+at a free-flow scenario equilibrium, a dead time it can compensate):
 
-1. Refuse a PDE controller at a free-flow equilibrium (lambda_4 >= 0) before SUMO starts
-   (with ``equilibrium = "scenario"``).
+1. (the checks above, not repeated here)
 2. Start SUMO, with vehicles placed from the scenario's ``[initial]`` profile if asked.
-3. Warm up: the same period loop as control, under the nominal meter plan, for the
+3. Warm up: the same step loop as control, under the nominal meter plan, for the
    warm-up rounded up to whole control periods (at least one, to measure from).
 4. With ``equilibrium = "measured"``, take the mean Edie densities of the last 60 s of the
-   warm-up as the equilibrium of the (calibrated) model, and check its regime.
+   warm-up as the equilibrium of the (calibrated) model, and check its regime and the
+   dead time at it.
 5. Build the controller (kernels solved or loaded; ALINEA's settings from ``[alinea]``),
    the actuator and both twins from the measured state at the start of control.
-6. Every control period: the controller is checked on the estimate of the last period
-   (:mod:`~arzsumo.bridge.estimator`; with ``[estimation] method`` "smoothing" or "enkf"
-   built from the ``[sensing]`` loops and AV probes, fed the warm-up's records first:
-   :mod:`~arzsumo.bridge.estimators`) and its U goes to the meter
-   (:mod:`~arzsumo.bridge.actuator`); SUMO runs one period, read by the sensor
-   (:mod:`arzsumo.sumo.sensor`); the twins (:mod:`~arzsumo.bridge.twins`) advance; one
-   :class:`~arzsumo.bridge.records.PeriodRecord` is kept. No command follows the last
-   check (no period follows it: a plan change there would never run).
+6. Every control period: sense, estimate, decide, actuate, record, in one place
+   (:class:`~arzsumo.bridge.loop.ClosedLoop`, whose docstring follows a detector sample
+   from SUMO to the meter).
+7. After the window, with ``[sumo] drain_max_s`` > 0, the drain
+   (:func:`~arzsumo.bridge.drain.drain`) through the same step loop
+   (:class:`~arzsumo.sumo.plant.SumoPlant`).
 
 The meter's counts (plan and light changes, queue maximum) cover the control window only:
 the meter's window is closed at the start of control and the warm-up's counts are kept
@@ -33,13 +33,6 @@ moments of the section (``CoSimResult.section_speed``; its lateral snapshots:
 SUMO configuration (``run.sumocfg`` and its files) and, with ``[sumo] fcd``, SUMO's FCD
 output are kept in ``CoSimResult.files`` (:mod:`arzsumo.sumo.run_files`) for the results
 directory.
-
-A detector sample's path: ``SumoSensor.observe`` (libsumo, every step) ->
-``PeriodMeasurement`` -> ``Estimator.estimate`` -> ``MacroState`` -> ``Controller.check``
--> U -> ``MeterActuator.apply`` (the ``[actuation]`` limits; the U applied goes back to
-``Controller.applied``, and to a delay compensator, ``Controller.actuated``:
-:mod:`~arzsumo.bridge.delay`) -> ``RampMeter.command_outflow`` (or a release rate,
-``OnePerGreenMeter.command_rate``) -> the light, set by ``step`` at the next cycle start.
 """
 
 from __future__ import annotations
@@ -58,14 +51,14 @@ import numpy as np
 from arzsumo.bridge.actuator import ActuationLimits, MeterActuator
 from arzsumo.bridge.delay import check_delay, compensate
 from arzsumo.bridge.drain import drain, whole_demand
-from arzsumo.bridge.estimator import Estimator
 from arzsumo.bridge.estimators import RecordedEstimator, estimation_stage
-from arzsumo.bridge.records import Decision, PeriodRecord, Trace, columns, micro_fields
-from arzsumo.bridge.reference import ReferenceShift, reference_shift
+from arzsumo.bridge.loop import ClosedLoop
+from arzsumo.bridge.records import Trace, columns
+from arzsumo.bridge.reference import reference_shift
 from arzsumo.bridge.result import CoSimResult
 from arzsumo.bridge.twins import TwinPair
 from arzsumo.control.alinea import AlineaSettings, ReleaseRates
-from arzsumo.control.base import Controller, MacroState
+from arzsumo.control.base import Controller
 from arzsumo.control.etc import EtcDesign
 from arzsumo.control.registry import ControllerInputs, controller_spec, is_pde
 from arzsumo.errors import ArzsumoError, ScenarioError
@@ -77,11 +70,11 @@ from arzsumo.scenario import Scenario
 from arzsumo.scenario.run import RunSettings
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.meter import DEFAULT_CURVE, GreenShareCurve
-from arzsumo.sumo.meter_release import make_meter
 from arzsumo.sumo.network_measures import network_options
 from arzsumo.sumo.paths import scratch_dir
+from arzsumo.sumo.plant import SumoPlant
 from arzsumo.sumo.run_files import FCD_FILE, RunFiles
-from arzsumo.sumo.sensor import PeriodMeasurement, SumoSensor
+from arzsumo.sumo.sensor import PeriodMeasurement
 from arzsumo.sumo.simulation import SumoSimulation, open_simulation
 from arzsumo.sumo.window import WindowStart, measure_network
 from arzsumo.twin.solver import SolverOptions
@@ -92,44 +85,19 @@ log = logging.getLogger(__name__)
 MEASURE_WINDOW = 60.0
 
 
-def check_before_start(settings: RunSettings, eq: Equilibrium) -> Linearization:
-    """Refuse a PDE controller at a free-flow equilibrium (lambda_4 >= 0), before SUMO runs."""
+def check_before_start(settings: RunSettings, eq: Equilibrium, at: str | None = None,
+                       at_eq: str = "this equilibrium") -> Linearization:
+    """Refuse a PDE controller at a free-flow equilibrium (lambda_4 >= 0), before SUMO runs;
+    the refusal names the controller as ``at`` (default ``controller = 'NAME'``) and the
+    equilibrium as ``at_eq``."""
     lin = linearize(eq)
     if is_pde(settings.controller) and lin.regime != "congested":
+        who = at or f"controller = {settings.controller!r}"
         raise ScenarioError(
-            f"controller = {settings.controller!r} is not allowed at this equilibrium: "
+            f"{who} is not allowed at {at_eq}: "
             f"lambda_4 = {lin.eigenvalues[3] * 3.6:.2f} km/h >= 0 (free flow); PDE "
             "boundary control needs congestion (lambda_4 < 0); use 'open' or 'alinea'")
     return lin
-
-
-class SumoPlant:
-    """SUMO with its sensor and meter, advanced one control period at a time."""
-
-    def __init__(self, sim: SumoSimulation, length: float, cfg: SumoConfig,
-                 curve: GreenShareCurve, scenario: Scenario | None = None) -> None:
-        self.sim = sim
-        self.meter = make_meter(sim.lib, cfg, curve)
-        est = scenario.estimation if scenario else None
-        self.sensor = SumoSensor(sim.lib, length, cfg, window=True,
-                                 layout=scenario.sensing if scenario else None,
-                                 loop_noise=est.loop_noise if est else None,
-                                 probe_noise=est.probe_noise if est else None)
-        self.timings = {"sumo_step": 0.0, "measure_actuate": 0.0}
-
-    def advance(self) -> PeriodMeasurement:
-        """Step SUMO to the end of the current control period; its measurement."""
-        while True:
-            s0 = time.perf_counter()
-            t = self.sim.step()
-            s1 = time.perf_counter()
-            got = self.sensor.observe(t, self.sim.pending)
-            self.meter.step(self.sensor.queue)
-            s2 = time.perf_counter()
-            self.timings["sumo_step"] += s1 - s0
-            self.timings["measure_actuate"] += s2 - s1
-            if got is not None:
-                return got
 
 
 def warm_up(plant: SumoPlant, warmup: float, period: float,
@@ -155,7 +123,7 @@ def operating_point(settings: RunSettings, eq: Equilibrium,
     except ArzsumoError as exc:
         raise ScenarioError(f"the measured operating point is not an admissible "
                             f"equilibrium of the model: {exc}") from None
-    check_before_start(settings, measured)
+    check_before_start(settings, measured, at_eq="the measured operating point")
     return measured
 
 
@@ -177,77 +145,6 @@ def build_controller(name: str, lin: Linearization, kernels: Any, design: EtcDes
     ctrl = controller_spec(name, "sumo").build(inputs)
     ctrl.reset()
     return ctrl
-
-
-class ClosedLoop:
-    """The stages of the control window, wired together (see the module docstring)."""
-
-    def __init__(self, plant: SumoPlant, estimator: Estimator, controller: Controller,
-                 actuator: MeterActuator, twins: TwinPair, period: float,
-                 anti_windup: bool = True, shift: ReferenceShift | None = None) -> None:
-        self.plant, self.estimator, self.controller = plant, estimator, controller
-        self.actuator, self.twins, self.period = actuator, twins, period
-        self.anti_windup, self.shift = anti_windup, shift
-        self.timings = {"controller": 0.0, "twins": 0.0, "estimator": 0.0}
-
-    def decide(self, state: MacroState, final: bool) -> Decision:
-        """Check the controller and the reference twin's; command the meter unless this
-        is the ``final`` check."""
-        c0 = time.perf_counter()
-        u = self.controller.check(self.shift.apply(state) if self.shift else state)
-        c1 = time.perf_counter()
-        u_ref = self.twins.check_reference()
-        self.timings["controller"] += c1 - c0
-        self.timings["twins"] += time.perf_counter() - c1
-        log_ = self.controller.log
-        u_cont = log_.u_continuous[-1] if log_.u_continuous else u
-        triggered = float(log_.triggered[-1]) if log_.triggered else 0.0
-        if final:
-            return Decision(state.t, u, u_cont, triggered, self.plant.meter.green_share,
-                            u_ref, c1 - c0)
-        act = self.actuator.apply(u)
-        self.controller.actuated(act.u_applied)
-        if self.anti_windup:
-            self.controller.applied(act.u_applied, act.lower, act.upper)
-        rate = self.plant.meter.release_rate
-        return Decision(state.t, u, u_cont, triggered, act.green, u_ref, c1 - c0,
-                        act.u_applied, float(act.saturated), float(act.rate_limited),
-                        math.nan if rate is None else rate)
-
-    def record(self, d: Decision, m: PeriodMeasurement) -> PeriodRecord:
-        meter, c = self.plant.meter, m.cells
-        return PeriodRecord(d.t, d.u_applied, d.u_continuous, d.triggered,
-                            d.green_commanded, meter.green_share, meter.light_changes,
-                            meter.plan_changes, meter.queue, meter.max_queue, c.inflow_h,
-                            c.inflow_a, c.outflow_h, c.outflow_a, m.occupancy_out,
-                            d.u_reference, d.controller_s, d.u, d.u_applied, d.saturated,
-                            d.rate_limited, m.flow_out_loop, d.release_rate,
-                            float(meter.override()))
-
-    def run(self, start: PeriodMeasurement, horizon: float, bar: Progress) -> Trace:
-        """Control from the measurement ``start`` (t = 0) until ``horizon`` seconds."""
-        t0, trace = start.t, Trace(start.cells.x, micro_fields(start.cells))
-        state = self.estimator.estimate(start, 0.0)
-        while True:
-            final = state.t >= horizon - 1e-9
-            decision = self.decide(state, final)
-            if final:
-                return trace
-            m = self.plant.advance()
-            t = m.t - t0
-            w0 = time.perf_counter()
-            self.twins.advance(m.cells, t, self.period, decision.u_reference)
-            self.timings["twins"] += time.perf_counter() - w0
-            c = m.cells
-            trace.records.append(self.record(decision, m))
-            trace.t.append(t)
-            trace.micro.append(micro_fields(c))
-            trace.replay.append(self.twins.replay.sample(trace.x))
-            trace.reference.append(self.twins.reference.sample(trace.x))
-            e0 = time.perf_counter()
-            state = self.estimator.estimate(m, t)
-            self.timings["estimator"] += time.perf_counter() - e0
-            bar.update(m.t)
 
 
 def place_initial(params: ModelParameters, settings: RunSettings, cfg: SumoConfig,
@@ -296,8 +193,6 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
     (:mod:`arzsumo.sumo.run_files`).
     """
     wall0 = time.perf_counter()
-    if settings.equilibrium == "scenario":
-        check_before_start(settings, scenario.equilibrium)
     run_cfg = cfg.with_(horizon=settings.warmup + cfg.horizon)
     initial, placement = place_initial(scenario.params, settings, run_cfg, initial_fields)
     bar = Progress(run_cfg.horizon, f"{settings.controller} seed {cfg.seed}",
@@ -311,16 +206,16 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
                              loops=scenario.sensing.loop_x(scenario.params.length),
                              downstream_loop=scenario.alinea.loop_distance) as sim:
             c = control(sim, scenario, settings, cfg, design, curve, bar, keep_measurements)
-            meter = c.loop.plant.meter
-            meter_summary = {**meter.summary(), "ramp_storage": cfg.ramp_storage}
+            plant = c.loop.plant
+            meter_summary = {**plant.meter_summary(), "ramp_storage": cfg.ramp_storage}
             t_end = sim.time
-            drained = drain(sim, meter, cfg.drain_max) if cfg.drain_max > 0 else None
+            drained = drain(plant, cfg.drain_max) if cfg.drain_max > 0 else None
         records = c.trace.records
         outlet = round(sum((r.outflow_h + r.outflow_a) * cfg.control_period for r in records))
         network, trips = measure_network(net_dir, c.start, t_end, outlet,
                                          drained.end if drained else None, sim.time)
         if drained is not None:
-            network = whole_demand(network, trips, meter, sim, drained)
+            network = whole_demand(network, trips, plant, drained)
         if cfg.fcd:   # moved, not read: an FCD file is large
             files.adopt(net_dir / FCD_FILE, FCD_FILE)
     except BaseException:
@@ -330,15 +225,19 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
         shutil.rmtree(net_dir, ignore_errors=True)
     bar.close()
     loop, trace = c.loop, c.trace
-    return CoSimResult(scenario, settings, cfg, c.eq, c.q_nom, np.asarray(trace.t), trace.x,
-                       np.asarray(trace.micro), np.asarray(trace.replay),
-                       np.asarray(trace.reference), columns(records), loop.controller.log,
-                       c.ref_ctrl.log, meter_summary, sim.report, loop.twins.status(),
-                       placement, time.perf_counter() - wall0,
-                       {**loop.plant.timings, **loop.timings}, c.warmup_meter, network,
-                       loop.plant.sensor.speeds.summary(), trace.start,
-                       np.asarray(c.estimator.fields[1:]), c.estimator,
-                       loop.shift, loop.plant.sensor.lateral.record(), files)
+    sensor = loop.plant.sensor
+    return CoSimResult(
+        scenario=scenario, settings=settings, sumo=cfg, equilibrium=c.eq, q_nominal=c.q_nom,
+        t=np.asarray(trace.t), x=trace.x, micro=np.asarray(trace.micro),
+        replay=np.asarray(trace.replay), reference=np.asarray(trace.reference),
+        periods=columns(records), controller_log=loop.controller.log,
+        reference_log=c.ref_ctrl.log, meter=meter_summary, report=sim.report,
+        twin_status=loop.twins.status(), placement=placement,
+        wall_time=time.perf_counter() - wall0,
+        timings={**loop.plant.timings, **loop.timings}, warmup_meter=c.warmup_meter,
+        network=network, section_speed=sensor.speeds.summary(), start=trace.start,
+        estimate=np.asarray(c.estimator.fields[1:]), estimator=c.estimator,
+        shift=loop.shift, lateral=sensor.lateral.record(), files=files)
 
 
 def control(sim: SumoSimulation, scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
@@ -348,12 +247,13 @@ def control(sim: SumoSimulation, scenario: Scenario, settings: RunSettings, cfg:
     docstring); ``cfg`` has the control horizon."""
     from arzsumo.kernel_cache import cached_kernels
 
-    params, period = scenario.params, cfg.control_period
-    plant = SumoPlant(sim, params.length, cfg, curve, scenario)
+    params, period, est = scenario.params, cfg.control_period, scenario.estimation
+    plant = SumoPlant(sim, params.length, cfg, curve, layout=scenario.sensing,
+                      loop_noise=est.loop_noise, probe_noise=est.probe_noise, window=True)
     warm = warm_up(plant, settings.warmup, period, bar)
     plant.timings = dict.fromkeys(plant.timings, 0.0)   # time the control window only
-    warmup_meter = {**plant.meter.start_window(), "duration_s": float(warm[-1].t)}
-    start = plant.sensor.start_window(warm[-1].t)
+    counts, start = plant.start_window(warm[-1].t)
+    warmup_meter = {**counts, "duration_s": float(warm[-1].t)}
     eq = operating_point(settings, scenario.equilibrium, warm, period)
     lin = linearize(eq)
     kernels = (cached_kernels(lin.system, settings.kernel_cells)
@@ -361,12 +261,11 @@ def control(sim: SumoSimulation, scenario: Scenario, settings: RunSettings, cfg:
     estimator, acting = estimation_stage(scenario.estimation, scenario.sensing,
                                          settings.controller, eq, warm[-1].cells.x,
                                          keep_measurements)
-    est = scenario.estimation
     warm_fields = estimator.prime(warm[:-1], warm[-1].t)
     shift = (reference_shift(est.reference, warm_fields, eq, est.reference_window, period)
              if is_pde(acting) and est.reference != "equilibrium" and warm_fields else None)
-    check_delay(scenario, acting, lin.eigenvalues, "measured" if eq is not scenario.equilibrium
-                else "")
+    if eq is not scenario.equilibrium:     # prepare_run checked the scenario's
+        check_delay(scenario, acting, lin.eigenvalues, "measured")
     ctrl = compensate(build_controller(acting, lin, kernels, design, settings, cfg,
                                        scenario.alinea), acting, scenario)
     ref_name = settings.controller if is_pde(settings.controller) else "open"
@@ -378,7 +277,7 @@ def control(sim: SumoSimulation, scenario: Scenario, settings: RunSettings, cfg:
     twins = TwinPair(eq, lin, warm[-1].cells, opts, settings.smoothing, ref_ctrl, q_nom)
     act = scenario.actuation
     actuator = MeterActuator(plant.meter, q_nom, settings.controller == "open",
-                             ActuationLimits.of(act, q_nom, curve, cfg))
+                             ActuationLimits.of(act, q_nom, period))
     loop = ClosedLoop(plant, estimator, ctrl, actuator, twins, period, act.anti_windup,
                       shift)
     trace = loop.run(warm[-1], cfg.horizon, bar)

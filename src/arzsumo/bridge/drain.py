@@ -26,12 +26,10 @@ from dataclasses import dataclass, replace
 
 import pandas as pd
 
-from arzsumo.sumo.meter import MeterLight
 from arzsumo.sumo.network import NetworkSpec
-from arzsumo.sumo.sensor import ramp_queue
-from arzsumo.sumo.simulation import SumoSimulation
+from arzsumo.sumo.plant import SumoPlant
 from arzsumo.sumo.whole_demand import ramp_waits, whole_demand_summary
-from arzsumo.sumo.window import NetworkMeasures, WindowEnd, finish_window, window_end
+from arzsumo.sumo.window import NetworkMeasures, WindowEnd
 
 #: a drain with no arrival for this long while vehicles remain is a gridlock, s
 STALL_S = 300.0
@@ -48,33 +46,31 @@ class Drained:
     gridlock: bool = False
 
 
-def drain(sim: SumoSimulation, meter: MeterLight, limit: float) -> Drained:
-    """Step ``sim`` after the control window under the drain policy (module docstring)
+def drain(plant: SumoPlant, limit: float) -> Drained:
+    """Step ``plant`` after the control window under the drain policy (module docstring)
     until no vehicle is in the system or expected, at most ``limit`` seconds."""
-    lib = sim.lib
+    sim = plant.sim
     t_end = sim.time
-    at_end, ledger = window_end(lib, t_end)
-    meter.drain()
+    plant.end_window()
     arrived, last_arrival, gridlock = sim.arrived, t_end, False
-    while sim.time - t_end < limit - 1e-9 and lib.simulation.getMinExpectedNumber() > 0:
-        sim.step()
-        ledger.add()
-        meter.step(ramp_queue(lib, sim.pending))
+    while sim.time - t_end < limit - 1e-9 and sim.lib.simulation.getMinExpectedNumber() > 0:
+        plant.step()
         if sim.arrived > arrived:
             arrived, last_arrival = sim.arrived, sim.time
         elif sim.time - last_arrival >= STALL_S:
             gridlock = True
             break
-    return Drained(finish_window(t_end, at_end, ledger), sim.time - t_end, limit, gridlock)
+    return Drained(plant.sensor.window_end_values(), sim.time - t_end, limit, gridlock)
 
 
-def whole_demand(network: NetworkMeasures, trips: pd.DataFrame, meter: MeterLight,
-                 sim: SumoSimulation, drained: Drained) -> NetworkMeasures:
+def whole_demand(network: NetworkMeasures, trips: pd.DataFrame, plant: SumoPlant,
+                 drained: Drained) -> NetworkMeasures:
     """``network`` with its ``whole_demand`` block (:mod:`arzsumo.sumo.whole_demand`):
     the whole run after the drain, the per-step integral of vehicles in the system and
     the ramp vehicles' waits at the meter."""
     spec = NetworkSpec()
-    waits = ramp_waits(trips, meter.stop_line.crossings, sim.cfg.step_length,
+    sim = plant.sim
+    waits = ramp_waits(trips, plant.sensor.stop_line.crossings, sim.cfg.step_length,
                        spec.ramp_length / spec.ramp_speed)
     block = whole_demand_summary(network.whole_run, waits, sim.in_system_s,
                                  drained.duration_s, drained.max_s, drained.gridlock)

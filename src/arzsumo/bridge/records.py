@@ -11,7 +11,11 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
+from arzsumo.bridge.actuator import Actuation
+from arzsumo.control.base import Command
 from arzsumo.sumo.measure import CellData
+from arzsumo.sumo.meter import MeterState
+from arzsumo.sumo.sensor import PeriodMeasurement
 
 
 @dataclass(frozen=True)
@@ -57,6 +61,25 @@ class PeriodRecord:
     release_rate: float = float("nan")
     override: float = 0.0
 
+    @classmethod
+    def of(cls, t: float, command: Command, act: Actuation, u_reference: float,
+           controller_s: float, m: PeriodMeasurement, meter: MeterState) -> PeriodRecord:
+        """The record of the check at ``t`` (s from the start of control): what it decided
+        and what was applied, the reference twin's U (veh/s), the check's wall time (s),
+        and the period that followed (the sensor's measurement, the meter at its end)."""
+        c = m.cells
+        return cls(t=t, u=act.u_applied, u_continuous=command.u_continuous,
+                   triggered=float(command.triggered), green_commanded=act.green,
+                   green_running=meter.green_share, light_changes=meter.light_changes,
+                   plan_changes=meter.plan_changes, queue=meter.queue,
+                   max_queue=meter.max_queue, inflow_h=c.inflow_h, inflow_a=c.inflow_a,
+                   outflow_h=c.outflow_h, outflow_a=c.outflow_a,
+                   occupancy_out=m.occupancy_out, u_reference=u_reference,
+                   controller_s=controller_s, u_raw=command.u, u_applied=act.u_applied,
+                   saturated=float(act.saturated), rate_limited=float(act.rate_limited),
+                   flow_out_loop=m.flow_out_loop, release_rate=act.release_rate,
+                   override=float(meter.override))
+
 
 def columns(records: list[PeriodRecord]) -> dict[str, np.ndarray]:
     """The records as one float array per field (the ``periods`` table's columns)."""
@@ -80,22 +103,3 @@ class Trace:
     micro: list[np.ndarray] = field(default_factory=list)
     replay: list[np.ndarray] = field(default_factory=list)
     reference: list[np.ndarray] = field(default_factory=list)
-
-
-@dataclass(frozen=True)
-class Decision:
-    """One check: U held (veh/s), its continuous value, event flag, meter command, the
-    U applied (veh/s) with the limit flags (1.0 or 0.0), and the release rate asked of
-    the meter (veh/s; NaN for a fixed-cycle meter)."""
-
-    t: float
-    u: float
-    u_continuous: float
-    triggered: float
-    green_commanded: float
-    u_reference: float
-    controller_s: float
-    u_applied: float = float("nan")
-    saturated: float = 0.0
-    rate_limited: float = 0.0
-    release_rate: float = float("nan")

@@ -28,7 +28,7 @@ from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.measure import EdieGrid
 from arzsumo.sumo.meter import DEFAULT_CURVE, GreenShareCurve
 from arzsumo.sumo.network import NetworkSpec
-from arzsumo.tables import in_user_terms, not_allowed, written
+from arzsumo.tables import in_user_terms, not_allowed, restated, where, written
 from arzsumo.twin.initial import initial_fields
 from arzsumo.units import ms_to_kmh
 
@@ -94,10 +94,7 @@ def _override(sc: Scenario, dotted: str, value: object, option: str) -> Scenario
     try:
         return sc.with_({dotted: value})
     except ScenarioError as exc:
-        prefix = f"{sc.source}: [{table}] {key} = {written(value)} "
-        if str(exc).startswith(prefix):
-            raise ScenarioError(f"{option} = {value} " + str(exc)[len(prefix):]) from None
-        raise
+        raise restated(exc, where(sc.source, table), key, option, value) from None
 
 
 def _check_model(sc: Scenario, cfg: SumoConfig) -> None:
@@ -122,14 +119,9 @@ def _check_model(sc: Scenario, cfg: SumoConfig) -> None:
 
 def _check_regime(sc: Scenario, settings: RunSettings, from_cli: bool) -> None:
     """:func:`check_before_start`, its refusal naming where the controller was chosen."""
-    try:
-        check_before_start(settings, sc.equilibrium)
-    except ScenarioError as exc:
-        at = (f"--controller = {settings.controller}" if from_cli else
-              f"{sc.source}: [run] controller = {written(settings.controller)}")
-        reason = str(exc).split("this equilibrium: ", 1)[-1]
-        raise ScenarioError(f"{at} is not allowed at the "
-                            f"[equilibrium] of {sc.source}: {reason}") from None
+    at = (f"--controller = {settings.controller}" if from_cli else
+          f"{sc.source}: [run] controller = {written(settings.controller)}")
+    check_before_start(settings, sc.equilibrium, at, f"the [equilibrium] of {sc.source}")
 
 
 def _check_estimation(sc: Scenario, settings: RunSettings, from_cli: bool) -> None:
@@ -227,6 +219,12 @@ def run_in_sumo(sc: Scenario, *, controller: str | None = None, seed: int | None
     """
     run = prepare_run(sc, controller=controller, seed=seed, horizon=horizon, warmup=warmup,
                       fcd=fcd)
+    return run_prepared(run, progress=progress, frontend=frontend)
+
+
+def run_prepared(run: PreparedRun, *, progress: bool = False,
+                 frontend: str = "libsumo") -> SumoSession:
+    """Run a :class:`PreparedRun` (checked once, by :func:`prepare_run`) in SUMO."""
     res = run_cosimulation(run.scenario, run.settings, run.sumo, run.design,
                            initial_fields=run.initial, curve=run.curve, progress=progress,
                            frontend=frontend)

@@ -35,6 +35,31 @@ class MacroState:
     occupancy_out: float = float("nan")
 
 
+@dataclass(frozen=True)
+class Applied:
+    """What the actuator applied for a check, told to the controller at its next check.
+
+    ``u`` is the U applied (veh/s, after every limit); ``[lower, upper]`` (veh/s) the
+    range in force then; ``anti_windup`` False: the controller is told ``u`` alone (its
+    history, for a delay compensator) and not the range it is limited to.
+    """
+
+    u: float
+    lower: float = -math.inf
+    upper: float = math.inf
+    anti_windup: bool = True
+
+
+@dataclass(frozen=True)
+class Command:
+    """What one check decided: the U to hold (veh/s), the continuous law's value at the
+    check (veh/s) and whether the held U was updated (an event)."""
+
+    u: float
+    u_continuous: float
+    triggered: bool
+
+
 @dataclass
 class ControlLog:
     """What a controller did at each check: times, applied and continuous control, events.
@@ -89,6 +114,23 @@ class Controller(ABC):
     def check(self, state: MacroState) -> float:
         """Evaluate the controller at a check instant and return U (veh/s) to hold."""
         return self.decide(state)
+
+    def step(self, state: MacroState, applied: Applied | None = None) -> Command:
+        """One check of a closed loop with an actuator: take in what was ``applied`` for
+        the previous check (None before the first), then check on ``state``.
+
+        The actuator's output flows forward into the next check, so no stage calls back
+        into the controller: :meth:`actuated` always, :meth:`applied` with
+        ``applied.anti_windup``, then :meth:`check`.
+        """
+        if applied is not None:
+            self.actuated(applied.u)
+            if applied.anti_windup:
+                self.applied(applied.u, applied.lower, applied.upper)
+        u = self.check(state)
+        log = self.log
+        return Command(u, log.u_continuous[-1] if log.u_continuous else u,
+                       bool(log.triggered[-1]) if log.triggered else False)
 
     @abstractmethod
     def decide(self, state: MacroState) -> float:

@@ -16,10 +16,8 @@ import numpy as np
 
 from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.loops import DownstreamLoop
 from arzsumo.sumo.meter import DEFAULT_CURVE, GreenShareCurve
-from arzsumo.sumo.meter_release import make_meter
-from arzsumo.sumo.sensor import ramp_queue
+from arzsumo.sumo.plant import SumoPlant
 from arzsumo.sumo.simulation import open_simulation
 
 
@@ -41,15 +39,12 @@ def record_downstream_loop(params: ModelParameters, cfg: SumoConfig, distance: f
     meter); the loop's series (module docstring)."""
     t_out, occ, flow = [], [], []
     with open_simulation(params, cfg, downstream_loop=distance) as sim:
-        meter = make_meter(sim.lib, cfg, curve)
-        loop = DownstreamLoop(sim.lib, cfg.step_length, cfg.steps_per_period)
+        plant = SumoPlant(sim, params.length, cfg, curve)
         while sim.time < cfg.horizon - 1e-9:
-            t = sim.step()
-            got = loop.observe(t)
-            meter.step(ramp_queue(sim.lib))
+            got = plant.step()
             if got is not None:
-                t_out.append(t)
-                occ.append(got[0])
-                flow.append(got[1])
+                t_out.append(got.t)
+                occ.append(got.occupancy_out)
+                flow.append(got.flow_out_loop)
     return LoopSeries(np.asarray(t_out), np.asarray(occ), np.asarray(flow),
                       cfg.control_period, cfg.seed)

@@ -11,17 +11,20 @@ each start or end of a green is a *light change*. With a clearance ``meter_clear
 red; the yellow's end is not a light change), so that ramp vehicles at the line stop
 without an emergency stop. The ramp queue (halted vehicles on ``ramp_up`` plus ramp
 vehicles waiting to be inserted), read by the sensor (:mod:`arzsumo.sumo.sensor`) and
-handed to :meth:`RampMeter.step` every step, and its maximum are tracked; an optional
+handed to :meth:`MeterLight.step` every step, and its maximum are tracked; an optional
 queue override forces green while the queue exceeds the ramp's storage
 (``ramp_storage``), and for good once :meth:`MeterLight.drain` hands the meter to the drain
 policy after the control window.
 
-Besides setting the light the meter reads one thing from SUMO, its own stop-line
-detector (:class:`StopLine`): the vehicles leaving ``ramp_up`` (*releases*, counted per
-green interval, from one green's start to the next) and the emergency stops and braking
-of the vehicles at the head of the ramp. The other realisation, one vehicle per green at
-a commanded release rate, is :class:`arzsumo.sumo.meter_release.OnePerGreenMeter`;
-:func:`arzsumo.sumo.meter_release.make_meter` builds the one ``[sumo] meter_mode`` names.
+The meter reads nothing from SUMO: every step the sensor hands it a
+:class:`~arzsumo.sumo.stop_line.MeterReading`, the ramp queue and the vehicles that crossed
+its stop line (*releases*, counted per green interval, from one green's start to the next).
+The other realisation, one vehicle per green at a commanded release rate, is
+:class:`arzsumo.sumo.meter_release.OnePerGreenMeter`;
+:func:`arzsumo.sumo.meter_release.make_meter` builds the one ``[sumo] meter_mode`` names,
+once per run. Each realisation maps an outflow command U to its own plan variable (green
+share, release rate) and states the plan's bounds and the U it can realise; the actuator
+(:mod:`arzsumo.bridge.actuator`) saturates in one place.
 
 The counts (plan and light changes, override steps, releases, queue maximum) run over a
 *window*: from the meter's creation until :meth:`RampMeter.start_window`, which returns
@@ -34,23 +37,19 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from types import ModuleType
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from arzsumo.errors import ArzsumoError, require
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.network import METER_TL, RAMP_UP
+from arzsumo.sumo.network import METER_TL
+from arzsumo.sumo.stop_line import MeterReading
 
 GREEN, YELLOW, RED = "G", "y", "r"
-#: vehicles at the head of the ramp whose braking the stop-line detector watches
-HEAD_VEHICLES = 3
 #: the queue override, on above the ramp's storage, stays on until the queue is back at this
 #: share of the storage (rounded down)
 OVERRIDE_OFF = 0.8
-#: braking beyond a vehicle type's ``decel`` by more than this counts as emergency braking
-#: at the meter, m/s^2 (SUMO's own count is network-wide)
-BRAKING_MARGIN = 0.1
 
 
 @dataclass(frozen=True)
@@ -114,42 +113,17 @@ def plan_green_steps(g: float, cycle: int, min_green: int, min_red: int) -> int:
     return green
 
 
-class StopLine:
-    """The meter's detector at the stop line of ``ramp_up`` (libsumo, read every step).
+class MeterState(NamedTuple):
+    """The meter at the end of a control period: the running green share, light and plan
+    changes of the window so far (counts), the ramp queue and its maximum so far (veh),
+    and whether the queue override is on."""
 
-    A vehicle is *released* when its front leaves ``ramp_up`` (crosses the stop line).
-    Safety at the meter: SUMO's emergency stops of vehicles on ``ramp_up``, and emergency
-    braking episodes (deceleration beyond the vehicle type's ``decel`` by more than
-    :data:`BRAKING_MARGIN`, counted once per vehicle and episode) of the
-    :data:`HEAD_VEHICLES` vehicles nearest the line.
-    """
-
-    def __init__(self, lib: ModuleType, edge: str = RAMP_UP) -> None:
-        self.lib, self.edge = lib, edge
-        #: every release: (vehicle id, steps since SUMO started when its front had left)
-        self.crossings: list[tuple[str, int]] = []
-        self._steps = 0
-        self._on: set[str] = set()
-        self._braking: set[str] = set()
-        self.emergency_stops = self.emergency_braking = 0
-
-    def read(self) -> int:
-        """Vehicles released since the last read; updates the safety counts."""
-        ids = self.lib.edge.getLastStepVehicleIDs(self.edge)   # upstream first
-        now = set(ids)
-        self._steps += 1
-        gone = self._on - now
-        self.crossings += [(v, self._steps) for v in sorted(gone)]
-        released = len(gone)
-        self._on = now
-        veh = self.lib.vehicle
-        for v in self.lib.simulation.getEmergencyStoppingVehiclesIDList():
-            self.emergency_stops += v in now
-        braking = {v for v in ids[-HEAD_VEHICLES:]
-                   if veh.getAcceleration(v) < -veh.getDecel(v) - BRAKING_MARGIN}
-        self.emergency_braking += len(braking - self._braking)
-        self._braking = braking
-        return released
+    green_share: float
+    light_changes: int
+    plan_changes: int
+    queue: int
+    max_queue: int
+    override: bool
 
 
 @dataclass
@@ -177,7 +151,6 @@ class MeterLight:
         self.lib, self.cfg, self.tl_id = lib, cfg, tl_id
         self.dt = cfg.step_length
         self.clearance_steps = round(cfg.meter_clearance / self.dt)
-        self.stop_line = StopLine(lib)
         self.plan_changes = self.light_changes = self.override_steps = 0
         self.queue = self.max_queue = 0
         self.draining = False                 # handed to the drain policy (:meth:`drain`)
@@ -194,10 +167,34 @@ class MeterLight:
         """GREEN or RED wanted by the plan at this step (called once per step)."""
         raise NotImplementedError
 
-    def command(self, u: float, q_nominal: float) -> float:
-        """Command the outflow deviation U (veh/s) from the nominal outflow ``q_nominal``
-        (veh/s); return the green share of the requested plan."""
+    def plan_for(self, u: float, q_nominal: float) -> float:
+        """The plan variable (green share; release rate, veh/s) that realises the outflow
+        deviation U (veh/s) from ``q_nominal`` (veh/s), before the plan's bounds."""
         raise NotImplementedError
+
+    @property
+    def plan_bounds(self) -> tuple[float, float]:
+        """Least and largest plan variable the meter may run (:meth:`plan_for`'s unit)."""
+        raise NotImplementedError
+
+    def set_plan(self, plan: float) -> float:
+        """Request the plan variable ``plan`` (within :attr:`plan_bounds`); a new timing is
+        a plan change from the next cycle on. Returns the green share of the request."""
+        raise NotImplementedError
+
+    def u_range(self, q_nominal: float) -> tuple[float, float]:
+        """The U (veh/s) the meter can realise around ``q_nominal`` (veh/s), widened to
+        include 0 (the nominal plan is always allowed)."""
+        raise NotImplementedError
+
+    def ramp_floor(self, queue: float, q_nominal: float) -> float:
+        """Least U (veh/s) the ramp can deliver with ``queue`` vehicles waiting."""
+        raise NotImplementedError
+
+    def _check_plan(self, plan: float) -> None:
+        lo, hi = self.plan_bounds
+        require(math.isfinite(plan) and lo <= plan <= hi, "plan", plan,
+                f"a value in [{lo:.6g}, {hi:.6g}] (saturate in the actuator)", ArzsumoError)
 
     def _set(self, state: str) -> None:
         self.lib.trafficlight.setRedYellowGreenState(self.tl_id, state)
@@ -220,15 +217,15 @@ class MeterLight:
         self._set(state)
         self.light = state
 
-    def step(self, queue: int) -> str:
-        """Call once after every SUMO step with the ramp queue the sensor read (vehicles,
-        :func:`arzsumo.sumo.sensor.ramp_queue`): read the stop line, update the plan and
-        the light; return the light."""
+    def step(self, reading: MeterReading) -> str:
+        """Call once after every SUMO step with the sensor's reading (the ramp queue and the
+        stop line's releases, :class:`~arzsumo.sumo.stop_line.MeterReading`): update the
+        override, the plan and the light; return the light."""
+        queue, released = reading
         self.queue = queue
         self.max_queue = max(self.max_queue, queue)
         self._update_override()
         self._steps += 1
-        released = self.stop_line.read()
         self.releases += released
         if self.greens:
             g = self.greens[-1]
@@ -238,6 +235,11 @@ class MeterLight:
         self._show(self._plan())
         self.override_on_steps += self.override() and not self.draining
         return self.light
+
+    def state(self) -> MeterState:
+        """The meter now (:class:`MeterState`)."""
+        return MeterState(self.green_share, self.light_changes, self.plan_changes,
+                          self.queue, self.max_queue, self.override())
 
     @property
     def released_this_green(self) -> int:
@@ -283,7 +285,6 @@ class MeterLight:
         self.plan_changes = self.light_changes = self.override_steps = self.releases = 0
         self.max_queue = self.override_on_steps = 0
         self._window_greens = len(self.greens)
-        self.stop_line.emergency_stops = self.stop_line.emergency_braking = 0
         return closed
 
     @property
@@ -294,7 +295,7 @@ class MeterLight:
     def summary(self) -> dict[str, Any]:
         """Counts of the current window (see :meth:`start_window`): plan and light changes,
         queue maximum (veh), override steps, releases (veh), green intervals begun and the
-        most releases in one, emergency stops and braking at the meter; the last queue and
+        most releases in one; the last queue and
         green share, the mode, clearance (s) and release rate (veh/s; None for the fixed
         cycle)."""
         greens = self.greens[self._window_greens:]
@@ -306,8 +307,6 @@ class MeterLight:
                 "mode": self.mode, "clearance_s": self.cfg.meter_clearance,
                 "releases": self.releases, "greens": len(greens),
                 "releases_per_green_max": max((g.releases for g in greens), default=0),
-                "emergency_stops": self.stop_line.emergency_stops,
-                "emergency_braking": self.stop_line.emergency_braking,
                 "release_rate": self.release_rate}
 
     @property
@@ -327,7 +326,7 @@ class RampMeter(MeterLight):
         Cycle, minimum green and red, clearance, nominal green share, spillback
         threshold, step.
     curve : GreenShareCurve
-        Mainline outflow against green share, inverted by :meth:`command_outflow`.
+        Mainline outflow against green share, inverted by :meth:`plan_for`.
     """
 
     mode = "fixed_cycle"
@@ -367,21 +366,29 @@ class RampMeter(MeterLight):
         self.plan_changes += 1
         return True
 
-    def command_outflow(self, q: float) -> float:
-        """Request mainline outflow ``q`` (veh/s) = q* + U; return the green share chosen.
-
-        The green share is saturated to [cfg.green_share_min, cfg.green_share_max].
-        """
+    def plan_for(self, u: float, q_nominal: float) -> float:
+        """Green share whose curve outflow is ``q_nominal + u`` (veh/s; the curve's ends
+        outside it)."""
+        q = q_nominal + u
         require(math.isfinite(q), "outflow", q, "a finite flow in veh/s", ArzsumoError)
-        g = min(self.cfg.green_share_max,
-                max(self.cfg.green_share_min, self.curve.green_share_for(q)))
-        self.set_green_share(g)
+        return self.curve.green_share_for(q)
+
+    @property
+    def plan_bounds(self) -> tuple[float, float]:
+        """``[sumo] green_share_min`` and ``green_share_max``."""
+        return self.cfg.green_share_min, self.cfg.green_share_max
+
+    def set_plan(self, plan: float) -> float:
+        """Request the green share ``plan``; return the green share of the timing chosen."""
+        self._check_plan(plan)
+        self.set_green_share(plan)
         return self._pending / self.cycle_steps
 
-    def command(self, u: float, q_nominal: float) -> float:
-        """Command U (veh/s) around the nominal outflow ``q_nominal``: the outflow
-        ``q_nominal + u`` (:meth:`command_outflow`); return the green share chosen."""
-        return self.command_outflow(q_nominal + u)
+    def u_range(self, q_nominal: float) -> tuple[float, float]:
+        return fixed_cycle_u_range(self.curve, self.cfg, q_nominal)
+
+    def ramp_floor(self, queue: float, q_nominal: float) -> float:
+        return fixed_cycle_ramp_floor(self.curve, self.cfg, q_nominal, queue)
 
     # -- per-step plan -------------------------------------------------------------------
     def _plan(self) -> str:
@@ -394,3 +401,30 @@ class RampMeter(MeterLight):
             self.override_steps += light == RED
             light = GREEN
         return light
+
+
+def fixed_cycle_u_range(curve: GreenShareCurve, cfg: SumoConfig,
+                        q_nominal: float) -> tuple[float, float]:
+    """The U (veh/s) a fixed-cycle meter can command: the monotone curve's outflow between
+    ``green_share_max`` (least mainline outflow) and ``green_share_min``, minus q*;
+    widened to include 0 (the nominal plan is always allowed)."""
+    m = curve.monotone()
+    return (min(0.0, m.outflow_at(cfg.green_share_max) - q_nominal),
+            max(0.0, m.outflow_at(cfg.green_share_min) - q_nominal))
+
+
+def fixed_cycle_ramp_floor(curve: GreenShareCurve, cfg: SumoConfig, q_nominal: float,
+                           queue: float) -> float:
+    """Least U (veh/s) the ramp can deliver with ``queue`` vehicles waiting.
+
+    The merge passes ``q_open`` = the curve's mainline outflow at green share 0 (mainline
+    alone, ramp closed) in all, so each ramp vehicle released takes one from the
+    mainline. Over the next plan, ``H = max(meter cycle, control period)`` seconds, the
+    ramp can release at most its arrivals and its queue, ``r + queue / H`` veh/s (``r``:
+    ``[sumo] ramp_demand``), so more ramp green cannot bring the mainline outflow below
+    ``q_open - r - queue / H``: U below that minus q* is not deliverable. Capped at 0
+    (the nominal plan is always allowed), so it only bounds U < 0 (more ramp release).
+    """
+    q_open = curve.monotone().outflow_at(0.0)
+    horizon = max(cfg.meter_cycle, cfg.control_period)
+    return min(0.0, q_open - cfg.ramp_demand - queue / horizon - q_nominal)

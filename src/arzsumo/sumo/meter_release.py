@@ -13,9 +13,9 @@ drains after the control window, the queue override runs the cycles at
 ``release_rate_max``.
 
 The controller's command is an outflow deviation U (veh/s) from the nominal outflow;
-:func:`release_rate_for` maps it to r by one rule: a released ramp vehicle takes one
-mainline slot at the merge, so r = r_nominal - U (``release_rate`` is r_nominal, the
-open loop's rate), saturated to the rate bounds.
+:meth:`OnePerGreenMeter.plan_for` maps it to r by one rule: a released ramp vehicle takes
+one mainline slot at the merge, so r = r_nominal - U (``release_rate`` is r_nominal, the
+open loop's rate); the actuator saturates r to the rate bounds.
 """
 
 from __future__ import annotations
@@ -39,14 +39,12 @@ from arzsumo.sumo.network import METER_TL
 
 
 def release_rate_for(u: float, cfg: SumoConfig) -> float:
-    """Release rate r (veh/s) for the outflow command U (veh/s): r = r_nominal - U.
-
-    One released ramp vehicle takes one mainline slot at the merge, so lowering the
-    mainline outflow by U more releases U more ramp vehicles; r_nominal is
-    ``cfg.release_rate``, saturated to [``cfg.release_rate_min``, ``cfg.release_rate_max``].
-    """
+    """Release rate r = r_nominal - U (veh/s) for the outflow command U (veh/s), before the
+    rate bounds: one released ramp vehicle takes one mainline slot at the merge, so
+    lowering the mainline outflow by U releases U more ramp vehicles (r_nominal:
+    ``cfg.release_rate``)."""
     require(math.isfinite(u), "U", u, "a finite flow in veh/s", ArzsumoError)
-    return min(cfg.release_rate_max, max(cfg.release_rate_min, cfg.release_rate - u))
+    return cfg.release_rate - u
 
 
 class OnePerGreenMeter(MeterLight):
@@ -93,26 +91,36 @@ class OnePerGreenMeter(MeterLight):
         """Release rate commanded last, veh/s (saturated to the bounds)."""
         return self.rate
 
-    def command_rate(self, r: float) -> float:
-        """Request release rate ``r`` (veh/s), saturated to the bounds; return the green
-        share of the requested plan. A changed cycle (whole steps) is a plan change."""
-        require(math.isfinite(r), "release_rate", r, "a finite rate in veh/s", ArzsumoError)
-        self.rate = min(self.cfg.release_rate_max, max(self.cfg.release_rate_min, r))
+    def plan_for(self, u: float, q_nominal: float) -> float:
+        """Release rate for U (veh/s; :func:`release_rate_for`; ``q_nominal`` unused)."""
+        return release_rate_for(u, self.cfg)
+
+    @property
+    def plan_bounds(self) -> tuple[float, float]:
+        """``[sumo] release_rate_min_veh_h`` and ``release_rate_max_veh_h``, veh/s."""
+        return self.cfg.release_rate_min, self.cfg.release_rate_max
+
+    def set_plan(self, plan: float) -> float:
+        """Request release rate ``plan`` (veh/s); return the green share of the requested
+        plan. A changed cycle (whole steps) is a plan change."""
+        self._check_plan(plan)
+        self.rate = plan
         new = self._cycle(self.rate)
         if new != self._pending:
             self._pending = new
             self.plan_changes += 1
         return self.min_green_steps / self._pending
 
+    def u_range(self, q_nominal: float) -> tuple[float, float]:
+        return one_per_green_u_range(self.cfg)
+
+    def ramp_floor(self, queue: float, q_nominal: float) -> float:
+        return one_per_green_ramp_floor(self.cfg, queue)
+
     def override_u(self, q_nominal: float) -> float:
         """U (veh/s) of the override's rate: r_nominal - ``release_rate_max``
-        (``q_nominal`` unused, as in :meth:`command`)."""
+        (``q_nominal`` unused, as in :meth:`plan_for`)."""
         return self.cfg.release_rate - self.cfg.release_rate_max
-
-    def command(self, u: float, q_nominal: float) -> float:
-        """Command U (veh/s) (``q_nominal`` unused: the rule is relative,
-        :func:`release_rate_for`); return the green share of the requested plan."""
-        return self.command_rate(release_rate_for(u, self.cfg))
 
     def _plan(self) -> str:
         fastest = self._cycle(self.cfg.release_rate_max)
@@ -133,6 +141,22 @@ class OnePerGreenMeter(MeterLight):
                 self._phases = self._k + self.clearance_steps + self.min_red_steps
                 self._length = max(self.cycle_steps, self._phases)
         return GREEN if self._green else RED
+
+
+def one_per_green_u_range(cfg: SumoConfig) -> tuple[float, float]:
+    """The U (veh/s) one vehicle per green can command: r_nominal - r for r in
+    [``release_rate_min``, ``release_rate_max``], widened to include 0."""
+    return (min(0.0, cfg.release_rate - cfg.release_rate_max),
+            max(0.0, cfg.release_rate - cfg.release_rate_min))
+
+
+def one_per_green_ramp_floor(cfg: SumoConfig, queue: float) -> float:
+    """Least U (veh/s) with ``queue`` vehicles waiting: r_nominal - r - queue / H (``r``:
+    ``[sumo] ramp_demand``; H the longer of the nominal cycle 1 / r_nominal and the
+    control period), capped at 0 (as
+    :func:`~arzsumo.sumo.meter.fixed_cycle_ramp_floor`)."""
+    horizon = max(1.0 / cfg.release_rate, cfg.control_period)
+    return min(0.0, cfg.release_rate - cfg.ramp_demand - queue / horizon)
 
 
 def make_meter(lib: ModuleType, cfg: SumoConfig,

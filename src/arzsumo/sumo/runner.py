@@ -17,10 +17,9 @@ from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.demand import InitialVehicle
 from arzsumo.sumo.measure import MeasurementLog
 from arzsumo.sumo.meter import DEFAULT_CURVE, GreenShareCurve
-from arzsumo.sumo.meter_release import make_meter
 from arzsumo.sumo.network import RAMP_UP
 from arzsumo.sumo.paths import SumoError
-from arzsumo.sumo.sensor import SumoSensor, ramp_queue
+from arzsumo.sumo.plant import SumoPlant
 from arzsumo.sumo.simulation import RunReport, open_simulation
 
 log = logging.getLogger(__name__)
@@ -59,21 +58,15 @@ def run_fixed_meter(params: ModelParameters, cfg: SumoConfig, green_share: float
     g = cfg.green_share if green_share is None else green_share
     cfg = cfg.with_(green_share=g)
     with open_simulation(params, cfg, initial=initial, net_dir=net_dir) as sim:
-        meter = make_meter(sim.lib, cfg, curve)
-        sensor = SumoSensor(sim.lib, params.length, cfg)
+        plant = SumoPlant(sim, params.length, cfg, curve, measure=measure)
         measurements = MeasurementLog()
         while sim.time < cfg.horizon - 1e-9:
-            t = sim.step()
-            if measure:
-                got = sensor.observe(t)
-                if got is not None:
-                    measurements.append(got.cells)
-                meter.step(sensor.queue)
-            else:
-                meter.step(ramp_queue(sim.lib))
+            got = plant.step()
+            if got is not None:
+                measurements.append(got.cells)
         # ramp vehicles past the meter: inserted minus those still upstream of it
         ramp_passed = sim.inserted_ramp - int(sim.lib.edge.getLastStepVehicleNumber(RAMP_UP))
     if sim.report is None:  # pragma: no cover - close() failed to read SUMO's counts
         raise SumoError("SUMO closed without a final report")
     log.info("%s", sim.report.summary())
-    return RunResult(cfg, g, measurements, sim.report, meter.summary(), ramp_passed)
+    return RunResult(cfg, g, measurements, sim.report, plant.meter_summary(), ramp_passed)

@@ -7,19 +7,23 @@ One :class:`SumoSensor` per run. After each SUMO step :meth:`SumoSensor.observe`
 * the occupancy and flow of the E1 loop on ``down`` past the merge nose (ALINEA's
   measurement, :class:`~arzsumo.sumo.loops.DownstreamLoop`; every run has it,
   ``open_simulation(..., downstream_loop=d)``), and
-* the ramp queue (halted vehicles on ``ramp_up`` plus ramp vehicles still waiting to be
-  inserted), which the meter's spillback override needs every step,
+* for the meter, every step: the ramp queue (halted vehicles on ``ramp_up`` plus ramp
+  vehicles still waiting to be inserted) and its stop line
+  (:class:`~arzsumo.sumo.stop_line.StopLine`), handed over as a
+  :class:`~arzsumo.sumo.stop_line.MeterReading`,
 * with a :class:`~arzsumo.sumo.sensing.SensorLayout` holding them, the E1 loop stations
   (:class:`~arzsumo.sumo.loops.LoopSensor`; the run must be opened with their positions,
   ``open_simulation(..., loops=layout.loop_x(L))``) and, at a period's last step, the
   reporting AVs (:class:`~arzsumo.sumo.probes.AvProbes`, from the sample above),
 * until the control window opens (:meth:`SumoSensor.start_window`), every vehicle's fuel
-  and CO2 (:class:`~arzsumo.sumo.window.EmissionsLedger`); after, the speed moments per class
-  of the vehicles on ``main`` (:class:`SpeedMoments`, from the samples above) and, at
-  a period's last step, their lateral offsets (:class:`~arzsumo.sumo.lateral.LateralSampler`),
+  and CO2 (:class:`~arzsumo.sumo.window.EmissionsLedger`); in the window, the speed moments
+  per class of the vehicles on ``main`` (:class:`SpeedMoments`, from the samples above)
+  and, at a period's last step, their lateral offsets
+  (:class:`~arzsumo.sumo.lateral.LateralSampler`); after it
+  (:meth:`SumoSensor.end_window`, the drain), only the meter's reading and fuel and CO2,
 
 and when a control period is complete returns one :class:`PeriodMeasurement`. Nothing
-else in the closed loop reads SUMO; the meter only writes the traffic light.
+else in the run reads SUMO while it steps; the meter only writes the traffic light.
 """
 
 from __future__ import annotations
@@ -41,20 +45,17 @@ from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.lateral import LateralSampler
 from arzsumo.sumo.loops import DownstreamLoop, LoopSensor
 from arzsumo.sumo.measure import CellData, MainlineSensor
-from arzsumo.sumo.network import RAMP_UP
 from arzsumo.sumo.probes import AvProbes
 from arzsumo.sumo.sensing import SensorLayout
-from arzsumo.sumo.window import EmissionsLedger, WindowStart
+from arzsumo.sumo.stop_line import MeterReading, StopLine, ramp_queue
+from arzsumo.sumo.window import (
+    EmissionsLedger,
+    WindowEnd,
+    WindowStart,
+    finish_window,
+    window_end,
+)
 from arzsumo.units import ms_to_kmh
-
-
-def ramp_queue(lib: ModuleType, pending: Sequence[str] | None = None) -> int:
-    """Halted vehicles on ``ramp_up`` plus ramp vehicles still waiting to be inserted
-    (``pending``: the ids SUMO holds back this step, read here when not given)."""
-    if pending is None:
-        pending = lib.simulation.getPendingVehicles()
-    waiting = sum(1 for v in pending if v.startswith("ramp"))
-    return int(lib.edge.getLastStepHaltingNumber(RAMP_UP)) + waiting
 
 
 @dataclass(frozen=True)
@@ -138,13 +139,17 @@ class SumoSensor:
         Loop stations and AV probes read besides the cells (default: none).
     loop_noise, probe_noise : LoopNoise, ProbeNoise, optional
         Noise models attached to their records (the estimators' assumed errors).
+    measure : bool
+        Read the mainline and the loops (False: the meter's reading only).
     """
 
     def __init__(self, lib: ModuleType, length: float, cfg: SumoConfig,
                  window: bool = False, layout: SensorLayout | None = None,
                  loop_noise: LoopNoise | None = None,
-                 probe_noise: ProbeNoise | None = None) -> None:
-        self.lib = lib
+                 probe_noise: ProbeNoise | None = None, measure: bool = True) -> None:
+        self.lib, self.measure = lib, measure
+        self.stop_line = StopLine(lib)
+        self._end: tuple[float, object, EmissionsLedger] | None = None
         self.mainline = MainlineSensor(lib, length, cfg.cell_length, cfg.step_length,
                                        cfg.steps_per_period)
         layout = layout or SensorLayout()
@@ -168,13 +173,32 @@ class SumoSensor:
         self.window_open = True
         return self.ledger.close(t)
 
+    def end_window(self, t: float) -> None:
+        """Close the control window at ``t`` (s): keep the values of the vehicles on the
+        network now; from now on only the meter's reading and fuel and CO2 are read."""
+        on_network, ledger = window_end(self.lib, t)
+        self._end = (t, on_network, ledger)
+
+    def window_end_values(self) -> WindowEnd:
+        """The window's end (:meth:`end_window`) with the fuel and CO2 summed since."""
+        if self._end is None:
+            raise RuntimeError("window_end_values needs end_window first")
+        t, on_network, ledger = self._end
+        return finish_window(t, on_network, ledger)
+
     def observe(self, t: float, pending: Sequence[str] | None = None
-                ) -> PeriodMeasurement | None:
+                ) -> tuple[MeterReading, PeriodMeasurement | None]:
         """Sample the step that ended at ``t`` (s; ``pending``: the vehicles SUMO holds
-        back now, :attr:`arzsumo.sumo.simulation.SumoSimulation.pending`); return the
-        period's measurement when the period is complete, else None. :attr:`queue` is the
-        ramp queue now."""
+        back now, :attr:`arzsumo.sumo.simulation.SumoSimulation.pending`): the meter's
+        reading, and the period's measurement when the period is complete (else None).
+        :attr:`queue` is the ramp queue now."""
         self.queue = ramp_queue(self.lib, pending)
+        reading = MeterReading(self.queue, self.stop_line.read())
+        if self._end is not None:
+            self._end[2].add()
+            return reading, None
+        if not self.measure:
+            return reading, None
         down = self.downstream.observe(t)
         cells = self.mainline.collect(t)
         loops = self.loops.observe(t) if self.loops is not None else None
@@ -183,11 +207,11 @@ class SumoSensor:
         elif self.ledger is not None:
             self.ledger.add()
         if cells is None:
-            return None
+            return reading, None
         occupancy, flow = down if down is not None else (float("nan"), float("nan"))
         m = self.mainline
         if self.window_open:     # once per period: a libsumo call per vehicle
             self.lateral.sample(t, m.last_ids, m.last_pos, m.last_speed, m.last_av)
         probes = self.probes.observe(t, m.last_ids, m.last_pos, m.last_speed, m.last_av) \
             if self.probes is not None else None
-        return PeriodMeasurement(cells, occupancy, self.queue, loops, probes, flow)
+        return reading, PeriodMeasurement(cells, occupancy, self.queue, loops, probes, flow)

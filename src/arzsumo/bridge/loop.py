@@ -1,0 +1,140 @@
+"""One control period of the closed loop, in one place: sense, estimate, decide, actuate, record.
+
+:meth:`ClosedLoop.run` is the whole control window. Each stage is one call, and what it
+returns flows forward only:
+
+1. **sense**: SUMO runs one control period under the meter's present command
+   (:meth:`arzsumo.sumo.plant.SumoPlant.run_period`): the sensor's
+   :class:`~arzsumo.sumo.sensor.PeriodMeasurement` and the meter's state at the period's
+   end (:class:`~arzsumo.sumo.meter.MeterState`). The sensor is the only reader of SUMO.
+2. **estimate**: the measurement becomes the macroscopic state the controller acts on
+   (:class:`~arzsumo.bridge.estimator.Estimator`; minus the warm-up reference,
+   :mod:`~arzsumo.bridge.reference`, when the scenario asks for it).
+3. **decide**: the controller takes what the actuator applied for its previous check and
+   checks on the state (:meth:`arzsumo.control.base.Controller.step`, a
+   :class:`~arzsumo.control.base.Command`); the reference twin's controller checks on
+   the reference twin.
+4. **actuate**: the command's U, limited by ``[actuation]``, the queue override and the
+   meter's bounds, becomes the meter's plan (:class:`~arzsumo.bridge.actuator.MeterActuator`,
+   an :class:`~arzsumo.bridge.actuator.Actuation`); what it applied is told to the
+   controller at the next check.
+5. **record**: the check and the period that followed become one
+   :class:`~arzsumo.bridge.records.PeriodRecord`; both twins advance over the period
+   (:class:`~arzsumo.bridge.twins.TwinPair`) and their fields are kept beside SUMO's.
+
+The first check is on the warm-up's last measurement (t = 0). No command follows the
+last check, at the horizon: no period follows it, and a plan change there would never run.
+
+A detector sample's path: ``SumoSensor.observe`` (libsumo, every step) ->
+``PeriodMeasurement`` -> ``Estimator.estimate`` -> ``MacroState`` -> ``Controller.step``
+-> ``Command`` -> ``MeterActuator.apply`` (limits, override, the meter's bounds) ->
+``MeterLight.set_plan`` -> the light, set by ``MeterLight.step`` from the next cycle on.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+from arzsumo.bridge.actuator import Actuation, MeterActuator
+from arzsumo.bridge.estimator import Estimator
+from arzsumo.bridge.records import PeriodRecord, Trace, micro_fields
+from arzsumo.bridge.reference import ReferenceShift
+from arzsumo.bridge.twins import TwinPair
+from arzsumo.control.base import Applied, Command, Controller, MacroState
+from arzsumo.progress import Progress
+from arzsumo.sumo.meter import MeterState
+from arzsumo.sumo.plant import SumoPlant
+from arzsumo.sumo.sensor import PeriodMeasurement
+
+
+@dataclass(frozen=True)
+class Check:
+    """One check: its time (s from the start of control), the controller's command, the
+    reference twin's U (veh/s) and the wall time of the controller's check (s)."""
+
+    t: float
+    command: Command
+    u_reference: float
+    wall_s: float
+
+
+class ClosedLoop:
+    """The stages of the control window (module docstring), each one object.
+
+    Parameters
+    ----------
+    plant : SumoPlant
+        SUMO with its sensor and meter.
+    estimator : Estimator
+        Measurement -> the state the controller acts on.
+    controller : Controller
+        The acting law.
+    actuator : MeterActuator
+        U -> the meter's plan.
+    twins : TwinPair
+        The replay and reference PDE twins beside SUMO.
+    period : float
+        Control period, s.
+    anti_windup : bool
+        Tell the controller the range its U was limited to (``[actuation] anti_windup``).
+    shift : ReferenceShift, optional
+        The warm-up reference subtracted from the estimate.
+    """
+
+    def __init__(self, plant: SumoPlant, estimator: Estimator, controller: Controller,
+                 actuator: MeterActuator, twins: TwinPair, period: float,
+                 anti_windup: bool = True, shift: ReferenceShift | None = None) -> None:
+        self.plant, self.estimator, self.controller = plant, estimator, controller
+        self.actuator, self.twins, self.period = actuator, twins, period
+        self.anti_windup, self.shift = anti_windup, shift
+        self.timings = {"controller": 0.0, "twins": 0.0, "estimator": 0.0}
+
+    def run(self, start: PeriodMeasurement, horizon: float, bar: Progress) -> Trace:
+        """Control from the measurement ``start`` (t = 0) until ``horizon`` seconds."""
+        t0, trace = start.t, Trace(start.cells.x, micro_fields(start.cells))
+        m, t, told = start, 0.0, None
+        while True:
+            state = self.estimate(m, t)
+            check = self.decide(state, told)
+            if t >= horizon - 1e-9:
+                return trace
+            act = self.actuator.apply(check.command.u)
+            told = act.told(self.anti_windup)
+            m, meter = self.plant.run_period()
+            t = m.t - t0
+            self.record(trace, t, check, act, m, meter)
+            bar.update(m.t)
+
+    def estimate(self, m: PeriodMeasurement, t: float) -> MacroState:
+        """The state the controller acts on at ``t`` (s from the start of control)."""
+        e0 = time.perf_counter()
+        state = self.estimator.estimate(m, t)
+        self.timings["estimator"] += time.perf_counter() - e0
+        return state
+
+    def decide(self, state: MacroState, told: Applied | None) -> Check:
+        """Check the controller (told what was applied for its last check) and the
+        reference twin's controller."""
+        c0 = time.perf_counter()
+        command = self.controller.step(self.shift.apply(state) if self.shift else state,
+                                       told)
+        c1 = time.perf_counter()
+        u_reference = self.twins.check_reference()
+        self.timings["controller"] += c1 - c0
+        self.timings["twins"] += time.perf_counter() - c1
+        return Check(state.t, command, u_reference, c1 - c0)
+
+    def record(self, trace: Trace, t: float, check: Check, act: Actuation,
+               m: PeriodMeasurement, meter: MeterState) -> None:
+        """Keep ``check`` with the period that followed, ending at ``t`` (s from the start
+        of control); advance the twins over it and keep their fields at its end."""
+        w0 = time.perf_counter()
+        self.twins.advance(m.cells, t, self.period, check.u_reference)
+        self.timings["twins"] += time.perf_counter() - w0
+        trace.records.append(PeriodRecord.of(check.t, check.command, act,
+                                             check.u_reference, check.wall_s, m, meter))
+        trace.t.append(t)
+        trace.micro.append(micro_fields(m.cells))
+        trace.replay.append(self.twins.replay.sample(trace.x))
+        trace.reference.append(self.twins.reference.sample(trace.x))
