@@ -1,4 +1,4 @@
-"""limit_u and the actuator's ranges (issue 17): pure functions, known answers, properties."""
+"""limit_u and the actuator's ranges: pure functions, known answers, properties."""
 
 from __future__ import annotations
 
