@@ -1,4 +1,4 @@
-"""Actuation limits in the closed loop with real SUMO (issue 17): short runs of
+"""Actuation limits in the closed loop with real SUMO: short runs of
 ``scenarios/legacy_default.toml`` (60 s warm-up, 60 s of control, seed 42)."""
 
 from __future__ import annotations

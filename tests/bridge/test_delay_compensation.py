@@ -1,4 +1,4 @@
-"""Delay compensation in the closed loop with real SUMO (issue 17, 1c): a short run of
+"""Delay compensation in the closed loop with real SUMO: a short run of
 ``scenarios/legacy_default.toml`` (30 s warm-up, 30 s of control, seed 42), backstepping
 with ``delay_compensation_s = 12`` and ``u_max_fraction = 0.1`` (so the U applied differs
 from the law's); every command is recomputed here from the state the controller got."""

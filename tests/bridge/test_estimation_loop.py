@@ -1,4 +1,4 @@
-"""Sensing and estimation in the closed loop (issue 16): real SUMO, short runs on
+"""Sensing and estimation in the closed loop: real SUMO, short runs on
 ``scenarios/legacy_default.toml`` (40 s warm-up, seed 42).
 
 Measured when written (60 s of control, loops every 250 m and every AV a probe):
@@ -99,7 +99,7 @@ def test_controllers_change_the_plan_less_often_on_the_asm_estimate(runs, contro
 
 @pytest.mark.parametrize("controller", [
     pytest.param("backstepping", marks=pytest.mark.xfail(
-        strict=True, reason="with the model-error noise (issue 16) the EnKF's mean follows "
+        strict=True, reason="with the model-error noise the EnKF's mean follows "
                             "the loops more closely and backstepping's U on it is rougher: "
                             "52 plan changes against 49 on raw cells (44 without the noise)")),
     "etc"])

@@ -1,6 +1,6 @@
-"""Issue 13's pinned numbers: ``scenarios/legacy_default.toml``, seed 42, 60 s of control, for ETC
-and backstepping, recorded before the restructure (pipeline stages, typed scenario) and
-unchanged by it. A change here is a change of the closed loop's behaviour."""
+"""Pinned numbers of the closed loop: ``scenarios/legacy_default.toml``, seed 42, 60 s of
+control, for ETC and backstepping, recorded before the restructure (pipeline stages, typed
+scenario) and unchanged by it. A change here is a change of the closed loop's behaviour."""
 
 from __future__ import annotations
 
@@ -15,8 +15,9 @@ from arzsumo.scenario import load_scenario
 pytestmark = pytest.mark.sumo
 
 DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "legacy_default.toml"
-#: recorded with run_in_sumo on the code before the restructure (TTT and delay equal to the
-#: numbers before issue 12 too; the counts are per control window since issue 12)
+#: recorded with run_in_sumo on the code before the restructure (TTT and delay also equal
+#: those recorded before the meter counts were split; the counts are per control window,
+#: the warm-up's apart)
 PINNED = {
     "etc": {"plan_changes": 11, "light_changes": 14, "triggers": 13, "max_ramp_queue": 6,
             "TTT": {"h": 3915.450000000001, "a": 2477.1500000000005,

@@ -1,5 +1,5 @@
 """The warm-up reference (``[estimation] reference = "warmup"``): a PDE law measures its
-deviations from the mean state SUMO held in the warm-up (issue 17)."""
+deviations from the mean state SUMO held in the warm-up."""
 
 from __future__ import annotations
 

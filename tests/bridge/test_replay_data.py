@@ -33,7 +33,7 @@ TOLERANCE = 1e-9
 @pytest.fixture(scope="module")
 def run():
     """60 s of open loop after the scenario's warm-up (seed 5: no re-sync on legacy_default,
-    the default before issue 15; the test compares up to the first re-sync if any)."""
+    the former default scenario; the test compares up to the first re-sync if any)."""
     sc = load_scenario(DEFAULT)
     settings = replace(sc.run, controller="open")
     return run_cosimulation(sc, settings, sc.sumo.with_(horizon=60.0, seed=5), PAPER_DESIGN)

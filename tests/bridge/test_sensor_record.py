@@ -1,5 +1,5 @@
-"""Offline estimation on a recorded run equals the estimator inside the closed loop
-(issue 16): real SUMO, ``scenarios/legacy_default.toml``, 40 s warm-up + 30 s, seed 42."""
+"""Offline estimation on a recorded run equals the estimator inside the closed loop:
+real SUMO, ``scenarios/legacy_default.toml``, 40 s warm-up + 30 s, seed 42."""
 
 from __future__ import annotations
 
@@ -52,7 +52,7 @@ def test_the_record_holds_the_superset_and_survives_the_file(recorded):
 
 
 def test_a_record_without_harmonic_speeds_replays_time_mean_only(recorded, tmp_path):
-    # records saved before issue 17's harmonic speeds: time_mean as before, harmonic refused
+    # records saved without harmonic speeds: time_mean as before, harmonic refused
     old = dataclasses.replace(recorded[1], speed_harmonic=None)
     old.save(tmp_path / "old.npz")
     loaded = SensorRecord.load(tmp_path / "old.npz")[0]

@@ -1,4 +1,4 @@
-"""Anti-windup (issue 17): controllers with state see the U applied and the actuator's range."""
+"""Anti-windup: controllers with state see the U applied and the actuator's range."""
 
 from __future__ import annotations
 

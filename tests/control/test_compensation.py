@@ -1,4 +1,4 @@
-"""Delay compensation (issue 17, 1c): the law on the predicted state, with the commands
+"""Delay compensation: the law on the predicted state, with the commands
 applied in the last theta seconds; against the linear plant with an input delay."""
 
 from __future__ import annotations

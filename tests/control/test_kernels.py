@@ -4,7 +4,34 @@ import numpy as np
 import pytest
 
 from arzsumo.control.kernels import solve_kernels
-from arzsumo.model.single_class import single_class_arz
+from arzsumo.model.characteristic import CharacteristicSystem
+
+
+def single_class_arz(v_free, rho_max, gamma, tau, rho, length, inlet):
+    """Known-answer reference: the linearised single-class ARZ model (n = 1) in the
+    characteristic form of the mixed model.
+
+    rho_t + (rho v)_x = 0, (v - Ve)_t + v (v - Ve)_x = (Ve - v) / tau with
+    Ve(rho) = V (1 - (rho / rho_max)^gamma) (Yu and Krstic, 2019). At (rho*, v* = Ve(rho*))
+    the speeds are lambda_1 = v* (w_1 = v~ - Ve'(rho*) rho~) and lambda_2 = v* + rho* Ve'
+    (w_2 = v~), rows normalised like the mixed model (speed coefficient one); the outlet
+    is v* rho~ + rho* v~ = U. ``inlet``: "flow" (constant inflow, as in the mixed model)
+    or "reflecting-free" (Q = 0, which has a closed-form kernel). Units m, s, veh/m.
+    """
+    v = v_free * (1 - (rho / rho_max) ** gamma)
+    dve = -v_free * gamma / rho_max * (rho / rho_max) ** (gamma - 1)
+    lam = np.array([v, v + rho * dve])
+    assert lam[1] < 0, "the equilibrium must be congested"
+    t = np.array([[-dve, 1.0], [0.0, 1.0]])
+    t_inv = np.linalg.inv(t)
+    b = np.array([[0.0, 0.0], [dve / tau, -1.0 / tau]])
+    j_hat = t @ b @ t_inv
+    kappa = np.array([v, rho]) @ t_inv
+    # "flow": one downstream-travelling state, hence one inlet condition kappa . w(0) = 0
+    q = {"flow": np.array([-kappa[1] / kappa[0]]), "reflecting-free": np.zeros(1)}[inlet]
+    rate = np.diag(j_hat) / lam
+    r = np.array([-(kappa[0] / kappa[1]) * np.exp((rate[0] - rate[1]) * length)])
+    return CharacteristicSystem(lam, j_hat, q, r, length)
 
 
 @pytest.fixture(scope="module")

@@ -256,7 +256,7 @@ def test_inlet_station_lies_beyond_every_inserted_vehicle():
 
 
 def test_default_scenario_senses_loops_every_250_m_and_av_probes():
-    # issue 17's best configuration; the built-in layout stays the probe alone
+    # the scenario's layout (loops and AV probes); the built-in layout stays the probe alone
     assert SensorLayout().kinds == ("probe",) and SensorLayout().loop_x(1000.0) == ()
     assert SCENARIO.sensing.kinds == ("loops", "av_probes")
     np.testing.assert_allclose(SCENARIO.sensing.loop_x(1000.0), [0, 250, 500, 750, 1000])

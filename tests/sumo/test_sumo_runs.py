@@ -39,8 +39,18 @@ def test_vehicles_are_conserved():
     assert checked >= 9 and r.requested > 190 and r.arrived > 10
     assert r.requested == r.inserted + r.waiting
     assert r.inserted == r.arrived + r.on_network
-    assert r.teleports == 0 and r.collisions == 0 and r.emergency_braking >= 0
+    assert r.teleports == 0 and r.collisions == 0 and r.emergency_stops == 0
     assert r.requested_ramp > 30 and r.delivered_main == 1.0
+
+
+def test_no_emergency_braking_without_merging_traffic():
+    """Emergency braking is read from SUMO's statistics (-1 when it is not there). SUMO
+    reports a few at the merge when the ramp has traffic; with none, nobody brakes hard."""
+    cfg = FAST.with_(horizon=100.0, ramp_demand=0.0)
+    r = run_fixed_meter(PARAMS, cfg, measure=False).report
+    assert r.requested > 150 and r.requested_ramp == 0
+    assert r.requested == r.inserted + r.waiting and r.inserted == r.arrived + r.on_network
+    assert r.emergency_braking == 0 and r.emergency_stops == 0 and r.collisions == 0
 
 
 def test_edie_density_of_single_step_is_count_over_length():
@@ -157,7 +167,11 @@ def test_lifecycle_close_twice_one_at_a_time_and_errors_in_one_line():
     assert "SUMO did not start" in str(info.value) and "\n" not in str(info.value)
     with open_simulation(PARAMS, FAST) as again:       # libsumo restarts in one process
         again.run_until(2.0)
-        assert again.lib.edge.getLastStepVehicleNumber(RAMP_UP) >= 0
+        r = again.take_report()
+        # counts start again from zero; in 2 s no vehicle leaves the edge it entered
+        assert r.time == pytest.approx(2.0) and r.inserted == r.on_network > 0
+        assert again.lib.edge.getLastStepVehicleNumber(RAMP_UP) == r.inserted_ramp
+        assert again.lib.edge.getLastStepVehicleNumber(MAIN) == r.inserted - r.inserted_ramp
     assert again.closed
 
 
@@ -167,25 +181,6 @@ def test_teleports_counted_when_enabled():
     assert res.report.teleports > 0
     # vehicles in a teleport still count as on the network
     assert res.report.inserted == res.report.arrived + res.report.on_network
-
-
-def test_e2_chain_counts_each_vehicle_once_like_the_position_sensor():
-    from arzsumo.sumo.detectors import E2Sensor
-
-    cfg = FAST.with_(horizon=80.0, cell_length=50.0)
-    with open_simulation(PARAMS, cfg, e2_chain=True) as sim:
-        sim.run_until(70.0)                  # traffic over the whole 1000 m
-        e2 = E2Sensor(sim.lib, PARAMS.length, cfg.cell_length, cfg.step_length, 1)
-        pos = MainlineSensor(sim.lib, PARAMS.length, cfg.cell_length, cfg.step_length, 1)
-        t = sim.step()
-        a, b = e2.collect(t), pos.collect(t)
-        naive = sum(len(sim.lib.lanearea.getLastStepVehicleIDs(d)) for d in e2.ids)
-    assert a is not None and b is not None
-    np.testing.assert_array_equal(a.rho_h, b.rho_h)
-    np.testing.assert_array_equal(a.rho_a, b.rho_a)
-    np.testing.assert_allclose(a.q_h, b.q_h, rtol=1e-12)
-    assert e2.double_counted > 0 and naive == round((a.rho_h + a.rho_a).sum() * 50) + \
-        e2.double_counted
 
 
 def test_spillback_override_releases_a_long_queue():

@@ -196,7 +196,10 @@ def test_a_sumo_sweep_runs_the_closed_loop(tmp_path):
     assert df.loc["open", "plan_changes"] == 0 and df.loc["open", "triggers"] == 0
     assert df.loc["etc", "triggers"] >= 1 and df.loc["etc", "seed"] == 5
     assert (df["horizon"] == 30).all() and (df["collisions"] == 0).all()
-    assert (df["warnings"] >= 0).all()   # SUMO's warnings are kept per run, not printed
-    periods = pq.read_table(tmp_path / "out" / "runs" / "controller=etc,seed=5" /
-                            "periods.parquet")
+    runs = tmp_path / "out" / "runs"
+    for controller in ("open", "etc"):   # SUMO's warnings are kept per run, not printed
+        doc = json.loads((runs / f"controller={controller},seed=5" / "summary.json")
+                         .read_text(encoding="utf-8"))
+        assert df.loc[controller, "warnings"] == len(doc["warnings"])
+    periods = pq.read_table(runs / "controller=etc,seed=5" / "periods.parquet")
     assert int(periods.column("triggered").to_numpy().sum()) == df.loc["etc", "triggers"]

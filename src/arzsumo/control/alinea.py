@@ -118,10 +118,6 @@ class ReleaseRates:
         require(0 < self.low <= self.nominal <= self.high, "release_rate", self.nominal,
                 f"a rate in [{self.low}, {self.high}] veh/s", ModelError)
 
-    def clamp(self, r: float, low: float = -math.inf, high: float = math.inf) -> float:
-        """``r`` within the bounds (and within ``[low, high]`` where they are narrower)."""
-        return min(min(self.high, high), max(max(self.low, low), r))
-
 
 def alinea_step(r_prev: float, occupancy: float, target: float, gain: float,
                 low: float, high: float) -> float:

@@ -9,7 +9,7 @@ when a run starts), so the math packages and the CLI stay light.
 * :mod:`~arzsumo.sumo.config`: :class:`SumoConfig` and the ``[sumo]`` scenario table
 * :mod:`~arzsumo.sumo.vtypes`, :mod:`~arzsumo.sumo.demand`: vehicle types, route files
 * :mod:`~arzsumo.sumo.simulation`: the run lifecycle
-* :mod:`~arzsumo.sumo.measure`, :mod:`~arzsumo.sumo.detectors`: micro to macro
+* :mod:`~arzsumo.sumo.measure`: micro to macro
 * :mod:`~arzsumo.sumo.placement`: macro to micro
 * :mod:`~arzsumo.sumo.meter`, :mod:`~arzsumo.sumo.meter_release`: the ramp-meter actuator
   (fixed cycle; one vehicle per green)

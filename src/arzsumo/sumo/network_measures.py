@@ -21,7 +21,7 @@ Outputs (files in ``out``; SUMO 1.28 checked):
   ``CO2_abs`` in mg (no ``--emissions.volumetric-fuel``).
 * ``edgedata.xml`` (``--edgedata-output``): one interval over the run; ``left`` on the
   ``main`` edge counts the vehicles that crossed the section outlet x = L (edge-based, so
-  no additional file that would clash with the E2 chain's ``--additional-files``).
+  no additional file that would clash with the run's ``--additional-files``).
 * ``statistics.xml`` (SUMO's ``--statistic-output``, written to ``output_dir`` by
   :func:`~arzsumo.sumo.simulation.open_simulation`): end time and SUMO's own vehicle
   counts, used to check that every loaded vehicle has a record.

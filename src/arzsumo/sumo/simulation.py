@@ -320,7 +320,7 @@ def network_file(cfg: SumoConfig, net_dir: Path | None, workdir: Path) -> Path:
 
 def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
                     initial: Sequence[InitialVehicle] = (), net_dir: Path | None = None,
-                    extra_args: Sequence[str] = (), e2_chain: bool = False,
+                    extra_args: Sequence[str] = (),
                     loops: Sequence[float] = (),
                     downstream_loop: float = DOWNSTREAM_DISTANCE,
                     output_dir: Path | None = None, keep: RunFiles | None = None,
@@ -328,8 +328,7 @@ def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
     """A started simulation of the network of :func:`network_file` with the demand of
     ``cfg``.
 
-    The route file (and, with ``e2_chain``, an E2 detector per measurement cell, see
-    :mod:`arzsumo.sumo.detectors`; with ``loops``, an E1 loop station at each of those
+    The route file (and, with ``loops``, an E1 loop station at each of those
     positions on ``main``, m in [0, L], see :mod:`arzsumo.sumo.loops`; always, the E1
     loop on ``down`` at ``downstream_loop`` m past the merge nose that the sensor reads,
     :func:`~arzsumo.sumo.loops.write_downstream_loop`) goes to a
@@ -346,11 +345,6 @@ def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
         net = network_file(cfg, net_dir, workdir)
         route = write_route_file(workdir / "run.rou.xml", params, cfg, initial)
         adds = [write_downstream_loop(workdir / "e1_down.add.xml", downstream_loop)]
-        if e2_chain:
-            from arzsumo.sumo.detectors import write_e2_chain
-
-            adds.append(write_e2_chain(workdir / "e2.add.xml", params.length,
-                                       cfg.cell_length))
         if len(loops):
             from arzsumo.sumo.loops import write_loops
 

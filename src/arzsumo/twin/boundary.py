@@ -44,7 +44,6 @@ from arzsumo.errors import ModelError, require
 from arzsumo.model.characteristic import Linearization
 from arzsumo.model.equilibrium import equilibrium_from_demand
 from arzsumo.model.params import ModelParameters
-from arzsumo.twin.state import to_conserved
 
 Signal = float | Callable[[float], float]
 
@@ -127,10 +126,6 @@ class Inlet:
         v_h = (c * rho_a - l3 * flow) / det
         v_a = (l1 * flow - rho_h * c) / det
         return np.array([rho_h, v_h, rho_a, v_a])
-
-    def boundary_state(self, p: ModelParameters, t: float, z0: np.ndarray) -> np.ndarray:
-        """Conserved boundary state at x = 0, shape (4,)."""
-        return to_conserved(p, *self.boundary_primitive(t, z0))
 
     def boundary_flux(self, p: ModelParameters, t: float,
                       z0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -126,12 +126,6 @@ def waves(p: ModelParameters, q: np.ndarray) -> Waves:
                  np.minimum(lo, np.minimum(v_h, v_a)), np.maximum(hi, np.maximum(v_h, v_a)))
 
 
-def speed_bounds(p: ModelParameters, q: np.ndarray) -> tuple[np.ndarray, ...]:
-    """(lambda_min, lambda_max, v_h, v_a) at states ``q``, m/s."""
-    w = waves(p, q)
-    return w.lo, w.hi, w.v_h, w.v_a
-
-
 def hll(left: Waves, right: Waves) -> tuple[np.ndarray, np.ndarray]:
     """HLL numerical flux between ``left`` and ``right`` states, shape (4, n_faces).
 
@@ -157,18 +151,6 @@ def rusanov(left: Waves, right: Waves) -> tuple[np.ndarray, np.ndarray]:
     """Rusanov (local Lax-Friedrichs) flux, alpha = max |lambda| of both states."""
     alpha = np.maximum(np.maximum(-left.lo, left.hi), np.maximum(-right.lo, right.hi))
     return 0.5 * (left.f + right.f) - 0.5 * alpha * (right.q - left.q), alpha
-
-
-def hll_flux(p: ModelParameters, q_l: np.ndarray, q_r: np.ndarray) -> tuple[np.ndarray,
-                                                                             np.ndarray]:
-    """:func:`hll` from conserved left and right states."""
-    return hll(waves(p, q_l), waves(p, q_r))
-
-
-def rusanov_flux(p: ModelParameters, q_l: np.ndarray, q_r: np.ndarray) -> tuple[np.ndarray,
-                                                                                 np.ndarray]:
-    """:func:`rusanov` from conserved left and right states."""
-    return rusanov(waves(p, q_l), waves(p, q_r))
 
 
 #: Numerical fluxes, all with the signature ``(left: Waves, right: Waves) -> (flux, s_max)``.
@@ -198,14 +180,6 @@ def monotonized_central(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 LIMITERS: dict[str, Limiter] = {"minmod": minmod, "vanleer": van_leer,
                                 "mc": monotonized_central}
-
-
-def to_reconstruction(p: ModelParameters, q: np.ndarray) -> np.ndarray:
-    """Reconstruction variables (rho_h, w_h, rho_a, w_a), w_i = y_i / rho_i (m/s)."""
-    r = q.copy()
-    r[Y_H] /= q[RHO_H]
-    r[Y_A] /= q[RHO_A]
-    return r
 
 
 def from_reconstruction(r: np.ndarray) -> np.ndarray:
