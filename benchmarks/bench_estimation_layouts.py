@@ -13,7 +13,7 @@ acts on the truth itself (RMSE 0). Prints means over seeds with 95 % t half-widt
 writes one row per layout, method and seed to ``--out``::
 
     PYTHONPATH=src python benchmarks/bench_estimation_layouts.py --seeds 1 2 3 4 5 \\
-        --workers 2 --out docs/estimation_layouts_default.csv
+        --workers 2 --out docs/results/estimation_layouts/estimation_layouts_default.csv
 """
 
 from __future__ import annotations

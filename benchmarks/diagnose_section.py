@@ -3,7 +3,7 @@
 Prints, every 30 s: HV and AV density (veh/km) and HV speed (km/h) per 200 m of the
 section, class in- and outflows (veh/h), vehicles on the approach and its queue length (m),
 and the ramp queue (veh). Used to find the HV blocking at the approach junction
-(docs/sumo_map.md)::
+(docs/results/sumo_fill.md)::
 
     PYTHONPATH=src python benchmarks/diagnose_section.py scenarios/default.toml 3 1350
 """

@@ -5,7 +5,8 @@ the full probe's raw 50 m x 1 s cells (``[estimation] method = "none"``) and onc
 estimator on loops every 250 m plus AV probes. Writes ``--out`` (PNG; U in veh/h) and
 prints the plan changes and the U step statistics of each::
 
-    PYTHONPATH=src python benchmarks/plot_u_estimate.py --out docs/u_on_estimate.png
+    PYTHONPATH=src python benchmarks/plot_u_estimate.py \\
+        --out docs/results/u_on_estimate/u_on_estimate.png
 """
 
 from __future__ import annotations

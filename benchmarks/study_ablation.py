@@ -10,7 +10,8 @@ so the baseline is paid once. The step scenarios are written next to the evaluat
     python benchmarks/study_ablation.py --steps identified,estimator --seeds 10 \\
         --workers 2 --out /path/to/ablation          # run (resumable), then:
     python benchmarks/study_ablation.py --report --out /path/to/ablation \\
-        --csv docs/control_in_sumo.csv               # the table of docs/control_in_sumo.md
+        --csv docs/results/control_in_sumo/control_in_sumo.csv
+    # the table of docs/results/control_in_sumo.md
 
 ``identified`` is ``scenarios/default.toml`` without its controller-side tables
 ([sensing], [estimation], [actuation], [design]: the ablation's best, shipped since issue
@@ -50,16 +51,17 @@ MEASURES = {"section.speed_sd_kmh.h": "HV speed sd (km/h)",
 #: the evaluation of the configuration before issue 15 (scenarios/legacy_default.toml,
 #: 150 s warm-up, 10 seeds), the ablation's starting point
 RECORDED = {"legacy": ("old scenario and calibrated model, raw cells (before issue 15)",
-                       ROOT / "docs" / "evaluation_default.csv")}
+                       ROOT / "docs" / "results" / "evaluation_default" / "evaluation_default.csv")}
 #: the ETC design chosen by ``arzsumo design-check --auto`` for scenarios/default.toml
 #: (docs/design.md)
 DESIGNED = {"zeta": 0.00797514, "sigma": 0.5, "eta": 0.00391508,
             "A": [0.300438, 0.277601, 0.300438], "B": 2.0,
             "varsigma": [0.0788248, 0.0559883, 0.0346649, 0.5], "mu": 0.00783016}
 #: (the noise dead band is left off: on held-out seed 11 it left 3-6 events in 450 s at
-#: noise_k 0.25-0.5, a held U rather than feedback; docs/control_in_sumo.md)
+#: noise_k 0.25-0.5, a held U rather than feedback; docs/results/control_in_sumo.md)
 #: prediction horizon of the delay step, s: the measured dead time from a new plan to the
-#: section's outflow (10-14 s) plus the mean wait for the next cycle (docs/meter_dynamics.md)
+#: section's outflow (10-14 s) plus the mean wait for the next cycle
+#: (docs/results/meter_dynamics.md)
 PREDICTION_S = 14.0
 #: [sumo] keys of the meter realisation: the `meter` step's change, shipped in the default
 METER_KEYS = ("meter_mode", "meter_clearance_s")

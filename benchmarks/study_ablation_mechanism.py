@@ -9,13 +9,13 @@ depart delay (veh h); and, paired with the open loop of the same seed, the diffe
 Two figures show the mechanism the ablation table summarises:
 
 * ``*_map.png``: section outflow against mean green share, every run, with the static
-  levels of ``docs/meter_dynamics.md``: what the green share actually bought;
+  levels of ``docs/results/meter_dynamics.md``: what the green share actually bought;
 * ``*_shift.png``: the paired change of each class's speed sd against the change of its
   mean speed: a speed sd that rises with the mean speed is a change of operating point
   within the window (a transition), not more stop-and-go.
 
     python benchmarks/study_ablation_mechanism.py --out /path/to/ablation \\
-        --csv docs/ablation/mechanism.csv --png docs/ablation/mechanism
+        --csv docs/results/control_in_sumo/mechanism.csv --png OUT/mechanism
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ import numpy as np
 import pandas as pd
 
 #: static outflow levels (veh/h) at held green shares on the default, seeds 1-2
-#: (docs/meter_dynamics.md)
+#: (docs/results/meter_dynamics.md)
 STATIC_LEVELS = {0.2: 4395.0, 0.5: 4268.0, 0.8: 3180.0}
 #: the ablation's steps in order (benchmarks/study_ablation.py)
 ORDER = ("scenario", "identified", "estimator", "reference", "saturation", "design", "delay",
@@ -141,7 +141,7 @@ def plot_map(df: pd.DataFrame, path: Path) -> None:
         ax.scatter(g["green_mean"], g["section_outflow_veh_h"], s=14,
                    label=f"{step} " + ("open loop" if ctrl == "open" else ctrl))
     ax.plot(list(STATIC_LEVELS), list(STATIC_LEVELS.values()), "k--", marker="s",
-            label="static levels, held plans (docs/meter_dynamics.md)")
+            label="static levels, held plans (docs/results/meter_dynamics.md)")
     ax.set(xlabel="mean green share over the control window", xlim=(-0.02, 1.02),
            ylabel="section outflow (veh/h)",
            title="What the green share bought (default, seeds 1-10)")

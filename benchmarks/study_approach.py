@@ -18,9 +18,10 @@ green share x Krauss sigma x seed. After ``--warmup`` s, ``--measured`` s are me
 
 Usage (one CSV row per run, appended as runs finish; existing rows are skipped)::
 
-    PYTHONPATH=src python benchmarks/study_approach.py --out docs/sumo_map.csv --jobs 2 \\
+    PYTHONPATH=src python benchmarks/study_approach.py \\
+        --out docs/results/sumo_map/sumo_map.csv --jobs 2 \\
         --demands 4400 4800 5200 5664 6000 --greens 0.3 0.5 0.7 0.9 --sigmas 0.5 0.8
-    PYTHONPATH=src python benchmarks/study_approach.py --plot docs/sumo_map.csv
+    PYTHONPATH=src python benchmarks/study_approach.py --plot docs/results/sumo_map/sumo_map.csv
 """
 
 from __future__ import annotations
@@ -231,7 +232,7 @@ def sweep(args: argparse.Namespace) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--out", default="docs/sumo_map.csv")
+    p.add_argument("--out", default="docs/results/sumo_map/sumo_map.csv")
     p.add_argument("--demands", type=float, nargs="+", default=[4400, 4800, 5200, 5664, 6000])
     p.add_argument("--greens", type=float, nargs="+", default=[0.3, 0.5, 0.7, 0.9])
     p.add_argument("--sigmas", type=float, nargs="+", default=[0.5])

@@ -10,7 +10,8 @@ test, densities, Edie speeds, speed sd, inserted fraction, approach queue, lambd
 
 Usage (one CSV row per run, appended as runs finish; existing rows are skipped)::
 
-    PYTHONPATH=src python benchmarks/study_fill.py --out docs/sumo_fill.csv --jobs 2 \\
+    PYTHONPATH=src python benchmarks/study_fill.py \\
+        --out docs/results/sumo_fill/sumo_fill.csv --jobs 2 \\
         --holds 3750:850 3900:950 --seeds 1 2 3
 """
 
@@ -112,7 +113,7 @@ def sweep(args: argparse.Namespace) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--out", default="docs/sumo_fill.csv")
+    p.add_argument("--out", default="docs/results/sumo_fill/sumo_fill.csv")
     p.add_argument("--holds", nargs="+", default=["3750:850"],
                    help="hold demands HV:AV, veh/h")
     p.add_argument("--fill-h", type=float, default=4200.0, help="HV fill demand, veh/h")

@@ -10,13 +10,15 @@ ramp flow past the meter:
   (0.5 -> 0.2, ...), over seeds and repeats (K, theta, T shared, one level per step);
 * per seed, the whole staircase on one level.
 
-Writes ``docs/meter_steps.csv`` (one row per fit, units in the column names), the static
-levels (mean of the last ``--settled`` s of each hold) against ``meter.DEFAULT_CURVE``
-and the figure ``docs/meter_steps.png``; prints the tables of ``docs/meter_dynamics.md``.
+Writes ``docs/results/meter_dynamics/meter_steps.csv`` (one row per fit, units in the
+column names), the static levels (mean of the last ``--settled`` s of each hold) against
+``meter.DEFAULT_CURVE`` and the figure ``docs/results/meter_dynamics/meter_steps.png``;
+prints the tables of ``docs/results/meter_dynamics.md``.
 
 Usage::
 
-    PYTHONPATH=src python benchmarks/study_meter_fit.py docs/meter_steps_series.csv
+    PYTHONPATH=src python benchmarks/study_meter_fit.py \\
+        docs/results/meter_dynamics/meter_steps_series.csv
 """
 
 from __future__ import annotations
@@ -154,8 +156,9 @@ def staircase_model(d: dict[str, np.ndarray], r: dict[str, Any], pre: float
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("series", type=Path)
-    p.add_argument("--out", type=Path, default=Path("docs/meter_steps.csv"))
-    p.add_argument("--figure", type=Path, default=Path("docs/meter_steps.png"))
+    p.add_argument("--out", type=Path, default=Path("docs/results/meter_dynamics/meter_steps.csv"))
+    p.add_argument("--figure", type=Path,
+                   default=Path("docs/results/meter_dynamics/meter_steps.png"))
     p.add_argument("--pre", type=float, default=60.0, help="s before each change fitted")
     p.add_argument("--settled", type=float, default=60.0, help="s averaged for levels")
     args = p.parse_args(argv)

@@ -25,7 +25,7 @@ def _spread(rows: list[dict[str, Any]], key: str, scale: float = 1.0) -> str:
 
 def print_tables(rows: list[dict[str, Any]], levels: dict[float, list[float]],
                  curve: GreenShareCurve) -> None:
-    """The markdown tables of docs/meter_dynamics.md."""
+    """The markdown tables of docs/results/meter_dynamics.md."""
     print("| signal | scope | seed | step | n | K veh/h per unit | theta s | T s | "
           "resid sd veh/s |\n|---|---|---|---|---|---|---|---|---|")
     for r in rows:

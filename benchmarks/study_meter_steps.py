@@ -20,8 +20,9 @@ fits the first-order-plus-dead-time model per step and writes the table, CSV and
 Usage (2 runs in parallel at most; the machine is shared)::
 
     PYTHONPATH=src python benchmarks/study_meter_steps.py --seeds 1 2 3 --jobs 2 \\
-        --series docs/meter_steps_series.csv
-    PYTHONPATH=src python benchmarks/study_meter_fit.py docs/meter_steps_series.csv
+        --series docs/results/meter_dynamics/meter_steps_series.csv
+    PYTHONPATH=src python benchmarks/study_meter_fit.py \\
+        docs/results/meter_dynamics/meter_steps_series.csv
 """
 
 from __future__ import annotations
@@ -113,7 +114,7 @@ def main(argv: list[str] | None = None) -> int:
                    default=[0.2, 0.5, 0.8, 0.5, 0.2, 0.5, 0.8, 0.5])
     p.add_argument("--hold", type=float, default=102.0, help="s per step (17 cycles)")
     p.add_argument("--jobs", type=int, default=2)
-    p.add_argument("--series", default="docs/meter_steps_series.csv")
+    p.add_argument("--series", default="docs/results/meter_dynamics/meter_steps_series.csv")
     args = p.parse_args(argv)
     out = Path(args.series)
     new = not out.is_file()

@@ -13,7 +13,7 @@ power ``--gain``; ``--rounds`` rounds. Inflation-only settings (no model noise) 
 reported beside it::
 
     PYTHONPATH=src python benchmarks/tune_enkf_noise.py --tune-seeds 1 2 \\
-        --report-seeds 3 4 5 --out docs/enkf_noise_default.csv
+        --report-seeds 3 4 5 --out docs/results/enkf_noise/enkf_noise_default.csv
 """
 
 from __future__ import annotations
