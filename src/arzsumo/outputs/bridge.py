@@ -46,15 +46,20 @@ from arzsumo.bridge.delay import compensated_delay
 from arzsumo.bridge.estimator import fill_speeds
 from arzsumo.bridge.result import CoSimResult
 from arzsumo.bridge.sensor_record import estimation_scores
-from arzsumo.control.base import ControlLog
 from arzsumo.control.events import release_time
 from arzsumo.evaluation.fields import field_rmse, oscillation, wave_travel
 from arzsumo.evaluation.stationarity import count_trend
 from arzsumo.io import json_safe
 from arzsumo.model.characteristic import linearize
 from arzsumo.outdir import OutputDir, atomic_dir, target_of
+from arzsumo.outputs.run_summary import (
+    Accounting,
+    RunIdentity,
+    RunSummary,
+    WindowCounts,
+)
 from arzsumo.outputs.waves import waves_summary
-from arzsumo.schema import CELLS, PERIODS, RUN_SUMMARY, key_units, with_units
+from arzsumo.schema import CELLS, PERIODS, with_units
 from arzsumo.twin.metrics import performance
 from arzsumo.units import ms_to_kmh
 
@@ -155,10 +160,6 @@ def actuation_summary(res: CoSimResult) -> dict[str, Any]:
             "delay_compensation": compensated_delay(res.scenario, res.settings.controller)}
 
 
-#: ``summary.json["kind"]`` of a closed-loop run in SUMO (``arzsumo run``)
-KIND = "run"
-
-
 def warmup_summary(res: CoSimResult) -> dict[str, Any]:
     """The warm-up's meter counts, labelled as such (``summary.json["warmup"]``)."""
     w = res.warmup_meter
@@ -242,63 +243,47 @@ def meter_summary(res: CoSimResult) -> dict[str, Any]:
     return {k: res.meter.get(k) for k in METER_KEYS}
 
 
-def summary(res: CoSimResult) -> dict[str, Any]:
+def summary(res: CoSimResult) -> RunSummary:
     """The run's summary: meter counts, events, indices (micro and twins), fidelity, accounting.
 
     Meter counts (``plan_changes``, ``light_changes``, ``max_ramp_queue``) cover the
     control window; the warm-up's are under ``warmup`` (:func:`warmup_summary`).
     """
-    per = res.periods
-    rep = res.report
+    per, rep, net = res.periods, res.report, res.network
     triggered = per["triggered"].astype(bool)
     horizon = float(res.sumo.horizon)
     log = res.controller_log
     n = triggered.size
-    clipped = ControlLog(list(log.t[:n]), list(log.u_applied[:n]),
-                         list(log.u_continuous[:n]), list(log.triggered[:n]))
     v = res.micro[:, [1, 3]]
-    eq = res.equilibrium
     micro = _indices(res, res.micro)
-    net = res.network
-    summ = {
-        "kind": KIND,
-        "scenario": res.scenario.name, "source": res.scenario.source, "version": __version__,
-        "seed": res.sumo.seed, "controller": res.settings.controller, "complete": True,
-        "units": "SI: veh, s, m; U and flows in veh/s",
-        "equilibrium": eq.as_dict(), "lambda_4": float(linearize(eq).eigenvalues[3]),
-        "q_nominal": res.q_nominal, "horizon": horizon, "warmup": warmup_summary(res),
-        "plan_changes": int(res.meter["plan_changes"]),
-        "light_changes": int(res.meter["light_changes"]),
-        "triggers": int(triggered.sum()),
-        "release_time": release_time(clipped.t, clipped.triggered, horizon),
-        "max_ramp_queue": int(res.meter["max_queue"]),
-        "meter": meter_summary(res),
-        "speed_variance": {"h": float(np.nanvar(v[:, 0])), "a": float(np.nanvar(v[:, 1]))},
-        **micro,
-        "section": section_summary(res, micro),
-        "network": net.window if net else None,
-        "network_whole_run": net.whole_run if net else None,
-        "network_whole_demand": net.whole_demand if net else None,
-        "twin_replay": _indices(res, res.replay), "twin_reference": _indices(res, res.reference),
-        "rmse": {"replay": rmse(res, res.replay), "reference": rmse(res, res.reference)},
-        "rmse_blocks": rmse_blocks(res),
-        "section_trend": section_trend(res),
-        "estimation": estimation_summary(res),
-        "actuation": actuation_summary(res),
-        "twin_status": res.twin_status,
-        "inserted": rep.inserted if rep else None, "requested": rep.requested if rep else None,
-        "inserted_fraction_main": rep.delivered_main if rep else None,
-        "waiting": rep.waiting if rep else None, "arrived": rep.arrived if rep else None,
-        "teleports": rep.teleports if rep else None,
-        "collisions": rep.collisions if rep else None,
-        "emergency_braking": rep.emergency_braking if rep else None,
-        "placement": res.placement,
-        "wall_time": res.wall_time, "timings": res.timings,
-        "controller_time_per_period": float(np.mean(per["controller_s"])) if n else None,
-        "settings": res.settings.as_dict(),
-    }
-    summ["units_by_key"] = key_units(summ, RUN_SUMMARY)
-    return summ
+    counts = WindowCounts(
+        plan_changes=int(res.meter["plan_changes"]),
+        light_changes=int(res.meter["light_changes"]), triggers=int(triggered.sum()),
+        release_time=release_time(list(log.t[:n]), list(log.triggered[:n]), horizon),
+        max_ramp_queue=int(res.meter["max_queue"]))
+    accounting = Accounting(rep.inserted, rep.requested, rep.delivered_main, rep.waiting,
+                            rep.arrived, rep.teleports, rep.collisions,
+                            rep.emergency_braking) if rep else Accounting()
+    return RunSummary(
+        identity=RunIdentity(res.scenario.name, res.scenario.source, __version__,
+                             res.sumo.seed, res.settings.controller),
+        equilibrium=res.equilibrium.as_dict(),
+        lambda_4=float(linearize(res.equilibrium).eigenvalues[3]),
+        q_nominal=res.q_nominal, horizon=horizon, warmup=warmup_summary(res), counts=counts,
+        meter=meter_summary(res),
+        speed_variance={"h": float(np.nanvar(v[:, 0])), "a": float(np.nanvar(v[:, 1]))},
+        micro=micro, section=section_summary(res, micro),
+        network=net.window if net else None,
+        network_whole_run=net.whole_run if net else None,
+        network_whole_demand=net.whole_demand if net else None,
+        twin_replay=_indices(res, res.replay), twin_reference=_indices(res, res.reference),
+        rmse={"replay": rmse(res, res.replay), "reference": rmse(res, res.reference)},
+        rmse_blocks=rmse_blocks(res), section_trend=section_trend(res),
+        estimation=estimation_summary(res), actuation=actuation_summary(res),
+        twin_status=res.twin_status, accounting=accounting, placement=res.placement,
+        wall_time=res.wall_time, timings=res.timings,
+        controller_time_per_period=float(np.mean(per["controller_s"])) if n else None,
+        settings=res.settings.as_dict())
 
 
 def periods_table(res: CoSimResult) -> pa.Table:
@@ -327,7 +312,7 @@ def write_results(res: CoSimResult, out: str | Path | OutputDir, scenario_text: 
     only with ``overwrite``, see :mod:`arzsumo.outdir`); return the path and summary."""
     from arzsumo.plots.bridge import write_bridge_plots
 
-    summ = summary(res)
+    summ = summary(res).to_dict()
     with atomic_dir(out, "run", overwrite=overwrite) as tmp:
         pq.write_table(periods_table(res), tmp / "periods.parquet")
         pq.write_table(cells_table(res), tmp / "cells.parquet")

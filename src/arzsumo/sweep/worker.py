@@ -108,7 +108,7 @@ def _run_sumo(task: RunTask) -> tuple[str, dict[str, Any], dict[str, bytes]]:
 
     sc = scenario_from_dict(task.scenario, task.source)
     session = run_in_sumo(sc)
-    summ = json_safe(summary(session.result))
+    summ = json_safe(summary(session.result).to_dict())
     summ["settings_resolved"] = session.resolved_comment()
     return "ok", summ, {"periods.parquet": _parquet(periods_table(session.result))}
 
