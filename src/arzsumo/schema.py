@@ -37,6 +37,15 @@ class Column(NamedTuple):
 
 
 _PERIOD = "over the control period [t_s, t_s + control period]"
+#: The meter's two counts, defined once (docs/outputs.md "Counts", ``arzsumo run --help``)
+PLAN_CHANGE = ("a plan change: a command that asks the meter for a timing other than the one "
+               "it holds (a green share's green steps, a release rate's cycle in whole SUMO "
+               "steps), counted when asked whether or not it ever runs (several asked "
+               "within one cycle all count; the last one runs)")
+LIGHT_CHANGE = ("a light change: a green begins or ends on the ramp light (green, yellow, red "
+                "is one change: the clearance yellow is not counted; the queue override's "
+                "greens are counted)")
+
 #: ``periods.parquet`` of ``arzsumo run``: one row per control period
 PERIODS: dict[str, Column] = {
     "t_s": Column("s", "time of the controller check that opens the period, from the start "
@@ -50,13 +59,13 @@ PERIODS: dict[str, Column] = {
                                    "one_per_green: minimum green over the commanded cycle)"),
     "green_running": Column("1", "green share the meter runs at the end of the period "
                                  "(one_per_green: minimum green over the running cycle)"),
-    "light_changes": Column("count", "ramp-light changes so far, from SUMO start (warm-up "
-                                     "included), cumulative"),
-    "plan_changes": Column("count", "meter plan (green share) changes so far, from SUMO "
-                                    "start, cumulative"),
+    "light_changes": Column("count", "light changes (see Counts) since the start of "
+                                     "control, cumulative, read at the end of the period"),
+    "plan_changes": Column("count", "plan changes (see Counts) since the start of control, "
+                                    "cumulative, read at the end of the period"),
     "queue": Column("veh", "ramp queue at the end of the period: halted on ramp_up plus "
                            "ramp vehicles waiting for insertion"),
-    "max_queue": Column("veh", "largest ramp queue so far (from SUMO start)"),
+    "max_queue": Column("veh", "largest ramp queue since the start of control"),
     "inflow_h": Column("veh/s", f"HVs entering the mainline at x = 0 {_PERIOD}"),
     "inflow_a": Column("veh/s", f"AVs entering the mainline at x = 0 {_PERIOD}"),
     "outflow_h": Column("veh/s", f"HVs leaving the mainline at x = L {_PERIOD}"),

@@ -188,3 +188,25 @@ def test_spillback_override_releases_a_long_queue():
     res = run_fixed_meter(PARAMS, cfg, 0.0, measure=False)
     assert res.meter["override_steps"] > 0 and res.ramp_passed > 0
     assert res.meter["max_queue"] >= 4
+
+
+def test_plan_changes_count_requests_and_light_changes_count_green_edges():
+    """The counts as docs/outputs.md defines them: two timings asked within one cycle are
+    two plan changes and only the last runs; a yellow is not a light change."""
+    cfg = FAST.with_(horizon=30.0, meter_cycle=6.0, min_green=1.0, min_red=1.0,
+                     meter_clearance=1.0)
+    with open_simulation(PARAMS, cfg) as sim:
+        plant = SumoPlant(sim, PARAMS.length, cfg, measure=False)
+        meter = plant.meter                       # nominal green share 0.5
+        assert command_meter(meter, 1e6, 0.0) == 0.0            # all red asked ...
+        assert command_meter(meter, -1e6, 0.0) == 1.0           # ... then all green
+        shown = []
+        for _ in range(round(18.0 / cfg.step_length)):
+            plant.step()
+            shown.append(meter.light)
+    assert meter.plan_changes == 2
+    # the first cycle runs the nominal plan (G, y, r: one change at G->y, one at r->G),
+    # then all green: no red ever again
+    last = round(12.0 / cfg.step_length)
+    assert "y" in shown and shown[-last:] == ["G"] * last
+    assert meter.light_changes == 2
