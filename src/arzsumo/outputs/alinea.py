@@ -18,7 +18,8 @@ import numpy as np
 from arzsumo.evaluation.critical_occupancy import CriticalOccupancy, binned_curve
 from arzsumo.io import json_safe
 from arzsumo.outdir import OutputDir, atomic_dir, target_of
-from arzsumo.plots.alinea import write_loop_curve_figure
+from arzsumo.outputs.figures import save_png
+from arzsumo.plots.alinea import loop_curve_figure
 from arzsumo.units import veh_s_to_veh_h
 
 
@@ -61,7 +62,7 @@ def write_alinea_target(out: str | Path | OutputDir, samples: list[tuple[int, np
         (tmp / "target.json").write_text(json.dumps(json_safe(target_json(crit, meta)),
                                                     indent=2), encoding="utf-8")
         o = np.linspace(0.0, 1.05 * float(occ.max()), 200)
-        write_loop_curve_figure(tmp / "curve.png", occ, flow, centres, mean,
-                                (o, crit.fit.flow(o)), crit.critical, crit.target, title,
-                                lower_bound=not crit.saturated)
+        fig = loop_curve_figure(occ, flow, centres, mean, (o, crit.fit.flow(o)), crit.critical,
+                                crit.target, title, lower_bound=not crit.saturated)
+        save_png(fig, tmp / "curve.png", dpi=110)
     return target_of(out)

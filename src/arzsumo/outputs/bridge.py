@@ -310,7 +310,8 @@ def write_results(res: CoSimResult, out: str | Path | OutputDir, scenario_text: 
                   plots: bool = True, overwrite: bool = False) -> tuple[Path, dict[str, Any]]:
     """Write everything into ``out`` atomically (a previous ``run`` result there is replaced
     only with ``overwrite``, see :mod:`arzsumo.outdir`); return the path and summary."""
-    from arzsumo.plots.bridge import write_bridge_plots
+    from arzsumo.outputs.figures import save_figures
+    from arzsumo.plots.bridge import bridge_figures
 
     summ = summary(res).to_dict()
     with atomic_dir(out, "run", overwrite=overwrite) as tmp:
@@ -324,5 +325,5 @@ def write_results(res: CoSimResult, out: str | Path | OutputDir, scenario_text: 
         if res.files is not None:   # linked or copied in chunks, never read into memory
             res.files.place(tmp)
         if plots:
-            write_bridge_plots(res, tmp)
+            save_figures(bridge_figures(res), tmp, dpi=100)
     return target_of(out), summ

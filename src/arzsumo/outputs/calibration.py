@@ -12,7 +12,8 @@ from pathlib import Path
 import numpy as np
 
 from arzsumo.outdir import OutputDir, atomic_dir, target_of
-from arzsumo.plots.calibration import write_calibration_figure
+from arzsumo.outputs.figures import save_png
+from arzsumo.plots.calibration import calibration_figure
 from arzsumo.sumo.calibrate import Calibration
 from arzsumo.sumo.calibration_io import calibration_json, curve_text, scenario_text
 from arzsumo.sumo.config import SumoConfig
@@ -34,10 +35,11 @@ def write_calibration(out: str | Path | OutputDir, cal: Calibration, cfg: SumoCo
         eq = cal.equilibrium
         mark = (eq["ao"], eq["v_h"], eq["v_a"]) if math.isfinite(eq.get("v_h", math.nan)) \
             else None
-        write_calibration_figure(
-            tmp / "calibration.png", cal.points,
+        fig = calibration_figure(
+            cal.points,
             {"h": (c.v_free_h, c.ao_max_h, c.gamma_h), "a": (c.v_free_a, c.ao_max_a, c.gamma_a)},
             {"h": (p.v_free_h, p.ao_max_h, p.gamma_h), "a": (p.v_free_a, p.ao_max_a, p.gamma_a)},
             {k: f.r2 for k, f in cal.fits.items()},
             (np.asarray(cal.curve.green_share), np.asarray(cal.curve.outflow)), mark)
+        save_png(fig, tmp / "calibration.png", dpi=110)
     return target_of(out)

@@ -44,7 +44,7 @@ def compare_runs(runs: list[Path], out: Path,
     Refuses (:class:`~arzsumo.bridge.compare.CompareError`, nothing written) results that
     are not comparable unless ``allow_mixed``.
     """
-    from arzsumo.plots import save_png
+    from arzsumo.outputs.figures import save_png
     from arzsumo.plots.compare import comparison_figure
 
     summaries = load_summaries(runs)

@@ -35,7 +35,7 @@ def write_evaluation(out: Path, long: pd.DataFrame, runs: pd.DataFrame,
 
 def _figure(out: Path, long: pd.DataFrame, runs: pd.DataFrame, controllers: Sequence[str],
             baseline: str, measures: Sequence[Measure]) -> Path:
-    from arzsumo.plots import save_png
+    from arzsumo.outputs.figures import save_png
     from arzsumo.plots.evaluation import DiffPanel, paired_differences_figure
 
     panels = []

@@ -1,13 +1,83 @@
-"""Single-figure writers of the CLI: the regime map (``arzsumo model --regime-map``) and the
-kernels (``arzsumo kernels --plot``), saved as PNG atomically."""
+"""Figure files: every PNG of arzsumo is saved here, atomically, and its figure closed.
+
+The figures are drawn by :mod:`arzsumo.plots` (functions that return Figures and write
+nothing); :func:`save_png` saves one, :func:`save_figures` a dict of them by name. The
+single-figure writers of the CLI are here too: the regime map (``arzsumo model
+--regime-map``) and the kernels (``arzsumo kernels --plot``). Importing this module selects
+matplotlib's Agg backend (through :mod:`arzsumo.plots`): nothing is ever displayed.
+"""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from arzsumo.control.kernels import Kernels
-from arzsumo.model.regime import RegimeMap
-from arzsumo.plots import save_png
+from matplotlib.figure import Figure
+
+from arzsumo.io import atomic_file
+from arzsumo.plots import plt
+
+if TYPE_CHECKING:                  # annotations only: saving a figure needs neither
+    from arzsumo.control.kernels import Kernels
+    from arzsumo.model.regime import RegimeMap
+
+
+def save_png(fig: Figure, path: str | Path, dpi: int = 110) -> Path:
+    """Save ``fig`` as PNG at ``path`` atomically and close it.
+
+    Parameters
+    ----------
+    fig : Figure
+        The figure; closed afterwards, also when saving fails.
+    path : str or Path
+        The file written (missing parent directories are made).
+    dpi : int, optional
+        Resolution in dots per inch.
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
+    try:
+        with atomic_file(path) as tmp:
+            fig.savefig(tmp, dpi=dpi, format="png")
+    finally:
+        plt.close(fig)
+    return Path(path)
+
+
+def save_figures(figs: Mapping[str, Figure], directory: str | Path,
+                 dpi: int = 110) -> list[Path]:
+    """Save each figure of ``figs`` as ``<name>.png`` in ``directory`` and close them all.
+
+    Parameters
+    ----------
+    figs : mapping of str to Figure
+        Figures by name (the file name without ``.png``), saved in this order.
+    directory : str or Path
+        The directory (made if missing).
+    dpi : int, optional
+        Resolution in dots per inch, the same for every figure.
+
+    Returns
+    -------
+    list of Path
+        The files written, in the order of ``figs``. If one fails, the figures not yet
+        saved are closed too.
+    """
+    directory = Path(directory)
+    pending = list(figs.items())
+    written = []
+    try:
+        while pending:
+            name, fig = pending.pop(0)
+            written.append(save_png(fig, directory / f"{name}.png", dpi=dpi))
+    finally:
+        for _, fig in pending:
+            plt.close(fig)
+    return written
 
 
 def write_regime_map(path: str | Path, rmap: RegimeMap,

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from arzsumo.outdir import OutputDir, atomic_dir, target_of
-from arzsumo.plots import save_png
+from arzsumo.outputs.figures import save_png
 from arzsumo.plots.identify import fields_figure, scatter_figure
 
 #: the marker kind of an identification's directory

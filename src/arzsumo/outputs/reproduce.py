@@ -50,7 +50,7 @@ def _write_csv(path: Path, rows: Sequence[Mapping[str, Any]]) -> None:
 
 def write_figures(figs: ReproduceFigures, out: str | Path) -> list[Path]:
     """Write release_instants.png, penetration.png and sensitivity.png (those with data)."""
-    from arzsumo.plots import save_png
+    from arzsumo.outputs.figures import save_png
     from arzsumo.plots.reproduce import (
         penetration_figure,
         release_instants_figure,

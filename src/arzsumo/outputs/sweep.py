@@ -36,7 +36,7 @@ def write_sweep_plots(ok: pd.DataFrame, layout: SweepLayout, out: str | Path,
     other axes give one line each, and ``paper`` (metric -> {axis value: value}) is drawn
     beside them.
     """
-    from arzsumo.plots import save_png
+    from arzsumo.outputs.figures import save_png
     from arzsumo.plots.sweep import sensitivity_figure, study_figure
 
     out = Path(out)

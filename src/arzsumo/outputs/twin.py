@@ -53,7 +53,8 @@ def write_run(run: TwinRun, out: str | Path | OutputDir, plots: bool = True,
               overwrite: bool = False) -> Path:
     """Write ``run`` into the directory ``out`` atomically (a previous ``twin`` result is
     replaced only with ``overwrite``, see :mod:`arzsumo.outdir`); return its path."""
-    from arzsumo.plots.twin import write_twin_plots
+    from arzsumo.outputs.figures import save_figures
+    from arzsumo.plots.twin import twin_figures
 
     with atomic_dir(out, "twin", overwrite=overwrite) as tmp:
         pq.write_table(fields_table(run), tmp / "fields.parquet")
@@ -61,5 +62,5 @@ def write_run(run: TwinRun, out: str | Path | OutputDir, plots: bool = True,
         (tmp / "summary.json").write_text(json.dumps(json_safe(run.summary()), indent=2)
                                           + "\n", encoding="utf-8")
         if plots:
-            write_twin_plots(run, tmp)
+            save_figures(twin_figures(run), tmp, dpi=110)
     return target_of(out)

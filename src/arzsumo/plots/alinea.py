@@ -3,13 +3,10 @@ the target (``arzsumo alinea-target``). Occupancy in %, flow in veh/h (a report)
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 
-from arzsumo.io import atomic_file
 from arzsumo.units import veh_s_to_veh_h
 
 
@@ -32,12 +29,3 @@ def loop_curve_figure(occupancy: np.ndarray, flow: np.ndarray, centres: np.ndarr
     ax.set_title(title)
     ax.legend(fontsize=8)
     return fig
-
-
-def write_loop_curve_figure(path: str | Path, *args: object, **kwargs: object) -> Path:
-    """Draw :func:`loop_curve_figure` and save it as PNG at ``path`` (atomically)."""
-    fig = loop_curve_figure(*args, **kwargs)  # type: ignore[arg-type]
-    with atomic_file(path) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
-    plt.close(fig)
-    return Path(path)

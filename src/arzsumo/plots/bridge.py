@@ -1,19 +1,19 @@
 """Figures of a co-simulation: micro and twin space-time fields side by side, and the
 control and meter signals with release instants.
 
-``*_figure`` functions take arrays and return a Figure; :func:`write_bridge_plots` takes a
-:class:`arzsumo.bridge.result.CoSimResult` and saves PNGs atomically.
+``*_figure`` functions take arrays and return a Figure; :func:`bridge_figures` takes a
+:class:`arzsumo.bridge.result.CoSimResult` and returns the three figures of a run by name.
+Nothing is written here: :func:`arzsumo.outputs.figures.save_figures` saves them.
 """
 
 from __future__ import annotations
 
-from pathlib import Path
+from typing import Any
 
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 
-from arzsumo.plots import save_png
 from arzsumo.units import ms_to_kmh, veh_m_to_veh_km, veh_s_to_veh_h
 
 _LABEL = {"h": ("HVs", 0), "a": ("AVs", 2)}
@@ -88,25 +88,30 @@ def signals_figure(t: np.ndarray, u: np.ndarray, u_cont: np.ndarray, events: np.
     return fig
 
 
-def _save(fig: Figure, path: Path) -> Path:
-    return save_png(fig, path, dpi=100)
+def bridge_figures(res: Any) -> dict[str, Figure]:
+    """The figures of a co-simulation run, by name: ``fields_h``, ``fields_a``, ``control``.
 
+    Parameters
+    ----------
+    res : CoSimResult
+        Read by attribute (:class:`arzsumo.bridge.result.CoSimResult`): fields in SI, the
+        equilibrium (veh/m, m/s), the per-period table and the meter's counts.
 
-def write_bridge_plots(res, out: str | Path) -> list[Path]:
-    """Save fields_h.png, fields_a.png and control.png into ``out``."""
-    out = Path(out)
+    Returns
+    -------
+    dict of str to Figure
+        Open figures; the caller saves and closes them.
+    """
     eq = res.equilibrium
     title = f"{res.scenario.name}: {res.settings.controller}, seed {res.sumo.seed}"
     panels = {"SUMO (Edie)": res.micro, "twin replay": res.replay,
               "twin reference": res.reference}
-    paths = []
-    for cls, star in (("h", (eq.rho_h, eq.v_h)), ("a", (eq.rho_a, eq.v_a))):
-        paths.append(_save(side_by_side_figure(res.t, res.x, panels, cls, star, title),
-                           out / f"fields_{cls}.png"))
+    figs = {f"fields_{cls}": side_by_side_figure(res.t, res.x, panels, cls, star, title)
+            for cls, star in (("h", (eq.rho_h, eq.v_h)), ("a", (eq.rho_a, eq.v_a)))}
     p = res.periods
-    paths.append(_save(signals_figure(p["t"], p["u"], p["u_continuous"],
-                                      p["triggered"].astype(bool), p["green_commanded"],
-                                      p["green_running"], p["queue"],
-                                      res.meter["light_changes"], res.meter["plan_changes"],
-                                      title), out / "control.png"))
-    return paths
+    figs["control"] = signals_figure(p["t"], p["u"], p["u_continuous"],
+                                     p["triggered"].astype(bool), p["green_commanded"],
+                                     p["green_running"], p["queue"],
+                                     res.meter["light_changes"], res.meter["plan_changes"],
+                                     title)
+    return figs

@@ -3,13 +3,10 @@ and the mainline outflow against the meter's green share."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 
-from arzsumo.io import atomic_file
 from arzsumo.units import ms_to_kmh, veh_s_to_veh_h
 
 
@@ -52,12 +49,3 @@ def calibration_figure(points: dict[str, tuple[np.ndarray, np.ndarray]],
     axes[2].set_title("Outflow against green share (medium demand)")
     axes[2].grid(alpha=0.3)
     return fig
-
-
-def write_calibration_figure(path: str | Path, *args: object, **kwargs: object) -> Path:
-    """Draw :func:`calibration_figure` and save it as PNG at ``path`` (atomically)."""
-    fig = calibration_figure(*args, **kwargs)  # type: ignore[arg-type]
-    with atomic_file(path) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
-    plt.close(fig)
-    return Path(path)

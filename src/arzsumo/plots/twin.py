@@ -1,19 +1,19 @@
 """Figures of a twin run: space-time fields per class (the paper's figures open-loop and
 cl_event, as heatmaps) and the control input with release instants (figure event-control).
 
-Two layers: ``*_figure`` functions take arrays and return a Figure; :func:`write_twin_plots`
-takes a :class:`arzsumo.engines.twin.TwinRun` and saves PNGs atomically.
+``*_figure`` functions take arrays and return a Figure; :func:`twin_figures` takes a
+:class:`arzsumo.engines.twin.TwinRun` and returns the three figures of a run by name.
+Nothing is written here: :func:`arzsumo.outputs.figures.save_figures` saves them.
 """
 
 from __future__ import annotations
 
-from pathlib import Path
+from typing import Any
 
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 
-from arzsumo.plots import save_png
 from arzsumo.units import ms_to_kmh, veh_m_to_veh_km, veh_s_to_veh_h
 
 _CLASS = {"h": ("HVs", 0), "a": ("AVs", 2)}
@@ -98,26 +98,28 @@ def control_figure(control_t: np.ndarray, u_applied: np.ndarray, events: np.ndar
     return fig
 
 
-def _save(fig: Figure, path: Path) -> Path:
-    return save_png(fig, path, dpi=110)
+def twin_figures(run: Any) -> dict[str, Figure]:
+    """The figures of a twin run, by name: ``fields_h``, ``fields_a``, ``control``.
 
+    Parameters
+    ----------
+    run : TwinRun
+        Read by attribute (:class:`arzsumo.engines.twin.TwinRun`): the result's fields in
+        SI, the control history (veh/s), the events and the deviation norm.
 
-def write_twin_plots(run, out: str | Path) -> list[Path]:
-    """Save fields_h.png, fields_a.png and control.png of a :class:`TwinRun` into ``out``."""
-    out = Path(out)
+    Returns
+    -------
+    dict of str to Figure
+        Open figures; the caller saves and closes them.
+    """
     r, eq = run.result, run.scenario.equilibrium
     tag = f"{run.scenario.name}, {r.controller.name}"
     if not r.complete:
         tag += " (INCOMPLETE)"
-    paths = [
-        _save(fields_figure(r.t, r.x, r.fields, "h", (eq.rho_h, eq.v_h), tag),
-              out / "fields_h.png"),
-        _save(fields_figure(r.t, r.x, r.fields, "a", (eq.rho_a, eq.v_a), tag),
-              out / "fields_a.png"),
-    ]
+    figs = {"fields_h": fields_figure(r.t, r.x, r.fields, "h", (eq.rho_h, eq.v_h), tag),
+            "fields_a": fields_figure(r.t, r.x, r.fields, "a", (eq.rho_a, eq.v_a), tag)}
     log = r.controller.log
     cont = np.asarray(log.u_continuous) if len(log.u_continuous) == r.control_t.size else None
-    paths.append(_save(control_figure(r.control_t, r.control_u, run.events, cont, r.u_range,
-                                      r.t, run.norm, run.release_time, tag),
-                       out / "control.png"))
-    return paths
+    figs["control"] = control_figure(r.control_t, r.control_u, run.events, cont, r.u_range,
+                                     r.t, run.norm, run.release_time, tag)
+    return figs
