@@ -76,7 +76,7 @@ from arzsumo.sumo.plant import SumoPlant
 from arzsumo.sumo.run_files import FCD_FILE, RunFiles
 from arzsumo.sumo.sensor import PeriodMeasurement
 from arzsumo.sumo.simulation import SumoSimulation, open_simulation
-from arzsumo.sumo.window import WindowStart, measure_network
+from arzsumo.sumo.window import NetworkMeasures, WindowStart, measure_network
 from arzsumo.twin.solver import SolverOptions
 
 log = logging.getLogger(__name__)
@@ -175,6 +175,7 @@ class Controlled:
     warmup_meter: dict[str, float]
     start: WindowStart
     estimator: RecordedEstimator
+    settings: RunSettings
 
 
 def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
@@ -224,16 +225,23 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
     finally:
         shutil.rmtree(net_dir, ignore_errors=True)
     bar.close()
+    return _result(c, scenario, cfg, meter_summary, sim, network, placement, files,
+                   time.perf_counter() - wall0)
+
+
+def _result(c: Controlled, scenario: Scenario, cfg: SumoConfig, meter: dict[str, Any],
+            sim: SumoSimulation, network: NetworkMeasures, placement: str, files: RunFiles,
+            wall_time: float) -> CoSimResult:
+    """The :class:`CoSimResult` of a finished run."""
     loop, trace = c.loop, c.trace
     sensor = loop.plant.sensor
     return CoSimResult(
-        scenario=scenario, settings=settings, sumo=cfg, equilibrium=c.eq, q_nominal=c.q_nom,
-        t=np.asarray(trace.t), x=trace.x, micro=np.asarray(trace.micro),
+        scenario=scenario, settings=c.settings, sumo=cfg, equilibrium=c.eq,
+        q_nominal=c.q_nom, t=np.asarray(trace.t), x=trace.x, micro=np.asarray(trace.micro),
         replay=np.asarray(trace.replay), reference=np.asarray(trace.reference),
-        periods=columns(records), controller_log=loop.controller.log,
-        reference_log=c.ref_ctrl.log, meter=meter_summary, report=sim.report,
-        twin_status=loop.twins.status(), placement=placement,
-        wall_time=time.perf_counter() - wall0,
+        periods=columns(trace.records), controller_log=loop.controller.log,
+        reference_log=c.ref_ctrl.log, meter=meter, report=sim.report,
+        twin_status=loop.twins.status(), placement=placement, wall_time=wall_time,
         timings={**loop.plant.timings, **loop.timings}, warmup_meter=c.warmup_meter,
         network=network, section_speed=sensor.speeds.summary(), start=trace.start,
         estimate=np.asarray(c.estimator.fields[1:]), estimator=c.estimator,
@@ -281,4 +289,5 @@ def control(sim: SumoSimulation, scenario: Scenario, settings: RunSettings, cfg:
     loop = ClosedLoop(plant, estimator, ctrl, actuator, twins, period, act.anti_windup,
                       shift)
     trace = loop.run(warm[-1], cfg.horizon, bar)
-    return Controlled(loop, trace, ref_ctrl, eq, q_nom, warmup_meter, start, estimator)
+    return Controlled(loop, trace, ref_ctrl, eq, q_nom, warmup_meter, start, estimator,
+                      settings)
