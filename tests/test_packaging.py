@@ -99,7 +99,8 @@ def test_installed_wheel_runs_from_another_directory(wheel, tmp_path):
                            capture_output=True, text=True, check=True).stdout.strip()
     assert Path(where).is_relative_to(venv)
     proc = subprocess.run([str(venv / "bin" / "arzsumo"), "run", "--horizon", "30",
-                           "--warmup", "30", "--quiet", "--no-plots", "--out", "r"],
+                           "--warmup", "30", "--allow-short-warmup", "--quiet", "--no-plots",
+                           "--out", "r"],
                           cwd=elsewhere, env=env,
                           capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr[-2000:]

@@ -8,6 +8,7 @@ repository root are symbolic links to these directories.
 
 from __future__ import annotations
 
+import re
 from importlib.resources import files
 from pathlib import Path
 
@@ -45,3 +46,38 @@ def shipped_nets_dir() -> Path:
 def default_scenario() -> Path:
     """The shipped default scenario file of ``arzsumo run``."""
     return shipped_scenarios_dir() / DEFAULT_SCENARIO_NAME
+
+
+#: directories (under the shipped scenarios) of the files a scenario argument may name
+SCENARIO_DIRS = (".", "paper")
+#: directory of the files a sweep argument may name
+SWEEP_DIRS = ("sweeps",)
+_NAME = re.compile(r"^(?:([A-Za-z0-9_-]+)/)?([A-Za-z0-9_.-]+?)(?:\.toml)?$")
+
+
+def shipped_names(dirs: tuple[str, ...] = SCENARIO_DIRS) -> list[str]:
+    """Names of the shipped files in ``dirs``, in order: the file stems (``default``,
+    ``base_etc``), which :func:`shipped_named` resolves."""
+    root = shipped_scenarios_dir()
+    return [f.stem for d in dirs for f in sorted((root / d).glob("*.toml"))]
+
+
+def shipped_named(name: str, dirs: tuple[str, ...] = SCENARIO_DIRS) -> Path | None:
+    """The shipped file called ``name`` in ``dirs``, or None.
+
+    ``name`` is a file stem (``default``, ``base_etc``), with ``.toml`` or not, or
+    ``DIR/STEM`` (``paper/base_etc``) with DIR one of ``dirs``; the first of ``dirs``
+    holding it wins (the stems are unique across the shipped files).
+    """
+    m = _NAME.match(name)
+    if m is None:
+        return None
+    sub, stem = m.groups()
+    if sub is not None and (sub not in dirs or sub == "."):
+        return None
+    root = shipped_scenarios_dir()
+    for d in (sub,) if sub else dirs:
+        path = root / d / f"{stem}.toml"
+        if path.is_file():
+            return path
+    return None

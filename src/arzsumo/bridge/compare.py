@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import json
 import math
+import textwrap
 from pathlib import Path
 from typing import Any
 
@@ -29,17 +30,26 @@ class CompareError(ArzsumoError, ValueError):
     """Results that are missing, not ``arzsumo run`` results, or not comparable."""
 
 
-#: (column, header in the text table)
+#: (column, header in the text table): the identity, then the measures the project judges
+#: a controller by (whole-demand time spent, the ramp's 95th-percentile wait, the network's
+#: time loss), then the rest; every header states its unit (:data:`LEGEND` the long ones)
 COLUMNS: tuple[tuple[str, str], ...] = (
     ("scenario", "scenario"), ("horizon_s", "horizon s"), ("warmup_s", "warm-up s"),
     ("controller", "controller"), ("seed", "seed"), ("kind", "kind"),
     ("whole_tts_veh_h", "whole TTS veh.h"), ("ramp_wait_p95_s", "ramp wait p95 s"),
-    ("plan_changes", "plan chg"),
-    ("light_changes", "light chg"), ("triggers", "updates"), ("release_time", "release s"),
-    ("TTT_veh_h", "TTT veh.h"), ("delay_veh_h", "delay veh.h"), ("J_fuel", "J_fuel"),
-    ("J_discom", "J_discom"), ("speed_sd_h_kmh", "sd v_h km/h"),
-    ("speed_sd_a_kmh", "sd v_a km/h"), ("max_ramp_queue", "max queue"),
-    ("rmse_rho_rel", "replay RMSE rho"), ("rmse_v_rel", "replay RMSE v"))
+    ("network_time_loss_veh_h", "time loss veh.h"),
+    ("TTT_veh_h", "TTT veh.h"), ("delay_veh_h", "delay vs V veh.h"),
+    ("plan_changes", "plan chg n"), ("light_changes", "light chg n"),
+    ("triggers", "updates n"), ("release_time", "release s"), ("J_fuel", "J_fuel veh"),
+    ("J_discom", "J_discom SI"), ("speed_sd_h_kmh", "sd v_h km/h"),
+    ("speed_sd_a_kmh", "sd v_a km/h"), ("max_ramp_queue", "max queue veh"),
+    ("rmse_rho_rel", "replay RMSE rho 1"), ("rmse_v_rel", "replay RMSE v 1"))
+#: printed under the text table: what the short headers mean
+LEGEND = ("whole TTS: every vehicle of the demand to its arrival; time loss: SUMO's "
+          "timeLoss + depart delay over the window (>= 0); TTT and delay vs V: the section "
+          "(delay vs V = TTT - TMT / V_free with the model's free speeds, negative where "
+          "SUMO drives faster); n: counts; J_discom SI: veh m^2/s^3 + veh m^2/s^5; replay "
+          "RMSE: relative (1)")
 #: identity columns that must agree between compared rows (unless mixing is allowed)
 MUST_AGREE = ("kind", "scenario", "horizon_s", "warmup_s")
 #: what each kind of result is, for messages and headers
@@ -79,6 +89,11 @@ def _total(summ: dict[str, Any], *keys: str) -> float:
     return float("nan")
 
 
+def _sd_kmh(variance: float | None) -> float:
+    """Standard deviation, km/h, of a speed variance in m^2/s^2 (NaN when None; 0 is 0)."""
+    return math.nan if variance is None else math.sqrt(variance) * 3.6
+
+
 def row_of(summ: dict[str, Any]) -> dict[str, Any]:
     """One flat row (identity, then metrics in human units) from a result's summary."""
     rm = summ.get("rmse", {}).get("replay", {})
@@ -100,10 +115,10 @@ def row_of(summ: dict[str, Any]) -> dict[str, Any]:
         "TTT_veh_h": _total(summ, "TTT", "J_TTT") / 3600.0,
         "delay_veh_h": _total(summ, "total_delay") / 3600.0,
         "J_fuel": _total(summ, "J_fuel"), "J_discom": _total(summ, "J_discom"),
-        "speed_sd_h_kmh": (var.get("h") or float("nan")) ** 0.5 * 3.6,
-        "speed_sd_a_kmh": (var.get("a") or float("nan")) ** 0.5 * 3.6,
+        "speed_sd_h_kmh": _sd_kmh(var.get("h")), "speed_sd_a_kmh": _sd_kmh(var.get("a")),
         "max_ramp_queue": summ.get("max_ramp_queue"),
         "rmse_rho_rel": rel("rho_h", "rho_a"), "rmse_v_rel": rel("v_h", "v_a"),
+        "network_time_loss_veh_h": _total(summ.get("network") or {}, "time_loss_s") / 3600.0,
     }
 
 
@@ -142,13 +157,15 @@ def header(df: pd.DataFrame) -> str:
 def summary_table(summaries: list[dict[str, Any]]) -> str:
     """Text table of results (one row each) under a header line (:func:`header`).
 
-    The identity columns shared by every row are in the header, not the rows.
+    The identity columns shared by every row are in the header, not the rows; the
+    columns follow :data:`COLUMNS`, each header with its unit, :data:`LEGEND` below.
     """
     df = pd.DataFrame([row_of(s) for s in summaries])
     mix = differing(df)
-    drop = [c for c in ("scenario", "horizon_s", "warmup_s", "kind") if c not in mix]
-    body = df.drop(columns=drop).rename(columns=dict(COLUMNS))
-    return header(df) + "\n" + body.to_string(index=False, float_format=lambda v: f"{v:.3g}")
+    drop = {c for c in ("scenario", "horizon_s", "warmup_s", "kind") if c not in mix}
+    body = df[[c for c, _ in COLUMNS if c not in drop]].rename(columns=dict(COLUMNS))
+    table = body.to_string(index=False, float_format=lambda v: f"{v:.3g}")
+    return f"{header(df)}\n{table}\n{textwrap.fill(LEGEND, 100)}"
 
 
 def load_summaries(runs: list[Path]) -> list[dict[str, Any]]:

@@ -67,9 +67,20 @@ class PreparedRun:
                 f"  controller {s.controller}, start {s.start}, warm-up {s.warmup:g} s + "
                 f"control horizon {c.horizon:g} s, SUMO seed {c.seed}, step {c.step_length:g} s"
                 f"\n  equilibrium {s.equilibrium} (scenario lambda_4 = {lam4:.2f} km/h)"
-                f"\n  estimation {self.scenario.estimation.method} from sensors "
-                f"{', '.join(self.scenario.sensing.kinds)}"
+                f"\n  {self.sensing()}"
                 + ("\n  SUMO's FCD output kept (fcd.xml.gz)" if c.fcd else ""))
+
+    def sensing(self) -> str:
+        """What the controller reads: the estimator and its sensors (observer-ETC: the
+        boundary loops only, or the inlet speeds of the paper's observer)."""
+        method = self.scenario.estimation.method
+        if self.settings.controller == "observer-etc":
+            if acting_controller(method, "observer-etc") == "observer-etc":
+                return ("observer-etc on the paper's boundary observer: inlet speeds only "
+                        "(no estimator, [estimation] method = none)")
+            return (f"estimation {method} from the boundary loops only (x = 0 and x = L), "
+                    "the ETC acting on that estimate")
+        return f"estimation {method} from sensors {', '.join(self.scenario.sensing.kinds)}"
 
 
 def _seed(seed: int) -> int:

@@ -243,6 +243,16 @@ def meter_summary(res: CoSimResult) -> dict[str, Any]:
     return {k: res.meter.get(k) for k in METER_KEYS}
 
 
+def finite_variance(values: np.ndarray) -> float:
+    """``numpy.nanvar`` of ``values`` (their unit squared, here m^2/s^2).
+
+    NaN, without numpy's "Degrees of freedom <= 0" warning, when every value is NaN: no
+    vehicle of the class was sampled in the window (a section still empty).
+    """
+    values = np.asarray(values, float)
+    return float(np.nanvar(values)) if (~np.isnan(values)).any() else float("nan")
+
+
 def summary(res: CoSimResult) -> RunSummary:
     """The run's summary: meter counts, events, indices (micro and twins), fidelity, accounting.
 
@@ -271,7 +281,7 @@ def summary(res: CoSimResult) -> RunSummary:
         lambda_4=float(linearize(res.equilibrium).eigenvalues[3]),
         q_nominal=res.q_nominal, horizon=horizon, warmup=warmup_summary(res), counts=counts,
         meter=meter_summary(res),
-        speed_variance={"h": float(np.nanvar(v[:, 0])), "a": float(np.nanvar(v[:, 1]))},
+        speed_variance={"h": finite_variance(v[:, 0]), "a": finite_variance(v[:, 1])},
         micro=micro, section=section_summary(res, micro),
         network=net.window if net else None,
         network_whole_run=net.whole_run if net else None,

@@ -115,24 +115,32 @@ def check_controllers(controllers: Sequence[str]) -> list[str]:
 
 
 def evaluation_spec(scenario: Path, controllers: Sequence[str], seeds: Sequence[int],
-                    horizon: float | None = None) -> SweepSpec:
+                    horizon: float | None = None, warmup: float | None = None) -> SweepSpec:
     """The sweep of an evaluation: ``scenario`` x controllers x seeds (``horizon``: the
-    control horizon, s, instead of ``[sumo] horizon_s``)."""
+    control horizon, s, instead of ``[sumo] horizon_s``; ``warmup``: the warm-up, s,
+    instead of ``[run] warmup_s``)."""
     scenario = Path(scenario).resolve()
     name = re.sub(r"[^A-Za-z0-9._-]", "_", f"evaluate-{scenario.stem}")
     data: dict = {"name": name, "base": str(scenario), "engine": "sumo",
                   "seeds": list(seeds),
                   "axis": [{"field": "run.controller", "name": "controller",
                             "values": list(controllers)}]}
+    changes: dict = {}
     if horizon is not None:
-        data["set"] = {"sumo": {"horizon_s": float(horizon)}}
+        changes["sumo"] = {"horizon_s": float(horizon)}
+    if warmup is not None:
+        changes["run"] = {"warmup_s": float(warmup)}
+    if changes:
+        data["set"] = changes
     spec = sweep_from_dict(data, f"arzsumo evaluate {scenario}", root=scenario.parent)
+    warm = "" if warmup is None else f"# warmup_s = {warmup}\n"
     return replace(spec, text=f"# arzsumo evaluate (built in code)\n# base = {scenario}\n"
                               f"# controllers = {list(controllers)}\n# seeds = {list(seeds)}"
-                              f"\n# horizon_s = {horizon}\n")
+                              f"\n# horizon_s = {horizon}\n{warm}")
 
 
-def check_runs(scenario: Path, controllers: Sequence[str], horizon: float | None) -> str:
+def check_runs(scenario: Path, controllers: Sequence[str], horizon: float | None,
+               warmup: float | None = None) -> str:
     """What ``arzsumo run`` checks, for every controller, before any SUMO run starts;
     returns the scenario's name."""
     from arzsumo.bridge.session import prepare_run
@@ -140,7 +148,7 @@ def check_runs(scenario: Path, controllers: Sequence[str], horizon: float | None
 
     sc = load_scenario(scenario)
     for c in controllers:
-        prepare_run(sc, controller=c, horizon=horizon)
+        prepare_run(sc, controller=c, horizon=horizon, warmup=warmup)
     return sc.name
 
 
@@ -244,12 +252,13 @@ def borrowed_controller(spec: SweepSpec, source: Path) -> pd.DataFrame | None:
 
 
 def _borrow(scenario: Path, controllers: Sequence[str], seeds: Sequence[int],
-            horizon: float | None, sources: Sequence[Path]) -> dict[str, pd.DataFrame]:
+            horizon: float | None, warmup: float | None,
+            sources: Sequence[Path]) -> dict[str, pd.DataFrame]:
     """Per controller found complete in one of ``sources``, its borrowed rows."""
     out: dict[str, pd.DataFrame] = {}
     for c in controllers:
         for source in sources:
-            table = borrowed_controller(evaluation_spec(scenario, [c], seeds, horizon),
+            table = borrowed_controller(evaluation_spec(scenario, [c], seeds, horizon, warmup),
                                         Path(source))
             if table is not None:
                 out[c] = table.assign(borrowed_from=str(source))
@@ -271,7 +280,8 @@ def _forget_previous(out: Path, user: str) -> None:
 
 
 def run_evaluation(scenario: Path, controllers: Sequence[str], seeds: Sequence[int], *,
-                   out: Path, horizon: float | None = None, workers: int | None = None,
+                   out: Path, horizon: float | None = None, warmup: float | None = None,
+                   workers: int | None = None,
                    scheduler: str | None = None, overwrite: bool = False,
                    progress: bool = True, plots: bool = True,
                    command: str = "", baseline_from: Path | None = None,
@@ -281,7 +291,8 @@ def run_evaluation(scenario: Path, controllers: Sequence[str], seeds: Sequence[i
 
     ``out`` may be new, empty, or a previous evaluation: continued (runs already finished
     with the same resolved scenario are not run again), or started afresh with
-    ``overwrite``. ``command`` is printed at the top of ``evaluation.md``.
+    ``overwrite``. ``horizon`` and ``warmup`` (s) replace ``[sumo] horizon_s`` and ``[run]
+    warmup_s``. ``command`` is printed at the top of ``evaluation.md``.
     ``baseline_from``: take the open-loop runs from this earlier evaluation (module
     docstring) instead of running them. ``runs_from``: earlier evaluations or sweeps;
     every controller whose runs on all ``seeds`` one of them holds (the same SUMO runs:
@@ -289,24 +300,25 @@ def run_evaluation(scenario: Path, controllers: Sequence[str], seeds: Sequence[i
     is taken from there instead of run.
     """
     controllers = check_controllers(controllers)
-    name = check_runs(scenario, controllers, horizon)
+    name = check_runs(scenario, controllers, horizon, warmup)
     borrowed = pd.DataFrame()
     if baseline_from is not None:
         if len(controllers) == 1:
             raise SweepError(f"--controllers = {BASELINE!r} is not allowed with "
                              "--baseline-from: nothing would run; allowed: at least one "
                              "controller besides the open loop")
-        borrowed = borrowed_baseline(evaluation_spec(scenario, [BASELINE], seeds, horizon),
-                                     Path(baseline_from), str(baseline_from))
+        borrowed = borrowed_baseline(
+            evaluation_spec(scenario, [BASELINE], seeds, horizon, warmup),
+            Path(baseline_from), str(baseline_from))
     taken = _borrow(scenario, controllers[1:] if baseline_from else controllers, seeds,
-                    horizon, runs_from)
+                    horizon, warmup, runs_from)
     to_run = [c for c in (controllers[1:] if baseline_from else controllers)
               if c not in taken]
     if overwrite:
         _forget_previous(Path(out), str(out))
     rep, target = None, Path(out)
     if to_run:
-        rep = run_sweep(evaluation_spec(scenario, to_run, seeds, horizon), out,
+        rep = run_sweep(evaluation_spec(scenario, to_run, seeds, horizon, warmup), out,
                         workers=workers, scheduler=scheduler, progress=progress,
                         plots=False, kind=KIND)
         target = rep.out

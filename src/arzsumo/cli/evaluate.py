@@ -1,8 +1,10 @@
 """``arzsumo evaluate SCENARIO --controllers LIST --seeds N``: controllers on the same seeds
 in SUMO, compared with the open loop seed by seed.
 
-Checks the scenario for every controller (as ``arzsumo run`` would) before any run,
-then calls :func:`arzsumo.sweep.evaluate.run_evaluation` and prints where the report is.
+Checks the scenario for every controller (as ``arzsumo run`` would, the warm-up against
+the scenario's fill phase included) before any run, then calls
+:func:`arzsumo.sweep.evaluate.run_evaluation` and prints the headline differences and
+where the report is.
 Exit codes: 0 every run finished, 4 some runs were invalid, failed or crashed (the
 report uses the seeds that finished for both members of a pair), 2 a user error.
 """
@@ -14,22 +16,37 @@ import shlex
 import sys
 from pathlib import Path
 
-from arzsumo.cli_args import positive_float, positive_int, seed_int
+from arzsumo.cli.args import positive_float, positive_int, seed_int
+from arzsumo.cli.options import (
+    add_no_plots,
+    add_out,
+    add_overwrite,
+    add_parallel,
+    add_quiet,
+    add_scenario,
+    add_warmup,
+)
+from arzsumo.cli.scenarios import check_warmup, load_named
 
 EXIT_SOME_FAILED = 4
+#: the measures printed, in the report's order: whole-demand time spent, the ramp's
+#: 95th-percentile wait, the network's time loss over the window
+HEADLINES = ("network_whole_demand.time_spent_s.total", "network_whole_demand.ramp_wait_s.p95",
+             "network.time_loss_s.total")
 
 
 def cmd_evaluate(args: argparse.Namespace) -> int:
     from arzsumo.sweep.evaluate import BASELINE, run_evaluation
-    from arzsumo.sweep.evaluate import WHOLE_DEMAND_KEY as HEADLINE
 
-    scenario = Path(args.scenario)
+    scenario, sc = load_named(args.scenario)
+    check_warmup(sc, args.warmup, args.horizon, args.allow_short_warmup)
     seeds = list(range(args.seed_start, args.seed_start + args.seeds))
     controllers = [c.strip() for c in args.controllers.split(",") if c.strip()]
     out = Path(args.out) if args.out else Path("results") / "evaluate" / scenario.stem
     command = "arzsumo " + " ".join(shlex.quote(a) for a in sys.argv[1:]) \
         if sys.argv[1:2] == ["evaluate"] else ""
     res = run_evaluation(scenario, controllers, seeds, out=out, horizon=args.horizon,
+                         warmup=args.warmup,
                          workers=args.workers, scheduler=args.scheduler,
                          overwrite=args.overwrite, progress=not args.quiet,
                          plots=not args.no_plots, command=command,
@@ -45,7 +62,7 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
     if bad is not None:
         for _, row in bad.iterrows():
             print(f"  {row['run_id']}: {row['status']}: {str(row['error']).splitlines()[0]}")
-    main = res.table[res.table["measure"].isin([HEADLINE, "network.time_loss_s.total"])]
+    main = res.table[res.table["measure"].isin(HEADLINES)]
     for r in main.itertuples(index=False):
         if r.controller != BASELINE:
             print(f"  {r.label} ({r.unit}), {r.controller} minus {BASELINE}: "
@@ -63,7 +80,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                                    "report per measure the mean with its 95 % CI and the "
                                    "paired difference against the open loop with its 95 % "
                                    "CI, wins and losses.")
-    p.add_argument("scenario", metavar="SCENARIO.toml", help="scenario file")
+    add_scenario(p)
     p.add_argument("--controllers",
                    default="open,held,alinea,pi-alinea,backstepping,etc,observer-etc",
                    help="comma-separated controllers; open (the baseline) is added first "
@@ -74,26 +91,23 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="first seed S: the seeds are S, S+1, ..., S+N-1")
     p.add_argument("--horizon", type=positive_float,
                    help="control horizon after the warm-up, s (default: [sumo] horizon_s)")
-    p.add_argument("--workers", type=positive_int,
-                   help="local processes (default: one per core); ignored with --scheduler")
-    p.add_argument("--scheduler", metavar="ADDRESS",
-                   help="Dask scheduler address, e.g. tcp://SCHEDULER-HOST:8786")
-    p.add_argument("--out", metavar="DIR",
-                   help="output directory (default results/evaluate/<scenario file name>); "
-                        "a restart with the same directory runs only what is missing")
-    p.add_argument("--overwrite", action="store_true",
-                   help="discard the runs and report of a previous evaluation in --out and "
-                        "run everything again")
+    add_warmup(p, "warm-up under the nominal meter before control, s; at least the "
+                  "scenario's fill phase (default: [run] warmup_s)")
+    add_parallel(p)
+    add_out(p, "output directory (default results/evaluate/<scenario file name>); a "
+               "restart with the same directory runs only what is missing")
+    add_overwrite(p, "evaluation", "discard the runs and report of a previous evaluation "
+                                   "in --out and run everything again")
     p.add_argument("--baseline-from", metavar="DIR",
                    help="take the open-loop runs from the earlier evaluation in DIR instead "
-                        "of running them (same seeds and horizon; its scenario may differ "
-                        "only in what does not act on an open loop: [estimation], "
+                        "of running them (same seeds, horizon and warm-up; its scenario may "
+                        "differ only in what does not act on an open loop: [estimation], "
                         "[sensing], [actuation], [design], [run] controller)")
     p.add_argument("--runs-from", metavar="DIR", action="append",
                    help="an earlier evaluation or sweep (repeatable): a controller whose "
                         "runs on all the seeds are there, the same SUMO runs (scenarios "
                         "that differ only in what that controller does not read), is taken "
                         "from there instead of run")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
-    p.add_argument("--no-plots", action="store_true", help="skip the figure")
+    add_quiet(p)
+    add_no_plots(p, "skip the figure")
     p.set_defaults(func=cmd_evaluate)

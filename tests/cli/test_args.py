@@ -11,9 +11,9 @@ from pathlib import Path
 import pytest
 
 from arzsumo.cli import build_parser, main
-from arzsumo.cli_args import cells_int, positive_float, positive_int, seed_int
+from arzsumo.cli.args import cells_int, positive_float, positive_int, seed_int
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.mark.parametrize(("helper", "text", "value"), [
@@ -80,7 +80,7 @@ def test_every_command_has_help_and_description():
     commands = _subparsers(build_parser())
     assert {"model", "kernels", "verify", "design-check", "twin", "reproduce", "build-net",
             "calibrate", "run", "compare", "alinea-target", "sweep", "evaluate", "identify",
-            "list"} == set(commands)
+            "list", "study"} == set(commands)
     for name, p in commands.items():
         assert p.description and len(p.description) > 30, name
 
@@ -101,13 +101,18 @@ def test_help_shows_defaults_environment_and_exit_codes(capsys):
     assert "--dry-run" in run and "(default: [sumo] horizon_s)" in run
 
 
-def test_list_shows_shipped_scenarios_and_sweeps(capsys, monkeypatch):
+def test_list_shows_shipped_names_and_where_they_run(capsys, monkeypatch):
     monkeypatch.chdir(ROOT)
     assert main(["list"]) == 0
     out = capsys.readouterr().out
-    assert "scenarios/default.toml" in out
+    assert "scenarios/" not in out and ".toml" not in out      # names, not package paths
+    lines = out.splitlines()
+    sumo = lines.index(next(x for x in lines if x.startswith("SUMO scenarios")))
+    twin = lines.index(next(x for x in lines if x.startswith("twin-only scenarios")))
+    assert sumo < lines.index(next(x for x in lines if x.split()[:1] == ["default"])) < twin
+    assert lines.index(next(x for x in lines if x.split()[:1] == ["paper_base"])) > twin
     assert "Stationary congested section in SUMO (fill, then hold" in out
-    assert "scenarios/sweeps/penetration_twin.toml" in out
+    assert any(x.split()[:2] == ["penetration_twin", "[twin]"] for x in lines)
     assert main(["list", "--json"]) == 0
     files = json.loads(capsys.readouterr().out)
     data = ROOT / "src" / "arzsumo" / "data"      # the package's own copy (shipped)
@@ -116,3 +121,7 @@ def test_list_shows_shipped_scenarios_and_sweeps(capsys, monkeypatch):
     assert all(f["description"] for f in files)         # every shipped file says what it is
     groups = {f["name"]: f["group"] for f in files}
     assert groups["demand_sumo"].startswith("sweeps") and groups["base_etc"].startswith("paper")
+    where = {f["name"]: f["runs_in"] for f in files}
+    assert where["default"] == where["legacy_default"] == where["demand_sumo"] == "sumo"
+    assert where["paper_base"] == where["base_etc"] == where["penetration_twin"] == "twin"
+    assert len(groups) == len(files)                    # every name is one file

@@ -13,7 +13,9 @@ import argparse
 import logging
 from pathlib import Path
 
-from arzsumo.cli_args import non_negative_int, positive_float, positive_int, seed_list
+from arzsumo.cli.args import non_negative_int, positive_float, positive_int
+from arzsumo.cli.options import add_out, add_overwrite, add_scenario, add_seeds, add_workers
+from arzsumo.cli.scenarios import load_named
 
 log = logging.getLogger("arzsumo")
 
@@ -21,12 +23,10 @@ log = logging.getLogger("arzsumo")
 def cmd_identify(args: argparse.Namespace) -> int:
     from arzsumo.identify import FitSettings
     from arzsumo.outdir import OutputDir
-    from arzsumo.scenario import load_scenario
     from arzsumo.studies.identify import make_setup, run_identification
     from arzsumo.studies.identify_report import write_study
 
-    path = Path(args.scenario)
-    sc = load_scenario(path)
+    path, sc = load_named(args.scenario)
     setup = make_setup(sc, args.train_seeds, args.validate_seeds, vary=args.vary or (),
                        which=args.which, horizon=args.horizon, warmup=args.warmup,
                        fit=FitSettings(max_nfev=args.max_nfev, bootstrap=args.bootstrap),
@@ -62,11 +62,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                                    "least squares, Jacobian and bootstrap uncertainties), "
                                    "validate on both sets, and write a ready-to-run "
                                    "scenario with the identified model.")
-    p.add_argument("scenario", metavar="SCENARIO.toml", help="scenario file")
-    p.add_argument("--train-seeds", type=seed_list, required=True, metavar="SEEDS",
-                   help="training seeds, e.g. 1,2,3 or 1-3")
-    p.add_argument("--validate-seeds", type=seed_list, required=True, metavar="SEEDS",
-                   help="held-out validation seeds (none of the training seeds)")
+    add_scenario(p)
+    add_seeds(p, "training seeds, e.g. 1,2,3 or 1-3", flag="--train-seeds", required=True)
+    add_seeds(p, "held-out validation seeds (none of the training seeds)",
+              flag="--validate-seeds", required=True)
     p.add_argument("--vary", action="append", metavar="TABLE.KEY=V1,V2",
                    help="operating points: a scenario key and its values (file units), "
                         "e.g. sumo.green_share=0.4,0.5,0.6; repeat for a product")
@@ -78,14 +77,11 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="bootstrap refits over training runs drawn with replacement")
     p.add_argument("--max-nfev", type=positive_int, default=40, metavar="N",
                    help="largest number of least-squares steps (scipy's max_nfev)")
-    p.add_argument("--workers", type=positive_int,
-                   help="SUMO runs in parallel (default: one per core)")
+    add_workers(p, "SUMO runs in parallel (default: one per core)")
     p.add_argument("--horizon", type=positive_float,
                    help="control horizon of each run, s (default: [sumo] horizon_s)")
     p.add_argument("--warmup", type=positive_float,
                    help="warm-up of each run, s (default: [run] warmup_s)")
-    p.add_argument("--out", metavar="DIR",
-                   help="output directory (default results/identify/<scenario file name>)")
-    p.add_argument("--overwrite", action="store_true",
-                   help="replace a previous identification in --out")
+    add_out(p, "output directory (default results/identify/<scenario file name>)")
+    add_overwrite(p, "identify")
     p.set_defaults(func=cmd_identify)

@@ -16,10 +16,11 @@ import pytest
 from arzsumo.outdir import MARKER, write_marker
 from tests.test_outdir import checksums, result
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 TWIN = str(ROOT / "scenarios" / "paper_base.toml")
 # a short warm-up: these tests are about where results go, not about the fill phase
-RUN = ("run", "--warmup", "30", "--horizon", "60", "--no-plots", "--quiet")
+RUN = ("run", "--warmup", "30", "--allow-short-warmup", "--horizon", "60", "--no-plots",
+       "--quiet")
 
 
 def cli_cmd(*args: str) -> list[str]:

@@ -12,7 +12,7 @@ import pytest
 
 from arzsumo.cli import main
 
-SCENARIO = Path(__file__).resolve().parents[1] / "scenarios" / "default.toml"
+SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "default.toml"
 
 
 def _run_dir(path: Path, seed: int) -> Path:

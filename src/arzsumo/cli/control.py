@@ -6,8 +6,9 @@ import argparse
 import json
 import time
 
-from arzsumo.cli_args import cells_int, positive_float
-from arzsumo.cli_common import add_model_source, scenario_of
+from arzsumo.cli.args import cells_int, positive_float
+from arzsumo.cli.options import add_json, add_model_source
+from arzsumo.cli.scenarios import scenario_of
 from arzsumo.control.registry import pde_controller_names
 from arzsumo.errors import require
 from arzsumo.kernel_cache import cached_kernels
@@ -107,7 +108,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--period", type=positive_float, default=1.0, help="check period, s")
     p.add_argument("--horizon", type=positive_float, default=450.0, help="run length, s")
     _add_design(p)
-    p.add_argument("--json", action="store_true", help="print JSON")
+    add_json(p)
     p.set_defaults(func=cmd_verify)
 
     p = sub.add_parser("design-check", help="ETC design conditions select1-select4 and tau*",
@@ -119,7 +120,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--auto", action="store_true",
                    help="choose the design for this model (arzsumo.control.design."
                         "design_for), print it as a [design] table, then check it")
-    p.add_argument("--json", action="store_true", help="print JSON")
+    add_json(p)
     p.set_defaults(func=cmd_design_check)
 
 

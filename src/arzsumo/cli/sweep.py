@@ -10,7 +10,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from arzsumo.cli_args import positive_int
+from arzsumo.cli.options import add_no_plots, add_out, add_parallel, add_quiet
+from arzsumo.cli.scenarios import sweep_file
 
 EXIT_SOME_FAILED = 4
 
@@ -20,7 +21,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     from arzsumo.sweep import load_sweep, run_sweep
     from arzsumo.sweep.worker import FINISHED
 
-    spec = load_sweep(args.sweep)
+    spec = load_sweep(sweep_file(args.sweep))
     if args.list:
         for run in spec.runs():
             print(run.run_id)
@@ -48,15 +49,13 @@ def register(sub: argparse._SubParsersAction) -> None:
                                    "seeds) into runs, run what is not finished yet, and write "
                                    "one table and plots. 'arzsumo list' shows the shipped "
                                    "sweep files.")
-    p.add_argument("sweep", metavar="SWEEP.toml", help="sweep file (base, engine, axes)")
-    p.add_argument("--workers", type=positive_int,
-                   help="local processes (default: one per core); ignored with --scheduler")
-    p.add_argument("--scheduler", metavar="ADDRESS",
-                   help="Dask scheduler address, e.g. tcp://SCHEDULER-HOST:8786")
-    p.add_argument("--out", metavar="DIR",
-                   help="output directory (default results/sweeps/<name>); a restart with "
-                        "the same directory runs only what is missing")
+    p.add_argument("sweep", metavar="SWEEP",
+                   help="sweep file (base, engine, axes), or a shipped sweep name "
+                        "('arzsumo list')")
+    add_parallel(p)
+    add_out(p, "output directory (default results/sweeps/<name>); a restart with the same "
+               "directory runs only what is missing")
     p.add_argument("--list", action="store_true", help="print the run IDs and exit")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
-    p.add_argument("--no-plots", action="store_true", help="skip the PNG figures")
+    add_quiet(p)
+    add_no_plots(p)
     p.set_defaults(func=cmd_sweep)

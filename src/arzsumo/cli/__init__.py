@@ -1,0 +1,122 @@
+"""Command-line interface: one thin command per stage, one module per command or group.
+
+``arzsumo.cli.options`` declares the options the commands share; each command module
+(``run``, ``compare``, ``evaluate``, ...) adds its parser with ``register(sub)``. Each
+command loads and validates its input, calls one library function and prints or
+saves. User mistakes (:class:`arzsumo.errors.ArzsumoError`) end as one line on stderr
+with exit code 2; Ctrl-C (SIGINT) ends as ``arzsumo: interrupted`` with exit code 130,
+after the command's temporary files are removed; logging is configured here and nowhere
+else.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import logging
+import os
+import signal
+import sys
+import threading
+from collections.abc import Callable, Sequence
+
+from arzsumo import __version__
+from arzsumo.cli import (
+    compare,
+    control,
+    evaluate,
+    identify,
+    listing,
+    model,
+    reproduce,
+    run,
+    study,
+    sumo,
+    sweep,
+    twin,
+)
+from arzsumo.cli.args import Parser
+from arzsumo.errors import ArzsumoError
+from arzsumo.interrupts import EXIT_INTERRUPTED
+
+log = logging.getLogger("arzsumo")
+
+Command = Callable[[argparse.Namespace], int]
+
+#: what adds each command, in the order ``arzsumo --help`` lists them
+REGISTER: tuple[Callable[[argparse._SubParsersAction], None], ...] = (
+    model.register, control.register, twin.register, reproduce.register, sumo.register,
+    run.register, compare.register, sumo.register_alinea_target, sweep.register,
+    evaluate.register, identify.register, listing.register, study.register)
+
+
+EPILOG = """\
+environment variables:
+  ARZSUMO_CACHE      directory of the backstepping kernel cache (kernels in its kernels/)
+                     (default: ~/.cache/arzsumo)
+  ARZSUMO_SUMO_NETS  directory of the SUMO network written by 'arzsumo build-net'
+                     (default: the network shipped in the package, arzsumo/data/sumo_nets)
+
+exit codes:
+  0    done
+  2    user error (bad argument, scenario or sweep file): one line on stderr
+  3    the PDE twin left the physical domain (twin, reproduce: partial results written)
+  4    some sweep runs were invalid, failed or crashed (sweep, evaluate: the others
+       completed)
+  130  interrupted (Ctrl-C)
+
+'arzsumo list' shows the shipped scenario and sweep files; 'arzsumo CMD --help' each
+command's options."""
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``arzsumo`` parser with every command of :data:`REGISTER`."""
+    parser = Parser(
+        prog="arzsumo",
+        description="PDE boundary control of mixed-autonomy traffic, from the ARZ model "
+                    "into SUMO.", epilog=EPILOG)
+    parser.add_argument("--version", action="version", version=f"arzsumo {__version__}")
+    parser.add_argument("-v", "--verbose", action="store_true", help="debug logging")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    for register in REGISTER:
+        register(sub)
+    return parser
+
+
+def _interrupt(signum: int, frame: object) -> None:
+    # a second Ctrl-C must not cut short the removal of the partial output
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    raise KeyboardInterrupt
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run ``arzsumo ARGV`` (``sys.argv[1:]`` when None); return the exit code."""
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # --help, --version, or a refused argument (one line printed)
+        return int(exc.code or 0)
+    logging.basicConfig(level=logging.DEBUG if args.verbose else logging.INFO,
+                        format="%(levelname)s %(name)s: %(message)s")
+    logging.getLogger("matplotlib").setLevel(logging.WARNING)
+    func: Command = args.func
+    main_thread = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGINT, _interrupt) if main_thread else None
+    try:
+        return func(args)
+    except ArzsumoError as exc:
+        print(f"arzsumo: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("arzsumo: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except BrokenPipeError:  # `arzsumo ... | head`: the reader left; no traceback
+        with contextlib.suppress(OSError):
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
+    finally:
+        if main_thread:
+            signal.signal(signal.SIGINT, previous)
+
+
+__all__ = ["build_parser", "main"]

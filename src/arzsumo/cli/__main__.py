@@ -1,0 +1,8 @@
+"""``python -m arzsumo.cli``: the ``arzsumo`` command."""
+
+import sys
+
+from arzsumo.cli import main
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,97 @@
+"""``arzsumo run [SCENARIO]``: one closed loop in SUMO with the PDE twins alongside.
+
+Checks the scenario and the options as the run would (:func:`arzsumo.bridge.session.
+prepare_run`, and a warm-up that outlasts the scenario's fill phase,
+:func:`arzsumo.cli.scenarios.check_warmup`), claims the output directory, runs SUMO
+(:func:`arzsumo.bridge.session.run_prepared`, on what was checked), writes the results
+and prints the summary table. ``--dry-run`` makes the same checks and prints what the run would do.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from arzsumo.cli.args import positive_float
+from arzsumo.cli.options import (
+    add_json,
+    add_no_plots,
+    add_out,
+    add_overwrite,
+    add_quiet,
+    add_scenario,
+    add_seed,
+    add_warmup,
+)
+from arzsumo.cli.scenarios import check_warmup, load_named
+from arzsumo.control.registry import controller_names
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    from arzsumo.bridge.session import default_run_name, prepare_run, run_prepared
+    from arzsumo.outdir import OutputDir
+    from arzsumo.outputs.bridge import write_results
+    from arzsumo.sumo.frontend import Frontend
+
+    # a shipped name or the shipped default is found in the package: any directory will do
+    path, sc = load_named(args.scenario)
+    fcd = True if args.fcd else None   # without --fcd the scenario's [sumo] fcd holds
+    prepared = prepare_run(sc, controller=args.controller, seed=args.seed,
+                           horizon=args.horizon, warmup=args.warmup, fcd=fcd)
+    check_warmup(sc, args.warmup, args.horizon, args.allow_short_warmup)
+    frontend = "gui" if args.gui else "libsumo"
+    Frontend(frontend).check()   # no display or no sumo-gui: one line, before any output
+    if args.dry_run:
+        print(prepared.describe())
+        return 0
+    out = Path(args.out) if args.out else Path("results") / default_run_name(
+        sc, prepared.settings, prepared.sumo)
+    # the output is checked and claimed before SUMO starts; Ctrl-C or an error removes it
+    with OutputDir(out, "run", overwrite=args.overwrite) as target:
+        session = run_prepared(prepared, progress=not args.quiet, frontend=frontend)
+        text = path.read_text(encoding="utf-8") + session.resolved_comment()
+        _, summ = write_results(session.result, target, text, plots=not args.no_plots)
+    if args.json:
+        from arzsumo.io import json_safe
+
+        print(json.dumps(json_safe(summ), indent=2))
+    else:
+        from arzsumo.bridge.compare import summary_table
+
+        print(summary_table([summ]))
+        print(f"results: {out}")
+    return 0
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add ``run`` to the top-level parser."""
+    p = sub.add_parser("run", help="closed loop in SUMO with the PDE twin alongside",
+                       description="Run a scenario's closed loop in SUMO: warm-up under the "
+                                   "nominal meter, then the [run] controller on the ramp "
+                                   "meter, with the PDE twins alongside; write the results.")
+    add_scenario(p, optional=True)
+    add_out(p, "results directory (default results/NAME-CONTROLLER-seedN-hTs)")
+    add_overwrite(p, "run")
+    add_seed(p, "[sumo] seed")
+    p.add_argument("--controller", choices=list(controller_names("sumo")),
+                   help="controller (default: [run] controller)")
+    p.add_argument("--horizon", type=positive_float,
+                   help="control horizon after the warm-up, s; at least one control period "
+                        "(default: [sumo] horizon_s)")
+    add_warmup(p, "warm-up under the nominal meter before control, s; at least the "
+                  "scenario's fill phase (default: [run] warmup_s; the name of the default "
+                  "--out then ends in -wWs)")
+    p.add_argument("--dry-run", action="store_true",
+                   help="check the scenario and the options as the run would, print what "
+                        "it would do, and exit without starting SUMO")
+    p.add_argument("--fcd", action="store_true",
+                   help="keep SUMO's trajectories of every vehicle every step in "
+                        "fcd.xml.gz (as [sumo] fcd = true)")
+    p.add_argument("--gui", action="store_true",
+                   help="watch the run in sumo-gui (driven through TraCI; slower; needs a "
+                        "display)")
+    add_quiet(p)
+    add_no_plots(p)
+    add_json(p, "print the summary as JSON")
+    p.set_defaults(func=cmd_run)
