@@ -67,14 +67,14 @@ def test_the_table_leads_with_the_judged_measures_each_with_its_unit():
                          "time loss veh.h"]
     row = text.splitlines()[2].split()
     assert row[:5] == ["etc", "1", "10", "95", "0.5"]            # 36000 s, 95 s, 1800 s
-    units = ("veh.h", " s", "km/h", " n", " veh", " SI", " 1")
+    units = ("veh.h", " s", "km/h", " n", " veh", " SI", " %")
     measures = [h for c, h in COLUMNS if c not in ("scenario", "controller", "seed", "kind")]
     assert all(h.endswith(units) for h in measures), measures
     assert "J_discom SI: veh m^2/s^3 + veh m^2/s^5" in " ".join(text.split())
 
 
 def test_the_figure_draws_no_negative_delay(tmp_path, monkeypatch):
-    import arzsumo.plots as plots
+    import arzsumo.outputs.figures as plots
     from arzsumo.outputs.compare import compare_runs
 
     figures = []

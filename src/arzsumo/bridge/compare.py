@@ -43,13 +43,15 @@ COLUMNS: tuple[tuple[str, str], ...] = (
     ("triggers", "updates n"), ("release_time", "release s"), ("J_fuel", "J_fuel veh"),
     ("J_discom", "J_discom SI"), ("speed_sd_h_kmh", "sd v_h km/h"),
     ("speed_sd_a_kmh", "sd v_a km/h"), ("max_ramp_queue", "max queue veh"),
-    ("rmse_rho_rel", "replay RMSE rho 1"), ("rmse_v_rel", "replay RMSE v 1"))
+    ("replay_rho_h_pct", "replay rho_h %"), ("replay_rho_a_pct", "replay rho_a %"),
+    ("reference_rho_h_pct", "ref rho_h %"), ("reference_rho_a_pct", "ref rho_a %"))
 #: printed under the text table: what the short headers mean
 LEGEND = ("whole TTS: every vehicle of the demand to its arrival; time loss: SUMO's "
           "timeLoss + depart delay over the window (>= 0); TTT and delay vs V: the section "
           "(delay vs V = TTT - TMT / V_free with the model's free speeds, negative where "
           "SUMO drives faster); n: counts; J_discom SI: veh m^2/s^3 + veh m^2/s^5; replay "
-          "RMSE: relative (1)")
+          "and ref rho %: the twin's density error against SUMO, RMSE on 100 m x 10 s "
+          "blocks relative to the equilibrium density, per class")
 #: identity columns that must agree between compared rows (unless mixing is allowed)
 MUST_AGREE = ("kind", "scenario", "horizon_s", "warmup_s")
 #: what each kind of result is, for messages and headers
@@ -96,11 +98,11 @@ def _sd_kmh(variance: float | None) -> float:
 
 def row_of(summ: dict[str, Any]) -> dict[str, Any]:
     """One flat row (identity, then metrics in human units) from a result's summary."""
-    rm = summ.get("rmse", {}).get("replay", {})
+    blocks = summ.get("rmse_blocks") or {}
 
-    def rel(*names: str) -> float:
-        vals = [rm[n]["relative"] for n in names if n in rm and rm[n]["relative"] is not None]
-        return sum(vals) / len(vals) if vals else float("nan")
+    def pct(twin: str, name: str) -> float:
+        value = (blocks.get(twin) or {}).get(name, {}).get("relative")
+        return float("nan") if value is None else 100.0 * value
 
     var = summ.get("speed_variance", {})
     whole = summ.get("network_whole_demand") or {}
@@ -117,7 +119,9 @@ def row_of(summ: dict[str, Any]) -> dict[str, Any]:
         "J_fuel": _total(summ, "J_fuel"), "J_discom": _total(summ, "J_discom"),
         "speed_sd_h_kmh": _sd_kmh(var.get("h")), "speed_sd_a_kmh": _sd_kmh(var.get("a")),
         "max_ramp_queue": summ.get("max_ramp_queue"),
-        "rmse_rho_rel": rel("rho_h", "rho_a"), "rmse_v_rel": rel("v_h", "v_a"),
+        "replay_rho_h_pct": pct("replay", "rho_h"), "replay_rho_a_pct": pct("replay", "rho_a"),
+        "reference_rho_h_pct": pct("reference", "rho_h"),
+        "reference_rho_a_pct": pct("reference", "rho_a"),
         "network_time_loss_veh_h": _total(summ.get("network") or {}, "time_loss_s") / 3600.0,
     }
 

@@ -47,6 +47,10 @@ def cmd_identify(args: argparse.Namespace) -> int:
                         ("validation", study.validation)):
         rel = ", ".join(f"{v} {e['relative']:.1%}" for v, e in score.pooled.items())
         print(f"  relative RMSE, {role}: {rel}; objective {score.total:.3g}")
+        blocks = ", ".join(f"{r.name} rho_h {r.rmse['rho_h']['blocks_relative']:.1%} "
+                           f"rho_a {r.rmse['rho_a']['blocks_relative']:.1%}"
+                           for r in score.runs)
+        print(f"    on 100 m x 10 s blocks (as run and compare print it): {blocks}")
     print(f"results: {out}")
     return 0
 
