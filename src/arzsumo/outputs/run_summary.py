@@ -108,7 +108,7 @@ class RunSummary:
         """Whole-demand total time spent, veh h (NaN when the run is not complete)."""
         if not self.whole_demand_complete:
             return math.nan
-        return float(self.network_whole_demand["total"]["time_spent_s"]) / 3600.0
+        return float(self.network_whole_demand["time_spent_s"]["total"]) / 3600.0
 
     @cached_property
     def _dict(self) -> dict[str, Any]:
