@@ -24,10 +24,8 @@ import numpy as np
 
 from arzsumo.control.base import MacroState
 from arzsumo.model.equilibrium import Equilibrium
+from arzsumo.model.params import VARIABLES
 from arzsumo.scenario.estimation import REFERENCES
-
-#: the variables of an offset, in order (SI: veh/m, m/s, veh/m, m/s)
-VARIABLES = ("rho_h", "v_h", "rho_a", "v_a")
 
 
 @dataclass(frozen=True)

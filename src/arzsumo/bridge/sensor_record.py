@@ -31,6 +31,7 @@ from arzsumo.estimate.observations import LoopObservation, ProbeObservation
 from arzsumo.evaluation.fields import field_rmse
 from arzsumo.io import atomic_file
 from arzsumo.model.equilibrium import Equilibrium
+from arzsumo.model.params import VARIABLES
 from arzsumo.scenario import Scenario
 from arzsumo.scenario.estimation import EstimationSettings
 from arzsumo.sumo.loops import placed_positions
@@ -43,7 +44,6 @@ SUPERSET_SPACING = 50.0
 #: the recorded superset, as ``[sensing]`` keys
 SUPERSET = {"sensing.kinds": ["loops", "av_probes"],
             "sensing.loop_spacing_m": SUPERSET_SPACING, "sensing.av_probe_share": 1.0}
-VARIABLES = ("rho_h", "v_h", "rho_a", "v_a")
 _CELLS = ("rho_h", "rho_a", "q_h", "q_a", "samples_h", "samples_a")
 _FLOWS = ("inflow_h", "inflow_a", "outflow_h", "outflow_a")
 

@@ -18,9 +18,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from arzsumo.errors import ArzsumoError
+from arzsumo.model.params import VARIABLES
 
-#: Variable names, in the storage order of fields, inlet, initial and scale.
-VARIABLES = ("rho_h", "v_h", "rho_a", "v_a")
 #: Their SI units.
 UNITS = ("veh/m", "m/s", "veh/m", "m/s")
 

@@ -17,10 +17,11 @@ from arzsumo.model.equilibrium import (
     equilibrium_from_densities,
 )
 from arzsumo.model.fd import area_occupancy, equilibrium_speeds, speed_jacobian
-from arzsumo.model.params import PRESETS, ModelParameters, Preset, get_preset
+from arzsumo.model.params import PRESETS, VARIABLES, ModelParameters, Preset, get_preset
 
 __all__ = [
     "PRESETS",
+    "VARIABLES",
     "CharacteristicSystem",
     "Equilibrium",
     "Linearization",

@@ -19,6 +19,10 @@ from dataclasses import dataclass, fields, replace
 from arzsumo.errors import ModelError, require
 from arzsumo.units import kmh_to_ms, veh_km_to_veh_m
 
+#: the macroscopic fields, in the storage order of every field array of the package:
+#: HV density (veh/m), HV speed (m/s), AV density (veh/m), AV speed (m/s)
+VARIABLES = ("rho_h", "v_h", "rho_a", "v_a")
+
 
 def _positive(name: str, value: float) -> None:
     require(isinstance(value, int | float) and math.isfinite(value) and value > 0,

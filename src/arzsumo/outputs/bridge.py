@@ -51,6 +51,7 @@ from arzsumo.evaluation.fields import field_rmse, oscillation, wave_travel
 from arzsumo.evaluation.stationarity import count_trend
 from arzsumo.io import json_safe
 from arzsumo.model.characteristic import linearize
+from arzsumo.model.params import VARIABLES
 from arzsumo.outdir import OutputDir, atomic_dir, target_of
 from arzsumo.outputs.run_summary import (
     Accounting,
@@ -63,7 +64,6 @@ from arzsumo.schema import CELLS, PERIODS, with_units
 from arzsumo.twin.metrics import performance
 from arzsumo.units import ms_to_kmh
 
-VARIABLES = ("rho_h", "v_h", "rho_a", "v_a")
 #: SUMO's tripinfo output of the run (every loaded vehicle), gzip-compressed
 TRIPINFO_GZ = "tripinfo.xml.gz"
 
