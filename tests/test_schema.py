@@ -148,3 +148,14 @@ def test_docs_give_every_summary_key(table):
     for pattern, unit in table.items():
         if unit != "-":
             assert f"`{pattern}` | {unit} |" in text, pattern
+
+
+def test_the_docs_example_opens_the_directory_make_run_writes():
+    from arzsumo.bridge.session import default_run_name
+    from arzsumo.scenario import load_scenario
+
+    root = Path(__file__).resolve().parents[1]
+    sc = load_scenario(root / "scenarios" / "default.toml")
+    (opened,) = re.findall(r'pq\.read_table\("results/([^/]+)/periods\.parquet"\)',
+                           DOC.read_text(encoding="utf-8"))
+    assert opened == default_run_name(sc, sc.run, sc.sumo)
