@@ -19,6 +19,18 @@ test: $(STAMP)
 	$(BIN)/lint-imports
 	$(BIN)/python -m pytest -q -n 2
 
+# make bench: the quick benchmarks (numerics only, no SUMO; 1-2 min), each printing ratios;
+# the SUMO ones (bench_cosim, bench_sensing, bench_sumo_measurement, bench_network_measures,
+# bench_estimation_cost, bench_evaluate) and bench_sweep take longer: run them by hand
+bench: $(STAMP)
+	OPENBLAS_NUM_THREADS=1 $(BIN)/python benchmarks/bench_etc.py
+	OPENBLAS_NUM_THREADS=1 $(BIN)/python benchmarks/bench_kernels.py
+	OPENBLAS_NUM_THREADS=1 $(BIN)/python benchmarks/bench_compensation_cost.py --checks 500
+	OPENBLAS_NUM_THREADS=1 $(BIN)/python benchmarks/bench_delay_predictor.py --delays 0 6 14
+	OPENBLAS_NUM_THREADS=1 $(BIN)/python benchmarks/bench_estimate.py --periods 50
+	OPENBLAS_NUM_THREADS=1 $(BIN)/python benchmarks/bench_identify.py --quick
+	OPENBLAS_NUM_THREADS=1 $(BIN)/python benchmarks/bench_twin.py --quick
+
 lint: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks
 

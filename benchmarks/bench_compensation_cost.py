@@ -1,4 +1,4 @@
-"""Cost of the delay predictor per control check (issue 17, point 1c).
+"""Cost of the delay predictor per control check, against the plain check.
 
 Times ``check`` of backstepping and the ETC, plain and wrapped in
 :class:`~arzsumo.control.compensation.DelayCompensated` (prediction theta s ahead with the

@@ -1,4 +1,4 @@
-"""Cost of the estimators per control period (issue 16), on the default 1 km grid.
+"""Cost of the estimators per control period, on the default 1 km grid.
 
 The default scenario's model at its congested equilibrium with a 5 % stop-and-go wave;
 loops every 250 m (both boundaries) and every AV as a probe, 1 s periods. Prints the wall
@@ -85,7 +85,7 @@ def bench_grid(eq, cells: int, periods: int) -> None:
             periods)))
     rows.append(("32 single twins (TwinStepper, first order)", t_single))
     print(f"\n{cells} cells ({p.length / cells:g} m), {periods} periods of 1 s")
-    print(f"{'estimator':<44} {'ms/period':>10} {'/ 32 singles':>13}")
+    print(f"{'estimator':<44} {'ms/period':>10} {'ratio to 32 singles':>13}")
     for name, sec in rows:
         print(f"{name:<44} {sec * 1e3:10.2f} {sec / t_single:13.2f}")
 

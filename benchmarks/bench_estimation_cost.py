@@ -1,4 +1,4 @@
-"""Co-simulation wall time with each estimator (issue 16): none, smoothing, enkf (32).
+"""Co-simulation wall time with each estimator: none, smoothing, enkf (32).
 
 ``scenarios/legacy_default.toml`` (150 s warm-up; ``--scenario`` another, e.g. the
 default with its 600 s fill, ``--warmup`` to override), a short control horizon (120 s by

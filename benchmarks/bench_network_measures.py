@@ -17,9 +17,8 @@ from pathlib import Path
 
 from arzsumo.model import get_preset
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.meter_release import make_meter
 from arzsumo.sumo.network_measures import network_options, network_summary
-from arzsumo.sumo.sensor import ramp_queue
+from arzsumo.sumo.plant import SumoPlant
 from arzsumo.sumo.simulation import open_simulation
 
 
@@ -29,10 +28,9 @@ def run(cfg: SumoConfig, out: Path | None) -> tuple[float, float, float, int]:
     extra = network_options(out) if out is not None else []
     t0, c0 = time.perf_counter(), time.process_time()
     with open_simulation(params, cfg, extra_args=extra, output_dir=out) as sim:
-        meter = make_meter(sim.lib, cfg)
+        plant = SumoPlant(sim, params.length, cfg, measure=False)
         while sim.time < cfg.horizon - 1e-9:
-            sim.step()
-            meter.step(ramp_queue(sim.lib))
+            plant.step()
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     assert sim.report is not None
     if out is None:

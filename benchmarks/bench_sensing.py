@@ -95,7 +95,7 @@ def main() -> None:
     print(f"{sc.name}: {args.horizon:g} s, step {sc.sumo.step_length:g} s, period "
           f"{sc.sumo.control_period:g} s; bare SUMO {base:.3f} ms per period")
     print(f"{'spacing':>8} {'stations':>8}  {'component':18} {'ms/period':>10} "
-          f"{'/ bare step':>10}")
+          f"{'ratio to bare step':>10}")
     for spacing in (float(s) for s in args.spacings.split(",")):
         spent, n = run(sc, args.horizon, spacing)
         k = len(SensorLayout(("loops",), loop_spacing=spacing).loop_x(sc.params.length))

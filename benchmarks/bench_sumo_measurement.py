@@ -15,10 +15,11 @@ import argparse
 import math
 import time
 
+from arzsumo.bridge.actuator import command_meter
 from arzsumo.model import get_preset
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.meter_release import make_meter
-from arzsumo.sumo.sensor import SumoSensor
+from arzsumo.sumo.meter import DEFAULT_CURVE
+from arzsumo.sumo.plant import SumoPlant
 from arzsumo.sumo.simulation import open_simulation
 
 
@@ -35,20 +36,17 @@ def run(cfg: SumoConfig, measured: bool) -> tuple[float, float, float, int, floa
     with open_simulation(params, cfg) as sim:
         lib = sim.lib
         if measured:
-            meter = make_meter(lib, cfg)
-            sensor = SumoSensor(lib, params.length, cfg)
-            q_star = meter.curve.outflow_at(cfg.green_share)
+            plant = SumoPlant(sim, params.length, cfg)
+            meter = plant.meter
+            q_star = DEFAULT_CURVE.outflow_at(cfg.green_share)
             while sim.time < cfg.horizon - 1e-9:
-                t = sim.step()
-                a = clock()
-                data = sensor.observe(t)
-                meter.step(sensor.queue)
+                data = plant.step()
                 if data is not None:   # a controller would run here; command a varying U
-                    meter.command_outflow(q_star + 0.05 * math.sin(t / 20.0))
-                inside += clock() - a
+                    command_meter(meter, 0.05 * math.sin(sim.time / 20.0), q_star)
                 on_net += lib.vehicle.getIDCount()
                 steps += 1
-            meter_summary = meter.summary()
+            inside = plant.timings["measure_actuate"]
+            meter_summary = plant.meter_summary()
         else:
             while sim.time < cfg.horizon - 1e-9:
                 sim.step()

@@ -1,4 +1,4 @@
-"""``arzsumo study NAME``: one sub-command per catalogue entry, with the common options."""
+"""``arzsumo study NAME``: one sub-command per catalogue entry, with the study's options."""
 
 from __future__ import annotations
 
@@ -7,9 +7,9 @@ import argparse
 import pytest
 
 from arzsumo.cli import main
-from arzsumo.cli.args import Parser
-from arzsumo.cli.options import add_common_study_options
+from arzsumo.cli.study import register
 from arzsumo.studies.catalog import STUDIES, Study
+from arzsumo.studies.common import add_output, add_runs
 
 
 @pytest.fixture
@@ -18,6 +18,8 @@ def seen(monkeypatch) -> list[argparse.Namespace]:
     calls: list[argparse.Namespace] = []
 
     def add(p: argparse.ArgumentParser) -> None:
+        add_output(p, "probe", "probe")
+        add_runs(p, "1-2")
         p.add_argument("--horizon", type=float, default=450.0, help="control horizon, s")
 
     def run(args: argparse.Namespace) -> int:
@@ -34,7 +36,7 @@ def test_a_study_gets_the_common_options_and_its_own(seen, capsys):
                  "--horizon", "60"]) == 7
     (args,) = seen
     assert args.seeds == [1, 2, 3, 7] and args.workers == 2 and args.quiet is True
-    assert args.out == "results/studies/probe" and args.no_plots is False
+    assert args.out.as_posix() == "results/studies/probe" and args.no_plots is False
     assert args.scheduler is None and args.horizon == 60.0
     assert main(["study", "--help"]) == 0
     text = capsys.readouterr().out
@@ -49,18 +51,16 @@ def test_study_refusals_are_one_line(seen, capsys):
     assert seen == []
 
 
-def test_an_empty_catalogue_says_so(capsys):
+def test_every_study_of_the_catalogue_is_a_sub_command(capsys):
     assert main(["study", "--help"]) == 0
-    assert "no studies are registered yet" in capsys.readouterr().out
+    text = capsys.readouterr().out
+    assert all(name in text for name in STUDIES) and len(STUDIES) >= 12
+    for name in STUDIES:                       # each parses its own options, no clash
+        assert main(["study", name, "--help"]) == 0
 
 
-def test_common_options_are_added_once_and_out_is_required_without_a_default():
-    p = Parser(prog="x")
-    add_common_study_options(p)
-    add_common_study_options(p)                 # a second call adds nothing
-    flags = [f for a in p._actions for f in a.option_strings]
-    assert len(flags) == len(set(flags))
-    with pytest.raises(SystemExit):
-        p.parse_args([])
-    args = p.parse_args(["--out", "o", "--no-plots"])
-    assert (args.out, args.no_plots, args.seeds, args.workers) == ("o", True, None, None)
+def test_an_empty_catalogue_says_so():
+    parser = argparse.ArgumentParser()
+    register(parser.add_subparsers(), {})
+    study = parser._subparsers._group_actions[0].choices["study"]
+    assert "no studies are registered yet" in study.format_help()

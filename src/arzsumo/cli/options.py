@@ -5,8 +5,8 @@ a flag means the same and is checked the same in every command: where results go
 (``--out``, ``--overwrite``), how runs execute (``--workers``, ``--scheduler``, ``--quiet``,
 ``--no-plots``), which seeds (``--seed``, ``--seeds``), which scenario (a positional
 ``SCENARIO``, or ``--preset`` | ``--scenario``) and its warm-up (``--warmup``,
-``--allow-short-warmup``). :func:`add_common_study_options` gives every ``arzsumo study``
-sub-command the same set.
+``--allow-short-warmup``). The studies declare their options in
+:mod:`arzsumo.studies.common` (a room below the CLI).
 """
 
 from __future__ import annotations
@@ -18,10 +18,6 @@ from arzsumo.model.params import PRESETS
 
 #: help of --scheduler wherever it appears
 SCHEDULER_HELP = "Dask scheduler address, e.g. tcp://SCHEDULER-HOST:8786"
-
-
-def _has(p: argparse.ArgumentParser, flag: str) -> bool:
-    return any(flag in a.option_strings for a in p._actions)
 
 
 def add_out(p: argparse.ArgumentParser, help: str, *, default: str | None = None,
@@ -114,29 +110,3 @@ def add_warmup(p: argparse.ArgumentParser, help: str) -> None:
                    help="start control before the scenario's fill phase ([sumo] fill_s) "
                         "has ended (refused otherwise: the measures would describe the "
                         "fill)")
-
-
-def add_common_study_options(parser: argparse.ArgumentParser, *,
-                             default_out: str | None = None) -> None:
-    """The options every ``arzsumo study NAME`` has, added once (a flag already there is
-    left alone).
-
-    ``--out DIR`` (``default_out``, else required), ``--workers N``, ``--scheduler
-    ADDRESS``, ``--seeds SEEDS`` (a list; None: the study's own), ``--quiet``,
-    ``--no-plots``. A study's ``run`` reads them as ``args.out``, ``args.workers``,
-    ``args.scheduler``, ``args.seeds``, ``args.quiet``, ``args.no_plots``.
-    """
-    if not _has(parser, "--out"):
-        add_out(parser, "output directory" + (f" (default {default_out})" if default_out
-                                               else ""),
-                default=default_out, required=default_out is None)
-    if not _has(parser, "--workers"):
-        add_workers(parser)
-    if not _has(parser, "--scheduler"):
-        add_scheduler(parser)
-    if not _has(parser, "--seeds"):
-        add_seeds(parser, "SUMO seeds (default: the study's)")
-    if not _has(parser, "--quiet"):
-        add_quiet(parser)
-    if not _has(parser, "--no-plots"):
-        add_no_plots(parser)

@@ -1,17 +1,16 @@
 """``arzsumo study NAME [OPTIONS]``: one sub-command per study of
 :data:`arzsumo.studies.catalog.STUDIES`.
 
-Each sub-command gets the common study options
-(:func:`arzsumo.cli.options.add_common_study_options`, ``--out`` defaulting to
-``results/studies/NAME``), then the study's own (``Study.add_arguments``); running it
-calls ``Study.run``, whose return value is the exit code.
+Each sub-command gets the study's options (``Study.add_arguments``: every study declares
+its own, ``--out`` defaulting to ``results/studies/NAME``, from the shared helpers of
+:mod:`arzsumo.studies.common`); running it calls ``Study.run``, whose return value is the
+exit code.
 """
 
 from __future__ import annotations
 
 import argparse
 
-from arzsumo.cli.options import add_common_study_options
 from arzsumo.studies.catalog import STUDIES, Study
 
 
@@ -34,6 +33,5 @@ def register(sub: argparse._SubParsersAction, studies: dict[str, Study] | None =
     names = p.add_subparsers(dest="study", required=True, metavar="STUDY")
     for study in studies.values():
         s = names.add_parser(study.name, help=study.help, description=study.help)
-        add_common_study_options(s, default_out=f"results/studies/{study.name}")
         study.add_arguments(s)
         s.set_defaults(func=study.run)

@@ -24,7 +24,7 @@ them into a penalty).
 from __future__ import annotations
 
 import logging
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 
@@ -38,6 +38,9 @@ from arzsumo.model.params import ModelParameters
 from arzsumo.twin.boundary import Inlet
 from arzsumo.twin.solver import SolverOptions, TwinStepper, TwinStoppedError
 from arzsumo.twin.state import cell_centres
+
+#: an inlet rule of :func:`run_replay`: (held state, first cell's state) -> boundary state
+InletRule = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
 
 @dataclass(frozen=True)
@@ -87,13 +90,16 @@ class HeldInlet(Inlet):
     """
 
     state: np.ndarray = field(default_factory=lambda: np.ones(4))
+    #: a boundary rule instead of the ghost cell: (held state, first cell's state) ->
+    #: boundary state, each (rho_h, v_h, rho_a, v_a) in SI
+    rule: InletRule | None = None
 
     def hold(self, z: np.ndarray) -> None:
         """Hold the boundary state ``z`` (4,) from now on."""
         self.state[:] = z
 
     def boundary_primitive(self, t: float, z0: np.ndarray) -> np.ndarray:
-        return self.state
+        return self.state if self.rule is None else self.rule(self.state, z0)
 
 
 @dataclass(frozen=True)
@@ -169,16 +175,18 @@ def on_grid(values: np.ndarray, x_from: np.ndarray, x_to: np.ndarray) -> np.ndar
 
 
 def _stepper(params: ModelParameters, data: ReplayData, options: ReplayOptions,
-             x_twin: np.ndarray) -> tuple[TwinStepper, HeldInlet]:
+             x_twin: np.ndarray, rule: InletRule | None = None
+             ) -> tuple[TwinStepper, HeldInlet]:
     init = admissible(params, on_grid(data.initial, data.x, x_twin), options.ao_limit)
     eq = Equilibrium(params, float(init[0].mean()), float(init[2].mean()))
-    inlet = HeldInlet(eq.rho_h, eq.rho_a, eq.q, np.zeros(4))
+    inlet = HeldInlet(eq.rho_h, eq.rho_a, eq.q, np.zeros(4), rule=rule)
     with _quiet_regime():
         return TwinStepper(eq, init, options.solver(), inlet), inlet
 
 
 def run_replay(params: ModelParameters, data: ReplayData,
-               options: ReplayOptions | None = None) -> ReplayRun:
+               options: ReplayOptions | None = None, *,
+               inlet_rule: InletRule | None = None) -> ReplayRun:
     """Replay ``data`` with the twin under ``params``; see the module docstring.
 
     Parameters
@@ -187,6 +195,10 @@ def run_replay(params: ModelParameters, data: ReplayData,
     data : ReplayData
         ``data.x`` must lie in [0, params.length].
     options : ReplayOptions, optional
+    inlet_rule : callable, optional
+        The boundary state at x = 0 from the held (measured) state and the first cell's
+        state, instead of the ghost cell holding the measured state (an alternative inlet
+        condition; ``arzsumo study inlet``).
 
     Returns
     -------
@@ -202,7 +214,7 @@ def run_replay(params: ModelParameters, data: ReplayData,
     out = np.full((data.periods, 4, data.x.size), np.nan)
     inlet_states = admissible(params, data.inlet.T, opts.ao_limit).T
     try:
-        stepper, inlet = _stepper(params, data, opts, x_twin)
+        stepper, inlet = _stepper(params, data, opts, x_twin, inlet_rule)
     except ArzsumoError as exc:                        # start state not representable
         return ReplayRun(out, 0.0, str(exc), 0)
     for k in range(data.periods):

@@ -1,46 +1,37 @@
-"""The catalogue of studies: one ``arzsumo study NAME`` sub-command per entry of
-:data:`STUDIES`.
+"""The studies the CLI offers as ``arzsumo study NAME``: name, one line of help, the
+options each adds to its parser, and the function that runs it.
 
-A study is library code with a CLI verb: its entry says how the command is called
-(``name``, a one-line ``help``), which options it adds (``add_arguments``) and what it
-does (``run``, returning the exit code). ``arzsumo study --help`` lists the entries;
-:mod:`arzsumo.cli.study` builds the sub-commands.
+Every study writes its tables and figures under ``--out`` (default
+``results/studies/NAME``) and, with ``--docs [DIR]``, regenerates its block of its
+results page ``DIR/PAGE.md`` with its files in ``DIR/PAGE/`` (``DIR`` defaults to
+``docs/results``; ``PAGE`` is named by the study's module: ``control_in_sumo`` for
+ablation, ablation-mechanism, held-ramp and wave-speed, ``meter_dynamics``, ``sumo_map``
+for approach, ``sumo_fill`` for fill, ``identified_model`` for inlet,
+``estimation_layouts`` for estimation-layouts and loop-speed, ``enkf_noise``,
+``u_on_estimate``; :mod:`arzsumo.studies.common`). ``run`` returns the exit code (0
+done; 4 some runs were invalid, failed or crashed) and raises
+:class:`~arzsumo.errors.ArzsumoError` for bad input. A study's module is imported only
+when its options or its run are asked for.
 
-Options every study has. Before ``add_arguments`` is called, the CLI gives each
-study's parser the common options of
-:func:`arzsumo.cli.options.add_common_study_options` (the studies room sits below the
-CLI and does not import it): ``--out DIR`` (default ``results/studies/NAME``),
-``--workers N``, ``--scheduler ADDRESS``, ``--seeds SEEDS`` (a list, None when not
-given: the study's own seeds), ``--quiet`` and ``--no-plots``. ``run`` reads them as
-``args.out``, ``args.workers``, ``args.scheduler``, ``args.seeds``, ``args.quiet`` and
-``args.no_plots``; ``add_arguments`` adds only the study's own options (a default of a
-common one may be changed with ``parser.set_defaults``). A user error in ``run`` is an
-:class:`arzsumo.errors.ArzsumoError` (one line, exit code 2).
+Use without the CLI::
 
-Example::
-
-    def _add(parser):
-        parser.add_argument("--horizon", type=float, default=450.0,
-                            help="control horizon, s")
-
-    def _run(args):
-        ...                      # args.out, args.seeds, args.workers, args.horizon
-        return 0
-
-    STUDIES["horizon-scan"] = Study("horizon-scan", "control horizons in SUMO",
-                                    _add, _run)
+    parser = argparse.ArgumentParser()
+    study = STUDIES["ablation"]
+    study.add_arguments(parser)
+    code = study.run(parser.parse_args(["--steps", "identified", "--list"]))
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib
 from collections.abc import Callable
 from dataclasses import dataclass
 
 
 @dataclass(frozen=True)
 class Study:
-    """One study of the catalogue (see the module docstring)."""
+    """One study: the sub-command ``arzsumo study NAME``."""
 
     name: str                      # the sub-command: `arzsumo study NAME`
     help: str                      # one line for `arzsumo study --help`
@@ -48,5 +39,46 @@ class Study:
     run: Callable[[argparse.Namespace], int]   # exit code
 
 
-#: the studies by name, in the order ``arzsumo study --help`` lists them
-STUDIES: dict[str, Study] = {}
+def _lazy(module: str, attribute: str) -> Callable:
+    """``module.attribute``, imported at the first call."""
+    def call(arg):  # type: ignore[no-untyped-def]
+        return getattr(importlib.import_module(module), attribute)(arg)
+
+    call.__name__ = call.__qualname__ = attribute
+    call.__doc__ = f"{module}.{attribute} (imported when called)."
+    return call
+
+
+#: study name -> (module under arzsumo.studies, one line of help)
+_MODULES = {
+    "ablation": ("ablation", "the PDE controllers' ablation in SUMO: the default's "
+                             "controller side, one change at a time"),
+    "ablation-mechanism": ("ablation_mechanism", "what the ablation's controllers did to "
+                                                 "the meter and the section, run by run"),
+    "held-ramp": ("held_ramp", "the ablation's meter step against an open loop held at the "
+                               "least release rate"),
+    "meter-dynamics": ("meter_dynamics", "green-share steps of the meter in SUMO: FOPDT "
+                                         "fits and static levels"),
+    "approach": ("approach", "where SUMO holds a stationary congested section: demand x "
+                             "green share, open loop"),
+    "fill": ("fill", "fill-then-hold demand on the approach network: is the congested "
+                     "section stationary"),
+    "wave-speed": ("wave_speed", "which way SUMO's fluctuations travel on the section "
+                                 "(lagged cross-correlation)"),
+    "inlet": ("inlet", "the identification replay's inlet: ghost cell against the "
+                       "characteristic condition"),
+    "estimation-layouts": ("estimation_layouts", "estimation error against sensor layout, "
+                                                 "per estimator, on recorded SUMO runs"),
+    "loop-speed": ("loop_speed", "the ASM estimate's offset with time-mean against harmonic "
+                                 "loop speeds"),
+    "enkf-noise": ("enkf_noise", "the EnKF's model-error noise, tuned offline on recorded "
+                                 "SUMO runs"),
+    "u-estimate": ("u_estimate", "backstepping's U on raw cells beside U on the ASM and "
+                                 "EnKF estimates, same seed"),
+}
+
+STUDIES: dict[str, Study] = {
+    name: Study(name, text, _lazy(f"arzsumo.studies.{module}", "add_arguments"),
+                _lazy(f"arzsumo.studies.{module}", "run"))
+    for name, (module, text) in _MODULES.items()
+}

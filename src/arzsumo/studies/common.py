@@ -1,0 +1,187 @@
+"""What the studies of :mod:`arzsumo.studies.catalog` share: their command-line options,
+their error type, and the base scenarios they start from.
+
+Every study takes ``--out DIR`` (default ``results/studies/<name>``: tables, figures and
+the runs it made, continued by a later call with the same directory) and ``--docs
+[DIR]`` (also publish: regenerate the study's block of its results page ``DIR/<page>.md``,
+its tables and figures in ``DIR/<page>/``; ``DIR`` defaults to ``docs/results`` under the
+working directory; each study module names its ``PAGE``). Studies
+that run simulations take ``--seeds`` (``1-10`` or ``1,2,3``), ``--workers`` (local
+processes, default one per core), ``--scheduler`` (a Dask cluster instead), ``--quiet``
+(no progress bar) and ``--list`` (print the runs of the design and exit); studies that
+draw take ``--no-plots``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import copy
+import math
+from collections.abc import Callable
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+from arzsumo.errors import ArzsumoError
+from arzsumo.io import read_toml
+from arzsumo.resources import default_scenario, shipped_scenarios_dir
+from arzsumo.sweep.spec import SweepSpec, sweep_from_dict
+
+#: where a study's results go by default (``--out``), relative to the working directory
+RESULTS_DIR = Path("results") / "studies"
+#: where ``--docs`` publishes a study's page by default, relative to the working directory
+DOCS_DIR = Path("docs") / "results"
+#: the ``[sumo]`` keys of the meter realisation (one vehicle per green, with a yellow) that
+#: the shipped default carries; the meter studies and the ablation start from the plain
+#: fixed cycle without them
+METER_KEYS = ("meter_mode", "meter_clearance_s")
+#: SUMO's seed range
+SEED_LIMIT = 2**31
+#: exit code of a study some of whose runs were invalid, failed or crashed (the others
+#: completed; as ``arzsumo sweep`` and ``arzsumo evaluate``)
+EXIT_SOME_FAILED = 4
+
+
+class StudyError(ArzsumoError, ValueError):
+    """A study that cannot run as asked: a missing input, an invalid option value."""
+
+
+# -- argument types ------------------------------------------------------------------------
+def _typed(name: str, kind: type, ok: Callable[[Any], bool], allowed: str
+           ) -> Callable[[str], Any]:
+    """An argparse ``type=``: ``text`` read as ``kind``, refused as "TEXT is not allowed:
+    ALLOWED" unless ``ok``."""
+    def parse(text: str) -> Any:
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text} is not allowed: {allowed}") from None
+        if not ok(value):
+            raise argparse.ArgumentTypeError(f"{text} is not allowed: {allowed}")
+        return value
+
+    parse.__name__ = name
+    return parse
+
+
+positive_int = _typed("positive_int", int, lambda v: v >= 1, "an integer >= 1")
+non_negative_int = _typed("non_negative_int", int, lambda v: v >= 0, "an integer >= 0")
+non_negative_float = _typed("non_negative_float", float,
+                            lambda v: math.isfinite(v) and v >= 0, "a finite number >= 0")
+positive_float = _typed("positive_float", float, lambda v: math.isfinite(v) and v > 0,
+                        "a finite number > 0")
+fraction = _typed("fraction", float, lambda v: 0.0 <= v <= 1.0, "a number in [0, 1]")
+
+
+def seed_list(text: str) -> list[int]:
+    """Seeds ``1,2,3`` or a range ``1-10`` (inclusive), or both: ``1-3,7``."""
+    seeds: list[int] = []
+    for part in (p.strip() for p in text.split(",")):
+        first, sep, last = part.partition("-")
+        try:
+            lo, hi = int(first), int(last) if sep else int(first)
+        except ValueError:
+            lo, hi = -1, -1
+        if not (0 <= lo <= hi < SEED_LIMIT):
+            raise argparse.ArgumentTypeError(
+                f"{text} is not allowed: seeds in [0, 2^31), comma-separated, A-B a range")
+        seeds += list(range(lo, hi + 1))
+    if len(set(seeds)) != len(seeds):
+        raise argparse.ArgumentTypeError(f"{text} is not allowed: a seed repeats")
+    return seeds
+
+
+def number_list(text: str) -> list[float]:
+    """Comma-separated numbers: ``0.2,0.5,0.8``."""
+    try:
+        values = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        values = []
+    if not values or not all(math.isfinite(v) for v in values):
+        raise argparse.ArgumentTypeError(f"{text} is not allowed: comma-separated numbers")
+    return values
+
+
+# -- options -------------------------------------------------------------------------------
+def add_output(parser: argparse.ArgumentParser, name: str, page: str,
+               plots: bool = True) -> None:
+    """``--out`` (default ``results/studies/NAME``), ``--docs`` (the results page
+    ``page``) and, with ``plots``, ``--no-plots``."""
+    parser.add_argument("--out", type=Path, default=RESULTS_DIR / name, metavar="DIR",
+                        help="where the tables, figures and runs go; a later call with "
+                             "the same directory runs only what is missing")
+    parser.add_argument("--docs", type=Path, nargs="?", const=DOCS_DIR, metavar="DIR",
+                        help=f"also regenerate this study's block of the results page "
+                             f"DIR/{page}.md, its files in DIR/{page}/ (DIR: {DOCS_DIR})")
+    if plots:
+        parser.add_argument("--no-plots", action="store_true", help="skip the figures")
+
+
+def add_runs(parser: argparse.ArgumentParser, seeds: str | None) -> None:
+    """``--seeds`` (default ``seeds``; none when None), ``--workers``, ``--scheduler``,
+    ``--quiet``, ``--list``."""
+    if seeds is not None:
+        parser.add_argument("--seeds", type=seed_list, default=seed_list(seeds),
+                            metavar="LIST", help=f"SUMO seeds, e.g. 1-10 or 1,2,3 "
+                                                 f"(default: {seeds})")
+    parser.add_argument("--workers", type=positive_int, metavar="N",
+                        help="local processes (default: one per core); ignored with "
+                             "--scheduler")
+    parser.add_argument("--scheduler", metavar="ADDRESS",
+                        help="run on this Dask scheduler, e.g. tcp://HOST:8786")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    parser.add_argument("--list", action="store_true",
+                        help="print the runs of the design and exit")
+
+
+def plots_wanted(args: argparse.Namespace) -> bool:
+    """Whether the study draws its figures (``--no-plots`` not given)."""
+    return not getattr(args, "no_plots", False)
+
+
+# -- base scenarios ------------------------------------------------------------------------
+def shipped_scenario(name: str) -> Path:
+    """The shipped scenario file ``name`` (``default.toml``, ``legacy_default.toml``)."""
+    return default_scenario() if name == default_scenario().name else \
+        shipped_scenarios_dir() / name
+
+
+def scenario_data(path: Path) -> dict[str, Any]:
+    """The tables of the scenario file ``path`` as a mapping (a copy)."""
+    _, data = read_toml(path, "scenario", StudyError)
+    return copy.deepcopy(data)
+
+
+def fixed_cycle(data: dict[str, Any]) -> dict[str, Any]:
+    """``data`` with the meter realisation keys (:data:`METER_KEYS`) removed: the plain
+    fixed-cycle meter the meter studies and the ablation start from."""
+    out = copy.deepcopy(data)
+    for key in METER_KEYS:
+        out.get("sumo", {}).pop(key, None)
+    return out
+
+
+def seed_text(seeds: list[int]) -> str:
+    """``1-10`` for a run of consecutive seeds, else ``1,3,7``."""
+    seeds = sorted(seeds)
+    if len(seeds) > 2 and seeds == list(range(seeds[0], seeds[-1] + 1)):
+        return f"{seeds[0]}-{seeds[-1]}"
+    return ",".join(map(str, seeds))
+
+
+def study_spec(name: str, base: Path, data: dict[str, Any] | None = None, **keys: Any
+               ) -> SweepSpec:
+    """A sweep built in code for study ``name`` (``keys``: the sweep file's keys, e.g.
+    ``seeds``, ``set``, ``axis``) on the scenario file ``base``, whose tables are
+    replaced by ``data`` when given (a base changed in code, e.g. :func:`fixed_cycle`)."""
+    base = Path(base).resolve()
+    spec = sweep_from_dict({"name": name, "base": str(base), "engine": "sumo", **keys},
+                           f"study {name}", root=base.parent)
+    return spec if data is None else replace(spec, base_data=data)
+
+
+def print_list(run_ids: list[str]) -> int:
+    """``--list``: one run ID per line; exit code 0."""
+    for run_id in run_ids:
+        print(run_id)
+    return 0

@@ -1,0 +1,143 @@
+"""Is the ablation's `meter` gain feedback, or a ramp held at its least release rate?
+(``arzsumo study held-ramp``).
+
+In the ablation's ``meter`` step (one vehicle per green, on the default's controller
+side) the PDE laws lower the network time loss, and they spend much of the window at the
+upper bound of U, where the meter releases at ``release_rate_min``. This study evaluates
+the open loop of the same scenario with the nominal release rate set to that bound (a
+fixed, restrictive meter: no feedback, held from t = 0, the warm-up included) on the
+same seeds, and pairs every run set of the ``meter`` step (its open loop and both laws)
+against it. Because the held meter also holds during the warm-up, this compares two
+policies over the same window; it does not separate feedback from holding within it.
+
+The ``meter`` step is read from ``--ablation DIR`` (``arzsumo study ablation --steps
+identified,meter``); the held ramp's evaluation goes to ``OUT/held``.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from arzsumo.evaluation.report import MEASURES as EVALUATION_MEASURES
+from arzsumo.evaluation.report import Measure, per_seed
+from arzsumo.evaluation.stats import StatisticsError, paired_difference
+from arzsumo.io import dump_toml
+from arzsumo.outdir import resumable_dir
+from arzsumo.outputs.studies import publish, write_text
+from arzsumo.studies import ablation
+from arzsumo.studies.common import (
+    EXIT_SOME_FAILED,
+    RESULTS_DIR,
+    StudyError,
+    add_output,
+    add_runs,
+    plots_wanted,
+    seed_text,
+)
+from arzsumo.sweep.evaluate import BASELINE, run_evaluation
+from arzsumo.sweep.worker import FINISHED
+
+NAME = "held-ramp"
+#: the results page this study keeps a block of (the ablation's)
+PAGE = "control_in_sumo"
+#: the step compared, and its run sets: (label, controller)
+STEP = "meter"
+SETS = (("open loop, nominal rate", BASELINE), ("backstepping", "backstepping"),
+        ("ETC", "etc"))
+#: the measures compared (evaluation keys); max_ramp_queue is not an evaluation measure
+KEYS = ("network.time_loss_s.total", "network.time_loss_s.mainline",
+        "network.time_loss_s.ramp", "network.throughput_veh_h.section_outlet",
+        "section.speed_spread_kmh.h", "section.speed_spread_kmh.a")
+MAX_QUEUE = Measure("max_ramp_queue", "max ramp queue", "veh")
+#: the release rate of the held ramp when the scenario does not name its least one, veh/h
+RELEASE_MIN_VEH_H = 240.0
+
+
+def measures() -> list[Measure]:
+    """The compared measures, with the evaluation's labels, units and scales."""
+    return [next(m for m in EVALUATION_MEASURES if m.key == k) for k in KEYS] + [MAX_QUEUE]
+
+
+def held_scenario() -> dict:
+    """The ``meter`` step's scenario with the nominal release rate at its lower bound."""
+    data, _ = ablation.step_scenario(STEP)
+    low = data["sumo"].get("release_rate_min_veh_h", RELEASE_MIN_VEH_H)
+    data["sumo"]["release_rate_veh_h"] = low
+    data["name"] = "ablation-held-ramp"
+    return data
+
+
+def values(runs: pd.DataFrame, controller: str, m: Measure, seeds: list[int]) -> np.ndarray:
+    """``controller``'s measure ``m`` on ``seeds`` from a sweep table (NaN where missing)."""
+    wide = per_seed(runs, m, [controller])
+    return wide[controller].reindex(seeds).to_numpy(float)
+
+
+def report(meter: pd.DataFrame, held: pd.DataFrame, seeds: list[int]) -> str:
+    """Markdown: per measure, each run set minus the held-ramp open loop, paired by seed
+    (mean [95 % t], and in brackets the seeds lower / higher than the held ramp)."""
+    lines = ["| measure | held ramp (mean) | " + " | ".join(f"{n} minus held" for n, _ in SETS)
+             + " |", "|---" * (2 + len(SETS)) + "|"]
+    for m in measures():
+        base = values(held, BASELINE, m, seeds)
+        cells = []
+        for _, ctrl in SETS:
+            try:
+                d = paired_difference(values(meter, ctrl, m, seeds), base)
+                cells.append(f"{d.mean_diff:+.3g} [{d.t.low:+.3g}, {d.t.high:+.3g}] "
+                             f"({d.wins}/{d.losses})")
+            except StatisticsError:
+                cells.append("")
+        mean = f"{np.nanmean(base):.4g}" if np.isfinite(base).any() else ""
+        lines.append(f"| {m.label} ({m.unit}) | {mean} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The held-ramp study's options."""
+    parser.add_argument("--ablation", type=Path, default=RESULTS_DIR / ablation.NAME,
+                        metavar="DIR", help="the ablation directory holding the meter step")
+    add_runs(parser, seeds="1-10")
+    parser.add_argument("--report", action="store_true",
+                        help="run nothing: the table from the evaluations already there")
+    add_output(parser, NAME, PAGE)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Evaluate the held ramp (resumable) and pair the meter step against it."""
+    if args.list:
+        print(f"held: {BASELINE} on seeds {seed_text(args.seeds)}")
+        return 0
+    meter_table = Path(args.ablation) / STEP / "summaries.parquet"
+    if not meter_table.is_file():
+        raise StudyError(f"--ablation = {str(args.ablation)!r} has no finished {STEP!r} step; "
+                         "allowed: the --out of arzsumo study ablation --steps "
+                         f"identified,{STEP}")
+    ok = True
+    with resumable_dir(args.out, f"study-{NAME}") as out:
+        path = write_text(dump_toml(held_scenario()), out / "held.toml")
+        if not args.report:
+            res = run_evaluation(path, [BASELINE], args.seeds, out=out / "held",
+                                 workers=args.workers, scheduler=args.scheduler,
+                                 progress=not args.quiet, plots=plots_wanted(args))
+            ok = res.sweep is None or bool(res.sweep.table["status"].isin(FINISHED).all())
+        held = out / "held" / "summaries.parquet"
+        if not held.is_file():
+            raise StudyError(f"--out = {str(args.out)!r} has no held-ramp evaluation yet; "
+                             "allowed: a run without --report first")
+        text = report(pd.read_parquet(meter_table), pd.read_parquet(held), args.seeds)
+        files = [write_text(text, out / "held_comparison.md"), (path, "steps/held.toml")]
+        files += [(out / "held" / f"evaluation{x}", f"held{x}") for x in (".csv", ".md")
+                  if (out / "held" / f"evaluation{x}").is_file()]
+        if args.docs is not None:
+            publish(args.docs, PAGE, NAME, "Control in SUMO",
+                    f"The `meter` step against the held ramp, seeds {seed_text(args.seeds)}, "
+                    f"paired (`arzsumo study {NAME}`); the held ramp's evaluation "
+                    f"[held.md]({PAGE}/held.md), its scenario "
+                    f"[steps/held.toml]({PAGE}/steps/held.toml).\n\n{text}", files)
+    print(text)
+    return 0 if ok else EXIT_SOME_FAILED

@@ -1,0 +1,132 @@
+"""The replay's inlet: ghost cell against characteristic (``arzsumo study inlet``).
+
+The identification's replay holds SUMO's smoothed first-cell state in a ghost cell
+(:class:`arzsumo.identify.replay.HeldInlet`). The alternative here (:func:`characteristic`)
+prescribes three measured quantities (the class densities and the total flow) and takes
+the outgoing lambda_4 Riemann variable from the first cell (the paper's inlet condition,
+as in :class:`arzsumo.twin.boundary.Inlet`), falling back to the measured state where
+that gives a speed outside (0, V]. Both replay the last ``--last`` cached identification
+runs (``--runs DIR``, by default the cache ``arzsumo identify`` fills) under the
+scenario's parameters, without refitting; the table gives the relative RMSE per variable
+(rho_h, v_h, rho_a, v_a) on the grid and on 100 m x 10 s blocks (with the cache's 50 m x
+1 s cells).
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from arzsumo.outdir import resumable_dir
+from arzsumo.outputs.studies import markdown_table, publish, write_csv
+from arzsumo.studies.common import (
+    StudyError,
+    add_output,
+    positive_int,
+    shipped_scenario,
+)
+from arzsumo.sweep.driver import map_runs
+
+NAME = "inlet"
+#: the results page this study keeps a block of (the identification's)
+PAGE = "identified_model"
+INLETS = ("ghost", "characteristic")
+VARIABLES = ("rho_h", "v_h", "rho_a", "v_a")
+#: blocks of the second RMSE: periods x cells (10 s x 100 m on 1 s x 50 m data)
+BLOCK = (10, 2)
+
+
+def characteristic(measured: np.ndarray, z0: np.ndarray, l4: np.ndarray,
+                   v_max: tuple[float, float]) -> np.ndarray:
+    """Boundary state (SI) from the measured densities and flow and the interior's
+    lambda_4 variable; the measured state where that is not admissible."""
+    rho_h, rho_a = measured[0], measured[2]
+    flow = measured[0] * measured[1] + measured[2] * measured[3]
+    l0, l1, l2, l3 = l4
+    c = l0 * (z0[0] - rho_h) + l1 * z0[1] + l2 * (z0[2] - rho_a) + l3 * z0[3]
+    det = l1 * rho_a - l3 * rho_h
+    v_h, v_a = (c * rho_a - l3 * flow) / det, (l1 * flow - rho_h * c) / det
+    if not (0 < v_h <= v_max[0] and 0 < v_a <= v_max[1]):
+        return measured
+    return np.array([rho_h, v_h, rho_a, v_a])
+
+
+def replay_one(task: tuple[str, str, str]) -> dict[str, Any]:
+    """(cached run file, inlet, scenario file) -> the row of that replay."""
+    from arzsumo.evaluation.fields import field_rmse
+    from arzsumo.identify import ReplayData
+    from arzsumo.identify.replay import ReplayOptions, run_replay
+    from arzsumo.model.characteristic import linearize
+    from arzsumo.scenario import load_scenario
+    from arzsumo.studies.identify_cache import ARRAYS
+
+    path, inlet, scenario = task
+    sc = load_scenario(scenario)
+    params = sc.params
+    rule = None
+    if inlet == "characteristic":
+        rule = functools.partial(characteristic, l4=linearize(sc.equilibrium).T[3],
+                                 v_max=(params.v_free_h, params.v_free_a))
+    opts = ReplayOptions(cells=sc.run.twin_cells, scheme=sc.run.twin_scheme, ao_limit=0.9)
+    with np.load(path) as z:
+        data = ReplayData(**{k: z[k] for k in ARRAYS}, name=Path(path).stem[:8])
+    run = run_replay(params, data, opts, inlet_rule=rule)
+    grid, _ = field_rmse(data.fields, run.fields)
+    blocks, _ = field_rmse(data.fields, run.fields, *BLOCK)
+    row: dict[str, Any] = {"run": data.name, "inlet": inlet, "stopped_s": run.stopped}
+    row.update({f"{v}_grid_rel": float(e) for v, e in zip(VARIABLES, grid / data.scale,
+                                                           strict=True)})
+    row.update({f"{v}_blocks_rel": float(e) for v, e in zip(VARIABLES, blocks / data.scale,
+                                                             strict=True)})
+    return row
+
+
+def cached_runs(folder: Path, last: int) -> list[Path]:
+    """The ``last`` most recent ``.npz`` runs in ``folder``."""
+    files = sorted(Path(folder).glob("*.npz"), key=os.path.getmtime)[-last:]
+    if not files:
+        raise StudyError(f"--runs = {str(folder)!r} holds no cached identification runs "
+                         "(.npz); allowed: the cache arzsumo identify fills "
+                         "($ARZSUMO_CACHE/identify-runs)")
+    return files
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The inlet study's options."""
+    parser.add_argument("--runs", type=Path, metavar="DIR",
+                        help="cached identification runs (default: $ARZSUMO_CACHE/"
+                             "identify-runs)")
+    parser.add_argument("--last", type=positive_int, default=5,
+                        help="replay the most recent N runs")
+    parser.add_argument("--scenario", type=Path, default=None, metavar="SCENARIO.toml",
+                        help="the parameters replayed under (default: the shipped default)")
+    parser.add_argument("--workers", type=positive_int, default=1, metavar="N",
+                        help="local processes (1: in this process)")
+    add_output(parser, NAME, PAGE, plots=False)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Replay every run under both inlets and write the table."""
+    from arzsumo.studies.identify_cache import cache_dir
+
+    scenario = args.scenario or shipped_scenario("default.toml")
+    files = cached_runs(args.runs or cache_dir(), args.last)
+    tasks = [(str(f), inlet, str(scenario)) for f in files for inlet in INLETS]
+    rows = map_runs(replay_one, tasks, workers=args.workers, in_process=args.workers == 1)
+    df = pd.DataFrame(rows)
+    text = markdown_table(df, ".3f")
+    with resumable_dir(args.out, f"study-{NAME}") as out:
+        path = write_csv(df, out / "inlet.csv")
+        if args.docs is not None:
+            publish(args.docs, PAGE, NAME, "The identified model",
+                    f"The replay's inlet: relative RMSE of {len(files)} cached identification "
+                    f"runs replayed under `{Path(scenario).name}` (`arzsumo study {NAME}`). "
+                    f"Table: [inlet.csv]({PAGE}/inlet.csv).\n\n{text}", [path])
+    print(text)
+    return 0

@@ -1,0 +1,125 @@
+"""The ASM estimate's offset with time-mean against harmonic loop speeds
+(``arzsumo study loop-speed``).
+
+ONE open-loop SUMO run of the scenario (default: the shipped default, its fill as
+warm-up + ``--horizon`` s) records the superset of sensors and the truth, cached like the
+records of :mod:`arzsumo.studies.estimation_layouts`. The record holds both loop speeds,
+so each ``[sensing] loop_speed`` is an offline pass of the same estimator over the same
+traffic (loops every 250 m + AV probes, ``--method``). Per variable (rho_h, v_h, rho_a,
+v_a; veh/km and km/h over the control periods and cells): the mean of the truth, the mean
+offset of the estimate from the truth (cells where both are finite), the mean offset of
+the estimate from the scenario's equilibrium, and the RMSE relative to the equilibrium;
+and per class the loops' mean speeds against the truth's cell speeds at the stations.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from arzsumo.outdir import resumable_dir
+from arzsumo.outputs.studies import markdown_table, publish, write_csv, write_text
+from arzsumo.studies import estimation_layouts
+from arzsumo.studies.common import (
+    add_output,
+    add_runs,
+    positive_float,
+    print_list,
+    shipped_scenario,
+)
+
+NAME = "loop-speed"
+#: the results page this study keeps a block of
+PAGE = "estimation_layouts"
+VARS = estimation_layouts.VARS
+#: SI -> report units: veh/m -> veh/km, m/s -> km/h
+FACTOR = (1000.0, 3.6, 1000.0, 3.6)
+LAYOUT = estimation_layouts.LAYOUTS["loops 250 m + AV probes"]
+LOOP_SPEEDS = ("time_mean", "harmonic")
+
+
+def offsets(rec: Any, sc: Any, loop_speed: str, method: str) -> list[dict[str, Any]]:
+    """Per variable (report units): truth mean, estimate - truth, estimate - equilibrium,
+    relative RMSE."""
+    from arzsumo.bridge.sensor_record import estimation_scores, replay_estimation
+
+    s = sc.with_({**LAYOUT, "sensing.loop_speed": loop_speed, "estimation.method": method})
+    est = replay_estimation(rec, s)
+    truth = rec.truth()
+    fields = np.asarray(est.fields[1:])
+    scores = estimation_scores(truth, est, s.equilibrium)
+    eq = s.equilibrium
+    ref = (eq.rho_h, eq.v_h, eq.rho_a, eq.v_a)
+    rows = []
+    for k, name in enumerate(VARS):
+        ok = np.isfinite(truth[:, k]) & np.isfinite(fields[:, k])
+        f = FACTOR[k]
+        rows.append({"loop_speed": loop_speed, "variable": name,
+                     "truth_mean": f * truth[:, k][ok].mean(),
+                     "estimate_minus_truth": f * (fields[:, k] - truth[:, k])[ok].mean(),
+                     "estimate_minus_equilibrium": f * (fields[:, k][ok].mean() - ref[k]),
+                     "rmse_relative": scores[name]["relative"]})
+    return rows
+
+
+def station_speeds(rec: Any) -> list[str]:
+    """Per class: mean time-mean and harmonic loop speed over the control periods and
+    the interior stations, and the truth's cell speed at those stations (km/h)."""
+    k = slice(rec.start + 1, None)
+    truth = rec.truth()
+    cell = np.array([int(np.argmin(np.abs(rec.x - x))) for x in rec.loop_x])
+    lines = []
+    for c, name in enumerate(("h", "a")):
+        tm, hm = rec.speed[k][:, c, 1:-1], rec.speed_harmonic[k][:, c, 1:-1]
+        v = truth[:, 2 * c + 1][:, cell[1:-1]]
+        ok = np.isfinite(tm) & np.isfinite(v)
+        lines.append(f"v_{name} at the stations, km/h: time-mean {3.6 * tm[ok].mean():.2f}, "
+                     f"harmonic {3.6 * hm[ok].mean():.2f}, probe cells {3.6 * v[ok].mean():.2f}"
+                     f" ({int(ok.sum())} station-periods)")
+    return lines
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The loop-speed study's options."""
+    parser.add_argument("--scenario", type=Path, metavar="SCENARIO.toml",
+                        help="scenario recorded (default: the shipped default)")
+    add_runs(parser, seeds="1")
+    parser.add_argument("--horizon", type=positive_float, default=300.0,
+                        help="control horizon recorded, s")
+    parser.add_argument("--method", default="smoothing", choices=("smoothing", "enkf"),
+                        help="the estimator")
+    add_output(parser, NAME, PAGE, plots=False)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Record (or reuse) the runs, replay both loop speeds, write the table."""
+    from arzsumo.bridge.sensor_record import SensorRecord
+    from arzsumo.scenario import scenario_from_dict
+
+    runs = estimation_layouts.design(args.scenario or shipped_scenario("default.toml"),
+                                     args.seeds, horizon=args.horizon)
+    if args.list:
+        return print_list([r.run_id for r in runs])
+    rows, notes = [], []
+    with resumable_dir(args.out, f"study-{NAME}") as out:
+        for r, path in zip(runs, estimation_layouts.recorded(runs, args), strict=True):
+            rec, _ = SensorRecord.load(Path(path))
+            sc = scenario_from_dict(r.scenario, r.source)
+            for speed in LOOP_SPEEDS:
+                rows += [{"run": r.run_id, **row} for row in offsets(rec, sc, speed,
+                                                                      args.method)]
+            notes += [f"{r.run_id}: {line}" for line in station_speeds(rec)]
+        df = pd.DataFrame(rows)
+        text = markdown_table(df, ".3f") + "\n\n" + "\n".join(f"- {n}" for n in notes)
+        files = [write_csv(df, out / "loop_speed.csv"), write_text(text, out / "loop_speed.md")]
+        if args.docs is not None:
+            publish(args.docs, PAGE, NAME, "Estimation error against sensor layout",
+                    f"Time-mean against harmonic loop speeds: loops every 250 m + AV probes, "
+                    f"{args.method}, open loop (`arzsumo study {NAME}`). Table: "
+                    f"[loop_speed.csv]({PAGE}/loop_speed.csv).\n\n{text}", files)
+    print(text)
+    return 0

@@ -1,0 +1,216 @@
+"""The green-share -> mainline-outflow map from step responses in SUMO
+(``arzsumo study meter-dynamics``).
+
+Each run is one open-loop SUMO run of the shipped default scenario (2.5 km approach,
+fill then hold) with the plain fixed-cycle meter: the nominal plan (green share 0.5)
+through the fill and warm-up (``--warmup`` s), ``--base`` s more at 0.5, then a sequence
+of green-share steps (``--greens``, each held ``--hold`` s) that drive the meter directly
+(:meth:`~arzsumo.sumo.meter.RampMeter.set_green_share`; a new plan takes effect at the
+next cycle start). Every second, from 120 s before the warm-up's end, it records exactly:
+
+* ``g_req``: the requested green share; ``g_run``: that of the running plan (after the
+  cycle quantisation);
+* ``out_h_veh``, ``out_a_veh``: vehicles that left ``main`` at x = L in the second (the
+  section's mainline outflow: exact crossings);
+* ``in_h_veh``, ``in_a_veh``: vehicles that entered ``main`` at x = 0;
+* ``ramp_veh``: ramp vehicles that passed the meter in the second;
+* ``n_main_veh``: vehicles on ``main`` at the end of the second; ``ramp_queue_veh``.
+
+The series (``series.csv``, one row per second and seed) is fitted by
+:mod:`arzsumo.studies.meter_fit`: ``fits.csv`` (one row per fit), ``levels.csv`` (the
+static levels against the meter curve), ``tables.md`` and ``steps.png``. ``--series
+CSV`` fits a series recorded earlier instead of running SUMO.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from arzsumo.outdir import resumable_dir
+from arzsumo.outputs.studies import publish, write_csv, write_text
+from arzsumo.studies import meter_fit
+from arzsumo.studies.common import (
+    StudyError,
+    add_output,
+    add_runs,
+    fixed_cycle,
+    number_list,
+    plots_wanted,
+    positive_float,
+    print_list,
+    scenario_data,
+    seed_text,
+    shipped_scenario,
+    study_spec,
+)
+from arzsumo.studies.design import StudyRun, design_runs, run_design
+
+NAME = "meter-dynamics"
+#: the results page this study keeps a block of
+PAGE = "meter_dynamics"
+#: file in --out -> its name on the results page
+PUBLISHED = {"series.csv": "meter_steps_series.csv", "fits.csv": "meter_steps.csv",
+             "levels.csv": "meter_levels.csv", "tables.md": "meter_tables.md",
+             "steps.png": "meter_steps.png"}
+COLUMNS = ["seed", "t_s", "g_req", "g_run", "out_h_veh", "out_a_veh", "in_h_veh",
+           "in_a_veh", "ramp_veh", "n_main_veh", "ramp_queue_veh"]
+GREENS = (0.2, 0.5, 0.8, 0.5, 0.2, 0.5, 0.8, 0.5)
+#: s recorded before the end of the warm-up
+LEAD_S = 120.0
+
+
+def schedule(warmup: float, base: float, greens: list[float], hold: float
+             ) -> list[tuple[float, float]]:
+    """(start s, green share) of each segment: 0.5 from 0, then the steps."""
+    out = [(0.0, 0.5)]
+    t = warmup + base
+    for g in greens:
+        out.append((t, g))
+        t += hold
+    return out
+
+
+def design(seeds: list[int], warmup: float = 600.0, base: float = 60.0,
+           greens: tuple[float, ...] = GREENS, hold: float = 102.0) -> list[StudyRun]:
+    """One run per seed: the default (fixed cycle), 1 s periods, the warm-up and steps."""
+    path = shipped_scenario("default.toml")
+    spec = study_spec(NAME, path, fixed_cycle(scenario_data(path)), seeds=list(seeds),
+                      set={"sumo.control_period_s": 1.0, "run.warmup_s": warmup,
+                           "sumo.horizon_s": base + hold * len(greens)})
+    return design_runs(spec, {"base_s": base, "greens": list(greens), "hold_s": hold})
+
+
+def run_steps(run: StudyRun) -> dict[str, Any]:
+    """One open-loop run with the green-share steps: its per-second rows and report."""
+    from arzsumo.scenario import scenario_from_dict
+    from arzsumo.sumo.network import RAMP_DN
+    from arzsumo.sumo.plant import SumoPlant
+    from arzsumo.sumo.simulation import open_simulation
+
+    t0 = time.perf_counter()
+    sc = scenario_from_dict(run.scenario, run.source)
+    warmup, opt = sc.run.warmup, run.options
+    cfg = sc.sumo.with_(horizon=warmup + sc.sumo.horizon)
+    plan = schedule(warmup, opt["base_s"], opt["greens"], opt["hold_s"])
+    rows: list[dict[str, Any]] = []
+    with open_simulation(sc.params, cfg) as sim:
+        plant = SumoPlant(sim, sc.params.length, cfg)   # the fixed cycle: cfg's mode
+        meter = plant.meter
+        prev_dn: set[str] = set()
+        ramp, g_req = 0, 0.5
+        while sim.time < cfg.horizon - 1e-9:
+            for start, g in plan:    # asked half a cycle early: runs from ``start``
+                if abs(sim.time - (start - cfg.meter_cycle / 2)) < cfg.step_length / 2:
+                    g_req = g
+                    meter.set_green_share(g)
+            got = plant.step()
+            dn = set(sim.lib.edge.getLastStepVehicleIDs(RAMP_DN))
+            ramp += len(dn - prev_dn)
+            prev_dn = dn
+            if got is None:
+                continue
+            c = got.cells
+            if c.t > warmup - LEAD_S + 1e-9:
+                rows.append({"seed": cfg.seed, "t_s": round(c.t, 3), "g_req": g_req,
+                             "g_run": meter.green_share,
+                             "out_h_veh": round(c.outflow_h * c.window),
+                             "out_a_veh": round(c.outflow_a * c.window),
+                             "in_h_veh": round(c.inflow_h * c.window),
+                             "in_a_veh": round(c.inflow_a * c.window), "ramp_veh": ramp,
+                             "n_main_veh": sim.lib.edge.getLastStepVehicleNumber("main"),
+                             "ramp_queue_veh": got.ramp_queue})
+            ramp = 0
+    rep = sim.report
+    return {"series": rows, "info": {"seed": cfg.seed, "wall_s": time.perf_counter() - t0,
+                                     "collisions": rep.collisions,
+                                     "emergency_stops": rep.emergency_stops,
+                                     "inserted_main": rep.delivered_main}}
+
+
+def read_series(path: Path) -> pd.DataFrame:
+    """A series recorded earlier (the columns of :data:`COLUMNS`)."""
+    if not Path(path).is_file():
+        raise StudyError(f"--series = {str(path)!r} is not a file; allowed: a series.csv of "
+                         f"arzsumo study {NAME}")
+    df = pd.read_csv(path)
+    missing = [c for c in COLUMNS if c not in df]
+    if missing:
+        raise StudyError(f"--series = {str(path)!r} lacks the columns {', '.join(missing)}")
+    return df[COLUMNS]
+
+
+def analyse(series: pd.DataFrame, out: Path, pre: float, settled: float, plots: bool
+            ) -> tuple[list[Path], str]:
+    """Fit and write ``fits.csv``, ``levels.csv``, ``tables.md`` (and ``steps.png``);
+    return the files and the tables' text."""
+    from arzsumo.sumo.meter import DEFAULT_CURVE
+
+    data = meter_fit.by_seed(series)
+    rows = meter_fit.fits(data, "y", pre) + meter_fit.fits(data, "ramp", pre, detail=False)
+    levels = meter_fit.levels_table(meter_fit.static_levels(data, settled), DEFAULT_CURVE)
+    text = meter_fit.tables(rows, levels)
+    files = [write_csv(pd.DataFrame(rows, columns=meter_fit.FIT_FIELDS), out / "fits.csv",
+                       "%.5g"), write_csv(levels, out / "levels.csv"),
+             write_text(text, out / "tables.md")]
+    if plots:
+        from arzsumo.outputs.study_figures import write_meter_steps_figure
+
+        models = {r["seed"]: meter_fit.staircase_model(data[r["seed"]], r, pre) for r in rows
+                  if r["signal"] == "y" and r["scope"] == "staircase"}
+        files.append(write_meter_steps_figure(data, models, meter_fit.ensembles(data, rows),
+                                              out / "steps.png"))
+    return files, text
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The meter-dynamics study's options."""
+    add_runs(parser, seeds="1-3")
+    parser.add_argument("--warmup", type=positive_float, default=600.0,
+                        help="fill and warm-up at green share 0.5, s")
+    parser.add_argument("--base", type=positive_float, default=60.0,
+                        help="s more at 0.5 before the steps")
+    parser.add_argument("--greens", type=number_list, default=list(GREENS),
+                        help="the green shares of the steps, comma-separated "
+                             f"(default: {','.join(map(str, GREENS))})")
+    parser.add_argument("--hold", type=positive_float, default=102.0,
+                        help="s per step (17 cycles of 6 s)")
+    parser.add_argument("--pre", type=positive_float, default=60.0,
+                        help="s before each change in its fit")
+    parser.add_argument("--settled", type=positive_float, default=60.0,
+                        help="last s of each hold averaged for the static levels")
+    parser.add_argument("--series", type=Path, metavar="CSV",
+                        help="fit this series (a series.csv of this study) instead of "
+                             "running SUMO")
+    add_output(parser, NAME, PAGE)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the steps (or read ``--series``), fit, write (and publish with ``--docs``)."""
+    runs = design(args.seeds, args.warmup, args.base, tuple(args.greens), args.hold)
+    if args.list and args.series is None:
+        return print_list([r.run_id for r in runs])
+    with resumable_dir(args.out, f"study-{NAME}") as out:
+        if args.series is not None:
+            series = read_series(args.series)
+        else:
+            done = run_design(runs, run_steps, out, workers=args.workers,
+                              scheduler=args.scheduler, progress=not args.quiet, label=NAME)
+            series = pd.DataFrame([r for d in done for r in d["series"]], columns=COLUMNS)
+        files = [write_csv(series, out / "series.csv")]
+        more, text = analyse(series, out, args.pre, args.settled, plots_wanted(args))
+        files += more
+        if args.docs is not None:
+            seeds = sorted(series["seed"].unique().tolist())
+            body = (f"Green-share steps on seeds {seed_text(seeds)} (`arzsumo study {NAME}`): "
+                    f"[series]({PAGE}/meter_steps_series.csv), [fits]({PAGE}/meter_steps.csv),"
+                    f" [levels]({PAGE}/meter_levels.csv).\n\n{text}"
+                    + (f"\n\n![steps]({PAGE}/meter_steps.png)" if plots_wanted(args) else ""))
+            publish(args.docs, PAGE, NAME, "Meter dynamics in SUMO", body,
+                    [(p, PUBLISHED[p.name]) for p in files])
+    print(text)
+    return 0

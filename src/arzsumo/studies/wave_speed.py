@@ -1,0 +1,146 @@
+"""Which way SUMO's speed and density fluctuations travel on the section
+(``arzsumo study wave-speed``).
+
+The paper's actuator sits at the outlet x = L and acts on the section through the one
+characteristic that travels upstream (lambda_4 < 0 in congestion); whatever enters at
+x = 0 and travels downstream reaches the meter without the meter acting on it. This
+study measures the direction: for pairs of cells 250 m apart it cross-correlates the
+fluctuation of each variable (a cell's series minus its mean over the control window) in
+SUMO's measured cells, and reports the lag of the peak (s; > 0: the downstream cell
+follows) and the travel speed it implies (km/h).
+
+The runs are closed-loop SUMO runs of ``--scenario`` (default: the shipped default) for
+each of ``--controllers`` and ``--seeds``, through the sweep engine; ``--from DIR ...``
+reads the cells of earlier ``arzsumo run`` results (``cells.parquet``) instead.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from arzsumo.outdir import resumable_dir
+from arzsumo.outputs.studies import markdown_table, publish, write_csv
+from arzsumo.studies.common import (
+    StudyError,
+    add_output,
+    add_runs,
+    print_list,
+    shipped_scenario,
+    study_spec,
+)
+from arzsumo.studies.design import StudyRun, design_runs, run_design
+
+NAME = "wave-speed"
+#: the results page this study keeps a block of
+PAGE = "control_in_sumo"
+#: cell pairs (indices of the 50 m cells): 250 m apart, upstream, middle, downstream
+PAIRS = ((2, 7), (5, 10), (10, 15))
+MAX_LAG_S = 60.0
+VARIABLES = ("rho_h", "v_h", "rho_a", "v_a")
+
+
+def lagged_corr(u: np.ndarray, w: np.ndarray, lag: int) -> float:
+    """Correlation of u(t) with w(t + lag) (lag in samples, either sign)."""
+    if lag >= 0:
+        return float(np.corrcoef(u[:len(u) - lag], w[lag:])[0, 1])
+    return float(np.corrcoef(u[-lag:], w[:len(w) + lag])[0, 1])
+
+
+def travel(t: np.ndarray, x: np.ndarray, field: np.ndarray, var: str
+           ) -> list[dict[str, float | str]]:
+    """Peak lag (s) and implied speed (km/h) of the fluctuations of ``field`` (T, N) at
+    times ``t`` (s) and cell centres ``x`` (m), for every pair of :data:`PAIRS`."""
+    filled = pd.DataFrame(field).interpolate(limit_direction="both").to_numpy()
+    dt = float(np.median(np.diff(t)))
+    a = filled - filled.mean(axis=0)
+    lags = np.arange(-int(MAX_LAG_S / dt), int(MAX_LAG_S / dt) + 1)
+    rows: list[dict[str, float | str]] = []
+    for i, j in PAIRS:
+        corr = np.array([lagged_corr(a[:, i], a[:, j], int(k)) for k in lags])
+        k = int(np.nanargmax(corr))
+        lag_s = float(lags[k] * dt)
+        rows.append({"variable": var, "x_up_m": float(x[i]), "x_down_m": float(x[j]),
+                     "lag_s": lag_s, "peak_corr": float(corr[k]),
+                     "speed_kmh": (x[j] - x[i]) / lag_s * 3.6 if lag_s else np.nan})
+    return rows
+
+
+def travel_all(t: np.ndarray, x: np.ndarray, fields: np.ndarray) -> list[dict[str, Any]]:
+    """:func:`travel` of every variable of ``fields`` (T, 4, N) in :data:`VARIABLES` order."""
+    return [r for k, var in enumerate(VARIABLES) for r in travel(t, x, fields[:, k], var)]
+
+
+def from_cells(path: Path) -> list[dict[str, Any]]:
+    """The rows of an ``arzsumo run`` result directory (its measured cells)."""
+    cells = pd.read_parquet(Path(path) / "cells.parquet")
+    micro = cells[cells["source"] == "micro"]
+    fields = np.stack([micro.pivot(index="t_s", columns="x_m", values=v).to_numpy()
+                       for v in VARIABLES], axis=1)
+    t = np.sort(micro["t_s"].unique())
+    x = np.sort(micro["x_m"].unique())
+    return [{"run": Path(path).name, **r} for r in travel_all(t, x, fields)]
+
+
+def run_cells(run: StudyRun) -> dict[str, Any]:
+    """One closed-loop SUMO run; its rows (one per variable and pair)."""
+    from arzsumo.bridge.session import run_in_sumo
+    from arzsumo.scenario import scenario_from_dict
+
+    res = run_in_sumo(scenario_from_dict(run.scenario, run.source)).result
+    rows = travel_all(np.asarray(res.t), np.asarray(res.x), np.asarray(res.micro))
+    return {"rows": [{"run": run.run_id, **r} for r in rows]}
+
+
+def design(scenario: Path, controllers: list[str], seeds: list[int]) -> list[StudyRun]:
+    """One run per controller and seed."""
+    spec = study_spec(NAME, scenario, seeds=list(seeds),
+                      axis=[{"field": "run.controller", "name": "controller",
+                             "values": list(controllers)}])
+    return design_runs(spec)
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The wave-speed study's options."""
+    parser.add_argument("--scenario", type=Path, metavar="SCENARIO.toml",
+                        help="scenario run (default: the shipped default)")
+    parser.add_argument("--controllers", default="open,etc",
+                        help="comma-separated controllers")
+    add_runs(parser, seeds="42")
+    parser.add_argument("--from", dest="source", type=Path, nargs="+", metavar="DIR",
+                        help="read these arzsumo run results instead of running SUMO")
+    add_output(parser, NAME, PAGE, plots=False)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run (or read) and write the table of lags and speeds."""
+    controllers = [c.strip() for c in args.controllers.split(",") if c.strip()]
+    runs = design(args.scenario or shipped_scenario("default.toml"), controllers, args.seeds)
+    if args.list and not args.source:
+        return print_list([r.run_id for r in runs])
+    with resumable_dir(args.out, f"study-{NAME}") as out:
+        if args.source:
+            missing = [str(d) for d in args.source if not (Path(d) / "cells.parquet").is_file()]
+            if missing:
+                raise StudyError(f"--from: {', '.join(missing)} has no cells.parquet; "
+                                 "allowed: arzsumo run result directories")
+            rows = [r for d in args.source for r in from_cells(d)]
+        else:
+            done = run_design(runs, run_cells, out, workers=args.workers,
+                              scheduler=args.scheduler, progress=not args.quiet, label=NAME)
+            rows = [r for d in done for r in d["rows"]]
+        df = pd.DataFrame(rows)
+        path = write_csv(df, out / "wave_speed.csv")
+        text = markdown_table(df, ".3g")
+        if args.docs is not None:
+            publish(args.docs, PAGE, NAME, "Control in SUMO",
+                    f"Lag of the peak cross-correlation of cell fluctuations 250 m apart "
+                    f"(> 0: downstream follows) and the speed it implies (`arzsumo study "
+                    f"{NAME}`). Table: [wave_speed.csv]({PAGE}/wave_speed.csv).\n\n{text}",
+                    [path])
+    print(text)
+    return 0

@@ -1,0 +1,74 @@
+"""The estimation studies (estimation-layouts, loop-speed, enkf-noise) and u-estimate:
+their designs, the shared record cache, and the EnKF noise calibration step."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from arzsumo.scenario import load_scenario, scenario_from_dict
+from arzsumo.studies import enkf_noise, estimation_layouts, u_estimate
+from arzsumo.studies.common import shipped_scenario
+
+DEFAULT = shipped_scenario("default.toml")
+
+
+def test_the_layout_design_records_one_open_loop_per_seed():
+    runs = estimation_layouts.design(DEFAULT, [1, 2], horizon=300.0)
+    assert [r.run_id for r in runs] == ["seed=1", "seed=2"]
+    assert runs[0].scenario["run"]["controller"] == "open"
+    assert runs[0].scenario["sumo"]["horizon_s"] == 300.0
+    assert runs[0].scenario["run"]["warmup_s"] == 600            # the default's fill
+
+
+def test_records_are_cached_per_scenario_and_seed(monkeypatch, tmp_path):
+    monkeypatch.setenv("ARZSUMO_CACHE", str(tmp_path))
+    one, two = estimation_layouts.design(DEFAULT, [1, 2])
+    path = estimation_layouts.cache_path(one)
+    assert path.parent == tmp_path / "estimation-runs"
+    assert path.name.startswith("default-seed=1-") and path.suffix == ".npz"
+    assert path == estimation_layouts.cache_path(estimation_layouts.design(DEFAULT, [1])[0])
+    assert path != estimation_layouts.cache_path(two)
+    assert path != estimation_layouts.cache_path(
+        estimation_layouts.design(DEFAULT, [1], horizon=60.0)[0])
+
+
+@pytest.mark.parametrize("layout", list(estimation_layouts.LAYOUTS))
+def test_every_layout_is_a_valid_sensing_table(layout):
+    sc = load_scenario(DEFAULT).with_(estimation_layouts.LAYOUTS[layout])
+    assert sc.name == "default"
+
+
+def test_the_layout_table_gives_means_with_t_half_widths():
+    rows = [{"layout": "loops 250 m", "method": "smoothing", "seed": s,
+             **{f"{v}_rel": x for v in estimation_layouts.VARS}}
+            for s, x in ((1, 0.1), (2, 0.2), (3, 0.3))]
+    lines = estimation_layouts.table(rows).splitlines()
+    assert lines[2] == "| loops 250 m | smoothing | " + " | ".join(["0.200 +- 0.248"] * 4) + " |"
+
+
+def test_the_enkf_settings_are_scenario_keys_and_a_round_scales_by_the_error():
+    sc = load_scenario(DEFAULT).with_(enkf_noise.settings([2.0, 1.0, 1.0, 1.0], 1.05))
+    assert sc.name == "default"
+    rows = [{**{f"{v}_rel": e for v, e in zip(enkf_noise.VARS, (0.4, 0.1, 0.2, 0.01),
+                                               strict=True)},
+             **{f"{v}_spread_rel": 0.1 for v in enkf_noise.VARS}}]
+    assert enkf_noise.normalised(rows) == pytest.approx([4.0, 1.0, 2.0, 0.1])
+    sd = enkf_noise.next_sd(np.array([2.0, 1.0, 1.0, 1.0]), rows, gain=1.0)
+    assert sd == pytest.approx([8.0, 1.0, 2.0, 0.25])              # clipped to [1/4, 4]
+
+
+def test_the_u_estimate_design_is_one_run_per_estimator_on_legacy_default():
+    spec = u_estimate.design([42])
+    runs = spec.runs()
+    assert [r.run_id for r in runs] == ["estimator=none,seed=42", "estimator=smoothing,seed=42",
+                                        "estimator=enkf,seed=42"]
+    for r in runs:
+        sc = scenario_from_dict(r.scenario)
+        assert (sc.run.controller, sc.run.warmup, sc.sumo.horizon, sc.sumo.seed) == \
+            ("backstepping", 150.0, 120.0, 42)
+    assert runs[2].scenario["estimation"]["method"] == "enkf"
+    assert runs[2].scenario["sensing"] == {"kinds": ["loops", "av_probes"],
+                                           "loop_spacing_m": 250}
+    assert "sensing" not in runs[0].scenario or \
+        runs[0].scenario["sensing"].get("kinds") != ["loops", "av_probes"]
