@@ -18,7 +18,7 @@ import time
 from arzsumo.bridge.actuator import command_meter
 from arzsumo.model import get_preset
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.meter import DEFAULT_CURVE
+from arzsumo.sumo.green_share import DEFAULT_CURVE
 from arzsumo.sumo.plant import SumoPlant
 from arzsumo.sumo.simulation import open_simulation
 

@@ -14,7 +14,7 @@ from arzsumo.bridge.cosim import run_cosimulation
 from arzsumo.control.etc import PAPER_DESIGN
 from arzsumo.outputs.bridge import write_results
 from arzsumo.scenario import load_scenario
-from arzsumo.sumo.meter import DEFAULT_CURVE, fixed_cycle_ramp_floor, fixed_cycle_u_range
+from arzsumo.sumo.green_share import DEFAULT_CURVE, fixed_cycle_ramp_floor, fixed_cycle_u_range
 
 pytestmark = pytest.mark.sumo
 DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "legacy_default.toml"

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from arzsumo.bridge.actuator import ActuationLimits, MeterActuator, command_meter, limit_u
 from arzsumo.scenario.actuation import ActuationSettings
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.meter import DEFAULT_CURVE, fixed_cycle_ramp_floor, fixed_cycle_u_range
+from arzsumo.sumo.green_share import DEFAULT_CURVE, fixed_cycle_ramp_floor, fixed_cycle_u_range
 from arzsumo.sumo.meter_release import (
     one_per_green_ramp_floor,
     one_per_green_u_range,

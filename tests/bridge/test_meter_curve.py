@@ -11,7 +11,7 @@ from arzsumo.cli import main
 from arzsumo.resources import default_scenario
 from arzsumo.sumo.calibration_io import curve_text, load_green_share_curve
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.meter import DEFAULT_CURVE, GreenShareCurve
+from arzsumo.sumo.green_share import DEFAULT_CURVE, GreenShareCurve
 from arzsumo.sweep.spec import sweep_from_dict
 from arzsumo.units import veh_h_to_veh_s
 

@@ -19,7 +19,7 @@ from arzsumo.bridge.cosim import run_cosimulation
 from arzsumo.control.etc import PAPER_DESIGN
 from arzsumo.outputs.bridge import write_results
 from arzsumo.scenario import load_scenario
-from arzsumo.sumo.meter import plan_green_steps
+from arzsumo.sumo.green_share import plan_green_steps
 from arzsumo.sumo.runner import run_fixed_meter
 
 DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "legacy_default.toml"

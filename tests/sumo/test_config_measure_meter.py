@@ -10,8 +10,8 @@ from arzsumo.model import get_preset
 from arzsumo.scenario import scenario_from_dict
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.demand import Flow, demand_flows, route_file_text
+from arzsumo.sumo.green_share import GreenShareCurve, plan_green_steps
 from arzsumo.sumo.measure import EdieGrid
-from arzsumo.sumo.meter import GreenShareCurve, plan_green_steps
 from arzsumo.sumo.placement import place_vehicles
 from arzsumo.sumo.vtypes import vehicle_types
 

@@ -7,7 +7,7 @@ import pytest
 from arzsumo.errors import ArzsumoError, ScenarioError
 from arzsumo.scenario import scenario_from_dict
 from arzsumo.sumo.config import SumoConfig, ramp_capacity
-from arzsumo.sumo.meter import plan_green_steps
+from arzsumo.sumo.green_share import plan_green_steps
 from arzsumo.sumo.meter_release import nominal_phases, release_rate_for
 from arzsumo.sumo.run_files import meter_program_text
 

@@ -69,7 +69,7 @@ from arzsumo.progress import Progress
 from arzsumo.scenario import Scenario
 from arzsumo.scenario.run import RunSettings
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.meter import DEFAULT_CURVE, GreenShareCurve
+from arzsumo.sumo.green_share import DEFAULT_CURVE, GreenShareCurve
 from arzsumo.sumo.network_measures import network_options
 from arzsumo.sumo.paths import scratch_dir
 from arzsumo.sumo.plant import SumoPlant

@@ -25,8 +25,8 @@ from arzsumo.scenario.run import RunSettings
 from arzsumo.scenario.sumo import SUMO_KEYS
 from arzsumo.scenario.twin import seeded
 from arzsumo.sumo.config import SumoConfig
+from arzsumo.sumo.green_share import DEFAULT_CURVE, GreenShareCurve
 from arzsumo.sumo.measure import EdieGrid
-from arzsumo.sumo.meter import DEFAULT_CURVE, GreenShareCurve
 from arzsumo.sumo.network import NetworkSpec
 from arzsumo.tables import in_user_terms, not_allowed, restated, where, written
 from arzsumo.twin.initial import initial_fields

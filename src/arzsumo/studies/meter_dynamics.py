@@ -148,7 +148,7 @@ def analyse(series: pd.DataFrame, out: Path, pre: float, settled: float, plots: 
             ) -> tuple[list[Path], str]:
     """Fit and write ``fits.csv``, ``levels.csv``, ``tables.md`` (and ``steps.png``);
     return the files and the tables' text."""
-    from arzsumo.sumo.meter import DEFAULT_CURVE
+    from arzsumo.sumo.green_share import DEFAULT_CURVE
 
     data = meter_fit.by_seed(series)
     rows = meter_fit.fits(data, "y", pre) + meter_fit.fits(data, "ramp", pre, detail=False)

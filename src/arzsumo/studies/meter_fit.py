@@ -22,7 +22,7 @@ import numpy as np
 import pandas as pd
 
 from arzsumo.identify.step_response import FopdtFit, StepData, fit_fopdt, fopdt_response
-from arzsumo.sumo.meter import GreenShareCurve
+from arzsumo.sumo.green_share import GreenShareCurve
 
 #: columns of the fit table (units in the names; gains per unit of green share)
 FIT_FIELDS = ["signal", "scope", "seed", "step", "du", "n_steps", "gain_veh_s",

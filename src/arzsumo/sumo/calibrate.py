@@ -28,7 +28,7 @@ from arzsumo.model.characteristic import linearize
 from arzsumo.model.equilibrium import Equilibrium
 from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.meter import GreenShareCurve
+from arzsumo.sumo.green_share import GreenShareCurve
 from arzsumo.units import veh_h_to_veh_s
 
 log = logging.getLogger(__name__)

@@ -23,7 +23,7 @@ from arzsumo.errors import ArzsumoError
 from arzsumo.io import read_toml, toml_value
 from arzsumo.sumo.calibrate import Calibration
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.meter import GreenShareCurve
+from arzsumo.sumo.green_share import GreenShareCurve
 from arzsumo.units import ms_to_kmh, veh_h_to_veh_s, veh_m_to_veh_km, veh_s_to_veh_h
 
 

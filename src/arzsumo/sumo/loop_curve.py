@@ -16,7 +16,7 @@ import numpy as np
 
 from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.meter import DEFAULT_CURVE, GreenShareCurve
+from arzsumo.sumo.green_share import DEFAULT_CURVE, GreenShareCurve
 from arzsumo.sumo.plant import SumoPlant
 from arzsumo.sumo.simulation import open_simulation
 

@@ -1,8 +1,9 @@
 """The ramp-meter actuator: commanded mainline outflow -> green share -> signal program.
 
 The controller asks for a mainline outflow q* + U (veh/s). The calibrated curve of
-mainline outflow against the meter's green share (:class:`GreenShareCurve`, decreasing:
-more ramp green, less mainline outflow) is inverted to a green share g in [0, 1], which
+mainline outflow against the meter's green share
+(:class:`~arzsumo.sumo.green_share.GreenShareCurve`, decreasing: more ramp green, less
+mainline outflow) is inverted to a green share g in [0, 1], which
 becomes a fixed-cycle program: green for g C seconds, then red, with minimum green and
 red times (a shorter green becomes all-red or the minimum green, whichever is nearer; the
 same for red). A new timing is a *plan change* and takes effect at the next cycle start;
@@ -39,10 +40,15 @@ from dataclasses import dataclass
 from types import ModuleType
 from typing import Any, NamedTuple
 
-import numpy as np
-
 from arzsumo.errors import ArzsumoError, require
 from arzsumo.sumo.config import SumoConfig
+from arzsumo.sumo.green_share import (
+    DEFAULT_CURVE,
+    GreenShareCurve,
+    fixed_cycle_ramp_floor,
+    fixed_cycle_u_range,
+    plan_green_steps,
+)
 from arzsumo.sumo.network import METER_TL
 from arzsumo.sumo.stop_line import MeterReading
 
@@ -50,67 +56,6 @@ GREEN, YELLOW, RED = "G", "y", "r"
 #: the queue override, on above the ramp's storage, stays on until the queue is back at this
 #: share of the storage (rounded down)
 OVERRIDE_OFF = 0.8
-
-
-@dataclass(frozen=True)
-class GreenShareCurve:
-    """Mainline outflow (veh/s) measured at green shares (ascending, in [0, 1]).
-
-    Outflows must not increase with the green share (ramp vehicles take capacity).
-    """
-
-    green_share: tuple[float, ...]
-    outflow: tuple[float, ...]
-
-    def __post_init__(self) -> None:
-        g, q = np.asarray(self.green_share, float), np.asarray(self.outflow, float)
-        require(g.size >= 2 and g.size == q.size, "green_share", self.green_share,
-                "at least two points, as many as outflow values", ArzsumoError)
-        require(bool(np.all(np.diff(g) > 0)) and g[0] >= 0 and g[-1] <= 1, "green_share",
-                self.green_share, "strictly increasing values in [0, 1]", ArzsumoError)
-        require(bool(np.all(q > 0)), "outflow", self.outflow, "flows greater than 0 veh/s",
-                ArzsumoError)
-
-    def monotone(self) -> GreenShareCurve:
-        """The curve made non-increasing (running minimum), for a unique inverse."""
-        q = np.minimum.accumulate(np.asarray(self.outflow, float))
-        return GreenShareCurve(self.green_share, tuple(float(v) for v in q))
-
-    def outflow_at(self, g: float) -> float:
-        """Mainline outflow (veh/s) at green share ``g`` (linear interpolation)."""
-        return float(np.interp(g, self.green_share, self.outflow))
-
-    def green_share_for(self, q: float) -> float:
-        """Green share giving mainline outflow ``q`` (veh/s), saturated at the curve's ends."""
-        m = self.monotone()
-        g, out = np.asarray(m.green_share), np.asarray(m.outflow)
-        return float(np.interp(q, out[::-1], g[::-1]))
-
-
-#: Mainline outflow against green share on the default network, 6 s cycle, medium demand
-#: (4104 HV/h + 1560 AV/h, ramp 1200 veh/h, seed 42, 450 s, mean after 150 s), as written
-#: by ``arzsumo calibrate`` to ``meter_curve.toml`` (load others with
-#: :func:`arzsumo.sumo.calibration_io.load_green_share_curve`).
-DEFAULT_CURVE = GreenShareCurve((0.0, 0.25, 0.5, 0.75, 1.0),
-                                (5664 / 3600, 4512 / 3600, 4464 / 3600, 3300 / 3600,
-                                 3240 / 3600))
-
-
-def plan_green_steps(g: float, cycle: int, min_green: int, min_red: int) -> int:
-    """Green steps per cycle of ``cycle`` steps for green share ``g`` in [0, 1].
-
-    A green shorter than ``min_green`` steps becomes 0 (all red) or ``min_green``,
-    whichever is nearer; a red shorter than ``min_red`` becomes 0 (all green) or
-    ``min_red``. So g = 0 is always red and g = 1 always green.
-    """
-    require(math.isfinite(g) and 0.0 <= g <= 1.0, "green_share", g, "a number in [0, 1]",
-            ArzsumoError)
-    green = round(g * cycle)
-    if 0 < green < min_green:
-        green = 0 if green < min_green / 2 else min_green
-    if 0 < cycle - green < min_red:
-        green = cycle if cycle - green < min_red / 2 else cycle - min_red
-    return green
 
 
 class MeterState(NamedTuple):
@@ -401,30 +346,3 @@ class RampMeter(MeterLight):
             self.override_steps += light == RED
             light = GREEN
         return light
-
-
-def fixed_cycle_u_range(curve: GreenShareCurve, cfg: SumoConfig,
-                        q_nominal: float) -> tuple[float, float]:
-    """The U (veh/s) a fixed-cycle meter can command: the monotone curve's outflow between
-    ``green_share_max`` (least mainline outflow) and ``green_share_min``, minus q*;
-    widened to include 0 (the nominal plan is always allowed)."""
-    m = curve.monotone()
-    return (min(0.0, m.outflow_at(cfg.green_share_max) - q_nominal),
-            max(0.0, m.outflow_at(cfg.green_share_min) - q_nominal))
-
-
-def fixed_cycle_ramp_floor(curve: GreenShareCurve, cfg: SumoConfig, q_nominal: float,
-                           queue: float) -> float:
-    """Least U (veh/s) the ramp can deliver with ``queue`` vehicles waiting.
-
-    The merge passes ``q_open`` = the curve's mainline outflow at green share 0 (mainline
-    alone, ramp closed) in all, so each ramp vehicle released takes one from the
-    mainline. Over the next plan, ``H = max(meter cycle, control period)`` seconds, the
-    ramp can release at most its arrivals and its queue, ``r + queue / H`` veh/s (``r``:
-    ``[sumo] ramp_demand``), so more ramp green cannot bring the mainline outflow below
-    ``q_open - r - queue / H``: U below that minus q* is not deliverable. Capped at 0
-    (the nominal plan is always allowed), so it only bounds U < 0 (more ramp release).
-    """
-    q_open = curve.monotone().outflow_at(0.0)
-    horizon = max(cfg.meter_cycle, cfg.control_period)
-    return min(0.0, q_open - cfg.ramp_demand - queue / horizon - q_nominal)

@@ -25,16 +25,8 @@ from types import ModuleType
 
 from arzsumo.errors import ArzsumoError, require
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.meter import (
-    DEFAULT_CURVE,
-    GREEN,
-    RED,
-    YELLOW,
-    GreenShareCurve,
-    MeterLight,
-    RampMeter,
-    plan_green_steps,
-)
+from arzsumo.sumo.green_share import DEFAULT_CURVE, GreenShareCurve, plan_green_steps
+from arzsumo.sumo.meter import GREEN, RED, YELLOW, MeterLight, RampMeter
 from arzsumo.sumo.network import METER_TL
 
 

@@ -15,7 +15,8 @@ from typing import Any
 
 from arzsumo.estimate.observations import LoopNoise, ProbeNoise
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.meter import DEFAULT_CURVE, GreenShareCurve, MeterLight, MeterState
+from arzsumo.sumo.green_share import DEFAULT_CURVE, GreenShareCurve
+from arzsumo.sumo.meter import MeterLight, MeterState
 from arzsumo.sumo.meter_release import make_meter
 from arzsumo.sumo.sensing import SensorLayout
 from arzsumo.sumo.sensor import PeriodMeasurement, SumoSensor

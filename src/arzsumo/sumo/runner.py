@@ -15,8 +15,8 @@ from typing import Any
 from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.demand import InitialVehicle
+from arzsumo.sumo.green_share import DEFAULT_CURVE, GreenShareCurve
 from arzsumo.sumo.measure import MeasurementLog
-from arzsumo.sumo.meter import DEFAULT_CURVE, GreenShareCurve
 from arzsumo.sumo.network import RAMP_UP
 from arzsumo.sumo.paths import SumoError
 from arzsumo.sumo.plant import SumoPlant
