@@ -22,6 +22,8 @@ class ArzsumoError(Exception):
     #: where a scenario key's refusal was raised (``x.toml: [sumo]``) and the key
     at: str | None = None
     key: str | None = None
+    #: what follows ``field = `` in the message, for a caller that names the field its way
+    reason: str | None = None
 
 
 class ModelError(ArzsumoError, ValueError):

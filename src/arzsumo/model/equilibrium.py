@@ -110,11 +110,12 @@ def equilibrium_from_densities(params: ModelParameters, rho_h: float, rho_a: flo
         if stated is None:
             continue
         if abs(stated - computed) > tolerance * abs(computed):
-            raise ModelError(
-                f"{name} = {ms_to_kmh(stated):.2f} km/h disagrees with the fundamental diagram "
-                f"Ve = {ms_to_kmh(computed):.2f} km/h at these densities by more than "
-                f"{tolerance:.0%}; omit the speed or change the densities or parameters"
-            )
+            reason = (f"{ms_to_kmh(stated):.2f} km/h disagrees with the fundamental diagram "
+                      f"Ve = {ms_to_kmh(computed):.2f} km/h at these densities by more than "
+                      f"{tolerance:.0%}; omit the speed or change the densities or parameters")
+            exc = ModelError(f"{name} = {reason}")
+            exc.field, exc.value, exc.reason = name, stated, reason
+            raise exc
     return eq
 
 

@@ -18,7 +18,6 @@ restated with the key and the value as written (:func:`arzsumo.tables.in_user_te
 
 from __future__ import annotations
 
-import re
 from collections.abc import Mapping
 from typing import Any
 
@@ -150,8 +149,8 @@ def equilibrium_section(params: ModelParameters, preset: Preset, eqt: Mapping[st
                                           si.get("rho_a", preset.rho_a), v_h=si.get("v_h"),
                                           v_a=si.get("v_a"))
     except ArzsumoError as exc:
-        # the model states a disagreeing speed in km/h already: name the key
-        exc.args = (re.sub(r"^v_([ha]) = ", r"v_\1_kmh = ", str(exc)),)
+        if exc.field in ("v_h", "v_a") and exc.reason:   # a stated speed, in km/h already
+            raise ScenarioError(f"{at} {exc.field}_kmh = {exc.reason}") from None
         raise in_user_terms(exc, at, eqt, EQUILIBRIUM_KEYS) from None
 
 
