@@ -29,7 +29,7 @@ def run(tmp_path_factory):
 
     def counting(sensor: SumoSensor, t: float, pending=None):
         got = observe(sensor, t, pending)
-        if got is not None and sensor.window_open:
+        if got[1] is not None and sensor.window_open:
             on_main.append(int(sensor.lib.edge.getLastStepVehicleNumber(MAIN)))
         return got
 

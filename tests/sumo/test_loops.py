@@ -124,7 +124,7 @@ def _run(params, cfg) -> Reference:
                     p1 if p0 is None else p0, p1, x, length)
             ref.abreast += int((step >= 2).sum())
             cnt += step
-            m = sensor.observe(t)
+            _, m = sensor.observe(t)
             h = harmonic.observe(t)
             if m is None:
                 continue
