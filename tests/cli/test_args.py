@@ -79,8 +79,8 @@ def _subparsers(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentP
 def test_every_command_has_help_and_description():
     commands = _subparsers(build_parser())
     assert {"model", "kernels", "verify", "design-check", "twin", "reproduce", "build-net",
-            "calibrate", "run", "compare", "alinea-target", "sweep", "evaluate", "identify",
-            "list", "study"} == set(commands)
+            "calibrate", "run", "compare", "alinea-target", "sweep", "evaluate", "premise",
+            "identify", "list", "study"} == set(commands)
     for name, p in commands.items():
         assert p.description and len(p.description) > 30, name
 
@@ -90,7 +90,7 @@ def test_help_shows_defaults_environment_and_exit_codes(capsys):
     top = capsys.readouterr().out
     for text in ("ARZSUMO_CACHE", "~/.cache/arzsumo", "ARZSUMO_SUMO_NETS", "arzsumo/data/sumo_nets",
                  "0    done", "2    user error", "3    the PDE twin left", "4    some sweep",
-                 "130  interrupted", "arzsumo list"):
+                 "5    the scenario's premise", "130  interrupted", "arzsumo list"):
         assert text in top, text
     assert main(["verify", "--help"]) == 0
     verify = " ".join(capsys.readouterr().out.split())

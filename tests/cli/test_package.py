@@ -14,8 +14,8 @@ from arzsumo.cli import main
 PACKAGE = Path(__file__).resolve().parents[2] / "src" / "arzsumo"
 #: the commands of ``arzsumo --help``, in order
 COMMANDS = ["model", "kernels", "verify", "design-check", "twin", "reproduce", "build-net",
-            "calibrate", "run", "compare", "alinea-target", "sweep", "evaluate", "identify",
-            "list", "study"]
+            "calibrate", "run", "compare", "alinea-target", "sweep", "evaluate", "premise",
+            "identify", "list", "study"]
 
 
 def test_the_cli_is_a_package_and_no_flat_module_is_left():

@@ -28,6 +28,7 @@ from arzsumo.cli import (
     identify,
     listing,
     model,
+    premise,
     reproduce,
     run,
     study,
@@ -47,7 +48,8 @@ Command = Callable[[argparse.Namespace], int]
 REGISTER: tuple[Callable[[argparse._SubParsersAction], None], ...] = (
     model.register, control.register, twin.register, reproduce.register, sumo.register,
     run.register, compare.register, sumo.register_alinea_target, sweep.register,
-    evaluate.register, identify.register, listing.register, study.register)
+    evaluate.register, premise.register, identify.register, listing.register,
+    study.register)
 
 
 EPILOG = """\
@@ -63,6 +65,7 @@ exit codes:
   3    the PDE twin left the physical domain (twin, reproduce: partial results written)
   4    some sweep runs were invalid, failed or crashed (sweep, evaluate: the others
        completed)
+  5    the scenario's premise does not hold (premise: its report written)
   130  interrupted (Ctrl-C)
 
 'arzsumo list' shows the shipped scenario and sweep files; 'arzsumo CMD --help' each

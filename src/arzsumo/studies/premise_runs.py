@@ -1,0 +1,308 @@
+"""The SUMO side of ``arzsumo premise``: the open-loop runs the premise gates measure.
+
+Per seed three open-loop runs of the scenario, each the scenario's warm-up (``[run]
+warmup_s``, the fill phase ``[sumo] fill_s`` included) under the nominal meter plan, then
+a window, all through the one step loop :class:`~arzsumo.sumo.plant.SumoPlant`:
+
+* ``baseline``: the window (``window_s``) at the nominal plan. Kept per control period:
+  the Edie speed fields per class (50 m cells), the section's vehicle count (Edie, veh),
+  the vehicles on ``main`` at the period's end, and a lateral snapshot of every vehicle on
+  ``main`` (:class:`~arzsumo.sumo.lateral.LateralSampler` on the mainline sensor's sample
+  of the period's last step, as the sensor takes it in a control window; reduced here to
+  the coupling gates, the samples being too many to store: about 150 per period); SUMO's
+  report (inserted and requested vehicles) and the meter's largest ramp queue of the
+  window.
+* ``pulse``: the same seed and window, the meter at its *least plan* for ``pulse_s`` from
+  the window's start, then back at the nominal plan. The least plan is
+  ``meter.plan_bounds[0]``: green share ``[sumo] green_share_min`` for the fixed cycle (0:
+  red for the whole pulse) and ``[sumo] release_rate_min_veh_h`` for one vehicle per green
+  (its nearest to red: it has no red plan). The queue override still acts. Kept: the
+  speed fields.
+* ``staircase``: the release rate stepped by +-``step`` (veh/s) around the nominal,
+  ``levels`` levels of ``level_s`` after a nominal lead-in of ``level_s``, in the order
+  +, 0, -, 0, +, 0, ... (two steps up and two down every four levels). The plan of a
+  rate r = r_nominal + dr is :func:`plan_for_step`: the rate itself for one vehicle per
+  green (``meter.set_plan(r)``); for the fixed cycle the green share whose meter-curve
+  outflow is q* - dr (the command U = -dr, as :func:`arzsumo.bridge.actuator.command_meter`
+  maps it). Kept per period: the section's outflow q(L) (the sensor's outflow_h +
+  outflow_a), the commanded r, and the ramp vehicles released (the meter's count).
+
+:func:`premise_runs` lays out one :class:`~arzsumo.studies.design.StudyRun` per (seed,
+kind) for :func:`~arzsumo.studies.design.run_design` (the sweep engine's local pool or
+Dask); :func:`run_premise_task` is its worker. SI units: s, m, m/s, veh, veh/s.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from arzsumo.errors import ArzsumoError
+from arzsumo.scenario import Scenario
+from arzsumo.studies.common import study_spec
+from arzsumo.studies.design import StudyRun, design_runs
+from arzsumo.sumo.config import SumoConfig, ramp_capacity
+from arzsumo.sumo.green_share import GreenShareCurve
+
+NAME = "premise"
+#: the runs of one seed, in the order they are laid out
+KINDS = ("baseline", "pulse", "staircase")
+#: the staircase's levels in units of the step: +, 0, -, 0, repeated
+PATTERN = (1, 0, -1, 0)
+CLASSES = ("hv", "av")
+
+
+class PremiseRunError(ArzsumoError, ValueError):
+    """Premise runs that cannot be made as asked (durations, steps outside the meter)."""
+
+
+@dataclass(frozen=True)
+class PremiseOptions:
+    """The durations and steps of the premise runs (SI: s, veh/s).
+
+    ``window``: baseline and pulse window after the warm-up; ``pulse``: the least plan's
+    hold; ``level``: each staircase level (and the lead-in); ``levels``: staircase levels
+    after the lead-in; ``step``: the release-rate step.
+    """
+
+    window: float
+    pulse: float = 25.0
+    level: float = 120.0
+    levels: int = 8
+    step: float = 200.0 / 3600.0
+
+    def for_kind(self, kind: str) -> dict[str, Any]:
+        """The options one kind of run depends on (its row is reused while they hold)."""
+        if kind == "baseline":
+            return {"kind": kind, "window_s": self.window}
+        if kind == "pulse":
+            return {"kind": kind, "window_s": self.window, "pulse_s": self.pulse}
+        return {"kind": kind, "level_s": self.level, "levels": self.levels,
+                "step_veh_s": self.step}
+
+    def as_dict(self) -> dict[str, float | int]:
+        """The options with units in their names (s, veh/h)."""
+        return {"window_s": self.window, "pulse_s": self.pulse, "level_s": self.level,
+                "levels": self.levels, "step_veh_h": self.step * 3600.0}
+
+
+# -- the meter's plans (pure: no SUMO) -----------------------------------------------------
+def nominal_plan(cfg: SumoConfig) -> float:
+    """The open loop's plan: ``release_rate`` (veh/s, one per green) or ``green_share``."""
+    return cfg.release_rate if cfg.meter_mode == "one_per_green" else cfg.green_share
+
+
+def least_plan(cfg: SumoConfig) -> float:
+    """The pulse's plan, the meter's ``plan_bounds[0]``: ``release_rate_min`` (veh/s) or
+    ``green_share_min``."""
+    return cfg.release_rate_min if cfg.meter_mode == "one_per_green" else cfg.green_share_min
+
+
+def plan_for_step(cfg: SumoConfig, curve: GreenShareCurve, dr: float) -> float:
+    """The plan of release rate r_nominal + ``dr`` (veh/s): that rate (one per green), or
+    the green share whose outflow on ``curve`` is q* - dr (fixed cycle; q* the curve's
+    outflow at ``green_share``). Refused when the meter cannot run it."""
+    if dr == 0:
+        return nominal_plan(cfg)
+    if cfg.meter_mode == "one_per_green":
+        plan, lo, hi = cfg.release_rate + dr, cfg.release_rate_min, cfg.release_rate_max
+        if not lo <= plan <= hi:
+            raise PremiseRunError(
+                f"--step-veh-h = {abs(dr) * 3600:g} is not allowed: the release rate "
+                f"{cfg.release_rate * 3600:g} {'+' if dr > 0 else '-'} {abs(dr) * 3600:g} "
+                f"veh/h lies outside the meter's [{lo * 3600:g}, {hi * 3600:g}] veh/h "
+                "([sumo] release_rate_min_veh_h, release_rate_max_veh_h)")
+        return plan
+    m = curve.monotone()
+    q = m.outflow_at(cfg.green_share) - dr
+    plan = m.green_share_for(q)
+    if not (min(m.outflow) <= q <= max(m.outflow)
+            and cfg.green_share_min <= plan <= cfg.green_share_max):
+        raise PremiseRunError(
+            f"--step-veh-h = {abs(dr) * 3600:g} is not allowed: the fixed-cycle meter "
+            f"cannot move the mainline outflow to {q * 3600:.0f} veh/h within its meter "
+            f"curve ({min(m.outflow) * 3600:.0f}-{max(m.outflow) * 3600:.0f} veh/h) and "
+            f"[sumo] green_share_min .. green_share_max")
+    return plan
+
+
+def staircase_levels(levels: int) -> list[int]:
+    """The staircase in units of the step, lead-in first: 0, +1, 0, -1, 0, +1, ..."""
+    return [0] + [PATTERN[k % len(PATTERN)] for k in range(levels)]
+
+
+def check_options(sc: Scenario, opts: PremiseOptions, curve: GreenShareCurve) -> None:
+    """Refuse options the runs cannot realise, before any SUMO run (one line each)."""
+    period = sc.sumo.control_period
+    for flag, value in (("--window", opts.window), ("--pulse-s", opts.pulse),
+                        ("--level-s", opts.level)):
+        k = value / period
+        if abs(k - round(k)) > 1e-9 or round(k) < 2:
+            raise PremiseRunError(f"{flag} = {value:g} is not allowed: a whole number of "
+                                  f"control periods, at least 2 ({sc.source}: [sumo] "
+                                  f"control_period_s = {period:g})")
+    if opts.pulse >= opts.window:
+        raise PremiseRunError(f"--pulse-s = {opts.pulse:g} is not allowed: shorter than "
+                              f"the window (--window = {opts.window:g} s)")
+    if opts.levels < 2:
+        raise PremiseRunError(f"--levels = {opts.levels} is not allowed: at least 2 (a step "
+                              "up and a step down)")
+    for dr in (opts.step, -opts.step):
+        plan_for_step(sc.sumo, curve, dr)
+
+
+# -- the design ----------------------------------------------------------------------------
+def premise_runs(path: Path, seeds: list[int], warmup: float,
+                 opts: PremiseOptions) -> list[StudyRun]:
+    """One run per (seed, kind) of the scenario file ``path`` with warm-up ``warmup`` (s):
+    IDs ``seed=S,kind=K``, seeds in order, kinds as :data:`KINDS`."""
+    spec = study_spec(NAME, path, seeds=list(seeds), set={"run.warmup_s": float(warmup)})
+    return [replace(r, run_id=f"{r.run_id},kind={kind}", options=opts.for_kind(kind))
+            for r in design_runs(spec) for kind in KINDS]
+
+
+# -- the worker ----------------------------------------------------------------------------
+def run_premise_task(run: StudyRun) -> dict[str, Any]:
+    """One premise run (``run.options["kind"]``): its arrays as lists (JSON-able)."""
+    from arzsumo.scenario import scenario_from_dict
+
+    wall0 = time.perf_counter()
+    sc = scenario_from_dict(run.scenario, run.source)
+    opt = run.options
+    kind = opt["kind"]
+    if kind == "staircase":
+        row = _staircase(sc, opt)
+    else:
+        n = _periods(opt["window_s"], sc.sumo.control_period)
+        plans: dict[int, float] = {}
+        if kind == "pulse":
+            k = _periods(opt["pulse_s"], sc.sumo.control_period)
+            plans = {0: least_plan(sc.sumo), k: nominal_plan(sc.sumo)}
+        rec = _open_loop(sc, n, plans, lateral=kind == "baseline")
+        row = _fields_row(rec) if kind == "pulse" else _baseline_row(sc, rec)
+        if kind == "pulse":
+            row["pulse_plan"] = plans[0]
+    return {"kind": kind, "seed": sc.sumo.seed, **row,
+            "wall_s": time.perf_counter() - wall0}
+
+
+def _periods(duration: float, period: float) -> int:
+    return max(1, round(duration / period))
+
+
+@dataclass
+class _OpenLoop:
+    """What one open-loop run kept (per period of the window, SI)."""
+
+    t0: float
+    cells: list[Any]
+    main_vehicles: list[int]
+    releases: list[int]
+    lateral: Any
+    report: Any
+    meter: dict[str, Any]
+    cfg: SumoConfig
+
+
+def _open_loop(sc: Scenario, periods: int, plans: Mapping[int, float],
+               lateral: bool) -> _OpenLoop:
+    """Warm-up, then ``periods`` control periods; ``plans``: period index -> plan set at
+    that period's start."""
+    from arzsumo.bridge.cosim import warm_up
+    from arzsumo.bridge.session import meter_curve_of
+    from arzsumo.progress import Progress
+    from arzsumo.sumo.lateral import LateralSampler
+    from arzsumo.sumo.network import MAIN
+    from arzsumo.sumo.plant import SumoPlant
+    from arzsumo.sumo.simulation import open_simulation
+
+    period = sc.sumo.control_period
+    t_w = max(1, math.ceil(sc.run.warmup / period - 1e-9)) * period
+    cfg = sc.sumo.with_(horizon=t_w + periods * period)
+    cells, main, releases = [], [], []
+    with open_simulation(sc.params, cfg, downstream_loop=sc.alinea.loop_distance) as sim:
+        plant = SumoPlant(sim, sc.params.length, cfg, meter_curve_of(cfg, sc.source))
+        sampler, seen = LateralSampler(sim.lib), plant.sensor.mainline
+        warm = warm_up(plant, sc.run.warmup, period, Progress(1, enabled=False))
+        plant.meter.start_window()
+        for k in range(periods):
+            if k in plans:
+                plant.meter.set_plan(plans[k])
+            m = plant.advance()
+            cells.append(m.cells)
+            releases.append(plant.meter.releases)
+            main.append(int(sim.lib.edge.getLastStepVehicleNumber(MAIN)))
+            if lateral:   # the sensor's own snapshot call, at the period's last step
+                sampler.sample(m.t, seen.last_ids, seen.last_pos, seen.last_speed,
+                               seen.last_av)
+        meter = plant.meter.summary()
+        record = sampler.record() if lateral else None
+    return _OpenLoop(float(warm[-1].t), cells, main, releases, record, sim.report, meter,
+                     cfg)
+
+
+def _grid(rec: _OpenLoop) -> dict[str, Any]:
+    c0 = rec.cells[0]
+    return {"t0_s": rec.t0, "t_s": [c.t for c in rec.cells], "x_m": c0.x.tolist(),
+            "dx_m": float(c0.x[1] - c0.x[0]) if c0.x.size > 1 else rec.cfg.cell_length,
+            "period_s": rec.cfg.control_period}
+
+
+def _fields_row(rec: _OpenLoop) -> dict[str, Any]:
+    """The speed fields per class (periods x cells, m/s) on their grid."""
+    return {**_grid(rec), "v_hv": np.array([c.v_h for c in rec.cells]).tolist(),
+            "v_av": np.array([c.v_a for c in rec.cells]).tolist()}
+
+
+def _baseline_row(sc: Scenario, rec: _OpenLoop) -> dict[str, Any]:
+    """The fields, counts, coupling gates, SUMO's accounting and the ramp queue."""
+    from arzsumo.evaluation.premise import coupling_gate
+
+    dx = rec.cfg.cell_length
+    lat = rec.lateral
+    t = np.repeat(lat.t, lat.counts)
+    coupling, samples = [], {}
+    for name, mask in (("hv", ~lat.av), ("av", lat.av)):
+        samples[name] = int(mask.sum())
+        if samples[name] >= 2:
+            coupling.append(coupling_gate(t[mask], lat.pos[mask], lat.lat[mask],
+                                          lat.speed[mask], name).as_dict())
+    rep, cfg = rec.report, rec.cfg
+    storage = cfg.ramp_storage if cfg.ramp_storage > 0 else ramp_capacity()
+    return {**_fields_row(rec),
+            "count_veh": [float((c.rho_h.sum() + c.rho_a.sum()) * dx) for c in rec.cells],
+            "main_vehicles": rec.main_vehicles, "lateral_counts": lat.counts.tolist(),
+            "lateral_samples": int(lat.counts.sum()), "class_samples": samples,
+            "coupling": coupling,
+            "inserted_main": rep.inserted - rep.inserted_ramp,
+            "requested_main": rep.requested - rep.requested_ramp,
+            "collisions": rep.collisions, "ramp_demand_veh_s": cfg.ramp_demand,
+            "max_release_veh_s": cfg.release_rate_max if cfg.meter_mode == "one_per_green"
+            else None, "meter_mode": cfg.meter_mode,
+            "max_queue_veh": int(rec.meter["max_queue"]), "ramp_storage_veh": storage}
+
+
+def _staircase(sc: Scenario, opt: Mapping[str, Any]) -> dict[str, Any]:
+    """The release-rate staircase: q(L), the commanded r and the releases per period."""
+    from arzsumo.bridge.session import meter_curve_of
+
+    cfg, period = sc.sumo, sc.sumo.control_period
+    per_level = _periods(opt["level_s"], period)
+    steps = staircase_levels(int(opt["levels"]))
+    curve = meter_curve_of(cfg, sc.source)
+    dr = float(opt["step_veh_s"])
+    plans = {i * per_level: plan_for_step(cfg, curve, s * dr) for i, s in enumerate(steps)}
+    rec = _open_loop(sc, per_level * len(steps), plans, lateral=False)
+    rate = np.repeat([cfg.release_rate + s * dr for s in steps], per_level)
+    released = np.diff(np.r_[0, rec.releases]) / period
+    return {**_grid(rec), "q_veh_s": [c.outflow_h + c.outflow_a for c in rec.cells],
+            "r_veh_s": rate.tolist(), "released_veh_s": released.tolist(),
+            "step_times_s": [rec.t0 + i * per_level * period
+                             for i in range(1, len(steps))],
+            "meter_mode": cfg.meter_mode}

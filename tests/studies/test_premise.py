@@ -1,0 +1,155 @@
+"""The premise command's layout of runs, its plans and its analysis, on rows made here
+(no SUMO): a wave travelling upstream at 4 m/s, a pulse that dies out, a unit-gain meter."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from arzsumo.evaluation.premise import GateResult
+from arzsumo.scenario import load_scenario
+from arzsumo.studies import premise as study
+from arzsumo.studies.common import shipped_scenario
+from arzsumo.studies.premise_runs import (
+    PremiseOptions,
+    PremiseRunError,
+    check_options,
+    least_plan,
+    nominal_plan,
+    plan_for_step,
+    premise_runs,
+    staircase_levels,
+)
+from arzsumo.sumo.green_share import DEFAULT_CURVE
+
+DEFAULT, LEGACY = shipped_scenario("default.toml"), shipped_scenario("legacy_default.toml")
+T0, PERIODS, CELLS, DX = 100.0, 400, 20, 50.0
+WAVE_MS = -4.0
+
+
+def test_one_run_per_seed_and_kind_each_keyed_by_what_it_depends_on():
+    opts = PremiseOptions(window=300.0)
+    runs = premise_runs(LEGACY, [3, 4], 60.0, opts)
+    assert [r.run_id for r in runs] == [f"seed={s},kind={k}" for s in (3, 4)
+                                        for k in ("baseline", "pulse", "staircase")]
+    assert runs[0].scenario["sumo"]["seed"] == 3 and runs[0].scenario["run"]["warmup_s"] == 60
+    longer = premise_runs(LEGACY, [3], 60.0, PremiseOptions(window=300.0, level=60.0))
+    # a longer staircase level changes the staircase's run only
+    assert [a.sha256 == b.sha256 for a, b in zip(runs, longer, strict=False)] == [
+        True, True, False]
+
+
+def test_the_plans_of_both_meters():
+    one = load_scenario(DEFAULT).sumo
+    assert (nominal_plan(one), least_plan(one)) == (pytest.approx(600 / 3600),
+                                                   pytest.approx(240 / 3600))
+    assert plan_for_step(one, DEFAULT_CURVE, 200 / 3600) == pytest.approx(800 / 3600)
+    fixed = load_scenario(LEGACY).sumo
+    assert (nominal_plan(fixed), least_plan(fixed)) == (0.5, 0.0)
+    # the fixed cycle: the green share whose curve outflow is q* - dr
+    up = plan_for_step(fixed, DEFAULT_CURVE, 200 / 3600)
+    assert DEFAULT_CURVE.outflow_at(up) == pytest.approx((4464 - 200) / 3600)
+    assert plan_for_step(fixed, DEFAULT_CURVE, 0.0) == 0.5
+    assert staircase_levels(6) == [0, 1, 0, -1, 0, 1, 0]
+
+
+def test_options_the_meter_cannot_run_are_refused():
+    sc = load_scenario(DEFAULT)
+    check_options(sc, PremiseOptions(window=300.0), DEFAULT_CURVE)
+    with pytest.raises(PremiseRunError, match=r"^--step-veh-h = 400 is not allowed"):
+        check_options(sc, PremiseOptions(window=300.0, step=400 / 3600), DEFAULT_CURVE)
+    with pytest.raises(PremiseRunError, match=r"^--window = 300.5 is not allowed: a whole"):
+        check_options(sc, PremiseOptions(window=300.5), DEFAULT_CURVE)
+
+
+def _wave(t: np.ndarray, x: np.ndarray, seed: int) -> np.ndarray:
+    """8 m/s plus A(x) g(t - x / c): fluctuations travelling at c, their amplitude A
+    growing upstream from 1 at x = L to 2 at x = 0 (g: three incommensurate sines)."""
+    s = t[:, None] - x[None, :] / WAVE_MS + 0.5 * seed     # seeds: nearly alike
+    g = sum(np.sin(2 * np.pi * s / p + k) for k, p in enumerate((61.0, 97.0, 173.0)))
+    return 8.0 + (2.0 - x[None, :] / 1000.0) * g
+
+
+def _rows(seed: int) -> list[dict]:
+    """A baseline (a wave at -4 m/s), a pulse (+3 m/s decaying in 40 s) and a staircase
+    (q = q0 - (r - r0) exactly) of one seed, as the worker returns them."""
+    t = T0 + np.arange(1, PERIODS + 1, dtype=float)
+    x = (np.arange(CELLS) + 0.5) * DX
+    v = _wave(t, x, seed)
+    grid = {"seed": seed, "t0_s": T0, "t_s": t.tolist(), "x_m": x.tolist(), "dx_m": DX,
+            "period_s": 1.0, "wall_s": 1.0}
+    lateral = GateResult("coupling[hv]", 0.0, 10 / 3.6, True, {}).as_dict()
+    base = {**grid, "kind": "baseline", "v_hv": v.tolist(), "v_av": v.tolist(),
+            "count_veh": (100 + np.sin(t / 7.0)).tolist(), "main_vehicles": [100] * PERIODS,
+            "lateral_counts": [100] * PERIODS, "lateral_samples": 100 * PERIODS,
+            "class_samples": {"hv": 80 * PERIODS, "av": 20 * PERIODS},
+            "coupling": [lateral, {**lateral, "name": "coupling[av]"}],
+            "inserted_main": 990, "requested_main": 1000, "collisions": 0,
+            "ramp_demand_veh_s": 800 / 3600, "max_release_veh_s": 900 / 3600,
+            "meter_mode": "one_per_green", "max_queue_veh": 20, "ramp_storage_veh": 37}
+    bump = 3.0 * np.exp(-(t - T0) / 40.0)[:, None] * np.ones(CELLS)
+    pulse = {**grid, "kind": "pulse", "v_hv": (v + bump).tolist(), "v_av": v.tolist(),
+             "pulse_plan": 240 / 3600}
+    r = np.repeat(np.array([0, 1, 0, -1, 0]) * 200 / 3600 + 600 / 3600, 80)
+    stair = {**grid, "kind": "staircase", "q_veh_s": (1.2 - (r - 600 / 3600)).tolist(),
+             "r_veh_s": r.tolist(), "step_times_s": [T0 + 80 * k for k in range(1, 5)],
+             "released_veh_s": r.tolist()}
+    return [base, pulse, stair]
+
+
+@pytest.fixture(scope="module")
+def report() -> study.PremiseReport:
+    rows = _rows(1) + _rows(2)
+    return study.analyse(rows, load_scenario(LEGACY), study.AnalysisOptions(round_trip=100.0))
+
+
+def test_every_gate_is_measured_per_seed_in_order(report):
+    assert report.seeds == (1, 2)
+    assert [g.name for g in report.gates[1]] == [
+        "coupling[hv]", "coupling[av]", "waves[hv]", "waves[av]", "model_wave[hv]",
+        "model_wave[av]", "amplification[hv]", "amplification[av]", "pulse", "actuator",
+        "stationary", "inserted", "ramp_demand", "ramp_queue"]
+
+
+def test_the_gates_read_the_synthetic_stream(report):
+    g = {r.name: r for r in report.gates[1]}
+    assert g["waves[hv]"].value == pytest.approx(WAVE_MS, rel=0.05) and g["waves[hv]"].passed
+    # the pulse dies out within the first round trip: a stable stream fails the gate
+    assert g["pulse"].passed is False and g["pulse"].value < 100.0
+    assert g["actuator"].value == pytest.approx(-1.0) and g["actuator"].passed
+    assert report.pooled_actuator.detail["up"]["steps"] == 4
+    assert g["inserted"].value == pytest.approx(0.99) and g["inserted"].passed
+    assert g["ramp_demand"].value == pytest.approx(800 / 900)
+    assert g["ramp_queue"].value == pytest.approx(20 / 37)
+    # the amplitude at 50 and 150 m over that at 850 and 950 m: 1.9 / 1.1
+    assert g["amplification[hv]"].value == pytest.approx(1.9 / 1.1, rel=0.03)
+    assert g["amplification[hv]"].passed
+    # the model's lambda_4 of legacy_default (-17.9 km/h) against the measured 4 m/s
+    assert g["model_wave[hv]"].value == pytest.approx(4.9777 / 4.0, rel=0.05)
+
+
+def test_the_floor_of_two_seeds_is_the_distance_of_their_baselines(report):
+    assert report.floor_method == "seeds"
+    assert report.floors[1]["hv"] > 1.0 and report.floors[1]["total"] > report.floors[1]["hv"]
+    assert report.verdict.passed is False and "pulse" in report.verdict.failed
+
+
+def test_one_seed_falls_back_to_the_late_floor():
+    method, floors = study.floors({1: {r["kind"]: r for r in _rows(1)}}, "auto")
+    # the median of the bump's D = 3 exp(-t / 40 s) sqrt(L) over t = 301..400 s
+    assert method == "late" and floors[1]["av"] == 0.0
+    assert floors[1]["hv"] == pytest.approx(3.0 * math.exp(-350.5 / 40.0) * math.sqrt(1000),
+                                            rel=0.01)
+
+
+def test_the_window_refusals_name_the_bound():
+    study.check_window(200.0, 100.0, True)
+    with pytest.raises(PremiseRunError, match=r"2 x 100 s \(T: --round-trip\); allowed: "
+                                              r"at least 200 s"):
+        study.check_window(199.0, 100.0, True)
+    sc = load_scenario(LEGACY)
+    trip = study.model_speeds(sc).round_trip
+    assert trip == pytest.approx(1000 / 6.9083 + 1000 / 4.9777, rel=1e-3)
+    assert study.default_window(sc, trip) == math.ceil(2 * trip + 60)
