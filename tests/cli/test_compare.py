@@ -91,3 +91,18 @@ def test_the_figure_draws_no_negative_delay(tmp_path, monkeypatch):
     heights = np.array([b.get_height() for ax in fig.axes for b in ax.patches])
     assert heights.size == 2 * len(titles) and (heights >= 0).all()
     assert sorted(heights[:2]) == pytest.approx([10.0, 10.0])
+
+
+def test_compare_never_writes_into_a_run_or_a_user_directory(tmp_path, capsys):
+    a, b = _run(tmp_path / "a", "etc", 1), _run(tmp_path / "b", "open", 1)
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "comparison.csv").write_text("mine\n")
+    for out in (a, mine):       # a run's results, a directory of the user's
+        assert main(["compare", str(a), str(b), "--out", str(out)]) == 2
+        assert "allowed: a new or empty directory" in capsys.readouterr().err
+    assert (mine / "comparison.csv").read_text() == "mine\n"
+    assert sorted(p.name for p in a.iterdir()) == ["summary.json"]
+    out = tmp_path / "cmp"
+    assert main(["compare", str(a), str(b), "--out", str(out)]) == 0
+    assert main(["compare", str(a), str(b), "--out", str(out)]) == 0   # its own: rewritten

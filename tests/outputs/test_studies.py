@@ -50,3 +50,22 @@ def test_markdown_tables_format_floats_and_leave_nan_empty():
     df = pd.DataFrame({"a": ["x", "y"], "b": [1.23456, float("nan")]})
     assert markdown_table(df, ".3g").splitlines() == ["| a | b |", "|---|---|",
                                                       "| x | 1.23 |", "| y |  |"]
+
+
+def test_publish_replaces_nothing_of_a_page_written_by_hand(tmp_path):
+    import pytest
+
+    from arzsumo.outdir import OutputError
+
+    docs, src = tmp_path / "docs", tmp_path / "table.csv"
+    (docs / "page").mkdir(parents=True)
+    (docs / "page.md").write_text("# written by hand\n")
+    (docs / "page" / "table.csv").write_text("theirs\n")
+    src.write_text("ours\n")
+    with pytest.raises(OutputError, match=r"written by hand and table\.csv"):
+        publish(docs, "page", "study", "Title", "body", [src])
+    assert (docs / "page" / "table.csv").read_text() == "theirs\n"
+    assert (docs / "page.md").read_text() == "# written by hand\n"
+    (docs / "page.md").write_text(merged_page(None, "study", "Title", "old"))
+    publish(docs, "page", "study", "Title", "new", [src])     # the study's own page
+    assert (docs / "page" / "table.csv").read_text() == "ours\n"

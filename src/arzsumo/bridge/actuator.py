@@ -122,9 +122,8 @@ class ActuationLimits:
 @dataclass(frozen=True)
 class Actuation:
     """One command: the law's U and the U applied (veh/s), the limit flags, the range
-    ``[lower, upper]`` (veh/s) in force, the green share commanded, the release rate
-    asked of the meter (veh/s; NaN for a fixed cycle) and whether the queue override
-    held the meter."""
+    ``[lower, upper]`` (veh/s) in force, the green share commanded and the release rate
+    asked of the meter (veh/s; NaN for a fixed cycle)."""
 
     u_raw: float
     u_applied: float
@@ -134,7 +133,6 @@ class Actuation:
     upper: float
     green: float
     release_rate: float = math.nan
-    override: bool = False
 
     def told(self, anti_windup: bool) -> Applied:
         """What the controller is told at its next check: the U applied and, with
@@ -171,13 +169,12 @@ class MeterActuator:
         """Command U (veh/s), limited; return what was applied and the green share
         commanded (in [0, 1])."""
         meter = self.meter
-        override = meter.override()
         if self.hold_nominal:
             return Actuation(u, 0.0, False, False, -INF, INF, meter.green_share,
-                             _rate(meter), override)
+                             _rate(meter))
         lower, upper = self.limits.range(meter, self.q_nominal)
         rate_step = self.limits.rate_step
-        if override:
+        if meter.override():
             # the queue override runs the meter at its largest release whatever is
             # commanded: to the law, a saturation of its actuator (anti-windup sees it)
             lower = upper = meter.override_u(self.q_nominal)
@@ -186,7 +183,7 @@ class MeterActuator:
         self.u_prev = lim.u_applied
         green = command_meter(meter, lim.u_applied, self.q_nominal)
         return Actuation(u, lim.u_applied, lim.saturated, lim.rate_limited, lower, upper,
-                         green, _rate(meter), override)
+                         green, _rate(meter))
 
 
 def _rate(meter: MeterLight) -> float:

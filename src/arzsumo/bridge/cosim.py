@@ -209,6 +209,7 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
             c = control(sim, scenario, settings, cfg, design, curve, bar, keep_measurements)
             plant = c.loop.plant
             meter_summary = {**plant.meter_summary(), "ramp_storage": cfg.ramp_storage}
+            timings = {**plant.timings, **c.loop.timings}   # the window's, not the drain's
             t_end = sim.time
             drained = drain(plant, cfg.drain_max) if cfg.drain_max > 0 else None
         records = c.trace.records
@@ -226,12 +227,12 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
         shutil.rmtree(net_dir, ignore_errors=True)
     bar.close()
     return _result(c, scenario, cfg, meter_summary, sim, network, placement, files,
-                   time.perf_counter() - wall0)
+                   timings, time.perf_counter() - wall0)
 
 
 def _result(c: Controlled, scenario: Scenario, cfg: SumoConfig, meter: dict[str, Any],
             sim: SumoSimulation, network: NetworkMeasures, placement: str, files: RunFiles,
-            wall_time: float) -> CoSimResult:
+            timings: dict[str, float], wall_time: float) -> CoSimResult:
     """The :class:`CoSimResult` of a finished run."""
     loop, trace = c.loop, c.trace
     sensor = loop.plant.sensor
@@ -242,7 +243,7 @@ def _result(c: Controlled, scenario: Scenario, cfg: SumoConfig, meter: dict[str,
         periods=columns(trace.records), controller_log=loop.controller.log,
         reference_log=c.ref_ctrl.log, meter=meter, report=sim.report,
         twin_status=loop.twins.status(), placement=placement, wall_time=wall_time,
-        timings={**loop.plant.timings, **loop.timings}, warmup_meter=c.warmup_meter,
+        timings=timings, warmup_meter=c.warmup_meter,
         network=network, section_speed=sensor.speeds.summary(), start=trace.start,
         estimate=np.asarray(c.estimator.fields[1:]), estimator=c.estimator,
         shift=loop.shift, lateral=sensor.lateral.record(), files=files)

@@ -17,6 +17,7 @@ from arzsumo.bridge.compare import (
     summary_table,
 )
 from arzsumo.io import atomic_file
+from arzsumo.outdir import resumable_dir
 
 #: (column of the table, panel title with its unit): the measures the project judges by,
 #: each >= 0 by definition (the section's "delay vs V" is not: TTT - TMT / V_free with the
@@ -45,7 +46,9 @@ def compare_runs(runs: list[Path], out: Path,
     """Write ``comparison.csv`` and ``comparison.png`` into ``out``; return the text table.
 
     Refuses (:class:`~arzsumo.bridge.compare.CompareError`, nothing written) results that
-    are not comparable unless ``allow_mixed``.
+    are not comparable unless ``allow_mixed``. ``out`` is claimed as a comparison
+    (:func:`arzsumo.outdir.resumable_dir`): new, empty or an earlier comparison, which is
+    rewritten; any other directory (a run's results among them) is refused in one line.
     """
     from arzsumo.outputs.figures import save_png
     from arzsumo.plots.compare import comparison_figure
@@ -53,11 +56,12 @@ def compare_runs(runs: list[Path], out: Path,
     summaries = load_summaries(runs)
     check_comparable(runs, summaries, allow_mixed)
     df = pd.DataFrame([row_of(s) for s in summaries])
-    out.mkdir(parents=True, exist_ok=True)
-    csv = out / "comparison.csv"
-    with atomic_file(csv) as tmp:
-        df.to_csv(tmp, index=False)
     title, means = bar_title(df)
     labels, bars = _bars(df, means)
-    png = save_png(comparison_figure(labels, bars, title), out / "comparison.png", dpi=100)
+    with resumable_dir(out, "compare") as target:
+        csv = target / "comparison.csv"
+        with atomic_file(csv) as tmp:
+            df.to_csv(tmp, index=False)
+        png = save_png(comparison_figure(labels, bars, title), target / "comparison.png",
+                       dpi=100)
     return summary_table(summaries), csv, png

@@ -67,7 +67,14 @@ def publish(docs: Path, page: str, name: str, title: str, body: str,
     """Copy ``files`` into ``docs/page/`` (under their own names, or the names given with
     them) and write study ``name``'s block (``body``, whose links name the copies as
     ``page/FILE``) into the page ``docs/page.md`` (``title``: the heading of a new page);
-    return the paths written."""
+    return the paths written.
+
+    Nothing of the user's is overwritten: ``docs`` must be a directory (made when
+    missing), and a page written by hand (one without this study's block) whose files
+    would be replaced is refused, in one line, before anything is written. A page that
+    holds the block, or a new page, is regenerated.
+    """
+    _check_publishable(Path(docs), page, name, files)
     written = []
     for item in files:
         src, as_name = item if isinstance(item, tuple) else (item, Path(item).name)
@@ -80,6 +87,25 @@ def publish(docs: Path, page: str, name: str, title: str, body: str,
     old = path.read_text(encoding="utf-8") if path.is_file() else None
     written.append(write_text(merged_page(old, name, title, body), path))
     return written
+
+
+def _check_publishable(docs: Path, page: str, name: str,
+                       files: Sequence[Published]) -> None:
+    from arzsumo.outdir import OutputError
+
+    if docs.exists() and not docs.is_dir():
+        raise OutputError(f"--docs = {docs} is not allowed: a directory of results pages "
+                          "(docs/results), not a file")
+    path = docs / f"{page}.md"
+    if not path.is_file() or BEGIN.format(name=name) in path.read_text(encoding="utf-8"):
+        return
+    names = [item[1] if isinstance(item, tuple) else Path(item).name for item in files]
+    clash = [n for n in names if (docs / page / n).exists()]
+    if clash:
+        raise OutputError(f"--docs = {docs} is not allowed: {path} was written by hand "
+                          f"and {', '.join(clash)} in {docs / page} would be replaced; "
+                          "allowed: a directory without them, or the page with this "
+                          f"study's block ({BEGIN.format(name=name)})")
 
 
 def markdown_table(df: pd.DataFrame, floats: str = ".4g") -> str:

@@ -17,6 +17,7 @@ import numpy as np
 from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.green_share import DEFAULT_CURVE, GreenShareCurve
+from arzsumo.sumo.loops import DownstreamLoop
 from arzsumo.sumo.plant import SumoPlant
 from arzsumo.sumo.simulation import open_simulation
 
@@ -39,12 +40,15 @@ def record_downstream_loop(params: ModelParameters, cfg: SumoConfig, distance: f
     meter); the loop's series (module docstring)."""
     t_out, occ, flow = [], [], []
     with open_simulation(params, cfg, downstream_loop=distance) as sim:
-        plant = SumoPlant(sim, params.length, cfg, curve)
+        # the meter's reading only: the mainline cells are not needed here, the loop is
+        plant = SumoPlant(sim, params.length, cfg, curve, measure=False)
+        loop = DownstreamLoop(sim.lib, cfg.step_length, cfg.steps_per_period)
         while sim.time < cfg.horizon - 1e-9:
-            got = plant.step()
+            plant.step()
+            got = loop.observe(sim.time)
             if got is not None:
-                t_out.append(got.t)
-                occ.append(got.occupancy_out)
-                flow.append(got.flow_out_loop)
+                t_out.append(sim.time)
+                occ.append(got[0])
+                flow.append(got[1])
     return LoopSeries(np.asarray(t_out), np.asarray(occ), np.asarray(flow),
                       cfg.control_period, cfg.seed)
