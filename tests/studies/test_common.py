@@ -90,3 +90,11 @@ def test_a_design_on_a_relative_scenario_path_reads_that_file(monkeypatch):
     monkeypatch.chdir(root.parent)
     spec = study_spec("toy", root.relative_to(root.parent) / "legacy_default.toml", seeds=[1])
     assert spec.base == root / "legacy_default.toml"
+
+
+def test_a_scenario_name_cannot_lead_outside_the_directory_of_its_file():
+    from arzsumo.studies.common import file_stem
+
+    assert file_stem("default") == "default"
+    assert file_stem("../../etc/x y") == "_.._etc_x_y"
+    assert "/" not in file_stem("a/b") and file_stem("...") == "scenario"

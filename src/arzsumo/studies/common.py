@@ -161,6 +161,16 @@ def fixed_cycle(data: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
+def file_stem(name: object) -> str:
+    """``name`` (a scenario's, as the user wrote it) made safe as part of a file name:
+    characters other than letters, digits, ``-``, ``_`` and ``.`` become ``_``, so that a
+    name can never lead outside the directory it is written in."""
+    import re
+
+    stem = re.sub(r"[^A-Za-z0-9_.-]", "_", str(name)).lstrip(".")
+    return stem or "scenario"
+
+
 def seed_text(seeds: list[int]) -> str:
     """``1-10`` for a run of consecutive seeds, else ``1,3,7``."""
     seeds = sorted(seeds)

@@ -31,6 +31,7 @@ from arzsumo.studies import estimation_layouts as layouts
 from arzsumo.studies.common import (
     StudyError,
     add_output,
+    file_stem,
     non_negative_int,
     number_list,
     positive_float,
@@ -191,7 +192,7 @@ def run(args: argparse.Namespace) -> int:
         text = f"{chosen}\n\n{head}\n" + "\n".join(lines + more)
         files: list = [write_text(text, out / "enkf_noise.md")]
         if rows:
-            csv = f"{PAGE}_{runs[0].scenario.get('name', 'scenario')}.csv"
+            csv = f"{PAGE}_{file_stem(runs[0].scenario.get('name', 'scenario'))}.csv"
             files.append((write_csv(pd.DataFrame(rows), out / "enkf_noise.csv"), csv))
         if args.docs is not None:
             publish(args.docs, PAGE, NAME, "The EnKF's model-error noise",

@@ -36,6 +36,7 @@ from arzsumo.outputs.studies import publish, write_csv
 from arzsumo.studies.common import (
     add_output,
     add_runs,
+    file_stem,
     positive_float,
     print_list,
     seed_text,
@@ -82,7 +83,8 @@ def cache_path(run: StudyRun) -> Path:
     text = json.dumps([run.scenario, __version__], sort_keys=True, default=str)
     key = hashlib.sha256(text.encode()).hexdigest()[:24]
     root = Path(os.environ.get("ARZSUMO_CACHE", Path.home() / ".cache" / "arzsumo"))
-    return root / "estimation-runs" / f"{run.scenario.get('name', 'run')}-{run.run_id}-{key}.npz"
+    stem = file_stem(run.scenario.get("name", "run"))
+    return root / "estimation-runs" / f"{stem}-{run.run_id}-{key}.npz"
 
 
 def record(run: StudyRun) -> dict[str, Any]:
@@ -195,7 +197,7 @@ def run(args: argparse.Namespace) -> int:
         path = write_csv(pd.DataFrame(rows), out / "layouts.csv")
         text = table(rows)
         if args.docs is not None:
-            csv = f"{PAGE}_{runs[0].scenario.get('name', 'scenario')}.csv"
+            csv = f"{PAGE}_{file_stem(runs[0].scenario.get('name', 'scenario'))}.csv"
             publish(args.docs, PAGE, NAME, "Estimation error against sensor layout",
                     f"Relative RMSE of the estimate (1 = the equilibrium value), mean over "
                     f"seeds {seed_text(args.seeds)} +- 95 % t half-width, open loop "
