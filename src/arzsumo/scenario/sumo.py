@@ -20,7 +20,14 @@ from pathlib import Path
 from typing import Any
 
 from arzsumo.errors import ArzsumoError, ScenarioError
-from arzsumo.sumo.config import AV_MODELS, HV_MODELS, METER_MODES, SumoConfig
+from arzsumo.sumo.config import (
+    AV_MODELS,
+    DEPART_POS_LAT,
+    HV_MODELS,
+    LAT_ALIGNMENTS,
+    METER_MODES,
+    SumoConfig,
+)
 from arzsumo.tables import Key, in_user_terms, read_keys, written
 from arzsumo.units import KMH_PER_MS, VEH_H_PER_VEH_S
 
@@ -88,6 +95,24 @@ SUMO_KEYS: dict[str, Key] = {
     "hv_sigma": Key("hv_sigma", doc="HV driver imperfection, in [0, 1]"),
     "av_model": Key("av_model", "string", choices=AV_MODELS, doc="AV car-following model"),
     "min_gap_lat_m": Key("min_gap_lat", unit="m", doc="lateral gap kept by both classes"),
+    "lat_alignment": Key("lat_alignment", "string", choices=LAT_ALIGNMENTS,
+                         doc="both classes' preferred lateral position (SUMO latAlignment)"),
+    "lc_sublane": Key("lc_sublane", doc="eagerness for sublane changes (SUMO lcSublane), "
+                                        ">= 0"),
+    "lc_speed_gain": Key("lc_speed_gain", doc="eagerness for changes that gain speed (SUMO "
+                                              "lcSpeedGain), >= 0"),
+    "lc_pushy": Key("lc_pushy", doc="willingness to encroach laterally (SUMO lcPushy), in "
+                                    "[0, 1]"),
+    "depart_pos_lat": Key("depart_pos_lat", "string", choices=DEPART_POS_LAT,
+                          doc="mainline lateral insertion: fixed columns (HVs at the edges, "
+                              "AVs at the centre) or a SUMO departPosLat"),
+    "hv_tau_s": Key("hv_tau", unit="s", doc="HVs' desired time headway (SUMO tau)"),
+    "hv_action_step_s": Key("hv_action_step", unit="s",
+                            doc="HVs' action step (SUMO actionStepLength, a reaction time); "
+                                "0: every step"),
+    "down_speed_kmh": Key("down_speed", factor=KMH_PER_MS, unit="km/h",
+                          doc="speed limit of the downstream bottleneck edge down"),
+    "down_length_m": Key("down_length", unit="m", doc="length of the downstream edge down"),
     "meter_curve": Key("meter_curve", "string",
                        doc="meter_curve.toml of `arzsumo calibrate`, relative to the scenario "
                            "file; \"\" keeps the built-in curve"),

@@ -143,15 +143,17 @@ def _array(values: Any) -> np.ndarray:
     return np.array(values, dtype=float)
 
 
-def _classes(base: Mapping[str, Any]) -> list[str]:
+def classes_of(base: Mapping[str, Any]) -> list[str]:
+    """The classes a baseline row sampled (at least two lateral samples)."""
     return [c for c in CLASSES if base["class_samples"][c] >= 2]
 
 
-def _fields(row: Mapping[str, Any], classes: Sequence[str]) -> dict[str, np.ndarray]:
+def class_fields(row: Mapping[str, Any], classes: Sequence[str]) -> dict[str, np.ndarray]:
+    """The speed fields (periods x cells, m/s) of ``classes`` in a row."""
     return {c: _array(row[f"v_{c}"]) for c in classes}
 
 
-def _norms(a: Mapping[str, np.ndarray], b: Mapping[str, np.ndarray],
+def deviation_norms(a: Mapping[str, np.ndarray], b: Mapping[str, np.ndarray],
            dx: float) -> dict[str, np.ndarray]:
     """D(t) per class and their ``total`` (m/s m^(1/2))."""
     d = {c: deviation_norm(a[c], b[c], dx) for c in a}
@@ -180,31 +182,34 @@ def floors(rows: Mapping[int, Mapping[str, Mapping[str, Any]]], method: str
     out: dict[int, dict[str, float]] = {}
     for i, s in enumerate(seeds):
         base = rows[s]["baseline"]
-        cls, dx = _classes(base), float(base["dx_m"])
+        cls, dx = classes_of(base), float(base["dx_m"])
         if method == "none":
             out[s] = {}
             continue
         if method == "seeds":
             other = rows[seeds[(i + 1) % len(seeds)]]["baseline"]
-            d = _norms(_fields(base, cls), _fields(other, cls), dx)
+            d = deviation_norms(class_fields(base, cls), class_fields(other, cls), dx)
             out[s] = {k: _median(v) for k, v in d.items()}
         else:
-            d = _norms(_fields(base, cls), _fields(rows[s]["pulse"], cls), dx)
+            d = deviation_norms(class_fields(base, cls),
+                                class_fields(rows[s]["pulse"], cls), dx)
             start = int(len(d["total"]) * (1 - LATE_SHARE))
             out[s] = {k: _median(v[start:]) for k, v in d.items()}
     return method, out
 
 
-def _speed_gates(base: Mapping[str, Any], classes: Sequence[str], model: ModelSpeeds,
+def speed_gates(base: Mapping[str, Any], classes: Sequence[str], model: ModelSpeeds | None,
                  length: float, th: PremiseThresholds) -> list[GateResult]:
-    """coupling, waves, model_wave and amplification of each class."""
+    """coupling, waves, model_wave (unless ``model`` is None) and amplification of each
+    class."""
     dt, dx = float(base["period_s"]), float(base["dx_m"])
-    fields = _fields(base, classes)
+    fields = class_fields(base, classes)
     gates = [gate_from_dict(d) for d in base["coupling"]]
     waves = [wave_gate(fields[c], dt, dx, c, th) for c in classes]
     gates += waves
-    gates += [model_wave_gate(model.lambda_4, w.value, c, th)
-              for c, w in zip(classes, waves, strict=True)]
+    if model is not None:
+        gates += [model_wave_gate(model.lambda_4, w.value, c, th)
+                  for c, w in zip(classes, waves, strict=True)]
     bt, bx = max(1, round(BLOCK_S / dt)), max(1, round(BLOCK_M / dx))
     for c in classes:
         blocks = block_means(fields[c][:, None, :], bt, bx)[:, 0, :]
@@ -213,7 +218,7 @@ def _speed_gates(base: Mapping[str, Any], classes: Sequence[str], model: ModelSp
     return gates
 
 
-def _operating_gates(base: Mapping[str, Any], th: PremiseThresholds) -> list[GateResult]:
+def operating_gates(base: Mapping[str, Any], th: PremiseThresholds) -> list[GateResult]:
     """stationary, inserted, ramp_demand (one per green) and ramp_queue."""
     trend = count_trend(_array(base["count_veh"]), float(base["period_s"]))
     gates = [stationarity_gate(trend),
@@ -235,13 +240,13 @@ def seed_gates(runs: Mapping[str, Mapping[str, Any]], floor: Mapping[str, float]
                th: PremiseThresholds) -> list[GateResult]:
     """Every gate of one seed from its ``baseline``, ``pulse`` and ``staircase`` rows."""
     base, pulse = runs["baseline"], runs["pulse"]
-    classes = _classes(base)
-    gates = _speed_gates(base, classes, model, length, th)
-    gates.append(pulse_gate(_array(base["t_s"]), _fields(base, classes),
-                            _fields(pulse, classes), float(base["dx_m"]),
+    classes = classes_of(base)
+    gates = speed_gates(base, classes, model, length, th)
+    gates.append(pulse_gate(_array(base["t_s"]), class_fields(base, classes),
+                            class_fields(pulse, classes), float(base["dx_m"]),
                             float(base["t0_s"]), round_trip, floor, th, smooth))
     gates.append(actuator_gate(actuator_record(runs["staircase"]), th))
-    return gates + _operating_gates(base, th)
+    return gates + operating_gates(base, th)
 
 
 def _series(runs: Mapping[str, Mapping[str, Any]], floor: Mapping[str, float],
@@ -251,8 +256,9 @@ def _series(runs: Mapping[str, Mapping[str, Any]], floor: Mapping[str, float],
     from arzsumo.evaluation.premise.instability import smoothed
 
     base, pulse, stair = runs["baseline"], runs["pulse"], runs["staircase"]
-    cls = _classes(base)
-    d = _norms(_fields(base, cls), _fields(pulse, cls), float(base["dx_m"]))["total"]
+    cls = classes_of(base)
+    d = deviation_norms(class_fields(base, cls), class_fields(pulse, cls),
+                        float(base["dx_m"]))["total"]
     t = _array(base["t_s"]) - float(base["t0_s"])
     return ((t, d, smoothed(t, d, smooth), float(floor.get("total", 0.0)), window),
             (_array(stair["t_s"]), _array(stair["q_veh_s"]), _array(stair["r_veh_s"]),

@@ -4,7 +4,8 @@ Per seed three open-loop runs of the scenario, each the scenario's warm-up (``[r
 warmup_s``, the fill phase ``[sumo] fill_s`` included) under the nominal meter plan, then
 a window, all through the one step loop :class:`~arzsumo.sumo.plant.SumoPlant`:
 
-* ``baseline``: the window (``window_s``) at the nominal plan. Kept per control period:
+* ``baseline``: the window (``window_s``) at the nominal plan. Kept: the window's mean
+  class densities (veh/m) and mainline outflow q(L) (veh/s); per control period:
   the Edie speed fields per class (50 m cells), the section's vehicle count (Edie, veh),
   the vehicles on ``main`` at the period's end, and a lateral snapshot of every vehicle on
   ``main`` (:class:`~arzsumo.sumo.lateral.LateralSampler` on the mainline sensor's sample
@@ -280,6 +281,9 @@ def _baseline_row(sc: Scenario, rec: _OpenLoop) -> dict[str, Any]:
             "main_vehicles": rec.main_vehicles, "lateral_counts": lat.counts.tolist(),
             "lateral_samples": int(lat.counts.sum()), "class_samples": samples,
             "coupling": coupling,
+            "rho_hv_veh_m": float(np.nanmean([c.rho_h.mean() for c in rec.cells])),
+            "rho_av_veh_m": float(np.nanmean([c.rho_a.mean() for c in rec.cells])),
+            "outflow_veh_s": float(np.mean([c.outflow_h + c.outflow_a for c in rec.cells])),
             "inserted_main": rep.inserted - rep.inserted_ramp,
             "requested_main": rep.requested - rep.requested_ramp,
             "collisions": rep.collisions, "ramp_demand_veh_s": cfg.ramp_demand,

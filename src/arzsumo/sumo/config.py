@@ -17,6 +17,11 @@ HV_MODELS = ("Krauss", "IDM")
 #: Width of the mainline lane, m (the network's).
 LANE_WIDTH = 6.5
 AV_MODELS = ("ACC", "CACC")
+#: SUMO's latAlignment values a vehicle type may take (the sublane model)
+LAT_ALIGNMENTS = ("arbitrary", "center", "right", "left", "nice", "compact")
+#: mainline lateral insertion: the fixed columns (:mod:`arzsumo.sumo.demand`), or SUMO's
+#: own departPosLat values
+DEPART_POS_LAT = ("columns", "random", "random_free", "free", "center")
 #: How the ramp meter is realised (:mod:`arzsumo.sumo.meter`, :mod:`arzsumo.sumo.meter_release`)
 METER_MODES = ("fixed_cycle", "one_per_green")
 
@@ -92,6 +97,24 @@ class SumoConfig:
         AV car-following model ("ACC" or "CACC").
     min_gap_lat : float
         Lateral gap kept by both classes, m.
+    lat_alignment : str
+        Both classes' preferred lateral position in the lane (SUMO's ``latAlignment``, one
+        of :data:`LAT_ALIGNMENTS`; default "arbitrary": where they happen to be).
+    lc_sublane, lc_speed_gain, lc_pushy : float
+        Both classes' eagerness for sublane changes (>= 0), for changes that gain speed
+        (>= 0) and their willingness to encroach laterally (in [0, 1]): SUMO's
+        ``lcSublane``, ``lcSpeedGain``, ``lcPushy``.
+    depart_pos_lat : str
+        Lateral insertion on the mainline: "columns" (default; fixed columns, two HV
+        columns at the lane's edges and one AV column at its centre) or a SUMO
+        ``departPosLat`` for every mainline vehicle (:data:`DEPART_POS_LAT`).
+    hv_tau : float
+        HVs' desired time headway (SUMO's ``tau``), s.
+    hv_action_step : float
+        HVs' action step (SUMO's ``actionStepLength``: how often a driver decides, a
+        reaction time), s; 0 (default) decides every simulation step. A multiple of the step.
+    down_speed, down_length : float
+        Speed limit (m/s) and length (m) of the downstream bottleneck edge ``down``.
     meter_curve : str
         Meter-curve file (``meter_curve.toml`` of ``arzsumo calibrate``: mainline outflow
         against green share) that the actuator inverts; "" keeps the built-in
@@ -144,6 +167,15 @@ class SumoConfig:
     hv_sigma: float = 0.5
     av_model: str = "ACC"
     min_gap_lat: float = 0.15
+    lat_alignment: str = "arbitrary"
+    lc_sublane: float = 1.0
+    lc_speed_gain: float = 0.5
+    lc_pushy: float = 0.2
+    depart_pos_lat: str = "columns"
+    hv_tau: float = 1.0
+    hv_action_step: float = 0.0
+    down_speed: float = 50.0 / 3.6
+    down_length: float = 500.0
     meter_curve: str = ""
     approach_length: float = 0.0
     hv_max_speed: float = 0.0
@@ -166,16 +198,18 @@ class SumoConfig:
 
         for name in ("step_length", "lateral_resolution", "horizon", "cell_length",
                      "control_period", "meter_cycle", "min_gap_lat", "max_green",
-                     "release_rate", "release_rate_min", "release_rate_max"):
+                     "release_rate", "release_rate_min", "release_rate_max", "hv_tau",
+                     "down_speed", "down_length"):
             pos(name)
         for name in ("demand_h", "demand_a", "ramp_demand", "min_green", "min_red",
                      "approach_length", "meter_clearance", "fill_duration", "drain_max",
-                     "fill_demand_h", "fill_demand_a", "hv_max_speed", "av_max_speed"):
+                     "fill_demand_h", "fill_demand_a", "hv_max_speed", "av_max_speed",
+                     "lc_sublane", "lc_speed_gain", "hv_action_step"):
             v = getattr(self, name)
             require(isinstance(v, int | float) and math.isfinite(v) and v >= 0, name, v,
                     "a finite number of at least 0", ScenarioError)
         for name in ("ramp_av_share", "green_share", "hv_sigma", "green_share_min",
-                     "green_share_max"):
+                     "green_share_max", "lc_pushy"):
             unit(name)
         require(self.green_share_min <= self.green_share_max, "green_share_min",
                 self.green_share_min, f"at most green_share_max = {self.green_share_max}",
@@ -206,11 +240,25 @@ class SumoConfig:
         self._resolve_storage()
         require(self.time_to_teleport == -1 or self.time_to_teleport > 0, "time_to_teleport",
                 self.time_to_teleport, "-1 (off) or a time > 0 s", ScenarioError)
+        require(isinstance(self.fcd, bool), "fcd", self.fcd, "true or false", ScenarioError)
+        self._check_behaviour()
+
+    def _check_behaviour(self) -> None:
+        """The car-following models, the lateral behaviour's choices, the HVs' action step."""
         require(self.hv_model in HV_MODELS, "hv_model", self.hv_model,
                 " or ".join(HV_MODELS), ScenarioError)
         require(self.av_model in AV_MODELS, "av_model", self.av_model,
                 " or ".join(AV_MODELS), ScenarioError)
-        require(isinstance(self.fcd, bool), "fcd", self.fcd, "true or false", ScenarioError)
+        require(self.lat_alignment in LAT_ALIGNMENTS, "lat_alignment", self.lat_alignment,
+                ", ".join(LAT_ALIGNMENTS), ScenarioError)
+        require(self.depart_pos_lat in DEPART_POS_LAT, "depart_pos_lat", self.depart_pos_lat,
+                ", ".join(DEPART_POS_LAT), ScenarioError)
+        if self.hv_action_step > 0:
+            k = self.hv_action_step / self.step_length
+            require(round(k) >= 1 and abs(k - round(k)) < 1e-9, "hv_action_step",
+                    self.hv_action_step,
+                    f"0 (every step) or a multiple of step_length = {self.step_length} s",
+                    ScenarioError)
 
     def _resolve_storage(self) -> None:
         """Check ``ramp_storage``; -1 becomes what the ramp holds (:func:`ramp_capacity`)."""

@@ -99,15 +99,16 @@ def insertion_columns(road_width: float, vehicle_width: float, n: int) -> list[f
     return [0.0] if n == 1 else list(np.linspace(-edge, edge, n))
 
 
-def _columns(fid: str, vtype: str, rate: float, lats: list[float], end: float,
+def _columns(fid: str, vtype: str, rate: float, lats: Sequence[float | str], end: float,
              begin: float = 0.0) -> list[Flow]:
     n = len(lats)
     return [Flow(f"{fid}_{i}", vtype, ROUTE_MAIN, rate / n,
-                 begin + (i / rate if rate > 0 else 0.0), end, f"{lat:.3f}")
+                 begin + (i / rate if rate > 0 else 0.0), end,
+                 lat if isinstance(lat, str) else f"{lat:.3f}")
             for i, lat in enumerate(lats)]
 
 
-def _mainline(fid: str, vtype: str, lats: list[float], hold: float, fill: float,
+def _mainline(fid: str, vtype: str, lats: Sequence[float | str], hold: float, fill: float,
               cfg: SumoConfig) -> list[Flow]:
     """A class's mainline columns: ``fill`` veh/s until ``cfg.fill_duration``, then ``hold``."""
     if cfg.fill_duration <= 0:
@@ -121,16 +122,19 @@ def _mainline(fid: str, vtype: str, lats: list[float], hold: float, fill: float,
 
 def demand_flows(cfg: SumoConfig, road_width: float = 6.5,
                  vehicle_width: float = 2.0) -> list[Flow]:
-    """The class flows of ``cfg``, mainline flows split into columns (zero rates left out).
+    """The class flows of ``cfg``, mainline flows split into columns (zero rates left out;
+    one flow per class when ``cfg.depart_pos_lat`` is a SUMO value).
 
     With a fill phase, each mainline column is two flows: the fill demand from 0 to
     ``cfg.fill_duration``, then the hold demand to the end.
     """
     ramp_a = cfg.ramp_demand * cfg.ramp_av_share
-    hv_lats = insertion_columns(road_width, vehicle_width, HV_COLUMNS)
+    hv_lats: Sequence[float | str] = insertion_columns(road_width, vehicle_width, HV_COLUMNS)
+    av_lats: Sequence[float | str] = [0.0] * AV_COLUMNS
+    if cfg.depart_pos_lat != "columns":   # SUMO places every mainline vehicle itself
+        hv_lats = av_lats = [cfg.depart_pos_lat]
     flows = [*_mainline("hv", HV_TYPE, hv_lats, cfg.demand_h, cfg.fill_demand_h, cfg),
-             *_mainline("av", AV_TYPE, [0.0] * AV_COLUMNS, cfg.demand_a, cfg.fill_demand_a,
-                        cfg),
+             *_mainline("av", AV_TYPE, av_lats, cfg.demand_a, cfg.fill_demand_a, cfg),
              Flow("ramp_hv", HV_TYPE, ROUTE_RAMP, cfg.ramp_demand - ramp_a, 0.0, cfg.horizon),
              Flow("ramp_av", AV_TYPE, ROUTE_RAMP, ramp_a, 0.0, cfg.horizon)]
     return [f for f in flows if f.rate > 1e-12 and f.begin < f.end]   # SUMO refuses empty flows

@@ -37,6 +37,7 @@ from arzsumo.sumo.paths import (
     scratch_dir,
 )
 from arzsumo.sumo.run_files import RunFiles
+from arzsumo.units import ms_to_kmh
 
 log = logging.getLogger(__name__)
 
@@ -297,17 +298,31 @@ class SumoSimulation:
         self.close(warn=exc_type is None)
 
 
+def network_spec(cfg: SumoConfig) -> NetworkSpec:
+    """The network geometry of a run with ``cfg``: the shipped one with the run's
+    approach and downstream edge ``down``."""
+    return NetworkSpec(approach_length=cfg.approach_length, down_speed=cfg.down_speed,
+                       down_length=cfg.down_length)
+
+
 def network_file(cfg: SumoConfig, net_dir: Path | None, workdir: Path) -> Path:
     """The network of a run with ``cfg``.
 
     An explicit ``net_dir`` (or ``$ARZSUMO_SUMO_NETS``) is used as it is and must have an
-    ``approach`` edge of ``cfg.approach_length`` (none for 0). Otherwise the shipped
-    network serves ``approach_length = 0``, and a network with the approach is built with
-    netconvert into ``workdir`` (about 0.5 s; it goes with the run's temporary files).
+    ``approach`` edge of ``cfg.approach_length`` (none for 0) and the shipped ``down``.
+    Otherwise the shipped network serves the shipped geometry, and any other
+    (:func:`network_spec`) is built with netconvert into ``workdir`` (about 0.5 s; it
+    goes with the run's temporary files).
     """
-    if cfg.approach_length > 0 and net_dir is None and not os.environ.get(NETS_ENV):
-        spec = NetworkSpec(approach_length=cfg.approach_length)
+    spec = network_spec(cfg)
+    if spec != NetworkSpec() and net_dir is None and not os.environ.get(NETS_ENV):
         return build_network(workdir / "net", spec)
+    shipped = NetworkSpec()
+    if (spec.down_speed, spec.down_length) != (shipped.down_speed, shipped.down_length):
+        raise SumoError(f"down_speed = {ms_to_kmh(cfg.down_speed):g} km/h and down_length = "
+                        f"{cfg.down_length:g} m need a network built for them; allowed: no "
+                        f"network directory (the run builds it), or the shipped "
+                        f"{ms_to_kmh(shipped.down_speed):g} km/h and {shipped.down_length:g} m")
     net = nets_dir(net_dir) / NET_FILE
     have = approach_length_of(net)
     if abs(have - cfg.approach_length) > 1e-6:

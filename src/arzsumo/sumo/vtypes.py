@@ -3,8 +3,8 @@
 The spacing policy becomes ``length + minGap = s_i``, the width is the model's ``d``, the
 free-flow speed ``V_i`` caps the vehicle's speed. HVs drive a human car-following model
 with noise (Krauss with ``sigma`` or IDM with speed noise); AVs drive SUMO's ACC or CACC.
-Both use the sublane model (``latAlignment="arbitrary"``) so they spread over the whole
-6.5 m lane.
+Both use the sublane model (by default ``latAlignment="arbitrary"``, so they spread over
+the whole 6.5 m lane; ``[sumo] lat_alignment`` and the ``lc_*`` keys change it).
 """
 
 from __future__ import annotations
@@ -55,20 +55,24 @@ def _geometry(spacing: float) -> tuple[float, float]:
 
 def vehicle_types(params: ModelParameters, cfg: SumoConfig) -> tuple[VehicleType, VehicleType]:
     """(HV, AV) vehicle types for ``params`` under the run settings ``cfg``."""
-    sub = (("latAlignment", "arbitrary"), ("minGapLat", f"{cfg.min_gap_lat:.3f}"),
-           ("maxSpeedLat", "1.0"), ("lcSublane", "1.0"), ("lcPushy", "0.2"),
-           ("lcStrategic", "1.0"), ("lcKeepRight", "0"), ("lcSpeedGain", "0.5"))
+    sub = (("latAlignment", cfg.lat_alignment), ("minGapLat", f"{cfg.min_gap_lat:.3f}"),
+           ("maxSpeedLat", "1.0"), ("lcSublane", f"{cfg.lc_sublane:g}"),
+           ("lcPushy", f"{cfg.lc_pushy:g}"), ("lcStrategic", "1.0"), ("lcKeepRight", "0"),
+           ("lcSpeedGain", f"{cfg.lc_speed_gain:g}"))
     length, gap = _geometry(params.spacing_h)
     if cfg.hv_model == "Krauss":
         hv_model: tuple[tuple[str, str], ...] = (("sigma", f"{cfg.hv_sigma:.3f}"),)
     else:
         hv_model = (("speedDev", "0.1"),)
+    if cfg.hv_action_step > 0:
+        hv_model += (("actionStepLength", f"{cfg.hv_action_step:g}"),)
     hv = VehicleType(HV_TYPE, length, gap, params.vehicle_width,
                      cfg.hv_max_speed or params.v_free_h,
                      cfg.hv_model,
                      (("vClass", "passenger"), ("accel", "2.6"), ("decel", "4.5"),
-                      ("emergencyDecel", "9.0"), ("tau", "1.0"), ("speedFactor", "1"),
-                      ("speedDev", "0.05"), *hv_model, ("color", "0.2,0.4,1"), *sub))
+                      ("emergencyDecel", "9.0"), ("tau", f"{cfg.hv_tau:g}"),
+                      ("speedFactor", "1"), ("speedDev", "0.05"), *hv_model,
+                      ("color", "0.2,0.4,1"), *sub))
     length, gap = _geometry(params.spacing_a)
     av = VehicleType(AV_TYPE, length, gap, params.vehicle_width,
                      cfg.av_max_speed or params.v_free_a,

@@ -1,0 +1,25 @@
+"""The premise map's files: ``premise_map.csv`` (per point, seed and gate),
+``premise_map_points.csv`` (per point) and ``premise_map.png``."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+import pandas as pd
+
+from arzsumo.outputs.studies import write_csv
+
+
+def write_map(out: Path, long: pd.DataFrame, wide: pd.DataFrame, gates: Sequence[str],
+              plots: bool = True) -> list[Path]:
+    """Write the map's tables (and, with ``plots``, its figure of ``gates``) into ``out``;
+    return the paths."""
+    files = [write_csv(long, out / "premise_map.csv"),
+             write_csv(wide, out / "premise_map_points.csv")]
+    if plots and len(wide):
+        from arzsumo.outputs.figures import save_png
+        from arzsumo.plots.premise_map import premise_map_figure
+
+        files.append(save_png(premise_map_figure(wide, gates), out / "premise_map.png"))
+    return files

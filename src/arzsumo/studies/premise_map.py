@@ -1,0 +1,308 @@
+"""Where the paper's premise holds in SUMO: the premise gates over what the mission leaves
+free on the SUMO side (``arzsumo study premise-map``).
+
+The frame stays fixed (1 km, one 6.5 m lane under the sublane model, HV and AV types,
+the ramp meter at the outlet). Each :class:`MapPoint` changes a few ``[sumo]`` keys of
+the base scenario: the lateral behaviour, the HVs' car following, the downstream
+bottleneck, the AV share and the demand (:data:`POINTS`). Per point and seed an
+open-loop baseline (:mod:`arzsumo.studies.premise_runs`), and on the point's first seed
+the paired pulse; then the gates of ``arzsumo premise`` that these runs decide:
+
+* coupling and waves per class, amplification per class (the baseline);
+* the pulse, with the round trip L / v + L / |c| of the *measured* HV speed v and
+  upstream wave speed c (the model is identified only where the map points), and the
+  floor of two seeds' baselines (chance alone);
+* stationary, inserted, ramp demand and ramp queue (the operating point).
+
+The actuator's staircase and the model's gates are left to ``arzsumo premise`` on the
+point the map selects: the staircase costs four times a baseline, and the model is
+identified there. Outputs: ``premise_map.csv`` (one row per point, seed and gate),
+``premise_map_points.csv`` (per point: the share of seeds each gate passed on, the
+measured speeds, densities and outflow) and ``premise_map.png``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from arzsumo.evaluation.premise import GateResult, PremiseThresholds, pulse_gate
+from arzsumo.evaluation.premise.instability import round_trip_time
+from arzsumo.outdir import resumable_dir
+from arzsumo.outputs.premise_map import write_map
+from arzsumo.outputs.studies import markdown_table, publish
+from arzsumo.studies.common import (
+    StudyError,
+    add_output,
+    add_runs,
+    plots_wanted,
+    print_list,
+    shipped_scenario,
+    study_spec,
+)
+from arzsumo.studies.design import StudyRun, design_runs, run_design
+from arzsumo.studies.premise import (
+    class_fields,
+    classes_of,
+    deviation_norms,
+    model_speeds,
+    operating_gates,
+    speed_gates,
+)
+from arzsumo.studies.premise_runs import PremiseOptions, run_premise_task
+from arzsumo.units import VEH_H_PER_VEH_S, VEH_KM_PER_VEH_M, ms_to_kmh
+
+NAME = "premise-map"
+#: the results page this study keeps a block of
+PAGE = "premise_map"
+#: the gates the map decides, in the order of its table and figure
+MAP_GATES = ("coupling[hv]", "coupling[av]", "waves[hv]", "waves[av]",
+             "amplification[hv]", "amplification[av]", "pulse", "stationary", "inserted",
+             "ramp_queue")
+
+
+@dataclass(frozen=True)
+class MapPoint:
+    """One point of the map: ``name`` (its row), ``axis`` (what it varies) and ``set``
+    (sweep ``set`` keys of the base scenario, e.g. ``{"sumo.min_gap_lat_m": 0.6}``)."""
+
+    name: str
+    axis: str
+    set: Mapping[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        bad = [k for k in self.set if not k.startswith("sumo.")]
+        if bad or not self.name or "," in self.name or "=" in self.name:
+            raise StudyError(f"map point {self.name!r}: a name without ',' or '=' and "
+                             f"[sumo] keys only (got {bad})")
+
+
+def _point(name: str, axis: str, **keys: Any) -> MapPoint:
+    return MapPoint(name, axis, {f"sumo.{k}": v for k, v in keys.items()})
+
+
+#: the coupled base every point but ``today`` starts from: SUMO's default lateral gap,
+#: which keeps the classes from riding in files that do not interact, and a demand
+#: re-mapped to what the merge discharges with it
+COUPLED = {"min_gap_lat_m": 0.6, "fill_demand_h_veh_h": 3300, "fill_demand_a_veh_h": 900,
+           "demand_h_veh_h": 2750, "demand_a_veh_h": 650}
+
+#: the map: one change at a time from the coupled base (and today's default)
+POINTS: tuple[MapPoint, ...] = (
+    _point("today", "today's default"),
+    _point("coupled", "base", **COUPLED),
+    _point("gap-1.0", "lateral", **{**COUPLED, "min_gap_lat_m": 1.0}),
+    _point("align-center", "lateral", **COUPLED, lat_alignment="center"),
+    _point("random-lat", "lateral", **COUPLED, depart_pos_lat="random_free"),
+    _point("sigma-0.8", "car following", **COUPLED, hv_sigma=0.8),
+    _point("sigma-0.95", "car following", **COUPLED, hv_sigma=0.95),
+    _point("action-0.5", "car following", **COUPLED, hv_action_step_s=0.5),
+    _point("idm", "car following", **COUPLED, hv_model="IDM"),
+    _point("down-40", "bottleneck", **COUPLED, down_speed_kmh=40),
+    _point("down-60", "bottleneck", **COUPLED, down_speed_kmh=60),
+    _point("demand-0.9", "demand", **{**COUPLED, "demand_h_veh_h": 2475,
+                                      "demand_a_veh_h": 585}),
+    _point("demand-1.1", "demand", **{**COUPLED, "demand_h_veh_h": 3025,
+                                      "demand_a_veh_h": 715}),
+    _point("av-10", "penetration", **{**COUPLED, "demand_h_veh_h": 3060,
+                                      "demand_a_veh_h": 340}),
+    _point("av-50", "penetration", **{**COUPLED, "demand_h_veh_h": 1700,
+                                      "demand_a_veh_h": 1700}),
+)
+
+
+# -- the design ----------------------------------------------------------------------------
+def map_runs(path: Path, points: Sequence[MapPoint], seeds: Sequence[int], warmup: float,
+             opts: PremiseOptions) -> list[StudyRun]:
+    """Per point and seed its baseline, and on the first seed its pulse: IDs
+    ``point=P,seed=S,kind=K``."""
+    runs = []
+    for p in points:
+        spec = study_spec(NAME, path, seeds=list(seeds),
+                          set={"run.warmup_s": float(warmup), **p.set})
+        for r in design_runs(spec):
+            kinds = ("baseline", "pulse") if r.columns["seed"] == seeds[0] else ("baseline",)
+            runs += [replace(r, run_id=f"point={p.name},{r.run_id},kind={k}",
+                             columns={"point": p.name, "axis": p.axis, **r.columns},
+                             options=opts.for_kind(k)) for k in kinds]
+    return runs
+
+
+# -- the analysis (pure) -------------------------------------------------------------------
+def measured_round_trip(base: Mapping[str, Any], gates: Sequence[GateResult],
+                        length: float) -> float:
+    """L / v + L / |c| (s) of the baseline's mean HV speed v and its HV wave speed c;
+    NaN when the HV waves were not measured travelling upstream."""
+    wave = next((g for g in gates if g.name == "waves[hv]"), None)
+    v = float(np.nanmean(class_fields(base, ["hv"])["hv"]))
+    if wave is None or not math.isfinite(wave.value) or wave.value >= 0 or not v > 0:
+        return math.nan
+    return round_trip_time(length, v, wave.value)
+
+
+def point_gates(rows: Mapping[int, Mapping[str, Mapping[str, Any]]], length: float,
+                th: PremiseThresholds, smooth: float, fallback_trip: float
+                ) -> dict[int, list[GateResult]]:
+    """The map's gates per seed of one point (``rows``: seed -> kind -> row); the pulse's
+    round trip is :func:`measured_round_trip`, else ``fallback_trip`` (s)."""
+    seeds = sorted(rows)
+    floor: dict[str, float] = {}
+    if len(seeds) >= 2:   # two baselines that differ only by chance
+        a, b = rows[seeds[0]]["baseline"], rows[seeds[1]]["baseline"]
+        cls = [c for c in classes_of(a) if c in classes_of(b)]
+        d = deviation_norms(class_fields(a, cls), class_fields(b, cls), float(a["dx_m"]))
+        floor = {k: float(np.nanmedian(v)) for k, v in d.items()}
+    out: dict[int, list[GateResult]] = {}
+    for s in seeds:
+        base = rows[s]["baseline"]
+        cls = classes_of(base)
+        gates = speed_gates(base, cls, None, length, th)
+        if "pulse" in rows[s]:
+            trip = measured_round_trip(base, gates, length)
+            gates.append(_pulse(base, rows[s]["pulse"], cls,
+                                trip if math.isfinite(trip) else fallback_trip, floor, th,
+                                smooth))
+        out[s] = gates + operating_gates(base, th)
+    return out
+
+
+def _pulse(base: Mapping[str, Any], pulse: Mapping[str, Any], cls: Sequence[str],
+           trip: float, floor: Mapping[str, float], th: PremiseThresholds,
+           smooth: float) -> GateResult:
+    """The pulse gate; unmeasured (NaN, failed) when the window ends before the gate's
+    round trips after the pulse."""
+    t, t0 = np.array(base["t_s"], dtype=float), float(base["t0_s"])
+    need = t0 + th.pulse_round_trips * trip
+    if t[-1] < need:
+        return GateResult("pulse", math.nan, th.pulse_round_trips * trip, False,
+                          {"round_trip_s": trip, "window_s": float(t[-1] - t0),
+                           "reason": "the window ends before the gate's round trips"})
+    return pulse_gate(t, class_fields(base, cls), class_fields(pulse, cls),
+                      float(base["dx_m"]), t0, trip, floor, th, smooth)
+
+
+def point_measures(rows: Mapping[int, Mapping[str, Mapping[str, Any]]]) -> dict[str, float]:
+    """The baselines' means over seeds: class speeds (km/h), densities (veh/km) and the
+    mainline outflow q(L) (veh/h)."""
+    base = [r["baseline"] for r in rows.values()]
+    out = {}
+    for c in ("hv", "av"):
+        out[f"v_{c}_kmh"] = float(ms_to_kmh(np.nanmean([np.nanmean(b[f"v_{c}"])
+                                                         for b in base])))
+        out[f"rho_{c}_veh_km"] = float(np.mean([b.get(f"rho_{c}_veh_m", math.nan)
+                                               for b in base]) * VEH_KM_PER_VEH_M)
+    out["q_out_veh_h"] = float(np.mean([b.get("outflow_veh_s", math.nan) for b in base])
+                               * VEH_H_PER_VEH_S)
+    return out
+
+
+def map_tables(rows: Sequence[Mapping[str, Any]], points: Sequence[MapPoint], length: float,
+               fallback_trip: float, th: PremiseThresholds | None = None,
+               smooth: float = 30.0) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """(per point, seed and gate; per point) of the rows of :func:`map_runs`' runs, in
+    the order of ``points``; ``fallback_trip``: the pulse's round trip (s) where the HV
+    waves were not measured travelling upstream."""
+    th = th or PremiseThresholds()
+    by: dict[str, dict[int, dict[str, Mapping[str, Any]]]] = {}
+    for r in rows:
+        by.setdefault(r["point"], {}).setdefault(int(r["seed"]), {})[r["kind"]] = r
+    long, wide = [], []
+    for p in points:
+        if p.name not in by:
+            continue
+        gates = point_gates(by[p.name], length, th, smooth, fallback_trip)
+        row: dict[str, Any] = {"point": p.name, "axis": p.axis,
+                               "changes": "; ".join(f"{k[5:]} = {v}" for k, v in p.set.items()
+                                                    if k[5:] not in COUPLED
+                                                    or COUPLED[k[5:]] != v),
+                               "seeds": len(gates)}
+        for s, gs in gates.items():
+            long += [{"point": p.name, "seed": s, "gate": g.name, "value": g.value,
+                      "threshold": str(g.threshold), "passed": bool(g.passed)} for g in gs]
+        for name in MAP_GATES:
+            found = [g for gs in gates.values() for g in gs if g.name == name]
+            row[f"{name}_value"] = float(np.nanmean([g.value for g in found])) \
+                if found and any(math.isfinite(g.value) for g in found) else math.nan
+            row[f"{name}_passed"] = float(np.mean([g.passed for g in found])) \
+                if found else math.nan
+        wide.append({**row, **point_measures(by[p.name])})
+    return pd.DataFrame(long), pd.DataFrame(wide)
+
+
+# -- the command ---------------------------------------------------------------------------
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The premise map's options."""
+    parser.add_argument("--scenario", type=Path, metavar="SCENARIO.toml",
+                        help="base scenario every point changes (default: the shipped "
+                             "default)")
+    parser.add_argument("--points", default=None, metavar="LIST",
+                        help="comma-separated point names (default: all: "
+                             + ", ".join(p.name for p in POINTS) + ")")
+    parser.add_argument("--window", type=float, default=540.0,
+                        help="baseline and pulse window after the warm-up, s")
+    parser.add_argument("--pulse-s", type=float, default=25.0,
+                        help="the pulse: the meter at its least plan this long, s")
+    add_runs(parser, seeds="1,2")
+    add_output(parser, NAME, PAGE)
+
+
+def selected_points(text: str | None) -> list[MapPoint]:
+    """The points named in ``text`` (comma-separated; None: all)."""
+    if text is None:
+        return list(POINTS)
+    known = {p.name: p for p in POINTS}
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    bad = [n for n in names if n not in known]
+    if bad or not names:
+        raise StudyError(f"--points = {text!r} is not allowed: names among "
+                         f"{', '.join(known)}")
+    return [known[n] for n in names]
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the map's points (or read them from ``--out``) and write its tables."""
+    from arzsumo.scenario import load_scenario
+
+    path = args.scenario or shipped_scenario("default.toml")
+    points = selected_points(args.points)
+    sc = load_scenario(path)
+    opts = PremiseOptions(args.window, args.pulse_s)
+    runs = map_runs(path, points, args.seeds, sc.run.warmup, opts)
+    if args.list:
+        return print_list([r.run_id for r in runs])
+    with resumable_dir(args.out, f"study-{NAME}") as out:
+        rows = run_design(runs, _task, out, workers=args.workers, scheduler=args.scheduler,
+                          progress=not args.quiet, label=NAME)
+        long, wide = map_tables(rows, points, sc.params.length,
+                                model_speeds(sc).round_trip)
+        files = write_map(out, long, wide, MAP_GATES, plots=plots_wanted(args))
+        text = map_markdown(wide)
+        if args.docs is not None:
+            publish(args.docs, PAGE, NAME, "The premise map",
+                    "Share of seeds on which each premise gate passed, per point of the "
+                    f"map, and the measured means (`arzsumo study {NAME}`). Tables: "
+                    f"[premise_map_points.csv]({PAGE}/premise_map_points.csv), "
+                    f"[premise_map.csv]({PAGE}/premise_map.csv).\n\n{text}", files)
+    print(text)
+    return 0
+
+
+def _task(run: StudyRun) -> dict[str, Any]:
+    """A premise run with the map's point kept in its row."""
+    return {"point": run.columns["point"], **run_premise_task(run)}
+
+
+def map_markdown(wide: pd.DataFrame) -> str:
+    """The per-point table: pass shares of the gates and the measured means."""
+    cols = ["point", "changes", *[f"{g}_passed" for g in MAP_GATES], "v_hv_kmh", "v_av_kmh",
+            "rho_hv_veh_km", "rho_av_veh_km", "q_out_veh_h"]
+    table = wide[[c for c in cols if c in wide]].rename(
+        columns={f"{g}_passed": g for g in MAP_GATES})
+    return markdown_table(table, ".3g")
