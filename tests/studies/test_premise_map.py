@@ -32,13 +32,13 @@ def tables():
                          fallback_trip=100.0)
 
 
-def test_points_are_one_change_from_the_coupled_base_and_named_uniquely():
+def test_every_point_but_today_leaves_the_uncoupled_files_and_names_are_unique():
     names = [p.name for p in pm.POINTS]
     assert len(names) == len(set(names)) and names[:2] == ["today", "coupled"]
     assert pm.POINTS[0].set == {}
     for p in pm.POINTS[1:]:
-        changed = {k[5:] for k, v in p.set.items() if pm.COUPLED.get(k[5:]) != v}
-        assert len(changed) <= 2, p.name     # a demand point changes both classes
+        assert p.set["sumo.min_gap_lat_m"] >= 0.6, p.name
+        assert p.set["sumo.demand_h_veh_h"] < 3750, p.name      # re-mapped demand
 
 
 def test_the_design_pulses_the_first_seed_only():
