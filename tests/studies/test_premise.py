@@ -13,14 +13,17 @@ from arzsumo.scenario import load_scenario
 from arzsumo.studies import premise as study
 from arzsumo.studies.common import shipped_scenario
 from arzsumo.studies.premise_runs import (
+    KINDS,
     PremiseOptions,
     PremiseRunError,
     check_options,
+    grouped,
     least_plan,
     nominal_plan,
     plan_for_step,
     premise_runs,
     staircase_levels,
+    ungrouped,
 )
 from arzsumo.sumo.green_share import DEFAULT_CURVE
 
@@ -35,10 +38,27 @@ def test_one_run_per_seed_and_kind_each_keyed_by_what_it_depends_on():
     assert [r.run_id for r in runs] == [f"seed={s},kind={k}" for s in (3, 4)
                                         for k in ("baseline", "pulse", "staircase")]
     assert runs[0].scenario["sumo"]["seed"] == 3 and runs[0].scenario["run"]["warmup_s"] == 60
-    longer = premise_runs(LEGACY, [3], 60.0, PremiseOptions(window=300.0, level=60.0))
-    # a longer staircase level changes the staircase's run only
+    longer = premise_runs(LEGACY, [3], 60.0, PremiseOptions(window=300.0, pulse=20.0))
+    # a longer pulse changes the pulse's run only
     assert [a.sha256 == b.sha256 for a, b in zip(runs, longer, strict=False)] == [
-        True, True, False]
+        True, False, True]
+    # every kind of a seed is set up for the longest (the staircase: 9 x 120 s), so that
+    # the three share their warm-up; a shorter staircase changes them all
+    assert {r.options["horizon_periods"] for r in runs} == {1080}
+    shorter = premise_runs(LEGACY, [3], 60.0, PremiseOptions(window=300.0, level=60.0))
+    assert not any(a.sha256 == b.sha256 for a, b in zip(runs, shorter, strict=False))
+
+
+def test_a_seed_s_runs_are_one_group_and_come_apart_again():
+    runs = premise_runs(LEGACY, [3, 4], 60.0, PremiseOptions(window=300.0))
+    groups = grouped(runs)
+    assert [g.run_id for g in groups] == ["seed=3", "seed=4"]
+    assert [i for i, _ in groups[0].options["group"]] == [
+        "seed=3,kind=baseline", "seed=3,kind=pulse", "seed=3,kind=staircase"]
+    assert groups[1].scenario == runs[3].scenario
+    rows = [{"rows": [{"kind": k, "seed": s} for k in KINDS]} for s in (3, 4)]
+    assert [(r["seed"], r["kind"]) for r in ungrouped(rows)] == [
+        (s, k) for s in (3, 4) for k in KINDS]
 
 
 def test_the_plans_of_both_meters():

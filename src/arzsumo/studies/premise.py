@@ -302,18 +302,19 @@ def run_premise(path: Path, sc: Scenario, seeds: Sequence[int], warmup: float,
                 opts: PremiseOptions, analysis: AnalysisOptions, out: Path, *,
                 workers: int | None = None, scheduler: str | None = None,
                 progress: bool = True) -> PremiseReport:
-    """Run (or read from ``out/runs``) the premise runs of ``seeds`` and analyse them.
+    """Run (or read from ``out/runs``) the premise runs of ``seeds`` and analyse them: a
+    seed's runs share one warm-up (:func:`~arzsumo.studies.premise_runs.grouped`).
 
     ``path`` is the scenario file of ``sc``; ``warmup`` s; ``out`` the claimed output
     directory; ``workers``/``scheduler`` as :func:`~arzsumo.studies.design.run_design`.
     """
     from arzsumo.studies.design import run_design
-    from arzsumo.studies.premise_runs import run_premise_task
+    from arzsumo.studies.premise_runs import grouped, run_premise_group, ungrouped
 
-    runs = premise_runs(path, list(seeds), warmup, opts)
-    rows = run_design(runs, run_premise_task, out, workers=workers, scheduler=scheduler,
+    runs = grouped(premise_runs(path, list(seeds), warmup, opts))
+    rows = run_design(runs, run_premise_group, out, workers=workers, scheduler=scheduler,
                       progress=progress, label="premise")
-    return analyse(rows, sc, analysis)
+    return analyse(ungrouped(rows), sc, analysis)
 
 
 def check_window(window: float, round_trip: float, trip_given: bool,

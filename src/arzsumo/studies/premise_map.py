@@ -56,7 +56,13 @@ from arzsumo.studies.premise import (
     operating_gates,
     speed_gates,
 )
-from arzsumo.studies.premise_runs import PremiseOptions, run_premise_task
+from arzsumo.studies.premise_runs import (
+    PremiseOptions,
+    grouped,
+    horizon_periods,
+    run_premise_group,
+    ungrouped,
+)
 from arzsumo.units import VEH_H_PER_VEH_S, VEH_KM_PER_VEH_M, ms_to_kmh
 
 NAME = "premise-map"
@@ -131,9 +137,11 @@ def map_runs(path: Path, points: Sequence[MapPoint], seeds: Sequence[int], warmu
         for r in design_runs(spec):
             first = pulses and r.columns["seed"] == seeds[0]
             kinds = ("baseline", "pulse") if first else ("baseline",)
+            n = horizon_periods(opts, float(r.scenario["sumo"].get("control_period_s", 1.0)))
             runs += [replace(r, run_id=f"point={p.name},{r.run_id},kind={k}",
                              columns={"point": p.name, "axis": p.axis, **r.columns},
-                             options=opts.for_kind(k)) for k in kinds]
+                             options={**opts.for_kind(k), "horizon_periods": n})
+                     for k in kinds]
     return runs
 
 
@@ -282,8 +290,9 @@ def run(args: argparse.Namespace) -> int:
     if args.list:
         return print_list([r.run_id for r in runs])
     with resumable_dir(args.out, f"study-{NAME}") as out:
-        rows = run_design(runs, _task, out, workers=args.workers, scheduler=args.scheduler,
-                          progress=not args.quiet, label=NAME)
+        rows = ungrouped(run_design(grouped(runs), _task, out, workers=args.workers,
+                                    scheduler=args.scheduler, progress=not args.quiet,
+                                    label=NAME))
         long, wide = map_tables(rows, points, sc.params.length,
                                 model_speeds(sc).round_trip)
         files = write_map(out, long, wide, MAP_GATES, plots=plots_wanted(args))
@@ -299,8 +308,9 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _task(run: StudyRun) -> dict[str, Any]:
-    """A premise run with the map's point kept in its row."""
-    return {"point": run.columns["point"], **run_premise_task(run)}
+    """A point's runs on one seed (one warm-up), the point kept in their rows."""
+    rows = run_premise_group(run)["rows"]
+    return {"rows": [{"point": run.columns["point"], **r} for r in rows]}
 
 
 def map_markdown(wide: pd.DataFrame) -> str:

@@ -1,8 +1,10 @@
 """The SUMO side of ``arzsumo premise``: the open-loop runs the premise gates measure.
 
-Per seed three open-loop runs of the scenario, each the scenario's warm-up (``[run]
-warmup_s``, the fill phase ``[sumo] fill_s`` included) under the nominal meter plan, then
-a window, all through the one step loop :class:`~arzsumo.sumo.plant.SumoPlant`:
+Per seed three open-loop runs of the scenario that share one warm-up (``[run]
+warmup_s``, the fill phase ``[sumo] fill_s`` included) under the nominal meter plan: the
+warm-up runs once, and each run's window runs in a child process forked at its end
+(:mod:`arzsumo.sumo.fork`; bit for bit what three separate runs give), all through the
+one step loop :class:`~arzsumo.sumo.plant.SumoPlant`:
 
 * ``baseline``: the window (``window_s``) at the nominal plan. Kept: the window's mean
   class densities (veh/m) and mainline outflow q(L) (veh/s); per control period:
@@ -35,10 +37,12 @@ Dask); :func:`run_premise_task` is its worker. SI units: s, m, m/s, veh, veh/s.
 
 from __future__ import annotations
 
+import logging
 import math
 import time
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -49,7 +53,10 @@ from arzsumo.scenario import Scenario
 from arzsumo.studies.common import study_spec
 from arzsumo.studies.design import StudyRun, design_runs
 from arzsumo.sumo.config import SumoConfig, ramp_capacity
+from arzsumo.sumo.fork import BranchFailed
 from arzsumo.sumo.green_share import GreenShareCurve
+
+log = logging.getLogger(__name__)
 
 NAME = "premise"
 #: the runs of one seed, in the order they are laid out
@@ -159,42 +166,104 @@ def check_options(sc: Scenario, opts: PremiseOptions, curve: GreenShareCurve) ->
 
 
 # -- the design ----------------------------------------------------------------------------
+def horizon_periods(opts: PremiseOptions, period: float) -> int:
+    """Control periods after the warm-up that every kind's SUMO run is set up for (the
+    longest kind's): the runs of a seed then share everything up to the warm-up's end."""
+    return max(_periods(opts.window, period),
+               _periods(opts.level, period) * (opts.levels + 1))
+
+
 def premise_runs(path: Path, seeds: list[int], warmup: float,
                  opts: PremiseOptions) -> list[StudyRun]:
     """One run per (seed, kind) of the scenario file ``path`` with warm-up ``warmup`` (s):
     IDs ``seed=S,kind=K``, seeds in order, kinds as :data:`KINDS`."""
     spec = study_spec(NAME, path, seeds=list(seeds), set={"run.warmup_s": float(warmup)})
-    return [replace(r, run_id=f"{r.run_id},kind={kind}", options=opts.for_kind(kind))
-            for r in design_runs(spec) for kind in KINDS]
+    runs = design_runs(spec)
+    period = float(runs[0].scenario.get("sumo", {}).get("control_period_s", 1.0))
+    n = horizon_periods(opts, period)
+    return [replace(r, run_id=f"{r.run_id},kind={kind}",
+                    options={**opts.for_kind(kind), "horizon_periods": n})
+            for r in runs for kind in KINDS]
+
+
+def grouped(runs: Sequence[StudyRun]) -> list[StudyRun]:
+    """The runs that share a scenario (and so their warm-up) as one run each: ID
+    ``seed=S`` (the runs' IDs up to ``,kind=``), options ``{"group": [[ID, options],
+    ...]}``, for :func:`run_premise_group`."""
+    groups: dict[str, list[StudyRun]] = {}
+    for r in runs:
+        groups.setdefault(r.run_id.split(",kind=")[0], []).append(r)
+    return [replace(rs[0], run_id=key, options={"group": [[r.run_id, dict(r.options)]
+                                                          for r in rs]})
+            for key, rs in groups.items()]
+
+
+def ungrouped(rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
+    """The per-kind rows of :func:`run_premise_group`'s rows."""
+    return [dict(r) for g in rows for r in g["rows"]]
 
 
 # -- the worker ----------------------------------------------------------------------------
 def run_premise_task(run: StudyRun) -> dict[str, Any]:
-    """One premise run (``run.options["kind"]``): its arrays as lists (JSON-able)."""
+    """One premise run (``run.options["kind"]``) with its own warm-up: its arrays as lists
+    (JSON-able)."""
     from arzsumo.scenario import scenario_from_dict
 
-    wall0 = time.perf_counter()
     sc = scenario_from_dict(run.scenario, run.source)
-    opt = run.options
-    kind = opt["kind"]
-    if kind == "staircase":
-        row = _staircase(sc, opt)
-    else:
-        n = _periods(opt["window_s"], sc.sumo.control_period)
-        plans: dict[int, float] = {}
-        if kind == "pulse":
-            k = _periods(opt["pulse_s"], sc.sumo.control_period)
-            plans = {0: least_plan(sc.sumo), k: nominal_plan(sc.sumo)}
-        rec = _open_loop(sc, n, plans, lateral=kind == "baseline")
-        row = _fields_row(rec) if kind == "pulse" else _baseline_row(sc, rec)
-        if kind == "pulse":
-            row["pulse_plan"] = plans[0]
-    return {"kind": kind, "seed": sc.sumo.seed, **row,
-            "wall_s": time.perf_counter() - wall0}
+    return _simulate(sc, [run.options], fork=False)[0]
+
+
+def run_premise_group(run: StudyRun) -> dict[str, Any]:
+    """The runs of one group (:func:`grouped`): one warm-up, then each run in a child
+    forked at its end (:mod:`arzsumo.sumo.fork`), bit for bit what
+    :func:`run_premise_task` gives; a run whose child fails runs again alone."""
+    from arzsumo.scenario import scenario_from_dict
+    from arzsumo.sumo.fork import can_fork
+
+    sc = scenario_from_dict(run.scenario, run.source)
+    opts = [o for _, o in run.options["group"]]
+    if not can_fork():     # e.g. a threaded Dask worker: one warm-up per run instead
+        return {"rows": [_simulate(sc, [o], fork=False)[0] for o in opts]}
+    rows = _simulate(sc, opts, fork=True)
+    for i, row in enumerate(rows):
+        if isinstance(row, BranchFailed):
+            log.warning("%s %s: %s; running it again alone", run.run_id,
+                        opts[i]["kind"], row.reason)
+            rows[i] = {**_simulate(sc, [opts[i]], fork=False)[0], "rerun": True}
+    return {"rows": rows}
 
 
 def _periods(duration: float, period: float) -> int:
     return max(1, round(duration / period))
+
+
+def _simulate(sc: Scenario, opts: Sequence[Mapping[str, Any]], fork: bool) -> list[Any]:
+    """The warm-up, then the window of each of ``opts`` (in forked children with
+    ``fork`` and more than one, else the one window in this process). The caller checks
+    :func:`~arzsumo.sumo.fork.can_fork`."""
+    from arzsumo.bridge.cosim import warm_up
+    from arzsumo.bridge.session import meter_curve_of
+    from arzsumo.progress import Progress
+    from arzsumo.sumo.fork import run_branches
+    from arzsumo.sumo.plant import SumoPlant
+    from arzsumo.sumo.simulation import open_simulation
+
+    wall0 = time.perf_counter()
+    period = sc.sumo.control_period
+    t_w = max(1, math.ceil(sc.run.warmup / period - 1e-9)) * period
+    n = max(int(o.get("horizon_periods", 0)) for o in opts)
+    cfg = sc.sumo.with_(horizon=t_w + max(n, 1) * period)
+    with open_simulation(sc.params, cfg, downstream_loop=sc.alinea.loop_distance) as sim:
+        plant = SumoPlant(sim, sc.params.length, cfg, meter_curve_of(cfg, sc.source))
+        warm = warm_up(plant, sc.run.warmup, period, Progress(1, enabled=False))
+        warm_s = time.perf_counter() - wall0
+        branches = [partial(_branch, sc, sim, plant, float(warm[-1].t), o, warm_s)
+                    for o in opts]
+        if fork and len(branches) > 1:
+            return run_branches(branches)
+        if len(branches) != 1:
+            raise PremiseRunError("several premise runs without a fork; allowed: one")
+        return [branches[0]()]
 
 
 @dataclass
@@ -211,41 +280,49 @@ class _OpenLoop:
     cfg: SumoConfig
 
 
-def _open_loop(sc: Scenario, periods: int, plans: Mapping[int, float],
-               lateral: bool) -> _OpenLoop:
-    """Warm-up, then ``periods`` control periods; ``plans``: period index -> plan set at
-    that period's start."""
-    from arzsumo.bridge.cosim import warm_up
-    from arzsumo.bridge.session import meter_curve_of
-    from arzsumo.progress import Progress
+def _branch(sc: Scenario, sim: Any, plant: Any, t0: float, opt: Mapping[str, Any],
+            warm_s: float) -> dict[str, Any]:
+    """One kind's window after the warm-up, and its row."""
+    wall0 = time.perf_counter()
+    kind, period = opt["kind"], sc.sumo.control_period
+    if kind == "staircase":
+        row = _staircase(sc, sim, plant, t0, opt)
+    else:
+        plans: dict[int, float] = {}
+        if kind == "pulse":
+            plans = {0: least_plan(sc.sumo), _periods(opt["pulse_s"], period):
+                     nominal_plan(sc.sumo)}
+        rec = _window(sim, plant, t0, _periods(opt["window_s"], period), plans,
+                      lateral=kind == "baseline")
+        row = _fields_row(rec) if kind == "pulse" else _baseline_row(sc, rec)
+        if kind == "pulse":
+            row["pulse_plan"] = plans[0]
+    return {"kind": kind, "seed": sc.sumo.seed, **row,
+            "wall_s": time.perf_counter() - wall0 + warm_s}
+
+
+def _window(sim: Any, plant: Any, t0: float, periods: int, plans: Mapping[int, float],
+            lateral: bool) -> _OpenLoop:
+    """``periods`` control periods from the warm-up's end; ``plans``: period index ->
+    plan set at that period's start."""
     from arzsumo.sumo.lateral import LateralSampler
     from arzsumo.sumo.network import MAIN
-    from arzsumo.sumo.plant import SumoPlant
-    from arzsumo.sumo.simulation import open_simulation
 
-    period = sc.sumo.control_period
-    t_w = max(1, math.ceil(sc.run.warmup / period - 1e-9)) * period
-    cfg = sc.sumo.with_(horizon=t_w + periods * period)
     cells, main, releases = [], [], []
-    with open_simulation(sc.params, cfg, downstream_loop=sc.alinea.loop_distance) as sim:
-        plant = SumoPlant(sim, sc.params.length, cfg, meter_curve_of(cfg, sc.source))
-        sampler, seen = LateralSampler(sim.lib), plant.sensor.mainline
-        warm = warm_up(plant, sc.run.warmup, period, Progress(1, enabled=False))
-        plant.meter.start_window()
-        for k in range(periods):
-            if k in plans:
-                plant.meter.set_plan(plans[k])
-            m = plant.advance()
-            cells.append(m.cells)
-            releases.append(plant.meter.releases)
-            main.append(int(sim.lib.edge.getLastStepVehicleNumber(MAIN)))
-            if lateral:   # the sensor's own snapshot call, at the period's last step
-                sampler.sample(m.t, seen.last_ids, seen.last_pos, seen.last_speed,
-                               seen.last_av)
-        meter = plant.meter.summary()
-        record = sampler.record() if lateral else None
-    return _OpenLoop(float(warm[-1].t), cells, main, releases, record, sim.report, meter,
-                     cfg)
+    sampler, seen = LateralSampler(sim.lib), plant.sensor.mainline
+    plant.meter.start_window()
+    for k in range(periods):
+        if k in plans:
+            plant.meter.set_plan(plans[k])
+        m = plant.advance()
+        cells.append(m.cells)
+        releases.append(plant.meter.releases)
+        main.append(int(sim.lib.edge.getLastStepVehicleNumber(MAIN)))
+        if lateral:   # the sensor's own snapshot call, at the period's last step
+            sampler.sample(m.t, seen.last_ids, seen.last_pos, seen.last_speed,
+                           seen.last_av)
+    return _OpenLoop(t0, cells, main, releases, sampler.record() if lateral else None,
+                     sim.take_report(), plant.meter.summary(), sim.cfg)
 
 
 def _grid(rec: _OpenLoop) -> dict[str, Any]:
@@ -292,7 +369,8 @@ def _baseline_row(sc: Scenario, rec: _OpenLoop) -> dict[str, Any]:
             "max_queue_veh": int(rec.meter["max_queue"]), "ramp_storage_veh": storage}
 
 
-def _staircase(sc: Scenario, opt: Mapping[str, Any]) -> dict[str, Any]:
+def _staircase(sc: Scenario, sim: Any, plant: Any, t0: float,
+               opt: Mapping[str, Any]) -> dict[str, Any]:
     """The release-rate staircase: q(L), the commanded r and the releases per period."""
     from arzsumo.bridge.session import meter_curve_of
 
@@ -302,7 +380,7 @@ def _staircase(sc: Scenario, opt: Mapping[str, Any]) -> dict[str, Any]:
     curve = meter_curve_of(cfg, sc.source)
     dr = float(opt["step_veh_s"])
     plans = {i * per_level: plan_for_step(cfg, curve, s * dr) for i, s in enumerate(steps)}
-    rec = _open_loop(sc, per_level * len(steps), plans, lateral=False)
+    rec = _window(sim, plant, t0, per_level * len(steps), plans, lateral=False)
     rate = np.repeat([cfg.release_rate + s * dr for s in steps], per_level)
     released = np.diff(np.r_[0, rec.releases]) / period
     return {**_grid(rec), "q_veh_s": [c.outflow_h + c.outflow_a for c in rec.cells],

@@ -1,0 +1,64 @@
+"""A seed's premise runs share one warm-up by fork, bit for bit what separate runs give,
+and a child that dies is run again alone, leaving nothing behind (real SUMO, short)."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+
+import pytest
+
+from arzsumo.studies import premise_runs as pr
+from arzsumo.studies.common import shipped_scenario
+
+pytestmark = [pytest.mark.sumo, pytest.mark.slow]
+
+OPTS = pr.PremiseOptions(window=20.0, pulse=5.0, level=5.0, levels=2)
+
+
+def _runs():
+    return pr.premise_runs(shipped_scenario("legacy_default.toml"), [5], 20.0, OPTS)
+
+
+def _without_wall(row: dict) -> str:
+    """The row but its wall time, as text (NaN speeds of empty cells compare equal)."""
+    return json.dumps({k: v for k, v in row.items() if k not in ("wall_s", "rerun")},
+                      sort_keys=True)
+
+
+@pytest.fixture(scope="module")
+def plain():
+    return [pr.run_premise_task(r) for r in _runs()]
+
+
+def test_a_forked_group_equals_the_runs_made_alone(plain, monkeypatch, tmp_path):
+    monkeypatch.setenv("ARZSUMO_SCRATCH_DIR", str(tmp_path))
+    group = pr.run_premise_group(pr.grouped(_runs())[0])["rows"]
+    assert [r["kind"] for r in group] == list(pr.KINDS)
+    assert not any(r.get("rerun") for r in group)
+    assert len(plain[0]["t_s"]) == 20 and plain[0]["main_vehicles"][-1] > 20
+    for a, b in zip(group, plain, strict=True):
+        assert _without_wall(a) == _without_wall(b)
+    # the pulse moved the stream: the comparison is not between identical runs
+    assert plain[1]["v_hv"] != plain[0]["v_hv"]
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_killed_child_runs_again_alone_and_nothing_is_left(plain, monkeypatch, tmp_path):
+    monkeypatch.setenv("ARZSUMO_SCRATCH_DIR", str(tmp_path))
+    parent, branch = os.getpid(), pr._branch
+
+    def dies_in_the_pulse_child(sc, sim, plant, t0, opt, warm_s):
+        if os.getpid() != parent and opt["kind"] == "pulse":
+            os.kill(os.getpid(), signal.SIGKILL)
+        return branch(sc, sim, plant, t0, opt, warm_s)
+
+    monkeypatch.setattr(pr, "_branch", dies_in_the_pulse_child)
+    group = pr.run_premise_group(pr.grouped(_runs())[0])["rows"]
+    assert [bool(r.get("rerun")) for r in group] == [False, True, False]
+    for a, b in zip(group, plain, strict=True):
+        assert _without_wall(a) == _without_wall(b)
+    with pytest.raises(ChildProcessError):       # every child was reaped
+        os.waitpid(-1, os.WNOHANG)
+    assert list(tmp_path.iterdir()) == []
