@@ -34,11 +34,17 @@ def tables():
 
 def test_every_point_but_today_leaves_the_uncoupled_files_and_names_are_unique():
     names = [p.name for p in pm.POINTS]
-    assert len(names) == len(set(names)) and names[:2] == ["today", "coupled"]
+    assert len(names) == len(set(names)) and names[:2] == ["today", "columns-0.6"]
     assert pm.POINTS[0].set == {}
     for p in pm.POINTS[1:]:
         assert p.set["sumo.min_gap_lat_m"] >= 0.6, p.name
         assert p.set["sumo.demand_h_veh_h"] < 3750, p.name      # re-mapped demand
+
+
+def test_the_demand_splits_its_totals_by_the_av_share():
+    d = pm.demand(0.25, hold=4000, fill=4800)
+    assert d == {"demand_h_veh_h": 3000, "demand_a_veh_h": 1000,
+                 "fill_demand_h_veh_h": 3600, "fill_demand_a_veh_h": 1200}
 
 
 def test_the_design_pulses_the_first_seed_only():
@@ -50,6 +56,7 @@ def test_the_design_pulses_the_first_seed_only():
         "point=idm,seed=3,kind=pulse", "point=idm,seed=4,kind=baseline"]
     assert runs[3].scenario["sumo"]["hv_model"] == "IDM"
     assert runs[3].scenario["sumo"]["min_gap_lat_m"] == 0.6
+    assert runs[3].scenario["sumo"]["depart_pos_lat"] == "random_free"
     assert "hv_model" not in runs[0].scenario["sumo"]
 
 
@@ -103,4 +110,14 @@ def test_the_pulse_is_judged_within_the_round_trips_that_fit():
                             th=pm.PremiseThresholds(pulse_round_trips=0.9))
     pulse = long[long.gate == "pulse"].iloc[0]
     # the pulse decays in 40 s, well within 0.9 x 375 s: a stable stream fails the gate
+    assert pulse["value"] < 100.0 and not pulse["passed"]
+
+
+def test_one_seed_takes_the_late_floor_of_its_pulse():
+    rows = [r for r in _map_rows() if r["seed"] == 1]
+    long, _ = pm.map_tables(rows, [pm.MapPoint("p", "axis", {})], 1000.0,
+                            fallback_trip=100.0,
+                            th=pm.PremiseThresholds(pulse_round_trips=0.9))
+    pulse = long[long.gate == "pulse"].iloc[0]
+    # the late floor is the decayed pulse's own tail: it still decays within 40 s or so
     assert pulse["value"] < 100.0 and not pulse["passed"]

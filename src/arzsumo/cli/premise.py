@@ -3,9 +3,9 @@ scenario the stream the paper models?
 
 Per seed a baseline, a paired pulse and a release-rate staircase in SUMO, open loop
 (:mod:`arzsumo.studies.premise_runs`) sharing one warm-up, one task per seed on the sweep
-engine's local pool or a Dask cluster, resumable in ``OUT/runs``; then every premise gate per seed and the
-verdict over seeds (:mod:`arzsumo.studies.premise`, docs/premise.md); a table on stdout
-(or ``--json``) and ``premise.json``, ``premise.csv``, ``premise.png`` in ``--out``.
+engine's local pool or a Dask cluster, resumable in ``OUT/runs``; then every premise gate
+per seed and the verdict over seeds (:mod:`arzsumo.studies.premise`, docs/premise.md); a
+table on stdout (or ``--json``) and ``premise.json``, ``premise.csv``, ``premise.png`` in ``--out``.
 Exit codes: 0 the premise holds (every premise gate passes on most seeds; the model's
 gates are reported apart and do not decide), 5 it does not, 2 a user error.
 """

@@ -11,7 +11,8 @@ the paired pulse; then the gates of ``arzsumo premise`` that these runs decide:
 * coupling and waves per class, amplification per class (the baseline);
 * the pulse, with the round trip L / v + L / |c| of the *measured* HV speed v and
   upstream wave speed c (the model is identified only where the map points), and the
-  floor of two seeds' baselines (chance alone);
+  floor of two seeds' baselines (chance alone), or with one seed the pulse's own late
+  deviation;
 * stationary, inserted, ramp demand and ramp queue (the operating point).
 
 The actuator's staircase and the model's gates are left to ``arzsumo premise`` on the
@@ -49,6 +50,7 @@ from arzsumo.studies.common import (
 )
 from arzsumo.studies.design import StudyRun, design_runs, run_design
 from arzsumo.studies.premise import (
+    LATE_SHARE,
     class_fields,
     classes_of,
     deviation_norms,
@@ -94,34 +96,38 @@ def _point(name: str, axis: str, **keys: Any) -> MapPoint:
     return MapPoint(name, axis, {f"sumo.{k}": v for k, v in keys.items()})
 
 
-#: the coupled base every point but ``today`` starts from: SUMO's default lateral gap,
-#: with which the classes no longer ride in files that pass each other freely, and a hold
-#: demand re-mapped to about 4 % above the section outflow measured with it (3950 veh/h,
-#: seed 7); the fill stays the default's
-COUPLED = {"min_gap_lat_m": 0.6, "demand_h_veh_h": 3350, "demand_a_veh_h": 750}
-#: one file: a lateral gap that lets no two vehicles ride side by side on the 6.5 m lane
-#: (2 x 2 m + 2.6 m > 6.5 m), and a demand re-mapped to a single file's discharge
-ONE_FILE = {"min_gap_lat_m": 2.6, "demand_h_veh_h": 1700, "demand_a_veh_h": 400,
-            "fill_demand_h_veh_h": 2300, "fill_demand_a_veh_h": 700}
+def demand(av_share: float, hold: float = 3900.0, fill: float = 4400.0) -> dict[str, float]:
+    """Hold and fill demands (veh/h, scenario keys) of the totals ``hold`` and ``fill``
+    split by the AV share."""
+    return {"demand_h_veh_h": round(hold * (1 - av_share)),
+            "demand_a_veh_h": round(hold * av_share),
+            "fill_demand_h_veh_h": round(fill * (1 - av_share)),
+            "fill_demand_a_veh_h": round(fill * av_share)}
 
-#: the map: one change at a time from the coupled base (and today's default)
+
+#: the coupled base: SUMO's default lateral gap and SUMO's random free lateral insertion
+#: (no fixed columns, so no file is set up at x = 0), with the demand re-mapped to it:
+#: a hold about 1 % above the section outflow measured there (3860 veh/h, seed 1) and a
+#: fill that congests the section in the 10 min warm-up without filling the approach
+COUPLED = {"min_gap_lat_m": 0.6, "depart_pos_lat": "random_free", **demand(0.18)}
+
+#: the map: today's default, the lateral gap alone (with the fixed columns), one centre
+#: file, then one change at a time from the coupled base
 POINTS: tuple[MapPoint, ...] = (
     _point("today", "today's default"),
+    _point("columns-0.6", "lateral", min_gap_lat_m=0.6, demand_h_veh_h=3350,
+           demand_a_veh_h=750),
+    _point("centre-file", "lateral", min_gap_lat_m=0.6, lat_alignment="center",
+           depart_pos_lat="center", lc_speed_gain=0, demand_h_veh_h=1700,
+           demand_a_veh_h=400, fill_demand_h_veh_h=2300, fill_demand_a_veh_h=700),
     _point("coupled", "base", **COUPLED),
-    _point("one-file", "lateral", **ONE_FILE),
-    _point("centre-file", "lateral", **{**ONE_FILE, "min_gap_lat_m": 0.6},
-           lat_alignment="center", depart_pos_lat="center", lc_speed_gain=0),
-    _point("random-lat", "lateral", **COUPLED, depart_pos_lat="random_free"),
+    _point("gap-1.0", "lateral", **{**COUPLED, "min_gap_lat_m": 1.0}),
     _point("sigma-0.9", "car following", **COUPLED, hv_sigma=0.9),
     _point("action-1.0", "car following", **COUPLED, hv_action_step_s=1.0),
     _point("idm", "car following", **COUPLED, hv_model="IDM"),
-    _point("one-file-unstable", "car following", **ONE_FILE, hv_sigma=0.9,
-           hv_action_step_s=1.0),
     _point("down-40", "bottleneck", **COUPLED, down_speed_kmh=40),
-    _point("av-10", "penetration", **{**COUPLED, "demand_h_veh_h": 3690,
-                                      "demand_a_veh_h": 410}),
-    _point("av-50", "penetration", **{**COUPLED, "demand_h_veh_h": 2050,
-                                      "demand_a_veh_h": 2050}),
+    _point("av-10", "penetration", **{**COUPLED, **demand(0.10)}),
+    _point("av-50", "penetration", **{**COUPLED, **demand(0.50)}),
 )
 
 
@@ -163,12 +169,7 @@ def point_gates(rows: Mapping[int, Mapping[str, Mapping[str, Any]]], length: flo
     """The map's gates per seed of one point (``rows``: seed -> kind -> row); the pulse's
     round trip is :func:`measured_round_trip`, else ``fallback_trip`` (s)."""
     seeds = sorted(rows)
-    floor: dict[str, float] = {}
-    if len(seeds) >= 2:   # two baselines that differ only by chance
-        a, b = rows[seeds[0]]["baseline"], rows[seeds[1]]["baseline"]
-        cls = [c for c in classes_of(a) if c in classes_of(b)]
-        d = deviation_norms(class_fields(a, cls), class_fields(b, cls), float(a["dx_m"]))
-        floor = {k: float(np.nanmedian(v)) for k, v in d.items()}
+    floor = _floor(rows)
     out: dict[int, list[GateResult]] = {}
     for s in seeds:
         base = rows[s]["baseline"]
@@ -181,6 +182,25 @@ def point_gates(rows: Mapping[int, Mapping[str, Mapping[str, Any]]], length: flo
                                 smooth))
         out[s] = gates + operating_gates(base, th)
     return out
+
+
+def _floor(rows: Mapping[int, Mapping[str, Mapping[str, Any]]]) -> dict[str, float]:
+    """The pulse's floor (m/s m^(1/2)): the median distance of two seeds' baselines
+    (chance alone), or with one seed the median of the pulse's own deviation over the
+    record's last quarter (``arzsumo premise --floor late``: it counts a deviation that
+    persists as noise, so it errs towards a stable verdict)."""
+    seeds = sorted(rows)
+    a = rows[seeds[0]]["baseline"]
+    if len(seeds) >= 2:
+        b = rows[seeds[1]]["baseline"]
+    elif "pulse" in rows[seeds[0]]:
+        b = rows[seeds[0]]["pulse"]
+    else:
+        return {}
+    cls = [c for c in classes_of(a) if c in classes_of(rows[seeds[-1]]["baseline"])]
+    d = deviation_norms(class_fields(a, cls), class_fields(b, cls), float(a["dx_m"]))
+    start = 0 if len(seeds) >= 2 else int(len(d["total"]) * (1 - LATE_SHARE))
+    return {k: float(np.nanmedian(v[start:])) for k, v in d.items()}
 
 
 def _pulse(base: Mapping[str, Any], pulse: Mapping[str, Any], cls: Sequence[str],
@@ -202,14 +222,16 @@ def point_measures(rows: Mapping[int, Mapping[str, Mapping[str, Any]]]) -> dict[
     """The baselines' means over seeds: class speeds (km/h), densities (veh/km) and the
     mainline outflow q(L) (veh/h)."""
     base = [r["baseline"] for r in rows.values()]
+
+    def mean(key: str) -> float:    # stored rows hold NaN as None
+        return float(np.nanmean([np.nanmean(np.array(b.get(key, math.nan), dtype=float))
+                                 for b in base]))
+
     out = {}
     for c in ("hv", "av"):
-        out[f"v_{c}_kmh"] = float(ms_to_kmh(np.nanmean([np.nanmean(b[f"v_{c}"])
-                                                         for b in base])))
-        out[f"rho_{c}_veh_km"] = float(np.mean([b.get(f"rho_{c}_veh_m", math.nan)
-                                               for b in base]) * VEH_KM_PER_VEH_M)
-    out["q_out_veh_h"] = float(np.mean([b.get("outflow_veh_s", math.nan) for b in base])
-                               * VEH_H_PER_VEH_S)
+        out[f"v_{c}_kmh"] = float(ms_to_kmh(mean(f"v_{c}")))
+        out[f"rho_{c}_veh_km"] = mean(f"rho_{c}_veh_m") * VEH_KM_PER_VEH_M
+    out["q_out_veh_h"] = mean("outflow_veh_s") * VEH_H_PER_VEH_S
     return out
 
 
