@@ -11,8 +11,8 @@ the paired pulse; then the gates of ``arzsumo premise`` that these runs decide:
 * coupling and waves per class, amplification per class (the baseline);
 * the pulse, with the round trip L / v + L / |c| of the *measured* HV speed v and
   upstream wave speed c (the model is identified only where the map points), and the
-  floor of two seeds' baselines (chance alone), or with one seed the pulse's own late
-  deviation;
+  floor of two seeds' baselines (chance alone); with one seed the gate is left
+  undecided (its reading against the pulse's own late deviation is kept in its detail);
 * stationary, inserted, ramp demand and ramp queue (the operating point).
 
 The actuator's staircase and the model's gates are left to ``arzsumo premise`` on the
@@ -177,9 +177,11 @@ def point_gates(rows: Mapping[int, Mapping[str, Mapping[str, Any]]], length: flo
         gates = speed_gates(base, cls, None, length, th)
         if "pulse" in rows[s]:
             trip = measured_round_trip(base, gates, length)
-            gates.append(_pulse(base, rows[s]["pulse"], cls,
-                                trip if math.isfinite(trip) else fallback_trip, floor, th,
-                                smooth))
+            pulse = _pulse(base, rows[s]["pulse"], cls,
+                           trip if math.isfinite(trip) else fallback_trip, floor, th, smooth)
+            if len(seeds) < 2:
+                pulse = _undecided(pulse)
+            gates.append(pulse)
         out[s] = gates + operating_gates(base, th)
     return out
 
@@ -187,8 +189,8 @@ def point_gates(rows: Mapping[int, Mapping[str, Mapping[str, Any]]], length: flo
 def _floor(rows: Mapping[int, Mapping[str, Mapping[str, Any]]]) -> dict[str, float]:
     """The pulse's floor (m/s m^(1/2)): the median distance of two seeds' baselines
     (chance alone), or with one seed the median of the pulse's own deviation over the
-    record's last quarter (``arzsumo premise --floor late``: it counts a deviation that
-    persists as noise, so it errs towards a stable verdict)."""
+    record's last quarter (``arzsumo premise --floor late``), which leaves the gate
+    undecided (:func:`_undecided`)."""
     seeds = sorted(rows)
     a = rows[seeds[0]]["baseline"]
     if len(seeds) >= 2:
@@ -201,6 +203,16 @@ def _floor(rows: Mapping[int, Mapping[str, Mapping[str, Any]]]) -> dict[str, flo
     d = deviation_norms(class_fields(a, cls), class_fields(b, cls), float(a["dx_m"]))
     start = 0 if len(seeds) >= 2 else int(len(d["total"]) * (1 - LATE_SHARE))
     return {k: float(np.nanmedian(v[start:])) for k, v in d.items()}
+
+
+def _undecided(pulse: GateResult) -> GateResult:
+    """The pulse gate of a single seed, kept as a reading but not decided: the late floor
+    cannot tell a pulse that grows from two runs that drift apart by chance (on SUMO's
+    streams the paired deviation grows to the chance level within a few minutes)."""
+    return GateResult("pulse", math.nan, pulse.threshold, False,
+                      {**pulse.detail, "late_floor_value": pulse.value,
+                       "reason": "one seed: no floor of chance (two baselines) to decide "
+                                 "against"})
 
 
 def _pulse(base: Mapping[str, Any], pulse: Mapping[str, Any], cls: Sequence[str],
