@@ -30,7 +30,7 @@ def test_shipped_dirs_are_inside_the_package_and_hold_their_files():
     assert sorted(p.stem for p in shipped_sweeps_dir().glob("*.toml")) == list(SWEEPS)
     assert len(list((shipped_scenarios_dir() / "paper").glob("*.toml"))) == 20
     sc = load_scenario(default_scenario())
-    assert sc.name == "default" and sc.sumo.demand_h * 3600 == pytest.approx(3750)
+    assert sc.name == "default" and sc.sumo.demand_h * 3600 == pytest.approx(3198)
     assert sc.sumo.approach_length == 2500 and sc.sumo.fill_duration == sc.run.warmup == 600
 
 

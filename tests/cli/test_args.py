@@ -111,7 +111,8 @@ def test_list_shows_shipped_names_and_where_they_run(capsys, monkeypatch):
     twin = lines.index(next(x for x in lines if x.startswith("twin-only scenarios")))
     assert sumo < lines.index(next(x for x in lines if x.split()[:1] == ["default"])) < twin
     assert lines.index(next(x for x in lines if x.split()[:1] == ["paper_base"])) > twin
-    assert "Stationary congested section in SUMO (fill, then hold" in out
+    assert "One coupled mixed stream in SUMO, congested by the merge (fill" in out
+    assert any(x.split()[:1] == ["lateral_files"] for x in lines)
     assert any(x.split()[:2] == ["penetration_twin", "[twin]"] for x in lines)
     assert main(["list", "--json"]) == 0
     files = json.loads(capsys.readouterr().out)

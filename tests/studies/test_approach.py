@@ -52,8 +52,8 @@ def test_the_trend_of_a_linear_count_is_its_slope():
 def test_the_regime_follows_the_sign_of_lambda_4():
     from arzsumo.scenario import load_scenario
 
-    params = load_scenario(approach.shipped_scenario("default.toml")).params
-    lam, regime = open_loop.regime(params, 93.46, 47.08)     # the default's equilibrium
+    params = load_scenario(approach.shipped_scenario("lateral_files.toml")).params
+    lam, regime = open_loop.regime(params, 93.46, 47.08)     # the former default's
     assert regime == "congested" and lam == pytest.approx(-11.2, abs=0.2)
     assert open_loop.regime(params, 10.0, 5.0)[1] == "free"
 

@@ -46,7 +46,7 @@ def test_the_fixed_cycle_base_drops_the_defaults_meter_realisation():
     assert all(k in data["sumo"] for k in METER_KEYS)
     base = fixed_cycle(data)
     assert not any(k in base["sumo"] for k in METER_KEYS)
-    assert base["sumo"]["demand_h_veh_h"] == data["sumo"]["demand_h_veh_h"] == 3750
+    assert base["sumo"]["demand_h_veh_h"] == data["sumo"]["demand_h_veh_h"] == 3198
     assert all(k in data["sumo"] for k in METER_KEYS)          # the input is left alone
 
 

@@ -15,7 +15,7 @@ from arzsumo.studies import inlet
 from arzsumo.studies.common import StudyError, shipped_scenario
 from arzsumo.studies.identify_cache import ARRAYS
 
-DEFAULT = load_scenario(shipped_scenario("default.toml"))
+DEFAULT = load_scenario(shipped_scenario("lateral_files.toml"))   # the former default
 
 
 def test_the_characteristic_inlet_keeps_the_measured_densities_and_flow():

@@ -27,6 +27,17 @@ def _without_wall(row: dict) -> str:
                       sort_keys=True)
 
 
+def _children() -> set[int]:
+    """This process's child processes (Linux: /proc), zombies included."""
+    from pathlib import Path
+
+    found: set[int] = set()
+    for task in Path(f"/proc/{os.getpid()}/task").iterdir():
+        text = (task / "children").read_text().split()
+        found.update(int(p) for p in text)
+    return found
+
+
 @pytest.fixture(scope="module")
 def plain():
     return [pr.run_premise_task(r) for r in _runs()]
@@ -55,10 +66,40 @@ def test_a_killed_child_runs_again_alone_and_nothing_is_left(plain, monkeypatch,
         return branch(sc, sim, plant, t0, opt, warm_s)
 
     monkeypatch.setattr(pr, "_branch", dies_in_the_pulse_child)
+    before = _children()
     group = pr.run_premise_group(pr.grouped(_runs())[0])["rows"]
     assert [bool(r.get("rerun")) for r in group] == [False, True, False]
     for a, b in zip(group, plain, strict=True):
         assert _without_wall(a) == _without_wall(b)
-    with pytest.raises(ChildProcessError):       # every child was reaped
-        os.waitpid(-1, os.WNOHANG)
+    assert _children() == before                 # every child was reaped
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_branch_dies_with_its_parent(tmp_path):
+    """A process that runs branches and is killed from outside leaves no child running."""
+    import subprocess
+    import sys
+    import time
+
+    flag = tmp_path / "child.pid"
+    code = ("import os, time\n"
+            "from arzsumo.sumo.fork import run_branches\n"
+            f"def branch():\n    open({str(flag)!r}, 'w').write(str(os.getpid()))\n"
+            "    time.sleep(60)\n"
+            "run_branches([branch])\n")
+    parent = subprocess.Popen([sys.executable, "-c", code])
+    for _ in range(200):
+        if flag.exists() and flag.read_text():
+            break
+        time.sleep(0.05)
+    child = int(flag.read_text())
+    parent.kill()
+    parent.wait()
+    for _ in range(100):
+        try:
+            os.kill(child, 0)
+        except ProcessLookupError:
+            break
+        time.sleep(0.05)
+    with pytest.raises(ProcessLookupError):
+        os.kill(child, 0)

@@ -48,7 +48,7 @@ def test_the_demand_splits_its_totals_by_the_av_share():
 
 
 def test_the_design_pulses_the_first_seed_only():
-    runs = pm.map_runs(shipped_scenario("default.toml"), pm.selected_points("today,idm"),
+    runs = pm.map_runs(shipped_scenario("lateral_files.toml"), pm.selected_points("today,idm"),
                        [3, 4], 600.0, PremiseOptions(window=540.0))
     assert [r.run_id for r in runs] == [
         "point=today,seed=3,kind=baseline", "point=today,seed=3,kind=pulse",

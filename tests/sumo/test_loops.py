@@ -7,7 +7,7 @@ and 999.9 m) and every AV as a probe:
 
 * ``insert``: ``scenarios/legacy_default.toml``, 60 s: mainline vehicles inserted at
   x = 0, in front of the station at 0+;
-* ``approach``: ``scenarios/default.toml`` with a 100 m approach edge, 40 s: mainline
+* ``approach``: ``scenarios/lateral_files.toml`` with a 100 m approach edge, 40 s: mainline
   vehicles enter ``main`` through the junction from the approach.
 
 The reference follows every vehicle on ``main`` after every step, and on until its back
@@ -32,7 +32,7 @@ from arzsumo.sumo.vtypes import AV_TYPE, MAX_LENGTH
 
 pytestmark = pytest.mark.sumo
 
-SCENARIO = load_scenario("scenarios/default.toml")
+SCENARIO = load_scenario("scenarios/lateral_files.toml")   # the counts were set on it
 PARAMS = SCENARIO.params
 LEGACY = load_scenario("scenarios/legacy_default.toml")
 CASES = {"insert": (LEGACY.params, LEGACY.sumo.with_(horizon=60.0)),

@@ -1,5 +1,6 @@
 """The designed ETC (design_for + noise dead band) in the nonlinear twin on the identified
-default model: it converges, and on a noisy state it triggers far less than the paper's."""
+model of the former default (lateral_files): it converges, and on a noisy state it
+triggers far less than the paper's."""
 
 from pathlib import Path
 
@@ -40,7 +41,7 @@ class NoisyEtc(EventTriggered):
 
 @pytest.fixture(scope="module")
 def runs():
-    eq = load_scenario(ROOT / "scenarios/default.toml").equilibrium
+    eq = load_scenario(ROOT / "scenarios/lateral_files.toml").equilibrium
     lin = linearize(eq)
     kernels = solve_kernels(lin.system, 50)
     plain = design_for(lin.system, kernels).design

@@ -51,6 +51,9 @@ positive_float = _checked("positive_float", float, lambda v: math.isfinite(v) an
 non_negative_float = _checked("non_negative_float", float,
                               lambda v: math.isfinite(v) and v >= 0, "a finite number >= 0",
                               "A finite number >= 0 (lengths that may be absent).")
+negative_float = _checked("negative_float", float, lambda v: math.isfinite(v) and v < 0,
+                          "a finite number < 0",
+                          "A finite number < 0 (speeds of waves that travel upstream).")
 positive_int = _checked("positive_int", int, lambda v: v >= 1, "an integer >= 1",
                         "An integer >= 1 (workers, jobs).")
 non_negative_int = _checked("non_negative_int", int, lambda v: v >= 0, "an integer >= 0",

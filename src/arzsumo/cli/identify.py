@@ -13,7 +13,13 @@ import argparse
 import logging
 from pathlib import Path
 
-from arzsumo.cli.args import non_negative_int, positive_float, positive_int
+from arzsumo.cli.args import (
+    negative_float,
+    non_negative_float,
+    non_negative_int,
+    positive_float,
+    positive_int,
+)
 from arzsumo.cli.options import add_out, add_overwrite, add_scenario, add_seeds, add_workers
 from arzsumo.cli.scenarios import load_named
 
@@ -25,12 +31,16 @@ def cmd_identify(args: argparse.Namespace) -> int:
     from arzsumo.outdir import OutputDir
     from arzsumo.studies.identify import make_setup, run_identification
     from arzsumo.studies.identify_report import write_study
+    from arzsumo.units import kmh_to_ms
 
     path, sc = load_named(args.scenario)
     setup = make_setup(sc, args.train_seeds, args.validate_seeds, vary=args.vary or (),
                        which=args.which, horizon=args.horizon, warmup=args.warmup,
                        fit=FitSettings(max_nfev=args.max_nfev, bootstrap=args.bootstrap),
-                       workers=args.workers)
+                       workers=args.workers,
+                       wave_speed=None if args.wave_speed_kmh is None
+                       else kmh_to_ms(args.wave_speed_kmh),
+                       wave_weight=args.wave_weight)
     out = Path(args.out) if args.out else Path("results") / "identify" / path.stem
     runs = len(setup.points) * (len(setup.train_seeds) + len(setup.validate_seeds))
     log.info("identify %s: %d SUMO runs on %d workers, fitting %s", sc.name, runs,
@@ -79,6 +89,13 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "spacing_h, spacing_a)")
     p.add_argument("--bootstrap", type=non_negative_int, default=0, metavar="N",
                    help="bootstrap refits over training runs drawn with replacement")
+    p.add_argument("--wave-speed-kmh", type=negative_float, metavar="C",
+                   help="fit lambda_4 at the measured equilibrium to this measured upstream "
+                        "wave speed too, km/h (< 0; e.g. the waves[hv] reading of arzsumo "
+                        "premise)")
+    p.add_argument("--wave-weight", type=non_negative_float, default=1.0, metavar="W",
+                   help="weight of the wave-speed gap: W = 1 trades a 10 %% gap against a "
+                        "uniform 10 %% replay error")
     p.add_argument("--max-nfev", type=positive_int, default=40, metavar="N",
                    help="largest number of least-squares steps (scipy's max_nfev)")
     add_workers(p, "SUMO runs in parallel (default: one per core)")

@@ -36,6 +36,7 @@ from arzsumo.identify.objective import (
     validate,
 )
 from arzsumo.identify.replay import ReplayOptions
+from arzsumo.identify.wave_target import WaveTarget
 from arzsumo.model.params import ModelParameters
 
 log = logging.getLogger(__name__)
@@ -175,13 +176,13 @@ def _solve(objective: Objective, z0: np.ndarray, settings: FitSettings) -> Optim
 
 def _bootstrap(space: ParameterSpace, runs: tuple[ReplayData, ...], z_opt: np.ndarray,
                weights: np.ndarray, options: ReplayOptions, penalty: float,
-               settings: FitSettings) -> np.ndarray:
+               settings: FitSettings, target: WaveTarget | None = None) -> np.ndarray:
     """Refits on runs drawn with replacement, started at the optimum; (B, n) values."""
     rng = np.random.default_rng(settings.seed)
     rows = []
     for b in range(settings.bootstrap):
         pick = rng.integers(0, len(runs), size=len(runs))
-        obj = Objective(space, [runs[i] for i in pick], weights, options, penalty)
+        obj = Objective(space, [runs[i] for i in pick], weights, options, penalty, target)
         res = _solve(obj, z_opt, settings)
         rows.append(space.to_p(res.x))
         log.info("bootstrap %d/%d on runs %s: %s", b + 1, settings.bootstrap, pick.tolist(),
@@ -193,7 +194,8 @@ def identify(datasets: Sequence[ReplayData], initial_guess: ModelParameters,
              bounds: Mapping[str, tuple[float, float]] | None = None,
              which: Sequence[str] = DEFAULT_WHICH, weights: Sequence[float] | None = None,
              *, options: ReplayOptions | None = None, settings: FitSettings | None = None,
-             penalty: float = DEFAULT_PENALTY) -> IdentificationResult:
+             penalty: float = DEFAULT_PENALTY, wave_target: WaveTarget | None = None
+             ) -> IdentificationResult:
     """Fit the model parameters ``which`` to the runs ``datasets`` by replay least squares.
 
     Parameters
@@ -215,6 +217,8 @@ def identify(datasets: Sequence[ReplayData], initial_guess: ModelParameters,
     settings : FitSettings, optional
     penalty : float
         Residual (in scale units) of a value the replay could not predict.
+    wave_target : WaveTarget, optional
+        A measured wave speed lambda_4 should match: one more residual (its module).
 
     Returns
     -------
@@ -227,7 +231,7 @@ def identify(datasets: Sequence[ReplayData], initial_guess: ModelParameters,
     cfg = settings if settings is not None else FitSettings()
     if not (isinstance(penalty, int | float) and 0.0 < penalty < np.inf):
         raise IdentifyError(f"penalty = {penalty!r} is not allowed: a number > 0")
-    objective = Objective(space, runs, w, opts, float(penalty))
+    objective = Objective(space, runs, w, opts, float(penalty), wave_target)
     start = time.perf_counter()
     res = _solve(objective, np.zeros(len(space.which)), cfg)
     wall = time.perf_counter() - start
@@ -235,12 +239,11 @@ def identify(datasets: Sequence[ReplayData], initial_guess: ModelParameters,
     cov = covariance(res.jac, res.fun, p)
     sigma = np.sqrt(np.maximum(np.diag(cov), 0.0))
     with np.errstate(invalid="ignore", divide="ignore"):
-        corr = cov / np.outer(sigma, sigma)
-    params = space.params(p)
+        corr, params = cov / np.outer(sigma, sigma), space.params(p)
     log.info("identified %s in %.1f s (%d evaluations, %d twin failures): %s",
              ", ".join(space.which), wall, objective.evaluations, objective.failures,
              res.message)
-    boot = (_bootstrap(space, runs, res.x, w, opts, float(penalty), cfg)
+    boot = (_bootstrap(space, runs, res.x, w, opts, float(penalty), cfg, wave_target)
             if cfg.bootstrap > 0 else None)
     return IdentificationResult(
         params, space.which, p, sigma, corr, res.active_mask != 0, boot,

@@ -24,6 +24,7 @@ import numpy as np
 
 from arzsumo.identify.data import VARIABLES, IdentifyError, ReplayData
 from arzsumo.identify.replay import ReplayOptions, run_replay
+from arzsumo.identify.wave_target import WaveTarget
 from arzsumo.model.params import ModelParameters
 
 #: Parameters that can be identified, with default bounds (SI: m/s, -, -, s, m).
@@ -144,7 +145,8 @@ def relative_errors(data: ReplayData, predicted: np.ndarray,
 
 
 class Objective:
-    """Residual vector over all runs, for :func:`scipy.optimize.least_squares`.
+    """Residual vector over all runs, for :func:`scipy.optimize.least_squares`; with a
+    ``wave_target``, one more: its weighted wave-speed gap.
 
     Calling it with z runs the replay of every dataset; it counts evaluations and the
     replays that stopped (``failures``), keeps the smallest cost seen, and logs progress
@@ -152,8 +154,10 @@ class Objective:
     """
 
     def __init__(self, space: ParameterSpace, datasets: Sequence[ReplayData],
-                 weights: np.ndarray, options: ReplayOptions, penalty: float) -> None:
+                 weights: np.ndarray, options: ReplayOptions, penalty: float,
+                 wave_target: WaveTarget | None = None) -> None:
         self.space, self.datasets = space, tuple(datasets)
+        self.wave_target = wave_target
         self.sqrt_w = np.sqrt(weights)[None, :, None]
         self.options, self.penalty = options, penalty
         self.evaluations = self.failures = 0
@@ -170,6 +174,8 @@ class Objective:
             parts.append(err[data.mask])
         self.evaluations += 1
         r = np.concatenate(parts)
+        if self.wave_target is not None:    # lambda_4 at the measured equilibrium
+            r = np.append(r, self.wave_target.residual(params, r.size))
         self.best = min(self.best, 0.5 * float(r @ r))
         now = time.perf_counter()
         if now - self._logged >= PROGRESS_EVERY:

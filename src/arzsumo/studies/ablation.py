@@ -1,7 +1,7 @@
 """The ablation of the PDE controllers in SUMO, one change at a time
 (``arzsumo study ablation``).
 
-The steps start from the shipped default scenario without its controller side (the
+The steps start from the former default scenario (lateral_files) without its controller side (the
 tables the evaluation counts as inert for an open loop: [sensing], [estimation],
 [actuation], [design]; :data:`arzsumo.sweep.evaluate.OPEN_LOOP_INERT`) and without its meter
 realisation (the plain fixed cycle), and switch the default's controller side on again
@@ -21,8 +21,8 @@ delay          the laws on the state predicted :data:`PREDICTION_S` s ahead
 meter          one vehicle per green at a release rate with a yellow (on ``design``)
 =============  ===========================================================================
 
-Every change but ``delay``'s is read from the shipped default, so the ablation is that of
-the default's controller side. Each step is an evaluation (:func:`~arzsumo.sweep.
+Every change but ``delay``'s is read from the former default (lateral_files), so the
+ablation is that of its controller side. Each step is an evaluation (:func:`~arzsumo.sweep.
 evaluate.run_evaluation`, paired by seed against the open loop) of its scenario, written
 to ``OUT/steps/<step>.toml``, into ``OUT/<step>/``. A step whose changes do not act on an
 open loop (the evaluation's inert tables, or the model when SUMO fills the road itself)
@@ -47,6 +47,7 @@ from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, write_csv, write_text
 from arzsumo.studies.common import (
     EXIT_SOME_FAILED,
+    FORMER_DEFAULT,
     StudyError,
     add_output,
     add_runs,
@@ -85,7 +86,7 @@ MEASURES = ("network_whole_demand.time_spent_s.total", "section.speed_spread_kmh
 class Step:
     """One step: its name, what it switches on, and where its changes come from.
 
-    ``keys``: ``table.key`` (or a whole ``table``) taken from the shipped default;
+    ``keys``: ``table.key`` (or a whole ``table``) taken from the former default (lateral_files);
     ``values``: ``table.key`` -> value set explicitly; ``laws``: the controllers compared
     with the open loop; ``legacy``: the [model] and [equilibrium] of
     ``legacy_default.toml``; ``after``: the step it builds on when not the one listed
@@ -154,8 +155,8 @@ def changes(s: Step, default: Mapping[str, Any]) -> dict[str, Any]:
         found = default.get(table, {})
         for name, value in (found.items() if not k else [(k, found.get(k))]):
             if value is None:
-                raise StudyError(f"the shipped default has no {table}.{name}: the ablation "
-                                 f"step {s.name!r} switches it on")
+                raise StudyError(f"the former default (lateral_files) has no "
+                                 f"{table}.{name}: the ablation step {s.name!r} switches it on")
             out[f"{table}.{name}"] = copy.deepcopy(value)
     return out | dict(s.values)
 
@@ -182,7 +183,7 @@ def acts_on_open_loop(key: str) -> bool:
 def step_scenario(name: str, default: Mapping[str, Any] | None = None,
                   legacy: Mapping[str, Any] | None = None) -> tuple[dict[str, Any], str | None]:
     """The scenario tables of step ``name`` and the step whose open loop it borrows."""
-    default = default if default is not None else scenario_data(shipped_scenario("default.toml"))
+    default = default if default is not None else scenario_data(shipped_scenario(FORMER_DEFAULT))
     data = base_scenario(default)
     flat: dict[str, Any] = {}
     if step(name).legacy:

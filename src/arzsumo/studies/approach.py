@@ -2,7 +2,7 @@
 green share (``arzsumo study approach``).
 
 Each point is one open-loop SUMO run (fixed-cycle meter at its nominal plan, no fill
-phase) of the shipped default scenario's network, with its ``approach`` buffer edge
+phase) of the former default scenario (lateral_files)'s network, with its ``approach`` buffer edge
 before x = 0: mainline demand (HV + AV at ``--av-share``) x nominal green share x Krauss
 sigma x seed, started from a congested section (``--empty-start``: from an empty one).
 After ``--warmup`` s, ``--measured`` s are measured on ``main``
@@ -29,6 +29,7 @@ import pandas as pd
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, write_csv
 from arzsumo.studies.common import (
+    FORMER_DEFAULT,
     StudyError,
     add_output,
     add_runs,
@@ -62,7 +63,7 @@ def design(demands: list[float], greens: list[float], sigmas: list[float], seeds
            step: float = 0.1, initial: bool = True, av_share: float = AV_SHARE
            ) -> list[StudyRun]:
     """The runs of the map: demand x green share x sigma x seed."""
-    path = shipped_scenario("default.toml")
+    path = shipped_scenario(FORMER_DEFAULT)
     sets = [{"sumo.demand_h_veh_h": d * (1 - av_share), "sumo.demand_a_veh_h": d * av_share}
             for d in demands]
     spec = study_spec(

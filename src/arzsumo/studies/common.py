@@ -140,6 +140,11 @@ def plots_wanted(args: argparse.Namespace) -> bool:
 
 
 # -- base scenarios ------------------------------------------------------------------------
+#: the scenario file the studies' results pages were measured on, and their default: the
+#: former default, whose vehicles ride in three lateral files (docs/results/)
+FORMER_DEFAULT = "lateral_files.toml"
+
+
 def shipped_scenario(name: str) -> Path:
     """The shipped scenario file ``name`` (``default.toml``, ``legacy_default.toml``)."""
     return default_scenario() if name == default_scenario().name else \

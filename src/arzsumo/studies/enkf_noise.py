@@ -29,6 +29,7 @@ from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, write_csv, write_text
 from arzsumo.studies import estimation_layouts as layouts
 from arzsumo.studies.common import (
+    FORMER_DEFAULT,
     StudyError,
     add_output,
     file_stem,
@@ -140,7 +141,7 @@ def report(tuner: Tuner, sd: np.ndarray, args: argparse.Namespace
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """The EnKF noise study's options."""
     parser.add_argument("--scenario", type=Path, metavar="SCENARIO.toml",
-                        help="scenario recorded (default: the shipped default)")
+                        help="scenario recorded (default: the former default, lateral_files)")
     parser.add_argument("--tune-seeds", type=seed_list, default=[1, 2], metavar="LIST",
                         help="seeds the noise is tuned on (default: 1,2)")
     parser.add_argument("--report-seeds", type=seed_list, default=[3, 4, 5], metavar="LIST",
@@ -174,7 +175,7 @@ def run(args: argparse.Namespace) -> int:
         raise StudyError(f"--start = {args.start} is not allowed: 4 sd (rho_h veh/km, v_h "
                          "km/h, rho_a veh/km, v_a km/h)")
     seeds = sorted(set(args.tune_seeds) | set(args.report_seeds))
-    runs = layouts.design(args.scenario or shipped_scenario("default.toml"), seeds,
+    runs = layouts.design(args.scenario or shipped_scenario(FORMER_DEFAULT), seeds,
                           args.warmup, args.horizon)
     workers = args.workers or default_workers()
     with resumable_dir(args.out, f"study-{NAME}") as out:

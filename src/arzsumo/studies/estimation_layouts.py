@@ -1,7 +1,7 @@
 """Estimation error against sensor layout, per estimator, over seeds
 (``arzsumo study estimation-layouts``).
 
-Per seed ONE open-loop SUMO run of the scenario (default: the shipped default, its fill
+Per seed ONE open-loop SUMO run of the scenario (default: the former default lateral_files, its fill
 as warm-up + its control horizon) records the sensor data of a superset of sensors (loop
 stations every 50 m with both boundaries, every AV a probe) and the truth (the full
 probe's cells): :func:`arzsumo.bridge.sensor_record.record_run`, cached as ``.npz`` in
@@ -34,6 +34,7 @@ from scipy import stats
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, write_csv
 from arzsumo.studies.common import (
+    FORMER_DEFAULT,
     add_output,
     add_runs,
     file_stem,
@@ -162,7 +163,7 @@ def table(rows: list[dict[str, Any]]) -> str:
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """The layout study's options."""
     parser.add_argument("--scenario", type=Path, metavar="SCENARIO.toml",
-                        help="scenario recorded (default: the shipped default)")
+                        help="scenario recorded (default: the former default, lateral_files)")
     add_runs(parser, seeds="1-5")
     parser.add_argument("--warmup", type=positive_float, help="s (default: the scenario's)")
     parser.add_argument("--horizon", type=positive_float,
@@ -183,7 +184,7 @@ def run(args: argparse.Namespace) -> int:
     """Record the missing seeds, score every layout and method, write the table."""
     from arzsumo.sweep.driver import map_runs
 
-    runs = design(args.scenario or shipped_scenario("default.toml"), args.seeds,
+    runs = design(args.scenario or shipped_scenario(FORMER_DEFAULT), args.seeds,
                   args.warmup, args.horizon)
     if args.list:
         return print_list([r.run_id for r in runs])

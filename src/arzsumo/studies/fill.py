@@ -22,6 +22,7 @@ import pandas as pd
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import markdown_table, publish, write_csv
 from arzsumo.studies.common import (
+    FORMER_DEFAULT,
     StudyError,
     add_output,
     add_runs,
@@ -63,7 +64,7 @@ def design(holds: list[str], greens: list[float], sigmas: list[float], seeds: li
            step: float = 0.1) -> list[StudyRun]:
     """The runs: hold demand x green share x sigma x seed; ``fill``: (HV veh/h, AV veh/h,
     duration s) of the fill phase."""
-    path = shipped_scenario("default.toml")
+    path = shipped_scenario(FORMER_DEFAULT)
     pairs = [hold_pair(h) for h in holds]
     spec = study_spec(
         NAME, path, fixed_cycle(scenario_data(path)), seeds=list(seeds),

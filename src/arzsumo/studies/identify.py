@@ -42,6 +42,7 @@ from arzsumo.identify import (
     ReplayOptions,
     identify,
 )
+from arzsumo.identify.wave_target import WaveTarget
 from arzsumo.model.equilibrium import Equilibrium
 from arzsumo.model.params import ModelParameters
 from arzsumo.scenario import Scenario, scenario_from_dict
@@ -109,6 +110,10 @@ class IdentifySetup:
     which: tuple[str, ...]
     fit: FitSettings
     workers: int
+    #: the measured upstream wave speed lambda_4 is fitted to (m/s, < 0), and its weight
+    #: (:mod:`arzsumo.identify.wave_target`); None: the replay residual alone
+    wave_speed: float | None = None
+    wave_weight: float = 1.0
 
     @property
     def options(self) -> ReplayOptions:
@@ -178,7 +183,8 @@ def check_seeds(train: Sequence[int], held_out: Sequence[int]) -> None:
 def make_setup(sc: Scenario, train: Sequence[int], held_out: Sequence[int], *,
                vary: Sequence[str] = (), which: str | None = None,
                horizon: float | None = None, warmup: float | None = None,
-               fit: FitSettings | None = None, workers: int | None = None) -> IdentifySetup:
+               fit: FitSettings | None = None, workers: int | None = None,
+               wave_speed: float | None = None, wave_weight: float = 1.0) -> IdentifySetup:
     """Check everything before SUMO starts: seeds, points, parameter names and bounds."""
     check_seeds(train, held_out)
     changes: dict[str, Any] = {"run.controller": "open"}
@@ -196,8 +202,11 @@ def make_setup(sc: Scenario, train: Sequence[int], held_out: Sequence[int], *,
                                 f"the bounds [{low:g}, {high:g}] of the fit; allowed: a start "
                                 "value within them")
     points = parse_vary(vary, sc) or (Point(),)
+    if wave_speed is not None:    # checked here, before SUMO starts
+        WaveTarget(wave_speed, 0.0, 0.0, wave_weight)
     return IdentifySetup(base, sc, tuple(train), tuple(held_out), points, names,
-                         fit or FitSettings(), workers or default_workers())
+                         fit or FitSettings(), workers or default_workers(), wave_speed,
+                         wave_weight)
 
 
 def plan(setup: IdentifySetup) -> list[RunTask]:
@@ -291,13 +300,15 @@ def run_identification(setup: IdentifySetup) -> IdentifyStudy:
     floor = ao_floor(guess, train, opts.ao_limit)
     bounds = {name: (floor, 1.0) if name.startswith("ao_max") else DEFAULT_BOUNDS[name]
               for name in setup.which}
+    rho = measured_densities(train)
+    target = (WaveTarget(setup.wave_speed, *rho, setup.wave_weight)
+              if setup.wave_speed is not None else None)
     fit = identify(train, guess, bounds, which=setup.which, options=opts,
-                   settings=setup.fit)
+                   settings=setup.fit, wave_target=target)
     t3 = time.perf_counter()
     training = score_set(fit.params, train, opts)
     validation = score_set(fit.params, held_out, opts)
     t4 = time.perf_counter()
-    rho = measured_densities(train)
     wall = {"sumo": t1 - t0, "sumo_runs": float(sum(r.wall_time for r in runs)),
             "fit": fit.wall_time, "bootstrap": t3 - t2 - fit.wall_time,
             "validate": (t4 - t3) + (t2 - t1), "total": t4 - t0}

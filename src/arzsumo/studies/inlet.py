@@ -26,6 +26,7 @@ import pandas as pd
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import markdown_table, publish, write_csv
 from arzsumo.studies.common import (
+    FORMER_DEFAULT,
     StudyError,
     add_output,
     positive_int,
@@ -105,7 +106,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--last", type=positive_int, default=5,
                         help="replay the most recent N runs")
     parser.add_argument("--scenario", type=Path, default=None, metavar="SCENARIO.toml",
-                        help="the parameters replayed under (default: the shipped default)")
+                        help="the parameters replayed under (default: the former default, "
+                             "lateral_files)")
     parser.add_argument("--workers", type=positive_int, default=1, metavar="N",
                         help="local processes (1: in this process)")
     add_output(parser, NAME, PAGE, plots=False)
@@ -115,7 +117,7 @@ def run(args: argparse.Namespace) -> int:
     """Replay every run under both inlets and write the table."""
     from arzsumo.studies.identify_cache import cache_dir
 
-    scenario = args.scenario or shipped_scenario("default.toml")
+    scenario = args.scenario or shipped_scenario(FORMER_DEFAULT)
     files = cached_runs(args.runs or cache_dir(), args.last)
     tasks = [(str(f), inlet, str(scenario)) for f in files for inlet in INLETS]
     rows = map_runs(replay_one, tasks, workers=args.workers, in_process=args.workers == 1)

@@ -1,7 +1,7 @@
 """The ASM estimate's offset with time-mean against harmonic loop speeds
 (``arzsumo study loop-speed``).
 
-ONE open-loop SUMO run of the scenario (default: the shipped default, its fill as
+ONE open-loop SUMO run of the scenario (default: the former default lateral_files, its fill as
 warm-up + ``--horizon`` s) records the superset of sensors and the truth, cached like the
 records of :mod:`arzsumo.studies.estimation_layouts`. The record holds both loop speeds,
 so each ``[sensing] loop_speed`` is an offline pass of the same estimator over the same
@@ -25,6 +25,7 @@ from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import markdown_table, publish, write_csv, write_text
 from arzsumo.studies import estimation_layouts
 from arzsumo.studies.common import (
+    FORMER_DEFAULT,
     add_output,
     add_runs,
     positive_float,
@@ -86,7 +87,7 @@ def station_speeds(rec: Any) -> list[str]:
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """The loop-speed study's options."""
     parser.add_argument("--scenario", type=Path, metavar="SCENARIO.toml",
-                        help="scenario recorded (default: the shipped default)")
+                        help="scenario recorded (default: the former default, lateral_files)")
     add_runs(parser, seeds="1")
     parser.add_argument("--horizon", type=positive_float, default=300.0,
                         help="control horizon recorded, s")
@@ -100,7 +101,7 @@ def run(args: argparse.Namespace) -> int:
     from arzsumo.bridge.sensor_record import SensorRecord
     from arzsumo.scenario import scenario_from_dict
 
-    runs = estimation_layouts.design(args.scenario or shipped_scenario("default.toml"),
+    runs = estimation_layouts.design(args.scenario or shipped_scenario(FORMER_DEFAULT),
                                      args.seeds, horizon=args.horizon)
     if args.list:
         return print_list([r.run_id for r in runs])

@@ -1,7 +1,7 @@
 """The green-share -> mainline-outflow map from step responses in SUMO
 (``arzsumo study meter-dynamics``).
 
-Each run is one open-loop SUMO run of the shipped default scenario (2.5 km approach,
+Each run is one open-loop SUMO run of the former default scenario (lateral_files) (2.5 km approach,
 fill then hold) with the plain fixed-cycle meter: the nominal plan (green share 0.5)
 through the fill and warm-up (``--warmup`` s), ``--base`` s more at 0.5, then a sequence
 of green-share steps (``--greens``, each held ``--hold`` s) that drive the meter directly
@@ -35,6 +35,7 @@ from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, write_csv, write_text
 from arzsumo.studies import meter_fit
 from arzsumo.studies.common import (
+    FORMER_DEFAULT,
     StudyError,
     add_output,
     add_runs,
@@ -78,7 +79,7 @@ def schedule(warmup: float, base: float, greens: list[float], hold: float
 def design(seeds: list[int], warmup: float = 600.0, base: float = 60.0,
            greens: tuple[float, ...] = GREENS, hold: float = 102.0) -> list[StudyRun]:
     """One run per seed: the default (fixed cycle), 1 s periods, the warm-up and steps."""
-    path = shipped_scenario("default.toml")
+    path = shipped_scenario(FORMER_DEFAULT)
     spec = study_spec(NAME, path, fixed_cycle(scenario_data(path)), seeds=list(seeds),
                       set={"sumo.control_period_s": 1.0, "run.warmup_s": warmup,
                            "sumo.horizon_s": base + hold * len(greens)})

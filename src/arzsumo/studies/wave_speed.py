@@ -9,9 +9,9 @@ fluctuation of each variable (a cell's series minus its mean over the control wi
 SUMO's measured cells, and reports the lag of the peak (s; > 0: the downstream cell
 follows) and the travel speed it implies (km/h).
 
-The runs are closed-loop SUMO runs of ``--scenario`` (default: the shipped default) for
-each of ``--controllers`` and ``--seeds``, through the sweep engine; ``--from DIR ...``
-reads the cells of earlier ``arzsumo run`` results (``cells.parquet``) instead.
+The runs are closed-loop SUMO runs of ``--scenario`` (default: the former default,
+lateral_files) for each of ``--controllers`` and ``--seeds``, through the sweep engine;
+``--from DIR ...`` reads the cells of earlier ``arzsumo run`` results (``cells.parquet``) instead.
 """
 
 from __future__ import annotations
@@ -26,6 +26,7 @@ import pandas as pd
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import markdown_table, publish, write_csv
 from arzsumo.studies.common import (
+    FORMER_DEFAULT,
     StudyError,
     add_output,
     add_runs,
@@ -107,7 +108,7 @@ def design(scenario: Path, controllers: list[str], seeds: list[int]) -> list[Stu
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """The wave-speed study's options."""
     parser.add_argument("--scenario", type=Path, metavar="SCENARIO.toml",
-                        help="scenario run (default: the shipped default)")
+                        help="scenario run (default: the former default, lateral_files)")
     parser.add_argument("--controllers", default="open,etc",
                         help="comma-separated controllers")
     add_runs(parser, seeds="42")
@@ -119,7 +120,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run (or read) and write the table of lags and speeds."""
     controllers = [c.strip() for c in args.controllers.split(",") if c.strip()]
-    runs = design(args.scenario or shipped_scenario("default.toml"), controllers, args.seeds)
+    runs = design(args.scenario or shipped_scenario(FORMER_DEFAULT), controllers, args.seeds)
     if args.list and not args.source:
         return print_list([r.run_id for r in runs])
     with resumable_dir(args.out, f"study-{NAME}") as out:

@@ -17,11 +17,15 @@ from __future__ import annotations
 
 import os
 import pickle
+import signal
 import threading
 import traceback
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
+
+#: prctl option: the signal a child gets when its parent dies (linux/prctl.h)
+PR_SET_PDEATHSIG = 1
 
 
 @dataclass(frozen=True)
@@ -39,9 +43,22 @@ def can_fork() -> bool:
     return hasattr(os, "fork") and threading.active_count() == 1
 
 
+def _die_with_parent() -> None:
+    """Linux: have the kernel kill this child when its parent dies (a group's process
+    killed from outside leaves no SUMO running); elsewhere nothing."""
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
+    except (OSError, AttributeError):   # not Linux: the parent's waitpid still reaps it
+        pass
+
+
 def _child(fn: Callable[[], Any], write_fd: int) -> None:
     """In the child: run ``fn`` and send ("ok", result) or ("error", text); never return."""
     try:
+        _die_with_parent()
         try:
             payload = pickle.dumps(("ok", fn()))
         except BaseException as exc:   # everything goes back to the parent
