@@ -120,6 +120,8 @@ def test_one_seed_reads_the_pulse_but_leaves_it_undecided():
                             th=pm.PremiseThresholds(pulse_round_trips=0.9))
     pulse = long[long.gate == "pulse"].iloc[0]
     assert math.isnan(pulse["value"]) and not pulse["passed"]
+    _, wide = pm.map_tables(rows, [pm.MapPoint("p", "axis", {})], 1000.0, fallback_trip=100.0)
+    assert math.isnan(wide.iloc[0]["pulse_passed"])       # undecided: neither pass nor fail
     gates = pm.point_gates({1: {r["kind"]: r for r in rows}}, 1000.0,
                            pm.PremiseThresholds(pulse_round_trips=0.9), 30.0, 100.0)[1]
     detail = next(g.detail for g in gates if g.name == "pulse")

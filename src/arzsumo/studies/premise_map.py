@@ -116,7 +116,7 @@ COUPLED = {"min_gap_lat_m": 0.6, "depart_pos_lat": "random_free", **demand(0.18)
 #: the map: today's default, the lateral gap alone (with the fixed columns), one centre
 #: file, then one change at a time from the coupled base
 POINTS: tuple[MapPoint, ...] = (
-    _point("today", "today's default"),
+    _point("today", "former default"),
     _point("columns-0.6", "lateral", min_gap_lat_m=0.6, demand_h_veh_h=3350,
            demand_a_veh_h=750),
     _point("centre-file", "lateral", min_gap_lat_m=0.6, lat_alignment="center",
@@ -281,10 +281,12 @@ def map_tables(rows: Sequence[Mapping[str, Any]], points: Sequence[MapPoint], le
                       "threshold": str(g.threshold), "passed": bool(g.passed)} for g in gs]
         for name in MAP_GATES:
             found = [g for gs in gates.values() for g in gs if g.name == name]
+            decided = [g for g in found if "late_floor_value" not in g.detail]
             row[f"{name}_value"] = float(np.nanmean([g.value for g in found])) \
                 if found and any(math.isfinite(g.value) for g in found) else math.nan
-            row[f"{name}_passed"] = float(np.mean([g.passed for g in found])) \
-                if found else math.nan
+            # a gate left undecided (one seed's pulse) is no pass and no fail: NaN
+            row[f"{name}_passed"] = float(np.mean([g.passed for g in decided])) \
+                if decided else math.nan
         wide.append({**row, **point_measures(by[p.name])})
     return pd.DataFrame(long), pd.DataFrame(wide)
 
