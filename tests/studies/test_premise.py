@@ -173,3 +173,14 @@ def test_the_window_refusals_name_the_bound():
     trip = study.model_speeds(sc).round_trip
     assert trip == pytest.approx(1000 / 6.9083 + 1000 / 4.9777, rel=1e-3)
     assert study.default_window(sc, trip) == math.ceil(2 * trip + 60)
+
+
+def test_a_pulse_with_no_deviation_to_read_is_unmeasured_not_a_crash():
+    rows = _rows(1) + _rows(2)
+    for r in rows:
+        if r["kind"] == "pulse":      # the AVs left the section during the pulse
+            r["v_av"] = [[None] * CELLS] * PERIODS
+    rep = study.analyse(rows, load_scenario(LEGACY), study.AnalysisOptions(round_trip=100.0))
+    pulse = next(g for g in rep.gates[1] if g.name == "pulse")
+    assert math.isnan(pulse.value) and not pulse.passed
+    assert "norm" in pulse.detail["reason"]

@@ -36,6 +36,7 @@ from arzsumo.evaluation.fields import block_means
 from arzsumo.evaluation.premise import (
     ActuatorRecord,
     GateResult,
+    PremiseError,
     PremiseThresholds,
     PremiseVerdict,
     actuator_gate,
@@ -235,6 +236,21 @@ def actuator_record(stair: Mapping[str, Any]) -> ActuatorRecord:
                           _array(stair["r_veh_s"]), tuple(stair["step_times_s"]))
 
 
+def read_pulse(base: Mapping[str, Any], pulse: Mapping[str, Any], classes: Sequence[str],
+               round_trip: float, floor: Mapping[str, float], th: PremiseThresholds,
+               smooth: float) -> GateResult:
+    """The pulse gate on a seed's baseline and pulse rows; unmeasured (NaN, failed, the
+    reason in its detail) where the pulse run has no deviation to read (a class that
+    left the section during the pulse)."""
+    try:
+        return pulse_gate(_array(base["t_s"]), class_fields(base, classes),
+                          class_fields(pulse, classes), float(base["dx_m"]),
+                          float(base["t0_s"]), round_trip, floor, th, smooth)
+    except PremiseError as exc:
+        return GateResult("pulse", math.nan, th.pulse_round_trips * round_trip, False,
+                          {"round_trip_s": round_trip, "reason": str(exc)})
+
+
 def seed_gates(runs: Mapping[str, Mapping[str, Any]], floor: Mapping[str, float],
                model: ModelSpeeds, round_trip: float, length: float, smooth: float,
                th: PremiseThresholds) -> list[GateResult]:
@@ -242,9 +258,7 @@ def seed_gates(runs: Mapping[str, Mapping[str, Any]], floor: Mapping[str, float]
     base, pulse = runs["baseline"], runs["pulse"]
     classes = classes_of(base)
     gates = speed_gates(base, classes, model, length, th)
-    gates.append(pulse_gate(_array(base["t_s"]), class_fields(base, classes),
-                            class_fields(pulse, classes), float(base["dx_m"]),
-                            float(base["t0_s"]), round_trip, floor, th, smooth))
+    gates.append(read_pulse(base, pulse, classes, round_trip, floor, th, smooth))
     gates.append(actuator_gate(actuator_record(runs["staircase"]), th))
     return gates + operating_gates(base, th)
 

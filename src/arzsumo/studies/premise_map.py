@@ -34,8 +34,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from arzsumo.evaluation.premise import GateResult, PremiseThresholds, pulse_gate
-from arzsumo.evaluation.premise.gates import PremiseError
+from arzsumo.evaluation.premise import GateResult, PremiseThresholds
 from arzsumo.evaluation.premise.instability import round_trip_time
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.premise_map import write_map
@@ -58,6 +57,7 @@ from arzsumo.studies.premise import (
     deviation_norms,
     model_speeds,
     operating_gates,
+    read_pulse,
     speed_gates,
 )
 from arzsumo.studies.premise_runs import (
@@ -231,12 +231,7 @@ def _pulse(base: Mapping[str, Any], pulse: Mapping[str, Any], cls: Sequence[str]
         return GateResult("pulse", math.nan, th.pulse_round_trips * trip, False,
                           {"round_trip_s": trip, "window_s": float(t[-1] - t0),
                            "reason": "the window ends before the gate's round trips"})
-    try:
-        return pulse_gate(t, class_fields(base, cls), class_fields(pulse, cls),
-                          float(base["dx_m"]), t0, trip, floor, th, smooth)
-    except PremiseError as exc:   # e.g. a class that left the section: no D(t) to read
-        return GateResult("pulse", math.nan, th.pulse_round_trips * trip, False,
-                          {"round_trip_s": trip, "reason": str(exc)})
+    return read_pulse(base, pulse, cls, trip, floor, th, smooth)
 
 
 def point_measures(rows: Mapping[int, Mapping[str, Mapping[str, Any]]]) -> dict[str, float]:
