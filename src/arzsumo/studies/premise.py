@@ -282,6 +282,7 @@ def _series(runs: Mapping[str, Mapping[str, Any]], floor: Mapping[str, float],
 def _accounting(runs: Mapping[str, Mapping[str, Any]]) -> dict[str, Any]:
     base = runs["baseline"]
     return {"wall_s": {k: runs[k]["wall_s"] for k in KINDS},
+            "warmup_wall_s": runs["baseline"].get("warmup_wall_s"),
             "lateral_samples": base["lateral_samples"],
             "main_vehicles_total": int(sum(base["main_vehicles"])),
             "class_samples": dict(base["class_samples"]), "collisions": base["collisions"],

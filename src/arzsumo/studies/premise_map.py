@@ -148,7 +148,7 @@ def map_runs(path: Path, points: Sequence[MapPoint], seeds: Sequence[int], warmu
         for r in design_runs(spec):
             first = pulses and r.columns["seed"] == seeds[0]
             kinds = ("baseline", "pulse") if first else ("baseline",)
-            n = horizon_periods(opts, float(r.scenario["sumo"].get("control_period_s", 1.0)))
+            n = horizon_periods(opts, r)
             runs += [replace(r, run_id=f"point={p.name},{r.run_id},kind={k}",
                              columns={"point": p.name, "axis": p.axis, **r.columns},
                              options={**opts.for_kind(k), "horizon_periods": n})

@@ -166,9 +166,13 @@ def check_options(sc: Scenario, opts: PremiseOptions, curve: GreenShareCurve) ->
 
 
 # -- the design ----------------------------------------------------------------------------
-def horizon_periods(opts: PremiseOptions, period: float) -> int:
-    """Control periods after the warm-up that every kind's SUMO run is set up for (the
-    longest kind's): the runs of a seed then share everything up to the warm-up's end."""
+def horizon_periods(opts: PremiseOptions, run: StudyRun) -> int:
+    """Control periods after the warm-up that every kind's SUMO run of ``run``'s scenario
+    is set up for (the longest kind's): the runs of a seed then share everything up to
+    the warm-up's end."""
+    from arzsumo.scenario import scenario_from_dict
+
+    period = scenario_from_dict(run.scenario, run.source).sumo.control_period
     return max(_periods(opts.window, period),
                _periods(opts.level, period) * (opts.levels + 1))
 
@@ -179,8 +183,7 @@ def premise_runs(path: Path, seeds: list[int], warmup: float,
     IDs ``seed=S,kind=K``, seeds in order, kinds as :data:`KINDS`."""
     spec = study_spec(NAME, path, seeds=list(seeds), set={"run.warmup_s": float(warmup)})
     runs = design_runs(spec)
-    period = float(runs[0].scenario.get("sumo", {}).get("control_period_s", 1.0))
-    n = horizon_periods(opts, period)
+    n = horizon_periods(opts, runs[0])
     return [replace(r, run_id=f"{r.run_id},kind={kind}",
                     options={**opts.for_kind(kind), "horizon_periods": n})
             for r in runs for kind in KINDS]
@@ -297,8 +300,9 @@ def _branch(sc: Scenario, sim: Any, plant: Any, t0: float, opt: Mapping[str, Any
         row = _fields_row(rec) if kind == "pulse" else _baseline_row(sc, rec)
         if kind == "pulse":
             row["pulse_plan"] = plans[0]
+    # the window's own wall time; the shared warm-up's apart (once per seed, not per kind)
     return {"kind": kind, "seed": sc.sumo.seed, **row,
-            "wall_s": time.perf_counter() - wall0 + warm_s}
+            "wall_s": time.perf_counter() - wall0, "warmup_wall_s": warm_s}
 
 
 def _window(sim: Any, plant: Any, t0: float, periods: int, plans: Mapping[int, float],
