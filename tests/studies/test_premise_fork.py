@@ -23,8 +23,8 @@ def _runs():
 
 def _without_wall(row: dict) -> str:
     """The row but its wall times, as text (NaN speeds of empty cells compare equal)."""
-    return json.dumps({k: v for k, v in row.items() if k not in ("wall_s", "warmup_wall_s", "rerun")},
-                      sort_keys=True)
+    times = ("wall_s", "warmup_wall_s", "rerun")
+    return json.dumps({k: v for k, v in row.items() if k not in times}, sort_keys=True)
 
 
 def _children() -> set[int]:

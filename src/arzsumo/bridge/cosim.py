@@ -42,6 +42,8 @@ import math
 import shutil
 import tempfile
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -178,6 +180,47 @@ class Controlled:
     settings: RunSettings
 
 
+@dataclass
+class OpenRun:
+    """A started run: SUMO, where its outputs go, the files kept for its results."""
+
+    sim: SumoSimulation
+    out_dir: Path          # SUMO's tripinfo, edge data, statistics (and FCD)
+    files: RunFiles
+    bar: Progress
+    placement: str
+    wall0: float
+
+
+@contextmanager
+def open_run(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
+             initial_fields: np.ndarray | None = None, *, progress: bool = False,
+             frontend: str = "libsumo") -> Iterator[OpenRun]:
+    """SUMO started for warm-up plus control horizon with the run's outputs (step 2 of
+    the module docstring); its scratch directory goes on leaving, its kept files too
+    when leaving on an error."""
+    wall0 = time.perf_counter()
+    run_cfg = cfg.with_(horizon=settings.warmup + cfg.horizon)
+    initial, placement = place_initial(scenario.params, settings, run_cfg, initial_fields)
+    bar = Progress(run_cfg.horizon, f"{settings.controller} seed {cfg.seed}",
+                   enabled=progress)
+    net_dir = Path(tempfile.mkdtemp(prefix="arzsumo-net-", dir=scratch_dir()))
+    files = RunFiles()
+    try:
+        with open_simulation(scenario.params, run_cfg, initial=initial,
+                             extra_args=network_options(net_dir, fcd=cfg.fcd),
+                             output_dir=net_dir, keep=files, frontend=frontend,
+                             loops=scenario.sensing.loop_x(scenario.params.length),
+                             downstream_loop=scenario.alinea.loop_distance) as sim:
+            yield OpenRun(sim, net_dir, files, bar, placement, wall0)
+    except BaseException:
+        files.remove()
+        raise
+    finally:
+        shutil.rmtree(net_dir, ignore_errors=True)
+        bar.close()
+
+
 def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
                      design: EtcDesign, *, initial_fields: np.ndarray | None = None,
                      curve: GreenShareCurve = DEFAULT_CURVE,
@@ -193,41 +236,36 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
     configuration, and with ``cfg.fcd`` its FCD output, are kept in ``files``
     (:mod:`arzsumo.sumo.run_files`).
     """
-    wall0 = time.perf_counter()
-    run_cfg = cfg.with_(horizon=settings.warmup + cfg.horizon)
-    initial, placement = place_initial(scenario.params, settings, run_cfg, initial_fields)
-    bar = Progress(run_cfg.horizon, f"{settings.controller} seed {cfg.seed}",
-                   enabled=progress)
-    net_dir = Path(tempfile.mkdtemp(prefix="arzsumo-net-", dir=scratch_dir()))
-    files = RunFiles()
-    try:
-        with open_simulation(scenario.params, run_cfg, initial=initial,
-                             extra_args=network_options(net_dir, fcd=cfg.fcd),
-                             output_dir=net_dir, keep=files, frontend=frontend,
-                             loops=scenario.sensing.loop_x(scenario.params.length),
-                             downstream_loop=scenario.alinea.loop_distance) as sim:
-            c = control(sim, scenario, settings, cfg, design, curve, bar, keep_measurements)
-            plant = c.loop.plant
-            meter_summary = {**plant.meter_summary(), "ramp_storage": cfg.ramp_storage}
-            timings = {**plant.timings, **c.loop.timings}   # the window's, not the drain's
-            t_end = sim.time
-            drained = drain(plant, cfg.drain_max) if cfg.drain_max > 0 else None
-        records = c.trace.records
-        outlet = round(sum((r.outflow_h + r.outflow_a) * cfg.control_period for r in records))
-        network, trips = measure_network(net_dir, c.start, t_end, outlet,
-                                         drained.end if drained else None, sim.time)
-        if drained is not None:
-            network = whole_demand(network, trips, plant, drained)
-        if cfg.fcd:   # moved, not read: an FCD file is large
-            files.adopt(net_dir / FCD_FILE, FCD_FILE)
-    except BaseException:
-        files.remove()
-        raise
-    finally:
-        shutil.rmtree(net_dir, ignore_errors=True)
-    bar.close()
-    return _result(c, scenario, cfg, meter_summary, sim, network, placement, files,
-                   timings, time.perf_counter() - wall0)
+    with open_run(scenario, settings, cfg, initial_fields, progress=progress,
+                  frontend=frontend) as run:
+        warmed = warm_start(run.sim, scenario, settings, cfg, curve, run.bar)
+        return finish_run(run, warmed, scenario, settings, cfg, design, curve,
+                          keep_measurements)
+
+
+def finish_run(run: OpenRun, warmed: Warmed, scenario: Scenario, settings: RunSettings,
+               cfg: SumoConfig, design: EtcDesign, curve: GreenShareCurve,
+               keep_measurements: bool = False) -> CoSimResult:
+    """From the end of the warm-up: the control window, the drain, SUMO closed, and the
+    network measures read from SUMO's outputs (steps 4-7 of the module docstring)."""
+    sim = run.sim
+    c = control(warmed, scenario, settings, cfg, design, curve, run.bar, keep_measurements)
+    plant = c.loop.plant
+    meter_summary = {**plant.meter_summary(), "ramp_storage": cfg.ramp_storage}
+    timings = {**plant.timings, **c.loop.timings}   # the window's, not the drain's
+    t_end = sim.time
+    drained = drain(plant, cfg.drain_max) if cfg.drain_max > 0 else None
+    sim.close()                # SUMO writes the unfinished trips' tripinfo as it closes
+    records = c.trace.records
+    outlet = round(sum((r.outflow_h + r.outflow_a) * cfg.control_period for r in records))
+    network, trips = measure_network(run.out_dir, c.start, t_end, outlet,
+                                     drained.end if drained else None, sim.time)
+    if drained is not None:
+        network = whole_demand(network, trips, plant, drained)
+    if cfg.fcd:   # moved, not read: an FCD file is large
+        run.files.adopt(run.out_dir / FCD_FILE, FCD_FILE)
+    return _result(c, scenario, cfg, meter_summary, sim, network, run.placement, run.files,
+                   timings, time.perf_counter() - run.wall0)
 
 
 def _result(c: Controlled, scenario: Scenario, cfg: SumoConfig, meter: dict[str, Any],
@@ -249,20 +287,39 @@ def _result(c: Controlled, scenario: Scenario, cfg: SumoConfig, meter: dict[str,
         shift=loop.shift, lateral=sensor.lateral.record(), files=files)
 
 
-def control(sim: SumoSimulation, scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
+@dataclass
+class Warmed:
+    """The end of the warm-up (step 3 of the module docstring), the same for every
+    controller: the plant, the warm-up's measurements, its meter counts and the state of
+    the system as the control window opens."""
+
+    plant: SumoPlant
+    warm: list[PeriodMeasurement]
+    warmup_meter: dict[str, float]
+    start: WindowStart
+
+
+def warm_start(sim: SumoSimulation, scenario: Scenario, settings: RunSettings,
+               cfg: SumoConfig, curve: GreenShareCurve, bar: Progress) -> Warmed:
+    """The warm-up in the open ``sim``, and the control window opened at its end."""
+    est = scenario.estimation
+    plant = SumoPlant(sim, scenario.params.length, cfg, curve, layout=scenario.sensing,
+                      loop_noise=est.loop_noise, probe_noise=est.probe_noise, window=True)
+    warm = warm_up(plant, settings.warmup, cfg.control_period, bar)
+    plant.timings = dict.fromkeys(plant.timings, 0.0)   # time the control window only
+    counts, start = plant.start_window(warm[-1].t)
+    return Warmed(plant, warm, {**counts, "duration_s": float(warm[-1].t)}, start)
+
+
+def control(warmed: Warmed, scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
             design: EtcDesign, curve: GreenShareCurve, bar: Progress,
             keep_measurements: bool = False) -> Controlled:
-    """Warm-up, then the control window, in the open ``sim`` (steps 3-6 of the module
+    """The control window from the end of the warm-up (steps 4-6 of the module
     docstring); ``cfg`` has the control horizon."""
     from arzsumo.kernel_cache import cached_kernels
 
-    params, period, est = scenario.params, cfg.control_period, scenario.estimation
-    plant = SumoPlant(sim, params.length, cfg, curve, layout=scenario.sensing,
-                      loop_noise=est.loop_noise, probe_noise=est.probe_noise, window=True)
-    warm = warm_up(plant, settings.warmup, period, bar)
-    plant.timings = dict.fromkeys(plant.timings, 0.0)   # time the control window only
-    counts, start = plant.start_window(warm[-1].t)
-    warmup_meter = {**counts, "duration_s": float(warm[-1].t)}
+    period, est = cfg.control_period, scenario.estimation
+    plant, warm = warmed.plant, warmed.warm
     eq = operating_point(settings, scenario.equilibrium, warm, period)
     lin = linearize(eq)
     kernels = (cached_kernels(lin.system, settings.kernel_cells)
@@ -290,5 +347,5 @@ def control(sim: SumoSimulation, scenario: Scenario, settings: RunSettings, cfg:
     loop = ClosedLoop(plant, estimator, ctrl, actuator, twins, period, act.anti_windup,
                       shift)
     trace = loop.run(warm[-1], cfg.horizon, bar)
-    return Controlled(loop, trace, ref_ctrl, eq, q_nom, warmup_meter, start, estimator,
-                      settings)
+    return Controlled(loop, trace, ref_ctrl, eq, q_nom, warmed.warmup_meter, warmed.start,
+                      estimator, settings)

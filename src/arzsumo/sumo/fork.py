@@ -8,7 +8,10 @@ then each branch runs in its own child, one after the other, from that same stat
 sends its (picklable) result back through a pipe.
 
 A child ends with ``os._exit``: it runs no cleanup of the parent's (temporary files,
-SUMO's own outputs), so the parent's simulation and files stay as they were. A branch
+SUMO's own outputs), so the parent's simulation and files stay as they were. A child
+inherits the parent's open files too, offsets included: a branch that lets SUMO write
+its outputs calls :func:`own_files` first, so that it writes into copies of its own and
+reads at offsets of its own. A branch
 whose child dies or raises comes back as a :class:`BranchFailed`; the caller re-runs it
 alone. Forking is POSIX-only: :func:`can_fork` says whether this process may.
 """
@@ -17,12 +20,17 @@ from __future__ import annotations
 
 import os
 import pickle
+import shutil
 import signal
 import threading
 import traceback
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
+
+#: where Linux lists a process's open files and their offsets and flags
+PROC_FD, PROC_FDINFO = Path("/proc/self/fd"), Path("/proc/self/fdinfo")
 
 #: prctl option: the signal a child gets when its parent dies (linux/prctl.h)
 PR_SET_PDEATHSIG = 1
@@ -38,9 +46,66 @@ class BranchFailed:
 
 
 def can_fork() -> bool:
-    """Whether branches may fork here: a POSIX process with one thread (forking a
-    threaded process, such as a Dask worker's, may leave a lock held in the child)."""
-    return hasattr(os, "fork") and threading.active_count() == 1
+    """Whether branches may fork here: a Linux process with one thread (forking a
+    threaded process, such as a Dask worker's, may leave a lock held in the child;
+    :func:`own_files` reads ``/proc``)."""
+    return hasattr(os, "fork") and threading.active_count() == 1 and PROC_FD.is_dir()
+
+
+@dataclass(frozen=True)
+class OpenFile:
+    """A file this process holds open: descriptor, path, open flags and offset."""
+
+    fd: int
+    path: Path
+    flags: int
+    offset: int
+
+    @property
+    def writable(self) -> bool:
+        return self.flags & os.O_ACCMODE != os.O_RDONLY
+
+
+def open_files(under: Path) -> Iterator[OpenFile]:
+    """The regular files under ``under`` that this process holds open (Linux ``/proc``)."""
+    root = Path(under).resolve()
+    for entry in PROC_FD.iterdir():
+        try:
+            fd, path = int(entry.name), Path(os.readlink(entry))
+            info = dict(line.split(":", 1) for line in
+                        (PROC_FDINFO / entry.name).read_text().splitlines() if ":" in line)
+        except (OSError, ValueError):   # closed meanwhile, or not a file
+            continue
+        if path.is_relative_to(root) and path.is_file():
+            yield OpenFile(fd, path, int(info["flags"], 8), int(info["pos"]))
+
+
+def own_files(src: Path, dst: Path) -> list[Path]:
+    """In a forked child: make the files it inherited open under ``src`` its own.
+
+    A forked child shares each open file's offset with its parent, so its reads and
+    writes would move the parent's. Each file open for writing is copied as it stands
+    into ``dst`` (same relative path) and the child's descriptor now points at the copy,
+    at the same offset: what the child writes from now on (the bytes still in its
+    buffers included) goes there, after what the parent had written. Each file open for
+    reading only is opened again, at the same offset. Return the copies' paths.
+    """
+    copies = []
+    for f in list(open_files(src)):
+        if f.writable:
+            target = Path(dst) / f.path.relative_to(Path(src).resolve())
+            target.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(f.path, target)
+            new = os.open(target, f.flags & (os.O_ACCMODE | os.O_APPEND))
+            copies.append(target)
+        else:
+            new = os.open(f.path, os.O_RDONLY)
+        try:
+            os.lseek(new, f.offset, os.SEEK_SET)
+            os.dup2(new, f.fd, inheritable=False)
+        finally:
+            os.close(new)
+    return copies
 
 
 def _die_with_parent() -> None:

@@ -54,8 +54,8 @@ class RunFiles:
     ``arzsumo run``), removed by :meth:`remove` or when the object is collected.
     """
 
-    def __init__(self) -> None:
-        self.root = Path(tempfile.mkdtemp(prefix="arzsumo-keep-", dir=scratch_dir()))
+    def __init__(self, under: Path | None = None) -> None:
+        self.root = Path(tempfile.mkdtemp(prefix="arzsumo-keep-", dir=under or scratch_dir()))
         self._finalizer = weakref.finalize(self, shutil.rmtree, str(self.root), True)
 
     def keep_config(self, net: Path, route: Path, additional: Sequence[Path],
@@ -100,6 +100,14 @@ class RunFiles:
                 shutil.copyfile(self.root / rel, target)
             out.append(target)
         return out
+
+    def copy(self, under: Path | None = None) -> RunFiles:
+        """A new gathering (in ``under``, default the scratch directory) with copies of
+        the files kept so far: for a run that branches off this one
+        (:mod:`arzsumo.bridge.branches`)."""
+        other = RunFiles(under)
+        shutil.copytree(self.root, other.root, dirs_exist_ok=True)
+        return other
 
     def remove(self) -> None:
         """Remove the gathered files now (safe to call twice)."""

@@ -277,6 +277,23 @@ class SumoSimulation:
         self._remove_files()
         return self.report
 
+    def branch_off(self, out_dir: Path) -> None:
+        """In a child forked from this open run (:mod:`arzsumo.sumo.fork`): continue on
+        files of its own.
+
+        SUMO's outputs written so far are copied into ``out_dir`` and the rest of the
+        run writes there (:func:`~arzsumo.sumo.fork.own_files`; the statistics output
+        too, :attr:`stats_file`); the route and network files are read at offsets of the
+        child's own; :meth:`close` then removes nothing of the parent's.
+        """
+        from arzsumo.sumo.fork import own_files
+
+        out_dir = Path(out_dir)
+        out_dir.mkdir(parents=True, exist_ok=True)
+        for src in dict.fromkeys([self.output_dir or self.workdir, self.workdir]):
+            own_files(src, out_dir)
+        self.output_dir, self._own_workdir, self._cleanup = out_dir, False, ()
+
     def _read_braking(self) -> int:
         try:
             safety = ET.parse(self.stats_file).getroot().find("safety")

@@ -1,0 +1,91 @@
+"""Several controllers after one warm-up: the runs of a seed share the warm-up's SUMO.
+
+An evaluation runs every controller on the same seeds, and the runs of a seed are the
+same SUMO run until the control window opens: the warm-up holds the nominal plan
+whatever the controller (:func:`~arzsumo.bridge.cosim.warm_start`). :func:`run_branched`
+simulates that warm-up once and forks one child per controller at its end
+(:mod:`arzsumo.sumo.fork`). Each child continues SUMO bit for bit, on output files of its
+own (:meth:`~arzsumo.sumo.simulation.SumoSimulation.branch_off`), and finishes its run as
+:func:`~arzsumo.bridge.cosim.run_cosimulation` would: its summary, periods, cells and
+tripinfo are those of a plain run of the same scenario, controller and seed
+(``tests/bridge/test_branches.py``).
+
+Runs share a warm-up when everything SUMO and the warm-up read is the same
+(:func:`warmup_key`): the scenario's tables except ``[run] controller``, the resolved
+run settings and SUMO settings except the controller, and the placement profile.
+
+A child returns only what the caller's ``keep`` makes of its session (picklable; a
+:class:`~arzsumo.bridge.result.CoSimResult` holds open files and large arrays). A child
+that dies comes back as a :class:`~arzsumo.sumo.fork.BranchFailed`; the caller runs it
+again alone (:func:`arzsumo.sweep.worker.execute_group`).
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import replace
+from functools import partial
+from typing import Any, TypeVar
+
+from arzsumo.bridge.cosim import OpenRun, Warmed, finish_run, open_run, warm_start
+from arzsumo.bridge.session import PreparedRun, SumoSession
+from arzsumo.errors import ArzsumoError
+from arzsumo.io import json_safe
+from arzsumo.sumo.fork import BranchFailed, run_branches
+
+T = TypeVar("T")
+
+
+class BranchError(ArzsumoError, ValueError):
+    """Runs handed to :func:`run_branched` that do not share a warm-up."""
+
+
+def warmup_key(run: PreparedRun) -> str:
+    """What a run's warm-up depends on, as text: runs with equal keys share it."""
+    tables = {k: dict(v) if isinstance(v, dict) else v
+              for k, v in run.scenario.tables.items()}
+    tables.get("run", {}).pop("controller", None)
+    initial = None if run.initial is None else run.initial.tolist()
+    parts = {"tables": tables, "settings": repr(replace(run.settings, controller="open")),
+             "sumo": repr(run.sumo), "initial": initial}
+    return json.dumps(json_safe(parts), sort_keys=True, default=repr)
+
+
+def run_branched(runs: Sequence[PreparedRun], keep: Callable[[SumoSession], T]
+                 ) -> list[T | BranchFailed]:
+    """``keep`` of each run's session, the runs continuing one warm-up in forked children
+    (module docstring); a :class:`~arzsumo.sumo.fork.BranchFailed` where a child died or
+    raised. Runs that do not share a warm-up are refused (:class:`BranchError`)."""
+    if not runs:
+        return []
+    keys = {warmup_key(r) for r in runs}
+    if len(keys) > 1:
+        raise BranchError(f"{len(runs)} runs with {len(keys)} different warm-ups; allowed: "
+                          "runs that differ in [run] controller only")
+    first = runs[0]
+    with open_run(first.scenario, first.settings, first.sumo, first.initial) as run:
+        warmed = warm_start(run.sim, first.scenario, first.settings, first.sumo,
+                            first.curve, run.bar)
+        warm_wall = time.perf_counter() - run.wall0
+        return run_branches([partial(_branch, run, warmed, warm_wall, r, i, keep)
+                             for i, r in enumerate(runs)])
+
+
+def _branch(run: OpenRun, warmed: Warmed, warm_wall: float, prepared: PreparedRun,
+            index: int, keep: Callable[[SumoSession], Any]) -> Any:
+    """In the child: own files, finish the run, return ``keep`` of its session. Its wall
+    time is the shared warm-up's plus its own (what a plain run of it costs)."""
+    out_dir = run.out_dir / f"branch-{index}"    # under the parent's scratch directory
+    run.sim.branch_off(out_dir)
+    mine = replace(run, out_dir=out_dir, files=run.files.copy(under=out_dir),
+                   wall0=time.perf_counter() - warm_wall)
+    try:
+        result = finish_run(mine, warmed, prepared.scenario, prepared.settings,
+                            prepared.sumo, prepared.design, prepared.curve)
+        return keep(SumoSession(result, prepared.settings, prepared.sumo))
+    finally:
+        mine.files.remove()
+        shutil.rmtree(out_dir, ignore_errors=True)
