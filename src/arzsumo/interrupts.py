@@ -5,6 +5,11 @@ without care each prints a KeyboardInterrupt traceback, and a pool whose parent 
 interrupted waits for its running tasks (whole SUMO runs) before the command can end.
 :func:`worker_pool` gives workers a silent exit on SIGINT and ends them at once when the
 parent is interrupted; the CLI then prints one line and removes the partial output.
+
+Workers also end when their parent dies however it died (SIGTERM, SIGKILL, the OOM
+killer): the kernel sends them SIGTERM (Linux ``PR_SET_PDEATHSIG``), and a worker in the
+middle of a task unwinds it first (:class:`ParentGone`: SUMO is closed, its temporary
+files removed) before it exits; an idle one exits at once.
 """
 
 from __future__ import annotations
@@ -14,16 +19,61 @@ import contextlib
 import multiprocessing.context
 import os
 import signal
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
+from typing import Any
 
-#: exit status of a process ended by Ctrl-C (128 + SIGINT)
-EXIT_INTERRUPTED = 130
+#: exit status of a process ended by Ctrl-C (128 + SIGINT), by SIGTERM (128 + 15)
+EXIT_INTERRUPTED, EXIT_TERMINATED = 130, 143
+#: prctl option: the signal a child gets when its parent dies (linux/prctl.h)
+PR_SET_PDEATHSIG = 1
+
+_busy = False   # a worker's task is running (set by guarded)
 
 
-def quiet_worker() -> None:
+class ParentGone(BaseException):
+    """Raised in a busy worker whose parent died: unwinds the task, then the worker exits."""
+
+
+def die_with_parent(sig: int = signal.SIGKILL) -> None:
+    """Linux: have the kernel send ``sig`` to this process when its parent dies;
+    elsewhere nothing (the parent's own cleanup still ends its children)."""
+    try:
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, int(sig))
+    except (OSError, AttributeError):
+        pass
+
+
+def _parent_gone(signum: int, frame: object) -> None:
+    if _busy:
+        raise ParentGone
+    os._exit(EXIT_TERMINATED)
+
+
+def quiet_worker(parent: int | None = None) -> None:
     """Initializer of worker processes: SIGINT ends the worker at once, silently (its
-    parent reports the interrupt)."""
+    parent reports the interrupt); with the ``parent`` pid, SIGTERM or the parent's
+    death ends it after unwinding its task (module docstring)."""
     signal.signal(signal.SIGINT, lambda signum, frame: os._exit(EXIT_INTERRUPTED))
+    if parent is not None:
+        signal.signal(signal.SIGTERM, _parent_gone)
+        die_with_parent(signal.SIGTERM)
+        if os.getppid() != parent:    # the parent died before the line above
+            os._exit(EXIT_TERMINATED)
+
+
+def guarded(fn: Callable[[Any], Any], task: Any) -> Any:
+    """``fn(task)`` in a worker of :func:`worker_pool`, exiting once it has unwound if
+    the parent died meanwhile (submit ``guarded, fn, task``)."""
+    global _busy
+    _busy = True
+    try:
+        return fn(task)
+    except ParentGone:
+        os._exit(EXIT_TERMINATED)
+    finally:
+        _busy = False
 
 
 def stop_pool(pool: cf.ProcessPoolExecutor) -> None:
@@ -42,7 +92,7 @@ def worker_pool(workers: int, mp_context: multiprocessing.context.BaseContext | 
     """A process pool (as ``ProcessPoolExecutor(workers, mp_context)``) whose workers exit
     silently on SIGINT and are ended at once when the caller is interrupted."""
     pool = cf.ProcessPoolExecutor(max_workers=workers, mp_context=mp_context,
-                                  initializer=quiet_worker)
+                                  initializer=quiet_worker, initargs=(os.getpid(),))
     try:
         yield pool
     except KeyboardInterrupt:

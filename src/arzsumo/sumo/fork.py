@@ -29,11 +29,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from arzsumo.interrupts import die_with_parent
+
 #: where Linux lists a process's open files and their offsets and flags
 PROC_FD, PROC_FDINFO = Path("/proc/self/fd"), Path("/proc/self/fdinfo")
 
-#: prctl option: the signal a child gets when its parent dies (linux/prctl.h)
-PR_SET_PDEATHSIG = 1
 
 
 @dataclass(frozen=True)
@@ -108,22 +108,10 @@ def own_files(src: Path, dst: Path) -> list[Path]:
     return copies
 
 
-def _die_with_parent() -> None:
-    """Linux: have the kernel kill this child when its parent dies (a group's process
-    killed from outside leaves no SUMO running); elsewhere nothing."""
-    try:
-        import ctypes
-
-        libc = ctypes.CDLL(None, use_errno=True)
-        libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
-    except (OSError, AttributeError):   # not Linux: the parent's waitpid still reaps it
-        pass
-
-
 def _child(fn: Callable[[], Any], write_fd: int) -> None:
     """In the child: run ``fn`` and send ("ok", result) or ("error", text); never return."""
     try:
-        _die_with_parent()
+        die_with_parent(signal.SIGKILL)   # a group killed from outside leaves no SUMO
         try:
             payload = pickle.dumps(("ok", fn()))
         except BaseException as exc:   # everything goes back to the parent

@@ -12,7 +12,9 @@ Layout of the output directory::
 
 Each run directory is written atomically, so a sweep killed at any moment leaves only
 whole runs; a restart executes exactly the runs without a current result. Both backends
-call the same :func:`arzsumo.sweep.worker.execute`.
+call the same :func:`arzsumo.sweep.groups.execute_group`: the SUMO runs that differ only
+in ``[run] controller`` share one warm-up (:mod:`arzsumo.sweep.groups`), each of the
+others is a plain :func:`arzsumo.sweep.worker.execute`.
 """
 
 from __future__ import annotations
@@ -35,10 +37,11 @@ from typing import Any
 import pandas as pd
 
 from arzsumo import __version__
-from arzsumo.interrupts import worker_pool
+from arzsumo.interrupts import guarded, worker_pool
 from arzsumo.io import atomic_file
 from arzsumo.outdir import atomic_dir, resumable_dir
 from arzsumo.progress import Progress
+from arzsumo.sweep.groups import crashed_group, execute_group, share_warmups
 from arzsumo.sweep.spec import RunSpec, SweepError, SweepSpec
 from arzsumo.sweep.table import arrow_table, read_record, run_dir, sweep_table
 from arzsumo.sweep.worker import FINISHED, RunOutcome, RunTask, crashed, execute
@@ -123,7 +126,7 @@ def run_local(tasks: Iterable[Any], workers: int, on_done: Callable[[Any], None]
             while (queue or running) and not suspects:
                 while queue and len(running) < workers:
                     task = queue.popleft()
-                    running[pool.submit(fn, task)] = task
+                    running[pool.submit(guarded, fn, task)] = task
                 done, _ = cf.wait(running, return_when=cf.FIRST_COMPLETED)
                 for fut in done:
                     task = running.pop(fut)
@@ -137,7 +140,7 @@ def run_local(tasks: Iterable[Any], workers: int, on_done: Callable[[Any], None]
                         getattr(task, "run_id", task))
             with worker_pool(1, ctx) as alone:
                 try:
-                    on_done(alone.submit(fn, task).result())
+                    on_done(alone.submit(guarded, fn, task).result())
                 except BrokenProcessPool:
                     on_done(on_crash(task, "the worker process died (twice, the second "
                                            "time running this task alone)"))
@@ -292,12 +295,18 @@ def _run(spec: SweepSpec, out: Path, runs: list[RunSpec], workers: int | None,
             log.warning("run %s: %s: %s", outcome.run_id, outcome.status, first)
         bar.update(sum(counts.values()))
 
-    tasks = [task_of(spec, r) for r in todo]
+    def on_group_done(outcomes: list[RunOutcome]) -> None:
+        for outcome in outcomes:
+            on_done(outcome)
+
+    groups = share_warmups([task_of(spec, r) for r in todo], workers or default_workers())
     try:
-        if tasks and scheduler:
-            run_dask(tasks, scheduler, on_done, one_thread=spec.engine == "sumo")
-        elif tasks:
-            run_local(tasks, workers or default_workers(), on_done)
+        if groups and scheduler:
+            run_dask(groups, scheduler, on_group_done, one_thread=spec.engine == "sumo",
+                     fn=execute_group, on_crash=crashed_group)
+        elif groups:
+            run_local(groups, workers or default_workers(), on_group_done,
+                      fn=execute_group, on_crash=crashed_group)
     finally:
         bar.close()
     report = SweepReport(spec.name, out, backend, len(runs), len(runs) - len(todo),

@@ -70,9 +70,10 @@ class _Collect(logging.Handler):
 
 
 @contextlib.contextmanager
-def _collected_warnings() -> Iterator[list[str]]:
+def collected_warnings() -> Iterator[list[str]]:
     """Warnings logged by arzsumo during a run go into its outcome, not onto the sweep's
-    terminal (a hundred workers would bury the progress bar)."""
+    terminal (a hundred workers would bury the progress bar). A child forked inside
+    inherits the list and adds its own (:mod:`arzsumo.sweep.groups`)."""
     logger = logging.getLogger("arzsumo")
     handler, propagate = _Collect(), logger.propagate
     logger.addHandler(handler)
@@ -103,11 +104,16 @@ def _run_twin(task: RunTask) -> tuple[str, dict[str, Any], dict[str, bytes]]:
 
 def _run_sumo(task: RunTask) -> tuple[str, dict[str, Any], dict[str, bytes]]:
     from arzsumo.bridge.session import run_in_sumo
-    from arzsumo.outputs.bridge import periods_table, summary
     from arzsumo.scenario import scenario_from_dict
 
-    sc = scenario_from_dict(task.scenario, task.source)
-    session = run_in_sumo(sc)
+    return sumo_outcome(run_in_sumo(scenario_from_dict(task.scenario, task.source)))
+
+
+def sumo_outcome(session: Any) -> tuple[str, dict[str, Any], dict[str, bytes]]:
+    """Status, summary and tables of a finished SUMO session (a plain run's or a branch's
+    of :mod:`arzsumo.sweep.groups`)."""
+    from arzsumo.outputs.bridge import periods_table, summary
+
     summ = json_safe(summary(session.result).to_dict())
     summ["settings_resolved"] = session.resolved_comment()
     return "ok", summ, {"periods.parquet": _parquet(periods_table(session.result))}
@@ -118,24 +124,33 @@ ENGINES = {"twin": _run_twin, "sumo": _run_sumo}
 
 def execute(task: RunTask) -> RunOutcome:
     """Run ``task`` and report; never raises for a bad run (see the module docstring)."""
-    started = time.time()
     t0 = time.perf_counter()
-    execution = {"id": uuid.uuid4().hex, "host": socket.gethostname(), "pid": os.getpid(),
-                 "started": started}
+    execution = execution_record()
     text = dump_toml(task.scenario)
-    with _collected_warnings() as warnings:
-        try:
-            status, summ, tables = ENGINES[task.engine](task)
-            error = None
-        except ArzsumoError as exc:
-            status, summ, tables, error = "invalid", None, {}, f"{type(exc).__name__}: {exc}"
-        except Exception as exc:
-            tb = traceback.format_exc(limit=-4)
-            status, summ, tables = "failed", None, {}
-            error = f"{type(exc).__name__}: {exc}\n{tb}"
+    with collected_warnings() as warnings:
+        status, summ, tables, error = classified(lambda: ENGINES[task.engine](task))
     execution["wall_s"] = time.perf_counter() - t0
     return RunOutcome(task.run_id, status, summ, error, text, tables, execution,
                       list(warnings))
+
+
+def classified(fn: Any) -> tuple[str, dict[str, Any] | None, dict[str, bytes], str | None]:
+    """``fn()``'s (status, summary, tables) with no error, or the error classified: a
+    user's error is ``invalid``, anything else ``failed`` (with the last frames)."""
+    try:
+        status, summ, tables = fn()
+        return status, summ, tables, None
+    except ArzsumoError as exc:
+        return "invalid", None, {}, f"{type(exc).__name__}: {exc}"
+    except Exception as exc:
+        tb = traceback.format_exc(limit=-4)
+        return "failed", None, {}, f"{type(exc).__name__}: {exc}\n{tb}"
+
+
+def execution_record(**extra: Any) -> dict[str, Any]:
+    """Where and when an execution ran (``wall_s`` added when it ends)."""
+    return {"id": uuid.uuid4().hex, "host": socket.gethostname(), "pid": os.getpid(),
+            "started": time.time(), **extra}
 
 
 def crashed(task: RunTask, why: str) -> RunOutcome:
