@@ -1,64 +1,71 @@
-"""Wall time of ``arzsumo evaluate`` (2 controllers x 4 seeds in SUMO) on 1 and 2 local
-processes, and the ratio.
+"""``arzsumo evaluate`` with and without the shared warm-up: wall times and the speed-up.
 
-    .venv/bin/python benchmarks/bench_evaluate.py [--seeds 4] [--warmup 30] [--horizon 60]
+    .venv/bin/python benchmarks/bench_evaluate.py [--seeds 4] [--workers 2]
+        [--controllers open,alinea,pi-alinea,backstepping,etc] [--horizon S] [--warmup S]
 
-The default scenario with a shorter warm-up (``--warmup`` s) and control horizon
-(``--horizon`` s); open loop and ALINEA (no kernels to solve). Each evaluation runs into
-a fresh directory (nothing skipped); wall times include starting the worker processes
-and writing the report (CSV, Markdown, figure).
+The default scenario as shipped unless ``--horizon`` / ``--warmup`` (s) shorten it. The
+two evaluations run one after the other into fresh directories (nothing skipped): first
+every run with its own warm-up, then the runs of each seed continuing one warm-up
+(:mod:`arzsumo.sweep.groups`). Wall times include the worker processes' start and the
+report. The script also checks that both gave the same whole-demand time spent, run by
+run, and prints the goal of the shared warm-up (a speed-up of at least 1.6).
 """
 
 from __future__ import annotations
 
 import argparse
-import os
 import shutil
 import tempfile
 import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+DEFAULT = ROOT / "scenarios" / "default.toml"
+CONTROLLERS = "open,alinea,pi-alinea,backstepping,etc"
+KEY = "network_whole_demand.time_spent_s.total"
 
 
-def scenario(tmp: Path, warmup: float) -> Path:
-    text = (ROOT / "scenarios" / "default.toml").read_text(encoding="utf-8")
-    path = tmp / "bench_evaluate.toml"
-    path.write_text(text.replace("warmup_s = 150", f"warmup_s = {warmup:g}"), encoding="utf-8")
-    return path
-
-
-def timed(path: Path, tmp: Path, seeds: int, horizon: float, workers: int) -> float:
+def timed(controllers: list[str], seeds: int, args: argparse.Namespace, share: bool,
+          tmp: Path):
     from arzsumo.sweep.evaluate import run_evaluation
 
     out = Path(tempfile.mkdtemp(dir=tmp)) / "out"
     t0 = time.perf_counter()
-    res = run_evaluation(path, ["open", "alinea"], list(range(1, seeds + 1)), out=out,
-                         horizon=horizon, workers=workers, progress=False)
+    res = run_evaluation(DEFAULT, controllers, list(range(1, seeds + 1)), out=out,
+                         horizon=args.horizon, warmup=args.warmup, workers=args.workers,
+                         share_warmup=share, progress=False, plots=False)
     wall = time.perf_counter() - t0
-    assert res.sweep.executed == 2 * seeds and res.sweep.statuses == {"ok": 2 * seeds}
+    n = len(controllers) * seeds
+    assert res.sweep.statuses == {"ok": n}, res.sweep.statuses
+    runs = res.runs.set_index("run_id")[KEY].sort_index()
     shutil.rmtree(out.parent)
-    return wall
+    return wall, runs
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=4)
-    ap.add_argument("--warmup", type=float, default=30.0)
-    ap.add_argument("--horizon", type=float, default=60.0)
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--controllers", default=CONTROLLERS)
+    ap.add_argument("--horizon", type=float, default=None)
+    ap.add_argument("--warmup", type=float, default=None)
     args = ap.parse_args()
+    controllers = args.controllers.split(",")
     tmp = Path(tempfile.mkdtemp(prefix="bench_evaluate."))
-    os.environ["ARZSUMO_CACHE"] = str(tmp / "kernels")
-    path = scenario(tmp, args.warmup)
-    n = 2 * args.seeds
-    one = timed(path, tmp, args.seeds, args.horizon, 1)
-    two = timed(path, tmp, args.seeds, args.horizon, 2)
-    print(f"evaluate: open, alinea x {args.seeds} seeds = {n} SUMO runs of "
-          f"{args.warmup:g} s warm-up + {args.horizon:g} s control")
-    print(f"  1 process  : {one:7.2f} s  {one / n:6.2f} s/run")
-    print(f"  2 processes: {two:7.2f} s  {two / n:6.2f} s/run")
-    print(f"  speed-up 2 / 1 processes: {one / two:.2f}")
-    shutil.rmtree(tmp, ignore_errors=True)
+    try:
+        plain, a = timed(controllers, args.seeds, args, False, tmp)
+        shared, b = timed(controllers, args.seeds, args, True, tmp)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    n = len(controllers) * args.seeds
+    same = a.index.equals(b.index) and bool((a == b).all())
+    print(f"evaluate default: {len(controllers)} controllers x {args.seeds} seeds = {n} runs, "
+          f"{args.workers} local processes, warm-up {args.warmup or 'as shipped'}, "
+          f"horizon {args.horizon or 'as shipped'}")
+    print(f"own warm-up per run      {plain:8.1f} s   ({plain / n:.1f} s per run)")
+    print(f"shared warm-up per seed  {shared:8.1f} s   ({shared / n:.1f} s per run)")
+    print(f"speed-up                 {plain / shared:8.2f}   (goal >= 1.6)")
+    print(f"whole-demand time spent equal run by run: {same}")
 
 
 if __name__ == "__main__":

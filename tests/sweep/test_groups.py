@@ -19,7 +19,7 @@ import pytest
 from arzsumo.io import dump_toml
 from arzsumo.resources import shipped_scenarios_dir
 from arzsumo.sumo.fork import can_fork
-from arzsumo.sweep.groups import RunGroup, share_warmups, warmup_key
+from arzsumo.sweep.groups import CHILD_COMMAND, RunGroup, share_warmups, warmup_key
 from arzsumo.sweep.worker import RunTask, execute
 
 DEFAULT = shipped_scenarios_dir() / "default.toml"
@@ -82,7 +82,7 @@ def test_a_group_with_a_killed_branch_completes_and_equals_plain_runs(tmp_path):
     scratch = tmp_path / "scratch"
     env = {**os.environ, "ARZSUMO_SCRATCH_DIR": str(scratch),
            "ARZSUMO_CACHE": str(tmp_path / "cache")}
-    proc = subprocess.Popen([sys.executable, "-m", "arzsumo.sweep.groups"], env=env,
+    proc = subprocess.Popen(CHILD_COMMAND, env=env,
                             stdin=subprocess.PIPE, stdout=subprocess.PIPE)
     proc.stdin.write(pickle.dumps(group))
     proc.stdin.close()
@@ -126,15 +126,18 @@ def test_a_terminated_sweep_leaves_no_worker_and_no_file(tmp_path):
     def in_scratch() -> list[Path]:   # the run's scratch directory: SUMO's files
         return [f for d in out.glob(".scratch.*") for f in d.iterdir()]
 
-    deadline = time.monotonic() + 120
-    while time.monotonic() < deadline and len(in_scratch()) < 2:
-        time.sleep(0.2)                   # both workers are in SUMO
-    workers = [p for p in _children(proc.pid) if b"spawn_main" in _cmdline(p)]
-    assert len(workers) == 2 and len(in_scratch()) >= 2
+    def workers() -> list[int]:
+        return [p for p in _children(proc.pid) if b"spawn_main" in _cmdline(p)]
+
+    deadline = time.monotonic() + 120     # both workers in SUMO: 3 scratch entries a run
+    while time.monotonic() < deadline and (len(workers()) < 2 or len(in_scratch()) < 6):
+        time.sleep(0.2)
+    pool = workers()
+    assert len(pool) == 2 and len(in_scratch()) >= 6
     proc.send_signal(signal.SIGTERM)
     proc.wait(timeout=30)
     deadline = time.monotonic() + 60
-    while time.monotonic() < deadline and any(Path(f"/proc/{p}").exists() for p in workers):
+    while time.monotonic() < deadline and any(Path(f"/proc/{p}").exists() for p in pool):
         time.sleep(0.2)
-    assert not any(Path(f"/proc/{p}").exists() for p in workers)
+    assert not any(Path(f"/proc/{p}").exists() for p in pool)
     assert in_scratch() == []             # each worker closed SUMO and removed its files

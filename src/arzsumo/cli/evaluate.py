@@ -48,6 +48,7 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
     res = run_evaluation(scenario, controllers, seeds, out=out, horizon=args.horizon,
                          warmup=args.warmup,
                          workers=args.workers, scheduler=args.scheduler,
+                         share_warmup=not args.no_shared_warmup,
                          overwrite=args.overwrite, progress=not args.quiet,
                          plots=not args.no_plots, command=command,
                          baseline_from=Path(args.baseline_from) if args.baseline_from else None,

@@ -46,9 +46,14 @@ def add_scheduler(p: argparse.ArgumentParser) -> None:
 
 
 def add_parallel(p: argparse.ArgumentParser) -> None:
-    """``--workers N`` and ``--scheduler ADDRESS`` (the sweep engine's executors)."""
+    """``--workers N``, ``--scheduler ADDRESS`` (the sweep engine's executors) and
+    ``--no-shared-warmup``."""
     add_workers(p)
     add_scheduler(p)
+    p.add_argument("--no-shared-warmup", action="store_true",
+                   help="give every SUMO run its own warm-up (by default the runs of a "
+                        "seed that differ only in the controller simulate it once; the "
+                        "results are the same to the last bit)")
 
 
 def add_quiet(p: argparse.ArgumentParser) -> None:

@@ -28,6 +28,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         return 0
     out = Path(args.out) if args.out else Path("results") / "sweeps" / spec.name
     rep = run_sweep(spec, out, workers=args.workers, scheduler=args.scheduler,
+                    share_warmup=not args.no_shared_warmup,
                     progress=not args.quiet, plots=not args.no_plots,
                     paper=paper_points(spec.paper))
     df = rep.table

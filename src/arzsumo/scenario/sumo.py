@@ -132,6 +132,9 @@ SUMO_KEYS: dict[str, Key] = {
     "fill_demand_a_veh_h": Key("fill_demand_a", factor=VEH_H_PER_VEH_S, allowed=_DEMAND,
                                unit="veh/h", doc="AV flow requested at the mainline "
                                                  "entrance during the fill phase"),
+    "eager_insert": Key("eager_insert", "bool",
+                        doc="try every vehicle waiting for insertion every step (SUMO "
+                            "--eager-insert), not only the first of each edge"),
     "fcd": Key("fcd", "bool", doc="write SUMO's trajectories of every vehicle every step "
                                   "(fcd.xml.gz in the run directory; `arzsumo run --fcd`)"),
 }

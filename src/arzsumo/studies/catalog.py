@@ -8,7 +8,8 @@ results page ``DIR/PAGE.md`` with its files in ``DIR/PAGE/`` (``DIR`` defaults t
 ablation, ablation-mechanism, held-ramp and wave-speed, ``meter_dynamics``, ``sumo_map``
 for approach, ``sumo_fill`` for fill, ``identified_model`` for inlet,
 ``estimation_layouts`` for estimation-layouts and loop-speed, ``enkf_noise``,
-``u_on_estimate``, ``premise_map``; :mod:`arzsumo.studies.common`). ``run`` returns the exit code (0
+``u_on_estimate``, ``premise_map``, ``sumo_options``; :mod:`arzsumo.studies.common`).
+``run`` returns the exit code (0
 done; 4 some runs were invalid, failed or crashed) and raises
 :class:`~arzsumo.errors.ArzsumoError` for bad input. A study's module is imported only
 when its options or its run are asked for.
@@ -77,6 +78,8 @@ _MODULES = {
                                  "EnKF estimates, same seed"),
     "premise-map": ("premise_map", "where the paper's premise holds in SUMO: premise gates "
                                    "over the free SUMO parameters"),
+    "sumo-options": ("sumo_options", "what SUMO's options (lateral resolution, action step, "
+                                     "approach, insertion) cost and change, paired by seed"),
 }
 
 STUDIES: dict[str, Study] = {

@@ -133,6 +133,10 @@ class SumoConfig:
         demand above then holds from ``fill_duration`` to the end. A fill above the
         bottleneck's discharge builds the congested section fast; the hold
         demand, a little above the discharge, keeps it without filling the approach.
+    eager_insert : bool
+        SUMO's ``--eager-insert``: every vehicle waiting for insertion (the virtual queues
+        of the mainline and the ramp) is tried every step, not only each edge's first
+        (default True).
     fcd : bool
         Have SUMO write its floating-car data (every vehicle every step: position, lateral
         position, speed, lane, type) into ``fcd.xml.gz`` of ``arzsumo run``'s directory.
@@ -183,6 +187,7 @@ class SumoConfig:
     fill_duration: float = 0.0
     fill_demand_h: float = 0.0
     fill_demand_a: float = 0.0
+    eager_insert: bool = True
     fcd: bool = False
 
     def __post_init__(self) -> None:
@@ -241,6 +246,8 @@ class SumoConfig:
         require(self.time_to_teleport == -1 or self.time_to_teleport > 0, "time_to_teleport",
                 self.time_to_teleport, "-1 (off) or a time > 0 s", ScenarioError)
         require(isinstance(self.fcd, bool), "fcd", self.fcd, "true or false", ScenarioError)
+        require(isinstance(self.eager_insert, bool), "eager_insert", self.eager_insert,
+                "true or false", ScenarioError)
         self._check_behaviour()
 
     def _check_behaviour(self) -> None:

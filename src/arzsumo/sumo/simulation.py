@@ -140,6 +140,8 @@ class SumoSimulation:
         #: integral of the vehicles in the system (on the network or waiting to be
         #: inserted) over the run, veh s: counted every step, independently of tripinfo
         self.in_system_s = 0.0
+        #: vehicles moved by SUMO, summed over the steps (SUMO's "vehicle updates")
+        self.vehicle_updates = 0
         self.pending: Sequence[str] = ()
         self.report: RunReport | None = None
 
@@ -156,7 +158,7 @@ class SumoSimulation:
                 "--step-length", f"{c.step_length:.6g}", "--seed", str(c.seed),
                 "--lateral-resolution", f"{c.lateral_resolution:.6g}",
                 "--time-to-teleport", f"{c.time_to_teleport:.6g}",
-                "--eager-insert", "true", "--collision.action", "warn",
+                "--eager-insert", str(c.eager_insert).lower(), "--collision.action", "warn",
                 "--collision.check-junctions", "true",
                 "--statistic-output", str(self.stats_file),
                 "--no-step-log", "true", "--no-warnings", "true",
@@ -217,7 +219,9 @@ class SumoSimulation:
         self.arrived += sim.getArrivedNumber()
         #: vehicles due but not yet inserted after this step (ids), read once per step
         self.pending = sim.getPendingVehicles()
-        self.in_system_s += (lib.vehicle.getIDCount() + len(self.pending)) * self.cfg.step_length
+        on_network = lib.vehicle.getIDCount()
+        self.vehicle_updates += on_network
+        self.in_system_s += (on_network + len(self.pending)) * self.cfg.step_length
         self.collisions += sim.getCollidingVehiclesNumber()
         self.emergency_stops += sim.getEmergencyStoppingVehiclesNumber()
         if self.cfg.time_to_teleport > 0:

@@ -41,7 +41,7 @@ from arzsumo.interrupts import guarded, worker_pool
 from arzsumo.io import atomic_file
 from arzsumo.outdir import atomic_dir, resumable_dir
 from arzsumo.progress import Progress
-from arzsumo.sweep.groups import crashed_group, execute_group, share_warmups
+from arzsumo.sweep.groups import RunGroup, crashed_group, execute_group, share_warmups
 from arzsumo.sweep.spec import RunSpec, SweepError, SweepSpec
 from arzsumo.sweep.table import arrow_table, read_record, run_dir, sweep_table
 from arzsumo.sweep.worker import FINISHED, RunOutcome, RunTask, crashed, execute
@@ -243,7 +243,7 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
               scheduler: str | None = None, progress: bool = True,
               plots: bool = True,
               paper: Mapping[str, Mapping[float, float]] | None = None,
-              kind: str = "sweep") -> SweepReport:
+              kind: str = "sweep", share_warmup: bool = True) -> SweepReport:
     """Execute the runs of ``spec`` that have no current result under ``out``; then write
     the table, plots and manifest.
 
@@ -263,18 +263,23 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
     kind : str
         The kind of result ``out`` holds (its marker): ``sweep``, or ``evaluation`` for
         ``arzsumo evaluate``; a directory of another kind is refused.
+    share_warmup : bool
+        SUMO runs that differ only in ``[run] controller`` continue one warm-up
+        (:mod:`arzsumo.sweep.groups`); False gives each its own (same results).
     """
     t0 = time.perf_counter()
     runs = spec.runs()
     if workers is not None and workers < 1:
         raise SweepError(f"--workers = {workers} is not allowed: an integer >= 1")
     with resumable_dir(out, kind) as target:
-        return _run(spec, target, runs, workers, scheduler, progress, plots, paper, t0)
+        return _run(spec, target, runs, workers, scheduler, progress, plots, paper, t0,
+                    share_warmup)
 
 
 def _run(spec: SweepSpec, out: Path, runs: list[RunSpec], workers: int | None,
          scheduler: str | None, progress: bool, plots: bool,
-         paper: Mapping[str, Mapping[float, float]] | None, t0: float) -> SweepReport:
+         paper: Mapping[str, Mapping[float, float]] | None, t0: float,
+         share_warmup: bool = True) -> SweepReport:
     """The body of :func:`run_sweep` inside its claimed output directory ``out``."""
     with atomic_file(out / "sweep.toml") as tmp:
         tmp.write_text(spec.text or f"# sweep {spec.name} (built in code)\n", encoding="utf-8")
@@ -299,7 +304,9 @@ def _run(spec: SweepSpec, out: Path, runs: list[RunSpec], workers: int | None,
         for outcome in outcomes:
             on_done(outcome)
 
-    groups = share_warmups([task_of(spec, r) for r in todo], workers or default_workers())
+    tasks = [task_of(spec, r) for r in todo]
+    groups = (share_warmups(tasks, workers or default_workers()) if share_warmup
+              else [RunGroup((t,)) for t in tasks])
     try:
         if groups and scheduler:
             run_dask(groups, scheduler, on_group_done, one_thread=spec.engine == "sumo",

@@ -282,7 +282,8 @@ def _forget_previous(out: Path, user: str) -> None:
 def run_evaluation(scenario: Path, controllers: Sequence[str], seeds: Sequence[int], *,
                    out: Path, horizon: float | None = None, warmup: float | None = None,
                    workers: int | None = None,
-                   scheduler: str | None = None, overwrite: bool = False,
+                   scheduler: str | None = None, share_warmup: bool = True,
+                   overwrite: bool = False,
                    progress: bool = True, plots: bool = True,
                    command: str = "", baseline_from: Path | None = None,
                    runs_from: Sequence[Path] = ()) -> EvaluationResult:
@@ -320,7 +321,7 @@ def run_evaluation(scenario: Path, controllers: Sequence[str], seeds: Sequence[i
     if to_run:
         rep = run_sweep(evaluation_spec(scenario, to_run, seeds, horizon, warmup), out,
                         workers=workers, scheduler=scheduler, progress=progress,
-                        plots=False, kind=KIND)
+                        plots=False, kind=KIND, share_warmup=share_warmup)
         target = rep.out
     else:   # every run taken from elsewhere: only the report is written here
         with resumable_dir(out, KIND) as claimed:

@@ -39,6 +39,9 @@ from arzsumo.sweep.worker import (
 )
 
 log = logging.getLogger(__name__)
+#: a fresh single-threaded Python process that runs one group (:func:`in_subprocess`)
+CHILD_COMMAND = [sys.executable, "-c",
+                 "from arzsumo.sweep.groups import child_main; child_main()"]
 
 
 @dataclass(frozen=True)
@@ -138,8 +141,8 @@ def in_subprocess(group: RunGroup) -> list[RunOutcome] | None:
     """:func:`execute_group` in a fresh Python process (one thread, so it may fork); None
     if that process gave no result."""
     t0 = time.perf_counter()
-    done = subprocess.run([sys.executable, "-m", "arzsumo.sweep.groups"],
-                          input=pickle.dumps(group), capture_output=True, check=False)
+    done = subprocess.run(CHILD_COMMAND, input=pickle.dumps(group), capture_output=True,
+                          check=False)
     try:
         out = pickle.loads(done.stdout)
     except Exception:   # it died, or printed something else
@@ -149,14 +152,11 @@ def in_subprocess(group: RunGroup) -> list[RunOutcome] | None:
     return out if isinstance(out, list) else None
 
 
-def _main() -> None:   # python -m arzsumo.sweep.groups: a pickled group in, outcomes out
+def child_main() -> None:
+    """:data:`CHILD_COMMAND`: a pickled group on stdin, its pickled outcomes on stdout."""
     group = pickle.loads(sys.stdin.buffer.read())
     result = os.dup(1)            # SUMO may print: only the outcomes go to the caller
     os.dup2(2, 1)
     out = pickle.dumps(execute_group(group))
     with os.fdopen(result, "wb") as pipe:
         pipe.write(out)
-
-
-if __name__ == "__main__":
-    _main()

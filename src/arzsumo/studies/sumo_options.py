@@ -1,0 +1,158 @@
+"""What SUMO's options cost and what they change: the open loop of the default scenario,
+one option changed at a time (``arzsumo study sumo-options``).
+
+Each variant is the default scenario with one ``[sumo]`` key changed (:data:`VARIANTS`):
+
+* the lateral resolution (0.5 m as shipped: 13 sublanes of the 6.5 m lane; 0.65 m and
+  1.3 m, also divisors of the lane width, as SUMO advises);
+* the HVs' action step (every 0.1 s step as shipped; 0.5 s);
+* the approach length (2500 m as shipped; 1500 m: the queue's tail waits off the
+  network, in SUMO's insertion queue, where it costs nothing per step);
+* SUMO's eager insertion (every waiting vehicle of the virtual queues tried every step
+  as shipped; off: only each edge's first).
+
+Every run is an ``arzsumo run`` of the open loop through the sweep engine (its drain
+included), on the same seeds for every variant. For each variant against the shipped
+one, seed by seed, ``sumo_options.csv`` gives the wall time per run and its ratio, and
+the paired difference of each measure (:data:`MEASURES`) with its 95 % t interval and
+whether it moves beyond seed noise (the interval excludes zero). A default may change
+only where nothing moves.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from arzsumo.evaluation.stats import paired_difference
+from arzsumo.outdir import resumable_dir
+from arzsumo.outputs.studies import publish, write_csv
+from arzsumo.studies.common import add_output, add_runs, print_list, shipped_scenario, study_spec
+
+NAME = "sumo-options"
+PAGE = "sumo_options"
+#: the column naming which variant a run is
+OPTION = "option"
+#: the shipped value first (the baseline), then the variants; field -> values
+VARIANTS: dict[str, list[Any]] = {
+    "sumo.lateral_resolution_m": [0.5, 0.65, 1.3],
+    "sumo.hv_action_step_s": [0.5],
+    "sumo.approach_length_m": [1500.0],
+    "sumo.eager_insert": [False],
+}
+#: summary column -> (label, unit factor from SI, unit)
+MEASURES: dict[str, tuple[str, float, str]] = {
+    "network_whole_demand.time_spent_s.total": ("whole-demand time spent", 1 / 3600, "veh h"),
+    "network_whole_demand.ramp_wait_s.p95": ("ramp wait p95", 1.0, "s"),
+    "section.speed_mean_kmh.h": ("HV mean speed", 1.0, "km/h"),
+    "section.speed_mean_kmh.a": ("AV mean speed", 1.0, "km/h"),
+    "section.waves.h.oscillation_kmh": ("HV oscillation", 1.0, "km/h"),
+    "section.waves.a.oscillation_kmh": ("AV oscillation", 1.0, "km/h"),
+}
+WALL = "execution.wall_s"
+
+
+def options_spec(seeds: list[int], scenario: str = "default.toml"):
+    """The sweep of the study: one axis per option, varied one at a time."""
+    axes = [{"field": f, "values": v, "group": OPTION} for f, v in VARIANTS.items()]
+    return study_spec(NAME, shipped_scenario(scenario), seeds=list(seeds),
+                      set={"run.controller": "open"}, axis=axes)
+
+
+def variant_name(key: str, value: Any) -> str:
+    """``key=value`` as the study's tables name a variant."""
+    text = str(value).lower() if isinstance(value, bool | np.bool_) else f"{value:g}"
+    return f"{key}={text}"
+
+
+def variant_of(row: pd.Series) -> str:
+    """The variant a run of the sweep is: the option its group column names, its value."""
+    return variant_name(row[OPTION], row[row[OPTION]])
+
+
+def compare(df: pd.DataFrame) -> pd.DataFrame:
+    """One row per variant and measure: the paired difference against the shipped options
+    over the seeds both finished (module docstring)."""
+    ok = df[df["status"] == "ok"].copy()
+    ok["variant"] = ok.apply(variant_of, axis=1)
+    first = next(iter(VARIANTS))
+    base_name = variant_name(first.split(".", 1)[1], VARIANTS[first][0])
+    base = ok[ok["variant"] == base_name].set_index("seed")
+    rows = []
+    for variant, runs in ok.groupby("variant", sort=False):
+        runs = runs.set_index("seed")
+        seeds = sorted(set(runs.index) & set(base.index))
+        wall = runs.loc[seeds, WALL].to_numpy(float)
+        ratio = wall / base.loc[seeds, WALL].to_numpy(float)
+        for col, (label, factor, unit) in MEASURES.items():
+            if col not in runs:
+                continue
+            a = runs.loc[seeds, col].to_numpy(float) * factor
+            b = base.loc[seeds, col].to_numpy(float) * factor
+            same = variant == base_name
+            pc = None if same or len(seeds) < 2 else paired_difference(a, b, n_resamples=999)
+            rows.append({
+                "variant": variant, "seeds": len(seeds), "wall_s_per_run": wall.mean(),
+                "wall_ratio": float(np.mean(ratio)), "measure": label, "unit": unit,
+                "base_mean": float(np.nanmean(b)), "variant_mean": float(np.nanmean(a)),
+                "diff_mean": pc.mean_diff if pc else 0.0,
+                "diff_low": pc.t.low if pc else 0.0, "diff_high": pc.t.high if pc else 0.0,
+                "moves": bool(pc and not pc.t.covers(0.0))})
+    return pd.DataFrame(rows)
+
+
+def markdown(table: pd.DataFrame) -> str:
+    """The comparison as a Markdown table, one line per variant."""
+    lines = ["| variant | seeds | wall s / run | wall ratio | "
+             + " | ".join(f"{m} ({u})" for m, u in dict.fromkeys(
+                 zip(table["measure"], table["unit"], strict=True)))
+             + " |", "|---|---:|---:|---:|" + "---|" * table["measure"].nunique()]
+    for variant, rows in table.groupby("variant", sort=False):
+        cells = []
+        for r in rows.itertuples():
+            if r.diff_low == r.diff_high == 0.0:
+                cells.append(f"{r.base_mean:.3g}")
+            else:
+                star = " **moves**" if r.moves else ""
+                cells.append(f"{r.diff_mean:+.3g} [{r.diff_low:+.3g}, {r.diff_high:+.3g}]"
+                             f"{star}")
+        r0 = rows.iloc[0]
+        lines.append(f"| {variant} | {r0.seeds} | {r0.wall_s_per_run:.0f} | "
+                     f"{r0.wall_ratio:.2f} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The study's options."""
+    add_runs(parser, seeds="1-10")
+    add_output(parser, NAME, PAGE, plots=False)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the missing variants and seeds, write the comparison."""
+    from arzsumo.sweep.driver import run_sweep
+
+    spec = options_spec(args.seeds)
+    if args.list:
+        return print_list([r.run_id for r in spec.runs()])
+    with resumable_dir(args.out, f"study-{NAME}") as out:
+        rep = run_sweep(spec, Path(out) / "sweep", workers=args.workers,
+                        scheduler=args.scheduler, progress=not args.quiet, plots=False)
+        table = compare(rep.table)
+        files = [write_csv(table, Path(out) / f"{PAGE}.csv")]
+        text = markdown(table)
+        if args.docs is not None:
+            body = ("The open loop of the default scenario, one SUMO option changed at a "
+                    f"time, paired by seed (`arzsumo study {NAME}`). Each cell: the "
+                    "variant minus the shipped options, mean [95 % t interval]; **moves**: "
+                    "the interval excludes zero. The first row gives the shipped means.\n\n"
+                    f"{text}\n\nTable: [{PAGE}.csv]({PAGE}/{PAGE}.csv).")
+            publish(args.docs, PAGE, NAME, "What SUMO's options cost and change", body,
+                    [(p, p.name) for p in files])
+    print(text)
+    bad = sum(v for k, v in rep.statuses.items() if k != "ok")
+    return 4 if bad else 0
