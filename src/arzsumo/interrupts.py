@@ -9,7 +9,10 @@ parent is interrupted; the CLI then prints one line and removes the partial outp
 Workers also end when their parent dies however it died (SIGTERM, SIGKILL, the OOM
 killer): the kernel sends them SIGTERM (Linux ``PR_SET_PDEATHSIG``), and a worker in the
 middle of a task unwinds it first (:class:`ParentGone`: SUMO is closed, its temporary
-files removed) before it exits; an idle one exits at once.
+files removed) before it exits; an idle one exits at once. Each worker keeps its temporary
+files in a scratch directory of its own, inside its parent's, and removes it as it exits
+that way: a signal that lands between a file's creation and the code that owns it leaves
+nothing either.
 """
 
 from __future__ import annotations
@@ -18,9 +21,14 @@ import concurrent.futures as cf
 import contextlib
 import multiprocessing.context
 import os
+import shutil
 import signal
+import tempfile
 from collections.abc import Callable, Iterator
+from pathlib import Path
 from typing import Any
+
+from arzsumo.outdir import SCRATCH_ENV
 
 #: exit status of a process ended by Ctrl-C (128 + SIGINT), by SIGTERM (128 + 15)
 EXIT_INTERRUPTED, EXIT_TERMINATED = 130, 143
@@ -28,6 +36,7 @@ EXIT_INTERRUPTED, EXIT_TERMINATED = 130, 143
 PR_SET_PDEATHSIG = 1
 
 _busy = False   # a worker's task is running (set by guarded)
+_own_scratch: Path | None = None   # a worker's scratch directory (set by quiet_worker)
 
 
 class ParentGone(BaseException):
@@ -48,6 +57,12 @@ def die_with_parent(sig: int = signal.SIGKILL) -> None:
 def _parent_gone(signum: int, frame: object) -> None:
     if _busy:
         raise ParentGone
+    _exit_terminated()
+
+
+def _exit_terminated() -> None:
+    if _own_scratch is not None:
+        shutil.rmtree(_own_scratch, ignore_errors=True)
     os._exit(EXIT_TERMINATED)
 
 
@@ -55,12 +70,17 @@ def quiet_worker(parent: int | None = None) -> None:
     """Initializer of worker processes: SIGINT ends the worker at once, silently (its
     parent reports the interrupt); with the ``parent`` pid, SIGTERM or the parent's
     death ends it after unwinding its task (module docstring)."""
+    global _own_scratch
     signal.signal(signal.SIGINT, lambda signum, frame: os._exit(EXIT_INTERRUPTED))
     if parent is not None:
+        base = os.environ.get(SCRATCH_ENV)
+        if base:
+            _own_scratch = Path(tempfile.mkdtemp(prefix=f"worker.{os.getpid()}.", dir=base))
+            os.environ[SCRATCH_ENV] = str(_own_scratch)
         signal.signal(signal.SIGTERM, _parent_gone)
         die_with_parent(signal.SIGTERM)
         if os.getppid() != parent:    # the parent died before the line above
-            os._exit(EXIT_TERMINATED)
+            _exit_terminated()
 
 
 def guarded(fn: Callable[[Any], Any], task: Any) -> Any:
@@ -71,7 +91,7 @@ def guarded(fn: Callable[[Any], Any], task: Any) -> Any:
     try:
         return fn(task)
     except ParentGone:
-        os._exit(EXIT_TERMINATED)
+        _exit_terminated()
     finally:
         _busy = False
 

@@ -11,6 +11,7 @@ import pytest
 
 from arzsumo.studies import premise_runs as pr
 from arzsumo.studies.common import shipped_scenario
+from arzsumo.sumo import fork
 
 pytestmark = [pytest.mark.sumo, pytest.mark.slow]
 
@@ -45,6 +46,7 @@ def plain():
 
 def test_a_forked_group_equals_the_runs_made_alone(plain, monkeypatch, tmp_path):
     monkeypatch.setenv("ARZSUMO_SCRATCH_DIR", str(tmp_path))
+    monkeypatch.setattr(fork, "can_fork", lambda: True)   # see the next test
     group = pr.run_premise_group(pr.grouped(_runs())[0])["rows"]
     assert [r["kind"] for r in group] == list(pr.KINDS)
     assert not any(r.get("rerun") for r in group)
@@ -66,6 +68,9 @@ def test_a_killed_child_runs_again_alone_and_nothing_is_left(plain, monkeypatch,
         return branch(sc, sim, plant, t0, opt, warm_s)
 
     monkeypatch.setattr(pr, "_branch", dies_in_the_pulse_child)
+    # an earlier test in this process may have left an idle thread (Dask's offload
+    # thread), which makes can_fork refuse; this test is about the re-run, so fork anyway
+    monkeypatch.setattr(fork, "can_fork", lambda: True)
     before = _children()
     group = pr.run_premise_group(pr.grouped(_runs())[0])["rows"]
     assert [bool(r.get("rerun")) for r in group] == [False, True, False]

@@ -124,16 +124,19 @@ def test_a_terminated_sweep_leaves_no_worker_and_no_file(tmp_path):
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 
     def in_scratch() -> list[Path]:   # the run's scratch directory: SUMO's files
-        return [f for d in out.glob(".scratch.*") for f in d.iterdir()]
+        return [f for d in out.glob(".scratch.*") for f in d.rglob("*")]
+
+    def runs_started() -> int:        # each run makes 3 directories: SUMO's, its outputs'
+        return sum(1 for f in in_scratch() if f.name.startswith("arzsumo-"))  # and kept
 
     def workers() -> list[int]:
         return [p for p in _children(proc.pid) if b"spawn_main" in _cmdline(p)]
 
     deadline = time.monotonic() + 120     # both workers in SUMO: 3 scratch entries a run
-    while time.monotonic() < deadline and (len(workers()) < 2 or len(in_scratch()) < 6):
+    while time.monotonic() < deadline and (len(workers()) < 2 or runs_started() < 6):
         time.sleep(0.2)
     pool = workers()
-    assert len(pool) == 2 and len(in_scratch()) >= 6
+    assert len(pool) == 2 and runs_started() >= 6
     proc.send_signal(signal.SIGTERM)
     proc.wait(timeout=30)
     deadline = time.monotonic() + 60

@@ -174,20 +174,22 @@ class SumoSimulation:
         if _ACTIVE is not None:
             raise SumoError("another SUMO simulation is open in this process; allowed: one "
                             "at a time (close it first)")
-        try:
+        try:                    # any way out of here but started leaves no files
             self.frontend.check()
-        except SumoError:
-            self._remove_files()
+            lib = self.frontend.load()
+            try:
+                self.frontend.start(lib, self.command())
+            except Exception as exc:
+                raise SumoError(f"SUMO did not start: {_one_line(exc).rstrip('.')}"
+                                f"{self.frontend.failed_hint()}") from None
+            self._lib, self.started, _ACTIVE = lib, True, self
+            self.time = float(lib.simulation.getTime())
+        except BaseException:   # Ctrl-C or a dying parent too
+            if self._lib is not None:
+                self.close(warn=False)
+            else:
+                self._remove_files()
             raise
-        lib = self.frontend.load()
-        try:
-            self.frontend.start(lib, self.command())
-        except Exception as exc:
-            self._remove_files()
-            raise SumoError(f"SUMO did not start: {_one_line(exc).rstrip('.')}"
-                            f"{self.frontend.failed_hint()}") from None
-        self._lib, self.started, _ACTIVE = lib, True, self
-        self.time = float(lib.simulation.getTime())
         log.debug("SUMO started: seed %d, step %.3g s", self.cfg.seed, self.cfg.step_length)
         return self
 
