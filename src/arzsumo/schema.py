@@ -132,7 +132,12 @@ SWEEP_FIXED: dict[str, Column] = {
     "execution.host": Column(TEXT, "host name of the worker"),
     "execution.pid": Column(TEXT, "process id of the worker"),
     "execution.started": Column("s", "start, seconds since 1970-01-01 UTC"),
-    "execution.wall_s": Column("s", "wall time of the execution"),
+    "execution.wall_s": Column("s", "wall time of the execution (a run that shared its "
+                                    "warm-up: the warm-up's plus its own)"),
+    "execution.shared_warmup": Column("count", "runs that continued the same simulated "
+                                               "warm-up (empty: the run had its own)"),
+    "execution.rerun_alone": Column(TEXT, "why the run's branch of a shared warm-up failed "
+                                          "(it was then run alone; empty: it did not)"),
 }
 
 _FUEL = "veh"          # the paper's fuel rate is in 1/s; integrated over veh s

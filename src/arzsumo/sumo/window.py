@@ -63,6 +63,11 @@ class EmissionsLedger:
     the warm-up's until :meth:`close` reads the window's start, and the drain's after the
     window's end (:func:`window_end`).
 
+    Each step's rates are kept as arrays and summed per vehicle only when read
+    (:attr:`fuel_mg`, :attr:`co2_mg`): in step order, so the sums are those of adding
+    every step's ``rate * dt`` as it comes, without a dictionary update per vehicle and
+    step in the hot loop.
+
     Parameters
     ----------
     lib : module
@@ -73,18 +78,46 @@ class EmissionsLedger:
 
     def __init__(self, lib: ModuleType, dt: float) -> None:
         self.lib, self.dt = lib, dt
-        self.fuel_mg: dict[str, float] = {}
-        self.co2_mg: dict[str, float] = {}
+        self._ids: list[tuple[str, ...]] = []
+        self._rates: list[np.ndarray] = []           # (2, n): fuel, CO2 in mg/s
+        self._sums: tuple[dict[str, float], dict[str, float]] = ({}, {})
 
     def add(self) -> None:
-        """Add the step just simulated (libsumo rates in mg/s times dt)."""
+        """Keep the step just simulated (libsumo rates in mg/s)."""
         v = self.lib.vehicle
         ids = v.getIDList()
-        fuel, co2 = self.fuel_mg, self.co2_mg
-        for i, f, c in zip(ids, map(v.getFuelConsumption, ids), map(v.getCO2Emission, ids),
-                           strict=True):
-            fuel[i] = fuel.get(i, 0.0) + f * self.dt
-            co2[i] = co2.get(i, 0.0) + c * self.dt
+        n = len(ids)
+        rates = np.empty((2, n))
+        rates[0] = np.fromiter(map(v.getFuelConsumption, ids), float, n)
+        rates[1] = np.fromiter(map(v.getCO2Emission, ids), float, n)
+        self._ids.append(ids)
+        self._rates.append(rates)
+
+    @property
+    def fuel_mg(self) -> dict[str, float]:
+        """Fuel of every vehicle seen so far, mg."""
+        return self._summed()[0]
+
+    @property
+    def co2_mg(self) -> dict[str, float]:
+        """CO2 of every vehicle seen so far, mg."""
+        return self._summed()[1]
+
+    def _summed(self) -> tuple[dict[str, float], dict[str, float]]:
+        if self._ids:
+            ids = np.concatenate([np.asarray(i, dtype=object) for i in self._ids])
+            rates = np.concatenate(self._rates, axis=1) * self.dt
+            seen = list(self._sums[0])       # vehicles summed before: their sums go first
+            codes, names = pd.factorize(np.concatenate([np.asarray(seen, dtype=object),
+                                                        ids]))
+            for k, total in enumerate(self._sums):
+                start = np.array([total[i] for i in seen], dtype=float)
+                summed = np.bincount(codes, np.concatenate([start, rates[k]]),
+                                     minlength=len(names))
+                total.clear()
+                total.update(zip(names.tolist(), summed.tolist(), strict=True))
+            self._ids, self._rates = [], []
+        return self._sums
 
     def close(self, t: float) -> WindowStart:
         """The :class:`WindowStart` at time ``t`` (s): read the vehicles now in the system."""
