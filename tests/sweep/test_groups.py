@@ -12,6 +12,7 @@ import time
 import tomllib
 from pathlib import Path
 
+import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
@@ -144,3 +145,30 @@ def test_a_terminated_sweep_leaves_no_worker_and_no_file(tmp_path):
         time.sleep(0.2)
     assert not any(Path(f"/proc/{p}").exists() for p in pool)
     assert in_scratch() == []             # each worker closed SUMO and removed its files
+
+
+@pytest.mark.sumo
+@pytest.mark.slow
+def test_a_group_on_dask_runs_in_a_process_of_its_own_and_equals_the_local_pool(tmp_path):
+    from distributed import LocalCluster
+
+    from arzsumo.sweep.driver import run_sweep
+    from arzsumo.sweep.spec import sweep_from_dict
+    from arzsumo.sweep.table import comparable
+
+    spec = sweep_from_dict({
+        "name": "groups", "base": str(DEFAULT), "engine": "sumo", "seeds": [5],
+        "set": {"run.warmup_s": 60.0, "run.kernel_cells": 50, "run.twin_cells": 50,
+                "sumo.horizon_s": 40.0, "sumo.drain_max_s": 0.0},
+        "axis": [{"field": "run.controller", "values": ["open", "etc"]}]},
+        "test", root=DEFAULT.parent)
+    local = run_sweep(spec, tmp_path / "local", workers=1, progress=False, plots=False)
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, host="127.0.0.1",
+                      dashboard_address=None) as cluster:
+        dask = run_sweep(spec, tmp_path / "dask", scheduler=cluster.scheduler_address,
+                         progress=False, plots=False)
+    assert local.statuses == dask.statuses == {"ok": 2}
+    a = pd.read_parquet(tmp_path / "local" / "summaries.parquet")
+    b = pd.read_parquet(tmp_path / "dask" / "summaries.parquet")
+    assert list(a["execution.shared_warmup"]) == list(b["execution.shared_warmup"]) == [2, 2]
+    pd.testing.assert_frame_equal(comparable(a), comparable(b))

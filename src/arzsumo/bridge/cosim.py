@@ -165,6 +165,30 @@ def place_initial(params: ModelParameters, settings: RunSettings, cfg: SumoConfi
 
 
 @dataclass
+class Warmed:
+    """The end of the warm-up (step 3 of the module docstring), the same for every
+    controller: the plant, the warm-up's measurements, its meter counts and the state of
+    the system as the control window opens."""
+
+    plant: SumoPlant
+    warm: list[PeriodMeasurement]
+    warmup_meter: dict[str, float]
+    start: WindowStart
+
+
+def warm_start(sim: SumoSimulation, scenario: Scenario, settings: RunSettings,
+               cfg: SumoConfig, curve: GreenShareCurve, bar: Progress) -> Warmed:
+    """The warm-up in the open ``sim``, and the control window opened at its end."""
+    est = scenario.estimation
+    plant = SumoPlant(sim, scenario.params.length, cfg, curve, layout=scenario.sensing,
+                      loop_noise=est.loop_noise, probe_noise=est.probe_noise, window=True)
+    warm = warm_up(plant, settings.warmup, cfg.control_period, bar)
+    plant.timings = dict.fromkeys(plant.timings, 0.0)   # time the control window only
+    counts, start = plant.start_window(warm[-1].t)
+    return Warmed(plant, warm, {**counts, "duration_s": float(warm[-1].t)}, start)
+
+
+@dataclass
 class Controlled:
     """What the warm-up and the control window left: the loop (plant, controller, twins),
     its trace, the design point, the warm-up's meter counts and the window's start."""
@@ -285,30 +309,6 @@ def _result(c: Controlled, scenario: Scenario, cfg: SumoConfig, meter: dict[str,
         network=network, section_speed=sensor.speeds.summary(), start=trace.start,
         estimate=np.asarray(c.estimator.fields[1:]), estimator=c.estimator,
         shift=loop.shift, lateral=sensor.lateral.record(), files=files)
-
-
-@dataclass
-class Warmed:
-    """The end of the warm-up (step 3 of the module docstring), the same for every
-    controller: the plant, the warm-up's measurements, its meter counts and the state of
-    the system as the control window opens."""
-
-    plant: SumoPlant
-    warm: list[PeriodMeasurement]
-    warmup_meter: dict[str, float]
-    start: WindowStart
-
-
-def warm_start(sim: SumoSimulation, scenario: Scenario, settings: RunSettings,
-               cfg: SumoConfig, curve: GreenShareCurve, bar: Progress) -> Warmed:
-    """The warm-up in the open ``sim``, and the control window opened at its end."""
-    est = scenario.estimation
-    plant = SumoPlant(sim, scenario.params.length, cfg, curve, layout=scenario.sensing,
-                      loop_noise=est.loop_noise, probe_noise=est.probe_noise, window=True)
-    warm = warm_up(plant, settings.warmup, cfg.control_period, bar)
-    plant.timings = dict.fromkeys(plant.timings, 0.0)   # time the control window only
-    counts, start = plant.start_window(warm[-1].t)
-    return Warmed(plant, warm, {**counts, "duration_s": float(warm[-1].t)}, start)
 
 
 def control(warmed: Warmed, scenario: Scenario, settings: RunSettings, cfg: SumoConfig,

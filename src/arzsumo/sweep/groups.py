@@ -118,10 +118,16 @@ def _forked(group: RunGroup) -> list[RunOutcome]:
         except Exception:   # refused before SUMO: the plain run says so, classified
             outcomes[task.run_id] = execute(task)
     started = execution_record(shared_warmup=len(ready))
-    with collected_warnings() as warnings:   # the warm-up's; each child adds its own
-        branches = run_branched([r for _, r in ready],
-                                lambda session: (*sumo_outcome(session),
-                                                 session.result.wall_time, list(warnings)))
+    try:
+        with collected_warnings() as warnings:   # the warm-up's; each child adds its own
+            branches = run_branched([r for _, r in ready],
+                                    lambda session: (*sumo_outcome(session),
+                                                     session.result.wall_time,
+                                                     list(warnings)))
+    except Exception as exc:   # the shared warm-up itself failed: each run says why, alone
+        log.warning("group %s: the shared warm-up failed (%s); plain runs instead",
+                    group.run_id, type(exc).__name__)
+        return [outcomes.get(t.run_id) or execute(t) for t in group.tasks]
     for (task, _), got in zip(ready, branches, strict=True):
         if isinstance(got, BranchFailed):
             log.warning("run %s: its branch of the shared warm-up failed (%s); running it "
