@@ -20,6 +20,10 @@ at a free-flow scenario equilibrium, a dead time it can compensate):
    (:func:`~arzsumo.bridge.drain.drain`) through the same step loop
    (:class:`~arzsumo.sumo.plant.SumoPlant`).
 
+Steps 2, 3 and 4-7 are :func:`open_run`, :func:`warm_start` and :func:`finish_run`; the
+warm-up does not depend on the controller, so several controllers can continue one
+(:mod:`arzsumo.bridge.branches`).
+
 The meter's counts (plan and light changes, queue maximum) cover the control window only:
 the meter's window is closed at the start of control and the warm-up's counts are kept
 apart (``CoSimResult.warmup_meter``).
