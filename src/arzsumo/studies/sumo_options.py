@@ -12,7 +12,8 @@ Each variant is the default scenario with one ``[sumo]`` key changed (:data:`VAR
   as shipped; off: only each edge's first).
 
 Every run is an ``arzsumo run`` of the open loop through the sweep engine (its drain
-included), on the same seeds for every variant. For each variant against the shipped
+included unless ``--no-drain``), on the same seeds for every variant. For each variant
+against the shipped
 one, seed by seed, ``sumo_options.csv`` gives the wall time per run and its ratio, and
 the paired difference of each measure (:data:`MEASURES`) with its 95 % t interval and
 whether it moves beyond seed noise (the interval excludes zero). A default may change
@@ -46,6 +47,7 @@ VARIANTS: dict[str, list[Any]] = {
 }
 #: summary column -> (label, unit factor from SI, unit)
 MEASURES: dict[str, tuple[str, float, str]] = {
+    "network.time_spent_s.total": ("window time spent", 1 / 3600, "veh h"),
     "network_whole_demand.time_spent_s.total": ("whole-demand time spent", 1 / 3600, "veh h"),
     "network_whole_demand.ramp_wait_s.p95": ("ramp wait p95", 1.0, "s"),
     "section.speed_mean_kmh.h": ("HV mean speed", 1.0, "km/h"),
@@ -56,11 +58,16 @@ MEASURES: dict[str, tuple[str, float, str]] = {
 WALL = "execution.wall_s"
 
 
-def options_spec(seeds: list[int], scenario: str = "default.toml"):
-    """The sweep of the study: one axis per option, varied one at a time."""
+def options_spec(seeds: list[int], scenario: str = "default.toml", drain: bool = True):
+    """The sweep of the study: one axis per option, varied one at a time; without
+    ``drain`` the runs end with the control window (the whole-demand measures then stop
+    there too, and are left out)."""
     axes = [{"field": f, "values": v, "group": OPTION} for f, v in VARIANTS.items()]
-    return study_spec(NAME, shipped_scenario(scenario), seeds=list(seeds),
-                      set={"run.controller": "open"}, axis=axes)
+    fixed: dict[str, Any] = {"run.controller": "open"}
+    if not drain:
+        fixed["sumo.drain_max_s"] = 0.0
+    return study_spec(NAME, shipped_scenario(scenario), seeds=list(seeds), set=fixed,
+                      axis=axes)
 
 
 def variant_name(key: str, value: Any) -> str:
@@ -74,9 +81,10 @@ def variant_of(row: pd.Series) -> str:
     return variant_name(row[OPTION], row[row[OPTION]])
 
 
-def compare(df: pd.DataFrame) -> pd.DataFrame:
+def compare(df: pd.DataFrame, drained: bool = True) -> pd.DataFrame:
     """One row per variant and measure: the paired difference against the shipped options
-    over the seeds both finished (module docstring)."""
+    over the seeds both finished (module docstring); whole-demand measures only when the
+    runs were ``drained``."""
     ok = df[df["status"] == "ok"].copy()
     ok["variant"] = ok.apply(variant_of, axis=1)
     first = next(iter(VARIANTS))
@@ -89,7 +97,7 @@ def compare(df: pd.DataFrame) -> pd.DataFrame:
         wall = runs.loc[seeds, WALL].to_numpy(float)
         ratio = wall / base.loc[seeds, WALL].to_numpy(float)
         for col, (label, factor, unit) in MEASURES.items():
-            if col not in runs:
+            if col not in runs or (not drained and col.startswith("network_whole_demand")):
                 continue
             a = runs.loc[seeds, col].to_numpy(float) * factor
             b = base.loc[seeds, col].to_numpy(float) * factor
@@ -129,6 +137,9 @@ def markdown(table: pd.DataFrame) -> str:
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """The study's options."""
     add_runs(parser, seeds="1-10")
+    parser.add_argument("--no-drain", action="store_true",
+                        help="end each run with the control window (faster; no "
+                             "whole-demand measures)")
     add_output(parser, NAME, PAGE, plots=False)
 
 
@@ -136,20 +147,22 @@ def run(args: argparse.Namespace) -> int:
     """Run the missing variants and seeds, write the comparison."""
     from arzsumo.sweep.driver import run_sweep
 
-    spec = options_spec(args.seeds)
+    spec = options_spec(args.seeds, drain=not args.no_drain)
     if args.list:
         return print_list([r.run_id for r in spec.runs()])
     with resumable_dir(args.out, f"study-{NAME}") as out:
         rep = run_sweep(spec, Path(out) / "sweep", workers=args.workers,
                         scheduler=args.scheduler, progress=not args.quiet, plots=False)
-        table = compare(rep.table)
+        table = compare(rep.table, drained=not args.no_drain)
         files = [write_csv(table, Path(out) / f"{PAGE}.csv")]
         text = markdown(table)
         if args.docs is not None:
             body = ("The open loop of the default scenario, one SUMO option changed at a "
                     f"time, paired by seed (`arzsumo study {NAME}`). Each cell: the "
                     "variant minus the shipped options, mean [95 % t interval]; **moves**: "
-                    "the interval excludes zero. The first row gives the shipped means.\n\n"
+                    "the interval excludes zero. The first row gives the shipped means."
+                    + (" The runs end with the control window (`--no-drain`)."
+                       if args.no_drain else "") + "\n\n"
                     f"{text}\n\nTable: [{PAGE}.csv]({PAGE}/{PAGE}.csv).")
             publish(args.docs, PAGE, NAME, "What SUMO's options cost and change", body,
                     [(p, p.name) for p in files])
