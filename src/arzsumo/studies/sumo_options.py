@@ -14,9 +14,9 @@ Each variant is the default scenario with one ``[sumo]`` key changed (:data:`VAR
 Every run is an ``arzsumo run`` of the open loop through the sweep engine (its drain
 included unless ``--no-drain``), on the same seeds for every variant. For each variant
 against the shipped one, seed by seed, ``sumo_options.csv`` gives the wall time per run
-and its ratio, and the paired difference of each measure (:data:`MEASURES`) with its 95 % t interval and
-whether it moves beyond seed noise (the interval excludes zero). A default may change
-only where nothing moves.
+and its ratio, and the paired difference of each measure (:data:`MEASURES`) with its
+95 % t interval and whether it moves beyond seed noise (the interval excludes zero). A
+default may change only where nothing moves.
 """
 
 from __future__ import annotations

@@ -305,7 +305,9 @@ def _run(spec: SweepSpec, out: Path, runs: list[RunSpec], workers: int | None,
             on_done(outcome)
 
     tasks = [task_of(spec, r) for r in todo]
-    groups = (share_warmups(tasks, workers or default_workers()) if share_warmup
+    # a seed's runs are split over idle local workers; a cluster's size is not known here
+    spread = 1 if scheduler else workers or default_workers()
+    groups = (share_warmups(tasks, spread) if share_warmup
               else [RunGroup((t,)) for t in tasks])
     try:
         if groups and scheduler:
