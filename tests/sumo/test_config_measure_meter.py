@@ -103,8 +103,14 @@ def test_a_fill_phase_requests_the_fill_demand_then_the_hold_demand():
 
 
 def test_sublane_grid_must_separate_insertion_columns():
-    with pytest.raises(ScenarioError, match=r"lateral_resolution = 0\.65 is not allowed"):
+    with pytest.raises(ScenarioError, match=r"lateral_resolution = 0\.65 is not allowed: "
+                                            r"with vehicles 2 m wide in columns at -2\.25, "
+                                            r"0, 2\.25 m on a 6\.5 m lane"):
         route_file_text(PARAMS, SumoConfig(lateral_resolution=0.65))
+    # without the fixed columns SUMO places every vehicle itself: any sublane grid
+    free = route_file_text(PARAMS, SumoConfig(lateral_resolution=1.3,
+                                              depart_pos_lat="random_free"))
+    assert 'departPosLat="random_free"' in free
 
 
 def test_edie_single_step_density_is_count_over_length():

@@ -154,8 +154,9 @@ def check_columns(road_width: float, vehicle_width: float, resolution: float,
         hi = math.ceil((left + vehicle_width) / resolution - 1e-9) - 1
         if used and lo <= used[-1][1]:
             raise ScenarioError(
-                f"lateral_resolution = {resolution} is not allowed: with vehicles "
-                f"{vehicle_width} m wide in columns at {list(offsets)} m on a {road_width} m "
+                f"lateral_resolution = {resolution:g} is not allowed: with vehicles "
+                f"{vehicle_width:g} m wide in columns at "
+                f"{', '.join(f'{float(o):g}' for o in offsets)} m on a {road_width:g} m "
                 "lane, neighbouring columns share a sublane; use a resolution such as 0.5 "
                 "or 0.25 m")
         used.append((lo, hi))
@@ -168,8 +169,9 @@ def route_file_text(params: ModelParameters, cfg: SumoConfig,
     Mainline flows start on ``approach`` when ``cfg.approach_length > 0`` (the network
     must have that edge), else on ``main`` at x = 0.
     """
-    check_columns(params.road_width, params.vehicle_width, cfg.lateral_resolution,
-                  insertion_columns(params.road_width, params.vehicle_width, 3))
+    if cfg.depart_pos_lat == "columns":   # otherwise SUMO places every vehicle itself
+        check_columns(params.road_width, params.vehicle_width, cfg.lateral_resolution,
+                      insertion_columns(params.road_width, params.vehicle_width, 3))
     hv, av = vehicle_types(params, cfg)
     section = f"{MAIN} {MERGE} {DOWN}"
     lines = [hv.to_xml(), av.to_xml()]
