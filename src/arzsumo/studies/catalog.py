@@ -78,8 +78,8 @@ _MODULES = {
                                  "EnKF estimates, same seed"),
     "premise-map": ("premise_map", "where the paper's premise holds in SUMO: premise gates "
                                    "over the free SUMO parameters"),
-    "sumo-options": ("sumo_options", "what SUMO's options (lateral resolution, action step, "
-                                     "approach, insertion) cost and change, paired by seed"),
+    "sumo-options": ("sumo_options", "what SUMO's options (sublanes, action step, approach, "
+                                     "insertion) cost and change, by seed"),
 }
 
 STUDIES: dict[str, Study] = {
