@@ -10,8 +10,10 @@ vehicle with emissions, edge data, statistics), for the same simulated time; its
 ``--duration-log.statistics`` gives its vehicle updates per second (UPS). Each arzsumo
 run is the whole ``run_cosimulation`` of the default scenario without the drain: start,
 warm-up, control window, SUMO's outputs read. Its updates are the vehicles on the
-network summed over its steps. The goals: an open loop at most 5 % slower than bare
-SUMO, the ETC with the ASM estimator at most 10 %.
+network summed over its steps. A third reference is libsumo alone: the run's network,
+routes, loops and outputs opened as a run opens them, then nothing but ``simulationStep``
+(what in-process SUMO costs before arzsumo reads anything). The goals: an open loop at
+most 5 % slower than bare SUMO, the ETC with the ASM estimator at most 10 %.
 """
 
 from __future__ import annotations
@@ -45,6 +47,23 @@ def cosim(sc, controller: str, seed: int, horizon: float | None, keep: Path | No
     if keep is not None:
         res.files.place(keep)
     return wall, updates, end
+
+
+def libsumo_alone(sc, seed: int, end: float) -> float:
+    """Wall time (s) of libsumo stepping the run's network with its outputs, nothing read."""
+    from arzsumo.sumo.network_measures import network_options
+    from arzsumo.sumo.simulation import open_simulation
+
+    out = Path(tempfile.mkdtemp(prefix="bench_sumo_speed.lib."))
+    cfg = sc.sumo.with_(seed=seed, horizon=end)
+    t0 = time.perf_counter()
+    with open_simulation(sc.params, cfg, extra_args=network_options(out / "net"),
+                         output_dir=out / "net", loops=sc.sensing.loop_x(sc.params.length),
+                         downstream_loop=sc.alinea.loop_distance) as sim:
+        lib = sim.lib
+        while lib.simulation.getTime() < end - 1e-9:
+            lib.simulationStep()
+    return time.perf_counter() - t0
 
 
 def bare(config: Path, end: float) -> tuple[float, float, int]:
@@ -81,16 +100,19 @@ def main() -> None:
         runs[name] = cosim(sc, name, args.seed, args.horizon, keep if i == 0 else None)
     end = runs[controllers[0]][2]
     b_wall, b_ups, b_updates = bare(keep / "run.sumocfg", end)
+    lib_wall = libsumo_alone(sc, args.seed, end)
     print(f"default scenario, seed {args.seed}, {end:.0f} s simulated "
           f"(warm-up and control window, no drain)")
     print(f"{'':22s}{'wall s':>9s}{'updates':>11s}{'updates/s':>11s}{'ratio':>8s}")
     print(f"{'bare sumo':22s}{b_wall:9.1f}{b_updates:11d}{b_updates / b_wall:11.0f}"
           f"{1.0:8.3f}   (SUMO's own UPS {b_ups:.0f})")
+    print(f"{'libsumo alone':22s}{lib_wall:9.1f}{'':11s}{'':11s}{lib_wall / b_wall:8.3f}"
+          "   (no reads: in-process SUMO's own cost)")
     for name, (wall, updates, _) in runs.items():
         goal = GOALS.get(name)
         note = f"   (goal <= {goal:.2f})" if goal else ""
         print(f"{'arzsumo ' + name:22s}{wall:9.1f}{updates:11d}{updates / wall:11.0f}"
-              f"{wall / b_wall:8.3f}{note}")
+              f"{wall / b_wall:8.3f}{note}   ratio to libsumo alone {wall / lib_wall:.3f}")
 
 
 if __name__ == "__main__":
