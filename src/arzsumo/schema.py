@@ -208,6 +208,9 @@ RUN_SUMMARY: dict[str, str] = {
     "network_whole_demand.ramp_wait_s.not_crossed": "veh",
     "network_whole_demand.ramp_wait_s.*": "s",
     "meter.emergency_braking": "count",
+    "disturbance": TEXT, "disturbance.kind": TEXT, "disturbance.edge": TEXT,  # null: none
+    "disturbance.speed_m_s": "m/s", "disturbance.original_speed_m_s": "m/s",
+    "disturbance.began_s": "s", "disturbance.ended_s": "s",
     "speed_variance.*": "m^2/s^2",
     **{f"{k}.*": u for k, u in _RUN_INDICES.items()}, "until_s": "s",
     **{f"twin_*.{k}.*": u for k, u in _RUN_INDICES.items()}, "twin_*.until_s": "s",

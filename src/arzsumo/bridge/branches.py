@@ -44,10 +44,12 @@ class BranchError(ArzsumoError, ValueError):
 
 
 def warmup_key(run: PreparedRun) -> str:
-    """What a run's warm-up depends on, as text: runs with equal keys share it."""
+    """What a run's warm-up depends on, as text: runs with equal keys share it (a
+    ``[disturbance]`` acts after the warm-up, so it is left out)."""
     tables = {k: dict(v) if isinstance(v, dict) else v
               for k, v in run.scenario.tables.items()}
     tables.get("run", {}).pop("controller", None)
+    tables.pop("disturbance", None)      # it acts from the start of control on
     initial = None if run.initial is None else run.initial.tolist()
     parts = {"tables": tables, "settings": repr(replace(run.settings, controller="open")),
              "sumo": repr(run.sumo), "initial": initial}

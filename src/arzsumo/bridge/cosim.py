@@ -312,7 +312,9 @@ def _result(c: Controlled, scenario: Scenario, cfg: SumoConfig, meter: dict[str,
         timings=timings, warmup_meter=c.warmup_meter,
         network=network, section_speed=sensor.speeds.summary(), start=trace.start,
         estimate=np.asarray(c.estimator.fields[1:]), estimator=c.estimator,
-        shift=loop.shift, lateral=sensor.lateral.record(), files=files)
+        shift=loop.shift, lateral=sensor.lateral.record(), files=files,
+        disturbance=(dict(loop.plant.disturbance.applied) if loop.plant.disturbance
+                     else None))
 
 
 def control(warmed: Warmed, scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
@@ -350,6 +352,7 @@ def control(warmed: Warmed, scenario: Scenario, settings: RunSettings, cfg: Sumo
                              ActuationLimits.of(act, q_nom, period))
     loop = ClosedLoop(plant, estimator, ctrl, actuator, twins, period, act.anti_windup,
                       shift)
+    plant.disturb(scenario.disturbance, warm[-1].t)
     trace = loop.run(warm[-1], cfg.horizon, bar)
     return Controlled(loop, trace, ref_ctrl, eq, q_nom, warmed.warmup_meter, warmed.start,
                       estimator, settings)

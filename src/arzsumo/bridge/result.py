@@ -73,3 +73,6 @@ class CoSimResult:
     #: the SUMO configuration the run ran (``run.sumocfg``, ``sumo/``) and, with
     #: ``[sumo] fcd``, its FCD output, to be placed into the results directory
     files: RunFiles | None = None
+    #: what the ``[disturbance]`` did (:class:`arzsumo.sumo.disturbance.DisturbanceSchedule`
+    #: ``applied``: SUMO times in s, speeds in m/s); None without one
+    disturbance: dict[str, Any] | None = None

@@ -293,7 +293,7 @@ def summary(res: CoSimResult) -> RunSummary:
         twin_status=res.twin_status, accounting=accounting, placement=res.placement,
         wall_time=res.wall_time, timings=res.timings,
         controller_time_per_period=float(np.mean(per["controller_s"])) if n else None,
-        settings=res.settings.as_dict())
+        settings=res.settings.as_dict(), disturbance=res.disturbance)
 
 
 def periods_table(res: CoSimResult) -> pa.Table:

@@ -98,6 +98,7 @@ class RunSummary:
     controller_time_per_period: float | None
     settings: Mapping[str, Any]
     complete: bool = True
+    disturbance: Mapping[str, Any] | None = None
 
     @property
     def whole_demand_complete(self) -> bool:
@@ -131,7 +132,7 @@ class RunSummary:
             **asdict(self.accounting), "placement": self.placement,
             "wall_time": self.wall_time, "timings": dict(self.timings),
             "controller_time_per_period": self.controller_time_per_period,
-            "settings": dict(self.settings)}
+            "settings": dict(self.settings), "disturbance": self.disturbance}
         out["units_by_key"] = key_units(out, RUN_SUMMARY)
         return out
 

@@ -20,6 +20,7 @@ section                   record                                     keys (units
 ``[estimation]``          ``estimation``: EstimationSettings         :mod:`.estimation`
 ``[actuation]``           ``actuation``: ActuationSettings (``run``) :mod:`.actuation`
 ``[alinea]``              ``alinea``: AlineaSettings (``run``)       :mod:`.alinea`
+``[disturbance]``         ``disturbance``: Slowdown (``run``)        :mod:`.disturbance`
 ``[sweep]``               ``sweep``: DesignSweep (``reproduce``)     here
 ========================  =========================================  ====================
 
@@ -52,6 +53,7 @@ from arzsumo.scenario.actuation import (
     check_delay_horizon,
 )
 from arzsumo.scenario.alinea import ALINEA_KEYS, alinea_section, check_alinea_period
+from arzsumo.scenario.disturbance import DISTURBANCE_KEYS, disturbance_section
 from arzsumo.scenario.estimation import (
     ESTIMATION_KEYS,
     EstimationSettings,
@@ -83,6 +85,7 @@ from arzsumo.scenario.twin import (
     twin_section,
 )
 from arzsumo.sumo.config import SumoConfig
+from arzsumo.sumo.disturbance import Slowdown
 from arzsumo.sumo.sensing import SensorLayout
 from arzsumo.tables import Key, check_keys, check_renamed, checked, not_allowed, where
 from arzsumo.twin.initial import InitialCondition
@@ -101,7 +104,7 @@ KEYS: dict[str, dict[str, Key]] = {
     "model": MODEL_KEYS, "equilibrium": EQUILIBRIUM_KEYS, "design": DESIGN_KEYS,
     "initial": INITIAL_KEYS, "twin": TWIN_KEYS, "sumo": SUMO_KEYS, "run": RUN_KEYS,
     "sensing": SENSING_KEYS, "estimation": ESTIMATION_KEYS, "actuation": ACTUATION_KEYS,
-    "alinea": ALINEA_KEYS, "sweep": SWEEP_KEYS,
+    "alinea": ALINEA_KEYS, "disturbance": DISTURBANCE_KEYS, "sweep": SWEEP_KEYS,
 }
 #: table -> {old key: new key}: keys renamed since earlier versions (a one-line hint)
 RENAMED: dict[str, dict[str, str]] = {"run": RUN_RENAMED}
@@ -141,6 +144,7 @@ class Scenario:
     estimation: EstimationSettings = field(default_factory=EstimationSettings)
     actuation: ActuationSettings = field(default_factory=ActuationSettings)
     alinea: AlineaSettings = field(default_factory=AlineaSettings)
+    disturbance: Slowdown = field(default_factory=Slowdown)
 
     def with_(self, changes: Mapping[str, Any]) -> Scenario:
         """A new scenario with keys changed, parsed and validated again.
@@ -216,13 +220,15 @@ def scenario_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scena
     if uses_alinea(run.controller):
         check_alinea_period(alinea, sumo.control_period, at["alinea"],
                             t["alinea"].get("period_s"))
+    disturbance = disturbance_section(t["disturbance"], at["disturbance"])
     sweep = _sweep_section(t["sweep"], at["sweep"])
     default_name = Path(source).stem if source != "<dict>" else preset.name
     return Scenario(_text(data, "name", source, default_name),
                     _text(data, "description", source, preset.description), params, eq,
                     design, initial, twin, sumo, run, sweep, source,
                     copy.deepcopy(dict(data)), sensing=sensing,
-                    estimation=estimation, actuation=actuation, alinea=alinea)
+                    estimation=estimation, actuation=actuation, alinea=alinea,
+                    disturbance=disturbance)
 
 
 def load_scenario(path: str | Path) -> Scenario:

@@ -20,6 +20,7 @@ from arzsumo.scenario.estimation import EstimationSettings
 from arzsumo.scenario.run import RunSettings
 from arzsumo.scenario.twin import DEFAULT_AMPLITUDE, TwinConfig
 from arzsumo.sumo.config import SumoConfig
+from arzsumo.sumo.disturbance import Slowdown
 from arzsumo.sumo.sensing import SensorLayout
 from arzsumo.tables import Key, written
 
@@ -55,6 +56,9 @@ SECTIONS: dict[str, tuple[str, Callable[[str], Any] | None]] = {
     "alinea": ("ALINEA and PI-ALINEA in `arzsumo run` (`alinea`, `pi-alinea`): period, loop, "
                "target and gains; the loop is read in every run (`occupancy_out`)",
                lambda f: getattr(AlineaSettings(), f)),
+    "disturbance": ("a reproducible perturbation of `arzsumo run` after the start of control "
+                    "(the disturbance experiment); default: none. Runs with and without it "
+                    "share their warm-up", lambda f: getattr(Slowdown(), f)),
     "sweep": ("`arzsumo reproduce` only: one ETC run per value of a [design] parameter", None),
 }
 

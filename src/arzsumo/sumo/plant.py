@@ -15,6 +15,7 @@ from typing import Any
 
 from arzsumo.estimate.observations import LoopNoise, ProbeNoise
 from arzsumo.sumo.config import SumoConfig
+from arzsumo.sumo.disturbance import DisturbanceSchedule, Slowdown
 from arzsumo.sumo.green_share import DEFAULT_CURVE, GreenShareCurve
 from arzsumo.sumo.meter import MeterLight, MeterState
 from arzsumo.sumo.meter_release import make_meter
@@ -53,12 +54,21 @@ class SumoPlant:
                                  loop_noise=loop_noise, probe_noise=probe_noise,
                                  measure=measure)
         self.timings = {"sumo_step": 0.0, "measure_actuate": 0.0}
+        self.disturbance: DisturbanceSchedule | None = None
+
+    def disturb(self, disturbance: Slowdown, t0: float) -> None:
+        """Schedule ``disturbance``, its times counted from ``t0`` (SUMO time, s): the
+        start of control (:mod:`arzsumo.sumo.disturbance`). Nothing when it is none."""
+        if disturbance.active:
+            self.disturbance = DisturbanceSchedule(self.sim.lib, disturbance, t0)
 
     def step(self) -> PeriodMeasurement | None:
         """One SUMO step, read and acted on; the period's measurement when one ends."""
         s0 = time.perf_counter()
         t = self.sim.step()
         s1 = time.perf_counter()
+        if self.disturbance is not None:
+            self.disturbance.due(t)
         reading, got = self.sensor.observe(t, self.sim.pending)
         self.meter.step(reading)
         self.timings["sumo_step"] += s1 - s0

@@ -57,10 +57,11 @@ class RunGroup:
 
 
 def warmup_key(task: RunTask) -> str:
-    """A task's scenario without ``[run] controller``, as text: tasks with equal keys
-    share a warm-up."""
+    """A task's scenario without ``[run] controller`` and ``[disturbance]`` (it acts
+    after the warm-up), as text: tasks with equal keys share a warm-up."""
     data = {k: dict(v) if isinstance(v, dict) else v for k, v in task.scenario.items()}
     data.get("run", {}).pop("controller", None)
+    data.pop("disturbance", None)
     return json.dumps([task.engine, data], sort_keys=True, default=repr)
 
 
