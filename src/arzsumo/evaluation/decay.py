@@ -1,0 +1,98 @@
+"""How far a run's section is from the stationary state, and how fast a disturbance decays.
+
+The paper judges its laws by the decay of the state's deviation from the equilibrium in
+L2 (section 5, ``\\label{sec:simulation}``). In SUMO the equilibrium the stream holds is
+measured, not assumed: the *stationary state* S (4, cells) is the time-mean of the open
+loop's Edie cells over its undisturbed control window on the same seed. For every run of
+that seed, the relative deviation norm per control period is
+
+    e(t) = sqrt( mean over variables k and cells x of ((f_k(t, x) - S_k(x)) / s_k)^2 ),
+
+with s_k the cell-mean of |S_k| (so densities and speeds weigh alike; NaN cells, where no
+vehicle of a class passed, are left out). Its 30 s moving mean ē(t) is compared with the
+*stationary band* theta: the 95th percentile of ē over the same open-loop window, what the
+stream's own fluctuations reach with nothing done to it. Then
+
+- ``decay_time_s``: the last time ē is above theta (0 when it never is); a run that ends
+  above theta has ``decayed = False`` and the window's length as its decay time;
+- ``deviation_integral_s``: the integral of e over the window (s), the paper's index;
+- ``deviation_excess_s``: the integral of max(ē - theta, 0) (s), the part above the band.
+
+Pure numpy: fields in SI (veh/m, m/s), times in s.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+#: moving-mean window of the deviation norm, s: longer than a cell's counting noise
+#: (1 s periods), shorter than the section's round trip (about 225 s)
+SMOOTH_S = 30.0
+#: the stationary band's percentile of the smoothed open-loop norm
+BAND_PERCENTILE = 95.0
+
+
+def stationary_state(fields: np.ndarray) -> np.ndarray:
+    """The time-mean (4, cells) of ``fields`` (periods, 4, cells), NaN ignored."""
+    f = np.asarray(fields, float)
+    count = np.sum(np.isfinite(f), axis=0)
+    total = np.nansum(f, axis=0)
+    return np.where(count > 0, total / np.maximum(count, 1), np.nan)
+
+
+def deviation_norm(fields: np.ndarray, stationary: np.ndarray) -> np.ndarray:
+    """e(t) (periods,) of ``fields`` (periods, 4, cells) from ``stationary`` (4, cells):
+    the relative RMS deviation of the module docstring (1)."""
+    f, s = np.asarray(fields, float), np.asarray(stationary, float)
+    scale = np.nanmean(np.abs(s), axis=1)                        # (4,)
+    d = (f - s[None]) / scale[None, :, None]
+    ok = np.isfinite(d)
+    sq = np.where(ok, d * d, 0.0).sum(axis=(1, 2))
+    n = ok.sum(axis=(1, 2))
+    return np.where(n > 0, np.sqrt(sq / np.maximum(n, 1)), np.nan)
+
+
+def moving_mean(e: np.ndarray, periods: int) -> np.ndarray:
+    """Trailing mean of ``e`` over ``periods`` samples (fewer at the start)."""
+    e = np.asarray(e, float)
+    c = np.concatenate([[0.0], np.cumsum(e)])
+    i = np.arange(1, e.size + 1)
+    lo = np.maximum(i - periods, 0)
+    return (c[i] - c[lo]) / (i - lo)
+
+
+@dataclass(frozen=True)
+class Decay:
+    """A run's deviation measures (module docstring): s, s, s, 1, bool."""
+
+    decay_time_s: float
+    deviation_integral_s: float
+    deviation_excess_s: float
+    band: float
+    decayed: bool
+
+    def as_dict(self) -> dict[str, float | bool]:
+        return asdict(self)
+
+
+def stationary_band(e_open: np.ndarray, period: float, smooth: float = SMOOTH_S) -> float:
+    """theta: the BAND_PERCENTILE of the open loop's smoothed norm ``e_open``."""
+    sm = moving_mean(e_open, max(1, round(smooth / period)))
+    return float(np.nanpercentile(sm, BAND_PERCENTILE))
+
+
+def decay(t: np.ndarray, e: np.ndarray, band: float, period: float,
+          smooth: float = SMOOTH_S) -> Decay:
+    """The :class:`Decay` of the norm ``e`` at times ``t`` (s from the start of control,
+    one per period of ``period`` s) against the stationary ``band``."""
+    t, e = np.asarray(t, float), np.asarray(e, float)
+    sm = moving_mean(e, max(1, round(smooth / period)))
+    above = sm > band
+    ended_above = bool(above[-1]) if above.size else False
+    last = float(t[np.flatnonzero(above)[-1]]) if above.any() else 0.0
+    return Decay(decay_time_s=float(t[-1]) if ended_above else last,
+                 deviation_integral_s=float(np.nansum(e) * period),
+                 deviation_excess_s=float(np.nansum(np.maximum(sm - band, 0.0)) * period),
+                 band=band, decayed=not ended_above)
