@@ -9,6 +9,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pyarrow.parquet as pq
 import pytest
 
@@ -74,6 +75,47 @@ def test_trigger_count_from_the_period_table_equals_the_summary(runs):
         table = pq.read_table(path / "periods.parquet").to_pandas()
         assert int(table["triggered"].sum()) == summ["triggers"]
         assert summ["release_time"] == pytest.approx(60.0 - summ["triggers"])
+
+
+def _paper_indices_from_cells(path: Path, scenario) -> dict[str, float]:
+    """The section's TTT, total delay, J_fuel and J_discom (paper, section 5) recomputed
+    from cells.parquet alone: the SUMO cells pivoted to (t, x), empty cells' speeds given
+    the equilibrium speed at their densities, integrals by numpy's trapezoid in time."""
+    from arzsumo.bridge.estimator import fill_speeds
+    from arzsumo.twin.metrics import B_FUEL
+
+    cells = pd.read_parquet(path / "cells.parquet")
+    micro = cells[cells["source"] == "micro"]
+    grid = {c: micro.pivot(index="t_s", columns="x_m", values=c)
+            for c in ("rho_h", "v_h", "rho_a", "v_a")}
+    t, x = grid["rho_h"].index.to_numpy(), grid["rho_h"].columns.to_numpy()
+    f = {c: g.to_numpy() for c, g in grid.items()}
+    f["v_h"], f["v_a"] = fill_speeds(scenario.params, f["rho_h"], f["v_h"], f["rho_a"],
+                                     f["v_a"])
+    dx, (b0, b1, b2, b3) = x[1] - x[0], B_FUEL
+    out = dict.fromkeys(("TTT", "total_delay", "J_fuel", "J_discom"), 0.0)
+    for rho, v, v_free in ((f["rho_h"], f["v_h"], scenario.params.v_free_h),
+                           (f["rho_a"], f["v_a"], scenario.params.v_free_a)):
+        a = np.gradient(v, t, axis=0) + v * np.gradient(v, x, axis=1)
+        a_t = np.gradient(a, t, axis=0)
+        def integral(q):
+            return float(np.trapezoid(q.sum(axis=1) * dx, t))
+        ttt = integral(rho)
+        out["TTT"] += ttt
+        out["total_delay"] += ttt - integral(rho * v) / v_free
+        out["J_fuel"] += integral(np.maximum(0, b0 + b1 * v + b2 * v * a + b3 * v ** 3) * rho)
+        out["J_discom"] += integral((a ** 2 + a_t ** 2) * rho)
+    return out
+
+
+def test_the_paper_indices_from_sumo_agree_with_a_recomputation_from_the_cells(scenario,
+                                                                               runs):
+    for name in ("open", "etc"):
+        _res, path, summ = runs[name]
+        again = _paper_indices_from_cells(path, scenario)
+        assert again["TTT"] > 60.0 * 5          # the section held vehicles all along
+        for key, value in again.items():
+            assert summ["section"][key]["total"] == pytest.approx(value, rel=1e-9), key
 
 
 def test_open_loop_never_touches_the_meter_and_backstepping_updates_every_period(runs):
