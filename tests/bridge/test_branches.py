@@ -135,5 +135,9 @@ def test_runs_that_differ_before_the_window_are_refused():
     a, b = prepared("open", seed=3), prepared("open", seed=4)
     assert warmup_key(a) != warmup_key(b)
     assert warmup_key(prepared("etc")) == warmup_key(a)
+    # the constant rate and a disturbance act from the start of control on
+    later = SC.with_({"run.constant_release_veh_h": 480.0, "disturbance.kind": "slowdown"})
+    assert warmup_key(prepare_run(later, controller="constant", seed=3, horizon=60.0,
+                                  warmup=90.0)) == warmup_key(a)
     with pytest.raises(BranchError, match="differ in \\[run\\] controller only"):
         run_branched([a, b], kept)

@@ -47,6 +47,18 @@ def test_runs_group_by_everything_but_the_controller():
     assert [len(g.tasks) for g in twins] == [1, 1]          # no SUMO warm-up to share
 
 
+def test_what_acts_only_in_the_window_shares_the_warmup():
+    base = task("open")
+    constant = task("constant")
+    constant.scenario["run"]["constant_release_veh_h"] = 480.0
+    disturbed = task("etc")
+    disturbed.scenario["disturbance"] = {"kind": "slowdown", "duration_s": 20.0}
+    assert warmup_key(constant) == warmup_key(base) == warmup_key(disturbed)
+    longer = task("open")
+    longer.scenario["run"]["warmup_s"] = 90.0          # the warm-up itself: not shared
+    assert warmup_key(longer) != warmup_key(base)
+
+
 def _table(blob: bytes) -> pa.Table:
     return pq.read_table(pa.BufferReader(blob))
 

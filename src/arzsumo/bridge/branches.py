@@ -11,8 +11,9 @@ tripinfo are those of a plain run of the same scenario, controller and seed
 (``tests/bridge/test_branches.py``).
 
 Runs share a warm-up when everything SUMO and the warm-up read is the same
-(:func:`warmup_key`): the scenario's tables except ``[run] controller``, the resolved
-run settings and SUMO settings except the controller, and the placement profile.
+(:func:`warmup_key`): the scenario's tables except what acts only from the start of
+control (``[run] controller`` and ``constant_release_veh_h``, ``[disturbance]``), the
+resolved run settings and SUMO settings except those, and the placement profile.
 
 A child returns only what the caller's ``keep`` makes of its session (picklable; a
 :class:`~arzsumo.bridge.result.CoSimResult` holds open files and large arrays). A child
@@ -34,6 +35,7 @@ from arzsumo.bridge.cosim import OpenRun, Warmed, finish_run, open_run, warm_sta
 from arzsumo.bridge.session import PreparedRun, SumoSession
 from arzsumo.errors import ArzsumoError
 from arzsumo.io import json_safe
+from arzsumo.scenario.run import WINDOW_ONLY_RUN_KEYS, RunSettings
 from arzsumo.sumo.fork import BranchFailed, run_branches
 
 T = TypeVar("T")
@@ -48,10 +50,13 @@ def warmup_key(run: PreparedRun) -> str:
     ``[disturbance]`` acts after the warm-up, so it is left out)."""
     tables = {k: dict(v) if isinstance(v, dict) else v
               for k, v in run.scenario.tables.items()}
-    tables.get("run", {}).pop("controller", None)
+    for key in WINDOW_ONLY_RUN_KEYS:
+        tables.get("run", {}).pop(key, None)
     tables.pop("disturbance", None)      # it acts from the start of control on
     initial = None if run.initial is None else run.initial.tolist()
-    parts = {"tables": tables, "settings": repr(replace(run.settings, controller="open")),
+    settings = replace(run.settings, controller="open",
+                       constant_release=RunSettings().constant_release)
+    parts = {"tables": tables, "settings": repr(settings),
              "sumo": repr(run.sumo), "initial": initial}
     return json.dumps(json_safe(parts), sort_keys=True, default=repr)
 

@@ -61,6 +61,11 @@ RUN_RENAMED = {"equilibrium": "operating_point",
                "alinea_gain_veh_h_per_pct": "[alinea] gain_veh_h_per_pct"}
 
 
+#: [run] keys that act only from the start of control: runs differing in them share a
+#: warm-up (it holds the nominal plan whatever the controller; arzsumo.bridge.branches)
+WINDOW_ONLY_RUN_KEYS = ("controller", "constant_release_veh_h")
+
+
 @dataclass(frozen=True)
 class RunSettings:
     """Settings of one co-simulation (SI; ``constant_release`` in veh/s)."""

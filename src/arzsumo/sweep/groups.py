@@ -28,6 +28,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from arzsumo.scenario.run import WINDOW_ONLY_RUN_KEYS
 from arzsumo.sweep.worker import (
     RunOutcome,
     RunTask,
@@ -57,10 +58,12 @@ class RunGroup:
 
 
 def warmup_key(task: RunTask) -> str:
-    """A task's scenario without ``[run] controller`` and ``[disturbance]`` (it acts
-    after the warm-up), as text: tasks with equal keys share a warm-up."""
+    """A task's scenario without what acts only from the start of control (the [run]
+    keys of :data:`~arzsumo.scenario.run.WINDOW_ONLY_RUN_KEYS`, ``[disturbance]``), as
+    text: tasks with equal keys share a warm-up."""
     data = {k: dict(v) if isinstance(v, dict) else v for k, v in task.scenario.items()}
-    data.get("run", {}).pop("controller", None)
+    for key in WINDOW_ONLY_RUN_KEYS:
+        data.get("run", {}).pop(key, None)
     data.pop("disturbance", None)
     return json.dumps([task.engine, data], sort_keys=True, default=repr)
 
