@@ -186,7 +186,11 @@ _SECTION = {"section.window": TEXT, "section.speed_mean_kmh.*": "km/h",
             "section.speed_wave.*.peak_corr": "1", "section.speed_wave.*.pairs": "count",
             **_WAVES,
             **{f"section.{k}.*": u for k, u in _RUN_INDICES.items()},
-            "section.until_s": "s"}
+            "section.until_s": "s", "section.deviation": TEXT,   # null: no reference
+            "section.deviation.decay_time_s": "s",
+            "section.deviation.deviation_integral_s": "s",
+            "section.deviation.deviation_excess_s": "s", "section.deviation.band": "1",
+            "section.deviation.decayed": "bool"}
 
 #: units of the keys of ``arzsumo run``'s summary.json (dotted; ``*`` within a name)
 RUN_SUMMARY: dict[str, str] = {

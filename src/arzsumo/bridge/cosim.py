@@ -59,7 +59,7 @@ from arzsumo.bridge.delay import check_delay, compensate
 from arzsumo.bridge.drain import drain, whole_demand
 from arzsumo.bridge.estimators import RecordedEstimator, estimation_stage
 from arzsumo.bridge.loop import ClosedLoop
-from arzsumo.bridge.records import Trace, columns
+from arzsumo.bridge.records import Trace, columns, micro_fields
 from arzsumo.bridge.reference import reference_shift
 from arzsumo.bridge.result import CoSimResult
 from arzsumo.bridge.twins import TwinPair
@@ -68,6 +68,7 @@ from arzsumo.control.base import Controller
 from arzsumo.control.etc import EtcDesign
 from arzsumo.control.registry import ControllerInputs, controller_spec, is_pde
 from arzsumo.errors import ArzsumoError, ScenarioError
+from arzsumo.evaluation.decay import stationary_reference
 from arzsumo.model.characteristic import Linearization, linearize
 from arzsumo.model.equilibrium import Equilibrium
 from arzsumo.model.params import ModelParameters
@@ -206,6 +207,7 @@ class Controlled:
     start: WindowStart
     estimator: RecordedEstimator
     settings: RunSettings
+    stationary: tuple[np.ndarray, float]   # the warm-up's state and band (evaluation.decay)
 
 
 @dataclass
@@ -314,7 +316,7 @@ def _result(c: Controlled, scenario: Scenario, cfg: SumoConfig, meter: dict[str,
         estimate=np.asarray(c.estimator.fields[1:]), estimator=c.estimator,
         shift=loop.shift, lateral=sensor.lateral.record(), files=files,
         disturbance=(dict(loop.plant.disturbance.applied) if loop.plant.disturbance
-                     else None))
+                     else None), stationary=c.stationary[0], stationary_band=c.stationary[1])
 
 
 def control(warmed: Warmed, scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
@@ -354,5 +356,8 @@ def control(warmed: Warmed, scenario: Scenario, settings: RunSettings, cfg: Sumo
                       shift)
     plant.disturb(scenario.disturbance, warm[-1].t)
     trace = loop.run(warm[-1], cfg.horizon, bar)
+    tail = warm[-max(1, round(est.reference_window / period)):]
+    stationary = stationary_reference(np.stack([micro_fields(m.cells) for m in tail]),
+                                      period)
     return Controlled(loop, trace, ref_ctrl, eq, q_nom, warmed.warmup_meter, warmed.start,
-                      estimator, settings)
+                      estimator, settings, stationary)

@@ -76,3 +76,7 @@ class CoSimResult:
     #: what the ``[disturbance]`` did (:class:`arzsumo.sumo.disturbance.DisturbanceSchedule`
     #: ``applied``: SUMO times in s, speeds in m/s); None without one
     disturbance: dict[str, Any] | None = None
+    #: the stationary state (4, cells; SI) and band (1) the window's deviation is measured
+    #: from: SUMO's cells over the warm-up's last minutes (:mod:`arzsumo.evaluation.decay`)
+    stationary: np.ndarray | None = None
+    stationary_band: float = float("nan")

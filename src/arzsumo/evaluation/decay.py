@@ -2,16 +2,17 @@
 
 The paper judges its laws by the decay of the state's deviation from the equilibrium in
 L2 (section 5, ``\\label{sec:simulation}``). In SUMO the equilibrium the stream holds is
-measured, not assumed: the *stationary state* S (4, cells) is the time-mean of the open
-loop's Edie cells over its undisturbed control window on the same seed. For every run of
-that seed, the relative deviation norm per control period is
+measured, not assumed: the *stationary state* S (4, cells) is the time-mean of SUMO's
+Edie cells over the warm-up's last minutes (the state the nominal plan holds, the same
+for every controller of a seed, and the reference the PDE laws act about). For the
+control window, the relative deviation norm per control period is
 
     e(t) = sqrt( mean over variables k and cells x of ((f_k(t, x) - S_k(x)) / s_k)^2 ),
 
 with s_k the cell-mean of |S_k| (so densities and speeds weigh alike; NaN cells, where no
 vehicle of a class passed, are left out). Its 30 s moving mean ē(t) is compared with the
-*stationary band* theta: the 95th percentile of ē over the same open-loop window, what the
-stream's own fluctuations reach with nothing done to it. Then
+*stationary band* theta: the 95th percentile of ē over the same warm-up minutes, what the
+stream's own fluctuations reach under the nominal plan. Then
 
 - ``decay_time_s``: the last time ē is above theta (0 when it never is); a run that ends
   above theta has ``decayed = False`` and the window's length as its decay time;
@@ -81,6 +82,13 @@ def stationary_band(e_open: np.ndarray, period: float, smooth: float = SMOOTH_S)
     """theta: the BAND_PERCENTILE of the open loop's smoothed norm ``e_open``."""
     sm = moving_mean(e_open, max(1, round(smooth / period)))
     return float(np.nanpercentile(sm, BAND_PERCENTILE))
+
+
+def stationary_reference(fields: np.ndarray, period: float) -> tuple[np.ndarray, float]:
+    """The stationary state S (4, cells) and band theta of the warm-up's last ``fields``
+    (periods, 4, cells; one per period of ``period`` s)."""
+    state = stationary_state(fields)
+    return state, stationary_band(deviation_norm(fields, state), period)
 
 
 def decay(t: np.ndarray, e: np.ndarray, band: float, period: float,

@@ -47,6 +47,7 @@ from arzsumo.bridge.estimator import fill_speeds
 from arzsumo.bridge.result import CoSimResult
 from arzsumo.bridge.sensor_record import estimation_scores
 from arzsumo.control.events import release_time
+from arzsumo.evaluation.decay import decay, deviation_norm
 from arzsumo.evaluation.fields import field_rmse, oscillation, wave_travel
 from arzsumo.evaluation.stationarity import count_trend
 from arzsumo.io import json_safe
@@ -221,11 +222,22 @@ def section_summary(res: CoSimResult, micro: dict[str, Any]) -> dict[str, Any]:
     ``speed_spread_kmh``, the spread across vehicles, also under its former name
     ``speed_sd_kmh``), the speed oscillation (:func:`speed_oscillation`), the waves'
     direction (:func:`speed_wave`), the wave measures per class and lateral file
-    (:func:`arzsumo.outputs.waves.waves_summary`) and the micro indices ``micro``
+    (:func:`arzsumo.outputs.waves.waves_summary`), the deviation from the warm-up's
+    stationary state (:func:`deviation_summary`) and the micro indices ``micro``
     (:func:`_indices`; also at the top level, kept for compatibility)."""
     return {"window": SECTION_WINDOW, **res.section_speed, **speed_oscillation(res),
             "speed_wave": speed_wave(res), "waves": waves_summary(res, *_blocks(res)),
-            **micro}
+            "deviation": deviation_summary(res), **micro}
+
+
+def deviation_summary(res: CoSimResult) -> dict[str, Any] | None:
+    """The window's deviation from the warm-up's stationary state: decay time (s),
+    integrated norm and its part above the stationary band (s), the band (1), whether it
+    ended inside it (:mod:`arzsumo.evaluation.decay`); None without a reference."""
+    if res.stationary is None or res.t.size < 2:
+        return None
+    e = deviation_norm(res.micro, res.stationary)
+    return decay(res.t, e, res.stationary_band, res.sumo.control_period).as_dict()
 
 
 #: ``summary.json["meter"]``: keys of the meter's own summary kept there (control window)

@@ -61,6 +61,7 @@ class SumoPlant:
         start of control (:mod:`arzsumo.sumo.disturbance`). Nothing when it is none."""
         if disturbance.active:
             self.disturbance = DisturbanceSchedule(self.sim.lib, disturbance, t0)
+            self.disturbance.due(self.sim.time)    # a start at 0 acts on the first step
 
     def step(self) -> PeriodMeasurement | None:
         """One SUMO step, read and acted on; the period's measurement when one ends."""

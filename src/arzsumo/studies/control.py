@@ -1,0 +1,200 @@
+"""The paper's controllers in SUMO, two experiments per seed (``arzsumo study control``).
+
+Every controller runs on the same seeds of one scenario (the shipped default unless
+``--scenario``), twice, paired against the open loop of its experiment:
+
+- **regulation**: the stationary congested state the warm-up left, over the control
+  window, then the drain (the whole demand is charged: docs/whole_demand.md);
+- **disturbance**: the same, with the edge past the merge slowed at the start of control
+  (:data:`DISTURBANCE`, a ``[disturbance]`` table: the paper's section 5 asks how fast a
+  law removes a perturbation). The slowdown is identical on every controller of a seed,
+  and up to the start of control every run of a seed is the same run.
+
+Each experiment is an evaluation (:func:`~arzsumo.sweep.evaluate.run_evaluation`, into
+``OUT/<experiment>/``; resumable, Dask-capable, one warm-up per seed). To its measures the
+study adds the deviation from the stationary state that every run records
+(``section.deviation``, :mod:`arzsumo.evaluation.decay`: the decay time and the
+integrated deviation norm from SUMO's state over the warm-up's last minutes, the same
+for every controller of a seed), the release time and the paper's J_fuel and J_discom
+over the section. Tables: per experiment
+``OUT/<experiment>/control.{csv,md}`` (every measure: mean with its 95 % interval, the
+paired difference against the open loop with Student t and BCa bootstrap intervals,
+wins and losses), and ``OUT/control.md`` with the headline measures of both.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from arzsumo.evaluation.report import MEASURES as EVALUATION_MEASURES
+from arzsumo.evaluation.report import Measure, evaluate, markdown
+from arzsumo.io import dump_toml, read_toml
+from arzsumo.outdir import resumable_dir
+from arzsumo.outputs.studies import publish, write_csv, write_text
+from arzsumo.resources import shipped_scenarios_dir
+from arzsumo.studies.common import EXIT_SOME_FAILED, StudyError, add_output, add_runs, seed_text
+from arzsumo.sweep.evaluate import BASELINE, check_controllers, run_evaluation
+from arzsumo.sweep.worker import FINISHED
+
+log = logging.getLogger(__name__)
+
+NAME = "control"
+#: the results page (``docs/results/PAGE.md``) this study keeps a block of
+PAGE = "control_default"
+#: the controllers judged: the open loop, the best constant rate, the practitioner's
+#: ALINEA and PI-ALINEA, and the paper's three laws
+CONTROLLERS = ("open", "constant", "alinea", "pi-alinea", "backstepping", "etc",
+               "observer-etc")
+#: the experiments, in order
+EXPERIMENTS = ("regulation", "disturbance")
+#: the disturbance experiment's [disturbance] table (scenario units): the edge past the
+#: merge at 10 km/h for 30 s from the start of control
+DISTURBANCE = {"kind": "slowdown", "edge": "down", "speed_kmh": 10.0, "start_s": 0.0,
+               "duration_s": 30.0}
+#: the deviation measures the study adds to the evaluation's (columns of the runs table)
+DEVIATION = (
+    Measure("section.deviation.decay_time_s", "decay time to the stationary band", "s"),
+    Measure("section.deviation.deviation_integral_s", "integrated deviation norm", "s"),
+    Measure("section.deviation.deviation_excess_s", "integrated deviation above the band",
+            "s"),
+)
+_EXTRA = (
+    Measure("release_time", "release time (no controller update)", "s",
+            lower_is_better=False),
+    Measure("section.J_fuel.total", "section J_fuel (paper)", "veh"),
+    Measure("section.J_discom.total", "section J_discom (paper)", "veh m^2/s^3"),
+)
+#: every measure of the per-experiment tables
+MEASURES: tuple[Measure, ...] = (*EVALUATION_MEASURES[:1], *DEVIATION,
+                                 *EVALUATION_MEASURES[1:], *_EXTRA)
+#: the headline measures of OUT/control.md (keys)
+HEADLINE = ("network_whole_demand.time_spent_s.total",
+            "section.deviation.deviation_excess_s", "section.deviation.decay_time_s",
+            "section.waves.h.band_power_kmh2",
+            "section.waves.a.band_power_kmh2", "section.speed_oscillation_kmh.h",
+            "section.speed_oscillation_kmh.a", "plan_changes", "light_changes",
+            "section.TTT.total", "section.total_delay.total", "section.J_fuel.total",
+            "section.J_discom.total")
+
+
+def experiment_scenario(base: dict, experiment: str) -> dict:
+    """The scenario (as written) of ``experiment`` on the base scenario ``base``."""
+    data = {k: dict(v) if isinstance(v, dict) else v for k, v in base.items()}
+    data.pop("disturbance", None)
+    if experiment == "disturbance":
+        data["disturbance"] = dict(DISTURBANCE)
+    data["name"] = f"{base.get('name', 'scenario')}-{experiment}"
+    return data
+
+
+def headline(tables: dict[str, pd.DataFrame]) -> str:
+    """Markdown: per headline measure and controller, the paired difference against the
+    open loop in each experiment (mean [95 % t] {95 % bootstrap} wins/losses)."""
+    head = ("| measure | unit | controller | "
+            + " | ".join(f"{e}: minus open [t] {{bootstrap}} w/l" for e in tables) + " |")
+    lines = [head, "|---" * (3 + len(tables)) + "|"]
+    first = next(iter(tables.values()))
+    for key in HEADLINE:
+        sel = first[first["measure"] == key]
+        for ctrl in sel["controller"]:
+            if ctrl == BASELINE:
+                continue
+            cells = []
+            for long in tables.values():
+                r = long[(long["measure"] == key) & (long["controller"] == ctrl)]
+                if r.empty or not np.isfinite(r["diff_mean"].iloc[0]):
+                    cells.append("")
+                    continue
+                r = r.iloc[0]
+                cells.append(f"{r.diff_mean:+.3g} [{r.diff_ci_low:+.3g}, {r.diff_ci_high:+.3g}]"
+                             f" {{{r.diff_boot_low:+.3g}, {r.diff_boot_high:+.3g}}}"
+                             f" {int(r.wins)}/{int(r.losses)}")
+            label = sel[sel["controller"] == ctrl].iloc[0]
+            lines.append(f"| {label.label} | {label.unit} | {ctrl} | " + " | ".join(cells)
+                         + " |")
+    return "\n".join(lines)
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The control study's options."""
+    parser.add_argument("--scenario", type=Path,
+                        default=shipped_scenarios_dir() / "default.toml", metavar="FILE",
+                        help="the base scenario (default: the shipped default)")
+    parser.add_argument("--controllers", default=",".join(CONTROLLERS),
+                        help="comma-separated controllers (default: %(default)s)")
+    parser.add_argument("--experiments", default=",".join(EXPERIMENTS),
+                        help="comma-separated, of regulation, disturbance (default: both)")
+    parser.add_argument("--runs-from", type=Path, action="append", default=[],
+                        metavar="DIR", help="an earlier evaluation or sweep (repeatable): "
+                        "a controller whose runs on all the seeds are there is taken from "
+                        "there (arzsumo evaluate --runs-from)")
+    parser.add_argument("--report", action="store_true",
+                        help="run nothing: the tables from the runs already there")
+    add_runs(parser, seeds="1-20")
+    add_output(parser, NAME, PAGE)
+
+
+def _experiments(text: str) -> list[str]:
+    names = [e.strip() for e in text.split(",") if e.strip()]
+    bad = [e for e in names if e not in EXPERIMENTS]
+    if bad or not names:
+        raise StudyError(f"--experiments = {text!r} is not allowed: a comma-separated list "
+                         f"of {', '.join(EXPERIMENTS)}")
+    return sorted(set(names), key=EXPERIMENTS.index)
+
+
+def _evaluate(args: argparse.Namespace, scenario: Path, controllers: Sequence[str],
+              out: Path) -> tuple[pd.DataFrame, bool]:
+    """One experiment's finished runs (its evaluation run unless ``--report``) and
+    whether every run finished."""
+    if not args.report:
+        res = run_evaluation(scenario, controllers, args.seeds, out=out,
+                             workers=args.workers, scheduler=args.scheduler,
+                             progress=not args.quiet, plots=False, runs_from=args.runs_from)
+        return res.runs, res.sweep is None or bool(
+            res.sweep.table["status"].isin(FINISHED).all())
+    table = out / "summaries.parquet"
+    if not table.is_file():
+        raise StudyError(f"--out has no {out.name} runs yet; allowed: a run without --report")
+    runs = pd.read_parquet(table)
+    return runs[runs["status"].isin(FINISHED) & runs["seed"].isin(args.seeds)], True
+
+
+def run(args: argparse.Namespace) -> int:
+    """Both experiments (resumable), the deviation measures, the tables."""
+    controllers = check_controllers(args.controllers.split(","))
+    experiments = _experiments(args.experiments)
+    _, base = read_toml(args.scenario, "scenario", StudyError)
+    if args.list:
+        for e in experiments:
+            print(f"{e}: {', '.join(controllers)} on seeds {seed_text(args.seeds)}")
+        return 0
+    ok, tables = True, {}
+    with resumable_dir(args.out, f"study-{NAME}") as out:
+        for e in experiments:
+            path = write_text(dump_toml(experiment_scenario(base, e)),
+                              out / "scenarios" / f"{e}.toml")
+            runs, finished = _evaluate(args, path, controllers, out / e)
+            ok &= finished
+            measures = [m for m in MEASURES if m.key in runs.columns]
+            long = evaluate(runs, controllers, BASELINE, measures)
+            tables[e] = long
+            write_csv(long, out / e / "control.csv")
+            write_text(f"# {e}\n\n{markdown(long, BASELINE)}", out / e / "control.md")
+        text = (f"Controllers {', '.join(controllers)} on seeds {seed_text(args.seeds)}, "
+                f"paired against the open loop (`arzsumo study {NAME}`).\n\n"
+                + headline(tables))
+        write_text(text, out / "control.md")
+        if args.docs is not None:
+            files = [(out / e / f"control{x}", f"{e}{x}") for e in tables
+                     for x in (".csv", ".md")]
+            publish(args.docs, PAGE, NAME, "The controllers on the default in SUMO", text,
+                    files)
+    print(text)
+    return 0 if ok else EXIT_SOME_FAILED

@@ -1,0 +1,84 @@
+"""``arzsumo study control``: both experiments from one scenario, the deviation measures
+from the regulation open loop's stationary state, tables paired by seed.
+
+The SUMO test runs a short version of the default (a 200 m approach, a 100 s fill, a 60 s
+window, a short drain) on two seeds: the disturbance must be felt where the regulation
+open loop is at its own stationary band."""
+
+from __future__ import annotations
+
+import tomllib
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from arzsumo.io import dump_toml
+from arzsumo.resources import shipped_scenarios_dir
+from arzsumo.studies.common import StudyError
+from arzsumo.studies.control import DISTURBANCE, experiment_scenario
+from arzsumo.sumo.fork import can_fork
+
+DEFAULT = shipped_scenarios_dir() / "default.toml"
+
+
+def base() -> dict:
+    return tomllib.loads(DEFAULT.read_text(encoding="utf-8"))
+
+
+def test_the_experiments_differ_only_in_the_disturbance():
+    reg, dis = (experiment_scenario(base(), e) for e in ("regulation", "disturbance"))
+    assert "disturbance" not in reg and dis["disturbance"] == DISTURBANCE
+    assert {k: v for k, v in dis.items() if k not in ("disturbance", "name")} == \
+        {k: v for k, v in reg.items() if k != "name"}
+    assert reg["name"] == "default-regulation"
+
+
+def test_unknown_experiments_are_refused(run_study, tmp_path):
+    with pytest.raises(StudyError, match="--experiments = 'regulation,pulse' is not allowed"):
+        run_study("control", "--experiments", "regulation,pulse", "--out", tmp_path)
+
+
+@pytest.fixture(scope="module")
+def short_default(tmp_path_factory):
+    data = base()
+    data["sumo"].update(approach_length_m=200.0, fill_s=100.0, horizon_s=60.0,
+                        drain_max_s=120.0)
+    data["run"].update(warmup_s=100.0, kernel_cells=50, twin_cells=50)
+    path = tmp_path_factory.mktemp("scenario") / "short.toml"
+    path.write_text(dump_toml(data), encoding="utf-8")
+    return path
+
+
+@pytest.mark.sumo
+@pytest.mark.slow
+@pytest.mark.skipif(not can_fork(), reason="needs fork and /proc")
+def test_the_study_pairs_both_experiments_and_measures_the_decay(run_study, short_default,
+                                                                 tmp_path, monkeypatch):
+    monkeypatch.setenv("ARZSUMO_CACHE", str(tmp_path / "cache"))
+    out = tmp_path / "control"
+    args = ("--scenario", short_default, "--controllers", "open,etc", "--seeds", "1,2",
+            "--workers", "1", "--quiet", "--out", out)
+    assert run_study("control", *args) == 0
+    reg = pd.read_csv(out / "regulation" / "control.csv")
+    dis = pd.read_csv(out / "disturbance" / "control.csv")
+    excess = "section.deviation.deviation_excess_s"
+
+    def value(long, controller):
+        row = long[(long["measure"] == excess) & (long["controller"] == controller)]
+        return float(row["mean"].iloc[0])
+    # the slowdown is felt: the open loop leaves its stationary band far more
+    assert value(dis, "open") > value(reg, "open") + 1.0
+    runs = pd.read_parquet(out / "disturbance" / "summaries.parquet")
+    assert np.allclose(runs["disturbance.began_s"], 100.0)
+    assert np.allclose(runs["disturbance.ended_s"], 130.0)
+    assert "disturbance.began_s" not in pd.read_parquet(
+        out / "regulation" / "summaries.parquet") or pd.read_parquet(
+        out / "regulation" / "summaries.parquet")["disturbance.began_s"].isna().all()
+    # one table row per (measure, controller), the paired difference of etc in both
+    text = (out / "control.md").read_text(encoding="utf-8")
+    row = next(x for x in text.splitlines() if x.startswith("| integrated deviation above"))
+    assert row.count("/") >= 2 and "| etc |" in row
+    # --report reads the same runs back and gives the same numbers
+    assert run_study("control", *args, "--report") == 0
+    assert pd.read_csv(out / "disturbance" / "control.csv").equals(dis)
