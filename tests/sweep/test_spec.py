@@ -124,3 +124,22 @@ def test_cli_user_errors_are_one_line_with_exit_2(tmp_path, capsys):
     assert not (tmp_path / "o").exists()                       # nothing half-written
     assert main(["sweep", str(good), "--list"]) == 0
     assert capsys.readouterr().out.split() == ["seed=1", "seed=2"]
+
+
+def test_a_fingerprint_ignores_what_the_runs_controller_does_not_read():
+    from arzsumo.sweep.spec import RunSpec
+
+    def fp(controller: str, engine: str = "sumo", **tables) -> str:
+        scenario = {"name": "a", "run": {"controller": controller, "warmup_s": 600},
+                    "alinea": {"target_pct": 42.8}, **tables}
+        return RunSpec("x", 0, {}, {}, scenario, engine, False).sha256
+
+    retuned = {"alinea": {"target_pct": 50.1}}
+    assert fp("open") == fp("open", **retuned)
+    assert fp("etc") == fp("etc", **retuned)
+    assert fp("alinea") != fp("alinea", **retuned)          # ALINEA reads its gains
+    assert fp("open") == fp("open", name="b", description="another label")
+    rate = {"run": {"controller": "open", "warmup_s": 600, "constant_release_veh_h": 480}}
+    assert fp("open") == fp("open", **rate)
+    assert fp("open", **{"run": {"controller": "open", "warmup_s": 300}}) != fp("open")
+    assert fp("open", engine="twin") != fp("open", engine="twin", **retuned)

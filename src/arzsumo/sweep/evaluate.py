@@ -41,7 +41,13 @@ from arzsumo.io import dump_toml
 from arzsumo.outdir import judge, resumable_dir, where
 from arzsumo.outputs.evaluation import write_evaluation
 from arzsumo.sweep.driver import SweepReport, run_sweep
-from arzsumo.sweep.spec import RunSpec, SweepError, SweepSpec, sweep_from_dict
+from arzsumo.sweep.spec import (
+    CONTROLLER_ONLY,
+    RunSpec,
+    SweepError,
+    SweepSpec,
+    sweep_from_dict,
+)
 from arzsumo.sweep.table import run_dir, sweep_table
 from arzsumo.sweep.worker import FINISHED
 
@@ -74,10 +80,6 @@ class EvaluationResult:
 #: runs whose resolved scenarios differ only here are the same SUMO run
 OPEN_LOOP_INERT = ("name", "description", "estimation", "sensing", "actuation", "design",
                    "run.controller")
-#: tables and keys that only some controllers read: for every other controller (the open
-#: loop included) they are inert, so two runs that differ only there are the same run
-CONTROLLER_ONLY: dict[str, tuple[str, ...]] = {
-    "alinea": ("alinea", "pi-alinea"), "run.constant_release_veh_h": ("constant",)}
 
 
 def inert_for(controller: str) -> tuple[str, ...]:

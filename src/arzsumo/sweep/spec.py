@@ -75,6 +75,33 @@ class Axis:
     group: str | None = None
 
 
+#: tables and keys that only some controllers read: for every other controller (the open
+#: loop included) they are inert, so two runs that differ only there are the same run
+CONTROLLER_ONLY: dict[str, tuple[str, ...]] = {
+    "alinea": ("alinea", "pi-alinea"), "run.constant_release_veh_h": ("constant",)}
+#: top-level keys that name a scenario and decide no number
+LABELS = ("name", "description")
+
+
+def deciding(scenario: Mapping[str, Any], engine: str) -> dict[str, Any]:
+    """``scenario`` without what decides none of a run's numbers: its labels and, for a
+    SUMO run, the :data:`CONTROLLER_ONLY` tables and keys its controller does not read."""
+    data = {k: dict(v) if isinstance(v, Mapping) else v for k, v in scenario.items()
+            if k not in LABELS}
+    if engine != "sumo":
+        return data
+    controller = str(data.get("run", {}).get("controller", "open"))
+    for dotted, users in CONTROLLER_ONLY.items():
+        if controller in users:
+            continue
+        table, _, key = dotted.partition(".")
+        if not key:
+            data.pop(table, None)
+        elif isinstance(data.get(table), dict):
+            data[table].pop(key, None)
+    return data
+
+
 @dataclass(frozen=True)
 class RunSpec:
     """One run of a sweep: its ID, axis values (table columns) and resolved scenario."""
@@ -89,9 +116,11 @@ class RunSpec:
 
     @property
     def sha256(self) -> str:
-        """Fingerprint of everything that decides the run's numbers."""
+        """Fingerprint of everything that decides the run's numbers (:func:`deciding`:
+        an edit of ALINEA's gains does not make an open loop's result stale)."""
         blob = json.dumps({"engine": self.engine, "baseline": self.baseline,
-                           "scenario": self.scenario}, sort_keys=True, default=str)
+                           "scenario": deciding(self.scenario, self.engine)},
+                          sort_keys=True, default=str)
         return hashlib.sha256(blob.encode()).hexdigest()
 
 
