@@ -1,0 +1,190 @@
+"""Which piece of the controllers' configuration matters, one at a time
+(``arzsumo study control-ablation``).
+
+The control study's regulation experiment (``arzsumo study control``) runs the PDE laws
+with every piece the former default's ablation found needed: the ASM estimate rather than
+raw cells, deviations from the warm-up's state, saturation with anti-windup, the meter
+releasing one vehicle per green. This study takes one piece away at a time (and adds the
+dead-time predictor, which the configuration lacks) and pairs each step, seed by seed,
+with the full configuration's runs of the same controller:
+
+==================  ==============================================================
+step                change on the regulation scenario
+==================  ==============================================================
+raw-cells           the laws on SUMO's Edie cells of every vehicle (no estimator)
+equilibrium         deviations from the model's equilibrium, not the warm-up's state
+no-saturation       no bound on U or its rate, no ramp bound, no anti-windup
+fixed-cycle         the meter as a fixed cycle of green shares (no one-per-green)
+predictor           the laws on the state predicted :data:`PREDICTION_S` s ahead
+==================  ==============================================================
+
+Each step is an evaluation (:func:`~arzsumo.sweep.evaluate.run_evaluation`) into
+``OUT/<step>/``. A step that does not act on an open loop borrows the open loop of the
+control study (``--control DIR``); ``fixed-cycle`` changes the plant and runs its own.
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Callable
+from pathlib import Path
+
+import pandas as pd
+
+from arzsumo.evaluation.report import Measure, per_seed
+from arzsumo.evaluation.stats import StatisticsError, paired_difference
+from arzsumo.io import dump_toml, read_toml
+from arzsumo.outdir import resumable_dir
+from arzsumo.outputs.studies import publish, write_text
+from arzsumo.studies import control
+from arzsumo.studies.common import (
+    EXIT_SOME_FAILED,
+    RESULTS_DIR,
+    StudyError,
+    add_output,
+    add_runs,
+    seed_text,
+)
+from arzsumo.sweep.evaluate import BASELINE, run_evaluation
+from arzsumo.sweep.worker import FINISHED
+
+NAME = "control-ablation"
+#: the results page this study keeps a block of (the control study's)
+PAGE = control.PAGE
+#: the laws ablated
+LAWS = ("backstepping", "etc")
+#: prediction horizon of ``predictor``, s: the dead time from a new plan to the section's
+#: outflow measured on the meter (10-14 s, docs/results/meter_dynamics.md)
+PREDICTION_S = 14.0
+
+
+def _set(changes: dict[str, object]) -> Callable[[dict], dict]:
+    def apply(data: dict) -> dict:
+        for dotted, value in changes.items():
+            table, _, key = dotted.partition(".")
+            data.setdefault(table, {})[key] = value
+        return data
+    return apply
+
+
+#: step -> (what it changes, the change on the scenario as written, acts on the open loop)
+STEPS: dict[str, tuple[str, Callable[[dict], dict], bool]] = {
+    "raw-cells": ("the laws on SUMO's Edie cells (no estimator)",
+                  _set({"estimation.method": "none"}), False),
+    "equilibrium": ("deviations from the model's equilibrium",
+                    _set({"estimation.reference": "equilibrium"}), False),
+    "no-saturation": ("no bounds on U, no ramp bound, no anti-windup",
+                      _set({"actuation.u_max_fraction": 0.0,
+                            "actuation.u_rate_max_veh_h_s": 0.0,
+                            "actuation.ramp_bound": False, "actuation.anti_windup": False}),
+                      False),
+    "fixed-cycle": ("the meter as a fixed cycle of green shares",
+                    _set({"sumo.meter_mode": "fixed_cycle"}), True),
+    "predictor": (f"the laws on the state predicted {PREDICTION_S:g} s ahead",
+                  _set({"actuation.delay_compensation_s": PREDICTION_S}), False),
+}
+#: the measures of the ablation table (keys of the control study's measures)
+KEYS = ("network_whole_demand.time_spent_s.total", "section.deviation.deviation_excess_s",
+        "section.waves.h.band_power_kmh2", "section.waves.a.band_power_kmh2",
+        "section.speed_oscillation_kmh.h", "plan_changes")
+
+
+def step_scenario(base: dict, step: str) -> dict:
+    """The regulation scenario of ``base`` with ``step``'s change."""
+    data = control.experiment_scenario(base, "regulation")
+    data = STEPS[step][1]({k: dict(v) if isinstance(v, dict) else v
+                           for k, v in data.items()})
+    data["name"] = f"{base.get('name', 'scenario')}-ablation-{step}"
+    return data
+
+
+def measures() -> list[Measure]:
+    return [next(m for m in control.MEASURES if m.key == k) for k in KEYS]
+
+
+def table(steps: dict[str, pd.DataFrame], full: pd.DataFrame, seeds: list[int]) -> str:
+    """Markdown: per step, law and measure, the step minus the full configuration, paired
+    by seed (mean [95 % t] wins/losses of the step)."""
+    lines = ["| step | law | " + " | ".join(f"{m.label} ({m.unit})" for m in measures())
+             + " |", "|---" * (2 + len(KEYS)) + "|"]
+    for step, runs in steps.items():
+        for law in LAWS:
+            cells = []
+            for m in measures():
+                a = per_seed(runs, m, [law])[law].reindex(seeds).to_numpy(float)
+                b = per_seed(full, m, [law])[law].reindex(seeds).to_numpy(float)
+                try:
+                    d = paired_difference(a, b, lower_is_better=m.lower_is_better)
+                    cells.append(f"{d.mean_diff:+.3g} [{d.t.low:+.3g}, {d.t.high:+.3g}] "
+                                 f"{d.wins}/{d.losses}")
+                except StatisticsError:
+                    cells.append("")
+            lines.append(f"| {step} | {law} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The ablation's options."""
+    parser.add_argument("--control", type=Path, default=RESULTS_DIR / control.NAME,
+                        metavar="DIR", help="the control study's --out (its regulation "
+                        "experiment is the full configuration)")
+    parser.add_argument("--steps", default=",".join(STEPS),
+                        help="comma-separated steps (default: %(default)s)")
+    parser.add_argument("--report", action="store_true",
+                        help="run nothing: the table from the evaluations already there")
+    add_runs(parser, seeds="1-10")
+    add_output(parser, NAME, PAGE, plots=False)
+
+
+def _steps(text: str) -> list[str]:
+    names = [s.strip() for s in text.split(",") if s.strip()]
+    bad = [s for s in names if s not in STEPS]
+    if bad or not names:
+        raise StudyError(f"--steps = {text!r} is not allowed: a comma-separated list of "
+                         f"{', '.join(STEPS)}")
+    return names
+
+
+def run(args: argparse.Namespace) -> int:
+    """Every step's evaluation (resumable), then the table against the full configuration."""
+    steps = _steps(args.steps)
+    if args.list:
+        for s in steps:
+            print(f"{s}: {STEPS[s][0]}; {', '.join(LAWS)} on seeds {seed_text(args.seeds)}")
+        return 0
+    regulation = Path(args.control) / "regulation"
+    full_table = regulation / "summaries.parquet"
+    if not full_table.is_file():
+        raise StudyError(f"--control = {str(args.control)!r} has no regulation experiment; "
+                         "allowed: the --out of arzsumo study control")
+    _, base = read_toml(Path(args.control) / "scenarios" / "regulation.toml", "scenario",
+                        StudyError)
+    ok, found = True, {}
+    with resumable_dir(args.out, f"study-{NAME}") as out:
+        for s in steps:
+            path = write_text(dump_toml(step_scenario(base, s)), out / "steps" / f"{s}.toml")
+            if not args.report:
+                own_open = STEPS[s][2]
+                res = run_evaluation(path, [BASELINE, *LAWS] if own_open else list(LAWS),
+                                     args.seeds, out=out / s, workers=args.workers,
+                                     scheduler=args.scheduler, progress=not args.quiet,
+                                     plots=False,
+                                     baseline_from=None if own_open else regulation)
+                ok &= res.sweep is None or bool(res.sweep.table["status"].isin(FINISHED).all())
+            summaries = out / s / "summaries.parquet"
+            if summaries.is_file():
+                runs = pd.read_parquet(summaries)
+                found[s] = runs[runs["status"].isin(FINISHED)]
+        full = pd.read_parquet(full_table)
+        text = table(found, full[full["status"].isin(FINISHED)], args.seeds)
+        write_text(text, out / "ablation.md")
+        if args.docs is not None:
+            publish(args.docs, PAGE, NAME, "The controllers on the default in SUMO",
+                    f"Ablation on seeds {seed_text(args.seeds)}: each step minus the full "
+                    f"configuration, paired by seed (`arzsumo study {NAME}`).\n\n{text}",
+                    [(out / "ablation.md", "ablation.md")])
+    print(text)
+    return 0 if ok else EXIT_SOME_FAILED
+
+
+__all__ = ["NAME", "STEPS", "run", "step_scenario", "table"]

@@ -1,0 +1,61 @@
+"""``arzsumo study control-ablation``: each step changes one piece of the regulation
+scenario and nothing else; the table pairs each step with the full configuration."""
+
+from __future__ import annotations
+
+import tomllib
+
+import pandas as pd
+import pytest
+
+from arzsumo.resources import shipped_scenarios_dir
+from arzsumo.scenario import scenario_from_dict
+from arzsumo.studies import control_ablation
+from arzsumo.studies.common import StudyError
+from arzsumo.studies.control import experiment_scenario
+
+BASE = tomllib.loads((shipped_scenarios_dir() / "default.toml").read_text(encoding="utf-8"))
+
+
+def _flat(data: dict) -> dict:
+    return {f"{t}.{k}": v for t, table in data.items() if isinstance(table, dict)
+            for k, v in table.items()}
+
+
+@pytest.mark.parametrize("step", list(control_ablation.STEPS))
+def test_each_step_is_a_valid_scenario_that_changes_one_piece(step):
+    data = control_ablation.step_scenario(BASE, step)
+    sc = scenario_from_dict(data, f"{step}.toml")
+    full = _flat(experiment_scenario(BASE, "regulation"))
+    changed = {k for k, v in _flat(data).items() if full.get(k) != v}
+    tables = {k.partition(".")[0] for k in changed}
+    assert len(tables) == 1, changed                 # one table of the configuration
+    if step == "raw-cells":
+        assert sc.estimation.method == "none"
+    if step == "predictor":
+        assert sc.actuation.delay_compensation == control_ablation.PREDICTION_S
+    if step == "fixed-cycle":
+        assert sc.sumo.meter_mode == "fixed_cycle" and control_ablation.STEPS[step][2]
+
+
+def test_the_table_pairs_each_step_with_the_full_configuration():
+    def runs(tts_h: dict[str, float]) -> pd.DataFrame:
+        return pd.DataFrame([{"controller": c, "seed": s,
+                              "network_whole_demand.time_spent_s.total":
+                                  3600.0 * (v + s), "plan_changes": 10.0 * s}
+                             for c, v in tts_h.items() for s in (1, 2, 3)])
+    full = runs({"backstepping": 100.0, "etc": 101.0})
+    step = runs({"backstepping": 102.0, "etc": 100.5})
+    text = control_ablation.table({"raw-cells": step}, full, [1, 2, 3])
+    bs = next(x for x in text.splitlines() if x.startswith("| raw-cells | backstepping"))
+    etc = next(x for x in text.splitlines() if x.startswith("| raw-cells | etc"))
+    assert "| +2 [+2, +2] 0/3 |" in bs              # 2 veh h worse on every seed
+    assert "| -0.5 [-0.5, -0.5] 3/0 |" in etc
+    assert "| +0 [+0, +0] 0/0 |" in bs               # the same plan changes: ties
+
+
+def test_unknown_steps_and_a_missing_control_study_are_refused(run_study, tmp_path):
+    with pytest.raises(StudyError, match="--steps = 'meter' is not allowed"):
+        run_study("control-ablation", "--steps", "meter", "--out", tmp_path / "a")
+    with pytest.raises(StudyError, match="has no regulation experiment"):
+        run_study("control-ablation", "--control", tmp_path, "--out", tmp_path / "a")
