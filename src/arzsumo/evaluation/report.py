@@ -107,7 +107,8 @@ def per_seed(runs: pd.DataFrame, measure: Measure, controllers: Sequence[str]) -
     values = pd.Series(math.nan, index=runs.index)
     for key in (measure.key, *measure.aliases):     # a former name fills older runs
         if key in runs:
-            values = values.fillna(pd.to_numeric(runs[key], errors="coerce"))
+            numbers = pd.to_numeric(runs[key].astype(object), errors="coerce")
+            values = values.fillna(pd.Series(numbers, index=runs.index, dtype=float))
     values = values * measure.scale
     if measure.key.startswith(f"{_WHOLE}.") and f"{_WHOLE}.complete" in runs:
         # a run whose drain did not empty the network (a gridlock, the drain limit) has

@@ -39,6 +39,7 @@ from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, write_csv, write_text
 from arzsumo.resources import shipped_scenarios_dir
 from arzsumo.studies.common import EXIT_SOME_FAILED, StudyError, add_output, add_runs, seed_text
+from arzsumo.studies.control_claims import claims_table
 from arzsumo.sweep.evaluate import BASELINE, check_controllers, run_evaluation
 from arzsumo.sweep.worker import FINISHED
 
@@ -175,7 +176,7 @@ def run(args: argparse.Namespace) -> int:
         for e in experiments:
             print(f"{e}: {', '.join(controllers)} on seeds {seed_text(args.seeds)}")
         return 0
-    ok, tables = True, {}
+    ok, tables, finished_runs = True, {}, {}
     with resumable_dir(args.out, f"study-{NAME}") as out:
         for e in experiments:
             path = write_text(dump_toml(experiment_scenario(base, e)),
@@ -184,12 +185,16 @@ def run(args: argparse.Namespace) -> int:
             ok &= finished
             measures = [m for m in MEASURES if m.key in runs.columns]
             long = evaluate(runs, controllers, BASELINE, measures)
-            tables[e] = long
+            tables[e], finished_runs[e] = long, runs
             write_csv(long, out / e / "control.csv")
             write_text(f"# {e}\n\n{markdown(long, BASELINE)}", out / e / "control.md")
         text = (f"Controllers {', '.join(controllers)} on seeds {seed_text(args.seeds)}, "
                 f"paired against the open loop (`arzsumo study {NAME}`).\n\n"
                 + headline(tables))
+        found = claims_table(finished_runs, args.seeds)
+        if found:
+            text += ("\n\nThe paper's section-5 claims, as SUMO tests them (95 % t intervals "
+                     "of the paired differences):\n\n" + found)
         write_text(text, out / "control.md")
         if args.docs is not None:
             files = [(out / e / f"control{x}", f"{e}{x}") for e in tables
