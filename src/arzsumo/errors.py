@@ -7,6 +7,12 @@ anything else is a bug and keeps its traceback.
 
 from __future__ import annotations
 
+#: exit codes of the CLI and the studies (``arzsumo --help`` lists them)
+EXIT_USAGE = 2            # a user error: one line on stderr
+EXIT_INCOMPLETE = 3       # the PDE twin left the physical domain (partial results written)
+EXIT_SOME_FAILED = 4      # some runs were invalid, failed or crashed (the others completed)
+EXIT_PREMISE_FAILS = 5    # the scenario's premise does not hold (its report written)
+
 
 class ArzsumoError(Exception):
     """A user-facing error: the message names the field, the value and what is allowed.

@@ -15,8 +15,8 @@ import re
 from collections.abc import Callable
 from typing import Any, NoReturn
 
-#: exit code of a user error (argparse's own, and the CLI's for ArzsumoError)
-EXIT_USAGE = 2
+from arzsumo.errors import EXIT_USAGE
+
 #: SUMO's seed range
 SEED_LIMIT = 2**31
 

@@ -27,8 +27,8 @@ from arzsumo.cli.options import (
     add_warmup,
 )
 from arzsumo.cli.scenarios import check_warmup, load_named
+from arzsumo.errors import EXIT_SOME_FAILED
 
-EXIT_SOME_FAILED = 4
 #: the measures printed, in the report's order: whole-demand time spent, the ramp's
 #: 95th-percentile wait, the network's time loss over the window
 HEADLINES = ("network_whole_demand.time_spent_s.total", "network_whole_demand.ramp_wait_s.p95",

@@ -27,10 +27,8 @@ from arzsumo.cli.options import (
     add_warmup,
 )
 from arzsumo.cli.scenarios import check_warmup, load_named
-from arzsumo.errors import ScenarioError
+from arzsumo.errors import EXIT_PREMISE_FAILS, ScenarioError
 
-#: exit code of a scenario whose premise does not hold
-EXIT_PREMISE_FAILS = 5
 #: the pulse floors of :data:`arzsumo.studies.premise.FLOORS` (kept here: no import of
 #: the studies when the parser is built)
 FLOORS = ("auto", "seeds", "late", "none")

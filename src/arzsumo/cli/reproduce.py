@@ -12,8 +12,7 @@ import argparse
 from pathlib import Path
 
 from arzsumo.cli.options import add_no_plots, add_out, add_overwrite, add_workers
-
-EXIT_INCOMPLETE = 3
+from arzsumo.errors import EXIT_INCOMPLETE
 
 
 def cmd_reproduce(args: argparse.Namespace) -> int:

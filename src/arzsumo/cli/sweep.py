@@ -12,8 +12,7 @@ from pathlib import Path
 
 from arzsumo.cli.options import add_no_plots, add_out, add_parallel, add_quiet
 from arzsumo.cli.scenarios import sweep_file
-
-EXIT_SOME_FAILED = 4
+from arzsumo.errors import EXIT_SOME_FAILED
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:

@@ -19,12 +19,12 @@ from pathlib import Path
 from arzsumo.cli.options import add_json, add_no_plots, add_out, add_overwrite, add_scenario
 from arzsumo.cli.scenarios import load_named
 from arzsumo.control.registry import controller_names
+from arzsumo.errors import EXIT_INCOMPLETE
 from arzsumo.scenario import Scenario
 from arzsumo.units import veh_s_to_veh_h
 
 log = logging.getLogger(__name__)
 
-EXIT_INCOMPLETE = 3
 
 #: (summary key, printed name, unit, factor from the summary's SI value); the times in
 #: veh h as ``arzsumo run`` prints them (docs/outputs.md: the indices and their units)

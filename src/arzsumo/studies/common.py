@@ -22,7 +22,10 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from arzsumo.errors import ArzsumoError
+from arzsumo.errors import (
+    EXIT_SOME_FAILED,  # noqa: F401 (re-exported)
+    ArzsumoError,
+)
 from arzsumo.io import read_toml
 from arzsumo.resources import default_scenario, shipped_scenarios_dir
 from arzsumo.sweep.spec import SweepSpec, sweep_from_dict
@@ -37,9 +40,6 @@ DOCS_DIR = Path("docs") / "results"
 METER_KEYS = ("meter_mode", "meter_clearance_s")
 #: SUMO's seed range
 SEED_LIMIT = 2**31
-#: exit code of a study some of whose runs were invalid, failed or crashed (the others
-#: completed; as ``arzsumo sweep`` and ``arzsumo evaluate``)
-EXIT_SOME_FAILED = 4
 
 
 class StudyError(ArzsumoError, ValueError):
