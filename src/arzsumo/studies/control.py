@@ -51,7 +51,7 @@ PAGE = "control_default"
 #: the controllers judged: the open loop, the best constant rate (on the default the
 #: least rate won the constant-rate sweep, so it is the held meter), the practitioner's
 #: ALINEA and PI-ALINEA, and the paper's three laws
-CONTROLLERS = ("open", "held", "alinea", "pi-alinea", "backstepping", "etc", "observer-etc")
+JUDGED = ("open", "held", "alinea", "pi-alinea", "backstepping", "etc", "observer-etc")
 #: the experiments, in order
 EXPERIMENTS = ("regulation", "disturbance")
 #: the disturbance experiment's [disturbance] table (scenario units): the edge past the
@@ -127,7 +127,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scenario", type=Path,
                         default=shipped_scenarios_dir() / "default.toml", metavar="FILE",
                         help="the base scenario (default: the shipped default)")
-    parser.add_argument("--controllers", default=",".join(CONTROLLERS),
+    parser.add_argument("--controllers", default=",".join(JUDGED),
                         help="comma-separated controllers (default: %(default)s)")
     parser.add_argument("--experiments", default=",".join(EXPERIMENTS),
                         help="comma-separated, of regulation, disturbance (default: both)")
