@@ -17,7 +17,7 @@ from __future__ import annotations
 import argparse
 import copy
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -103,6 +103,16 @@ def number_list(text: str) -> list[float]:
 
 
 # -- options -------------------------------------------------------------------------------
+def names_among(text: str, allowed: Sequence[str], flag: str) -> list[str]:
+    """The comma-separated names of ``text``, each among ``allowed``, in ``allowed``'s
+    order without repeats; else a StudyError naming ``flag`` and the value as written."""
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    if not names or any(n not in allowed for n in names):
+        raise StudyError(f"{flag} = {text!r} is not allowed: a comma-separated list of "
+                         f"{', '.join(allowed)}")
+    return sorted(set(names), key=list(allowed).index)
+
+
 def add_output(parser: argparse.ArgumentParser, name: str, page: str,
                plots: bool = True) -> None:
     """``--out`` (default ``results/studies/NAME``), ``--docs`` (the results page

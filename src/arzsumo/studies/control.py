@@ -38,7 +38,14 @@ from arzsumo.io import dump_toml, read_toml
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, write_csv, write_text
 from arzsumo.resources import shipped_scenarios_dir
-from arzsumo.studies.common import EXIT_SOME_FAILED, StudyError, add_output, add_runs, seed_text
+from arzsumo.studies.common import (
+    EXIT_SOME_FAILED,
+    StudyError,
+    add_output,
+    add_runs,
+    names_among,
+    seed_text,
+)
 from arzsumo.studies.control_claims import claims_table
 from arzsumo.sweep.evaluate import BASELINE, check_controllers, run_evaluation
 from arzsumo.sweep.worker import FINISHED
@@ -141,15 +148,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_output(parser, NAME, PAGE)
 
 
-def _experiments(text: str) -> list[str]:
-    names = [e.strip() for e in text.split(",") if e.strip()]
-    bad = [e for e in names if e not in EXPERIMENTS]
-    if bad or not names:
-        raise StudyError(f"--experiments = {text!r} is not allowed: a comma-separated list "
-                         f"of {', '.join(EXPERIMENTS)}")
-    return sorted(set(names), key=EXPERIMENTS.index)
-
-
 def _evaluate(args: argparse.Namespace, scenario: Path, controllers: Sequence[str],
               out: Path) -> tuple[pd.DataFrame, bool]:
     """One experiment's finished runs (its evaluation run unless ``--report``) and
@@ -170,7 +168,7 @@ def _evaluate(args: argparse.Namespace, scenario: Path, controllers: Sequence[st
 def run(args: argparse.Namespace) -> int:
     """Both experiments (resumable), the deviation measures, the tables."""
     controllers = check_controllers(args.controllers.split(","))
-    experiments = _experiments(args.experiments)
+    experiments = names_among(args.experiments, EXPERIMENTS, "--experiments")
     _, base = read_toml(args.scenario, "scenario", StudyError)
     if args.list:
         for e in experiments:

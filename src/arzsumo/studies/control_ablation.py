@@ -43,6 +43,7 @@ from arzsumo.studies.common import (
     StudyError,
     add_output,
     add_runs,
+    names_among,
     seed_text,
 )
 from arzsumo.sweep.evaluate import BASELINE, run_evaluation
@@ -136,18 +137,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_output(parser, NAME, PAGE, plots=False)
 
 
-def _steps(text: str) -> list[str]:
-    names = [s.strip() for s in text.split(",") if s.strip()]
-    bad = [s for s in names if s not in STEPS]
-    if bad or not names:
-        raise StudyError(f"--steps = {text!r} is not allowed: a comma-separated list of "
-                         f"{', '.join(STEPS)}")
-    return names
-
-
 def run(args: argparse.Namespace) -> int:
     """Every step's evaluation (resumable), then the table against the full configuration."""
-    steps = _steps(args.steps)
+    steps = names_among(args.steps, list(STEPS), "--steps")
     if args.list:
         for s in steps:
             print(f"{s}: {STEPS[s][0]}; {', '.join(LAWS)} on seeds {seed_text(args.seeds)}")
