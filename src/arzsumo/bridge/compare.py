@@ -24,6 +24,7 @@ from typing import Any
 import pandas as pd
 
 from arzsumo.errors import ArzsumoError
+from arzsumo.units import ms_to_kmh
 
 
 class CompareError(ArzsumoError, ValueError):
@@ -93,7 +94,7 @@ def _total(summ: dict[str, Any], *keys: str) -> float:
 
 def _sd_kmh(variance: float | None) -> float:
     """Standard deviation, km/h, of a speed variance in m^2/s^2 (NaN when None; 0 is 0)."""
-    return math.nan if variance is None else math.sqrt(variance) * 3.6
+    return math.nan if variance is None else ms_to_kmh(math.sqrt(variance))
 
 
 def row_of(summ: dict[str, Any]) -> dict[str, Any]:

@@ -85,6 +85,7 @@ from arzsumo.sumo.sensor import PeriodMeasurement
 from arzsumo.sumo.simulation import SumoSimulation, open_simulation
 from arzsumo.sumo.window import NetworkMeasures, WindowStart, measure_network
 from arzsumo.twin.solver import SolverOptions
+from arzsumo.units import ms_to_kmh
 
 log = logging.getLogger(__name__)
 
@@ -102,7 +103,7 @@ def check_before_start(settings: RunSettings, eq: Equilibrium, at: str | None = 
         who = at or f"controller = {settings.controller!r}"
         raise ScenarioError(
             f"{who} is not allowed at {at_eq}: "
-            f"lambda_4 = {lin.eigenvalues[3] * 3.6:.2f} km/h >= 0 (free flow); PDE "
+            f"lambda_4 = {ms_to_kmh(lin.eigenvalues[3]):.2f} km/h >= 0 (free flow); PDE "
             "boundary control needs congestion (lambda_4 < 0); use 'open' or 'alinea'")
     return lin
 

@@ -10,7 +10,7 @@ from arzsumo.cli.options import add_json, add_model_source
 from arzsumo.cli.scenarios import scenario_of
 from arzsumo.model import linearize
 from arzsumo.scenario import Scenario
-from arzsumo.units import ms_to_kmh
+from arzsumo.units import ms_to_kmh, veh_m_to_veh_km, veh_s_to_veh_h
 
 log = logging.getLogger("arzsumo")
 
@@ -34,10 +34,10 @@ def _print_model(summary: dict, description: str) -> None:
     lam = [float(ms_to_kmh(v)) for v in summary["eigenvalues"]]
     print(f"model {summary['scenario']}: {description}")
     print("equilibrium")
-    print(f"  HV  rho = {eq['rho_h'] * 1000:7.2f} veh/km   v = {eq['v_h'] * 3.6:6.2f} km/h"
-          f"   q = {eq['q_h'] * 3600:6.0f} veh/h")
-    print(f"  AV  rho = {eq['rho_a'] * 1000:7.2f} veh/km   v = {eq['v_a'] * 3.6:6.2f} km/h"
-          f"   q = {eq['q_a'] * 3600:6.0f} veh/h")
+    for label, c in (("HV", "h"), ("AV", "a")):
+        print(f"  {label}  rho = {veh_m_to_veh_km(eq[f'rho_{c}']):7.2f} veh/km"
+              f"   v = {ms_to_kmh(eq[f'v_{c}']):6.2f} km/h"
+              f"   q = {veh_s_to_veh_h(eq[f'q_{c}']):6.0f} veh/h")
     print(f"  AO = {eq['ao']:.4f}   AV penetration = {eq['penetration']:.1%}")
     print("characteristic speeds (km/h)")
     print(f"  lambda_1 = {lam[0]:8.3f}  (= v_h)\n  lambda_2 = {lam[1]:8.3f}\n"

@@ -87,7 +87,7 @@ def identified_toml(study: IdentifyStudy) -> str:
                                "rho_a_veh_km": round(float(rho_a), 4)}
         lam4 = linearize(study.equilibrium).eigenvalues[3]
         head.append(f"# [equilibrium]: mean measured densities of the training runs "
-                    f"(lambda_4 = {lam4 * 3.6:.2f} km/h under the identified model).")
+                    f"(lambda_4 = {ms_to_kmh(lam4):.2f} km/h under the identified model).")
         run = data.get("run", {})
         controller = run.get("controller", base.run.controller)
         if lam4 >= 0 and is_pde(controller):

@@ -32,13 +32,14 @@ from arzsumo.studies.common import (
     print_list,
     shipped_scenario,
 )
+from arzsumo.units import KMH_PER_MS, VEH_KM_PER_VEH_M, ms_to_kmh
 
 NAME = "loop-speed"
 #: the results page this study keeps a block of
 PAGE = "estimation_layouts"
 VARS = estimation_layouts.VARS
 #: SI -> report units: veh/m -> veh/km, m/s -> km/h
-FACTOR = (1000.0, 3.6, 1000.0, 3.6)
+FACTOR = (VEH_KM_PER_VEH_M, KMH_PER_MS, VEH_KM_PER_VEH_M, KMH_PER_MS)
 LAYOUT = estimation_layouts.LAYOUTS["loops 250 m + AV probes"]
 LOOP_SPEEDS = ("time_mean", "harmonic")
 
@@ -78,8 +79,9 @@ def station_speeds(rec: Any) -> list[str]:
         tm, hm = rec.speed[k][:, c, 1:-1], rec.speed_harmonic[k][:, c, 1:-1]
         v = truth[:, 2 * c + 1][:, cell[1:-1]]
         ok = np.isfinite(tm) & np.isfinite(v)
-        lines.append(f"v_{name} at the stations, km/h: time-mean {3.6 * tm[ok].mean():.2f}, "
-                     f"harmonic {3.6 * hm[ok].mean():.2f}, probe cells {3.6 * v[ok].mean():.2f}"
+        tm_kmh, hm_kmh, v_kmh = (ms_to_kmh(a[ok].mean()) for a in (tm, hm, v))
+        lines.append(f"v_{name} at the stations, km/h: time-mean {tm_kmh:.2f}, "
+                     f"harmonic {hm_kmh:.2f}, probe cells {v_kmh:.2f}"
                      f" ({int(ok.sum())} station-periods)")
     return lines
 

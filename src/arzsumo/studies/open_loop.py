@@ -25,6 +25,14 @@ from typing import Any
 import numpy as np
 from scipy import stats
 
+from arzsumo.units import (
+    kmh_to_ms,
+    ms_to_kmh,
+    veh_km_to_veh_m,
+    veh_m_to_veh_km,
+    veh_s_to_veh_h,
+)
+
 #: block length of the trend test, s
 BLOCK_S = 30.0
 #: a cell-period slower than this counts as congested, km/h
@@ -63,10 +71,11 @@ def regime(params: Any, rho_h: float, rho_a: float) -> tuple[float, str]:
     from arzsumo.model import Equilibrium, linearize
 
     try:
-        lam = linearize(Equilibrium(params, rho_h / 1000.0, rho_a / 1000.0)).eigenvalues
+        eq = Equilibrium(params, veh_km_to_veh_m(rho_h), veh_km_to_veh_m(rho_a))
+        lam = linearize(eq).eigenvalues
     except ModelError:  # AO beyond the model's AO_max: a state the model cannot hold
         return math.nan, "beyond AO_max"
-    lam4 = float(lam[3]) * 3.6
+    lam4 = ms_to_kmh(float(lam[3]))
     return lam4, "congested" if lam4 < 0 else "free"
 
 
@@ -75,7 +84,7 @@ def queue_end(lib: Any, length: float) -> tuple[int, float]:
     upstream vehicle slower than :data:`QUEUED_KMH`)."""
     ids = lib.edge.getLastStepVehicleIDs("approach")
     slow = [lib.vehicle.getLanePosition(v) for v in ids
-            if lib.vehicle.getSpeed(v) < QUEUED_KMH / 3.6]
+            if lib.vehicle.getSpeed(v) < kmh_to_ms(QUEUED_KMH)]
     return len(ids), (length - min(slow)) if slow else 0.0
 
 
@@ -85,9 +94,9 @@ def initial_vehicles(params: Any, cfg: Any) -> list[Any]:
 
     x = (np.arange(20) + 0.5) * params.length / 20
     one = np.ones_like(x)
-    v = INIT_V_KMH / 3.6 * one
-    return place_vehicles(params, cfg, x, INIT_RHO_H / 1000 * one, v,
-                          INIT_RHO_A / 1000 * one, v)[0]
+    v = kmh_to_ms(INIT_V_KMH) * one
+    return place_vehicles(params, cfg, x, veh_km_to_veh_m(INIT_RHO_H) * one, v,
+                          veh_km_to_veh_m(INIT_RHO_A) * one, v)[0]
 
 
 def open_loop(params: Any, cfg: Any, warmup: float, initial: list[Any] | None = None
@@ -119,17 +128,19 @@ def summarise(cells: list[Any], dx: float) -> dict[str, float]:
     n = ((rho["h"] + rho["a"]) * dx).sum(axis=1)
     out = trend(n, cells[0].window)
     for c in "ha":
-        out[f"rho_{c}_veh_km"] = float(rho[c].mean() * 1000)
-        out[f"v_{c}_kmh"] = float(q[c].sum() / rho[c].sum() * 3.6)
-        out[f"sd_v_{c}_kmh"] = float(np.nanstd(v[c]) * 3.6)
+        out[f"rho_{c}_veh_km"] = veh_m_to_veh_km(float(rho[c].mean()))
+        out[f"v_{c}_kmh"] = ms_to_kmh(float(q[c].sum() / rho[c].sum()))
+        out[f"sd_v_{c}_kmh"] = ms_to_kmh(float(np.nanstd(v[c])))
     total = rho["h"] + rho["a"]
     vmix = (q["h"] + q["a"]) / np.where(total > 0, total, np.nan)
-    out["congested_share"] = float(np.nanmean(vmix * 3.6 < CONGESTED_KMH))
-    out["inflow_veh_h"] = float(np.mean([d.inflow_h + d.inflow_a for d in cells]) * 3600)
-    out["outflow_veh_h"] = float(np.mean([d.outflow_h + d.outflow_a for d in cells]) * 3600)
+    out["congested_share"] = float(np.nanmean(ms_to_kmh(vmix) < CONGESTED_KMH))
+    inflow = np.mean([d.inflow_h + d.inflow_a for d in cells])
+    out["inflow_veh_h"] = veh_s_to_veh_h(float(inflow))
+    out["outflow_veh_h"] = veh_s_to_veh_h(float(np.mean([d.outflow_h + d.outflow_a
+                                                         for d in cells])))
     for c in "ha":
-        out[f"outflow_{c}_veh_h"] = float(np.mean([getattr(d, f"outflow_{c}")
-                                                   for d in cells]) * 3600)
+        out[f"outflow_{c}_veh_h"] = veh_s_to_veh_h(float(np.mean(
+            [getattr(d, f"outflow_{c}") for d in cells])))
     return out
 
 

@@ -35,6 +35,7 @@ from arzsumo.studies.common import (
     study_spec,
 )
 from arzsumo.studies.design import StudyRun, design_runs, run_design
+from arzsumo.units import ms_to_kmh
 
 NAME = "wave-speed"
 #: the results page this study keeps a block of
@@ -67,7 +68,7 @@ def travel(t: np.ndarray, x: np.ndarray, field: np.ndarray, var: str
         lag_s = float(lags[k] * dt)
         rows.append({"variable": var, "x_up_m": float(x[i]), "x_down_m": float(x[j]),
                      "lag_s": lag_s, "peak_corr": float(corr[k]),
-                     "speed_kmh": (x[j] - x[i]) / lag_s * 3.6 if lag_s else np.nan})
+                     "speed_kmh": ms_to_kmh((x[j] - x[i]) / lag_s) if lag_s else np.nan})
     return rows
 
 

@@ -40,6 +40,7 @@ from arzsumo.studies.paper.values import (
     SENSITIVITY,
     TOTALDELAY,
 )
+from arzsumo.units import veh_m_to_veh_km
 
 __all__ = ["MIN_CHANGE", "MIN_TREND", "MISSING", "NOT_REPRODUCED", "REPRODUCED", "Claim",
            "claims", "delay_table", "direction", "events_table", "penetration_table",
@@ -133,8 +134,8 @@ def penetration_table(rep: Reproduction) -> list[dict[str, Any]]:
         release, triggers = DIFFPENE[pen]
         eq = rec.summary["equilibrium"]
         rows.append({"penetration_percent": pen, "scenario": rec.name,
-                     "rho_h_veh_km": round(eq["rho_h"] * 1000, 3),
-                     "rho_a_veh_km": round(eq["rho_a"] * 1000, 3),
+                     "rho_h_veh_km": round(veh_m_to_veh_km(eq["rho_h"]), 3),
+                     "rho_a_veh_km": round(veh_m_to_veh_km(eq["rho_a"]), 3),
                      "paper_release_time_s": release, "ours_release_time_s": rec.release_time,
                      "paper_triggers": triggers, "ours_triggers": rec.triggers})
     return rows
