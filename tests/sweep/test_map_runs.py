@@ -21,3 +21,11 @@ def test_results_come_back_in_task_order_on_the_pool_and_here():
 def test_a_task_that_kills_its_process_twice_raises():
     with pytest.raises(RuntimeError, match="worker process died"):
         map_runs(os._exit, [3], workers=1)
+
+
+def test_a_labelled_batch_reports_its_progress_and_an_unlabelled_one_is_silent(capsys):
+    assert map_runs(abs, [-1, -2, -3], workers=1, progress="batch") == [1, 2, 3]
+    err = capsys.readouterr().err
+    assert "batch [" in err and "100.0%" in err
+    assert map_runs(abs, [-1, -2, -3], workers=1) == [1, 2, 3]
+    assert capsys.readouterr().err == ""

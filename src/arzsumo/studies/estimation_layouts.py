@@ -176,7 +176,8 @@ def recorded(runs: list[StudyRun], args: argparse.Namespace) -> list[str]:
     from arzsumo.sweep.driver import map_runs
 
     done = map_runs(record, runs, workers=args.workers or default_workers(),
-                    scheduler=args.scheduler)
+                    scheduler=args.scheduler,
+                    progress=None if args.quiet else f"{NAME}: recording")
     return [d["path"] for d in done]
 
 
@@ -192,9 +193,10 @@ def run(args: argparse.Namespace) -> int:
         paths = recorded(runs, args)
         tasks = [(p, r.scenario, r.scenario["sumo"]["seed"]) for p, r in zip(paths, runs,
                                                                              strict=True)]
-        rows = [row for part in map_runs(rows_of, tasks, workers=args.workers or
-                                         default_workers(), scheduler=args.scheduler)
-                for row in part]
+        parts = map_runs(rows_of, tasks, workers=args.workers or default_workers(),
+                         scheduler=args.scheduler,
+                         progress=None if args.quiet else f"{NAME}: scoring")
+        rows = [row for part in parts for row in part]
         path = write_csv(pd.DataFrame(rows), out / "layouts.csv")
         text = table(rows)
         if args.docs is not None:

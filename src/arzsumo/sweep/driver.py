@@ -192,28 +192,36 @@ def _raise_crash(task: Any, why: str) -> Any:
 
 
 def map_runs(fn: Callable[[Any], Any], tasks: Sequence[Any], *, workers: int = 1,
-             scheduler: str | None = None, in_process: bool = False) -> list[Any]:
+             scheduler: str | None = None, in_process: bool = False,
+             progress: str | None = None) -> list[Any]:
     """``[fn(t) for t in tasks]`` on the sweep's backends, results in the order of ``tasks``.
 
     ``fn`` must be a picklable module-level function and the tasks picklable. With
     ``scheduler`` the tasks run on that Dask cluster, else on ``workers`` fresh local
     processes (:func:`run_local`); ``in_process`` runs them here, one after the other
     (for runs shorter than a process start). A task whose process dies twice raises
-    ``RuntimeError``: unlike a sweep, the caller needs every result.
+    ``RuntimeError``: unlike a sweep, the caller needs every result. ``progress``, when
+    given, labels a progress bar on stderr.
     """
     if in_process or not tasks:
         return [fn(t) for t in tasks]
     results: dict[int, Any] = {}
     indexed = [_Indexed(i, t) for i, t in enumerate(tasks)]
     call = functools.partial(_call_indexed, fn)
+    bar = Progress(len(tasks), progress or "", enabled=progress is not None)
 
     def on_done(pair: tuple[int, Any]) -> None:
         results[pair[0]] = pair[1]
+        bar.update(len(results))
 
-    if scheduler:
-        run_dask(indexed, scheduler, on_done, one_thread=False, fn=call, on_crash=_raise_crash)
-    else:
-        run_local(indexed, workers, on_done, fn=call, on_crash=_raise_crash)
+    try:
+        if scheduler:
+            run_dask(indexed, scheduler, on_done, one_thread=False, fn=call,
+                     on_crash=_raise_crash)
+        else:
+            run_local(indexed, workers, on_done, fn=call, on_crash=_raise_crash)
+    finally:
+        bar.close()
     return [results[i] for i in range(len(tasks))]
 
 
