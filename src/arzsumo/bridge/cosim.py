@@ -85,6 +85,7 @@ from arzsumo.sumo.sensor import PeriodMeasurement
 from arzsumo.sumo.simulation import SumoSimulation, open_simulation
 from arzsumo.sumo.window import NetworkMeasures, WindowStart, measure_network
 from arzsumo.twin.solver import SolverOptions
+from arzsumo.twin.state import cell_centres
 from arzsumo.units import ms_to_kmh
 
 log = logging.getLogger(__name__)
@@ -164,8 +165,7 @@ def place_initial(params: ModelParameters, settings: RunSettings, cfg: SumoConfi
 
     if initial_fields is None:
         raise ScenarioError("start = 'placement' needs an [initial] profile")
-    n = initial_fields.shape[1]
-    xc = (np.arange(n) + 0.5) * params.length / n
+    xc = cell_centres(params.length, initial_fields.shape[1])
     initial, rep = place_vehicles(params, cfg, xc, *initial_fields)
     return initial, rep.summary()
 

@@ -33,6 +33,7 @@ from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.measure import CellData
 from arzsumo.twin.boundary import Inlet
 from arzsumo.twin.solver import SolverOptions, TwinStepper, TwinStoppedError
+from arzsumo.twin.state import cell_centres
 
 log = logging.getLogger(__name__)
 
@@ -181,7 +182,7 @@ class TwinPair:
         self.inlet = MeasuredInlet(eq, lin, smoothing)
         self.inlet.start(start)
         self.q_out = q_nominal
-        self.x = (np.arange(opts.cells) + 0.5) * self.params.length / opts.cells
+        self.x = cell_centres(self.params.length, opts.cells)
         fields, removed = to_twin_grid(self.params, start, self.x)
         if removed > 0.5:
             log.info("twin start: %.1f vehicles removed where the model cannot hold them",

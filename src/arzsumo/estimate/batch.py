@@ -29,7 +29,7 @@ from arzsumo.model.params import ModelParameters
 from arzsumo.twin.flux import FLUXES, Waves, waves
 from arzsumo.twin.solver import CFL_MAX
 from arzsumo.twin.source import relax
-from arzsumo.twin.state import RHO_A, RHO_H, to_conserved, to_primitive
+from arzsumo.twin.state import RHO_A, RHO_H, cell_centres, to_conserved, to_primitive
 
 
 def _sel(w: Waves, idx: slice) -> Waves:
@@ -112,7 +112,7 @@ class BatchStepper:
         self.p, self.cells, self.cfl = params, cells, cfl
         self.dx = params.length / cells
         self.riemann = FLUXES[flux]
-        self.x = (np.arange(cells) + 0.5) * self.dx
+        self.x = cell_centres(params.length, cells)
         self.steps = self.rejected = self.projected = 0
         self.last_speed: float | None = None     # largest wave speed of the last step, m/s
 

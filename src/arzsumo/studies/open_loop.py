@@ -91,8 +91,9 @@ def queue_end(lib: Any, length: float) -> tuple[int, float]:
 def initial_vehicles(params: Any, cfg: Any) -> list[Any]:
     """A uniform congested section at INIT_RHO_H / INIT_RHO_A and INIT_V_KMH."""
     from arzsumo.sumo.placement import place_vehicles
+    from arzsumo.twin.state import cell_centres
 
-    x = (np.arange(20) + 0.5) * params.length / 20
+    x = cell_centres(params.length, 20)
     one = np.ones_like(x)
     v = kmh_to_ms(INIT_V_KMH) * one
     return place_vehicles(params, cfg, x, veh_km_to_veh_m(INIT_RHO_H) * one, v,
