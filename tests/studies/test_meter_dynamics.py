@@ -60,6 +60,16 @@ def test_the_pooled_fit_recovers_the_step_response():
     assert pooled["time_constant_s"] == pytest.approx(TAU, abs=1.5)
 
 
+def test_the_figure_ensembles_leave_out_a_direction_without_steps():
+    data = meter_fit.by_seed(series(greens=(0.8,)))         # one step, upwards only
+    rows = meter_fit.fits(data, "y", pre=60.0, detail=False)
+    assert meter_fit.DOWN not in [r["step"] for r in rows]
+    found = meter_fit.ensembles(data, rows)
+    assert [name for name, *_ in found] == [meter_fit.UP]
+    _, lag, mean, fit, label = found[0]
+    assert lag.shape == mean.shape == fit.shape and "theta=" in label
+
+
 def test_the_static_levels_are_the_settled_outflow_per_green_share():
     data = meter_fit.by_seed(series(noise=0.0))
     levels = meter_fit.static_levels(data, settled=60.0)

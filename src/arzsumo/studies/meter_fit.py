@@ -175,12 +175,15 @@ def ensemble(data: Series, sign: int, span: float) -> tuple[np.ndarray, np.ndarr
 
 def ensembles(data: Series, rows: list[dict[str, Any]], span: float = 90.0
               ) -> list[tuple[str, np.ndarray, np.ndarray, np.ndarray, str]]:
-    """Per direction: (name, lag s, mean normalised response veh/h, the pooled fit's
-    response veh/h, the fit's label) for the figure's last panel."""
+    """Per direction with a pooled fit in ``rows``: (name, lag s, mean normalised
+    response veh/h, the pooled fit's response veh/h, the fit's label) for the figure's
+    last panel. A direction without a fit (no steps that way) is left out."""
     out = []
     for sign, name in ((-1, DOWN), (1, UP)):
+        r = next((r for r in rows if r["signal"] == "y" and r["step"] == name), None)
+        if r is None:
+            continue
         lag, mean = ensemble(data, sign, span)
-        r = next(r for r in rows if r["signal"] == "y" and r["step"] == name)
         fit = fopdt_response(lag, 0.0, r["gain_veh_s"], 1.0, 0.0, r["delay_s"],
                              r["time_constant_s"], 6.0)
         label = (f"fit K={r['gain_veh_s'] * 3600:.0f} veh/h, theta={r['delay_s']:.1f} s, "
