@@ -18,7 +18,8 @@ from .conftest import parse
 #: the studies, as documented in CHANGELOG.md and the catalog's docstring
 NAMES = ["ablation", "ablation-mechanism", "held-ramp", "meter-dynamics", "approach", "fill",
          "wave-speed", "inlet", "estimation-layouts", "loop-speed", "enkf-noise",
-         "u-estimate", "premise-map", "sumo-options", "control", "control-ablation"]
+         "u-estimate", "premise-map", "sumo-options", "control", "control-ablation",
+         "etc-noise"]
 
 
 def test_the_catalog_lists_the_studies_by_their_names():
@@ -90,4 +91,4 @@ def test_each_study_names_a_results_page_of_the_docs_layout():
                      "loop-speed": "estimation_layouts", "enkf-noise": "enkf_noise",
                      "u-estimate": "u_on_estimate", "premise-map": "premise_map",
                      "sumo-options": "sumo_options", "control": "control_default",
-                     "control-ablation": "control_default"}
+                     "control-ablation": "control_default", "etc-noise": "control_default"}

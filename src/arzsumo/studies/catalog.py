@@ -8,8 +8,8 @@ results page ``DIR/PAGE.md`` with its files in ``DIR/PAGE/`` (``DIR`` defaults t
 ablation, ablation-mechanism, held-ramp and wave-speed, ``meter_dynamics``, ``sumo_map``
 for approach, ``sumo_fill`` for fill, ``identified_model`` for inlet,
 ``estimation_layouts`` for estimation-layouts and loop-speed, ``enkf_noise``,
-``u_on_estimate``, ``premise_map``, ``sumo_options``, ``control_default`` for control
-and control-ablation; :mod:`arzsumo.studies.common`). ``run`` returns the exit code (0
+``u_on_estimate``, ``premise_map``, ``sumo_options``, ``control_default`` for control,
+control-ablation and etc-noise; :mod:`arzsumo.studies.common`). ``run`` returns the exit code (0
 done; 4 some runs were invalid, failed or crashed) and raises
 :class:`~arzsumo.errors.ArzsumoError` for bad input. A study's module is imported only
 when its options or its run are asked for.
@@ -84,6 +84,8 @@ _MODULES = {
                            "rejection, paired by seed"),
     "control-ablation": ("control_ablation", "the control study's configuration, one piece "
                                              "at a time, paired by seed"),
+    "etc-noise": ("etc_noise", "the ETC's event trigger in the twin on a noisy state, "
+                               "beside SUMO's runs"),
 }
 
 STUDIES: dict[str, Study] = {
