@@ -173,6 +173,22 @@ def summary_table(summaries: list[dict[str, Any]]) -> str:
     return f"{header(df)}\n{table}\n{textwrap.fill(LEGEND, 100)}"
 
 
+#: the controllers that hold U between events (paper, section 4)
+EVENT_TRIGGERED = ("etc", "observer-etc")
+
+
+def updates_line(summ: dict[str, Any]) -> str | None:
+    """For a run of an event-triggered controller, one line on how often it updated U
+    over the control window (a continuous law updates at every check); None otherwise."""
+    if summ.get("controller") not in EVENT_TRIGGERED or "triggers" not in summ:
+        return None
+    held = float(summ.get("release_time", math.nan))
+    return (f"{summ['controller']}: U updated at {int(summ['triggers'])} checks, held "
+            f"unchanged for {held:.0f} s of the {float(summ['horizon']):.0f} s window (the "
+            f"continuous law updates at every check; why in SUMO: "
+            f"docs/readings/control_default.md)")
+
+
 def load_summaries(runs: list[Path]) -> list[dict[str, Any]]:
     """The ``summary.json`` of each directory; refuses a missing, unreadable or unknown one."""
     out = []

@@ -57,9 +57,12 @@ def cmd_run(args: argparse.Namespace) -> int:
 
         print(json.dumps(json_safe(summ), indent=2))
     else:
-        from arzsumo.bridge.compare import summary_table
+        from arzsumo.bridge.compare import summary_table, updates_line
 
         print(summary_table([summ]))
+        line = updates_line(summ)
+        if line:
+            print(line)
         print(f"results: {out}")
     return 0
 
