@@ -16,12 +16,21 @@ from __future__ import annotations
 
 import argparse
 import copy
-import math
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
+from arzsumo.argtypes import (  # noqa: F401 (the studies' option types, re-exported)
+    SEED_LIMIT,
+    fraction,
+    non_negative_float,
+    non_negative_int,
+    number_list,
+    positive_float,
+    positive_int,
+    seed_list,
+)
 from arzsumo.errors import (
     EXIT_SOME_FAILED,  # noqa: F401 (re-exported)
     ArzsumoError,
@@ -38,71 +47,12 @@ DOCS_DIR = Path("docs") / "results"
 #: the shipped default carries; the meter studies and the ablation start from the plain
 #: fixed cycle without them
 METER_KEYS = ("meter_mode", "meter_clearance_s")
-#: SUMO's seed range
-SEED_LIMIT = 2**31
 
 
 class StudyError(ArzsumoError, ValueError):
     """A study that cannot run as asked: a missing input, an invalid option value."""
 
 
-# -- argument types ------------------------------------------------------------------------
-def _typed(name: str, kind: type, ok: Callable[[Any], bool], allowed: str
-           ) -> Callable[[str], Any]:
-    """An argparse ``type=``: ``text`` read as ``kind``, refused as "TEXT is not allowed:
-    ALLOWED" unless ``ok``."""
-    def parse(text: str) -> Any:
-        try:
-            value = kind(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{text} is not allowed: {allowed}") from None
-        if not ok(value):
-            raise argparse.ArgumentTypeError(f"{text} is not allowed: {allowed}")
-        return value
-
-    parse.__name__ = name
-    return parse
-
-
-positive_int = _typed("positive_int", int, lambda v: v >= 1, "an integer >= 1")
-non_negative_int = _typed("non_negative_int", int, lambda v: v >= 0, "an integer >= 0")
-non_negative_float = _typed("non_negative_float", float,
-                            lambda v: math.isfinite(v) and v >= 0, "a finite number >= 0")
-positive_float = _typed("positive_float", float, lambda v: math.isfinite(v) and v > 0,
-                        "a finite number > 0")
-fraction = _typed("fraction", float, lambda v: 0.0 <= v <= 1.0, "a number in [0, 1]")
-
-
-def seed_list(text: str) -> list[int]:
-    """Seeds ``1,2,3`` or a range ``1-10`` (inclusive), or both: ``1-3,7``."""
-    seeds: list[int] = []
-    for part in (p.strip() for p in text.split(",")):
-        first, sep, last = part.partition("-")
-        try:
-            lo, hi = int(first), int(last) if sep else int(first)
-        except ValueError:
-            lo, hi = -1, -1
-        if not (0 <= lo <= hi < SEED_LIMIT):
-            raise argparse.ArgumentTypeError(
-                f"{text} is not allowed: seeds in [0, 2^31), comma-separated, A-B a range")
-        seeds += list(range(lo, hi + 1))
-    if len(set(seeds)) != len(seeds):
-        raise argparse.ArgumentTypeError(f"{text} is not allowed: a seed repeats")
-    return seeds
-
-
-def number_list(text: str) -> list[float]:
-    """Comma-separated numbers: ``0.2,0.5,0.8``."""
-    try:
-        values = [float(v) for v in text.split(",") if v.strip()]
-    except ValueError:
-        values = []
-    if not values or not all(math.isfinite(v) for v in values):
-        raise argparse.ArgumentTypeError(f"{text} is not allowed: comma-separated numbers")
-    return values
-
-
-# -- options -------------------------------------------------------------------------------
 def names_among(text: str, allowed: Sequence[str], flag: str) -> list[str]:
     """The comma-separated names of ``text``, each among ``allowed``, in ``allowed``'s
     order without repeats; else a StudyError naming ``flag`` and the value as written."""
