@@ -59,7 +59,8 @@ def test_the_study_writes_its_tables(run_study, tmp_path, capsys):
     assert run_study("etc-noise", "--levels", "0", "--seeds", "1", "--workers", "1",
                      "--quiet", "--out", tmp_path / "out") == 0
     twin = pd.read_csv(tmp_path / "out" / "twin.csv")
-    assert twin["law"].tolist() == ["backstepping", "etc"] and twin["n"].tolist() == [1, 1]
+    assert twin["law"].tolist() == ["backstepping", "etc", "observer-etc"]
+    assert twin["n"].tolist() == [1, 1, 1]
     assert "| etc | 0 | 1 | 93" in capsys.readouterr().out
 
 

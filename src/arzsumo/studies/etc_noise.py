@@ -50,8 +50,8 @@ log = logging.getLogger(__name__)
 NAME = "etc-noise"
 #: the results page this study keeps a block of
 PAGE = "control_default"
-#: the laws compared: the ETC and the continuous law it samples
-LAWS = ("backstepping", "etc")
+#: the laws compared: the ETC, the continuous law it samples, the observer-based ETC
+LAWS = ("backstepping", "etc", "observer-etc")
 #: relative noise sd of the fields, %
 LEVELS_PCT = "0,0.01,0.03,0.1,0.3,1,2,4"
 
