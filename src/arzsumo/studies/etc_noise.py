@@ -19,6 +19,7 @@ output noise, and how many events the trigger fires at that level.
 from __future__ import annotations
 
 import argparse
+import functools
 import logging
 from dataclasses import replace
 from pathlib import Path
@@ -64,10 +65,14 @@ def output_noise_veh_h(u_continuous: np.ndarray) -> float:
     return float(veh_s_to_veh_h(np.std(np.diff(u)))) if u.size > 2 else float("nan")
 
 
+#: the scenario of a path, read once per process (every task of a study names the same one)
+_scenario = functools.lru_cache(maxsize=4)(load_scenario)
+
+
 def twin_row(task: tuple[Path, str, float, int]) -> dict[str, Any]:
     """One twin run: (scenario, law, noise sd in %, noise seed) -> its row."""
     path, law, level_pct, seed = task
-    sc = load_scenario(path)
+    sc = _scenario(path)
     cfg = replace(sc.twin, controller=law)
     ctrl = NoisyState(twin_controller(cfg, linearize(sc.equilibrium)), level_pct / 100.0,
                       seed)
