@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from arzsumo.evaluation.premise import (
@@ -106,8 +106,11 @@ def test_the_areas_agree_with_the_least_squares_fit():
 @settings(max_examples=25, deadline=None)
 @given(k=st.floats(-1.6, -0.4), delay=st.floats(0.0, 20.0), tau=st.floats(1.0, 15.0))
 def test_any_noise_free_fopdt_is_recovered(k, delay, tau):
-    g = actuator_gate(_record(k, k, delay=delay, tau=tau, steps=4))
     lo, hi = -1.3, -0.7
+    # the recovered gain is exact to float rounding only: within it of a bound the verdict
+    # may go either way, so the property is asserted away from the bounds
+    assume(min(abs(k - lo), abs(k - hi)) > 1e-6)
+    g = actuator_gate(_record(k, k, delay=delay, tau=tau, steps=4))
     assert g.passed is (lo <= k <= hi)
     # exact at bin edges; within the bin where a fast response rises, to half a bin
     tol = 0.05 if tau >= 3.0 else 0.5
