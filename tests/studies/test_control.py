@@ -57,8 +57,10 @@ def test_the_study_pairs_both_experiments_and_measures_the_decay(run_study, shor
                                                                  tmp_path, monkeypatch):
     monkeypatch.setenv("ARZSUMO_CACHE", str(tmp_path / "cache"))
     out = tmp_path / "control"
-    args = ("--scenario", short_default, "--controllers", "open,etc", "--seeds", "1,2",
-            "--workers", "1", "--quiet", "--out", out)
+    store = tmp_path / "records"
+    common = ("--scenario", short_default, "--controllers", "open,etc", "--seeds", "1,2",
+              "--workers", "1", "--quiet", "--records", store)
+    args = (*common, "--out", out)
     assert run_study("control", *args) == 0
     reg = pd.read_csv(out / "regulation" / "control.csv")
     dis = pd.read_csv(out / "disturbance" / "control.csv")
@@ -82,3 +84,12 @@ def test_the_study_pairs_both_experiments_and_measures_the_decay(run_study, shor
     # --report reads the same runs back and gives the same numbers
     assert run_study("control", *args, "--report") == 0
     assert pd.read_csv(out / "disturbance" / "control.csv").equals(dis)
+    # the record store holds every run, and carries the study to a new directory: the
+    # tables come back from it alone, and a continued study runs nothing it holds
+    assert len(list(store.glob("*/runs/*/summary.json"))) == 8
+    for flags in (("--report",), ()):
+        elsewhere = tmp_path / f"elsewhere{len(flags)}"
+        assert run_study("control", *common, "--out", elsewhere, *flags) == 0
+        assert pd.read_csv(elsewhere / "disturbance" / "control.csv").equals(dis)
+    assert not (elsewhere / "disturbance" / "runs" / "controller=open,seed=1"
+                / "periods.parquet").exists()

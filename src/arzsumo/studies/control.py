@@ -47,7 +47,10 @@ from arzsumo.studies.common import (
     seed_text,
 )
 from arzsumo.studies.control_claims import claims_table
-from arzsumo.sweep.evaluate import BASELINE, check_controllers, run_evaluation
+from arzsumo.sweep.evaluate import BASELINE, check_controllers, evaluation_spec, run_evaluation
+from arzsumo.sweep.evaluate import KIND as EVALUATION_KIND
+from arzsumo.sweep.records import copy_records
+from arzsumo.sweep.table import sweep_table
 from arzsumo.sweep.worker import FINISHED
 
 log = logging.getLogger(__name__)
@@ -143,7 +146,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         "a controller whose runs on all the seeds are there is taken from "
                         "there (arzsumo evaluate --runs-from)")
     parser.add_argument("--report", action="store_true",
-                        help="run nothing: the tables from the runs already there")
+                        help="run nothing: the tables from the runs already there "
+                             "(finished so far, while a study is running too)")
+    parser.add_argument("--records", type=Path, metavar="DIR",
+                        help="a store of run records (each finished run's scenario.toml "
+                             "and summary.json, DIR/<experiment>/runs/): the runs it holds "
+                             "are not run again, and every finished run is added to it; "
+                             "kept under version control, it carries the study across "
+                             "machines")
     add_runs(parser, seeds="1-20")
     add_output(parser, NAME, PAGE)
 
@@ -151,18 +161,30 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def _evaluate(args: argparse.Namespace, scenario: Path, controllers: Sequence[str],
               out: Path) -> tuple[pd.DataFrame, bool]:
     """One experiment's finished runs (its evaluation run unless ``--report``) and
-    whether every run finished."""
-    if not args.report:
-        res = run_evaluation(scenario, controllers, args.seeds, out=out,
-                             workers=args.workers, scheduler=args.scheduler,
-                             progress=not args.quiet, plots=False, runs_from=args.runs_from)
-        return res.runs, res.sweep is None or bool(
-            res.sweep.table["status"].isin(FINISHED).all())
-    table = out / "summaries.parquet"
-    if not table.is_file():
-        raise StudyError(f"--out has no {out.name} runs yet; allowed: a run without --report")
-    runs = pd.read_parquet(table)
-    return runs[runs["status"].isin(FINISHED) & runs["seed"].isin(args.seeds)], True
+    whether every run finished. With ``--records``, the store's runs are copied in first
+    and every finished run out afterwards."""
+    store = None if args.records is None else args.records / out.name
+    if store is not None:
+        with resumable_dir(out, EVALUATION_KIND):
+            log.info("%d run records taken from %s", copy_records(store, out, replace=False),
+                     store)
+    try:
+        if not args.report:
+            res = run_evaluation(scenario, controllers, args.seeds, out=out,
+                                 workers=args.workers, scheduler=args.scheduler,
+                                 progress=not args.quiet, plots=False,
+                                 runs_from=args.runs_from)
+            return res.runs, res.sweep is None or bool(
+                res.sweep.table["status"].isin(FINISHED).all())
+        runs = sweep_table(evaluation_spec(scenario, check_controllers(controllers),
+                                           args.seeds).runs(), out)
+        if not runs["status"].isin(FINISHED).any():
+            raise StudyError(f"--out has no finished {out.name} runs yet; allowed: a run "
+                             "without --report")
+        return runs[runs["status"].isin(FINISHED)], True
+    finally:
+        if store is not None:
+            copy_records(out, store, replace=True)
 
 
 def run(args: argparse.Namespace) -> int:
