@@ -86,6 +86,11 @@ MEASURES: tuple[Measure, ...] = (*EVALUATION_MEASURES[:1], *DEVIATION,
                                  *EVALUATION_MEASURES[1:], *_EXTRA)
 #: the headline measures of OUT/control.md (keys)
 HEADLINE = ("network_whole_demand.time_spent_s.total",
+            "network_whole_demand.time_spent_s.mainline",
+            "network_whole_demand.time_spent_s.ramp",
+            "network_whole_demand.ramp_wait_s.p95",
+            "network_whole_demand.ramp_wait_s.over_limit",
+            "network.throughput_veh_h.section_outlet",
             "section.deviation.deviation_excess_s", "section.deviation.decay_time_s",
             "section.waves.h.band_power_kmh2",
             "section.waves.a.band_power_kmh2", "section.speed_oscillation_kmh.h",
@@ -104,28 +109,36 @@ def experiment_scenario(base: dict, experiment: str) -> dict:
     return data
 
 
+def _cell(r: pd.Series, baseline: bool) -> str:
+    """One headline cell: the open loop's own mean [95 % t]; any other controller's paired
+    difference against it, mean [95 % t] {95 % bootstrap} wins/losses."""
+    if baseline:
+        return f"{r['mean']:.4g} [{r.ci_low:.4g}, {r.ci_high:.4g}] (its mean)"
+    if not np.isfinite(r.diff_mean):
+        return ""
+    return (f"{r.diff_mean:+.3g} [{r.diff_ci_low:+.3g}, {r.diff_ci_high:+.3g}]"
+            f" {{{r.diff_boot_low:+.3g}, {r.diff_boot_high:+.3g}}}"
+            f" {int(r.wins)}/{int(r.losses)}")
+
+
 def headline(tables: dict[str, pd.DataFrame]) -> str:
-    """Markdown: per headline measure and controller, the paired difference against the
-    open loop in each experiment (mean [95 % t] {95 % bootstrap} wins/losses)."""
+    """Markdown: per headline measure, the open loop's mean and every other controller's
+    paired difference against it in each experiment (:func:`_cell`)."""
     head = ("| measure | unit | controller | "
-            + " | ".join(f"{e}: minus open [t] {{bootstrap}} w/l" for e in tables) + " |")
+            + " | ".join(f"{e}: open mean [t]; others minus open [t] {{bootstrap}} w/l"
+                         for e in tables) + " |")
     lines = [head, "|---" * (3 + len(tables)) + "|"]
     first = next(iter(tables.values()))
     for key in HEADLINE:
         sel = first[first["measure"] == key]
         for ctrl in sel["controller"]:
-            if ctrl == BASELINE:
-                continue
             cells = []
             for long in tables.values():
                 r = long[(long["measure"] == key) & (long["controller"] == ctrl)]
-                if r.empty or not np.isfinite(r["diff_mean"].iloc[0]):
+                if r.empty or not np.isfinite(r["mean"].iloc[0]):
                     cells.append("")
                     continue
-                r = r.iloc[0]
-                cells.append(f"{r.diff_mean:+.3g} [{r.diff_ci_low:+.3g}, {r.diff_ci_high:+.3g}]"
-                             f" {{{r.diff_boot_low:+.3g}, {r.diff_boot_high:+.3g}}}"
-                             f" {int(r.wins)}/{int(r.losses)}")
+                cells.append(_cell(r.iloc[0], baseline=ctrl == BASELINE))
             label = sel[sel["controller"] == ctrl].iloc[0]
             lines.append(f"| {label.label} | {label.unit} | {ctrl} | " + " | ".join(cells)
                          + " |")
