@@ -79,8 +79,9 @@ def test_the_study_pairs_both_experiments_and_measures_the_decay(run_study, shor
         out / "regulation" / "summaries.parquet")["disturbance.began_s"].isna().all()
     # one table row per (measure, controller), the paired difference of etc in both
     text = (out / "control.md").read_text(encoding="utf-8")
-    row = next(x for x in text.splitlines() if x.startswith("| integrated deviation above"))
-    assert row.count("/") >= 2 and "| etc |" in row
+    rows = [x for x in text.splitlines() if x.startswith("| integrated deviation above")]
+    assert [r.split(" | ")[2] for r in rows] == ["open", "etc"]
+    assert rows[0].count("(its mean)") == 2 and rows[1].count("/") >= 2
     # --report reads the same runs back and gives the same numbers
     assert run_study("control", *args, "--report") == 0
     assert pd.read_csv(out / "disturbance" / "control.csv").equals(dis)
@@ -93,3 +94,23 @@ def test_the_study_pairs_both_experiments_and_measures_the_decay(run_study, shor
         assert pd.read_csv(elsewhere / "disturbance" / "control.csv").equals(dis)
     assert not (elsewhere / "disturbance" / "runs" / "controller=open,seed=1"
                 / "periods.parquet").exists()
+
+
+def test_the_headline_gives_the_open_loops_mean_and_the_paired_differences():
+    from arzsumo.evaluation.report import evaluate
+    from arzsumo.studies.control import MEASURES, headline
+
+    key = "network_whole_demand.time_spent_s.total"
+    open_s = np.array([100.0, 110.0, 120.0]) * 3600
+    runs = pd.DataFrame({"controller": ["open"] * 3 + ["held"] * 3, "seed": [1, 2, 3] * 2,
+                         key: np.r_[open_s, open_s - 3600 * np.array([1.0, 2.0, 3.0])]})
+    long = evaluate(runs, ["open", "held"], "open", [m for m in MEASURES if m.key == key])
+    rows = [r for r in headline({"regulation": long}).splitlines()
+            if r.startswith("| whole-demand time spent, total")]
+    # open: mean 110 veh h with its t interval (sd 10, n 3: half-width 24.84)
+    assert rows[0] == ("| whole-demand time spent, total | veh h | open | "
+                       "110 [85.16, 134.8] (its mean) |")
+    # held minus open: -2 veh h, t interval -2 -+ 4.303 * 1 / sqrt(3), three wins
+    assert rows[1].startswith("| whole-demand time spent, total | veh h | held | "
+                              "-2 [-4.48, +0.484] {")
+    assert rows[1].endswith(" 3/0 |")
