@@ -114,3 +114,8 @@ def test_the_headline_gives_the_open_loops_mean_and_the_paired_differences():
     assert rows[1].startswith("| whole-demand time spent, total | veh h | held | "
                               "-2 [-4.48, +0.484] {")
     assert rows[1].endswith(" 3/0 |")
+
+
+def test_a_report_without_any_finished_run_is_refused(run_study, tmp_path):
+    with pytest.raises(StudyError, match="has no finished runs yet; allowed: a run without"):
+        run_study("control", "--report", "--seeds", "1,2", "--out", tmp_path / "none")
