@@ -4,19 +4,14 @@ tabulates the same numbers; stale, failed and half-copied records are handled.""
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import pandas as pd
 import pytest
 
 from arzsumo.outdir import MARKER, resumable_dir
-from arzsumo.sweep import comparable, run_sweep, sweep_from_dict
+from arzsumo.sweep import comparable, run_sweep
 from arzsumo.sweep.records import RECORD, copy_records, finished_runs
-
-ROOT = Path(__file__).resolve().parents[2]
-PEN = "scenarios/paper/penetration_44_etc.toml"
-SMALL = {"initial": {"kind": "random"}, "twin": {"cells": 40, "horizon_s": 60,
-                                                 "kernel_cells": 40}}
+from tests.sweep.helpers import SMALL, small_spec
 
 
 @pytest.fixture(autouse=True)
@@ -25,10 +20,7 @@ def _cache(tmp_path_factory, monkeypatch):
 
 
 def spec(horizon=60):
-    data = {"name": "small", "base": PEN, "engine": "twin", "seeds": [1, 2],
-            "set": {**SMALL, "twin": {**SMALL["twin"], "horizon_s": horizon}},
-            "axis": [{"field": "equilibrium.penetration", "values": [0.44, 0.5]}]}
-    return sweep_from_dict(data, "small.toml", root=ROOT)
+    return small_spec(fixed={**SMALL, "twin": {**SMALL["twin"], "horizon_s": horizon}})
 
 
 @pytest.fixture(scope="module")

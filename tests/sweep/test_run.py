@@ -21,24 +21,13 @@ from arzsumo.io import FILE_MODE
 from arzsumo.sweep import comparable, run_sweep, sweep_from_dict
 from arzsumo.sweep.driver import run_local, task_of
 from arzsumo.sweep.worker import RunOutcome
-
-ROOT = Path(__file__).resolve().parents[2]
-PEN = "scenarios/paper/penetration_44_etc.toml"
-SMALL = {"initial": {"kind": "random"}, "twin": {"cells": 40, "horizon_s": 60,
-                                                 "kernel_cells": 40}}
+from tests.sweep.helpers import PEN, ROOT, SMALL, small_spec
 
 
 @pytest.fixture(autouse=True)
 def _cache(tmp_path_factory, monkeypatch):
     # one kernel cache for the module's workers (they inherit the environment)
     monkeypatch.setenv("ARZSUMO_CACHE", str(tmp_path_factory.getbasetemp() / "kernels"))
-
-
-def small_spec(values=(0.44, 0.5), seeds=(1, 2), fixed=None, **extra):
-    data = {"name": "small", "base": PEN, "engine": "twin", "seeds": list(seeds),
-            "set": fixed or SMALL,
-            "axis": [{"field": "equilibrium.penetration", "values": list(values)}], **extra}
-    return sweep_from_dict(data, "small.toml", root=ROOT)
 
 
 def write_sweep_file(path: Path, values, seeds, horizon=60) -> Path:
