@@ -131,6 +131,7 @@ SWEEP_FIXED: dict[str, Column] = {
     "execution.id": Column(TEXT, "identifier of the execution that produced the result"),
     "execution.host": Column(TEXT, "host name of the worker"),
     "execution.pid": Column(TEXT, "process id of the worker"),
+    "execution.sumo": Column(TEXT, "version of the installed SUMO (eclipse-sumo)"),
     "execution.started": Column("s", "start, seconds since 1970-01-01 UTC"),
     "execution.wall_s": Column("s", "wall time of the execution (a run that shared its "
                                     "warm-up: the warm-up's plus its own)"),

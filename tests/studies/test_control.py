@@ -82,9 +82,11 @@ def test_the_study_pairs_both_experiments_and_measures_the_decay(run_study, shor
     rows = [x for x in text.splitlines() if x.startswith("| integrated deviation above")]
     assert [r.split(" | ")[2] for r in rows] == ["open", "etc"]
     assert rows[0].count("(its mean)") == 2 and rows[1].count("/") >= 2
-    # --report reads the same runs back and gives the same numbers
+    # --report reads the same runs back and gives the same numbers, writing no run
+    runs_before = {p: p.stat().st_mtime_ns for p in out.glob("*/runs/**/*")}
     assert run_study("control", *args, "--report") == 0
     assert pd.read_csv(out / "disturbance" / "control.csv").equals(dis)
+    assert runs_before == {p: p.stat().st_mtime_ns for p in out.glob("*/runs/**/*")}
     # the record store holds every run, and carries the study to a new directory: the
     # tables come back from it alone, and a continued study runs nothing it holds
     assert len(list(store.glob("*/runs/*/summary.json"))) == 8
@@ -119,3 +121,34 @@ def test_the_headline_gives_the_open_loops_mean_and_the_paired_differences():
 def test_a_report_without_any_finished_run_is_refused(run_study, tmp_path):
     with pytest.raises(StudyError, match="has no finished runs yet; allowed: a run without"):
         run_study("control", "--report", "--seeds", "1,2", "--out", tmp_path / "none")
+
+
+@pytest.mark.parametrize("flags, message", [
+    (("--records", "FILE"), "--records = .*FILE is a file; allowed: a directory"),
+    (("--records", "DIR", "--runs-from", "DIR"),
+     "--runs-from = .*DIR is not allowed with --records; allowed: one of them"),
+    (("--report", "--runs-from", "DIR"),
+     "--runs-from = .*DIR is not allowed with --report; allowed: one of them"),
+])
+def test_unusable_record_options_are_refused(run_study, tmp_path, flags, message):
+    (tmp_path / "FILE").write_text("mine")
+    (tmp_path / "DIR").mkdir()
+    args = [str(tmp_path / f) if f in ("FILE", "DIR") else f for f in flags]
+    with pytest.raises(StudyError, match=message):
+        run_study("control", *args, "--seeds", "1", "--out", tmp_path / "out")
+    assert (tmp_path / "FILE").read_text() == "mine" and not (tmp_path / "out").exists()
+
+
+def test_a_study_whose_runs_all_failed_exits_with_some_failed(run_study, tmp_path,
+                                                             monkeypatch):
+    from types import SimpleNamespace
+
+    import arzsumo.studies.control as control
+    from arzsumo.studies.common import EXIT_SOME_FAILED
+
+    failed = SimpleNamespace(runs=pd.DataFrame(), sweep=SimpleNamespace(
+        table=pd.DataFrame({"status": ["failed", "crashed"]})))
+    monkeypatch.setattr(control, "run_evaluation", lambda *a, **k: failed)
+    assert run_study("control", "--seeds", "1", "--out", tmp_path / "out") == \
+        EXIT_SOME_FAILED
+    assert not (tmp_path / "out" / "control.md").exists()

@@ -1,5 +1,6 @@
 """Run records: a sweep continued from a record store runs nothing the store holds and
-tabulates the same numbers; stale, failed and half-copied records are handled."""
+tabulates the same numbers; stale, failed and half-copied records are handled, and a
+current record is never replaced by a stale one, in either direction."""
 
 from __future__ import annotations
 
@@ -10,7 +11,8 @@ import pytest
 
 from arzsumo.outdir import MARKER, resumable_dir
 from arzsumo.sweep import comparable, run_sweep
-from arzsumo.sweep.records import RECORD, copy_records, finished_runs
+from arzsumo.sweep.records import RECORD, copy_records, holds, records_table
+from arzsumo.sweep.table import run_dir
 from tests.sweep.helpers import SMALL, small_spec
 
 
@@ -23,6 +25,15 @@ def spec(horizon=60):
     return small_spec(fixed={**SMALL, "twin": {**SMALL["twin"], "horizon_s": horizon}})
 
 
+def runs(horizon=60):
+    return spec(horizon).runs()
+
+
+def fingerprints(place) -> set[str]:
+    return {json.loads(p.read_text())["sweep"]["sha256"]
+            for p in place.glob("runs/*/summary.json")}
+
+
 @pytest.fixture(scope="module")
 def swept(tmp_path_factory):
     out = tmp_path_factory.mktemp("sweep") / "out"
@@ -30,68 +41,109 @@ def swept(tmp_path_factory):
     return out
 
 
-def test_a_store_holds_only_the_two_record_files_of_each_run(swept, tmp_path):
-    assert copy_records(swept, tmp_path / "store", replace=True) == 4
+@pytest.fixture(scope="module")
+def swept_30(tmp_path_factory):
+    out = tmp_path_factory.mktemp("sweep30") / "out"
+    run_sweep(spec(30), out, workers=1, progress=False, plots=False)
+    return out
+
+
+def test_a_store_holds_only_the_three_record_files_of_each_run(swept, tmp_path):
+    assert copy_records(runs(), swept, tmp_path / "store") == 4
     files = sorted(p.name for p in (tmp_path / "store").rglob("*") if p.is_file())
     assert files == sorted(RECORD * 4)
-    # a second copy finds every record equal
-    assert copy_records(swept, tmp_path / "store", replace=True) == 0
+    assert fingerprints(tmp_path / "store") == {r.sha256 for r in runs()}
+    # a second copy finds every run held
+    assert copy_records(runs(), swept, tmp_path / "store") == 0
 
 
 def test_a_sweep_continued_from_records_runs_nothing_and_tabulates_the_same(swept,
                                                                              tmp_path):
-    copy_records(swept, tmp_path / "store", replace=True)
+    copy_records(runs(), swept, tmp_path / "store")
     fresh = tmp_path / "elsewhere" / "out"
     with resumable_dir(fresh, "sweep"):   # a sweep continues only its own directory
-        assert copy_records(tmp_path / "store", fresh, replace=False) == 4
+        assert copy_records(runs(), tmp_path / "store", fresh) == 4
     rep = run_sweep(spec(), fresh, workers=1, progress=False, plots=False)
     assert (rep.executed, rep.skipped) == (0, 4)
+    assert not (fresh / "executions.jsonl").exists()    # no execution at all
     before = comparable(pd.read_parquet(swept / "summaries.parquet"))
     pd.testing.assert_frame_equal(comparable(rep.table), before, check_dtype=False)
 
 
-def test_a_stale_record_is_run_again_and_replaced_in_the_store(swept, tmp_path):
+def test_a_stale_record_is_replaced_in_both_directions_and_never_replaces(swept, swept_30,
+                                                                          tmp_path):
     store = tmp_path / "store"
-    copy_records(swept, store, replace=True)
-    out = tmp_path / "out"
-    with resumable_dir(out, "sweep"):
-        copy_records(store, out, replace=False)
-    rep = run_sweep(spec(horizon=30), out, workers=1, progress=False, plots=False)
-    assert rep.executed == 4          # another horizon: every record is stale
-    assert copy_records(out, store, replace=True) == 4
-    doc = json.loads(next(store.rglob("summary.json")).read_text())
-    assert doc["sweep"]["sha256"] in {r.sha256 for r in spec(horizon=30).runs()}
+    copy_records(runs(60), swept, store)
+    # the scenario changed (another horizon): the store's records are stale for it, a
+    # sweep of it runs again and its records replace the stale ones
+    assert copy_records(runs(30), store, tmp_path / "none") == 0
+    assert copy_records(runs(30), swept_30, store) == 4
+    assert fingerprints(store) == {r.sha256 for r in runs(30)}
+    # the store is current: a directory with stale records does not overwrite it on the
+    # way out, and is itself brought up to date on the way in
+    stale = tmp_path / "stale"
+    copy_records(runs(60), swept, stale)
+    assert copy_records(runs(30), stale, store) == 0
+    assert copy_records(runs(30), store, stale) == 4
+    assert fingerprints(store) == fingerprints(stale) == {r.sha256 for r in runs(30)}
 
 
-def test_a_held_result_is_kept_unless_replacing_and_a_failure_is_superseded(swept,
-                                                                           tmp_path):
-    run = finished_runs(swept)[0]
-    mine = tmp_path / "out" / "runs" / run.name
+def test_a_current_result_is_kept_and_a_failure_is_superseded(swept, tmp_path):
+    run = runs()[0]
+    mine = run_dir(tmp_path / "out", run)
     mine.mkdir(parents=True)
-    (mine / "summary.json").write_text('{"sweep": {"status": "ok"}, "mine": 1}')
-    (mine / MARKER).write_bytes((run / MARKER).read_bytes())
+    for name in RECORD:
+        (mine / name).write_bytes((run_dir(swept, run) / name).read_bytes())
+    doc = json.loads((mine / "summary.json").read_text())
+    (mine / "summary.json").write_text(json.dumps({**doc, "mine": 1}))
     (mine / "cells.parquet").write_bytes(b"table")
-    assert copy_records(swept, tmp_path / "out", replace=False) == 3
+    assert copy_records(runs(), swept, tmp_path / "out") == 3
     assert "mine" in json.loads((mine / "summary.json").read_text())
-    assert copy_records(swept, tmp_path / "out", replace=True) == 1
-    assert (mine / "summary.json").read_bytes() == (run / "summary.json").read_bytes()
-    assert (mine / "cells.parquet").read_bytes() == b"table"
-    failed = tmp_path / "failed" / "runs" / run.name
+    failed = run_dir(tmp_path / "failed", run)
     failed.mkdir(parents=True)
-    (failed / "error.json").write_text("{}")
-    assert copy_records(swept, tmp_path / "failed", replace=False) == 4
-    assert not (failed / "error.json").exists()
+    (failed / "error.json").write_text(json.dumps({"sweep": {"sha256": run.sha256,
+                                                             "status": "failed"}}))
+    assert copy_records(runs(), swept, tmp_path / "failed") == 4
+    assert not (failed / "error.json").exists() and holds(tmp_path / "failed", run)
+
+
+def test_a_half_copied_record_is_not_held_and_is_completed(swept, tmp_path):
+    run = runs()[1]
+    half = run_dir(tmp_path / "half", run)
+    half.mkdir(parents=True)
+    (half / "summary.json").write_bytes((run_dir(swept, run) / "summary.json").read_bytes())
+    assert not holds(tmp_path / "half", run)           # no marker, no scenario
+    assert copy_records([run], swept, tmp_path / "half") == 1
+    assert holds(tmp_path / "half", run)
+    assert not list(half.glob(".*.part"))
 
 
 def test_unfinished_and_unreadable_runs_are_not_records(swept, tmp_path):
-    src = tmp_path / "src" / "runs"
-    for name, text in {"a": '{"sweep": {"status": "failed"}}', "b": "{not json",
-                       "c": '{"no": "sweep"}'}.items():
-        (src / name).mkdir(parents=True)
-        (src / name / "summary.json").write_text(text)
+    for run, text in zip(runs()[:3], ['{"sweep": {"status": "failed", "sha256": "%s"}}',
+                                      "{not json", '{"no": "sweep"}'], strict=True):
+        d = run_dir(tmp_path / "src", run)
+        d.mkdir(parents=True)
+        (d / "summary.json").write_text(text.replace("%s", run.sha256))
         for n in RECORD[:-1]:
-            (src / name / n).write_text("")
-    assert finished_runs(tmp_path / "src") == []
-    assert [p.name for p in finished_runs(swept)] == sorted(p.name for p in
-                                                            finished_runs(swept))
-    assert len(finished_runs(swept)) == 4
+            (d / n).write_text("")
+    assert not any(holds(tmp_path / "src", r) for r in runs())
+    assert copy_records(runs(), tmp_path / "src", tmp_path / "dst") == 0
+    assert all(holds(swept, r) for r in runs())
+
+
+def test_a_table_of_two_places_reads_each_run_where_it_is_held(swept, tmp_path):
+    store, out = tmp_path / "store", tmp_path / "out"
+    copy_records(runs()[:2], swept, store)
+    copy_records(runs()[2:3], swept, out)
+    before = {p: p.stat().st_mtime_ns for p in tmp_path.rglob("*")}
+    df = records_table(runs(), out, store)
+    assert before == {p: p.stat().st_mtime_ns for p in tmp_path.rglob("*")}   # reads only
+    assert list(df["run_id"]) == [r.run_id for r in runs()]
+    assert list(df["status"]) == ["ok", "ok", "ok", "missing"]
+    whole = comparable(pd.read_parquet(swept / "summaries.parquet")).iloc[:3]
+    mine = comparable(df.iloc[:3])[list(whole.columns)]
+
+    def gaps_as_none(d):        # a concatenation may turn a missing None into NaN
+        return d.astype(object).where(d.notna(), None)
+    pd.testing.assert_frame_equal(gaps_as_none(mine), gaps_as_none(whole), check_dtype=False)
+    assert MARKER in RECORD

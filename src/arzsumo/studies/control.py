@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -49,8 +50,7 @@ from arzsumo.studies.common import (
 from arzsumo.studies.control_claims import claims_table
 from arzsumo.sweep.evaluate import BASELINE, check_controllers, evaluation_spec, run_evaluation
 from arzsumo.sweep.evaluate import KIND as EVALUATION_KIND
-from arzsumo.sweep.records import copy_records
-from arzsumo.sweep.table import sweep_table
+from arzsumo.sweep.records import copy_records, records_table
 from arzsumo.sweep.worker import FINISHED
 
 log = logging.getLogger(__name__)
@@ -162,39 +162,62 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="run nothing: the tables from the runs already there "
                              "(finished so far, while a study is running too)")
     parser.add_argument("--records", type=Path, metavar="DIR",
-                        help="a store of run records (each finished run's scenario.toml "
-                             "and summary.json, DIR/<experiment>/runs/): the runs it holds "
-                             "are not run again, and every finished run is added to it; "
-                             "kept under version control, it carries the study across "
-                             "machines")
+                        help="a store of run records (each finished run's marker, "
+                             "scenario.toml and summary.json, DIR/<experiment>/runs/): "
+                             "the runs it holds are not run again, and every finished run "
+                             "is added to it; kept under version control, it carries the "
+                             "study across machines")
     add_runs(parser, seeds="1-20")
     add_output(parser, NAME, PAGE)
 
 
+def _check_records(args: argparse.Namespace) -> None:
+    """Refuse a ``--records`` that is not a usable directory, and ``--runs-from`` beside
+    ``--records`` or ``--report`` (their runs live elsewhere: neither store nor report
+    would see them)."""
+    if args.runs_from and (args.records is not None or args.report):
+        flag = "--records" if args.records is not None else "--report"
+        raise StudyError(f"--runs-from = {args.runs_from[0]} is not allowed with {flag}; "
+                         "allowed: one of them")
+    if args.records is None:
+        return
+    if args.records.exists() and not args.records.is_dir():
+        raise StudyError(f"--records = {args.records} is a file; allowed: a directory "
+                         "(made when missing)")
+    existing = next(p for p in (args.records, *args.records.parents) if p.exists())
+    if not args.report and not os.access(existing, os.W_OK | os.X_OK):
+        raise StudyError(f"--records = {args.records} cannot be written; allowed: a "
+                         "directory this user can write")
+
+
 def _evaluate(args: argparse.Namespace, scenario: Path, controllers: Sequence[str],
               out: Path) -> tuple[pd.DataFrame, bool]:
-    """One experiment's finished runs (its evaluation run unless ``--report``) and
-    whether every run finished. With ``--records``, the store's runs are copied in first
-    and every finished run out afterwards."""
+    """One experiment's finished runs and whether every run finished.
+
+    Unless ``--report``, the evaluation is run into ``out``; with ``--records``, the
+    store's runs are copied in first and every finished run out afterwards. With
+    ``--report`` no run is written under ``out`` (a study may be running there): each
+    run is read from ``out`` or else from the store."""
+    spec_runs = evaluation_spec(scenario, check_controllers(controllers), args.seeds).runs()
     store = None if args.records is None else args.records / out.name
+    if args.report:     # claimed only to hold this experiment's tables
+        with resumable_dir(out, EVALUATION_KIND):
+            runs = records_table(spec_runs, out, *([store] if store is not None else []))
+        return runs[runs["status"].isin(FINISHED)], True
     if store is not None:
         with resumable_dir(out, EVALUATION_KIND):
-            log.info("%d run records taken from %s", copy_records(store, out, replace=False),
+            log.info("%d run records taken from %s", copy_records(spec_runs, store, out),
                      store)
     try:
-        if not args.report:
-            res = run_evaluation(scenario, controllers, args.seeds, out=out,
-                                 workers=args.workers, scheduler=args.scheduler,
-                                 progress=not args.quiet, plots=False,
-                                 runs_from=args.runs_from)
-            return res.runs, res.sweep is None or bool(
-                res.sweep.table["status"].isin(FINISHED).all())
-        runs = sweep_table(evaluation_spec(scenario, check_controllers(controllers),
-                                           args.seeds).runs(), out)
-        return runs[runs["status"].isin(FINISHED)], True
+        res = run_evaluation(scenario, controllers, args.seeds, out=out,
+                             workers=args.workers, scheduler=args.scheduler,
+                             progress=not args.quiet, plots=False, runs_from=args.runs_from)
+        return res.runs, res.sweep is None or bool(
+            res.sweep.table["status"].isin(FINISHED).all())
     finally:
         if store is not None:
-            copy_records(out, store, replace=True)
+            log.info("%d run records added to %s", copy_records(spec_runs, out, store),
+                     store)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -202,6 +225,7 @@ def run(args: argparse.Namespace) -> int:
     controllers = check_controllers(args.controllers.split(","))
     experiments = names_among(args.experiments, EXPERIMENTS, "--experiments")
     _, base = read_toml(args.scenario, "scenario", StudyError)
+    _check_records(args)
     if args.list:
         for e in experiments:
             print(f"{e}: {', '.join(controllers)} on seeds {seed_text(args.seeds)}")
@@ -223,6 +247,9 @@ def run(args: argparse.Namespace) -> int:
             tables[e], finished_runs[e] = long, runs
             write_csv(long, out / e / "control.csv")
             write_text(f"# {e}\n\n{markdown(long, BASELINE)}", out / e / "control.md")
+        if not tables and not args.report:
+            log.error("no run finished: no tables; the failures are in %s", args.out)
+            return EXIT_SOME_FAILED
         if not tables:
             raise StudyError(f"--out = {args.out} has no finished runs yet; allowed: a run "
                              "without --report, or --records with a store that holds some")

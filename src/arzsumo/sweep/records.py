@@ -1,28 +1,35 @@
-"""Run records: the two files of a finished run that a sweep needs to count it as done and
-to tabulate it, copied between a sweep's output directory and a record store.
+"""Run records: the three small files of a finished run that a sweep needs to count it as
+done and to tabulate it, copied between a sweep's output directory and a record store.
 
-A finished run's directory holds ``scenario.toml`` (the resolved scenario),
-``summary.json`` (every measure, and the fingerprint of the scenario that made it) and
-the marker of an arzsumo result, beside
-larger tables (``periods.parquet``, ``cells.parquet``, ...) that only readings of single
-runs need. The two small files are enough for :func:`~arzsumo.sweep.table.read_record` to
-find the run finished and for :func:`~arzsumo.sweep.table.sweep_table` to give its row. A
-record store is a directory laid out like a sweep's (``runs/<run_id>/``) holding only
-those files: kept under version control, it carries a study of many hours across
-machines, a later call running only what the store does not hold.
+A finished run's directory holds the marker of an arzsumo result, ``scenario.toml`` (the
+resolved scenario) and ``summary.json`` (every measure, and the fingerprint of the
+scenario that made it), beside larger tables (``periods.parquet``, ``cells.parquet``,
+...) that only readings of single runs need. The three small files are enough for
+:func:`~arzsumo.sweep.table.read_record` to find the run finished and for
+:func:`~arzsumo.sweep.table.sweep_table` to give its row. A record store is a directory
+laid out like a sweep's (``runs/<run_id>/``) holding only those files: kept under version
+control, it carries a study of many hours across machines, a later call running only what
+the store does not hold.
 
-A record is found current by its fingerprint, wherever it was made, so a stale record (a
-run of another scenario under the same run ID) is not counted: it is run again and its
-record replaced.
+Whether a directory holds a run is decided by the run's fingerprint (the SHA-256 of its
+resolved scenario), wherever the record was made: a stale record (a run of another
+scenario under the same run ID) counts as absent, in a sweep's directory and in a store
+alike, so it never replaces a current one and is itself replaced by one.
 """
 
 from __future__ import annotations
 
-import json
+import os
 import shutil
+import tempfile
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 
+import pandas as pd
+
 from arzsumo.outdir import MARKER
+from arzsumo.sweep.spec import RunSpec
+from arzsumo.sweep.table import read_record, run_dir, sweep_table
 from arzsumo.sweep.worker import FINISHED
 
 #: the files of a run's record: the marker that lets a sweep rewrite the run's directory,
@@ -30,47 +37,59 @@ from arzsumo.sweep.worker import FINISHED
 RECORD = (MARKER, "scenario.toml", "summary.json")
 
 
-def finished_runs(out: Path) -> list[Path]:
-    """The run directories under ``out/runs`` whose ``summary.json`` records a finished
-    run, in name order."""
-    found = []
-    for summary in sorted(Path(out).glob("runs/*/summary.json")):
+def holds(out: Path, run: RunSpec) -> bool:
+    """Whether ``out`` holds the whole record of ``run`` finished, from its current
+    scenario (fingerprint)."""
+    found = read_record(out, run)
+    return (found is not None and found[0] in FINISHED
+            and all((run_dir(out, run) / n).is_file() for n in RECORD))
+
+
+def _copy_record(source: Path, dest: Path) -> None:
+    """Copy one record's files from ``source`` to ``dest``, its other files left alone.
+
+    The old ``summary.json`` goes first and the new one comes last, each file through a
+    temporary name of its own, so ``dest`` never pairs a summary with another run's
+    scenario, and an interrupted copy leaves a run that counts as not done.
+    """
+    dest.mkdir(parents=True, exist_ok=True)
+    for name in ("summary.json", "error.json"):
+        (dest / name).unlink(missing_ok=True)
+    for name in RECORD:
+        fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=".part", dir=dest)
+        os.close(fd)
         try:
-            status = json.loads(summary.read_text(encoding="utf-8"))["sweep"]["status"]
-        except (OSError, ValueError, KeyError, TypeError):
-            continue
-        if status in FINISHED and all((summary.parent / n).is_file() for n in RECORD):
-            found.append(summary.parent)
-    return found
+            shutil.copyfile(source / name, tmp)
+            Path(tmp).replace(dest / name)
+        finally:
+            Path(tmp).unlink(missing_ok=True)
 
 
-def _same(a: Path, b: Path) -> bool:
-    return all((b / n).is_file() and (a / n).read_bytes() == (b / n).read_bytes()
-               for n in RECORD)
+def copy_records(runs: Iterable[RunSpec], source: Path, target: Path) -> int:
+    """Copy the record of every run of ``runs`` that ``source`` holds and ``target`` does
+    not (:func:`holds`) from ``source/runs`` to ``target/runs``; return how many.
 
-
-def copy_records(source: Path, target: Path, *, replace: bool) -> int:
-    """Copy the record of every finished run under ``source`` to ``target/runs``; return
-    how many were copied.
-
-    A run ``target`` holds no finished result of (none, or a failure) is always copied.
-    One it holds a finished result of (a full run or a record) is left alone unless
-    ``replace``, and then its record files are replaced when they differ (its other files
-    stay). ``summary.json``, which makes a run count as done, is moved in last, from a
-    temporary name, so ``target`` never holds half of a record. A sweep continues only a
-    directory it made, so ``target``, when a sweep's, is claimed first
-    (:func:`arzsumo.outdir.resumable_dir`).
+    A current finished result in ``target`` is never replaced; a stale or failed one is.
+    A sweep continues only a directory it made, so ``target``, when a sweep's, is claimed
+    first (:func:`arzsumo.outdir.resumable_dir`).
     """
     copied = 0
-    for run in finished_runs(source):
-        dest = Path(target) / "runs" / run.name
-        if (dest / "summary.json").is_file() and (not replace or _same(run, dest)):
-            continue
-        dest.mkdir(parents=True, exist_ok=True)
-        (dest / "error.json").unlink(missing_ok=True)
-        for name in RECORD:
-            tmp = dest / f".{name}.part"
-            shutil.copyfile(run / name, tmp)
-            tmp.replace(dest / name)
-        copied += 1
+    for run in runs:
+        if holds(source, run) and not holds(target, run):
+            _copy_record(run_dir(source, run), run_dir(target, run))
+            copied += 1
     return copied
+
+
+def records_table(runs: Sequence[RunSpec], *places: Path) -> pd.DataFrame:
+    """:func:`~arzsumo.sweep.table.sweep_table` of ``runs``, each run read from the first
+    of ``places`` that holds it (a run none holds: as the first place has it), in the
+    order of ``runs``. Reads only: a running sweep's directory can be one of the places."""
+    where: dict[int, list[RunSpec]] = {}
+    for run in runs:
+        i = next((i for i, p in enumerate(places) if holds(p, run)), 0)
+        where.setdefault(i, []).append(run)
+    parts = [sweep_table(group, places[i]) for i, group in sorted(where.items())]
+    order = {run.run_id: k for k, run in enumerate(runs)}
+    df = pd.concat(parts, ignore_index=True)
+    return df.sort_values("run_id", key=lambda s: s.map(order)).reset_index(drop=True)

@@ -11,6 +11,8 @@ error becomes status ``invalid``, anything else ``failed``, each with its messag
 from __future__ import annotations
 
 import contextlib
+import functools
+import importlib.metadata
 import io
 import logging
 import os
@@ -147,10 +149,20 @@ def classified(fn: Any) -> tuple[str, dict[str, Any] | None, dict[str, bytes], s
         return "failed", None, {}, f"{type(exc).__name__}: {exc}\n{tb}"
 
 
+@functools.cache
+def sumo_version() -> str | None:
+    """The installed SUMO's version (the ``eclipse-sumo`` distribution), or None."""
+    try:
+        return importlib.metadata.version("eclipse-sumo")
+    except importlib.metadata.PackageNotFoundError:
+        return None
+
+
 def execution_record(**extra: Any) -> dict[str, Any]:
-    """Where and when an execution ran (``wall_s`` added when it ends)."""
+    """Where and when an execution ran, and with which SUMO (``wall_s`` added when it
+    ends): a run reproduces bit for bit only on the same SUMO version."""
     return {"id": uuid.uuid4().hex, "host": socket.gethostname(), "pid": os.getpid(),
-            "started": time.time(), **extra}
+            "started": time.time(), "sumo": sumo_version(), **extra}
 
 
 def crashed(task: RunTask, why: str) -> RunOutcome:
