@@ -143,12 +143,12 @@ def test_a_study_whose_runs_all_failed_exits_with_some_failed(run_study, tmp_pat
                                                              monkeypatch):
     from types import SimpleNamespace
 
-    import arzsumo.studies.control as control
+    import arzsumo.studies.recorded as recorded
     from arzsumo.studies.common import EXIT_SOME_FAILED
 
     failed = SimpleNamespace(runs=pd.DataFrame(), sweep=SimpleNamespace(
         table=pd.DataFrame({"status": ["failed", "crashed"]})))
-    monkeypatch.setattr(control, "run_evaluation", lambda *a, **k: failed)
+    monkeypatch.setattr(recorded, "run_evaluation", lambda *a, **k: failed)
     assert run_study("control", "--seeds", "1", "--out", tmp_path / "out") == \
         EXIT_SOME_FAILED
     assert not (tmp_path / "out" / "control.md").exists()

@@ -57,5 +57,7 @@ def test_the_table_pairs_each_step_with_the_full_configuration():
 def test_unknown_steps_and_a_missing_control_study_are_refused(run_study, tmp_path):
     with pytest.raises(StudyError, match="--steps = 'meter' is not allowed"):
         run_study("control-ablation", "--steps", "meter", "--out", tmp_path / "a")
-    with pytest.raises(StudyError, match="has no regulation experiment"):
+    with pytest.raises(StudyError, match="has no finished regulation run "
+                       "controller=backstepping,seed=1 of this scenario; allowed: the --out"):
         run_study("control-ablation", "--control", tmp_path, "--out", tmp_path / "a")
+    assert not (tmp_path / "a").exists()

@@ -26,8 +26,6 @@ from __future__ import annotations
 
 import argparse
 import logging
-import os
-from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -48,10 +46,8 @@ from arzsumo.studies.common import (
     seed_text,
 )
 from arzsumo.studies.control_claims import claims_table
-from arzsumo.sweep.evaluate import BASELINE, check_controllers, evaluation_spec, run_evaluation
-from arzsumo.sweep.evaluate import KIND as EVALUATION_KIND
-from arzsumo.sweep.records import copy_records, records_table
-from arzsumo.sweep.worker import FINISHED
+from arzsumo.studies.recorded import add_records, check_records, recorded_evaluation
+from arzsumo.sweep.evaluate import BASELINE, check_controllers
 
 log = logging.getLogger(__name__)
 
@@ -158,66 +154,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         metavar="DIR", help="an earlier evaluation or sweep (repeatable): "
                         "a controller whose runs on all the seeds are there is taken from "
                         "there (arzsumo evaluate --runs-from)")
-    parser.add_argument("--report", action="store_true",
-                        help="run nothing: the tables from the runs already there "
-                             "(finished so far, while a study is running too)")
-    parser.add_argument("--records", type=Path, metavar="DIR",
-                        help="a store of run records (each finished run's marker, "
-                             "scenario.toml and summary.json, DIR/<experiment>/runs/): "
-                             "the runs it holds are not run again, and every finished run "
-                             "is added to it; kept under version control, it carries the "
-                             "study across machines")
+    add_records(parser)
     add_runs(parser, seeds="1-20")
     add_output(parser, NAME, PAGE)
-
-
-def _check_records(args: argparse.Namespace) -> None:
-    """Refuse a ``--records`` that is not a usable directory, and ``--runs-from`` beside
-    ``--records`` or ``--report`` (their runs live elsewhere: neither store nor report
-    would see them)."""
-    if args.runs_from and (args.records is not None or args.report):
-        flag = "--records" if args.records is not None else "--report"
-        raise StudyError(f"--runs-from = {args.runs_from[0]} is not allowed with {flag}; "
-                         "allowed: one of them")
-    if args.records is None:
-        return
-    if args.records.exists() and not args.records.is_dir():
-        raise StudyError(f"--records = {args.records} is a file; allowed: a directory "
-                         "(made when missing)")
-    existing = next(p for p in (args.records, *args.records.parents) if p.exists())
-    if not args.report and not os.access(existing, os.W_OK | os.X_OK):
-        raise StudyError(f"--records = {args.records} cannot be written; allowed: a "
-                         "directory this user can write")
-
-
-def _evaluate(args: argparse.Namespace, scenario: Path, controllers: Sequence[str],
-              out: Path) -> tuple[pd.DataFrame, bool]:
-    """One experiment's finished runs and whether every run finished.
-
-    Unless ``--report``, the evaluation is run into ``out``; with ``--records``, the
-    store's runs are copied in first and every finished run out afterwards. With
-    ``--report`` no run is written under ``out`` (a study may be running there): each
-    run is read from ``out`` or else from the store."""
-    spec_runs = evaluation_spec(scenario, check_controllers(controllers), args.seeds).runs()
-    store = None if args.records is None else args.records / out.name
-    if args.report:     # claimed only to hold this experiment's tables
-        with resumable_dir(out, EVALUATION_KIND):
-            runs = records_table(spec_runs, out, *([store] if store is not None else []))
-        return runs[runs["status"].isin(FINISHED)], True
-    if store is not None:
-        with resumable_dir(out, EVALUATION_KIND):
-            log.info("%d run records taken from %s", copy_records(spec_runs, store, out),
-                     store)
-    try:
-        res = run_evaluation(scenario, controllers, args.seeds, out=out,
-                             workers=args.workers, scheduler=args.scheduler,
-                             progress=not args.quiet, plots=False, runs_from=args.runs_from)
-        return res.runs, res.sweep is None or bool(
-            res.sweep.table["status"].isin(FINISHED).all())
-    finally:
-        if store is not None:
-            log.info("%d run records added to %s", copy_records(spec_runs, out, store),
-                     store)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -225,7 +164,7 @@ def run(args: argparse.Namespace) -> int:
     controllers = check_controllers(args.controllers.split(","))
     experiments = names_among(args.experiments, EXPERIMENTS, "--experiments")
     _, base = read_toml(args.scenario, "scenario", StudyError)
-    _check_records(args)
+    check_records(args)
     if args.list:
         for e in experiments:
             print(f"{e}: {', '.join(controllers)} on seeds {seed_text(args.seeds)}")
@@ -235,7 +174,7 @@ def run(args: argparse.Namespace) -> int:
         for e in experiments:
             path = write_text(dump_toml(experiment_scenario(base, e)),
                               out / "scenarios" / f"{e}.toml")
-            runs, finished = _evaluate(args, path, controllers, out / e)
+            runs, finished = recorded_evaluation(args, path, controllers, out / e)
             ok &= finished
             counts.append(f"{e}: {len(runs)} of {len(controllers) * len(args.seeds)} runs "
                           "finished")

@@ -26,7 +26,8 @@ control study (``--control DIR``); ``fixed-cycle`` changes the plant and runs it
 from __future__ import annotations
 
 import argparse
-from collections.abc import Callable
+import tempfile
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import pandas as pd
@@ -36,6 +37,7 @@ from arzsumo.evaluation.stats import StatisticsError, paired_difference
 from arzsumo.io import dump_toml, read_toml
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, write_text
+from arzsumo.resources import shipped_scenarios_dir
 from arzsumo.studies import control
 from arzsumo.studies.common import (
     EXIT_SOME_FAILED,
@@ -46,7 +48,9 @@ from arzsumo.studies.common import (
     names_among,
     seed_text,
 )
-from arzsumo.sweep.evaluate import BASELINE, run_evaluation
+from arzsumo.studies.recorded import add_records, check_records, recorded_evaluation
+from arzsumo.sweep.evaluate import BASELINE, evaluation_spec
+from arzsumo.sweep.records import records_table
 from arzsumo.sweep.worker import FINISHED
 
 NAME = "control-ablation"
@@ -103,13 +107,14 @@ def measures() -> list[Measure]:
     return [next(m for m in control.MEASURES if m.key == k) for k in KEYS]
 
 
-def table(steps: dict[str, pd.DataFrame], full: pd.DataFrame, seeds: list[int]) -> str:
+def table(steps: dict[str, pd.DataFrame], full: pd.DataFrame, seeds: list[int],
+          laws: Sequence[str] = LAWS) -> str:
     """Markdown: per step, law and measure, the step minus the full configuration, paired
     by seed (mean [95 % t] wins/losses of the step)."""
     lines = ["| step | law | " + " | ".join(f"{m.label} ({m.unit})" for m in measures())
              + " |", "|---" * (2 + len(KEYS)) + "|"]
     for step, runs in steps.items():
-        for law in LAWS:
+        for law in laws:
             cells = []
             for m in measures():
                 a = per_seed(runs, m, [law])[law].reindex(seeds).to_numpy(float)
@@ -126,49 +131,63 @@ def table(steps: dict[str, pd.DataFrame], full: pd.DataFrame, seeds: list[int]) 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """The ablation's options."""
+    parser.add_argument("--scenario", type=Path,
+                        default=shipped_scenarios_dir() / "default.toml", metavar="FILE",
+                        help="the control study's base scenario (default: the shipped "
+                             "default)")
     parser.add_argument("--control", type=Path, default=RESULTS_DIR / control.NAME,
-                        metavar="DIR", help="the control study's --out (its regulation "
-                        "experiment is the full configuration)")
+                        metavar="DIR", help="the control study's --out, or its record "
+                        "store: its regulation runs are the full configuration")
     parser.add_argument("--steps", default=",".join(STEPS),
                         help="comma-separated steps (default: %(default)s)")
-    parser.add_argument("--report", action="store_true",
-                        help="run nothing: the table from the evaluations already there")
+    parser.add_argument("--laws", default=",".join(LAWS),
+                        help="comma-separated laws ablated (default: %(default)s)")
+    add_records(parser)
     add_runs(parser, seeds="1-10")
     add_output(parser, NAME, PAGE, plots=False)
+
+
+def full_configuration(regulation: Path, scenario: Path, laws: Sequence[str],
+                       seeds: Sequence[int], user: str) -> pd.DataFrame:
+    """The finished regulation runs of ``laws`` on ``seeds`` that the control study's
+    directory or store ``regulation`` holds of ``scenario``; a StudyError if one lacks."""
+    runs = records_table(evaluation_spec(scenario, laws, seeds).runs(), regulation)
+    missing = runs.loc[~runs["status"].isin(FINISHED), "run_id"].tolist()
+    if missing:
+        raise StudyError(f"--control = {user!r} is not allowed: it has no finished "
+                         f"regulation run {missing[0]} of this scenario; allowed: the "
+                         "--out or the record store of arzsumo study control with these "
+                         "laws and seeds")
+    return runs
 
 
 def run(args: argparse.Namespace) -> int:
     """Every step's evaluation (resumable), then the table against the full configuration."""
     steps = names_among(args.steps, list(STEPS), "--steps")
+    laws = names_among(args.laws, list(LAWS), "--laws")
+    check_records(args)
     if args.list:
         for s in steps:
-            print(f"{s}: {STEPS[s][0]}; {', '.join(LAWS)} on seeds {seed_text(args.seeds)}")
+            print(f"{s}: {STEPS[s][0]}; {', '.join(laws)} on seeds {seed_text(args.seeds)}")
         return 0
+    _, base = read_toml(args.scenario, "scenario", StudyError)
     regulation = Path(args.control) / "regulation"
-    full_table = regulation / "summaries.parquet"
-    if not full_table.is_file():
-        raise StudyError(f"--control = {str(args.control)!r} has no regulation experiment; "
-                         "allowed: the --out of arzsumo study control")
-    _, base = read_toml(Path(args.control) / "scenarios" / "regulation.toml", "scenario",
-                        StudyError)
     ok, found = True, {}
+    with tempfile.TemporaryDirectory() as tmp:     # checked before --out is touched
+        reg_path = write_text(dump_toml(control.experiment_scenario(base, "regulation")),
+                              Path(tmp) / "regulation.toml")
+        full = full_configuration(regulation, reg_path, laws, args.seeds, str(args.control))
     with resumable_dir(args.out, f"study-{NAME}") as out:
         for s in steps:
             path = write_text(dump_toml(step_scenario(base, s)), out / "steps" / f"{s}.toml")
-            if not args.report:
-                own_open = STEPS[s][2]
-                res = run_evaluation(path, [BASELINE, *LAWS] if own_open else list(LAWS),
-                                     args.seeds, out=out / s, workers=args.workers,
-                                     scheduler=args.scheduler, progress=not args.quiet,
-                                     plots=False,
-                                     baseline_from=None if own_open else regulation)
-                ok &= res.sweep is None or bool(res.sweep.table["status"].isin(FINISHED).all())
-            summaries = out / s / "summaries.parquet"
-            if summaries.is_file():
-                runs = pd.read_parquet(summaries)
-                found[s] = runs[runs["status"].isin(FINISHED)]
-        full = pd.read_parquet(full_table)
-        text = table(found, full[full["status"].isin(FINISHED)], args.seeds)
+            own_open = STEPS[s][2]
+            runs, finished = recorded_evaluation(
+                args, path, [BASELINE, *laws] if own_open else laws, out / s,
+                baseline_from=None if own_open else regulation)
+            ok &= finished
+            if not runs.empty:
+                found[s] = runs
+        text = table(found, full, args.seeds, laws)
         write_text(text, out / "ablation.md")
         if args.docs is not None:
             publish(args.docs, PAGE, NAME, "The controllers on the default in SUMO",
@@ -179,4 +198,4 @@ def run(args: argparse.Namespace) -> int:
     return 0 if ok else EXIT_SOME_FAILED
 
 
-__all__ = ["NAME", "STEPS", "run", "step_scenario", "table"]
+__all__ = ["NAME", "STEPS", "full_configuration", "run", "step_scenario", "table"]
