@@ -48,10 +48,10 @@ def swept_30(tmp_path_factory):
     return out
 
 
-def test_a_store_holds_only_the_three_record_files_of_each_run(swept, tmp_path):
+def test_a_store_holds_only_the_record_files_of_each_run(swept, tmp_path):
     assert copy_records(runs(), swept, tmp_path / "store") == 4
     files = sorted(p.name for p in (tmp_path / "store").rglob("*") if p.is_file())
-    assert files == sorted(RECORD * 4)
+    assert files == sorted((*RECORD, MARKER) * 4)
     assert fingerprints(tmp_path / "store") == {r.sha256 for r in runs()}
     # a second copy finds every run held
     assert copy_records(runs(), swept, tmp_path / "store") == 0
@@ -68,6 +68,21 @@ def test_a_sweep_continued_from_records_runs_nothing_and_tabulates_the_same(swep
     assert not (fresh / "executions.jsonl").exists()    # no execution at all
     before = comparable(pd.read_parquet(swept / "summaries.parquet"))
     pd.testing.assert_frame_equal(comparable(rep.table), before, check_dtype=False)
+
+
+def test_a_store_without_markers_as_version_control_keeps_it_still_carries_the_sweep(
+        swept, tmp_path):
+    store = tmp_path / "store"
+    copy_records(runs(), swept, store)
+    for marker in store.rglob(MARKER):      # the repository ignores result markers
+        marker.unlink()
+    assert all(holds(store, r) for r in runs())
+    fresh = tmp_path / "fresh"
+    with resumable_dir(fresh, "sweep"):
+        assert copy_records(runs(), store, fresh) == 4
+    assert len(list(fresh.glob(f"runs/*/{MARKER}"))) == 4
+    rep = run_sweep(spec(), fresh, workers=1, progress=False, plots=False)
+    assert (rep.executed, rep.skipped) == (0, 4)
 
 
 def test_a_stale_record_is_replaced_in_both_directions_and_never_replaces(swept, swept_30,
@@ -112,7 +127,7 @@ def test_a_half_copied_record_is_not_held_and_is_completed(swept, tmp_path):
     half = run_dir(tmp_path / "half", run)
     half.mkdir(parents=True)
     (half / "summary.json").write_bytes((run_dir(swept, run) / "summary.json").read_bytes())
-    assert not holds(tmp_path / "half", run)           # no marker, no scenario
+    assert not holds(tmp_path / "half", run)           # no scenario
     assert copy_records([run], swept, tmp_path / "half") == 1
     assert holds(tmp_path / "half", run)
     assert not list(half.glob(".*.part"))
@@ -146,4 +161,3 @@ def test_a_table_of_two_places_reads_each_run_where_it_is_held(swept, tmp_path):
     def gaps_as_none(d):        # a concatenation may turn a missing None into NaN
         return d.astype(object).where(d.notna(), None)
     pd.testing.assert_frame_equal(gaps_as_none(mine), gaps_as_none(whole), check_dtype=False)
-    assert MARKER in RECORD

@@ -42,7 +42,7 @@ def add_records(parser: argparse.ArgumentParser) -> None:
                         help="run nothing: the tables from the runs already there "
                              "(finished so far, while a study is running too)")
     parser.add_argument("--records", type=Path, metavar="DIR",
-                        help="a store of run records (each finished run's marker, "
+                        help="a store of run records (each finished run's "
                              "scenario.toml and summary.json, DIR/<experiment>/runs/): "
                              "the runs it holds are not run again, and every finished run "
                              "is added to it; kept under version control, it carries the "

@@ -1,15 +1,17 @@
 """Run records: the three small files of a finished run that a sweep needs to count it as
 done and to tabulate it, copied between a sweep's output directory and a record store.
 
-A finished run's directory holds the marker of an arzsumo result, ``scenario.toml`` (the
-resolved scenario) and ``summary.json`` (every measure, and the fingerprint of the
-scenario that made it), beside larger tables (``periods.parquet``, ``cells.parquet``,
-...) that only readings of single runs need. The three small files are enough for
+A finished run's directory holds ``scenario.toml`` (the resolved scenario) and
+``summary.json`` (every measure, and the fingerprint of the scenario that made it), beside
+the marker of an arzsumo result and larger tables (``periods.parquet``, ``cells.parquet``,
+...) that only readings of single runs need. The two small files are enough for
 :func:`~arzsumo.sweep.table.read_record` to find the run finished and for
 :func:`~arzsumo.sweep.table.sweep_table` to give its row. A record store is a directory
-laid out like a sweep's (``runs/<run_id>/``) holding only those files: kept under version
-control, it carries a study of many hours across machines, a later call running only what
-the store does not hold.
+laid out like a sweep's (``runs/<run_id>/``) holding only those two files: kept under
+version control, it carries a study of many hours across machines, a later call running
+only what the store does not hold. The marker is not part of a record (version control
+may ignore it, as this repository's does): it is written afresh wherever a record is
+copied to, so the sweep may later rewrite that run's directory.
 
 Whether a directory holds a run is decided by the run's fingerprint (the SHA-256 of its
 resolved scenario), wherever the record was made: a stale record (a run of another
@@ -27,14 +29,14 @@ from pathlib import Path
 
 import pandas as pd
 
-from arzsumo.outdir import MARKER
+from arzsumo.outdir import write_marker
 from arzsumo.sweep.spec import RunSpec
-from arzsumo.sweep.table import read_record, run_dir, sweep_table
+from arzsumo.sweep.table import RUN_KIND, read_record, run_dir, sweep_table
 from arzsumo.sweep.worker import FINISHED
 
-#: the files of a run's record: the marker that lets a sweep rewrite the run's directory,
-#: the resolved scenario, and the summary (last: its presence makes the run count as done)
-RECORD = (MARKER, "scenario.toml", "summary.json")
+#: the files of a run's record: the resolved scenario, and the summary (last: its presence
+#: makes the run count as done)
+RECORD = ("scenario.toml", "summary.json")
 
 
 def holds(out: Path, run: RunSpec) -> bool:
@@ -48,13 +50,14 @@ def holds(out: Path, run: RunSpec) -> bool:
 def _copy_record(source: Path, dest: Path) -> None:
     """Copy one record's files from ``source`` to ``dest``, its other files left alone.
 
-    The old ``summary.json`` goes first and the new one comes last, each file through a
-    temporary name of its own, so ``dest`` never pairs a summary with another run's
+    The old ``summary.json`` goes first, then the marker of a sweep's run is written, and
+    the new summary comes last, each file through a temporary name of its own, so ``dest`` never pairs a summary with another run's
     scenario, and an interrupted copy leaves a run that counts as not done.
     """
     dest.mkdir(parents=True, exist_ok=True)
     for name in ("summary.json", "error.json"):
         (dest / name).unlink(missing_ok=True)
+    write_marker(dest, RUN_KIND)
     for name in RECORD:
         fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=".part", dir=dest)
         os.close(fd)

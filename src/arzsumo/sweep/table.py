@@ -34,6 +34,8 @@ from arzsumo.sweep.spec import Axis, RunSpec
 #: executions of the same run and are left out when tables are compared
 VOLATILE = ("execution.", "wall_time", "numerics.wall_time_s", "numerics.speed_up",
             "timings.", "controller_time_per_period")
+#: the marker kind of one run's directory in a sweep (``runs/<run_id>/``)
+RUN_KIND = "sweep-run"
 #: summary entries that are not table columns
 SKIP = {"sweep", "settings_resolved", "units", "units_by_key"}
 
