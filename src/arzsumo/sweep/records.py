@@ -51,8 +51,9 @@ def _copy_record(source: Path, dest: Path) -> None:
     """Copy one record's files from ``source`` to ``dest``, its other files left alone.
 
     The old ``summary.json`` goes first, then the marker of a sweep's run is written, and
-    the new summary comes last, each file through a temporary name of its own, so ``dest`` never pairs a summary with another run's
-    scenario, and an interrupted copy leaves a run that counts as not done.
+    the new summary comes last, each file through a temporary name of its own, so
+    ``dest`` never pairs a summary with another run's scenario, and an interrupted copy
+    leaves a run that counts as not done.
     """
     dest.mkdir(parents=True, exist_ok=True)
     for name in ("summary.json", "error.json"):
