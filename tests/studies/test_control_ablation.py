@@ -8,6 +8,7 @@ import tomllib
 import pandas as pd
 import pytest
 
+from arzsumo.model import characteristic_speeds
 from arzsumo.resources import shipped_scenarios_dir
 from arzsumo.scenario import scenario_from_dict
 from arzsumo.studies import control_ablation
@@ -36,6 +37,16 @@ def test_each_step_is_a_valid_scenario_that_changes_one_piece(step):
         assert sc.actuation.delay_compensation == control_ablation.PREDICTION_S
     if step == "fixed-cycle":
         assert sc.sumo.meter_mode == "fixed_cycle" and control_ablation.STEPS[step][2]
+    if step == "wave-matched":
+        full_sc = scenario_from_dict(experiment_scenario(BASE, "regulation"))
+        eq, eq0 = sc.equilibrium, full_sc.equilibrium
+        lam4 = characteristic_speeds(sc.params, eq.rho_h, eq.rho_a)[3] * 3.6
+        lam4_0 = characteristic_speeds(full_sc.params, eq0.rho_h, eq0.rho_a)[3] * 3.6
+        assert lam4 == pytest.approx(control_ablation.WAVE_SPEED_KMH, abs=1e-6)
+        assert lam4_0 > -3.0                            # the identified model: -2.55
+        assert (eq.v_h, eq.v_a) == pytest.approx((eq0.v_h, eq0.v_a), rel=1e-9)
+        assert changed == {f"model.{k}" for k in ("gamma_h", "gamma_a", "ao_max_h",
+                                                  "ao_max_a")}
 
 
 def test_the_table_pairs_each_step_with_the_full_configuration():

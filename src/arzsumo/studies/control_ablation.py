@@ -16,6 +16,9 @@ equilibrium         deviations from the model's equilibrium, not the warm-up's s
 no-saturation       no bound on U or its rate, no ramp bound, no anti-windup
 fixed-cycle         the meter as a fixed cycle of green shares (no one-per-green)
 predictor           the laws on the state predicted :data:`PREDICTION_S` s ahead
+wave-matched        the laws (and twins) on the model whose lambda_4 is SUMO's
+                    measured wave speed :data:`WAVE_SPEED_KMH`, same equilibrium
+                    (:func:`arzsumo.model.wave_match.wave_matched`)
 ==================  ==============================================================
 
 Each step is an evaluation (:func:`~arzsumo.sweep.evaluate.run_evaluation`) into
@@ -35,9 +38,11 @@ import pandas as pd
 from arzsumo.evaluation.report import Measure, per_seed
 from arzsumo.evaluation.stats import StatisticsError, paired_difference
 from arzsumo.io import dump_toml, read_toml
+from arzsumo.model.wave_match import wave_matched
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, write_text
 from arzsumo.resources import shipped_scenarios_dir
+from arzsumo.scenario import scenario_from_dict
 from arzsumo.studies import control
 from arzsumo.studies.common import (
     EXIT_SOME_FAILED,
@@ -52,6 +57,7 @@ from arzsumo.studies.recorded import add_records, check_records, recorded_evalua
 from arzsumo.sweep.evaluate import BASELINE, evaluation_spec
 from arzsumo.sweep.records import records_table
 from arzsumo.sweep.worker import FINISHED
+from arzsumo.units import kmh_to_ms
 
 NAME = "control-ablation"
 #: the results page this study keeps a block of (the control study's)
@@ -72,6 +78,23 @@ def _set(changes: dict[str, object]) -> Callable[[dict], dict]:
     return apply
 
 
+#: SUMO's upstream wave speed on the default, km/h: the HV fluctuations' speed that
+#: ``arzsumo premise`` measured on seeds 6-8, -35 to -39 km/h
+#: (docs/results/premise_coupled.md); the identified model has lambda_4 = -2.55 km/h
+WAVE_SPEED_KMH = -35.0
+
+
+def _wave_matched(data: dict) -> dict:
+    """``data`` with the ``[model]`` of :func:`~arzsumo.model.wave_match.wave_matched`:
+    lambda_4 at the scenario's equilibrium moved to :data:`WAVE_SPEED_KMH`."""
+    sc = scenario_from_dict(data)
+    eq = sc.equilibrium
+    q = wave_matched(sc.params, eq.rho_h, eq.rho_a, float(kmh_to_ms(WAVE_SPEED_KMH)))
+    data.setdefault("model", {}).update(
+        {k: float(getattr(q, k)) for k in ("gamma_h", "gamma_a", "ao_max_h", "ao_max_a")})
+    return data
+
+
 #: step -> (what it changes, the change on the scenario as written, acts on the open loop)
 STEPS: dict[str, tuple[str, Callable[[dict], dict], bool]] = {
     "raw-cells": ("the laws on SUMO's Edie cells (no estimator)",
@@ -87,6 +110,8 @@ STEPS: dict[str, tuple[str, Callable[[dict], dict], bool]] = {
                     _set({"sumo.meter_mode": "fixed_cycle"}), True),
     "predictor": (f"the laws on the state predicted {PREDICTION_S:g} s ahead",
                   _set({"actuation.delay_compensation_s": PREDICTION_S}), False),
+    "wave-matched": (f"the model's lambda_4 at SUMO's wave speed, {WAVE_SPEED_KMH:g} km/h",
+                     _wave_matched, False),
 }
 #: the measures of the ablation table (keys of the control study's measures)
 KEYS = ("network_whole_demand.time_spent_s.total", "section.deviation.deviation_excess_s",
