@@ -82,6 +82,9 @@ def test_the_study_pairs_both_experiments_and_measures_the_decay(run_study, shor
     rows = [x for x in text.splitlines() if x.startswith("| integrated deviation above")]
     assert [r.split(" | ")[2] for r in rows] == ["open", "etc"]
     assert rows[0].count("(its mean)") == 2 and rows[1].count("/") >= 2
+    # each experiment's figure of the paired differences is a PNG
+    for e in ("regulation", "disturbance"):
+        assert (out / e / "control.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     # --report reads the same runs back and gives the same numbers, writing no run
     runs_before = {p: p.stat().st_mtime_ns for p in out.glob("*/runs/**/*")}
     assert run_study("control", *args, "--report") == 0

@@ -29,12 +29,17 @@ def write_evaluation(out: Path, long: pd.DataFrame, runs: pd.DataFrame,
         tmp.write_text(f"{header}\n\n{markdown(long, baseline)}\n", encoding="utf-8")
     written = [out / CSV, out / MARKDOWN]
     if plots and len(controllers) > 1:
-        written.append(_figure(out, long, runs, controllers, baseline, measures))
+        written.append(paired_figure(out / FIGURE, long, runs, controllers, baseline,
+                                     measures))
     return written
 
 
-def _figure(out: Path, long: pd.DataFrame, runs: pd.DataFrame, controllers: Sequence[str],
-            baseline: str, measures: Sequence[Measure]) -> Path:
+def paired_figure(path: Path, long: pd.DataFrame, runs: pd.DataFrame,
+                  controllers: Sequence[str], baseline: str,
+                  measures: Sequence[Measure]) -> Path:
+    """The per-seed differences of ``runs`` against ``baseline``, one panel per measure,
+    with the mean and 95 % t interval of ``long`` (:func:`~arzsumo.evaluation.report.
+    evaluate`), as a PNG at ``path``; return it."""
     from arzsumo.outputs.figures import save_png
     from arzsumo.plots.evaluation import DiffPanel, paired_differences_figure
 
@@ -49,4 +54,4 @@ def _figure(out: Path, long: pd.DataFrame, runs: pd.DataFrame, controllers: Sequ
     seeds = runs["seed"].nunique()
     title = (f"minus {baseline}, same seed: dots one seed each ({seeds} seeds), squares "
              "mean with 95 % CI (t)")
-    return save_png(paired_differences_figure(panels, title), out / FIGURE, dpi=100)
+    return save_png(paired_differences_figure(panels, title), path, dpi=100)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import textwrap
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
@@ -43,7 +44,7 @@ def paired_differences_figure(panels: Sequence[DiffPanel], title: str,
         ax.axhline(0.0, color="0.5", lw=0.8)
         ax.set_xticks(range(len(names)), names, rotation=30, fontsize=8)
         ax.set_xlim(-0.6, len(names) - 0.2)
-        ax.set_title(panel.title, fontsize=8)
+        ax.set_title(textwrap.fill(panel.title, 46), fontsize=8)   # long labels wrap
         ax.tick_params(axis="y", labelsize=7)
     for ax in axes.flat[len(panels):]:
         ax.set_visible(False)

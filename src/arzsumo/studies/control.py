@@ -19,7 +19,8 @@ for every controller of a seed), the release time and the paper's J_fuel and J_d
 over the section. Tables: per experiment
 ``OUT/<experiment>/control.{csv,md}`` (every measure: mean with its 95 % interval, the
 paired difference against the open loop with Student t and BCa bootstrap intervals,
-wins and losses), and ``OUT/control.md`` with the headline measures of both.
+wins and losses), ``OUT/<experiment>/control.png`` (the per-seed paired differences of
+:data:`FIGURE`'s measures), and ``OUT/control.md`` with the headline measures of both.
 """
 
 from __future__ import annotations
@@ -35,6 +36,7 @@ from arzsumo.evaluation.report import MEASURES as EVALUATION_MEASURES
 from arzsumo.evaluation.report import Measure, evaluate, markdown
 from arzsumo.io import dump_toml, read_toml
 from arzsumo.outdir import resumable_dir
+from arzsumo.outputs.evaluation import paired_figure
 from arzsumo.outputs.studies import publish, write_csv, write_text
 from arzsumo.resources import shipped_scenarios_dir
 from arzsumo.studies.common import (
@@ -43,6 +45,7 @@ from arzsumo.studies.common import (
     add_output,
     add_runs,
     names_among,
+    plots_wanted,
     seed_text,
 )
 from arzsumo.studies.control_claims import claims_table
@@ -93,6 +96,11 @@ HEADLINE = ("network_whole_demand.time_spent_s.total",
             "section.speed_oscillation_kmh.a", "plan_changes", "light_changes",
             "section.TTT.total", "section.total_delay.total", "section.J_fuel.total",
             "section.J_discom.total")
+#: the measures of each experiment's figure, ``OUT/<experiment>/control.png`` (keys)
+FIGURE = ("network_whole_demand.time_spent_s.total", "network_whole_demand.ramp_wait_s.p95",
+          "section.waves.h.band_power_kmh2", "section.waves.a.band_power_kmh2",
+          "section.speed_oscillation_kmh.h", "section.speed_oscillation_kmh.a",
+          "section.deviation.decay_time_s", "plan_changes")
 
 
 def experiment_scenario(base: dict, experiment: str) -> dict:
@@ -186,6 +194,10 @@ def run(args: argparse.Namespace) -> int:
             tables[e], finished_runs[e] = long, runs
             write_csv(long, out / e / "control.csv")
             write_text(f"# {e}\n\n{markdown(long, BASELINE)}", out / e / "control.md")
+            if plots_wanted(args) and len(controllers) > 1:
+                paired_figure(out / e / "control.png", long, runs, controllers, BASELINE,
+                              [m for m in MEASURES if m.key in FIGURE
+                               and m.key in runs.columns])
         if not tables and not args.report:
             log.error("no run finished: no tables; the failures are in %s", args.out)
             return EXIT_SOME_FAILED
@@ -202,7 +214,7 @@ def run(args: argparse.Namespace) -> int:
         write_text(text, out / "control.md")
         if args.docs is not None:
             files = [(out / e / f"control{x}", f"{e}{x}") for e in tables
-                     for x in (".csv", ".md")]
+                     for x in (".csv", ".md", ".png") if (out / e / f"control{x}").exists()]
             publish(args.docs, PAGE, NAME, "The controllers on the default in SUMO", text,
                     files)
     print(text)
