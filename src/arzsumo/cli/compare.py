@@ -50,7 +50,8 @@ def cmd_compare(args: argparse.Namespace) -> int:
                            "left to compare; allowed: results directories of arzsumo run")
     table, csv, png = compare_runs(runs, out, allow_mixed=args.allow_mixed)
     print(table)
-    print(f"written: {csv}, {png}")
+    fields = sorted(out.glob("fields_*.png"))
+    print("written: " + ", ".join(str(p) for p in (csv, png, *fields)))
     return 0
 
 

@@ -1,10 +1,13 @@
 """Write ``arzsumo compare``: ``comparison.csv`` and ``comparison.png`` from the table of
-:mod:`arzsumo.bridge.compare`."""
+:mod:`arzsumo.bridge.compare`, and, for a few SUMO runs on one grid, ``fields_hv.png`` and
+``fields_av.png``: each run's measured density and speed fields side by side."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from arzsumo.bridge.compare import (
@@ -26,6 +29,44 @@ METRICS = (("whole_tts_veh_h", "whole-demand TTS (veh h)"),
            ("ramp_wait_p95_s", "ramp wait, 95th percentile (s)"),
            ("network_time_loss_veh_h", "network time loss (veh h)"),
            ("TTT_veh_h", "section TTT (veh h)"), ("plan_changes", "meter plan changes (count)"))
+#: most runs whose fields are drawn side by side
+MAX_FIELD_RUNS = 6
+#: the Edie fields of a run's cells.parquet, in the order the field figures take
+FIELDS = ("rho_h", "v_h", "rho_a", "v_a")
+
+
+def micro_fields(run: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """(t s, x m, fields (n_t, 4, n_x) SI) of the SUMO cells of a run's ``cells.parquet``
+    (None without one)."""
+    path = run / "cells.parquet"
+    if not path.is_file():
+        return None
+    cells = pd.read_parquet(path, columns=["source", "t_s", "x_m", *FIELDS])
+    cells = cells[cells["source"] == "micro"]
+    t, x = np.unique(cells["t_s"].to_numpy()), np.unique(cells["x_m"].to_numpy())
+    grid = cells.set_index(["t_s", "x_m"])[list(FIELDS)].reindex(
+        pd.MultiIndex.from_product([t, x])).to_numpy(float)
+    return t, x, grid.reshape(t.size, x.size, 4).transpose(0, 2, 1)
+
+
+def field_figures(labels: Sequence[str], runs: Sequence[Path],
+                  star: tuple[float, float, float, float], target: Path) -> list[Path]:
+    """``fields_hv.png`` and ``fields_av.png`` in ``target`` for runs on one grid (at most
+    :data:`MAX_FIELD_RUNS`, each with its cells); none otherwise. ``star``: the equilibrium
+    (rho_h, v_h, rho_a, v_a), SI, marked on the colour bars."""
+    from arzsumo.outputs.figures import save_png
+    from arzsumo.plots.bridge import side_by_side_figure
+
+    found = [micro_fields(r) for r in runs]
+    if (len(runs) > MAX_FIELD_RUNS or any(f is None for f in found)
+            or len({(f[0].tobytes(), f[1].tobytes()) for f in found}) != 1):
+        return []
+    t, x = found[0][0], found[0][1]
+    panels = {label: f[2] for label, f in zip(labels, found, strict=True)}
+    return [save_png(side_by_side_figure(t, x, panels, cls, (star[k], star[k + 1]),
+                                         "SUMO's Edie cells over the control window"),
+                     target / f"fields_{name}.png", dpi=90)
+            for cls, k, name in (("h", 0, "hv"), ("a", 2, "av"))]
 
 def _bars(df: pd.DataFrame, means: bool) -> tuple[list[str], dict]:
     """Bar labels and heights (with sd error bars when ``means``) per metric panel."""
@@ -64,4 +105,9 @@ def compare_runs(runs: list[Path], out: Path,
             df.to_csv(tmp, index=False)
         png = save_png(comparison_figure(labels, bars, title), target / "comparison.png",
                        dpi=100)
+        for stale in target.glob("fields_*.png"):     # of an earlier comparison here
+            stale.unlink()
+        eq = summaries[0].get("equilibrium") or {}
+        if not means and all(k in eq for k in FIELDS):
+            field_figures(labels, runs, tuple(float(eq[k]) for k in FIELDS), target)
     return summary_table(summaries), csv, png
