@@ -114,9 +114,11 @@ STEPS: dict[str, tuple[str, Callable[[dict], dict], bool]] = {
                      _wave_matched, False),
 }
 #: the measures of the ablation table (keys of the control study's measures)
-KEYS = ("network_whole_demand.time_spent_s.total", "section.deviation.deviation_excess_s",
+KEYS = ("network_whole_demand.time_spent_s.total", "network_whole_demand.ramp_wait_s.p95",
+        "section.deviation.deviation_excess_s",
         "section.waves.h.band_power_kmh2", "section.waves.a.band_power_kmh2",
-        "section.speed_oscillation_kmh.h", "plan_changes")
+        "section.speed_oscillation_kmh.h", "section.speed_oscillation_kmh.a",
+        "section.waves.h.growth_per_km", "plan_changes")
 
 
 def step_scenario(base: dict, step: str) -> dict:
