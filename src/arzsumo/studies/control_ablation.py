@@ -134,25 +134,45 @@ def measures() -> list[Measure]:
     return [next(m for m in control.MEASURES if m.key == k) for k in KEYS]
 
 
+def _cells(a_runs: pd.DataFrame, a: str, b_runs: pd.DataFrame, b: str,
+           seeds: list[int]) -> list[str]:
+    """Per measure, ``a`` of ``a_runs`` minus ``b`` of ``b_runs``, paired by seed:
+    mean [95 % t] wins/losses of ``a`` (empty where there are too few pairs)."""
+    cells = []
+    for m in measures():
+        x = per_seed(a_runs, m, [a])[a].reindex(seeds).to_numpy(float)
+        y = per_seed(b_runs, m, [b])[b].reindex(seeds).to_numpy(float)
+        try:
+            d = paired_difference(x, y, lower_is_better=m.lower_is_better)
+            cells.append(f"{d.mean_diff:+.3g} [{d.t.low:+.3g}, {d.t.high:+.3g}] "
+                         f"{d.wins}/{d.losses}")
+        except StatisticsError:
+            cells.append("")
+    return cells
+
+
 def table(steps: dict[str, pd.DataFrame], full: pd.DataFrame, seeds: list[int],
           laws: Sequence[str] = LAWS) -> str:
-    """Markdown: per step, law and measure, the step minus the full configuration, paired
-    by seed (mean [95 % t] wins/losses of the step)."""
-    lines = ["| step | law | " + " | ".join(f"{m.label} ({m.unit})" for m in measures())
-             + " |", "|---" * (2 + len(KEYS)) + "|"]
+    """Markdown: per step, law and measure, the step minus the full configuration and the
+    step minus the open loop of its evaluation, paired by seed (mean [95 % t]
+    wins/losses of the step); first, the full configuration minus the open loop, where a
+    step borrowed the control study's open loop."""
+    lines = ["| step | law | minus | " + " | ".join(f"{m.label} ({m.unit})"
+                                                  for m in measures()) + " |",
+             "|---" * (3 + len(KEYS)) + "|"]
+    borrowed = next((r for s, r in steps.items() if not STEPS[s][2]
+                     and BASELINE in set(r["controller"])), None)
+    if borrowed is not None:
+        for law in laws:
+            lines.append(f"| full | {law} | open | "
+                         + " | ".join(_cells(full, law, borrowed, BASELINE, seeds)) + " |")
     for step, runs in steps.items():
         for law in laws:
-            cells = []
-            for m in measures():
-                a = per_seed(runs, m, [law])[law].reindex(seeds).to_numpy(float)
-                b = per_seed(full, m, [law])[law].reindex(seeds).to_numpy(float)
-                try:
-                    d = paired_difference(a, b, lower_is_better=m.lower_is_better)
-                    cells.append(f"{d.mean_diff:+.3g} [{d.t.low:+.3g}, {d.t.high:+.3g}] "
-                                 f"{d.wins}/{d.losses}")
-                except StatisticsError:
-                    cells.append("")
-            lines.append(f"| {step} | {law} | " + " | ".join(cells) + " |")
+            lines.append(f"| {step} | {law} | full | "
+                         + " | ".join(_cells(runs, law, full, law, seeds)) + " |")
+            if BASELINE in set(runs["controller"]):
+                lines.append(f"| {step} | {law} | open | "
+                             + " | ".join(_cells(runs, law, runs, BASELINE, seeds)) + " |")
     return "\n".join(lines)
 
 
