@@ -81,3 +81,17 @@ def test_unknown_steps_and_a_missing_control_study_are_refused(run_study, tmp_pa
                        "controller=backstepping,seed=1 of this scenario; allowed: the --out"):
         run_study("control-ablation", "--control", tmp_path, "--out", tmp_path / "a")
     assert not (tmp_path / "a").exists()
+
+
+def test_a_step_of_the_disturbance_experiment_keeps_the_slowdown_and_its_own_name():
+    data = control_ablation.step_scenario(BASE, "wave-matched", "disturbance")
+    full = experiment_scenario(BASE, "disturbance")
+    assert data["disturbance"] == full["disturbance"]
+    changed = {k for k, v in _flat(data).items() if _flat(full).get(k) != v}
+    assert {k.partition(".")[0] for k in changed} == {"model"}
+    assert data["name"].endswith("-ablation-wave-matched-disturbance")
+    assert control_ablation.step_name("wave-matched", "disturbance") != \
+        control_ablation.step_name("wave-matched")      # separate stores
+    # the regulation step keeps the name its records were made under
+    assert control_ablation.step_scenario(BASE, "wave-matched")["name"].endswith(
+        "-ablation-wave-matched")

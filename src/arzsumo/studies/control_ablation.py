@@ -1,7 +1,7 @@
 """Which piece of the controllers' configuration matters, one at a time
 (``arzsumo study control-ablation``).
 
-The control study's regulation experiment (``arzsumo study control``) runs the PDE laws
+The control study (``arzsumo study control``) runs the PDE laws
 with every piece the former default's ablation found needed: the ASM estimate rather than
 raw cells, deviations from the warm-up's state, saturation with anti-windup, the meter
 releasing one vehicle per green. This study takes one piece away at a time (and adds the
@@ -9,7 +9,7 @@ dead-time predictor, which the configuration lacks) and pairs each step, seed by
 with the full configuration's runs of the same controller:
 
 ==================  ==============================================================
-step                change on the regulation scenario
+step                change on the experiment's scenario
 ==================  ==============================================================
 raw-cells           the laws on SUMO's Edie cells of every vehicle (no estimator)
 equilibrium         deviations from the model's equilibrium, not the warm-up's state
@@ -21,9 +21,12 @@ wave-matched        the laws (and twins) on the model whose lambda_4 is SUMO's
                     (:func:`arzsumo.model.wave_match.wave_matched`)
 ==================  ==============================================================
 
-Each step is an evaluation (:func:`~arzsumo.sweep.evaluate.run_evaluation`) into
-``OUT/<step>/``. A step that does not act on an open loop borrows the open loop of the
-control study (``--control DIR``); ``fixed-cycle`` changes the plant and runs its own.
+The steps change the regulation experiment, or with ``--experiment disturbance`` the
+disturbance experiment (then against the control study's disturbance runs). Each step is
+an evaluation (:func:`~arzsumo.sweep.evaluate.run_evaluation`) into ``OUT/<step>/``
+(``OUT/<step>-disturbance/``). A step that does not act on an open loop borrows the open
+loop of the control study (``--control DIR``); ``fixed-cycle`` changes the plant and runs
+its own. The table gives each step minus the full configuration and minus the open loop.
 """
 
 from __future__ import annotations
@@ -121,12 +124,18 @@ KEYS = ("network_whole_demand.time_spent_s.total", "network_whole_demand.ramp_wa
         "section.waves.h.growth_per_km", "plan_changes")
 
 
-def step_scenario(base: dict, step: str) -> dict:
-    """The regulation scenario of ``base`` with ``step``'s change."""
-    data = control.experiment_scenario(base, "regulation")
+def step_name(step: str, experiment: str = "regulation") -> str:
+    """The name of a step's evaluation (its directory under ``--out`` and in the record
+    store): the step's own in the regulation experiment, suffixed in another."""
+    return step if experiment == "regulation" else f"{step}-{experiment}"
+
+
+def step_scenario(base: dict, step: str, experiment: str = "regulation") -> dict:
+    """The control study's ``experiment`` scenario of ``base`` with ``step``'s change."""
+    data = control.experiment_scenario(base, experiment)
     data = STEPS[step][1]({k: dict(v) if isinstance(v, dict) else v
                            for k, v in data.items()})
-    data["name"] = f"{base.get('name', 'scenario')}-ablation-{step}"
+    data["name"] = f"{base.get('name', 'scenario')}-ablation-{step_name(step, experiment)}"
     return data
 
 
@@ -184,7 +193,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "default)")
     parser.add_argument("--control", type=Path, default=RESULTS_DIR / control.NAME,
                         metavar="DIR", help="the control study's --out, or its record "
-                        "store: its regulation runs are the full configuration")
+                        "store: its runs of the experiment are the full configuration")
+    parser.add_argument("--experiment", choices=control.EXPERIMENTS, default="regulation",
+                        help="the control study's experiment the steps change "
+                             "(default: %(default)s)")
     parser.add_argument("--steps", default=",".join(STEPS),
                         help="comma-separated steps (default: %(default)s)")
     parser.add_argument("--laws", default=",".join(LAWS),
@@ -194,15 +206,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_output(parser, NAME, PAGE, plots=False)
 
 
-def full_configuration(regulation: Path, scenario: Path, laws: Sequence[str],
+def full_configuration(runs_dir: Path, scenario: Path, laws: Sequence[str],
                        seeds: Sequence[int], user: str) -> pd.DataFrame:
-    """The finished regulation runs of ``laws`` on ``seeds`` that the control study's
-    directory or store ``regulation`` holds of ``scenario``; a StudyError if one lacks."""
-    runs = records_table(evaluation_spec(scenario, laws, seeds).runs(), regulation)
+    """The finished runs of ``laws`` on ``seeds`` that the control study's directory or
+    store ``runs_dir`` (one experiment's) holds of ``scenario``; a StudyError if one
+    lacks."""
+    runs = records_table(evaluation_spec(scenario, laws, seeds).runs(), runs_dir)
     missing = runs.loc[~runs["status"].isin(FINISHED), "run_id"].tolist()
     if missing:
         raise StudyError(f"--control = {user!r} is not allowed: it has no finished "
-                         f"regulation run {missing[0]} of this scenario; allowed: the "
+                         f"{runs_dir.name} run {missing[0]} of this scenario; allowed: the "
                          "--out or the record store of arzsumo study control with these "
                          "laws and seeds")
     return runs
@@ -218,31 +231,37 @@ def run(args: argparse.Namespace) -> int:
             print(f"{s}: {STEPS[s][0]}; {', '.join(laws)} on seeds {seed_text(args.seeds)}")
         return 0
     _, base = read_toml(args.scenario, "scenario", StudyError)
-    regulation = Path(args.control) / "regulation"
+    experiment = args.experiment
+    control_runs = Path(args.control) / experiment
     ok, found = True, {}
     with tempfile.TemporaryDirectory() as tmp:     # checked before --out is touched
-        reg_path = write_text(dump_toml(control.experiment_scenario(base, "regulation")),
-                              Path(tmp) / "regulation.toml")
-        full = full_configuration(regulation, reg_path, laws, args.seeds, str(args.control))
+        exp_path = write_text(dump_toml(control.experiment_scenario(base, experiment)),
+                              Path(tmp) / f"{experiment}.toml")
+        full = full_configuration(control_runs, exp_path, laws, args.seeds,
+                                  str(args.control))
     with resumable_dir(args.out, f"study-{NAME}") as out:
         for s in steps:
-            path = write_text(dump_toml(step_scenario(base, s)), out / "steps" / f"{s}.toml")
+            name = step_name(s, experiment)
+            path = write_text(dump_toml(step_scenario(base, s, experiment)),
+                              out / "steps" / f"{name}.toml")
             own_open = STEPS[s][2]
             runs, finished = recorded_evaluation(
-                args, path, [BASELINE, *laws] if own_open else laws, out / s,
-                baseline_from=None if own_open else regulation)
+                args, path, [BASELINE, *laws] if own_open else laws, out / name,
+                baseline_from=None if own_open else control_runs)
             ok &= finished
             if not runs.empty:
                 found[s] = runs
         text = table(found, full, args.seeds, laws)
-        write_text(text, out / "ablation.md")
+        md = write_text(text, out / f"{step_name('ablation', experiment)}.md")
         if args.docs is not None:
             publish(args.docs, PAGE, NAME, "The controllers on the default in SUMO",
-                    f"Ablation on seeds {seed_text(args.seeds)}: each step minus the full "
-                    f"configuration, paired by seed (`arzsumo study {NAME}`).\n\n{text}",
-                    [(out / "ablation.md", "ablation.md")])
+                    f"Ablation of the {experiment} experiment on seeds "
+                    f"{seed_text(args.seeds)}: each step minus the full configuration and "
+                    f"minus the open loop, paired by seed (`arzsumo study {NAME}`).\n\n"
+                    f"{text}", [(md, md.name)])
     print(text)
     return 0 if ok else EXIT_SOME_FAILED
 
 
-__all__ = ["NAME", "STEPS", "full_configuration", "run", "step_scenario", "table"]
+__all__ = ["NAME", "STEPS", "full_configuration", "run", "step_name", "step_scenario",
+           "table"]
