@@ -17,7 +17,7 @@ DEFAULT = ModelParameters(tau_h=32.0192, tau_a=129.2219, gamma_h=1.056016,
 RHO = (0.1010331, 0.0224266)
 
 
-@pytest.mark.parametrize("target_kmh", [-35.0, -10.0, -60.0])
+@pytest.mark.parametrize("target_kmh", [-35.0, -10.0, -60.0, 0.0, 5.0])
 def test_lambda_4_reaches_the_target_and_the_class_speeds_stay(target_kmh):
     q = wave_matched(DEFAULT, *RHO, float(kmh_to_ms(target_kmh)))
     before, after = characteristic_speeds(DEFAULT, *RHO), characteristic_speeds(q, *RHO)
@@ -38,7 +38,7 @@ def test_scale_one_is_the_model_itself():
 
 
 def test_single_class_limit_is_linear_in_the_scale():
-    # HVs alone: the density Jacobian is diag(v_h + rho_h S_hh, v_a) with
+    # HVs alone: the density Jacobian is triangular, diagonal (v_h + rho_h S_hh, v_a), with
     # rho_h S_hh = -k gamma_h (V_h - v_h), so lambda_2 + lambda_4 - v_a is linear in k
     p = get_preset("paper_base").params
     rho_h = 0.12

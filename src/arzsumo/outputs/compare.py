@@ -53,7 +53,8 @@ def field_figures(labels: Sequence[str], runs: Sequence[Path],
                   star: tuple[float, float, float, float], target: Path) -> list[Path]:
     """``fields_hv.png`` and ``fields_av.png`` in ``target`` for runs on one grid (at most
     :data:`MAX_FIELD_RUNS`, each with its cells); none otherwise. ``star``: the equilibrium
-    (rho_h, v_h, rho_a, v_a), SI, marked on the colour bars."""
+    (rho_h, v_h, rho_a, v_a), SI, marked on the colour bars (the first run's, as the
+    table's header names it for a mixed comparison)."""
     from arzsumo.outputs.figures import save_png
     from arzsumo.plots.bridge import side_by_side_figure
 
@@ -62,7 +63,9 @@ def field_figures(labels: Sequence[str], runs: Sequence[Path],
             or len({(f[0].tobytes(), f[1].tobytes()) for f in found}) != 1):
         return []
     t, x = found[0][0], found[0][1]
-    panels = {label: f[2] for label, f in zip(labels, found, strict=True)}
+    names = [f"{k + 1}. {label}" if labels.count(label) > 1 else label
+             for k, label in enumerate(labels)]      # two runs never share a panel
+    panels = {name: f[2] for name, f in zip(names, found, strict=True)}
     return [save_png(side_by_side_figure(t, x, panels, cls, (star[k], star[k + 1]),
                                          "SUMO's Edie cells over the control window"),
                      target / f"fields_{name}.png", dpi=90)

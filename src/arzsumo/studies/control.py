@@ -168,6 +168,25 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_output(parser, NAME, PAGE)
 
 
+def write_tables(args: argparse.Namespace, long: pd.DataFrame, runs: pd.DataFrame,
+                 controllers: list[str], where: Path) -> list[tuple[Path, str]]:
+    """One experiment's ``control.csv``, ``control.md`` and (plots wanted, two controllers
+    or more) ``control.png`` in ``where``; return them as (path, published name). A figure
+    not redrawn is removed, so none of an earlier call is left to be published."""
+    e = where.name
+    files = [(write_csv(long, where / "control.csv"), f"{e}.csv"),
+             (write_text(f"# {e}\n\n{markdown(long, BASELINE)}", where / "control.md"),
+              f"{e}.md")]
+    figure = where / "control.png"
+    if plots_wanted(args) and len(controllers) > 1:
+        paired_figure(figure, long, runs, controllers, BASELINE,
+                      [m for m in MEASURES if m.key in FIGURE and m.key in runs.columns])
+        files.append((figure, f"{e}.png"))
+    else:
+        figure.unlink(missing_ok=True)
+    return files
+
+
 def run(args: argparse.Namespace) -> int:
     """Both experiments (resumable), the deviation measures, the tables."""
     controllers = check_controllers(args.controllers.split(","))
@@ -178,7 +197,7 @@ def run(args: argparse.Namespace) -> int:
         for e in experiments:
             print(f"{e}: {', '.join(controllers)} on seeds {seed_text(args.seeds)}")
         return 0
-    ok, tables, finished_runs, counts = True, {}, {}, []
+    ok, tables, finished_runs, counts, files = True, {}, {}, [], []
     with resumable_dir(args.out, f"study-{NAME}") as out:
         for e in experiments:
             path = write_text(dump_toml(experiment_scenario(base, e)),
@@ -191,14 +210,9 @@ def run(args: argparse.Namespace) -> int:
                 log.warning("no finished %s runs yet: its tables are left out", e)
                 continue
             measures = [m for m in MEASURES if m.key in runs.columns]
-            long = evaluate(runs, controllers, BASELINE, measures)
-            tables[e], finished_runs[e] = long, runs
-            write_csv(long, out / e / "control.csv")
-            write_text(f"# {e}\n\n{markdown(long, BASELINE)}", out / e / "control.md")
-            if plots_wanted(args) and len(controllers) > 1:
-                paired_figure(out / e / "control.png", long, runs, controllers, BASELINE,
-                              [m for m in MEASURES if m.key in FIGURE
-                               and m.key in runs.columns])
+            tables[e] = evaluate(runs, controllers, BASELINE, measures)
+            finished_runs[e] = runs
+            files += write_tables(args, tables[e], runs, controllers, out / e)
         if not tables and not args.report:
             log.error("no run finished: no tables; the failures are in %s", args.out)
             return EXIT_SOME_FAILED
@@ -214,8 +228,6 @@ def run(args: argparse.Namespace) -> int:
                      "of the paired differences):\n\n" + found)
         write_text(text, out / "control.md")
         if args.docs is not None:
-            files = [(out / e / f"control{x}", f"{e}{x}") for e in tables
-                     for x in (".csv", ".md", ".png") if (out / e / f"control{x}").exists()]
             publish(args.docs, PAGE, NAME, "The controllers on the default in SUMO", text,
                     files)
     print(text)

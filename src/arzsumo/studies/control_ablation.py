@@ -38,6 +38,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from arzsumo.errors import ArzsumoError
 from arzsumo.evaluation.report import Measure, per_seed
 from arzsumo.evaluation.stats import StatisticsError, paired_difference
 from arzsumo.io import dump_toml, read_toml
@@ -89,7 +90,12 @@ WAVE_SPEED_KMH = -35.0
 
 def _wave_matched(data: dict) -> dict:
     """``data`` with the ``[model]`` of :func:`~arzsumo.model.wave_match.wave_matched`:
-    lambda_4 at the scenario's equilibrium moved to :data:`WAVE_SPEED_KMH`."""
+    lambda_4 at the scenario's equilibrium moved to :data:`WAVE_SPEED_KMH`.
+
+    The four values are written with every digit of the root finder's answer, so the
+    step's fingerprint (and its records) hold for as long as numpy and scipy give the
+    same root to the last bit; another answer makes the records stale, and they run
+    again."""
     sc = scenario_from_dict(data)
     eq = sc.equilibrium
     q = wave_matched(sc.params, eq.rho_h, eq.rho_a, float(kmh_to_ms(WAVE_SPEED_KMH)))
@@ -185,6 +191,21 @@ def table(steps: dict[str, pd.DataFrame], full: pd.DataFrame, seeds: list[int],
     return "\n".join(lines)
 
 
+def step_scenarios(base: dict, steps: Sequence[str], experiment: str,
+                   user: str) -> dict[str, dict]:
+    """Every step's scenario, each checked as a scenario; a StudyError naming the first
+    step whose change the base scenario does not admit."""
+    out = {}
+    for s in steps:
+        try:
+            out[s] = step_scenario(base, s, experiment)
+            scenario_from_dict(out[s], f"{user} ({s})")
+        except ArzsumoError as exc:
+            raise StudyError(f"--steps = {s!r} is not allowed on --scenario = {user}: "
+                             f"{exc}; allowed: the other steps") from None
+    return out
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """The ablation's options."""
     parser.add_argument("--scenario", type=Path,
@@ -237,13 +258,13 @@ def run(args: argparse.Namespace) -> int:
     with tempfile.TemporaryDirectory() as tmp:     # checked before --out is touched
         exp_path = write_text(dump_toml(control.experiment_scenario(base, experiment)),
                               Path(tmp) / f"{experiment}.toml")
+        scenarios = step_scenarios(base, steps, experiment, str(args.scenario))
         full = full_configuration(control_runs, exp_path, laws, args.seeds,
                                   str(args.control))
     with resumable_dir(args.out, f"study-{NAME}") as out:
         for s in steps:
             name = step_name(s, experiment)
-            path = write_text(dump_toml(step_scenario(base, s, experiment)),
-                              out / "steps" / f"{name}.toml")
+            path = write_text(dump_toml(scenarios[s]), out / "steps" / f"{name}.toml")
             own_open = STEPS[s][2]
             runs, finished = recorded_evaluation(
                 args, path, [BASELINE, *laws] if own_open else laws, out / name,
@@ -254,7 +275,8 @@ def run(args: argparse.Namespace) -> int:
         text = table(found, full, args.seeds, laws)
         md = write_text(text, out / f"{step_name('ablation', experiment)}.md")
         if args.docs is not None:
-            publish(args.docs, PAGE, NAME, "The controllers on the default in SUMO",
+            publish(args.docs, PAGE, step_name(NAME, experiment),
+                    "The controllers on the default in SUMO",
                     f"Ablation of the {experiment} experiment on seeds "
                     f"{seed_text(args.seeds)}: each step minus the full configuration and "
                     f"minus the open loop, paired by seed (`arzsumo study {NAME}`).\n\n"

@@ -1,4 +1,4 @@
-"""Run records: the three small files of a finished run that a sweep needs to count it as
+"""Run records: the two small files of a finished run that a sweep needs to count it as
 done and to tabulate it, copied between a sweep's output directory and a record store.
 
 A finished run's directory holds ``scenario.toml`` (the resolved scenario) and
@@ -7,9 +7,9 @@ the marker of an arzsumo result and larger tables (``periods.parquet``, ``cells.
 ...) that only readings of single runs need. The two small files are enough for
 :func:`~arzsumo.sweep.table.read_record` to find the run finished and for
 :func:`~arzsumo.sweep.table.sweep_table` to give its row. A record store is a directory
-laid out like a sweep's (``runs/<run_id>/``) holding only those two files: kept under
-version control, it carries a study of many hours across machines, a later call running
-only what the store does not hold. The marker is not part of a record (version control
+laid out like a sweep's (``runs/<run_id>/``) holding only those two files (and the
+marker, below): kept under version control, it carries a study of many hours across
+machines, a later call running only what the store does not hold. The marker is not part of a record (version control
 may ignore it, as this repository's does): it is written afresh wherever a record is
 copied to, so the sweep may later rewrite that run's directory.
 
