@@ -9,9 +9,10 @@ the marker of an arzsumo result and larger tables (``periods.parquet``, ``cells.
 :func:`~arzsumo.sweep.table.sweep_table` to give its row. A record store is a directory
 laid out like a sweep's (``runs/<run_id>/``) holding only those two files (and the
 marker, below): kept under version control, it carries a study of many hours across
-machines, a later call running only what the store does not hold. The marker is not part of a record (version control
-may ignore it, as this repository's does): it is written afresh wherever a record is
-copied to, so the sweep may later rewrite that run's directory.
+machines, a later call running only what the store does not hold. The marker is not
+part of a record (version control may ignore it, as this repository's does): it is
+written afresh wherever a record is copied to, so the sweep may later rewrite that run's
+directory.
 
 Whether a directory holds a run is decided by the run's fingerprint (the SHA-256 of its
 resolved scenario), wherever the record was made: a stale record (a run of another
