@@ -124,7 +124,7 @@ STEPS: dict[str, tuple[str, Callable[[dict], dict], bool]] = {
 }
 #: the measures of the ablation table (keys of the control study's measures)
 KEYS = ("network_whole_demand.time_spent_s.total", "network_whole_demand.ramp_wait_s.p95",
-        "section.deviation.deviation_excess_s",
+        "section.deviation.deviation_excess_s", "section.deviation.decay_time_s",
         "section.waves.h.band_power_kmh2", "section.waves.a.band_power_kmh2",
         "section.speed_oscillation_kmh.h", "section.speed_oscillation_kmh.a",
         "section.waves.h.growth_per_km", "plan_changes")
