@@ -8,6 +8,7 @@ Nothing is written here: :func:`arzsumo.outputs.figures.save_figures` saves them
 
 from __future__ import annotations
 
+import textwrap
 from typing import Any
 
 import matplotlib.pyplot as plt
@@ -41,7 +42,9 @@ def side_by_side_figure(t: np.ndarray, x: np.ndarray, panels: dict[str, np.ndarr
             ax.set_facecolor("0.8")
             mesh = ax.pcolormesh(x / 1000.0, t, np.ma.masked_invalid(data[name]),
                                  shading="auto", cmap=cmap, vmin=vmin, vmax=vmax)
-            ax.set_title(f"{name}: {label} {'density' if row == 0 else 'speed'}")
+            ax.set_title(textwrap.fill(f"{name}: {label} "      # long run labels wrap
+                                       f"{'density' if row == 0 else 'speed'}", 48),
+                         fontsize=9)
             if row == 1:
                 ax.set_xlabel("x (km)")
             if col == 0:
