@@ -92,7 +92,9 @@ def test_the_study_pairs_both_experiments_and_measures_the_decay(run_study, shor
     assert runs_before == {p: p.stat().st_mtime_ns for p in out.glob("*/runs/**/*")}
     # the record store holds every run, and carries the study to a new directory: the
     # tables come back from it alone, and a continued study runs nothing it holds
-    assert len(list(store.glob("*/runs/*/summary.json"))) == 8
+    tables = sorted(p.relative_to(store).as_posix() for p in store.rglob("*") if p.is_file())
+    assert tables == ["disturbance/records.jsonl", "regulation/records.jsonl"]
+    assert [len((store / t).read_text().splitlines()) for t in tables] == [5, 5]
     for flags in (("--report",), ()):
         elsewhere = tmp_path / f"elsewhere{len(flags)}"
         assert run_study("control", *common, "--out", elsewhere, *flags) == 0

@@ -1,6 +1,7 @@
-"""Run records: a sweep continued from a record store runs nothing the store holds and
-tabulates the same numbers; stale, failed and half-copied records are handled, and a
-current record is never replaced by a stale one, in either direction."""
+"""Run records: a record store is one table; a sweep continued from it runs nothing it
+holds and tabulates the same numbers, to the last bit; stale, failed and half-copied
+records are handled, and a current record is never replaced by a stale one, in either
+direction."""
 
 from __future__ import annotations
 
@@ -11,8 +12,16 @@ import pytest
 
 from arzsumo.outdir import MARKER, resumable_dir
 from arzsumo.sweep import comparable, run_sweep
-from arzsumo.sweep.records import RECORD, copy_records, holds, records_table
-from arzsumo.sweep.table import run_dir
+from arzsumo.sweep.records import (
+    RECORD,
+    STORE,
+    copy_records,
+    holds,
+    read_store,
+    records_table,
+    stored_document,
+)
+from arzsumo.sweep.table import flatten, run_dir
 from tests.sweep.helpers import SMALL, small_spec
 
 
@@ -30,8 +39,15 @@ def runs(horizon=60):
 
 
 def fingerprints(place) -> set[str]:
+    if not (place / "runs").is_dir():
+        return {row["sweep.sha256"] for row in read_store(place).values()}
     return {json.loads(p.read_text())["sweep"]["sha256"]
             for p in place.glob("runs/*/summary.json")}
+
+
+def exactly(d: pd.DataFrame) -> pd.DataFrame:
+    """``d`` with its gaps as None (a concatenation may turn a missing None into NaN)."""
+    return d.astype(object).where(d.notna(), None)
 
 
 @pytest.fixture(scope="module")
@@ -48,13 +64,17 @@ def swept_30(tmp_path_factory):
     return out
 
 
-def test_a_store_holds_only_the_record_files_of_each_run(swept, tmp_path):
-    assert copy_records(runs(), swept, tmp_path / "store") == 4
-    files = sorted(p.name for p in (tmp_path / "store").rglob("*") if p.is_file())
-    assert files == sorted((*RECORD, MARKER) * 4)
-    assert fingerprints(tmp_path / "store") == {r.sha256 for r in runs()}
+def test_a_store_is_one_table_of_a_row_per_run(swept, tmp_path):
+    store = tmp_path / "store"
+    assert copy_records(runs()[:2], swept, store) == 2
+    assert copy_records(runs(), swept, store) == 2          # the rest, merged
+    assert [p.name for p in store.iterdir()] == [STORE]
+    lines = (store / STORE).read_text().splitlines()
+    assert len(lines) == 1 + 4          # the column names, a line per run
+    assert list(read_store(store)) == sorted(r.run_id for r in runs())
+    assert fingerprints(store) == {r.sha256 for r in runs()}
     # a second copy finds every run held
-    assert copy_records(runs(), swept, tmp_path / "store") == 0
+    assert copy_records(runs(), swept, store) == 0
 
 
 def test_a_sweep_continued_from_records_runs_nothing_and_tabulates_the_same(swept,
@@ -63,26 +83,39 @@ def test_a_sweep_continued_from_records_runs_nothing_and_tabulates_the_same(swep
     fresh = tmp_path / "elsewhere" / "out"
     with resumable_dir(fresh, "sweep"):   # a sweep continues only its own directory
         assert copy_records(runs(), tmp_path / "store", fresh) == 4
+    assert len(list(fresh.glob(f"runs/*/{MARKER}"))) == 4
     rep = run_sweep(spec(), fresh, workers=1, progress=False, plots=False)
     assert (rep.executed, rep.skipped) == (0, 4)
     assert not (fresh / "executions.jsonl").exists()    # no execution at all
     before = comparable(pd.read_parquet(swept / "summaries.parquet"))
-    pd.testing.assert_frame_equal(comparable(rep.table), before, check_dtype=False)
+    after = comparable(rep.table)
+    assert set(after.columns) == set(before.columns)
+    pd.testing.assert_frame_equal(exactly(after[list(before.columns)]), exactly(before),
+                                  check_dtype=False, check_exact=True)
+    # each restored scenario is the sweep's own text, so a borrowed open loop checks out
+    for run in runs():
+        assert (run_dir(fresh, run) / "scenario.toml").read_text() == \
+            (run_dir(swept, run) / "scenario.toml").read_text()
 
 
-def test_a_store_without_markers_as_version_control_keeps_it_still_carries_the_sweep(
-        swept, tmp_path):
-    store = tmp_path / "store"
-    copy_records(runs(), swept, store)
-    for marker in store.rglob(MARKER):      # the repository ignores result markers
-        marker.unlink()
-    assert all(holds(store, r) for r in runs())
-    fresh = tmp_path / "fresh"
-    with resumable_dir(fresh, "sweep"):
-        assert copy_records(runs(), store, fresh) == 4
-    assert len(list(fresh.glob(f"runs/*/{MARKER}"))) == 4
-    rep = run_sweep(spec(), fresh, workers=1, progress=False, plots=False)
-    assert (rep.executed, rep.skipped) == (0, 4)
+def test_a_record_keeps_every_kind_of_scalar(swept, tmp_path):
+    """Empty texts, nulls, booleans, integers and floats come back as they were, and a
+    table that is null in one run and a subtree in another gives each its own."""
+    first, second = runs()[:2]
+    odd = {"text": "", "name": "1e3", "none": None, "flag": True, "count": 3,
+           "third": 1 / 3, "tiny": 5e-324, "estimation": None}
+    for run, extra in ((first, odd), (second, {**odd, "estimation": {"gain": 2.0}})):
+        d = run_dir(tmp_path / "src", run)
+        d.mkdir(parents=True)
+        doc = json.loads((run_dir(swept, run) / "summary.json").read_text())
+        (d / "summary.json").write_text(json.dumps({**doc, **extra}))
+        (d / "scenario.toml").write_text((run_dir(swept, run) / "scenario.toml").read_text())
+    assert copy_records([first, second], tmp_path / "src", tmp_path / "store") == 2
+    records = read_store(tmp_path / "store")
+    for run in (first, second):
+        original = json.loads((run_dir(tmp_path / "src", run) / "summary.json").read_text())
+        back = stored_document(records[run.run_id], run)
+        assert flatten(back) == flatten(original)
 
 
 def test_a_stale_record_is_replaced_in_both_directions_and_never_replaces(swept, swept_30,
@@ -157,7 +190,5 @@ def test_a_table_of_two_places_reads_each_run_where_it_is_held(swept, tmp_path):
     assert list(df["status"]) == ["ok", "ok", "ok", "missing"]
     whole = comparable(pd.read_parquet(swept / "summaries.parquet")).iloc[:3]
     mine = comparable(df.iloc[:3])[list(whole.columns)]
-
-    def gaps_as_none(d):        # a concatenation may turn a missing None into NaN
-        return d.astype(object).where(d.notna(), None)
-    pd.testing.assert_frame_equal(gaps_as_none(mine), gaps_as_none(whole), check_dtype=False)
+    pd.testing.assert_frame_equal(exactly(mine), exactly(whole), check_dtype=False,
+                                  check_exact=True)

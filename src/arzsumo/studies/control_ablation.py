@@ -59,7 +59,9 @@ from arzsumo.studies.common import (
 )
 from arzsumo.studies.recorded import add_records, check_records, recorded_evaluation
 from arzsumo.sweep.evaluate import BASELINE, evaluation_spec
-from arzsumo.sweep.records import records_table
+from arzsumo.sweep.evaluate import KIND as EVALUATION_KIND
+from arzsumo.sweep.records import copy_records, is_store, records_table
+from arzsumo.sweep.spec import RunSpec
 from arzsumo.sweep.worker import FINISHED
 from arzsumo.units import kmh_to_ms
 
@@ -242,6 +244,16 @@ def full_configuration(runs_dir: Path, scenario: Path, laws: Sequence[str],
     return runs
 
 
+def open_loop_runs(control_runs: Path, runs: Sequence[RunSpec], here: Path) -> Path:
+    """Where the steps borrow the control study's open loop from: its directory, or, for
+    a record store, ``here``, where the store's open-loop ``runs`` are restored."""
+    if not is_store(control_runs):
+        return control_runs
+    with resumable_dir(here, EVALUATION_KIND) as claimed:
+        copy_records(runs, control_runs, claimed)
+    return here
+
+
 def run(args: argparse.Namespace) -> int:
     """Every step's evaluation (resumable), then the table against the full configuration."""
     steps = names_among(args.steps, list(STEPS), "--steps")
@@ -261,14 +273,17 @@ def run(args: argparse.Namespace) -> int:
         scenarios = step_scenarios(base, steps, experiment, str(args.scenario))
         full = full_configuration(control_runs, exp_path, laws, args.seeds,
                                   str(args.control))
+        open_runs = evaluation_spec(exp_path, [BASELINE], args.seeds).runs()
     with resumable_dir(args.out, f"study-{NAME}") as out:
+        baseline = open_loop_runs(control_runs, open_runs,
+                                  out / step_name("control-open", experiment))
         for s in steps:
             name = step_name(s, experiment)
             path = write_text(dump_toml(scenarios[s]), out / "steps" / f"{name}.toml")
             own_open = STEPS[s][2]
             runs, finished = recorded_evaluation(
                 args, path, [BASELINE, *laws] if own_open else laws, out / name,
-                baseline_from=None if own_open else control_runs)
+                baseline_from=None if own_open else baseline)
             ok &= finished
             if not runs.empty:
                 found[s] = runs

@@ -42,8 +42,8 @@ def add_records(parser: argparse.ArgumentParser) -> None:
                         help="run nothing: the tables from the runs already there "
                              "(finished so far, while a study is running too)")
     parser.add_argument("--records", type=Path, metavar="DIR",
-                        help="a store of run records (each finished run's "
-                             "scenario.toml and summary.json, DIR/<experiment>/runs/): "
+                        help="a store of run records (a table per experiment, "
+                             "DIR/<experiment>/records.jsonl, a line per finished run): "
                              "the runs it holds are not run again, and every finished run "
                              "is added to it; kept under version control, it carries the "
                              "study across machines")

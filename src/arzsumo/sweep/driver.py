@@ -43,7 +43,15 @@ from arzsumo.outdir import atomic_dir, resumable_dir
 from arzsumo.progress import Progress
 from arzsumo.sweep.groups import RunGroup, crashed_group, execute_group, share_warmups
 from arzsumo.sweep.spec import RunSpec, SweepError, SweepSpec
-from arzsumo.sweep.table import RUN_KIND, arrow_table, read_record, run_dir, sweep_table
+from arzsumo.sweep.table import (
+    RUN_KIND,
+    arrow_table,
+    read_record,
+    run_dir,
+    scenario_text,
+    sweep_record,
+    sweep_table,
+)
 from arzsumo.sweep.worker import FINISHED, RunOutcome, RunTask, crashed, execute
 
 log = logging.getLogger(__name__)
@@ -80,13 +88,10 @@ def task_of(spec: SweepSpec, run: RunSpec) -> RunTask:
 
 def write_outcome(out: Path, run: RunSpec, outcome: RunOutcome) -> None:
     """Store one outcome atomically under ``runs/<run_id>`` and log its execution."""
-    record = {"run_id": run.run_id, "index": run.index, "columns": dict(run.columns),
-              "overrides": dict(run.overrides), "sha256": run.sha256, "engine": run.engine,
-              "status": outcome.status, "execution": outcome.execution}
+    record = sweep_record(run, outcome.status, outcome.execution)
     with atomic_dir(run_dir(out, run), RUN_KIND, overwrite=True) as tmp:
-        (tmp / "scenario.toml").write_text(
-            f"# run {run.run_id} of a sweep: the resolved scenario\n"
-            + outcome.scenario_toml, encoding="utf-8")
+        (tmp / "scenario.toml").write_text(scenario_text(run, outcome.scenario_toml),
+                                           encoding="utf-8")
         if outcome.status in FINISHED and outcome.summary is not None:
             doc = {**outcome.summary, "warnings": outcome.warnings, "sweep": record}
             (tmp / "summary.json").write_text(json.dumps(doc, indent=2) + "\n",

@@ -59,6 +59,18 @@ def run_dir(out: Path, run: RunSpec) -> Path:
     return out / "runs" / run.run_id
 
 
+def sweep_record(run: RunSpec, status: str, execution: Mapping[str, Any]) -> dict[str, Any]:
+    """The ``sweep`` entry of a run's stored document: identity, fingerprint, outcome."""
+    return {"run_id": run.run_id, "index": run.index, "columns": dict(run.columns),
+            "overrides": dict(run.overrides), "sha256": run.sha256, "engine": run.engine,
+            "status": status, "execution": dict(execution)}
+
+
+def scenario_text(run: RunSpec, toml: str) -> str:
+    """The text of a run's ``scenario.toml``: its resolved scenario ``toml``, headed."""
+    return f"# run {run.run_id} of a sweep: the resolved scenario\n{toml}"
+
+
 def read_record(out: Path, run: RunSpec) -> tuple[str, dict[str, Any]] | None:
     """(status, stored document) of the run's current result, or None.
 
@@ -81,7 +93,7 @@ def read_record(out: Path, run: RunSpec) -> tuple[str, dict[str, Any]] | None:
     return None
 
 
-def _uniform(col: pd.Series) -> pd.Series:
+def uniform_types(col: pd.Series) -> pd.Series:
     """An object column Parquet can store: mixed Python types become strings."""
     if col.dtype != object:
         return col
@@ -92,26 +104,26 @@ def _uniform(col: pd.Series) -> pd.Series:
     return col.map(lambda v: v if v is None else str(v))
 
 
+def table_row(run: RunSpec, found: tuple[str, Mapping[str, Any]] | None) -> dict[str, Any]:
+    """The table row of ``run`` from its (status, stored document), or marked missing."""
+    row: dict[str, Any] = {"run_id": run.run_id, "index": run.index}
+    row.update(run.columns)
+    if found is None:
+        row.update(status="missing", error=None)
+        return row
+    status, doc = found
+    row.update(status=status, error=doc.get("error"), warnings=len(doc.get("warnings", [])))
+    ex = doc.get("sweep", {}).get("execution", {})
+    row.update({f"execution.{k}": v for k, v in ex.items()})
+    metrics = flatten(doc)
+    row.update({k: v for k, v in metrics.items() if k not in row})
+    return row
+
+
 def sweep_table(runs: Iterable[RunSpec], out: Path) -> pd.DataFrame:
     """The table of every run of the sweep as stored under ``out`` (missing runs marked)."""
-    rows = []
-    for run in runs:
-        row: dict[str, Any] = {"run_id": run.run_id, "index": run.index}
-        row.update(run.columns)
-        found = read_record(out, run)
-        if found is None:
-            row.update(status="missing", error=None)
-        else:
-            status, doc = found
-            row.update(status=status, error=doc.get("error"),
-                       warnings=len(doc.get("warnings", [])))
-            ex = doc.get("sweep", {}).get("execution", {})
-            row.update({f"execution.{k}": v for k, v in ex.items()})
-            metrics = flatten(doc)
-            row.update({k: v for k, v in metrics.items() if k not in row})
-        rows.append(row)
-    df = pd.DataFrame(rows)
-    return df.apply(_uniform)
+    df = pd.DataFrame([table_row(run, read_record(out, run)) for run in runs])
+    return df.apply(uniform_types)
 
 
 def comparable(df: pd.DataFrame) -> pd.DataFrame:
