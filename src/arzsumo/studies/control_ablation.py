@@ -19,6 +19,8 @@ predictor           the laws on the state predicted :data:`PREDICTION_S` s ahead
 wave-matched        the laws (and twins) on the model whose lambda_4 is SUMO's
                     measured wave speed :data:`WAVE_SPEED_KMH`, same equilibrium
                     (:func:`arzsumo.model.wave_match.wave_matched`)
+dead-band           the ETC's trigger with the noise dead band :data:`DEAD_BAND_KMH`
+                    (``[design] noise_sd_kmh``; backstepping does not read it)
 ==================  ==============================================================
 
 The steps change the regulation experiment, or with ``--experiment disturbance`` the
@@ -106,6 +108,12 @@ def _wave_matched(data: dict) -> dict:
     return data
 
 
+#: the ETC trigger's noise dead band of ``dead-band`` (``[design] noise_sd_kmh``, km/h, one
+#: sd per scaled Riemann variable w_1..w_4): twice the w-bar noise that 1 % relative state
+#: noise puts on the laws' grid, the band that brought the twin's ETC to 0.29 of its
+#: checks at SUMO's noise level (2 %; docs/readings/etc_remedies.md)
+DEAD_BAND_KMH = (5.569, 0.3392, 0.8406, 0.256)
+
 #: step -> (what it changes, the change on the scenario as written, acts on the open loop)
 STEPS: dict[str, tuple[str, Callable[[dict], dict], bool]] = {
     "raw-cells": ("the laws on SUMO's Edie cells (no estimator)",
@@ -123,6 +131,9 @@ STEPS: dict[str, tuple[str, Callable[[dict], dict], bool]] = {
                   _set({"actuation.delay_compensation_s": PREDICTION_S}), False),
     "wave-matched": (f"the model's lambda_4 at SUMO's wave speed, {WAVE_SPEED_KMH:g} km/h",
                      _wave_matched, False),
+    "dead-band": ("the ETC's trigger with a dead band sized to the estimate's noise",
+                  _set({"design.noise_sd_kmh": list(DEAD_BAND_KMH), "design.noise_k": 2.0}),
+                  False),
 }
 #: the measures of the ablation table (keys of the control study's measures)
 KEYS = ("network_whole_demand.time_spent_s.total", "network_whole_demand.ramp_wait_s.p95",
