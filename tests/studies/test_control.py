@@ -81,7 +81,7 @@ def test_the_study_pairs_both_experiments_and_measures_the_decay(run_study, shor
     text = (out / "control.md").read_text(encoding="utf-8")
     rows = [x for x in text.splitlines() if x.startswith("| integrated deviation above")]
     assert [r.split(" | ")[2] for r in rows] == ["open", "etc"]
-    assert rows[0].count("(its mean)") == 2 and rows[1].count("/") >= 2
+    assert rows[0].count("(its mean of 2)") == 2 and rows[1].count(" of 2") >= 2
     # each experiment's figure of the paired differences is a PNG
     for e in ("regulation", "disturbance"):
         assert (out / e / "control.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
@@ -116,11 +116,11 @@ def test_the_headline_gives_the_open_loops_mean_and_the_paired_differences():
             if r.startswith("| whole-demand time spent, total")]
     # open: mean 110 veh h with its t interval (sd 10, n 3: half-width 24.84)
     assert rows[0] == ("| whole-demand time spent, total | veh h | open | "
-                       "110 [85.16, 134.8] (its mean) |")
+                       "110 [85.16, 134.8] (its mean of 3) |")
     # held minus open: -2 veh h, t interval -2 -+ 4.303 * 1 / sqrt(3), three wins
     assert rows[1].startswith("| whole-demand time spent, total | veh h | held | "
                               "-2 [-4.48, +0.484] {")
-    assert rows[1].endswith(" 3/0 |")
+    assert rows[1].endswith(" 3/0 of 3 |")
 
 
 def test_a_report_without_any_finished_run_is_refused(run_study, tmp_path):

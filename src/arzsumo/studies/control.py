@@ -115,22 +115,25 @@ def experiment_scenario(base: dict, experiment: str) -> dict:
 
 
 def _cell(r: pd.Series, baseline: bool) -> str:
-    """One headline cell: the open loop's own mean [95 % t]; any other controller's paired
-    difference against it, mean [95 % t] {95 % bootstrap} wins/losses."""
+    """One headline cell: the open loop's own mean [95 % t] over its n seeds; any other
+    controller's paired difference against it, mean [95 % t] {95 % bootstrap}
+    wins/losses of the seeds paired (the controllers of a study may have run on
+    different numbers of seeds so far)."""
     if baseline:
-        return f"{r['mean']:.4g} [{r.ci_low:.4g}, {r.ci_high:.4g}] (its mean)"
+        return f"{r['mean']:.4g} [{r.ci_low:.4g}, {r.ci_high:.4g}] (its mean of {int(r.n)})"
     if not np.isfinite(r.diff_mean):
         return ""
     return (f"{r.diff_mean:+.3g} [{r.diff_ci_low:+.3g}, {r.diff_ci_high:+.3g}]"
             f" {{{r.diff_boot_low:+.3g}, {r.diff_boot_high:+.3g}}}"
-            f" {int(r.wins)}/{int(r.losses)}")
+            f" {int(r.wins)}/{int(r.losses)} of {int(r.wins + r.losses + r.ties)}")
 
 
 def headline(tables: dict[str, pd.DataFrame]) -> str:
     """Markdown: per headline measure, the open loop's mean and every other controller's
     paired difference against it in each experiment (:func:`_cell`)."""
     head = ("| measure | unit | controller | "
-            + " | ".join(f"{e}: open mean [t]; others minus open [t] {{bootstrap}} w/l"
+            + " | ".join(f"{e}: open mean [t]; others minus open [t] {{bootstrap}} w/l "
+                         "of pairs"
                          for e in tables) + " |")
     lines = [head, "|---" * (3 + len(tables)) + "|"]
     first = next(iter(tables.values()))
