@@ -141,7 +141,7 @@ KEYS = ("network_whole_demand.time_spent_s.total", "network_whole_demand.ramp_wa
         "section.deviation.deviation_excess_s", "section.deviation.decay_time_s",
         "section.waves.h.band_power_kmh2", "section.waves.a.band_power_kmh2",
         "section.speed_oscillation_kmh.h", "section.speed_oscillation_kmh.a",
-        "section.waves.h.growth_per_km", "plan_changes")
+        "section.waves.h.growth_per_km", "plan_changes", "triggers")
 
 
 def step_name(step: str, experiment: str = "regulation") -> str:
