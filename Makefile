@@ -1,4 +1,5 @@
-# make run  : create .venv if missing, install arzsumo with its extras, run the default job
+# make run  : create .venv if missing, install arzsumo with its extras, run the default job,
+#             then print the control study's result from its record store
 # make test : the same set-up, then the import contracts (lint-imports) and the whole test suite
 PYTHON ?= python3
 VENV   ?= .venv
@@ -12,8 +13,13 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --quiet --disable-pip-version-check -e '.[test]'
 	touch $(STAMP)
 
+# the default run, then the judged result: the control study's tables from the committed
+# record store (nothing runs; seconds)
+RECORDS := docs/readings/control_default/records
+
 run: $(STAMP)
 	$(BIN)/arzsumo run --overwrite
+	$(BIN)/arzsumo study control --report --seeds 1-20 --records $(RECORDS) --quiet
 
 test: $(STAMP)
 	$(BIN)/lint-imports
