@@ -75,6 +75,23 @@ def _cmdline(pid: int) -> bytes:
         return b""
 
 
+def _started(pid: int) -> tuple[str, str] | None:
+    """(state, start time) of process ``pid``, None when there is none. The start time
+    tells a process from a later one under the same reused PID (pid_max may be 32768)."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return None
+    return fields[0], fields[19]
+
+
+def _alive(pid: int, started: tuple[str, str] | None) -> bool:
+    """Whether the process that had ``started`` still runs (a zombie has exited)."""
+    now = _started(pid)
+    return now is not None and started is not None and now[1] == started[1] \
+        and now[0] != "Z"
+
+
 def _children(pid: int) -> list[int]:
     out = []
     for stat in Path("/proc").glob("[0-9]*/stat"):
@@ -148,14 +165,14 @@ def test_a_terminated_sweep_leaves_no_worker_and_no_file(tmp_path):
     deadline = time.monotonic() + 120     # both workers in SUMO: 3 scratch entries a run
     while time.monotonic() < deadline and (len(workers()) < 2 or runs_started() < 6):
         time.sleep(0.2)
-    pool = workers()
+    pool = {p: _started(p) for p in workers()}
     assert len(pool) == 2 and runs_started() >= 6
     proc.send_signal(signal.SIGTERM)
     proc.wait(timeout=30)
     deadline = time.monotonic() + 60
-    while time.monotonic() < deadline and any(Path(f"/proc/{p}").exists() for p in pool):
+    while time.monotonic() < deadline and any(_alive(p, t) for p, t in pool.items()):
         time.sleep(0.2)
-    assert not any(Path(f"/proc/{p}").exists() for p in pool)
+    assert not any(_alive(p, t) for p, t in pool.items())
     assert in_scratch() == []             # each worker closed SUMO and removed its files
 
 
