@@ -1,6 +1,7 @@
 # make run  : create .venv if missing, install arzsumo with its extras, run the default job,
 #             then print the control study's result from its record store
-# make test : the same set-up, then the import contracts (lint-imports) and the whole test suite
+# make test : the same set-up, then ruff, the import contracts (lint-imports) and the whole
+#             test suite
 PYTHON ?= python3
 VENV   ?= .venv
 BIN    := $(VENV)/bin
@@ -22,6 +23,7 @@ run: $(STAMP)
 	$(BIN)/arzsumo study control --report --seeds 1-20 --records $(RECORDS) --quiet
 
 test: $(STAMP)
+	$(BIN)/ruff check src tests benchmarks
 	$(BIN)/lint-imports
 	$(BIN)/python -m pytest -q -n 2
 

@@ -29,7 +29,8 @@ an evaluation (:func:`~arzsumo.sweep.evaluate.run_evaluation`) into ``OUT/<step>
 (``OUT/<step>-disturbance/``). A step that does not act on an open loop borrows the open
 loop of the control study (``--control DIR``: its ``--out``, or its record store, whose
 open-loop records are then restored into ``OUT/control-open/``); ``fixed-cycle`` changes
-the plant and runs its own. The table gives each step minus the full configuration and minus the open loop.
+the plant and runs its own. The table gives each step minus the full configuration and
+minus the open loop.
 """
 
 from __future__ import annotations
