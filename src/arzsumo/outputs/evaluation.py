@@ -51,7 +51,16 @@ def paired_figure(path: Path, long: pd.DataFrame, runs: pd.DataFrame,
         better = "lower" if m.lower_is_better else "higher"
         panels.append(DiffPanel(f"{m.label} ({m.unit}; {better} is better)",
                                 paired_differences(runs, m, controllers, baseline), ci))
-    seeds = runs["seed"].nunique()
-    title = (f"minus {baseline}, same seed: dots one seed each ({seeds} seeds), squares "
-             "mean with 95 % CI (t)")
-    return save_png(paired_differences_figure(panels, title), path, dpi=100)
+    return save_png(paired_differences_figure(panels, paired_title(runs, controllers,
+                                                                   baseline)),
+                    path, dpi=100)
+
+
+def paired_title(runs: pd.DataFrame, controllers: Sequence[str], baseline: str) -> str:
+    """The paired figure's title, naming the range of seed counts of the controllers
+    other than ``baseline`` (a study's controllers may stand at different counts)."""
+    counts = sorted({int(runs.loc[runs["controller"] == c, "seed"].nunique())
+                     for c in controllers if c != baseline})
+    seeds = "-".join(str(n) for n in dict.fromkeys((counts[0], counts[-1])))
+    return (f"minus {baseline}, same seed: dots one seed each ({seeds} seeds), squares "
+            "mean with 95 % CI (t)")
