@@ -20,7 +20,9 @@ over the section. Tables: per experiment
 ``OUT/<experiment>/control.{csv,md}`` (every measure: mean with its 95 % interval, the
 paired difference against the open loop with Student t and BCa bootstrap intervals,
 wins and losses), ``OUT/<experiment>/control.png`` (the per-seed paired differences of
-:data:`FIGURE`'s measures), and ``OUT/control.md`` with the headline measures of both.
+:data:`FIGURE`'s measures), and ``OUT/control.md`` with the headline measures of both,
+the paper's claims, and the section's lateral files per controller
+(:mod:`arzsumo.studies.control_files`).
 """
 
 from __future__ import annotations
@@ -49,6 +51,7 @@ from arzsumo.studies.common import (
     seed_text,
 )
 from arzsumo.studies.control_claims import claims_table
+from arzsumo.studies.control_files import MIN_SHARE, files_table
 from arzsumo.studies.recorded import add_records, check_records, recorded_evaluation
 from arzsumo.sweep.evaluate import BASELINE, check_controllers
 
@@ -229,6 +232,11 @@ def run(args: argparse.Namespace) -> int:
         if found:
             text += ("\n\nThe paper's section-5 claims, as SUMO tests them (95 % t intervals "
                      "of the paired differences):\n\n" + found)
+        for e, runs in finished_runs.items():
+            text += (f"\n\nThe section's lateral files, {e} (files holding at least "
+                     f"{MIN_SHARE:.0%} of a class's samples, and the largest gap between "
+                     "their mean speeds: a class-level average is the stream's only while "
+                     "its files ride at one speed):\n\n" + files_table(runs, controllers))
         write_text(text, out / "control.md")
         if args.docs is not None:
             publish(args.docs, PAGE, NAME, "The controllers on the default in SUMO", text,
