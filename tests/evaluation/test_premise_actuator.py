@@ -110,7 +110,11 @@ def test_any_noise_free_fopdt_is_recovered(k, delay, tau):
     # the recovered gain is exact to float rounding only: within it of a bound the verdict
     # may go either way, so the property is asserted away from the bounds
     assume(min(abs(k - lo), abs(k - hi)) > 1e-6)
-    g = actuator_gate(_record(k, k, delay=delay, tau=tau, steps=4))
+    # exactness needs a settled response: the level after a step is read over the hold's
+    # last 60 s, where an unsettled tail exp(-(hold - 60 - delay) / tau) would bias it
+    # (e.g. 2e-5 for delay 19 s, tau 15 s, hold 240 s)
+    hold = max(240.0, float(np.ceil(60.0 + delay + 15.0 * tau)))   # steps on bin edges
+    g = actuator_gate(_record(k, k, delay=delay, tau=tau, hold=hold, steps=4))
     assert g.passed is (lo <= k <= hi)
     # exact at bin edges; within the bin where a fast response rises, to half a bin
     tol = 0.05 if tau >= 3.0 else 0.5
