@@ -1,7 +1,7 @@
 """Delay compensation: a PDE law evaluated on the state predicted theta seconds ahead.
 
 The ramp meter moves the section's outflow only a dead time theta after a command (10-14 s
-in SUMO, ``docs/results/meter_dynamics.md``): the U-bar issued at t enters the
+in SUMO, ``arzsumo study meter-dynamics``): the U-bar issued at t enters the
 boundary condition clpsys4 at t + theta. :class:`DelayCompensated` wraps a law that takes
 scaled Riemann states (continuous backstepping, control_law; the full-state ETC, control
 law sam with defdynamic) and, at every check t,

@@ -1,7 +1,7 @@
 """Delay predictor: the scaled Riemann state theta seconds ahead by linear transport.
 
 The ramp meter moves the section's outflow only after a dead time theta
-(``docs/results/meter_dynamics.md``): a command U-bar issued at t reaches the boundary
+(``arzsumo study meter-dynamics``): a command U-bar issued at t reaches the boundary
 condition w-(L) = R w+(L) + U-bar (clpsys4) at t + theta. A law evaluated on the predicted
 state w-bar(t + theta) instead of w-bar(t) (a predictor in the sense of Smith, for
 hyperbolic boundary control: Krstic's predictor feedback) compensates it: the command

@@ -14,7 +14,7 @@ controller's U unchanged (the meter itself still saturates its green share to
 ``[sumo] green_share_min .. green_share_max``).
 
 ``delay_compensation_s`` is the dead time theta from a command to the section's outflow
-(10-14 s measured in SUMO, ``docs/results/meter_dynamics.md``): backstepping and the ETC then
+(10-14 s measured in SUMO, ``arzsumo study meter-dynamics``): backstepping and the ETC then
 evaluate control_law on the scaled Riemann state predicted theta seconds ahead
 (:func:`arzsumo.control.predictor.predict_riemann`, with the U applied in the last theta
 seconds; :class:`arzsumo.control.compensation.DelayCompensated`). It must be shorter than

@@ -75,7 +75,7 @@ PAGE = control.PAGE
 #: the laws ablated
 LAWS = ("backstepping", "etc")
 #: prediction horizon of ``predictor``, s: the dead time from a new plan to the section's
-#: outflow measured on the meter (10-14 s, docs/results/meter_dynamics.md)
+#: outflow measured on the meter (10-14 s, arzsumo study meter-dynamics)
 PREDICTION_S = 14.0
 
 

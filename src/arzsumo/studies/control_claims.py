@@ -2,8 +2,8 @@
 
 Each claim pairs two controllers on the same seeds of one experiment (Student t 95 %
 intervals, :func:`arzsumo.evaluation.stats.paired_difference`) and reads a verdict from
-the interval: the claims table of ``docs/results/paper_reproduction.md`` gets its SUMO
-column from :func:`claims_table`.
+the interval: :func:`claims_table` is the SUMO side of the twin's claims table
+(``arzsumo reproduce``).
 """
 
 from __future__ import annotations
