@@ -17,7 +17,8 @@ from arzsumo.sweep.spec import load_sweep
 ROOT = Path(__file__).resolve().parents[1]
 NET_FILES = ("ramp.net.xml", "ramp.rou.xml", "ramp.sumocfg", "ramp.nod.xml", "ramp.edg.xml",
              "ramp.con.xml", "ramp.tll.xml")
-SWEEPS = ("constant_release_sumo", "demand_sumo", "demand_twin", "penetration_sumo",
+SWEEPS = ("constant_release_sumo", "demand_sumo", "demand_twin", "penetration_legacy_sumo",
+          "penetration_sumo",
           "penetration_twin", "sensitivity_sumo", "sensitivity_twin")
 
 
