@@ -19,7 +19,7 @@ from .conftest import parse
 NAMES = ["ablation", "ablation-mechanism", "held-ramp", "meter-dynamics", "approach", "fill",
          "wave-speed", "inlet", "estimation-layouts", "loop-speed", "enkf-noise",
          "u-estimate", "premise-map", "sumo-options", "control", "control-ablation",
-         "etc-noise"]
+         "etc-noise", "meter-delay"]
 
 
 def test_the_catalog_lists_the_studies_by_their_names():
@@ -45,7 +45,8 @@ def test_each_study_writes_under_results_studies_name_and_publishes_on_request(n
 
 
 @pytest.mark.parametrize("name", [n for n in NAMES if n not in
-                                  ("ablation-mechanism", "inlet", "enkf-noise")])
+                                  ("ablation-mechanism", "inlet", "enkf-noise",
+                                   "meter-delay")])
 def test_studies_that_run_simulations_take_seeds_workers_and_list(name):
     args = parse(name, "--seeds", "3-5", "--workers", "2", "--quiet", "--list")
     assert (args.seeds, args.workers, args.quiet, args.list) == ([3, 4, 5], 2, True, True)
@@ -91,4 +92,5 @@ def test_each_study_names_a_results_page_of_the_docs_layout():
                      "loop-speed": "estimation_layouts", "enkf-noise": "enkf_noise",
                      "u-estimate": "u_on_estimate", "premise-map": "premise_map",
                      "sumo-options": "sumo_options", "control": "control_default",
-                     "control-ablation": "control_default", "etc-noise": "control_default"}
+                     "control-ablation": "control_default", "etc-noise": "control_default",
+                     "meter-delay": "control_default"}

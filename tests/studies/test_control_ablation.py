@@ -35,6 +35,8 @@ def test_each_step_is_a_valid_scenario_that_changes_one_piece(step):
         assert sc.estimation.method == "none"
     if step == "predictor":
         assert sc.actuation.delay_compensation == control_ablation.PREDICTION_S
+    if step == "predictor-measured":
+        assert sc.actuation.delay_compensation == control_ablation.MEASURED_DEAD_TIME_S
     if step == "fixed-cycle":
         assert sc.sumo.meter_mode == "fixed_cycle" and control_ablation.STEPS[step][2]
     if step == "wave-matched":

@@ -86,6 +86,8 @@ _MODULES = {
                                              "at a time, paired by seed"),
     "etc-noise": ("etc_noise", "the ETC's event trigger in the twin on a noisy state, "
                                "beside SUMO's runs"),
+    "meter-delay": ("meter_delay", "the meter's dead time to the section's outflow, from "
+                                   "the control study's paired runs"),
 }
 
 STUDIES: dict[str, Study] = {

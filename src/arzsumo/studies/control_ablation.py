@@ -16,6 +16,8 @@ equilibrium         deviations from the model's equilibrium, not the warm-up's s
 no-saturation       no bound on U or its rate, no ramp bound, no anti-windup
 fixed-cycle         the meter as a fixed cycle of green shares (no one-per-green)
 predictor           the laws on the state predicted :data:`PREDICTION_S` s ahead
+predictor-measured  the same, :data:`MEASURED_DEAD_TIME_S` s ahead: the meter's dead
+                    time measured on the default (``arzsumo study meter-delay``)
 wave-matched        the laws (and twins) on the model whose lambda_4 is SUMO's
                     measured wave speed :data:`WAVE_SPEED_KMH`, same equilibrium
                     (:func:`arzsumo.model.wave_match.wave_matched`)
@@ -77,6 +79,10 @@ LAWS = ("backstepping", "etc")
 #: prediction horizon of ``predictor``, s: the dead time from a new plan to the section's
 #: outflow measured on the meter (10-14 s, arzsumo study meter-dynamics)
 PREDICTION_S = 14.0
+#: prediction horizon of ``predictor-measured``, s: the dead time from the held meter's
+#: command to the section's outflow at x = L on the default, 26-27 s on regulation seeds
+#: 11-16 and 26-30 s on disturbance seeds 11-14 (arzsumo study meter-delay)
+MEASURED_DEAD_TIME_S = 27.0
 
 
 def _set(changes: dict[str, object]) -> Callable[[dict], dict]:
@@ -131,6 +137,10 @@ STEPS: dict[str, tuple[str, Callable[[dict], dict], bool]] = {
                     _set({"sumo.meter_mode": "fixed_cycle"}), True),
     "predictor": (f"the laws on the state predicted {PREDICTION_S:g} s ahead",
                   _set({"actuation.delay_compensation_s": PREDICTION_S}), False),
+    "predictor-measured": (f"the laws on the state predicted {MEASURED_DEAD_TIME_S:g} s "
+                           "ahead, the meter's dead time measured on the default",
+                           _set({"actuation.delay_compensation_s": MEASURED_DEAD_TIME_S}),
+                           False),
     "wave-matched": (f"the model's lambda_4 at SUMO's wave speed, {WAVE_SPEED_KMH:g} km/h",
                      _wave_matched, False),
     "dead-band": ("the ETC's trigger with a dead band sized to the estimate's noise",

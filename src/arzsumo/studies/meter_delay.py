@@ -1,0 +1,140 @@
+"""The meter's dead time on the default, read off paired runs (``arzsumo study
+meter-delay``).
+
+The controllers of a seed share one warm-up, so up to the start of control their runs are
+the same run, and after it SUMO stays bit-identical across them for as long as nothing
+the meter did has reached a vehicle. A controller that commands another release rate than
+the open loop (the held meter at once, ALINEA at the end of its first period) makes the
+two runs part at the meter; they part at the section's outflow x = L, where the PDE laws'
+U acts (section 2, ``eq:bc``), only when that change has travelled there. The gap between
+the two moments is the meter's transport time, measured per seed without noise: no fit,
+no step response to average.
+
+Read from a control study's ``--out`` (``periods.parquet`` of each run, one row per 1 s
+control period): per seed and controller, the first period whose release rate differs
+from the open loop's (the command), the first whose running light differs (the plan),
+and the first whose mainline outflow at x = L (HV + AV) differs (the effect). This is the
+dead time the predictor of ``[actuation] delay_compensation_s`` should cover.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from arzsumo.outdir import resumable_dir
+from arzsumo.outputs.studies import markdown_table, publish, write_csv, write_text
+from arzsumo.studies.common import (
+    RESULTS_DIR,
+    StudyError,
+    add_output,
+    names_among,
+    seed_text,
+)
+
+log = logging.getLogger(__name__)
+
+NAME = "meter-delay"
+#: the results page this study keeps a block of
+PAGE = "control_default"
+#: the controllers read against the open loop: each changes the release rate
+CONTROLLERS = ("held", "alinea", "pi-alinea")
+#: the events of a paired run: name -> the per-period columns compared
+EVENTS = {"command": ("release_rate",), "light": ("green_running",),
+          "outflow": ("outflow_h", "outflow_a")}
+
+
+def first_difference(a: np.ndarray, b: np.ndarray) -> int | None:
+    """Index of the first row where ``a`` and ``b`` (arrays of equal width) differ, over
+    their common length; None when they agree throughout. Exact: paired runs that have
+    not parted agree to the last bit."""
+    n = min(len(a), len(b))
+    a2 = np.asarray(a, float)[:n].reshape(n, -1)
+    b2 = np.asarray(b, float)[:n].reshape(n, -1)
+    differs = np.flatnonzero(np.any(a2 != b2, axis=1))
+    return int(differs[0]) if differs.size else None
+
+
+def paired_events(run: pd.DataFrame, open_loop: pd.DataFrame) -> dict[str, float]:
+    """The time (s from the start of control, the end of the period) at which ``run``
+    first differs from ``open_loop`` in each of :data:`EVENTS`, NaN when it never does,
+    and the dead time from command to outflow, s."""
+    times: dict[str, float] = {}
+    for event, cols in EVENTS.items():
+        i = first_difference(run[list(cols)].to_numpy(), open_loop[list(cols)].to_numpy())
+        times[f"{event}_s"] = float("nan") if i is None else float(run["t_s"].iloc[i]) + 1.0
+    times["dead_time_s"] = times["outflow_s"] - times["command_s"]
+    return times
+
+
+def delay_rows(out: Path, experiment: str, controllers: tuple[str, ...]) -> pd.DataFrame:
+    """Every seed of ``out/experiment`` with the open loop and a controller of
+    ``controllers``: one row per (controller, seed) of :func:`paired_events`."""
+    runs = out / experiment / "runs"
+    rows: list[dict[str, Any]] = []
+    for path in sorted(runs.glob("controller=open,seed=*/periods.parquet")):
+        seed = int(path.parent.name.split("seed=")[1])
+        open_loop = pd.read_parquet(path)
+        for ctrl in controllers:
+            other = runs / f"controller={ctrl},seed={seed}" / "periods.parquet"
+            if other.is_file():
+                rows.append({"controller": ctrl, "seed": seed,
+                             **paired_events(pd.read_parquet(other), open_loop)})
+    if not rows:
+        raise StudyError(f"--sumo {out} holds no paired runs of the open loop and "
+                         f"{', '.join(controllers)} in {experiment}; allowed: the --out of "
+                         f"arzsumo study control")
+    return pd.DataFrame(rows)
+
+
+def delay_summary(rows: pd.DataFrame) -> pd.DataFrame:
+    """Per controller: seeds, and the median, least and largest time of each event."""
+    out = []
+    for ctrl, g in rows.groupby("controller", sort=False):
+        row: dict[str, Any] = {"controller": ctrl, "n": len(g)}
+        for col, label in (("command_s", "command"), ("light_s", "light"),
+                           ("outflow_s", "outflow"), ("dead_time_s", "dead time")):
+            v = g[col].dropna()
+            row[f"{label} median, s"] = float(v.median()) if len(v) else float("nan")
+            row[f"{label} range, s"] = (f"{v.min():g}-{v.max():g}" if len(v) else "-")
+        out.append(row)
+    return pd.DataFrame(out)
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The study's options."""
+    parser.add_argument("--sumo", type=Path, metavar="DIR", default=RESULTS_DIR / "control",
+                        help="the --out of `arzsumo study control` (default: its default, "
+                             f"{RESULTS_DIR / 'control'})")
+    parser.add_argument("--experiment", default="regulation",
+                        help="the experiment whose runs are paired (default: regulation)")
+    parser.add_argument("--controllers", default=",".join(CONTROLLERS),
+                        help=f"comma-separated, of {', '.join(CONTROLLERS)} (default: all)")
+    add_output(parser, NAME, PAGE, plots=False)
+
+
+def run(args: argparse.Namespace) -> int:
+    """The paired events of every seed, their summary, the page block."""
+    controllers = tuple(names_among(args.controllers, CONTROLLERS, "--controllers"))
+    rows = delay_rows(args.sumo, args.experiment, controllers)
+    table = delay_summary(rows)
+    seeds = sorted(rows["seed"].unique().tolist())
+    text = (f"Paired runs of `arzsumo study control` ({args.experiment}, seeds "
+            f"{seed_text(seeds)}): the first second after the start of control at which a "
+            "controller's run differs from the open loop's in the commanded release rate, "
+            "the running light and the mainline outflow at x = L (`arzsumo study "
+            f"{NAME}`); dead time = outflow minus command.\n\n" + markdown_table(table))
+    with resumable_dir(args.out, f"study-{NAME}") as out:
+        write_csv(rows, out / "paired_events.csv")
+        files = [(write_csv(table, out / "meter_delay.csv"), "meter_delay.csv")]
+        write_text(text, out / "meter_delay.md")
+        if args.docs is not None:
+            publish(args.docs, PAGE, NAME, "The meter's dead time, from paired runs", text,
+                    files)
+    print(text)
+    return 0
