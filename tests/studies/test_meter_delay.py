@@ -60,7 +60,7 @@ def test_rows_pair_each_seed_with_its_open_loop_and_the_summary_takes_medians(tm
         _write(tmp_path, "held", seed, _periods(seed=seed, command=0, light=5,
                                                 outflow=parting))
     _write(tmp_path, "alinea", 4, _periods(seed=4, command=39))   # no open loop of seed 4
-    rows = delay_rows(tmp_path, "regulation", ("held", "alinea"))
+    rows = delay_rows([tmp_path], "regulation", ("held", "alinea"))
     assert sorted(rows["seed"]) == [1, 2, 3] and set(rows["controller"]) == {"held"}
     assert sorted(rows["dead_time_s"]) == [26.0, 27.0, 28.0]
     (row,) = delay_summary(rows).to_dict("records")
@@ -71,4 +71,13 @@ def test_rows_pair_each_seed_with_its_open_loop_and_the_summary_takes_medians(tm
 def test_a_directory_without_paired_runs_is_refused_naming_it(tmp_path):
     _write(tmp_path, "open", 1, _periods())
     with pytest.raises(StudyError, match=f"--sumo {tmp_path} holds no paired runs"):
-        delay_rows(tmp_path, "regulation", ("held",))
+        delay_rows([tmp_path], "regulation", ("held",))
+
+
+def test_runs_spread_over_two_outputs_are_paired_across_them(tmp_path):
+    first, second = tmp_path / "a", tmp_path / "b"
+    _write(first, "open", 5, _periods(seed=5))
+    _write(second, "held", 5, _periods(seed=5, command=0, outflow=30))
+    _write(second, "open", 5, _periods(seed=99))          # the first directory's counts
+    rows = delay_rows([first, second], "regulation", ("held",))
+    assert rows["dead_time_s"].tolist() == [30.0]

@@ -72,23 +72,33 @@ def paired_events(run: pd.DataFrame, open_loop: pd.DataFrame) -> dict[str, float
     return times
 
 
-def delay_rows(out: Path, experiment: str, controllers: tuple[str, ...]) -> pd.DataFrame:
-    """Every seed of ``out/experiment`` with the open loop and a controller of
-    ``controllers``: one row per (controller, seed) of :func:`paired_events`."""
-    runs = out / experiment / "runs"
+def _periods_files(outs: list[Path], experiment: str) -> dict[tuple[str, int], Path]:
+    """(controller, seed) -> its ``periods.parquet`` in the first of ``outs`` that has it
+    (a study's runs may be spread over several ``--out`` directories)."""
+    found: dict[tuple[str, int], Path] = {}
+    for out in outs:
+        for path in sorted((out / experiment / "runs").glob("controller=*,seed=*/periods.parquet")):
+            ctrl, seed = (part.split("=")[1] for part in path.parent.name.split(","))
+            found.setdefault((ctrl, int(seed)), path)
+    return found
+
+
+def delay_rows(outs: list[Path], experiment: str, controllers: tuple[str, ...]
+               ) -> pd.DataFrame:
+    """Every seed of ``OUT/experiment`` (over the directories ``outs``) with the open loop
+    and a controller of ``controllers``: one row per (controller, seed) of
+    :func:`paired_events`."""
+    files = _periods_files(outs, experiment)
     rows: list[dict[str, Any]] = []
-    for path in sorted(runs.glob("controller=open,seed=*/periods.parquet")):
-        seed = int(path.parent.name.split("seed=")[1])
-        open_loop = pd.read_parquet(path)
-        for ctrl in controllers:
-            other = runs / f"controller={ctrl},seed={seed}" / "periods.parquet"
-            if other.is_file():
-                rows.append({"controller": ctrl, "seed": seed,
-                             **paired_events(pd.read_parquet(other), open_loop)})
+    for ctrl in controllers:
+        for seed in sorted(s for c, s in files if c == ctrl and ("open", s) in files):
+            rows.append({"controller": ctrl, "seed": seed,
+                         **paired_events(pd.read_parquet(files[ctrl, seed]),
+                                         pd.read_parquet(files["open", seed]))})
     if not rows:
-        raise StudyError(f"--sumo {out} holds no paired runs of the open loop and "
-                         f"{', '.join(controllers)} in {experiment}; allowed: the --out of "
-                         f"arzsumo study control")
+        raise StudyError(f"--sumo {' '.join(map(str, outs))} holds no paired runs of the "
+                         f"open loop and {', '.join(controllers)} in {experiment}; allowed: "
+                         f"the --out of arzsumo study control")
     return pd.DataFrame(rows)
 
 
@@ -108,9 +118,9 @@ def delay_summary(rows: pd.DataFrame) -> pd.DataFrame:
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """The study's options."""
-    parser.add_argument("--sumo", type=Path, metavar="DIR", default=RESULTS_DIR / "control",
-                        help="the --out of `arzsumo study control` (default: its default, "
-                             f"{RESULTS_DIR / 'control'})")
+    parser.add_argument("--sumo", type=Path, metavar="DIR", action="append",
+                        help="the --out of `arzsumo study control`, repeatable: the runs of "
+                             f"several (default: {RESULTS_DIR / 'control'})")
     parser.add_argument("--experiment", default="regulation",
                         help="the experiment whose runs are paired (default: regulation)")
     parser.add_argument("--controllers", default=",".join(CONTROLLERS),
@@ -121,7 +131,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     """The paired events of every seed, their summary, the page block."""
     controllers = tuple(names_among(args.controllers, CONTROLLERS, "--controllers"))
-    rows = delay_rows(args.sumo, args.experiment, controllers)
+    rows = delay_rows(args.sumo or [RESULTS_DIR / "control"], args.experiment, controllers)
     table = delay_summary(rows)
     seeds = sorted(rows["seed"].unique().tolist())
     text = (f"Paired runs of `arzsumo study control` ({args.experiment}, seeds "
