@@ -42,7 +42,8 @@ def test_first_difference_finds_the_first_parting_row_or_none():
 
 def test_paired_events_time_the_command_light_and_outflow_at_the_periods_end():
     ev = meter_delay.paired_events(_periods(command=0, light=5, outflow=26), _periods())
-    assert ev == {"command_s": 1.0, "light_s": 6.0, "outflow_s": 27.0, "dead_time_s": 26.0}
+    assert ev == {"command_s": 1.0, "light_s": 6.0, "outflow_s": 27.0, "dead_time_s": 26.0,
+                  "light_to_outflow_s": 21.0}
     never = meter_delay.paired_events(_periods(command=39), _periods())
     assert never["command_s"] == 40.0 and np.isnan(never["outflow_s"])
     assert np.isnan(never["dead_time_s"])

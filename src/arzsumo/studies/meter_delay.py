@@ -63,12 +63,13 @@ def first_difference(a: np.ndarray, b: np.ndarray) -> int | None:
 def paired_events(run: pd.DataFrame, open_loop: pd.DataFrame) -> dict[str, float]:
     """The time (s from the start of control, the end of the period) at which ``run``
     first differs from ``open_loop`` in each of :data:`EVENTS`, NaN when it never does,
-    and the dead time from command to outflow, s."""
+    the dead time from command to outflow and the transport from light to outflow, s."""
     times: dict[str, float] = {}
     for event, cols in EVENTS.items():
         i = first_difference(run[list(cols)].to_numpy(), open_loop[list(cols)].to_numpy())
         times[f"{event}_s"] = float("nan") if i is None else float(run["t_s"].iloc[i]) + 1.0
     times["dead_time_s"] = times["outflow_s"] - times["command_s"]
+    times["light_to_outflow_s"] = times["outflow_s"] - times["light_s"]
     return times
 
 
@@ -108,7 +109,8 @@ def delay_summary(rows: pd.DataFrame) -> pd.DataFrame:
     for ctrl, g in rows.groupby("controller", sort=False):
         row: dict[str, Any] = {"controller": ctrl, "n": len(g)}
         for col, label in (("command_s", "command"), ("light_s", "light"),
-                           ("outflow_s", "outflow"), ("dead_time_s", "dead time")):
+                           ("outflow_s", "outflow"), ("dead_time_s", "dead time"),
+                           ("light_to_outflow_s", "light to outflow")):
             v = g[col].dropna()
             row[f"{label} median, s"] = float(v.median()) if len(v) else float("nan")
             row[f"{label} range, s"] = (f"{v.min():g}-{v.max():g}" if len(v) else "-")
@@ -138,7 +140,8 @@ def run(args: argparse.Namespace) -> int:
             f"{seed_text(seeds)}): the first second after the start of control at which a "
             "controller's run differs from the open loop's in the commanded release rate, "
             "the running light and the mainline outflow at x = L (`arzsumo study "
-            f"{NAME}`); dead time = outflow minus command.\n\n" + markdown_table(table))
+            f"{NAME}`); dead time = outflow minus command; light to outflow = outflow minus "
+            "light.\n\n" + markdown_table(table))
     with resumable_dir(args.out, f"study-{NAME}") as out:
         write_csv(rows, out / "paired_events.csv")
         files = [(write_csv(table, out / "meter_delay.csv"), "meter_delay.csv")]
