@@ -43,7 +43,7 @@ NAME = "meter-delay"
 #: the results page this study keeps a block of
 PAGE = "control_default"
 #: the controllers read against the open loop: each changes the release rate
-CONTROLLERS = ("held", "alinea", "pi-alinea")
+PAIRED = ("held", "alinea", "pi-alinea")
 #: the events of a paired run: name -> the per-period columns compared
 EVENTS = {"command": ("release_rate",), "light": ("green_running",),
           "outflow": ("outflow_h", "outflow_a")}
@@ -125,14 +125,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              f"several (default: {RESULTS_DIR / 'control'})")
     parser.add_argument("--experiment", default="regulation",
                         help="the experiment whose runs are paired (default: regulation)")
-    parser.add_argument("--controllers", default=",".join(CONTROLLERS),
-                        help=f"comma-separated, of {', '.join(CONTROLLERS)} (default: all)")
+    parser.add_argument("--controllers", default=",".join(PAIRED),
+                        help=f"comma-separated, of {', '.join(PAIRED)} (default: all)")
     add_output(parser, NAME, PAGE, plots=False)
 
 
 def run(args: argparse.Namespace) -> int:
     """The paired events of every seed, their summary, the page block."""
-    controllers = tuple(names_among(args.controllers, CONTROLLERS, "--controllers"))
+    controllers = tuple(names_among(args.controllers, PAIRED, "--controllers"))
     rows = delay_rows(args.sumo or [RESULTS_DIR / "control"], args.experiment, controllers)
     table = delay_summary(rows)
     seeds = sorted(rows["seed"].unique().tolist())
