@@ -9,10 +9,10 @@ parent is interrupted; the CLI then prints one line and removes the partial outp
 Workers also end when their parent dies however it died (SIGTERM, SIGKILL, the OOM
 killer): the kernel sends them SIGTERM (Linux ``PR_SET_PDEATHSIG``), and a worker in the
 middle of a task unwinds it first (:class:`ParentGone`: SUMO is closed, its temporary
-files removed) before it exits; an idle one exits at once. Each worker keeps its temporary
-files in a scratch directory of its own, inside its parent's, and removes it as it exits
-that way: a signal that lands between a file's creation and the code that owns it leaves
-nothing either.
+files removed) before it exits, within ``UNWIND_GRACE_S`` whatever the task does; an idle
+one exits at once. Each worker keeps its temporary files in a scratch directory of its
+own, inside its parent's, and removes it as it exits that way: a signal that lands
+between a file's creation and the code that owns it leaves nothing either.
 """
 
 from __future__ import annotations
@@ -34,6 +34,8 @@ from arzsumo.outdir import SCRATCH_ENV
 EXIT_INTERRUPTED, EXIT_TERMINATED = 130, 143
 #: prctl option: the signal a child gets when its parent dies (linux/prctl.h)
 PR_SET_PDEATHSIG = 1
+#: seconds a worker whose parent died has to unwind its task before it exits regardless
+UNWIND_GRACE_S = 10
 
 _busy = False   # a worker's task is running (set by guarded)
 _own_scratch: Path | None = None   # a worker's scratch directory (set by quiet_worker)
@@ -56,6 +58,11 @@ def die_with_parent(sig: int = signal.SIGKILL) -> None:
 
 def _parent_gone(signum: int, frame: object) -> None:
     if _busy:
+        # the unwinding gets UNWIND_GRACE_S: a ParentGone that lands where Python ignores
+        # exceptions (a __del__, a finaliser) or in the pool's own code would otherwise
+        # leave the worker running its task to the end for a parent that is gone
+        signal.signal(signal.SIGALRM, lambda signum, frame: _exit_terminated())
+        signal.alarm(UNWIND_GRACE_S)
         raise ParentGone
     _exit_terminated()
 
@@ -87,8 +94,8 @@ def guarded(fn: Callable[[Any], Any], task: Any) -> Any:
     """``fn(task)`` in a worker of :func:`worker_pool`, exiting once it has unwound if
     the parent died meanwhile (submit ``guarded, fn, task``)."""
     global _busy
-    _busy = True
     try:
+        _busy = True    # inside the try: a ParentGone from the first instant is caught
         return fn(task)
     except ParentGone:
         _exit_terminated()

@@ -108,3 +108,32 @@ def test_a_branch_dies_with_its_parent(tmp_path):
         time.sleep(0.05)
     with pytest.raises(ProcessLookupError):
         os.kill(child, 0)
+
+
+def test_a_parent_that_unwinds_ends_its_branch_at_once(tmp_path):
+    """An exception in the waiting parent (a dying parent's SIGTERM raises one in a pool
+    worker) ends the branch's child instead of waiting for its whole run."""
+    import subprocess
+    import sys
+    import time
+
+    flag = tmp_path / "child.pid"
+    code = ("import os, signal, time\n"
+            "from arzsumo.sumo.fork import run_branches\n"
+            "def stop(signum, frame):\n    raise RuntimeError('unwind')\n"
+            "signal.signal(signal.SIGTERM, stop)\n"
+            f"def branch():\n    open({str(flag)!r}, 'w').write(str(os.getpid()))\n"
+            "    time.sleep(60)\n"
+            "try:\n    run_branches([branch])\nexcept RuntimeError:\n    raise SystemExit(7)\n")
+    parent = subprocess.Popen([sys.executable, "-c", code])
+    for _ in range(200):
+        if flag.exists() and flag.read_text():
+            break
+        time.sleep(0.05)
+    child = int(flag.read_text())
+    t0 = time.monotonic()
+    parent.send_signal(signal.SIGTERM)
+    assert parent.wait(timeout=20) == 7          # unwound, not after the branch's 60 s
+    assert time.monotonic() - t0 < 10
+    with pytest.raises(ProcessLookupError):      # reaped by the parent's waitpid
+        os.kill(child, 0)

@@ -18,6 +18,7 @@ alone. Forking is POSIX-only: :func:`can_fork` says whether this process may.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import pickle
 import shutil
@@ -137,6 +138,12 @@ def run_branches(branches: Sequence[Callable[[], Any]]) -> list[Any]:
         try:
             with os.fdopen(read_fd, "rb") as pipe:
                 data = pipe.read()
+        except BaseException:
+            # this process unwinds (Ctrl-C, a dying parent's SIGTERM): end the branch now,
+            # or the wait below would wait for its whole run (it dies only with us)
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, signal.SIGKILL)
+            raise
         finally:
             _, status = os.waitpid(pid, 0)
         out.append(_result(index, status, data))
