@@ -19,7 +19,7 @@ from .conftest import parse
 NAMES = ["ablation", "ablation-mechanism", "held-ramp", "meter-dynamics", "approach", "fill",
          "wave-speed", "inlet", "estimation-layouts", "loop-speed", "enkf-noise",
          "u-estimate", "premise-map", "sumo-options", "control", "control-ablation",
-         "etc-noise", "meter-delay"]
+         "etc-noise", "meter-delay", "penetration"]
 
 
 def test_the_catalog_lists_the_studies_by_their_names():
@@ -93,4 +93,5 @@ def test_each_study_names_a_results_page_of_the_docs_layout():
                      "u-estimate": "u_on_estimate", "premise-map": "premise_map",
                      "sumo-options": "sumo_options", "control": "control_default",
                      "control-ablation": "control_default", "etc-noise": "control_default",
-                     "meter-delay": "control_default"}
+                     "meter-delay": "control_default",
+                     "penetration": "control_default"}

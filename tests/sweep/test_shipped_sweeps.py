@@ -35,8 +35,9 @@ def test_every_axis_passes_through_its_base(path):
             assert min(axis.values) <= base <= max(axis.values), (path.stem, axis.field)
 
 
-def test_the_default_penetration_sweep_keeps_the_inflow_and_names_the_share():
-    spec = load_sweep(shipped_sweeps_dir() / "penetration_sumo.toml")
+@pytest.mark.parametrize("name", ["penetration_sumo", "penetration_deadband_sumo"])
+def test_the_default_penetration_sweeps_keep_the_inflow_and_name_the_share(name):
+    spec = load_sweep(shipped_sweeps_dir() / f"{name}.toml")
     (axis,) = [a for a in spec.axes if a.name == "penetration"]
     for share, sets in zip(axis.values, axis.sets, strict=True):
         fill = sets["sumo.fill_demand_h_veh_h"] + sets["sumo.fill_demand_a_veh_h"]

@@ -9,8 +9,9 @@ ablation, ablation-mechanism, held-ramp and wave-speed, ``meter_dynamics``, ``su
 for approach, ``sumo_fill`` for fill, ``identified_model`` for inlet,
 ``estimation_layouts`` for estimation-layouts and loop-speed, ``enkf_noise``,
 ``u_on_estimate``, ``premise_map``, ``sumo_options``, ``control_default`` for control,
-control-ablation and etc-noise; :mod:`arzsumo.studies.common`). ``run`` returns the exit code (0
-done; 4 some runs were invalid, failed or crashed) and raises
+control-ablation, etc-noise, meter-delay and penetration;
+:mod:`arzsumo.studies.common`). ``run`` returns the exit code (0 done; 4 some runs were
+invalid, failed or crashed) and raises
 :class:`~arzsumo.errors.ArzsumoError` for bad input. A study's module is imported only
 when its options or its run are asked for.
 
@@ -88,6 +89,8 @@ _MODULES = {
                                "beside SUMO's runs"),
     "meter-delay": ("meter_delay", "the meter's dead time to the section's outflow, from "
                                    "the control study's paired runs"),
+    "penetration": ("penetration", "the ETC's triggers and release time against the AV "
+                                   "share in SUMO, per seed"),
 }
 
 STUDIES: dict[str, Study] = {

@@ -1,0 +1,217 @@
+"""The paper's penetration claim in SUMO (``arzsumo study penetration``).
+
+The paper (section 5, table diffpene) finds that more AVs at equal inflow make the ETC
+trigger less and leave the meter alone longer (44 -> 53 %: 245 -> 152 triggers, release
+time 206 -> 299 s). The study runs the ETC on the default over the AV share with the
+shipped sweeps (:data:`SWEEPS`, through the sweep engine; a record store with
+``--records`` carries them across machines):
+
+- ``penetration_sumo``: the ETC as the control study runs it;
+- ``penetration_deadband_sumo``: its trigger given the noise dead band of the control
+  ablation (without it the ETC fires at nearly every check at every share, so its
+  triggers cannot fall).
+
+Each measure's trend is read per seed, the seed being paired across shares: the
+least-squares slope of the measure against the share on that seed, in units per 10
+percentage points, then the mean slope over seeds with its Student t and BCa bootstrap
+95 % intervals (:mod:`arzsumo.evaluation.stats`). The claim holds when the triggers'
+interval lies below zero and the release time's above (:func:`verdict`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from arzsumo.evaluation.stats import MeanCI, bootstrap_mean_ci, mean_ci
+from arzsumo.outdir import resumable_dir
+from arzsumo.outputs.studies import publish, write_csv, write_text
+from arzsumo.resources import shipped_sweeps_dir
+from arzsumo.studies.common import (
+    EXIT_SOME_FAILED,
+    StudyError,
+    add_output,
+    add_runs,
+    seed_list,
+)
+from arzsumo.studies.recorded import add_records, check_records
+from arzsumo.sweep.records import copy_records, records_table
+from arzsumo.sweep.spec import SweepSpec, load_sweep
+from arzsumo.sweep.worker import FINISHED
+
+log = logging.getLogger(__name__)
+
+NAME, PAGE = "penetration", "control_default"
+#: the shipped sweeps the study runs: name -> what its ETC is
+SWEEPS = {"penetration_sumo": "ETC",
+          "penetration_deadband_sumo": "ETC with the noise dead band"}
+#: summary key -> (label, unit) of the measures the claim is about
+MEASURES = {"triggers": ("controller updates", "n"),
+            "release_time": ("release time", "s"),
+            "plan_changes": ("meter plan changes", "n")}
+SHARE = "penetration"
+#: the slope's unit of share: 10 percentage points
+PER = 0.10
+
+
+def seed_slopes(table: pd.DataFrame, key: str) -> pd.Series:
+    """Per seed, the least-squares slope of ``key`` against the AV share, per :data:`PER`
+    of share; seeds with fewer than two shares are left out."""
+    out = {}
+    for seed, g in table.dropna(subset=[key]).groupby("seed"):
+        x, y = g[SHARE].to_numpy(float), g[key].to_numpy(float)
+        if np.unique(x).size >= 2:
+            out[seed] = float(np.polyfit(x, y, 1)[0]) * PER
+    return pd.Series(out, name=key, dtype=float)
+
+
+def level_table(table: pd.DataFrame) -> pd.DataFrame:
+    """Per share and measure: mean over seeds with its 95 % t interval, and n."""
+    rows = []
+    for share, g in table.groupby(SHARE):
+        for key, (label, unit) in MEASURES.items():
+            ci = mean_ci(g[key].to_numpy(float))
+            rows.append({"share": share, "measure": label, "unit": unit, "mean": ci.mean,
+                         "low": ci.low, "high": ci.high, "n": ci.n})
+    return pd.DataFrame(rows)
+
+
+def slope_table(table: pd.DataFrame) -> pd.DataFrame:
+    """Per measure: the mean per-seed slope per 10 points of share, t and BCa intervals."""
+    rows = []
+    for key, (label, unit) in MEASURES.items():
+        s = seed_slopes(table, key).to_numpy()
+        t, boot = mean_ci(s), bootstrap_mean_ci(s)
+        rows.append({"measure": label, "unit": f"{unit} per 10 pt", "slope": t.mean,
+                     "t_low": t.low, "t_high": t.high, "boot_low": boot.low,
+                     "boot_high": boot.high, "n_seeds": t.n})
+    return pd.DataFrame(rows)
+
+
+def verdict(triggers: MeanCI, release: MeanCI) -> str:
+    """The paper's direction (fewer triggers, longer release with more AVs): "yes" when
+    both intervals lie on its side of zero, "no" when either lies on the other side,
+    else "not resolved"."""
+    if triggers.high < 0 < release.low:
+        return "yes"
+    if triggers.low > 0 or release.high < 0:
+        return "no"
+    return "not resolved"
+
+
+def claim_text(table: pd.DataFrame) -> tuple[str, str]:
+    """What SUMO measured of the claim on one sweep's finished runs, and the verdict."""
+    slopes = {k: mean_ci(seed_slopes(table, k).to_numpy()) for k in ("triggers",
+                                                                     "release_time")}
+    t, r = slopes["triggers"], slopes["release_time"]
+    lo, hi = table[SHARE].min(), table[SHARE].max()
+    means = table.groupby(SHARE)[["triggers", "release_time"]].mean()
+    return (f"{lo:.0%} -> {hi:.0%} AVs: triggers {means.triggers[lo]:.0f} -> "
+            f"{means.triggers[hi]:.0f}, release {means.release_time[lo]:.0f} -> "
+            f"{means.release_time[hi]:.0f} s; per 10 pt of share, triggers "
+            f"{t.mean:+.3g} [{t.low:+.3g}, {t.high:+.3g}], release {r.mean:+.3g} "
+            f"[{r.low:+.3g}, {r.high:+.3g}] s ({t.n} seeds)", verdict(t, r))
+
+
+def _markdown(frame: pd.DataFrame) -> str:
+    head = "| " + " | ".join(frame.columns) + " |\n" + "|---" * len(frame.columns) + "|\n"
+    return head + "\n".join("| " + " | ".join(f"{v:.4g}" if isinstance(v, float) else
+                                              str(v) for v in row) + " |"
+                            for row in frame.itertuples(index=False))
+
+
+def report(tables: dict[str, pd.DataFrame]) -> str:
+    """The study's page: per sweep the levels, the slopes and the claim's verdict."""
+    parts = ["The paper's claim: more AVs at equal inflow, fewer triggers and a longer "
+             "release (44 -> 53 %: 245 -> 152 triggers, 206 -> 299 s). Slopes are per "
+             "seed, against the share, then averaged over seeds (95 % t and BCa "
+             "intervals)."]
+    for name, table in tables.items():
+        measured, said = claim_text(table)
+        parts += [f"## {SWEEPS[name]} (`{name}`)", f"{measured}: **{said}**",
+                  _markdown(level_table(table)), _markdown(slope_table(table))]
+    return "\n\n".join(parts) + "\n"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The penetration study's options (the shares are the sweep files')."""
+    parser.add_argument("--seeds", type=seed_list, metavar="LIST",
+                        help="SUMO seeds, e.g. 1-10 (default: each sweep file's own)")
+    add_records(parser)
+    add_runs(parser, seeds=None)
+    add_output(parser, NAME, PAGE, plots=False)
+
+
+def with_seeds(spec: SweepSpec, seeds: list[int] | None) -> SweepSpec:
+    """``spec`` on ``seeds`` instead of its own (unchanged when None)."""
+    if seeds is None:
+        return spec
+    axes = tuple(replace(a, values=tuple(seeds), sets=tuple({a.field: s} for s in seeds))
+                 if a.name == "seed" else a for a in spec.axes)
+    return replace(spec, axes=axes)
+
+
+def _finished(args: argparse.Namespace, spec: SweepSpec, out: Path) -> pd.DataFrame:
+    """The sweep's finished runs in ``out`` or the store; unless ``--report`` the missing
+    ones are run first."""
+    from arzsumo.sweep.driver import run_sweep
+
+    store = None if args.records is None else args.records / spec.name
+    places = [out, *([store] if store is not None else [])]
+    if not args.report:
+        with resumable_dir(out, "sweep"):
+            if store is not None:
+                copy_records(spec.runs(), store, out)
+        try:
+            run_sweep(spec, out, workers=args.workers, scheduler=args.scheduler,
+                      progress=not args.quiet, plots=False)
+        finally:
+            if store is not None:
+                copy_records(spec.runs(), out, store)
+    table = records_table(spec.runs(), *places)
+    return table[table["status"].isin(FINISHED)]
+
+
+def _write(tables: dict[str, pd.DataFrame], out: Path, docs: Path | None) -> str:
+    """Each sweep's CSV (levels and slopes) and the page; return the page's text."""
+    for name, table in tables.items():
+        write_csv(pd.concat([level_table(table).assign(kind="level"),
+                             slope_table(table).assign(kind="slope")]), out / f"{name}.csv")
+    text = report(tables)
+    write_text(text, out / "penetration.md")
+    if docs is not None:
+        publish(docs, PAGE, NAME, "The controllers on the default in SUMO", text,
+                [(out / f"{n}.csv", f"{n}.csv") for n in tables])
+    return text
+
+
+def run(args: argparse.Namespace) -> int:
+    """Both sweeps (resumable), then the levels, slopes and verdicts."""
+    check_records(args)
+    specs = [with_seeds(load_sweep(shipped_sweeps_dir() / f"{n}.toml"), args.seeds)
+             for n in SWEEPS]
+    if args.list:
+        for spec in specs:
+            print(f"{spec.name}: {len(spec.runs())} runs")
+        return 0
+    if args.report:     # refused before anything is written when there is nothing to read
+        found = {s.name: _finished(args, s, args.out / s.name) for s in specs}
+        if all(t.empty for t in found.values()):
+            raise StudyError(f"--out = {args.out} has no finished runs yet; allowed: a run "
+                             "without --report, or --records with a store that holds some")
+    with resumable_dir(args.out, f"study-{NAME}") as out:
+        if not args.report:
+            found = {s.name: _finished(args, s, out / s.name) for s in specs}
+        tables = {n: t for n, t in found.items() if not t.empty}
+        if not tables:
+            raise StudyError(f"no run of {', '.join(found)} finished; the failures are in "
+                             f"{args.out}")
+        text = _write(tables, out, args.docs)
+    print(text)
+    complete = all(len(found[s.name]) == len(s.runs()) for s in specs)
+    return 0 if complete or args.report else EXIT_SOME_FAILED

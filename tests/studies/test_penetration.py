@@ -1,0 +1,92 @@
+"""The penetration study's trend statistics, on synthetic sweeps whose slopes are known."""
+
+import argparse
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from arzsumo.evaluation.stats import MeanCI
+from arzsumo.studies import penetration as pen
+from arzsumo.studies.common import StudyError
+
+SHARES = (0.10, 0.18, 0.30, 0.50)
+
+
+def _sweep(trigger_slope: float, release_slope: float, noise: float = 0.0,
+           seeds: int = 10) -> pd.DataFrame:
+    """Per seed and share: triggers and release time linear in the share (slopes per
+    10 points) about a per-seed offset, plus seeded noise."""
+    rng = np.random.default_rng(3)
+    rows = []
+    for seed in range(1, seeds + 1):
+        offset = rng.normal(0.0, 30.0)
+        for s in SHARES:
+            rows.append({"seed": seed, "penetration": s, "plan_changes": 100.0 + 5 * seed,
+                         "triggers": 300 + offset + trigger_slope * s / 0.1
+                         + rng.normal(0.0, noise),
+                         "release_time": 100 - offset + release_slope * s / 0.1
+                         + rng.normal(0.0, noise)})
+    return pd.DataFrame(rows)
+
+
+def test_each_seeds_slope_is_recovered_exactly_through_its_own_offset():
+    slopes = pen.seed_slopes(_sweep(-12.5, 7.0), "triggers")
+    assert len(slopes) == 10
+    np.testing.assert_allclose(slopes, -12.5, rtol=1e-9)   # the offsets differ by 30 veh
+
+
+def test_a_seed_with_one_share_has_no_slope():
+    table = _sweep(-12.5, 7.0)
+    table = table[~((table.seed == 4) & (table.penetration != 0.10))]
+    assert 4 not in pen.seed_slopes(table, "triggers").index
+
+
+@pytest.mark.parametrize(("trig", "rel", "expected"), [
+    ((-9.0, -1.0), (2.0, 8.0), "yes"),
+    ((1.0, 9.0), (2.0, 8.0), "no"),            # more triggers with more AVs
+    ((-9.0, -1.0), (-8.0, -2.0), "no"),        # shorter release
+    ((-9.0, 1.0), (2.0, 8.0), "not resolved"),
+])
+def test_the_verdict_reads_both_intervals(trig, rel, expected):
+    def ci(lo, hi):
+        return MeanCI((lo + hi) / 2, lo, hi, 10)
+    assert pen.verdict(ci(*trig), ci(*rel)) == expected
+
+
+def test_the_paper_direction_is_found_through_seed_noise_and_its_opposite_refused():
+    assert pen.claim_text(_sweep(-20.0, 20.0, noise=5.0))[1] == "yes"
+    assert pen.claim_text(_sweep(+20.0, -20.0, noise=5.0))[1] == "no"
+    assert pen.claim_text(_sweep(0.0, 0.0, noise=5.0))[1] == "not resolved"
+
+
+def test_the_tables_hold_every_share_and_the_slopes_with_both_intervals():
+    table = _sweep(-12.5, 7.0, noise=2.0)
+    levels = pen.level_table(table)
+    assert sorted(levels.share.unique()) == list(SHARES)
+    assert (levels.n == 10).all()
+    slopes = pen.slope_table(table).set_index("measure")
+    row = slopes.loc["controller updates"]
+    assert row.t_low < -12.5 < row.t_high and row.boot_low < -12.5 < row.boot_high
+    assert slopes.loc["meter plan changes", "slope"] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_a_report_without_finished_runs_is_refused(tmp_path):
+    args = argparse.Namespace(records=tmp_path / "store", report=True, list=False,
+                              out=tmp_path / "out", workers=None, scheduler=None,
+                              quiet=True, docs=None, seeds=None)
+    with pytest.raises(StudyError, match="no finished runs"):
+        pen.run(args)
+    assert list(tmp_path.iterdir()) == []          # nothing claimed, nothing written
+
+
+def test_seeds_replace_the_sweep_files_own_and_keep_the_shares():
+    from arzsumo.resources import shipped_sweeps_dir
+    from arzsumo.sweep.spec import load_sweep
+
+    spec = load_sweep(shipped_sweeps_dir() / "penetration_deadband_sumo.toml")
+    assert pen.with_seeds(spec, None) is spec
+    runs = pen.with_seeds(spec, [11, 12]).runs()
+    assert [r.run_id for r in runs] == [f"penetration={s},seed={n}" for s in (0.1, 0.18, 0.5)
+                                        for n in (11, 12)]
+    assert {r.scenario["sumo"]["seed"] for r in runs} == {11, 12}
