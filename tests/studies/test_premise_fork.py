@@ -80,24 +80,30 @@ def test_a_killed_child_runs_again_alone_and_nothing_is_left(plain, monkeypatch,
     assert list(tmp_path.iterdir()) == []
 
 
-def test_a_branch_dies_with_its_parent(tmp_path):
-    """A process that runs branches and is killed from outside leaves no child running."""
+def _parent_with_a_branch(tmp_path, setup: str = "", call: str = "run_branches([branch])\n"):
+    """A process that runs one branch sleeping 60 s, and the branch's pid once it runs."""
     import subprocess
     import sys
     import time
 
     flag = tmp_path / "child.pid"
-    code = ("import os, time\n"
-            "from arzsumo.sumo.fork import run_branches\n"
-            f"def branch():\n    open({str(flag)!r}, 'w').write(str(os.getpid()))\n"
-            "    time.sleep(60)\n"
-            "run_branches([branch])\n")
+    code = ("import os, signal, time\n"
+            "from arzsumo.sumo.fork import run_branches\n" + setup
+            + f"def branch():\n    open({str(flag)!r}, 'w').write(str(os.getpid()))\n"
+            "    time.sleep(60)\n" + call)
     parent = subprocess.Popen([sys.executable, "-c", code])
     for _ in range(200):
         if flag.exists() and flag.read_text():
             break
         time.sleep(0.05)
-    child = int(flag.read_text())
+    return parent, int(flag.read_text())
+
+
+def test_a_branch_dies_with_its_parent(tmp_path):
+    """A process that runs branches and is killed from outside leaves no child running."""
+    import time
+
+    parent, child = _parent_with_a_branch(tmp_path)
     parent.kill()
     parent.wait()
     for _ in range(100):
@@ -113,24 +119,12 @@ def test_a_branch_dies_with_its_parent(tmp_path):
 def test_a_parent_that_unwinds_ends_its_branch_at_once(tmp_path):
     """An exception in the waiting parent (a dying parent's SIGTERM raises one in a pool
     worker) ends the branch's child instead of waiting for its whole run."""
-    import subprocess
-    import sys
     import time
 
-    flag = tmp_path / "child.pid"
-    code = ("import os, signal, time\n"
-            "from arzsumo.sumo.fork import run_branches\n"
-            "def stop(signum, frame):\n    raise RuntimeError('unwind')\n"
-            "signal.signal(signal.SIGTERM, stop)\n"
-            f"def branch():\n    open({str(flag)!r}, 'w').write(str(os.getpid()))\n"
-            "    time.sleep(60)\n"
-            "try:\n    run_branches([branch])\nexcept RuntimeError:\n    raise SystemExit(7)\n")
-    parent = subprocess.Popen([sys.executable, "-c", code])
-    for _ in range(200):
-        if flag.exists() and flag.read_text():
-            break
-        time.sleep(0.05)
-    child = int(flag.read_text())
+    parent, child = _parent_with_a_branch(
+        tmp_path, setup="def stop(signum, frame):\n    raise RuntimeError('unwind')\n"
+                        "signal.signal(signal.SIGTERM, stop)\n",
+        call="try:\n    run_branches([branch])\nexcept RuntimeError:\n    raise SystemExit(7)\n")
     t0 = time.monotonic()
     parent.send_signal(signal.SIGTERM)
     assert parent.wait(timeout=20) == 7          # unwound, not after the branch's 60 s
