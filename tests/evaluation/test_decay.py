@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -31,6 +33,15 @@ def test_a_uniform_relative_offset_has_its_size_as_norm(a):
     f = np.stack([S * (1 + a)] * 3)
     f[1, 3, 4] = np.nan                           # NaN cells are left out, not zeros
     assert np.allclose(deviation_norm(f, S), abs(a))
+
+
+def test_a_field_without_a_stationary_level_is_left_out_quietly():
+    s = S.copy()
+    s[1] = np.nan                                 # no AVs: their density has no level
+    f = np.stack([s * 1.1] * 2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert np.allclose(deviation_norm(f, s), 0.1)
 
 
 def test_densities_and_speeds_weigh_alike():

@@ -47,7 +47,10 @@ def deviation_norm(fields: np.ndarray, stationary: np.ndarray) -> np.ndarray:
     """e(t) (periods,) of ``fields`` (periods, 4, cells) from ``stationary`` (4, cells):
     the relative RMS deviation of the module docstring (1)."""
     f, s = np.asarray(fields, float), np.asarray(stationary, float)
-    scale = np.nanmean(np.abs(s), axis=1)                        # (4,)
+    a = np.abs(s)
+    count = np.isfinite(a).sum(axis=1)
+    scale = np.where(count > 0, np.nansum(a, axis=1) / np.maximum(count, 1), np.nan)  # (4,)
+    scale = np.where(scale > 0, scale, np.nan)   # a field with no stationary level is left out
     d = (f - s[None]) / scale[None, :, None]
     ok = np.isfinite(d)
     sq = np.where(ok, d * d, 0.0).sum(axis=(1, 2))
