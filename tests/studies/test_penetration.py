@@ -23,6 +23,7 @@ def _sweep(trigger_slope: float, release_slope: float, noise: float = 0.0,
         offset = rng.normal(0.0, 30.0)
         for s in SHARES:
             rows.append({"seed": seed, "penetration": s, "plan_changes": 100.0 + 5 * seed,
+                         "inserted_fraction_main": 1.0 - s / 5,
                          "triggers": 300 + offset + trigger_slope * s / 0.1
                          + rng.normal(0.0, noise),
                          "release_time": 100 - offset + release_slope * s / 0.1
@@ -69,6 +70,7 @@ def test_the_tables_hold_every_share_and_the_slopes_with_both_intervals():
     row = slopes.loc["controller updates"]
     assert row.t_low < -12.5 < row.t_high and row.boot_low < -12.5 < row.boot_high
     assert slopes.loc["meter plan changes", "slope"] == pytest.approx(0.0, abs=1e-9)
+    assert slopes.loc["mainline demand inserted", "slope"] == pytest.approx(-0.02)
 
 
 def test_a_report_without_finished_runs_is_refused(tmp_path):
@@ -90,3 +92,17 @@ def test_seeds_replace_the_sweep_files_own_and_keep_the_shares():
     assert [r.run_id for r in runs] == [f"penetration={s},seed={n}" for s in (0.1, 0.18, 0.5)
                                         for n in (11, 12)]
     assert {r.scenario["sumo"]["seed"] for r in runs} == {11, 12}
+
+
+def test_the_figure_draws_every_seed_and_the_mean_per_panel():
+    from arzsumo.plots.penetration import PANELS, penetration_figure
+
+    table = _sweep(-12.5, 7.0, noise=2.0, seeds=4)
+    fig = penetration_figure({"ETC": table, "ETC with the dead band": table})
+    assert len(fig.axes) == len(PANELS)
+    for ax in fig.axes:
+        means = [line for line in ax.lines if line.get_marker() == "o"]
+        thin = [line for line in ax.lines if line.get_alpha() == 0.25]
+        assert len(thin) == 2 * 4                           # a thin line per seed
+        assert len(means) == 2
+        np.testing.assert_allclose(means[0].get_xdata(), [10, 18, 30, 50])

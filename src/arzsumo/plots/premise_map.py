@@ -18,8 +18,7 @@ def premise_map_figure(wide: pd.DataFrame, gates: Sequence[str]) -> Figure:
     share = np.array([[wide[f"{g}_passed"].iloc[i] for g in gates]
                       for i in range(len(wide))], dtype=float)
     fig, ax = plt.subplots(figsize=(1.0 + 0.75 * len(gates), 1.2 + 0.42 * len(wide)))
-    cmap = plt.get_cmap("RdYlGn").copy()
-    cmap.set_bad("0.85")
+    cmap = plt.get_cmap("RdYlGn").with_extremes(bad="0.85")
     ax.imshow(np.ma.masked_invalid(share), cmap=cmap, vmin=0, vmax=1, aspect="auto")
     for (i, j), v in np.ndenumerate(share):
         ax.text(j, i, "-" if np.isnan(v) else f"{v:.0%}", ha="center", va="center",

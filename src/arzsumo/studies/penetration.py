@@ -30,13 +30,14 @@ import pandas as pd
 
 from arzsumo.evaluation.stats import MeanCI, bootstrap_mean_ci, mean_ci
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.studies import publish, write_csv, write_text
+from arzsumo.outputs.studies import markdown_table, publish, write_csv, write_text
 from arzsumo.resources import shipped_sweeps_dir
 from arzsumo.studies.common import (
     EXIT_SOME_FAILED,
     StudyError,
     add_output,
     add_runs,
+    plots_wanted,
     seed_list,
 )
 from arzsumo.studies.recorded import add_records, check_records
@@ -53,7 +54,10 @@ SWEEPS = {"penetration_sumo": "ETC",
 #: summary key -> (label, unit) of the measures the claim is about
 MEASURES = {"triggers": ("controller updates", "n"),
             "release_time": ("release time", "s"),
-            "plan_changes": ("meter plan changes", "n")}
+            "plan_changes": ("meter plan changes", "n"),
+            # the premise's stationary point: a share whose queue spills past x = 0 starves
+            # insertion, and its runs are no longer the congested state the law regulates
+            "inserted_fraction_main": ("mainline demand inserted", "share")}
 SHARE = "penetration"
 #: the slope's unit of share: 10 percentage points
 PER = 0.10
@@ -115,14 +119,12 @@ def claim_text(table: pd.DataFrame) -> tuple[str, str]:
             f"{means.triggers[hi]:.0f}, release {means.release_time[lo]:.0f} -> "
             f"{means.release_time[hi]:.0f} s; per 10 pt of share, triggers "
             f"{t.mean:+.3g} [{t.low:+.3g}, {t.high:+.3g}], release {r.mean:+.3g} "
-            f"[{r.low:+.3g}, {r.high:+.3g}] s ({t.n} seeds)", verdict(t, r))
+            f"[{r.low:+.3g}, {r.high:+.3g}] s ({t.n} seeds); mainline demand inserted "
+            f"{_inserted(table, lo):.0%} -> {_inserted(table, hi):.0%}", verdict(t, r))
 
 
-def _markdown(frame: pd.DataFrame) -> str:
-    head = "| " + " | ".join(frame.columns) + " |\n" + "|---" * len(frame.columns) + "|\n"
-    return head + "\n".join("| " + " | ".join(f"{v:.4g}" if isinstance(v, float) else
-                                              str(v) for v in row) + " |"
-                            for row in frame.itertuples(index=False))
+def _inserted(table: pd.DataFrame, share: float) -> float:
+    return float(table.loc[table[SHARE] == share, "inserted_fraction_main"].mean())
 
 
 def report(tables: dict[str, pd.DataFrame]) -> str:
@@ -134,7 +136,7 @@ def report(tables: dict[str, pd.DataFrame]) -> str:
     for name, table in tables.items():
         measured, said = claim_text(table)
         parts += [f"## {SWEEPS[name]} (`{name}`)", f"{measured}: **{said}**",
-                  _markdown(level_table(table)), _markdown(slope_table(table))]
+                  markdown_table(level_table(table)), markdown_table(slope_table(table))]
     return "\n\n".join(parts) + "\n"
 
 
@@ -144,7 +146,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="SUMO seeds, e.g. 1-10 (default: each sweep file's own)")
     add_records(parser)
     add_runs(parser, seeds=None)
-    add_output(parser, NAME, PAGE, plots=False)
+    add_output(parser, NAME, PAGE)
 
 
 def with_seeds(spec: SweepSpec, seeds: list[int] | None) -> SweepSpec:
@@ -177,16 +179,24 @@ def _finished(args: argparse.Namespace, spec: SweepSpec, out: Path) -> pd.DataFr
     return table[table["status"].isin(FINISHED)]
 
 
-def _write(tables: dict[str, pd.DataFrame], out: Path, docs: Path | None) -> str:
-    """Each sweep's CSV (levels and slopes) and the page; return the page's text."""
+def _write(tables: dict[str, pd.DataFrame], out: Path, args: argparse.Namespace) -> str:
+    """Each sweep's CSV (levels and slopes), the figure and the page; return the text."""
+    files = []
     for name, table in tables.items():
-        write_csv(pd.concat([level_table(table).assign(kind="level"),
-                             slope_table(table).assign(kind="slope")]), out / f"{name}.csv")
+        files.append(write_csv(pd.concat([level_table(table).assign(kind="level"),
+                                          slope_table(table).assign(kind="slope")]),
+                               out / f"{name}.csv"))
     text = report(tables)
+    if plots_wanted(args):
+        from arzsumo.outputs.penetration import write_penetration_figure
+
+        files.append(write_penetration_figure(out, {SWEEPS[n]: t
+                                                    for n, t in tables.items()}))
+        text += "\n![ETC against the AV share](penetration.png)\n"
     write_text(text, out / "penetration.md")
-    if docs is not None:
-        publish(docs, PAGE, NAME, "The controllers on the default in SUMO", text,
-                [(out / f"{n}.csv", f"{n}.csv") for n in tables])
+    if args.docs is not None:
+        publish(args.docs, PAGE, NAME, "The controllers on the default in SUMO", text,
+                [(f, f.name) for f in files])
     return text
 
 
@@ -211,7 +221,7 @@ def run(args: argparse.Namespace) -> int:
         if not tables:
             raise StudyError(f"no run of {', '.join(found)} finished; the failures are in "
                              f"{args.out}")
-        text = _write(tables, out, args.docs)
+        text = _write(tables, out, args)
     print(text)
     complete = all(len(found[s.name]) == len(s.runs()) for s in specs)
     return 0 if complete or args.report else EXIT_SOME_FAILED

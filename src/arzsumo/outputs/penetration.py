@@ -1,0 +1,17 @@
+"""The penetration study's figure file, ``penetration.png``."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+
+import pandas as pd
+
+
+def write_penetration_figure(out: Path, tables: Mapping[str, pd.DataFrame]) -> Path:
+    """Draw :func:`arzsumo.plots.penetration.penetration_figure` of ``tables`` (label ->
+    finished runs) into ``out/penetration.png``; return its path."""
+    from arzsumo.outputs.figures import save_png
+    from arzsumo.plots.penetration import penetration_figure
+
+    return save_png(penetration_figure(tables), Path(out) / "penetration.png")
