@@ -62,7 +62,7 @@ def test_wheel_holds_the_network_and_every_scenario_and_sweep_file(wheel):
         shipped = {f"{PKG_DATA}/{p.relative_to(DATA).as_posix()}"
                    for p in DATA.rglob("*") if p.is_file() and not p.name.startswith(".")}
         assert shipped <= names
-        assert sum(n.startswith(f"{PKG_DATA}/scenarios/sweeps/") for n in names) == 8
+        assert sum(n.startswith(f"{PKG_DATA}/scenarios/sweeps/") for n in names) == 9
         assert z.read(f"{PKG_DATA}/scenarios/default.toml") == \
             (DATA / "scenarios" / "default.toml").read_bytes()
         entry = next(n for n in names if n.endswith(".dist-info/entry_points.txt"))

@@ -17,9 +17,9 @@ from arzsumo.sweep.spec import load_sweep
 ROOT = Path(__file__).resolve().parents[1]
 NET_FILES = ("ramp.net.xml", "ramp.rou.xml", "ramp.sumocfg", "ramp.nod.xml", "ramp.edg.xml",
              "ramp.con.xml", "ramp.tll.xml")
-SWEEPS = ("constant_release_sumo", "demand_sumo", "demand_twin", "penetration_legacy_sumo",
-          "penetration_sumo",
-          "penetration_twin", "sensitivity_sumo", "sensitivity_twin")
+SWEEPS = ("constant_release_sumo", "demand_sumo", "demand_twin", "penetration_deadband_sumo",
+          "penetration_legacy_sumo", "penetration_sumo", "penetration_twin",
+          "sensitivity_sumo", "sensitivity_twin")
 
 
 def test_shipped_dirs_are_inside_the_package_and_hold_their_files():
