@@ -1,5 +1,5 @@
 # make run  : create .venv if missing, install arzsumo with its extras, run the default job,
-#             then print the control study's result from its record store
+#             then print the control and penetration studies' results from their record store
 # make test : the same set-up, then ruff, the import contracts (lint-imports) and the whole
 #             test suite
 PYTHON ?= python3
@@ -14,13 +14,14 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --quiet --disable-pip-version-check -e '.[test]'
 	touch $(STAMP)
 
-# the default run, then the judged result: the control study's tables from the committed
-# record store (nothing runs; seconds)
+# the default run, then the judged result: the control and penetration studies' tables
+# from the committed record store (nothing runs; seconds)
 RECORDS := docs/readings/control_default/records
 
 run: $(STAMP)
 	$(BIN)/arzsumo run --overwrite
 	$(BIN)/arzsumo study control --report --seeds 1-20 --records $(RECORDS) --quiet
+	$(BIN)/arzsumo study penetration --report --records $(RECORDS) --quiet
 
 test: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks
