@@ -247,7 +247,7 @@ RUN_SUMMARY: dict[str, str] = {
     "twin_status.*.first_reason": TEXT,
     "inserted": "veh", "requested": "veh", "waiting": "veh", "arrived": "veh",
     "teleports": "count", "collisions": "count", "emergency_braking": "count",
-    "placement": TEXT, "wall_time": "s", "timings.*": "s",
+    "longest_standstill_main": "s", "placement": TEXT, "wall_time": "s", "timings.*": "s",
     "controller_time_per_period": "s", **_NETWORK, **_SECTION,
     "settings.warmup": "s", "settings.smoothing": "s", "settings.constant_release": "veh/s",
     "settings.kernel_cells": "count", "settings.twin_cells": "count", "settings.*": TEXT,

@@ -44,6 +44,12 @@ def test_a_field_without_a_stationary_level_is_left_out_quietly():
         assert np.allclose(deviation_norm(f, s), 0.1)
 
 
+def test_an_open_loop_without_a_finite_norm_has_no_band_and_says_nothing():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert np.isnan(stationary_band(np.full(50, np.nan), 1.0))
+
+
 def test_densities_and_speeds_weigh_alike():
     f = S.copy()[None]
     f[0, 0] *= 1.2                                # +20 % HV density, the rest exact

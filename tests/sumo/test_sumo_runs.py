@@ -210,3 +210,39 @@ def test_plan_changes_count_requests_and_light_changes_count_green_edges():
     last = round(12.0 / cfg.step_length)
     assert "y" in shown and shown[-last:] == ["G"] * last
     assert meter.light_changes == 2
+
+
+def test_a_mainline_vehicle_held_still_is_the_longest_standstill_and_told(caplog,
+                                                                          monkeypatch):
+    """A mainline vehicle stopped by hand stands longest; at the end it is named as a
+    deadlock once its standstill passes the threshold."""
+    from arzsumo.sumo import simulation
+
+    monkeypatch.setattr(simulation, "DEADLOCK_S", 30.0)
+    cfg = FAST.with_(horizon=100.0, ramp_demand=0.0)
+    with caplog.at_level("WARNING", logger="arzsumo.sumo.simulation"), \
+            open_simulation(PARAMS, cfg) as sim:
+        sim.run_until(20.0)
+        veh = sim.lib.vehicle
+        held = max((v for v in veh.getIDList() if not v.startswith("ramp")),
+                   key=veh.getLanePosition)           # the front one: nothing ahead
+        veh.setSpeed(held, 0.0)
+        stopped = None
+        while sim.time < 90.0 - 1e-9:
+            sim.step()
+            if stopped is None and veh.getSpeed(held) < 0.1:
+                stopped = sim.time
+        rep = sim.take_report()
+    assert stopped is not None and stopped < 40.0
+    assert rep.standstill_vehicle == held
+    assert abs(rep.standstill_main_s - (90.0 - stopped)) <= 2 * cfg.step_length
+    told = [r.getMessage() for r in caplog.records if "SUMO deadlock" in r.getMessage()]
+    assert len(told) == 1 and held in told[0]
+
+
+def test_a_flowing_run_stands_nobody_still_for_long():
+    cfg = FAST.with_(horizon=60.0, ramp_demand=0.0)
+    with open_simulation(PARAMS, cfg) as sim:
+        sim.run_until(60.0)
+        rep = sim.take_report()
+    assert rep.on_network > 20 and rep.standstill_main_s < 5.0

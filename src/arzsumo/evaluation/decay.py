@@ -84,7 +84,8 @@ class Decay:
 def stationary_band(e_open: np.ndarray, period: float, smooth: float = SMOOTH_S) -> float:
     """theta: the BAND_PERCENTILE of the open loop's smoothed norm ``e_open``."""
     sm = moving_mean(e_open, max(1, round(smooth / period)))
-    return float(np.nanpercentile(sm, BAND_PERCENTILE))
+    sm = sm[np.isfinite(sm)]      # none in a run too short to have a stationary state
+    return float(np.percentile(sm, BAND_PERCENTILE)) if sm.size else float("nan")
 
 
 def stationary_reference(fields: np.ndarray, period: float) -> tuple[np.ndarray, float]:

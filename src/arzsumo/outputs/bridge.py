@@ -285,7 +285,8 @@ def summary(res: CoSimResult) -> RunSummary:
         max_ramp_queue=int(res.meter["max_queue"]))
     accounting = Accounting(rep.inserted, rep.requested, rep.delivered_main, rep.waiting,
                             rep.arrived, rep.teleports, rep.collisions,
-                            rep.emergency_braking) if rep else Accounting()
+                            rep.emergency_braking, rep.standstill_main_s) if rep \
+        else Accounting()
     return RunSummary(
         identity=RunIdentity(res.scenario.name, res.scenario.source, __version__,
                              res.sumo.seed, res.settings.controller),

@@ -61,6 +61,7 @@ class Accounting:
     teleports: int | None = None
     collisions: int | None = None
     emergency_braking: int | None = None
+    longest_standstill_main: float | None = None
 
 
 @dataclass(frozen=True)

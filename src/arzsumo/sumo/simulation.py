@@ -40,6 +40,9 @@ from arzsumo.sumo.run_files import RunFiles
 from arzsumo.units import ms_to_kmh
 
 log = logging.getLogger(__name__)
+#: a mainline vehicle standing still longer than this (s) at a run's end is in a deadlock:
+#: the longest stop of a congested stream's stop-and-go is tens of seconds
+DEADLOCK_S = 300.0
 
 _ACTIVE: SumoSimulation | None = None
 
@@ -71,6 +74,10 @@ class RunReport:
     emergency_braking: int = -1
     requested_ramp: int = 0
     inserted_ramp: int = 0
+    #: the longest standstill of a mainline vehicle then on the network (SUMO's waiting
+    #: time: seconds at under 0.1 m/s without a break) and that vehicle's ID
+    standstill_main_s: float = 0.0
+    standstill_vehicle: str = ""
 
     @property
     def delivered(self) -> float:
@@ -248,12 +255,16 @@ class SumoSimulation:
 
     def take_report(self) -> RunReport:
         """Accounting at the current time (run must be open)."""
-        sim = self.lib.simulation
+        sim, veh = self.lib.simulation, self.lib.vehicle
+        waits = {v: float(veh.getWaitingTime(v)) for v in veh.getIDList()
+                 if not v.startswith("ramp")}   # the meter's queue stands by design
+        still = max(waits, key=waits.__getitem__, default="")
         return RunReport(self.time, self.requested(), self.loaded, self.inserted,
                          len(sim.getPendingVehicles()), self.arrived,
-                         int(self.lib.vehicle.getIDCount()), self.collisions, self.teleports,
+                         int(veh.getIDCount()), self.collisions, self.teleports,
                          self.emergency_stops, self.emergency_braking,
-                         self.requested(ramp_only=True), self.inserted_ramp)
+                         self.requested(ramp_only=True), self.inserted_ramp,
+                         waits.get(still, 0.0), still)
 
     def close(self, warn: bool = True) -> RunReport | None:
         """Close SUMO (safe to call twice); keep the final :attr:`report`; ``warn`` about
@@ -280,6 +291,10 @@ class SumoSimulation:
                                        "emergency_braking": self.emergency_braking})
             if warn and self.report.delivered_main < 0.98:
                 log.warning("mainline demand not delivered: %s", self.report.summary())
+            if warn and self.report.standstill_main_s > DEADLOCK_S:
+                log.warning("SUMO deadlock: mainline vehicle %s has stood still for %.0f s "
+                            "at the end of the run (teleports off: nothing ends it)",
+                            self.report.standstill_vehicle, self.report.standstill_main_s)
         self._remove_files()
         return self.report
 
