@@ -8,6 +8,16 @@ import pytest
 from arzsumo.model import PRESETS, equilibrium_from_densities
 
 
+@pytest.fixture(params=["power", "newell"])
+def any_family_eq(request):
+    """The paper's base equilibrium densities on each fundamental-diagram family."""
+    from tests.conftest import NEWELL_CHANGES
+
+    p = PRESETS["paper_base"]
+    params = p.params if request.param == "power" else p.params.with_(**NEWELL_CHANGES)
+    return equilibrium_from_densities(params, p.rho_h, p.rho_a)
+
+
 @pytest.fixture
 def base_eq():
     p = PRESETS["paper_base"]

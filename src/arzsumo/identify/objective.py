@@ -34,10 +34,17 @@ DEFAULT_BOUNDS: dict[str, tuple[float, float]] = {
     "gamma_h": (0.2, 8.0), "gamma_a": (0.2, 8.0),
     "tau_h": (0.5, 900.0), "tau_a": (0.5, 900.0),
     "spacing_h": (1.0, 60.0), "spacing_a": (1.0, 60.0),
+    "wave_speed_h": (1.0, 30.0), "wave_speed_a": (1.0, 30.0), "corner": (1.0, 20.0),
 }
 #: The default selection: per-class fundamental diagram and relaxation times.
 DEFAULT_WHICH = ("v_free_h", "v_free_a", "ao_max_h", "ao_max_a", "gamma_h", "gamma_a",
                  "tau_h", "tau_a")
+#: The default selection per fundamental-diagram family (:mod:`arzsumo.model.fd`)
+WHICH_BY_FAMILY: dict[str, tuple[str, ...]] = {
+    "power": DEFAULT_WHICH,
+    "newell": ("v_free_h", "v_free_a", "ao_max_h", "ao_max_a", "wave_speed_h",
+               "wave_speed_a", "tau_h", "tau_a"),
+}
 #: Residual of a value the replay could not predict (the twin stopped), in scale units.
 DEFAULT_PENALTY = 10.0
 #: seconds between progress lines of a long fit (logged at INFO)
@@ -70,6 +77,10 @@ class ParameterSpace:
         if unknown:
             raise IdentifyError(f"which = {unknown} is not allowed: names from "
                                 f"{', '.join(DEFAULT_BOUNDS)}")
+        ignored = [n for n in which if n in guess.ignored_fields]
+        if ignored:
+            raise IdentifyError(f"which = {ignored} is not allowed: family = "
+                                f"{guess.family!r} does not read them")
         given = dict(bounds or {})
         extra = sorted(set(given) - set(which))
         if extra:

@@ -19,6 +19,14 @@ from dataclasses import dataclass, fields, replace
 from arzsumo.errors import ModelError, require
 from arzsumo.units import kmh_to_ms, veh_km_to_veh_m
 
+#: the fundamental-diagram families (:mod:`arzsumo.model.fd`): the paper's power law and a
+#: smoothed Newell triangle whose congested branch carries a given wave speed
+FAMILIES = ("power", "newell")
+#: the fields only the ``newell`` family reads
+NEWELL_FIELDS = ("wave_speed_h", "wave_speed_a", "corner")
+#: the fields only the ``power`` family reads
+POWER_FIELDS = ("gamma_h", "gamma_a")
+
 #: the macroscopic fields, in the storage order of every field array of the package:
 #: HV density (veh/m), HV speed (m/s), AV density (veh/m), AV speed (m/s)
 VARIABLES = ("rho_h", "v_h", "rho_a", "v_a")
@@ -51,6 +59,15 @@ class ModelParameters:
         Maximum area occupancies, dimensionless, in (0, 1].
     v_free_h, v_free_a : float
         Free-flow speeds V_h, V_a, m/s.
+    family : {"power", "newell"}
+        Fundamental-diagram family (:mod:`arzsumo.model.fd`). ``power`` is the paper's
+        eq. (3): ``gamma_i`` shape it and ``ao_max_i`` is where the speed reaches 0.
+        ``newell`` is a smoothed Newell triangle: ``ao_max_i`` is its jam occupancy.
+    wave_speed_h, wave_speed_a : float
+        ``newell`` only: magnitude w_i of the congested branch's wave speed, m/s (the
+        slow characteristic tends to -w_i deep in congestion).
+    corner : float
+        ``newell`` only: order n >= 1 of the p-norm that smooths the triangle's corner.
     """
 
     length: float = 1000.0
@@ -66,10 +83,18 @@ class ModelParameters:
     ao_max_a: float = 0.85
     v_free_h: float = 80.0 / 3.6
     v_free_a: float = 60.0 / 3.6
+    family: str = "power"
+    wave_speed_h: float = 33.0 / 3.6
+    wave_speed_a: float = 33.0 / 3.6
+    corner: float = 4.0
 
     def __post_init__(self) -> None:
+        require(self.family in FAMILIES, "family", self.family,
+                f"one of {', '.join(FAMILIES)}")
         for f in fields(self):
-            _positive(f.name, getattr(self, f.name))
+            if f.name != "family":
+                _positive(f.name, getattr(self, f.name))
+        require(self.corner >= 1.0, "corner", self.corner, "an order n >= 1")
         for name in ("ao_max_h", "ao_max_a"):
             value = getattr(self, name)
             require(value <= 1.0, name, value, "an area occupancy in (0, 1]")
@@ -91,7 +116,12 @@ class ModelParameters:
         """Largest AO at which both equilibrium speeds stay positive."""
         return min(self.ao_max_h, self.ao_max_a)
 
-    def with_(self, **changes: float) -> ModelParameters:
+    @property
+    def ignored_fields(self) -> tuple[str, ...]:
+        """The fields this family does not read (a scenario that sets one is refused)."""
+        return NEWELL_FIELDS if self.family == "power" else POWER_FIELDS
+
+    def with_(self, **changes: float | str) -> ModelParameters:
         """A copy with some fields changed (validated again)."""
         unknown = set(changes) - {f.name for f in fields(self)}
         if unknown:

@@ -23,7 +23,7 @@ from dataclasses import replace
 import numpy as np
 from scipy.optimize import brentq
 
-from arzsumo.errors import ModelError
+from arzsumo.errors import ModelError, require
 from arzsumo.model.characteristic import characteristic_speeds
 from arzsumo.model.fd import area_occupancy, equilibrium_speeds
 from arzsumo.model.params import ModelParameters
@@ -36,6 +36,9 @@ def scaled_exponents(p: ModelParameters, rho_h: float, rho_a: float,
                      k: float) -> ModelParameters:
     """``p`` with both exponents times ``k`` and each AO_max moved so that the equilibrium
     speeds at (``rho_h``, ``rho_a``) (veh/m) are unchanged."""
+    require(p.family == "power", "family", p.family,
+            "'power' (the exponent scaling is the power law's; the newell family sets "
+            "wave_speed_h and wave_speed_a directly)")
     ao = float(area_occupancy(p, rho_h, rho_a))
     v_h, v_a = (float(v) for v in equilibrium_speeds(p, rho_h, rho_a))
     if not (0.0 < v_h < p.v_free_h and 0.0 < v_a < p.v_free_a):

@@ -64,6 +64,7 @@ from arzsumo.scenario.model import (
     DESIGN_KEYS,
     EQUILIBRIUM_KEYS,
     MODEL_KEYS,
+    check_congested_family,
     design_section,
     equilibrium_section,
     model_section,
@@ -202,6 +203,7 @@ def scenario_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scena
     at = {name: where(source, name) for name in KEYS}
     preset, params = model_section(t["model"], at["model"])
     eq = equilibrium_section(params, preset, t["equilibrium"], at["equilibrium"])
+    check_congested_family(eq, at["model"])
     design = design_section(t["design"], at["design"])
     initial = initial_section(t["initial"], at["initial"])
     twin = twin_section(t["twin"], at["twin"], initial, design)

@@ -24,14 +24,15 @@ from typing import Any
 from arzsumo.control.etc import PAPER_DESIGN, EtcDesign
 from arzsumo.errors import ArzsumoError, ScenarioError
 from arzsumo.io import toml_value
+from arzsumo.model.characteristic import linearize
 from arzsumo.model.equilibrium import (
     Equilibrium,
     equilibrium_at_penetration,
     equilibrium_from_demand,
     equilibrium_from_densities,
 )
-from arzsumo.model.params import PRESETS, ModelParameters, Preset, get_preset
-from arzsumo.tables import Key, checked, in_user_terms, read_keys
+from arzsumo.model.params import FAMILIES, PRESETS, ModelParameters, Preset, get_preset
+from arzsumo.tables import Key, checked, in_user_terms, read_keys, written
 from arzsumo.units import KMH_PER_MS, VEH_H_PER_VEH_S, VEH_KM_PER_VEH_M
 
 _SPEED = "a speed > 0 km/h"
@@ -54,6 +55,17 @@ MODEL_KEYS: dict[str, Key] = {
                         doc="HV free-flow speed V_h"),
     "v_free_a_kmh": Key("v_free_a", factor=KMH_PER_MS, allowed=_SPEED, unit="km/h",
                         doc="AV free-flow speed V_a"),
+    "family": Key("family", "string", choices=FAMILIES,
+                  doc="fundamental-diagram family: 'power' (the paper's eq. (3)) or "
+                      "'newell' (a smoothed Newell triangle; ao_max_* is its jam "
+                      "occupancy)"),
+    "wave_speed_h_kmh": Key("wave_speed_h", factor=KMH_PER_MS, allowed=_SPEED,
+                            unit="km/h", doc="newell: HV congested-branch wave speed "
+                                             "|w_h| (the branch's slope in flow)"),
+    "wave_speed_a_kmh": Key("wave_speed_a", factor=KMH_PER_MS, allowed=_SPEED,
+                            unit="km/h", doc="newell: AV congested-branch wave speed |w_a|"),
+    "corner": Key("corner", doc="newell: order n >= 1 of the smoothed corner between the "
+                                "free and congested branches (larger: sharper)"),
 }
 
 _DENSITY = "a density > 0 veh/km (both classes must be present)"
@@ -106,9 +118,21 @@ def model_section(table: Mapping[str, Any], at: str) -> tuple[Preset, ModelParam
     changes = read_keys(table, MODEL_KEYS, at)
     changes.pop("preset", None)
     try:
-        return preset, preset.params.with_(**changes)
+        params = preset.params.with_(**changes)
     except ArzsumoError as exc:
         raise in_user_terms(exc, at, table, MODEL_KEYS) from None
+    _refuse_ignored(table, params, at)
+    return preset, params
+
+
+def _refuse_ignored(table: Mapping[str, Any], params: ModelParameters, at: str) -> None:
+    """A key the model's family does not read is refused, naming it (it would do nothing)."""
+    for key, spec in MODEL_KEYS.items():
+        if key in table and spec.field in params.ignored_fields:
+            raise ScenarioError(
+                f"{at} {key} = {written(table[key])} is not read by family = "
+                f"{params.family!r}; allowed: omit it, or set family = "
+                f"{'newell' if params.family == 'power' else 'power'!r}")
 
 
 def _check_combination(eqt: Mapping[str, Any], at: str) -> tuple[str, ...]:
@@ -152,6 +176,24 @@ def equilibrium_section(params: ModelParameters, preset: Preset, eqt: Mapping[st
         if exc.field in ("v_h", "v_a") and exc.reason:   # a stated speed, in km/h already
             raise ScenarioError(f"{at} {exc.field}_kmh = {exc.reason}") from None
         raise in_user_terms(exc, at, eqt, EQUILIBRIUM_KEYS) from None
+
+
+def check_congested_family(eq: Equilibrium, at: str) -> None:
+    """A ``newell`` model whose equilibrium is not on its congested branch is refused.
+
+    The paper's laws are designed for a congested equilibrium (lambda_4 < 0); the smoothed
+    triangle's free branch is nearly flat, so below its corner it has no upstream wave.
+    """
+    if eq.params.family != "newell":
+        return
+    lam4 = float(linearize(eq).eigenvalues[3])
+    if lam4 < 0.0:
+        return
+    raise ScenarioError(
+        f"{at} family = 'newell' admits no congested equilibrium at rho_h = "
+        f"{eq.rho_h * VEH_KM_PER_VEH_M:.4g}, rho_a = {eq.rho_a * VEH_KM_PER_VEH_M:.4g} veh/km"
+        f" (AO {eq.ao:.3f}: lambda_4 = {lam4 * KMH_PER_MS:+.2f} km/h, its free branch); "
+        "allowed: densities past the corner, a lower ao_max_* or family = 'power'")
 
 
 def design_toml(design: EtcDesign, comment: str = "") -> str:

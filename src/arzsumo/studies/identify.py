@@ -35,7 +35,7 @@ from arzsumo.bridge.session import run_in_sumo
 from arzsumo.errors import ArzsumoError, ScenarioError
 from arzsumo.identify import (
     DEFAULT_BOUNDS,
-    DEFAULT_WHICH,
+    WHICH_BY_FAMILY,
     FitSettings,
     IdentificationResult,
     ReplayData,
@@ -155,15 +155,17 @@ def parse_vary(specs: Sequence[str], sc: Scenario) -> tuple[Point, ...]:
     return points
 
 
-def parse_which(text: str | None) -> tuple[str, ...]:
-    """``--which`` names (comma-separated), checked against DEFAULT_BOUNDS."""
+def parse_which(text: str | None, params: ModelParameters) -> tuple[str, ...]:
+    """``--which`` names (comma-separated), checked against DEFAULT_BOUNDS and the names
+    the model's family reads; the family's default selection without it."""
     if text is None:
-        return DEFAULT_WHICH
+        return WHICH_BY_FAMILY[params.family]
     names = tuple(n.strip() for n in text.split(",") if n.strip())
-    bad = [n for n in names if n not in DEFAULT_BOUNDS]
+    bad = [n for n in names if n not in DEFAULT_BOUNDS or n in params.ignored_fields]
     if not names or bad or len(set(names)) != len(names):
+        allowed = [n for n in DEFAULT_BOUNDS if n not in params.ignored_fields]
         raise ScenarioError(f"--which = {text} is not allowed: distinct names from "
-                            f"{', '.join(DEFAULT_BOUNDS)}")
+                            f"{', '.join(allowed)} (family = {params.family!r})")
     return names
 
 
@@ -193,7 +195,7 @@ def make_setup(sc: Scenario, train: Sequence[int], held_out: Sequence[int], *,
     if warmup is not None:
         changes["run.warmup_s"] = warmup
     base, sc = sc, sc.with_(changes)
-    names = parse_which(which)
+    names = parse_which(which, sc.params)
     for name in names:
         low, high = DEFAULT_BOUNDS[name]
         value = getattr(sc.params, name)

@@ -34,6 +34,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from arzsumo.model.fd import speed_terms_of_ao
 from arzsumo.model.params import ModelParameters
 from arzsumo.twin.state import RHO_A, RHO_H, Y_A, Y_H
 
@@ -51,32 +52,10 @@ def physical_flux(q: np.ndarray, v_h: np.ndarray, v_a: np.ndarray) -> np.ndarray
     return f
 
 
-def _power(r: np.ndarray, e: float) -> np.ndarray:
-    """r**e for r >= 0, with the half-integer exponents of the presets done by sqrt (fast)."""
-    if e == 1.0:
-        return r
-    if e == 0.5:
-        return np.sqrt(r)
-    if e == 1.5:
-        return r * np.sqrt(r)
-    if e == 2.0:
-        return r * r
-    return r ** e
-
-
 def _fd_terms(p: ModelParameters, rho_h: np.ndarray, rho_a: np.ndarray) -> tuple[np.ndarray,
                                                                                   ...]:
-    """Ve_h, Ve_a and dVe_h/dAO, dVe_a/dAO with one power per class (hot path).
-
-    Same values as :func:`arzsumo.model.fd.speed_of_ao` and :func:`dspeed_dao`.
-    """
-    ao = (p.area_h * rho_h + p.area_a * rho_a) / p.road_width
-    r_h, r_a = ao / p.ao_max_h, ao / p.ao_max_a
-    pm_h, pm_a = _power(r_h, p.gamma_h - 1.0), _power(r_a, p.gamma_a - 1.0)
-    ve_h = p.v_free_h * (1.0 - pm_h * r_h)
-    ve_a = p.v_free_a * (1.0 - pm_a * r_a)
-    return (ve_h, ve_a, -p.v_free_h * p.gamma_h / p.ao_max_h * pm_h,
-            -p.v_free_a * p.gamma_a / p.ao_max_a * pm_a)
+    """Ve_h, Ve_a and dVe_h/dAO, dVe_a/dAO of the model's family (hot path)."""
+    return speed_terms_of_ao(p, (p.area_h * rho_h + p.area_a * rho_a) / p.road_width)
 
 
 class Waves(NamedTuple):
