@@ -297,6 +297,19 @@ IDENTIFY_SUMMARY: dict[str, str] = {
     "runs.*.section_trend.mean_veh": "veh", "runs.*.section_trend.blocks": "count",
     "runs.*.section_trend.block_s": "s", "runs.*.section_trend.stationary": "bool",
     "wall_time.*": "s", "resolved_scenario.*": TEXT,
+    "parameters.wave_speed_*.*": "m/s", "parameters.corner.*": "1",
+    "stage_one": TEXT, "stage_one.blocks": "count", "stage_one.fit.family": TEXT,
+    "stage_one.fit.wave_speed_*": "m/s", "stage_one.fit.ao_max_*": "1",
+    "stage_one.fit.gamma_*": "1", "stage_one.fit.rmse_*": "m/s",
+    "stage_one.fit.lambda_4": "m/s", "stage_one.fit.wave_speed": "m/s",
+    "stage_one.fit.blocks": "count", "stage_one.waves.*": "m/s",
+    "stage_one.lambda_4.*": "m/s", "stage_one.wave_gap.*": "1",
+    "scenario_model_validation": TEXT,
+    "scenario_model_validation.*.rho_*.absolute": "veh/m",
+    "scenario_model_validation.*.v_*.absolute": "m/s",
+    "scenario_model_validation.*.samples": "count",
+    "scenario_model_validation.*.blocks": "count",
+    "scenario_model_validation.*": "1",
 }
 
 #: scenario-file key suffixes and their units (scenario files name their units)

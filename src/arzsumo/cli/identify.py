@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import logging
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from arzsumo.cli.args import (
     negative_float,
@@ -22,6 +23,9 @@ from arzsumo.cli.args import (
 )
 from arzsumo.cli.options import add_out, add_overwrite, add_scenario, add_seeds, add_workers
 from arzsumo.cli.scenarios import load_named
+
+if TYPE_CHECKING:
+    from arzsumo.studies.identify import IdentifyStudy
 
 log = logging.getLogger("arzsumo")
 
@@ -40,7 +44,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
                        workers=args.workers,
                        wave_speed=None if args.wave_speed_kmh is None
                        else kmh_to_ms(args.wave_speed_kmh),
-                       wave_weight=args.wave_weight)
+                       wave_weight=args.wave_weight, diagram=args.diagram)
     out = Path(args.out) if args.out else Path("results") / "identify" / path.stem
     runs = len(setup.points) * (len(setup.train_seeds) + len(setup.validate_seeds))
     log.info("identify %s: %d SUMO runs on %d workers, fitting %s", sc.name, runs,
@@ -51,10 +55,15 @@ def cmd_identify(args: argparse.Namespace) -> int:
     fit = study.fit
     print(f"identify {sc.name}: {runs} runs, SUMO {study.wall['sumo']:.1f} s, fit "
           f"{study.wall['fit']:.1f} s ({fit.nfev} steps, {fit.evaluations} evaluations)")
+    if study.stage_one is not None:
+        _print_stage_one(study)
     for i, name in enumerate(fit.which):
         print(f"  {name:<10} = {fit.values[i]:.4g} +- {fit.sigma[i]:.2g} (SI)")
-    for role, score in (("start, training", study.start), ("training", study.training),
-                        ("validation", study.validation)):
+    scores = [("start, training", study.start), ("training", study.training),
+              ("validation", study.validation)]
+    if study.scenario_validation is not None:
+        scores.append((f"validation, {sc.name}'s own model", study.scenario_validation))
+    for role, score in scores:
         rel = ", ".join(f"{v} {e['relative']:.1%}" for v, e in score.pooled.items())
         print(f"  relative RMSE, {role}: {rel}; objective {score.total:.3g}")
         blocks = ", ".join(f"{r.name} rho_h {r.rmse['rho_h']['blocks_relative']:.1%} "
@@ -63,6 +72,28 @@ def cmd_identify(args: argparse.Namespace) -> int:
         print(f"    on 100 m x 10 s blocks (as run and compare print it): {blocks}")
     print(f"results: {out}")
     return 0
+
+
+def _print_stage_one(study: IdentifyStudy) -> None:
+    """Stage 1's diagram and the wave check on both run sets (km/h)."""
+    from arzsumo.studies.identify_report import stage_lambda_4
+    from arzsumo.units import ms_to_kmh
+
+    one = study.stage_one
+    if one is None:
+        return
+    d = one.fit
+    print(f"  stage 1 ({d.params.family}, {d.blocks} stationary blocks): "
+          + ", ".join(f"{n} = {v:.4g} +- {s:.2g}" for n, v, s in zip(d.which, d.values,
+                                                                      d.sigma, strict=True))
+          + f"; speed RMSE HV {ms_to_kmh(d.rmse['h']):.2f}, AV {ms_to_kmh(d.rmse['a']):.2f}"
+          " km/h")
+    for role, lam4 in stage_lambda_4(study).items():
+        reading, gap = one.waves[role], one.wave_gaps(role, lam4)
+        print(f"  waves, {role}: SUMO HV {ms_to_kmh(reading.mean('h')):.1f}, AV "
+              f"{ms_to_kmh(reading.mean('a')):.1f} km/h; model lambda_4 "
+              f"{ms_to_kmh(lam4):.1f} km/h; |lambda_4 - c| / |c| HV {gap['h']:.0%}, "
+              f"AV {gap['a']:.0%}")
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -96,6 +127,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--wave-weight", type=non_negative_float, default=1.0, metavar="W",
                    help="weight of the wave-speed gap: W = 1 trades a 10 %% gap against a "
                         "uniform 10 %% replay error")
+    p.add_argument("--diagram", choices=("power", "newell"),
+                   help="two stages: the fundamental diagram of this family from the "
+                        "windows' stationary states and the measured wave speed (stage 1), "
+                        "then tau_h, tau_a by the replay with the diagram fixed (stage 2)")
     p.add_argument("--max-nfev", type=positive_int, default=40, metavar="N",
                    help="largest number of least-squares steps (scipy's max_nfev)")
     add_workers(p, "SUMO runs in parallel (default: one per core)")

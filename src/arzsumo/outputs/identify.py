@@ -1,5 +1,6 @@
 """Write an identification (``arzsumo identify --out DIR``) atomically as one directory:
-``identified.toml``, ``identification.json``, ``fields.png`` and ``scatter.png``.
+``identified.toml``, ``identification.json``, ``fields.png`` and ``scatter.png``, and with
+``--diagram`` ``diagram.png`` (stage 1's fit against SUMO's stationary states).
 
 Their content is made by :mod:`arzsumo.studies.identify_report`; here the texts are
 written and the figures (:mod:`arzsumo.plots.identify`) drawn from arrays.
@@ -13,8 +14,10 @@ from pathlib import Path
 
 import numpy as np
 
+from arzsumo.model.params import ModelParameters
 from arzsumo.outdir import OutputDir, atomic_dir, target_of
 from arzsumo.outputs.figures import save_png
+from arzsumo.plots.diagram import diagram_figure
 from arzsumo.plots.identify import fields_figure, scatter_figure
 
 #: the marker kind of an identification's directory
@@ -44,10 +47,23 @@ class ScatterPanel:
     title: str
 
 
+@dataclass(frozen=True)
+class DiagramPanel:
+    """``diagram.png``: SUMO's block states (``rho_h``, ``rho_a`` veh/m, ``v_h``, ``v_a``
+    m/s), the models to draw by label, the operating point (veh/m) and the measured wave
+    speed per class (m/s)."""
+
+    blocks: dict[str, np.ndarray]
+    models: dict[str, ModelParameters]
+    operating_point: tuple[float, float]
+    waves: dict[str, float]
+
+
 def write_identification(out: str | os.PathLike[str] | OutputDir, toml_text: str,
                          json_text: str, fields: FieldsPanel, scatter: ScatterPanel, *,
-                         overwrite: bool = False) -> Path:
-    """Write the four files into ``out`` (a path, or an :class:`~arzsumo.outdir.OutputDir`
+                         overwrite: bool = False, diagram: DiagramPanel | None = None
+                         ) -> Path:
+    """Write the files into ``out`` (a path, or an :class:`~arzsumo.outdir.OutputDir`
     of kind ``identify`` claimed before the runs) and put the directory in place."""
     with atomic_dir(out, KIND, overwrite=overwrite) as tmp:
         (tmp / "identified.toml").write_text(toml_text, encoding="utf-8")
@@ -56,4 +72,7 @@ def write_identification(out: str | os.PathLike[str] | OutputDir, toml_text: str
                                fields.title), tmp / "fields.png", dpi=90)
         save_png(scatter_figure(scatter.observed, scatter.predicted, scatter.rmse,
                                 scatter.title), tmp / "scatter.png", dpi=90)
+        if diagram is not None:
+            save_png(diagram_figure(diagram.blocks, diagram.models, diagram.operating_point,
+                                    diagram.waves), tmp / "diagram.png", dpi=90)
     return target_of(out)

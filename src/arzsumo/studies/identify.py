@@ -44,9 +44,10 @@ from arzsumo.identify import (
 )
 from arzsumo.identify.wave_target import WaveTarget
 from arzsumo.model.equilibrium import Equilibrium
-from arzsumo.model.params import ModelParameters
+from arzsumo.model.params import FAMILIES, ModelParameters
 from arzsumo.scenario import Scenario, scenario_from_dict
 from arzsumo.studies.identify_cache import load_run, run_key, save_run
+from arzsumo.studies.identify_diagram import STAGE_TWO, StageOne, fit_stage_one, read_waves
 from arzsumo.studies.identify_scores import (
     SetScore,
     ao_floor,
@@ -114,6 +115,9 @@ class IdentifySetup:
     #: (:mod:`arzsumo.identify.wave_target`); None: the replay residual alone
     wave_speed: float | None = None
     wave_weight: float = 1.0
+    #: the family whose diagram stage 1 fits from the windows' stationary states (stage 2
+    #: then fits tau_h, tau_a by the replay); None: one replay fit of ``which``
+    diagram: str | None = None
 
     @property
     def options(self) -> ReplayOptions:
@@ -186,8 +190,15 @@ def make_setup(sc: Scenario, train: Sequence[int], held_out: Sequence[int], *,
                vary: Sequence[str] = (), which: str | None = None,
                horizon: float | None = None, warmup: float | None = None,
                fit: FitSettings | None = None, workers: int | None = None,
-               wave_speed: float | None = None, wave_weight: float = 1.0) -> IdentifySetup:
+               wave_speed: float | None = None, wave_weight: float = 1.0,
+               diagram: str | None = None) -> IdentifySetup:
     """Check everything before SUMO starts: seeds, points, parameter names and bounds."""
+    if diagram is not None and diagram not in FAMILIES:
+        raise ScenarioError(f"--diagram = {diagram} is not allowed: one of "
+                            f"{', '.join(FAMILIES)}")
+    if diagram is not None and which is not None:
+        raise ScenarioError(f"--which = {which} is not allowed with --diagram: stage 2 "
+                            f"fits {', '.join(STAGE_TWO)}")
     check_seeds(train, held_out)
     changes: dict[str, Any] = {"run.controller": "open"}
     if horizon is not None:
@@ -195,7 +206,7 @@ def make_setup(sc: Scenario, train: Sequence[int], held_out: Sequence[int], *,
     if warmup is not None:
         changes["run.warmup_s"] = warmup
     base, sc = sc, sc.with_(changes)
-    names = parse_which(which, sc.params)
+    names = STAGE_TWO if diagram is not None else parse_which(which, sc.params)
     for name in names:
         low, high = DEFAULT_BOUNDS[name]
         value = getattr(sc.params, name)
@@ -208,7 +219,7 @@ def make_setup(sc: Scenario, train: Sequence[int], held_out: Sequence[int], *,
         WaveTarget(wave_speed, 0.0, 0.0, wave_weight)
     return IdentifySetup(base, sc, tuple(train), tuple(held_out), points, names,
                          fit or FitSettings(), workers or default_workers(), wave_speed,
-                         wave_weight)
+                         wave_weight, diagram)
 
 
 def plan(setup: IdentifySetup) -> list[RunTask]:
@@ -263,6 +274,9 @@ class IdentifyStudy:
     measured: tuple[float, float]
     equilibrium: Equilibrium | None
     wall: dict[str, float]
+    #: stage 1 (``--diagram``) and the scenario's own model scored on the held-out runs
+    stage_one: StageOne | None = None
+    scenario_validation: SetScore | None = None
 
     def data(self, role: str) -> list[ReplayData]:
         """The ReplayData of the ``training`` or ``validation`` runs."""
@@ -276,7 +290,8 @@ def measured_densities(datasets: Sequence[ReplayData]) -> tuple[float, float]:
     return float(np.nanmean(rho_h)), float(np.nanmean(rho_a))
 
 
-def _equilibrium(params: ModelParameters, rho: tuple[float, float]) -> Equilibrium | None:
+def equilibrium_at(params: ModelParameters, rho: tuple[float, float]) -> Equilibrium | None:
+    """The equilibrium of ``params`` at densities ``rho`` (veh/m), or None outside it."""
     try:
         return Equilibrium(params, *rho)
     except ArzsumoError:
@@ -293,18 +308,29 @@ def run_identification(setup: IdentifySetup) -> IdentifyStudy:
     train = [r.data for r in runs if r.task.role == "training"]
     held_out = [r.data for r in runs if r.task.role == "validation"]
     opts = setup.options
-    guess = start_params(setup.scenario.params, train, opts.ao_limit)
-    if guess != setup.scenario.params:
-        log.info("fit starts from AO_max_h = %.3f, AO_max_a = %.3f (the data's AO)",
-                 guess.ao_max_h, guess.ao_max_a)
+    rho = measured_densities(train)
+    stage_one = None
+    if setup.diagram is not None:
+        # the jam occupancy above every cell the replay is fed (at the bridge's AO limit)
+        diagram, reading, states = fit_stage_one(
+            setup.scenario, setup.diagram, train, rho, wave=setup.wave_speed,
+            wave_weight=setup.wave_weight, bootstrap=setup.fit.bootstrap,
+            floor=ao_floor(setup.scenario.params, train, opts.ao_limit))
+        stage_one = StageOne(diagram, states, {"training": reading,
+                                               "validation": read_waves(held_out)})
+        guess = diagram.params
+    else:
+        guess = start_params(setup.scenario.params, train, opts.ao_limit)
+    if guess.ao_max_h != setup.scenario.params.ao_max_h:
+        log.info("fit starts from AO_max_h = %.3f, AO_max_a = %.3f", guess.ao_max_h,
+                 guess.ao_max_a)
     start = score_set(guess, train, opts)
     t2 = time.perf_counter()
     floor = ao_floor(guess, train, opts.ao_limit)
     bounds = {name: (floor, 1.0) if name.startswith("ao_max") else DEFAULT_BOUNDS[name]
               for name in setup.which}
-    rho = measured_densities(train)
     target = (WaveTarget(setup.wave_speed, *rho, setup.wave_weight)
-              if setup.wave_speed is not None else None)
+              if setup.wave_speed is not None and stage_one is None else None)
     fit = identify(train, guess, bounds, which=setup.which, options=opts,
                    settings=setup.fit, wave_target=target)
     t3 = time.perf_counter()
@@ -315,4 +341,5 @@ def run_identification(setup: IdentifySetup) -> IdentifyStudy:
             "fit": fit.wall_time, "bootstrap": t3 - t2 - fit.wall_time,
             "validate": (t4 - t3) + (t2 - t1), "total": t4 - t0}
     return IdentifyStudy(setup, runs, fit, start, training, validation, rho,
-                         _equilibrium(fit.params, rho), wall)
+                         equilibrium_at(fit.params, rho), wall, stage_one,
+                         score_set(setup.scenario.params, held_out, opts))

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import copy
 import json
+import math
 from pathlib import Path
 from typing import Any
 
@@ -30,14 +31,15 @@ from arzsumo import __version__
 from arzsumo.control.registry import is_pde
 from arzsumo.evaluation.stationarity import count_trend
 from arzsumo.identify import VARIABLES, ReplayData
+from arzsumo.identify.diagram import DiagramFit
 from arzsumo.identify.objective import DEFAULT_PENALTY as PENALTY
 from arzsumo.io import dump_toml, json_safe
 from arzsumo.model.characteristic import linearize
 from arzsumo.outdir import OutputDir
-from arzsumo.outputs.identify import FieldsPanel, ScatterPanel
+from arzsumo.outputs.identify import DiagramPanel, FieldsPanel, ScatterPanel
 from arzsumo.scenario.model import MODEL_KEYS
 from arzsumo.schema import IDENTIFY_SUMMARY, key_units
-from arzsumo.studies.identify import IdentifyStudy
+from arzsumo.studies.identify import IdentifyStudy, equilibrium_at, measured_densities
 from arzsumo.studies.identify_scores import SetScore
 from arzsumo.sumo.vtypes import vehicle_types
 from arzsumo.units import ms_to_kmh, veh_m_to_veh_km
@@ -65,6 +67,31 @@ def _model_table(study: IdentifyStudy, table: dict[str, Any]) -> dict[str, str]:
         if fit.at_bound[i]:
             note += ", at a bound of the fit"
         notes[key] = note
+    if study.stage_one is not None:
+        notes.update(_diagram_table(study.stage_one.fit, table))
+    return notes
+
+
+def _diagram_table(diagram: DiagramFit, table: dict[str, Any]) -> dict[str, str]:
+    """Stage 1's family and values into the ``[model]`` table; their notes."""
+    p = diagram.params
+    table["family"] = p.family
+    for name in ("v_free_h", "v_free_a", "corner"):
+        if name not in p.ignored_fields:
+            spec = MODEL_KEYS[_model_key(name)]
+            table[_model_key(name)] = float(f"{getattr(p, name) * spec.factor:.{DIGITS}g}")
+    for key in [k for k in table if MODEL_KEYS.get(k) and
+                MODEL_KEYS[k].field in p.ignored_fields]:
+        del table[key]
+    notes = {"family": "stage 1: the diagram from the windows' stationary states"}
+    for i, name in enumerate(diagram.which):
+        key = _model_key(name)
+        spec = MODEL_KEYS[key]
+        table[key] = float(f"{diagram.values[i] * spec.factor:.{DIGITS}g}")
+        unit = f" {spec.unit}" if spec.unit else ""
+        notes[key] = f"stage 1, +- {diagram.sigma[i] * spec.factor:.3g}{unit} (Jacobian)"
+        if diagram.bootstrap_sigma is not None:
+            notes[key] += f", +- {diagram.bootstrap_sigma[i] * spec.factor:.3g}{unit} (bootstrap)"
     return notes
 
 
@@ -176,6 +203,21 @@ def _runs(study: IdentifyStudy) -> dict[str, Any]:
             for r in study.runs}
 
 
+def stage_lambda_4(study: IdentifyStudy) -> dict[str, float]:
+    """lambda_4 of the identified model at each run set's mean densities, m/s."""
+    out = {}
+    for role in ("training", "validation"):
+        eq = equilibrium_at(study.fit.params, measured_densities(study.data(role)))
+        out[role] = float(linearize(eq).eigenvalues[3]) if eq is not None else math.nan
+    return out
+
+
+def _stage_one(study: IdentifyStudy) -> dict[str, Any] | None:
+    if study.stage_one is None:
+        return None
+    return study.stage_one.as_dict(stage_lambda_4(study))
+
+
 def identification_json(study: IdentifyStudy) -> dict[str, Any]:
     """The content of ``identification.json`` (SI; units in ``units_by_key``)."""
     setup, fit, opts = study.setup, study.fit, study.setup.options
@@ -209,6 +251,9 @@ def identification_json(study: IdentifyStudy) -> dict[str, Any]:
                           for k, s in (("training", study.training),
                                        ("validation", study.validation))},
         "runs": _runs(study),
+        "stage_one": _stage_one(study),
+        "scenario_model_validation": (None if study.scenario_validation is None
+                                      else _set_dict(study.scenario_validation)),
         "wall_time": {f"{k}_s": v for k, v in study.wall.items()},
         "resolved_scenario": dict(setup.scenario.tables),
     }
@@ -251,4 +296,20 @@ def write_study(out: str | Path | OutputDir, study: IdentifyStudy, overwrite: bo
     fields, scatter = figures(study)
     text = json.dumps(identification_json(study), indent=2)
     return write_identification(out, identified_toml(study), text, fields, scatter,
-                                overwrite=overwrite)
+                                overwrite=overwrite, diagram=diagram_panel(study))
+
+
+def diagram_panel(study: IdentifyStudy) -> DiagramPanel | None:
+    """What ``diagram.png`` shows: stage 1's blocks, the identified model beside the
+    scenario's own, and the training runs' wave readings."""
+    one = study.stage_one
+    if one is None:
+        return None
+    s = one.states
+    models = {f"identified ({study.fit.params.family})": study.fit.params,
+              f"{study.setup.base.name}'s model ({study.setup.base.params.family})":
+                  study.setup.base.params}
+    reading = one.waves["training"]
+    return DiagramPanel({"rho_h": s.rho_h, "rho_a": s.rho_a, "v_h": s.v_h, "v_a": s.v_a},
+                        models, study.measured,
+                        {"h": reading.mean("h"), "a": reading.mean("a")})
