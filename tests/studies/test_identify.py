@@ -195,3 +195,38 @@ def test_the_fit_starts_from_an_ao_max_that_holds_the_observed_occupancy():
     assert ao > params.ao_max_a
     assert start.ao_max_a == pytest.approx(ao / 0.9) and start.ao_max_h >= params.ao_max_h
     assert start_params(start, [data], 0.9) == start             # already holds it
+
+
+#: the same runs, two stages: the Newell diagram from the windows, then the relaxation times
+TWO_STAGE = [a for a in ARGS if a not in ("--which", "tau_h,tau_a")] + [
+    "--diagram", "newell", "--wave-speed-kmh", "-30"]
+
+
+@pytest.mark.sumo
+def test_two_stages_write_a_newell_model_from_the_same_runs(result, cache, tmp_path):
+    out = tmp_path / "two"
+    assert main([*TWO_STAGE, "--out", str(out)]) == 0
+    doc = json.loads((out / "identification.json").read_text())
+    assert len(list((cache / "identify-runs").glob("*.npz"))) == 3      # no new SUMO run
+    assert (out / "diagram.png").stat().st_size > 0
+    one = doc["stage_one"]
+    assert one["fit"]["family"] == "newell" and one["fit"]["blocks"] >= 10
+    assert one["fit"]["wave_speed"] == pytest.approx(-30 / 3.6)
+    assert doc["settings"]["which"] == ["tau_h", "tau_a"]
+    sc = load_scenario(out / "identified.toml")
+    assert sc.params.family == "newell"
+    for name in ("wave_speed_h", "wave_speed_a", "ao_max_h", "ao_max_a"):
+        assert getattr(sc.params, name) == pytest.approx(one["fit"][name], rel=1e-6)
+    assert sc.params.tau_h == pytest.approx(doc["parameters"]["tau_h"]["value"], rel=1e-6)
+    # the held-out run under the scenario's own model, beside the identified one
+    assert set(doc["scenario_model_validation"]["runs"]) == {"seed3"}
+    assert set(one["wave_gap"]) == {"training", "validation"}
+
+
+@pytest.mark.sumo
+def test_which_and_diagram_together_are_refused_in_one_line(cache, tmp_path, capsys):
+    code = main([*ARGS, "--diagram", "newell", "--out", str(tmp_path / "x")])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "\n" not in err
+    assert "--which = tau_h,tau_a is not allowed with --diagram" in err
+    assert not (tmp_path / "x").exists()

@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from arzsumo.errors import ArzsumoError, ScenarioError
+from arzsumo.sumo.car_following import ignored, readers
 from arzsumo.sumo.config import (
     AV_MODELS,
     DEPART_POS_LAT,
@@ -32,6 +33,50 @@ from arzsumo.tables import Key, in_user_terms, read_keys, written
 from arzsumo.units import KMH_PER_MS, VEH_H_PER_VEH_S
 
 _DEMAND = "a demand >= 0 veh/h"
+_ACC = "an acceleration > 0 m/s^2"
+#: the car-following keys (arzsumo.sumo.car_following says which model reads which)
+CAR_FOLLOWING_KEYS: dict[str, Key] = {
+    "hv_accel_m_s2": Key("hv_accel", unit="m/s^2", allowed=_ACC,
+                         doc="HVs' largest acceleration (SUMO accel; every model)"),
+    "hv_decel_m_s2": Key("hv_decel", unit="m/s^2", allowed=_ACC,
+                         doc="HVs' comfortable deceleration (SUMO decel; every model)"),
+    "hv_sigma_step_s": Key("hv_sigma_step", unit="s",
+                           doc="Krauss: how often the driver imperfection is redrawn (SUMO "
+                               "sigmaStep); default every step, which dilutes sigma at "
+                               "small steps"),
+    "hv_delta": Key("hv_delta", doc="IDM, EIDM: acceleration exponent (SUMO delta, "
+                                    "default 4)"),
+    "hv_stepping_s": Key("hv_stepping", unit="s",
+                         doc="IDM, EIDM: internal step of the follow speed (SUMO stepping, "
+                             "default 0.25 s)"),
+    "hv_reaction_s": Key("hv_reaction", unit="s",
+                         doc="EIDM: reaction time (SUMO treaction, default 0.5 s)"),
+    "hv_sigma_error": Key("hv_sigma_error", doc="EIDM: error of the own speed estimate "
+                                                "(SUMO sigmaerror, default 0.1)"),
+    "hv_sigma_gap": Key("hv_sigma_gap", doc="EIDM: error of the gap estimate (SUMO "
+                                            "sigmagap, default 0.1)"),
+    "hv_sigma_leader": Key("hv_sigma_leader", doc="EIDM: error of the leader's speed "
+                                                  "estimate (SUMO sigmaleader, default "
+                                                  "0.02)"),
+    "av_accel_m_s2": Key("av_accel", unit="m/s^2", allowed=_ACC,
+                         doc="AVs' largest acceleration (SUMO accel)"),
+    "av_decel_m_s2": Key("av_decel", unit="m/s^2", allowed=_ACC,
+                         doc="AVs' comfortable deceleration (SUMO decel)"),
+    "av_speed_gain": Key("av_speed_gain", unit="1/s",
+                         doc="ACC, CACC: gain of the speed-control mode (SUMO "
+                             "speedControlGain, default -0.4)"),
+    "av_gap_gain_space": Key("av_gap_gain_space", unit="1/s^2",
+                             doc="ACC, CACC: gap-control gain on the spacing error (SUMO "
+                                 "gapControlGainSpace, default 0.23)"),
+    "av_gap_gain_speed": Key("av_gap_gain_speed", unit="1/s",
+                             doc="ACC, CACC: gap-control gain on the speed difference (SUMO "
+                                 "gapControlGainSpeed, default 0.07)"),
+    "av_gap_gain_gap": Key("av_gap_gain_gap", doc="CACC: gap-control gain on the gap error "
+                                                  "(SUMO gapControlGainGap, default 0.45)"),
+    "av_gap_gain_gap_dot": Key("av_gap_gain_gap_dot",
+                               doc="CACC: gap-control gain on the gap error's rate (SUMO "
+                                   "gapControlGainGapDot, default 0.0125)"),
+}
 _RATE = ("a rate > 0 veh/h, with release_rate_min_veh_h <= release_rate_veh_h <= "
          "release_rate_max_veh_h")
 #: [sumo] key -> SumoConfig field (SI), with its unit factor
@@ -92,7 +137,7 @@ SUMO_KEYS: dict[str, Key] = {
     "time_to_teleport_s": Key("time_to_teleport", unit="s",
                               doc="SUMO's --time-to-teleport; -1 disables teleports"),
     "hv_model": Key("hv_model", "string", choices=HV_MODELS, doc="HV car-following model"),
-    "hv_sigma": Key("hv_sigma", doc="HV driver imperfection, in [0, 1]"),
+    "hv_sigma": Key("hv_sigma", doc="Krauss: HV driver imperfection, in [0, 1] (SUMO sigma)"),
     "av_model": Key("av_model", "string", choices=AV_MODELS, doc="AV car-following model"),
     "min_gap_lat_m": Key("min_gap_lat", unit="m", doc="lateral gap kept by both classes"),
     "lat_alignment": Key("lat_alignment", "string", choices=LAT_ALIGNMENTS,
@@ -107,6 +152,7 @@ SUMO_KEYS: dict[str, Key] = {
                           doc="mainline lateral insertion: fixed columns (HVs at the edges, "
                               "AVs at the centre) or a SUMO departPosLat"),
     "hv_tau_s": Key("hv_tau", unit="s", doc="HVs' desired time headway (SUMO tau)"),
+    **CAR_FOLLOWING_KEYS,
     "hv_action_step_s": Key("hv_action_step", unit="s",
                             doc="HVs' action step (SUMO actionStepLength, a reaction time); "
                                 "0: every step"),
@@ -138,6 +184,20 @@ SUMO_KEYS: dict[str, Key] = {
     "fcd": Key("fcd", "bool", doc="write SUMO's trajectories of every vehicle every step "
                                   "(fcd.xml.gz in the run directory; `arzsumo run --fcd`)"),
 }
+
+
+def refuse_ignored_car_following(table: Mapping[str, Any], at: str, cfg: SumoConfig) -> None:
+    """Refuse a car-following key that the chosen model does not read: SUMO would ignore
+    it without a word (``hv_sigma`` under IDM)."""
+    by_field = {SUMO_KEYS[k].field: k for k in table if k in SUMO_KEYS}
+    for f in ignored(by_field, cfg.hv_model, cfg.av_model):
+        key, cls = by_field[f], f[:2]
+        model = cfg.hv_model if cls == "hv" else cfg.av_model
+        names = " or ".join(written(m) for m in readers(f))
+        raise ScenarioError(
+            f"{at} {key} = {written(table[key])} is not read by {cls}_model = "
+            f"{written(model)} (SUMO would ignore it); allowed: remove it, or set "
+            f"{cls}_model = {names}")
 
 
 #: [sumo] keys that act under one meter_mode only: under the other they would be ignored
@@ -174,6 +234,7 @@ def sumo_section(table: Mapping[str, Any], at: str, source: str = "<dict>") -> S
     except ArzsumoError as exc:
         raise in_user_terms(exc, at, table, SUMO_KEYS) from None
     refuse_inert_meter_keys(table, at, cfg.meter_mode)
+    refuse_ignored_car_following(table, at, cfg)
     if not cfg.meter_curve:
         return cfg
     path = Path(cfg.meter_curve).expanduser()

@@ -11,9 +11,10 @@ from dataclasses import dataclass, fields, replace
 from typing import Any
 
 from arzsumo.errors import ScenarioError, require
+from arzsumo.sumo.car_following import ATTRIBUTES, check_values
 from arzsumo.sumo.network import NetworkSpec
 
-HV_MODELS = ("Krauss", "IDM")
+HV_MODELS = ("Krauss", "IDM", "EIDM")
 #: Width of the mainline lane, m (the network's).
 LANE_WIDTH = 6.5
 AV_MODELS = ("ACC", "CACC")
@@ -92,9 +93,17 @@ class SumoConfig:
     time_to_teleport : float
         SUMO's --time-to-teleport, s; -1 disables teleports (default).
     hv_model, hv_sigma : str, float
-        HV car-following model ("Krauss" or "IDM") and its driver imperfection in [0, 1].
+        HV car-following model ("Krauss", "IDM" or "EIDM") and Krauss's driver
+        imperfection in [0, 1].
     av_model : str
         AV car-following model ("ACC" or "CACC").
+    hv_accel, hv_decel, av_accel, av_decel : float
+        Largest acceleration and comfortable deceleration per class, m/s^2.
+    hv_sigma_step, hv_delta, hv_stepping, hv_reaction, hv_sigma_error, hv_sigma_gap,
+    hv_sigma_leader, av_speed_gain, av_gap_gain_space, av_gap_gain_speed, av_gap_gain_gap,
+    av_gap_gain_gap_dot : float or None
+        The models' own parameters (:mod:`arzsumo.sumo.car_following` says which model
+        reads which, and what SUMO does with it); None: not written, SUMO's default.
     min_gap_lat : float
         Lateral gap kept by both classes, m.
     lat_alignment : str
@@ -170,6 +179,22 @@ class SumoConfig:
     hv_model: str = "Krauss"
     hv_sigma: float = 0.5
     av_model: str = "ACC"
+    hv_accel: float = 2.6
+    hv_decel: float = 4.5
+    av_accel: float = 2.0
+    av_decel: float = 4.5
+    hv_sigma_step: float | None = None
+    hv_delta: float | None = None
+    hv_stepping: float | None = None
+    hv_reaction: float | None = None
+    hv_sigma_error: float | None = None
+    hv_sigma_gap: float | None = None
+    hv_sigma_leader: float | None = None
+    av_speed_gain: float | None = None
+    av_gap_gain_space: float | None = None
+    av_gap_gain_speed: float | None = None
+    av_gap_gain_gap: float | None = None
+    av_gap_gain_gap_dot: float | None = None
     min_gap_lat: float = 0.15
     lat_alignment: str = "arbitrary"
     lc_sublane: float = 1.0
@@ -256,6 +281,7 @@ class SumoConfig:
                 " or ".join(HV_MODELS), ScenarioError)
         require(self.av_model in AV_MODELS, "av_model", self.av_model,
                 " or ".join(AV_MODELS), ScenarioError)
+        check_values({a.field: getattr(self, a.field) for a in ATTRIBUTES})
         require(self.lat_alignment in LAT_ALIGNMENTS, "lat_alignment", self.lat_alignment,
                 ", ".join(LAT_ALIGNMENTS), ScenarioError)
         require(self.depart_pos_lat in DEPART_POS_LAT, "depart_pos_lat", self.depart_pos_lat,
@@ -296,6 +322,10 @@ class SumoConfig:
                     "min_green + meter_clearance + min_red", phases,
                     f"at most the cycle 1 / release_rate_max = {1 / self.release_rate_max:.3g} "
                     "s of one_per_green", ScenarioError)
+
+    def car_following(self, cls: str) -> dict[str, float | None]:
+        """The car-following fields of class ``cls`` ("hv" or "av") by field name."""
+        return {a.field: getattr(self, a.field) for a in ATTRIBUTES if a.cls == cls}
 
     @property
     def steps_per_period(self) -> int:

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from xml.sax.saxutils import quoteattr
 
 from arzsumo.model.params import ModelParameters
+from arzsumo.sumo.car_following import vtype_attributes
 from arzsumo.sumo.config import SumoConfig
 
 HV_TYPE, AV_TYPE = "hv", "av"
@@ -53,6 +54,11 @@ def _geometry(spacing: float) -> tuple[float, float]:
     return length, spacing - length
 
 
+def _av_number(value: float, written_before: str) -> str:
+    """The AVs' accel and decel as the vTypes wrote them before they were keys ("2.0")."""
+    return written_before if value == float(written_before) else f"{value:g}"
+
+
 def vehicle_types(params: ModelParameters, cfg: SumoConfig) -> tuple[VehicleType, VehicleType]:
     """(HV, AV) vehicle types for ``params`` under the run settings ``cfg``."""
     sub = (("latAlignment", cfg.lat_alignment), ("minGapLat", f"{cfg.min_gap_lat:.3f}"),
@@ -64,12 +70,14 @@ def vehicle_types(params: ModelParameters, cfg: SumoConfig) -> tuple[VehicleType
         hv_model: tuple[tuple[str, str], ...] = (("sigma", f"{cfg.hv_sigma:.3f}"),)
     else:
         hv_model = (("speedDev", "0.1"),)
+    hv_model += vtype_attributes(cfg.car_following("hv"), "hv", cfg.hv_model)
     if cfg.hv_action_step > 0:
         hv_model += (("actionStepLength", f"{cfg.hv_action_step:g}"),)
     hv = VehicleType(HV_TYPE, length, gap, params.vehicle_width,
                      cfg.hv_max_speed or params.v_free_h,
                      cfg.hv_model,
-                     (("vClass", "passenger"), ("accel", "2.6"), ("decel", "4.5"),
+                     (("vClass", "passenger"), ("accel", f"{cfg.hv_accel:g}"),
+                      ("decel", f"{cfg.hv_decel:g}"),
                       ("emergencyDecel", "9.0"), ("tau", f"{cfg.hv_tau:g}"),
                       ("speedFactor", "1"), ("speedDev", "0.05"), *hv_model,
                       ("color", "0.2,0.4,1"), *sub))
@@ -77,7 +85,10 @@ def vehicle_types(params: ModelParameters, cfg: SumoConfig) -> tuple[VehicleType
     av = VehicleType(AV_TYPE, length, gap, params.vehicle_width,
                      cfg.av_max_speed or params.v_free_a,
                      cfg.av_model,
-                     (("vClass", "passenger"), ("accel", "2.0"), ("decel", "4.5"),
+                     (("vClass", "passenger"), ("accel", _av_number(cfg.av_accel, "2.0")),
+                      ("decel", _av_number(cfg.av_decel, "4.5")),
                       ("emergencyDecel", "9.0"), ("tau", "1.0"), ("speedFactor", "1"),
-                      ("speedDev", "0"), ("color", "1,0.3,0.1"), *sub))
+                      ("speedDev", "0"),
+                      *vtype_attributes(cfg.car_following("av"), "av", cfg.av_model),
+                      ("color", "1,0.3,0.1"), *sub))
     return hv, av
