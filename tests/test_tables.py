@@ -68,3 +68,17 @@ def test_unknown_keys_and_tables_are_all_named_with_the_allowed_ones():
     with pytest.raises(ScenarioError, match=r"^f: t = 3 is not allowed: a table \[t\]$"):
         sub_table({"t": 3}, "t", KEYS, "f")
     assert sub_table({}, "t", KEYS, "f") == {}          # a removed table: defaults
+
+
+@pytest.mark.parametrize(("data", "named"), [
+    ({"sumo": {"hv_sigm": 0.5}}, "[sumo] unknown key 'hv_sigm' (did you mean 'hv_sigma'?);"),
+    ({"sumoo": {}}, "unknown key 'sumoo' (did you mean 'sumo'?);"),
+    ({"model": {"famly": "newell"}}, "[model] unknown key 'famly' (did you mean 'family'?);"),
+    ({"sumo": {"zzz": 1}}, "[sumo] unknown key 'zzz'; allowed:"),
+])
+def test_a_misspelt_key_or_table_gets_the_closest_name(data, named):
+    from arzsumo.scenario import scenario_from_dict
+
+    with pytest.raises(ScenarioError) as err:
+        scenario_from_dict(data, "x.toml")
+    assert named in str(err.value) and "\n" not in str(err.value)

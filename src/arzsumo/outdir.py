@@ -145,6 +145,17 @@ def _created_parents(parent: Path) -> list[Path]:
     return missing[::-1]
 
 
+def check_target(path: str | os.PathLike[str], kind: str, *, overwrite: bool = False,
+                 flag: str = "--out") -> None:
+    """Refuse ``path`` as :class:`OutputDir` would, without claiming or creating anything
+    (``--dry-run``: valid means the real run would start)."""
+    target = Path(path).expanduser().resolve()
+    here = where(str(path), target, flag)
+    if target == target.parent:
+        raise OutputError(f"{here} has no name; allowed: " + ALLOWED.format(kind=kind))
+    judge(target, kind, here, overwrite=overwrite)
+
+
 class OutputDir:
     """A results directory of ``kind`` being written: checked and claimed on creation.
 

@@ -127,3 +127,26 @@ def test_dry_run_says_observer_etc_reads_the_boundary_loops_only():
     assert _sensing_line("default") == "  estimation smoothing from sensors loops, av_probes"
     assert "inlet speeds only" in _sensing_line("legacy_default", "--controller",
                                                 "observer-etc")
+
+
+def test_dry_run_refuses_the_out_directory_the_run_would_refuse(tmp_path):
+    """A foreign non-empty directory, or a run's result without --overwrite: exit 2 and one
+    line, as the real run gives before SUMO starts; nothing is created or deleted."""
+    foreign = tmp_path / "mine"
+    foreign.mkdir()
+    (foreign / "notes.txt").write_text("keep me", encoding="utf-8")
+    code, out, err = cli("run", "default", "--dry-run", "--out", str(foreign))
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert "--out" in err and (foreign / "notes.txt").read_text(encoding="utf-8") == "keep me"
+    result = tmp_path / "result"
+    result.mkdir()
+    from arzsumo.outdir import write_marker
+
+    write_marker(result, "run")
+    (result / "summary.json").write_text("{}", encoding="utf-8")
+    code, _, err = cli("run", "default", "--dry-run", "--out", str(result))
+    assert code == 2 and "--overwrite" in err
+    code, out, _ = cli("run", "default", "--dry-run", "--out", str(result), "--overwrite")
+    assert code == 0 and "valid" in out
+    code, out, _ = cli("run", "default", "--dry-run", "--out", str(tmp_path / "new" / "run"))
+    assert code == 0 and not (tmp_path / "new").exists()

@@ -30,7 +30,7 @@ from arzsumo.control.registry import controller_names
 
 def cmd_run(args: argparse.Namespace) -> int:
     from arzsumo.bridge.session import default_run_name, prepare_run, run_prepared
-    from arzsumo.outdir import OutputDir
+    from arzsumo.outdir import OutputDir, check_target
     from arzsumo.outputs.bridge import write_results
     from arzsumo.sumo.frontend import Frontend
 
@@ -42,11 +42,12 @@ def cmd_run(args: argparse.Namespace) -> int:
     check_warmup(sc, args.warmup, args.horizon, args.allow_short_warmup)
     frontend = "gui" if args.gui else "libsumo"
     Frontend(frontend).check()   # no display or no sumo-gui: one line, before any output
-    if args.dry_run:
-        print(prepared.describe())
-        return 0
     out = Path(args.out) if args.out else Path("results") / default_run_name(
         sc, prepared.settings, prepared.sumo)
+    if args.dry_run:
+        check_target(out, "run", overwrite=args.overwrite)   # as the run would refuse it
+        print(prepared.describe())
+        return 0
     # the output is checked and claimed before SUMO starts; Ctrl-C or an error removes it
     with OutputDir(out, "run", overwrite=args.overwrite) as target:
         session = run_prepared(prepared, progress=not args.quiet, frontend=frontend)
