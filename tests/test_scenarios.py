@@ -19,7 +19,8 @@ def test_scenario_from_demand():
 
 @pytest.mark.parametrize(("data", "error", "match"), [
     ({"modle": {}}, ScenarioError,
-     r"unknown key 'modle'; allowed: actuation, alinea, description, design, disturbance, "
+     r"unknown key 'modle' \(did you mean 'model'\?\); allowed: actuation, alinea, description, "
+     r"design, disturbance, "
      r"equilibrium"),
     ({"model": {"spacing_x_m": 3}}, ScenarioError, r"\[model\] unknown key 'spacing_x_m'"),
     ({"model": {"tau_h_s": "fast"}}, ScenarioError,

@@ -60,6 +60,12 @@ def _power_slope(v_free: float, ao_max: float, gamma: float, ao: np.ndarray) -> 
     return -v_free * gamma / ao_max * _power(ao / ao_max, gamma - 1.0)
 
 
+def power_law_speed(ao: ArrayLike, v_free: float, ao_max: float, gamma: float) -> np.ndarray:
+    """One class's eq. (3) speed V (1 - (AO / AO_max)^gamma), m/s, AO clipped at 0: the
+    power law with its parameters as arguments (fitting one class, drawing a curve)."""
+    return _power_speed(v_free, ao_max, gamma, np.maximum(np.asarray(ao, float), 0.0))
+
+
 def _newell_ratio(v_free: float, w: float, ao_jam: float, ao: np.ndarray) -> np.ndarray:
     """r = V / C(AO) = V AO / (w (AO_jam - AO)): free branch over congested branch."""
     return v_free * ao / (w * (ao_jam - ao))

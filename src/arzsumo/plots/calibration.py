@@ -7,11 +7,13 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 
+from arzsumo.model.fd import power_law_speed
 from arzsumo.units import ms_to_kmh, veh_s_to_veh_h
 
 
 def _fd(ao: np.ndarray, v: float, ao_max: float, gamma: float) -> np.ndarray:
-    return np.maximum(v * (1.0 - (ao / ao_max) ** gamma), 0.0)
+    """The power law, drawn at 0 where it would turn negative."""
+    return np.maximum(power_law_speed(ao, v, ao_max, gamma), 0.0)
 
 
 def calibration_figure(points: dict[str, tuple[np.ndarray, np.ndarray]],

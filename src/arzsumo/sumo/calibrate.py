@@ -26,6 +26,7 @@ from arzsumo.errors import ArzsumoError
 from arzsumo.interrupts import worker_pool
 from arzsumo.model.characteristic import linearize
 from arzsumo.model.equilibrium import Equilibrium
+from arzsumo.model.fd import power_law_speed
 from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.green_share import GreenShareCurve
@@ -118,9 +119,8 @@ def run_calibration_runs(params: ModelParameters, base: SumoConfig, plan: Calibr
 
 
 # -- fundamental diagram fit ----------------------------------------------------------------
-def fd_speed(ao: np.ndarray, v_free: float, ao_max: float, gamma: float) -> np.ndarray:
-    """V (1 - (AO / AO_max)^gamma), m/s (AO clipped at 0)."""
-    return v_free * (1.0 - (np.maximum(ao, 0.0) / ao_max) ** gamma)
+#: the power law of one class, V (1 - (AO / AO_max)^gamma) in m/s (AO clipped at 0)
+fd_speed = power_law_speed
 
 
 @dataclass(frozen=True)
