@@ -106,3 +106,15 @@ def test_compare_never_writes_into_a_run_or_a_user_directory(tmp_path, capsys):
     out = tmp_path / "cmp"
     assert main(["compare", str(a), str(b), "--out", str(out)]) == 0
     assert main(["compare", str(a), str(b), "--out", str(out)]) == 0   # its own: rewritten
+
+
+def test_the_default_out_is_under_results_and_the_table_explains_its_counts(tmp_path):
+    """Without --out the comparison goes to results/comparison (not the working directory's
+    top level), and the legend under the table says what plan, light and update counts are."""
+    from arzsumo.bridge.compare import LEGEND
+    from arzsumo.cli import build_parser
+
+    args = build_parser().parse_args(["compare", str(tmp_path)])
+    assert args.out == "results/comparison"
+    for words in ("plan chg:", "light chg:", "updates:"):
+        assert words in LEGEND

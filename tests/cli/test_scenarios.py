@@ -68,7 +68,8 @@ def test_an_unknown_name_is_one_line_naming_the_shipped_ones():
     assert "legacy_default" in err and "'arzsumo list'" in err
 
 
-def test_a_warmup_shorter_than_the_fill_is_refused_with_the_values():
+def test_a_warmup_shorter_than_the_fill_is_refused_with_the_values(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)      # a dry run checks the default --out under results/
     code, out, err = cli("run", "default", "--dry-run", "--warmup", "5", "--horizon", "5")
     assert code == 2 and out == "" and err.count("\n") == 1
     assert err == ("arzsumo: error: --warmup = 5 is not allowed: the control window (5-10 s) "
@@ -120,7 +121,8 @@ def _sensing_line(*args: str) -> str:
     return out.splitlines()[3]
 
 
-def test_dry_run_says_observer_etc_reads_the_boundary_loops_only():
+def test_dry_run_says_observer_etc_reads_the_boundary_loops_only(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)      # a dry run checks the default --out under results/
     line = _sensing_line("default", "--controller", "observer-etc")
     assert line == ("  estimation smoothing from the boundary loops only (x = 0 and x = L), "
                     "the ETC acting on that estimate")

@@ -47,7 +47,11 @@ COLUMNS: tuple[tuple[str, str], ...] = (
     ("replay_rho_h_pct", "replay rho_h %"), ("replay_rho_a_pct", "replay rho_a %"),
     ("reference_rho_h_pct", "ref rho_h %"), ("reference_rho_a_pct", "ref rho_a %"))
 #: printed under the text table: what the short headers mean
-LEGEND = ("whole TTS: every vehicle of the demand to its arrival; time loss: SUMO's "
+LEGEND = ("plan chg: commands asking the meter for a timing other than the one it holds, "
+          "counted when asked (several within one meter cycle all count, the last runs); "
+          "light chg: greens beginning or ending on the ramp light; updates: checks at "
+          "which the controller changed its U (docs/outputs.md, Counts); "
+          "whole TTS: every vehicle of the demand to its arrival; time loss: SUMO's "
           "timeLoss + depart delay over the window (>= 0); TTT and delay vs V: the section "
           "(delay vs V = TTT - TMT / V_free with the model's free speeds, negative where "
           "SUMO drives faster); n: counts; J_discom SI: veh m^2/s^3 + veh m^2/s^5; replay "

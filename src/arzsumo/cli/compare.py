@@ -64,7 +64,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                                    "RUN_DIR are skipped (a note says so).")
     p.add_argument("runs", nargs="+", metavar="RUN_DIR",
                    help="results directories of arzsumo run")
-    add_out(p, "directory for the CSV and plot", default="comparison")
+    add_out(p, "directory for the CSV and plot", default="results/comparison")
     p.add_argument("--allow-mixed", action="store_true",
                    help="tabulate results of different kinds (twin), scenarios, horizons or "
                         "warm-ups anyway; the table's header states the mix")
