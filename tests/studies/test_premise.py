@@ -184,3 +184,24 @@ def test_a_pulse_with_no_deviation_to_read_is_unmeasured_not_a_crash():
     pulse = next(g for g in rep.gates[1] if g.name == "pulse")
     assert math.isnan(pulse.value) and not pulse.passed
     assert "norm" in pulse.detail["reason"]
+
+
+def test_the_theory_is_predicted_at_each_seeds_baseline_operating_point():
+    """The prediction uses the baseline's mean densities and HV speed; a row without the
+    densities (an older record) has none."""
+    from arzsumo.sumo.stability import predict
+
+    sc = load_scenario(LEGACY)
+    rows = _rows(1)
+    rows[0] = {**rows[0], "rho_hv_veh_m": 0.1, "rho_av_veh_m": 0.02}
+    rep = study.analyse(rows + _rows(2), sc, study.AnalysisOptions(round_trip=100.0))
+    speed = float(np.nanmean(np.array(rows[0]["v_hv"])))
+    expected = predict(sc.params, sc.sumo, 0.1, 0.02, speed)
+    assert rep.theory[1]["av"] == expected["av"] and rep.theory[1]["av"].gain > 1.0
+    assert math.isnan(rep.theory[1]["hv"].gain)            # the legacy HVs drive Krauss
+    assert rep.theory[2] == {}
+    from arzsumo.outputs.premise import theory_lines
+
+    text = theory_lines(rep.theory)
+    assert "seed 1: hv Krauss: none (Krauss is not smooth" in text
+    assert f"av ACC: max|G| {expected['av'].gain:.4f}" in text

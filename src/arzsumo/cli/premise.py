@@ -38,7 +38,7 @@ def cmd_premise(args: argparse.Namespace) -> int:
     from arzsumo.bridge.session import meter_curve_of
     from arzsumo.io import dump_toml
     from arzsumo.outdir import resumable_dir
-    from arzsumo.outputs.premise import premise_table, write_premise
+    from arzsumo.outputs.premise import premise_table, theory_lines, write_premise
     from arzsumo.studies.premise import (
         AnalysisOptions,
         check_window,
@@ -81,6 +81,8 @@ def cmd_premise(args: argparse.Namespace) -> int:
               f"round trip T = {report.round_trip:.4g} s, pulse floor: "
               f"{report.floor_method}")
         print(premise_table(report.gates, report.verdict, report.pooled_actuator))
+        if report.theory:
+            print(theory_lines(report.theory))
         print("  report: " + ", ".join(str(p) for p in files))
     return 0 if report.verdict.passed else EXIT_PREMISE_FAILS
 

@@ -109,6 +109,23 @@ def premise_table(gates: Mapping[int, Sequence[GateResult]], verdict: PremiseVer
     return "\n".join(lines)
 
 
+def theory_lines(theory: Mapping[int, Mapping[str, Any]]) -> str:
+    """Per seed the linear string-stability prediction of each class's model at the
+    baseline's operating point: the theory beside the amplification and the pulse."""
+    lines = ["linear string stability at each seed's operating point (theory; beside "
+             "amplification and pulse):"]
+    for seed, by_class in theory.items():
+        parts = []
+        for cls, p in by_class.items():
+            if math.isnan(p.gain):
+                parts.append(f"{cls} {p.model}: none ({p.reason})")
+            else:
+                parts.append(f"{cls} {p.model}: max|G| {p.gain:.4f}, x {p.growth:.3g} over "
+                             f"{p.vehicles:.0f} vehicles")
+        lines.append(f"  seed {seed}: " + "; ".join(parts))
+    return "\n".join(lines) if theory else ""
+
+
 def write_premise(out: Path, document: Mapping[str, Any],
                   gates: Mapping[int, Sequence[GateResult]],
                   pulses: Mapping[int, tuple[Any, ...]] | None = None,

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -55,6 +55,7 @@ from arzsumo.evaluation.premise import (
 from arzsumo.evaluation.stationarity import count_trend
 from arzsumo.scenario import Scenario
 from arzsumo.studies.premise_runs import CLASSES, KINDS, PremiseOptions, premise_runs
+from arzsumo.sumo.stability import StringPrediction, predict
 
 #: blocks of the amplification gate: s and m
 BLOCK_S, BLOCK_M = 10.0, 100.0
@@ -130,6 +131,10 @@ class PremiseReport:
     runs: Mapping[int, Mapping[str, Any]]
     pulse_series: Mapping[int, tuple[Any, ...]] = field(default_factory=dict)
     staircases: Mapping[int, tuple[Any, ...]] = field(default_factory=dict)
+    #: per seed and class the linear string-stability prediction at the baseline's
+    #: measured operating point (:func:`arzsumo.sumo.stability.predict`), the theory
+    #: beside the measured amplification and pulse
+    theory: Mapping[int, Mapping[str, StringPrediction]] = field(default_factory=dict)
 
 
 def gate_from_dict(d: Mapping[str, Any]) -> GateResult:
@@ -279,6 +284,16 @@ def _series(runs: Mapping[str, Mapping[str, Any]], floor: Mapping[str, float],
              _array(stair["step_times_s"])))
 
 
+def theory_at(base: Mapping[str, Any], sc: Scenario) -> dict[str, StringPrediction]:
+    """The prediction at a baseline's mean class densities and HV speed ({} for a row
+    that does not carry the densities)."""
+    if "rho_hv_veh_m" not in base or "rho_av_veh_m" not in base:
+        return {}
+    v = float(np.nanmean(class_fields(base, ["hv"])["hv"]))
+    return predict(sc.params, sc.sumo, float(base["rho_hv_veh_m"]),
+                   float(base["rho_av_veh_m"]), v)
+
+
 def _accounting(runs: Mapping[str, Mapping[str, Any]]) -> dict[str, Any]:
     base = runs["baseline"]
     return {"wall_s": {k: runs[k]["wall_s"] for k in KINDS},
@@ -310,7 +325,8 @@ def analyse(rows: Sequence[Mapping[str, Any]], sc: Scenario, opts: AnalysisOptio
                          pooled, model, trip, method, floor,
                          {s: _accounting(by_seed[s]) for s in seeds},
                          {s: v[0] for s, v in series.items()},
-                         {s: v[1] for s, v in series.items()})
+                         {s: v[1] for s, v in series.items()},
+                         {s: theory_at(by_seed[s]["baseline"], sc) for s in seeds})
 
 
 def run_premise(path: Path, sc: Scenario, seeds: Sequence[int], warmup: float,
@@ -377,4 +393,6 @@ def report_document(report: PremiseReport, sc: Scenario, path: Path, scenario_te
         "pooled": {"actuator": report.pooled_actuator.as_dict()},
         "verdict": report.verdict.as_dict(),
         "runs": {str(s): dict(v) for s, v in report.runs.items()},
+        "theory": {str(s): {c: asdict(p) for c, p in v.items()}
+                   for s, v in report.theory.items()},
     }
