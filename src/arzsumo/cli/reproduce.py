@@ -30,13 +30,15 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
                         twin={"scheme": args.scheme} if args.scheme else None)
         write_reproduction(rep, target, plots=not args.no_plots)
     cl = claims(rep)
+    smoke = ("quick: a smoke test on a coarse grid and a short horizon; the verdicts say "
+             "the code runs, not what the paper's experiments give")
     print(f"reproduce: {len(rep.records)} runs, {rep.open_loops} open loops, "
-          f"{rep.wall_time:.1f} s{' (quick)' if rep.quick else ''}")
+          f"{rep.wall_time:.1f} s" + (f" ({smoke})" if rep.quick else ""))
     for c in cl:
         mark = "yes" if c.verdict == REPRODUCED else "NO "
-        print(f"  [{mark}] {c.claim}: {c.ours}")
+        print(f"  [{'smoke ' if rep.quick else ''}{mark}] {c.claim}: {c.ours}")
     print(f"  {sum(c.verdict == REPRODUCED for c in cl)} of {len(cl)} claims reproduced in "
-          f"direction; report in {out}/report.md")
+          f"direction{' in the smoke test' if rep.quick else ''}; report in {out}/report.md")
     incomplete = [r.name for r in rep.records if not r.summary["complete"]]
     if incomplete:
         print(f"  incomplete runs: {', '.join(incomplete)}")

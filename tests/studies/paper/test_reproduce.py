@@ -219,7 +219,13 @@ def test_cli_reproduce_quick(tmp_path, monkeypatch, capsys):
                  "base_etc", "--out", str(out), "--no-plots"])
     assert code == 0
     assert (out / "report.md").exists() and not (out / "sensitivity.png").exists()
-    assert "claims reproduced in direction" in capsys.readouterr().out
+    captured = capsys.readouterr()
+    assert "claims reproduced in direction in the smoke test" in captured.out
+    verdicts = [line for line in captured.out.splitlines() if line.startswith("  [")]
+    assert verdicts and all(line.startswith(("  [smoke yes]", "  [smoke NO ]"))
+                            for line in verdicts)
+    assert "quick: a smoke test" in captured.out.splitlines()[0]
+    assert "open loops for" not in captured.err          # no stray log line
 
 
 def test_twin_overrides_reach_every_scenario_and_are_validated():

@@ -243,7 +243,7 @@ def reproduce(directory: str | Path = DEFAULT_DIR, *, quick: bool = False,
     opens = dict(zip(first, _map(_open_loop, [tasks[i] for i in first.values()],
                                   workers, scheduler),
                      strict=True))
-    log.info("%d open loops for %d runs", len(opens), len(tasks))
+    log.debug("%d open loops for %d runs", len(opens), len(tasks))   # the summary says it
     reused = {i for g, i in first.items() if opens[g][3] is not None}
     todo = [i for i in range(len(tasks)) if i not in reused]
     done = _map(_controlled_pair, [(tasks[i], opens[tasks[i].group][:3]) for i in todo],
