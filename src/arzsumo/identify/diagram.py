@@ -31,19 +31,16 @@ from scipy.optimize import least_squares
 
 from arzsumo.errors import require
 from arzsumo.identify.data import IdentifyError, ReplayData
+from arzsumo.identify.objective import DEFAULT_BOUNDS
 from arzsumo.identify.wave_target import INADMISSIBLE, WaveTarget
 from arzsumo.model.fd import area_occupancy, speed_of_ao
 from arzsumo.model.params import ModelParameters
 
-#: the diagram parameters stage 1 fits, per family, and their bounds (SI)
+#: the diagram parameters stage 1 fits, per family (bounds: the identification's own,
+#: :data:`arzsumo.identify.objective.DEFAULT_BOUNDS`)
 DIAGRAM_WHICH: dict[str, tuple[str, ...]] = {
     "newell": ("wave_speed_h", "wave_speed_a", "ao_max_h", "ao_max_a"),
     "power": ("ao_max_h", "ao_max_a", "gamma_h", "gamma_a"),
-}
-DIAGRAM_BOUNDS: dict[str, tuple[float, float]] = {
-    "wave_speed_h": (1.0, 30.0), "wave_speed_a": (1.0, 30.0),
-    "ao_max_h": (0.1, 1.0), "ao_max_a": (0.1, 1.0),
-    "gamma_h": (0.2, 8.0), "gamma_a": (0.2, 8.0),
 }
 
 
@@ -166,7 +163,7 @@ def ao_floor(p: ModelParameters, s: StationaryStates) -> float:
 
 
 def _lower(name: str, floor: float) -> float:
-    low = DIAGRAM_BOUNDS[name][0]
+    low = DEFAULT_BOUNDS[name][0]
     return max(low, floor) if name.startswith("ao_max") else low
 
 
@@ -176,13 +173,13 @@ def _solve(guess: ModelParameters, which: tuple[str, ...], s: StationaryStates,
     """Least squares in z = log(p / p0): the parameters and the Jacobian in z; the jam
     occupancies (AO_max) at least ``floor`` (default: just above every block's AO)."""
     floor = max(ao_floor(guess, s), floor or 0.0)
-    require(floor < DIAGRAM_BOUNDS["ao_max_h"][1], "largest block AO", round(floor, 4),
+    require(floor < DEFAULT_BOUNDS["ao_max_h"][1], "largest block AO", round(floor, 4),
             "below 1 (the blocks are not area occupancies otherwise)", IdentifyError)
     guess = replace(guess, **{n: max(getattr(guess, n), floor * (1 + 1e-3))
                               for n in which if n.startswith("ao_max")})
     p0 = np.array([getattr(guess, n) for n in which])
     lo = np.log(np.array([_lower(n, floor) for n in which]) / p0)
-    hi = np.log(np.array([DIAGRAM_BOUNDS[n][1] for n in which]) / p0)
+    hi = np.log(np.array([DEFAULT_BOUNDS[n][1] for n in which]) / p0)
     scale = _speed_scale(s)
 
     def at(z: np.ndarray) -> ModelParameters:

@@ -1,9 +1,9 @@
 """Area-occupancy fundamental diagrams (paper, section 2, labels AOrelation and eq. (3)).
 
 Pure vectorised functions of a :class:`ModelParameters` and density arrays (veh/m).
-Each family is one function returning Ve_i(AO) and dVe_i/dAO together, so every consumer
-(equilibria, characteristic speeds, kernels, the twin's flux, the observer, the
-identification) reads the speed and its slope from the same definition:
+Each family defines its speed Ve_i(AO) and its slope dVe_i/dAO once (:data:`_FAMILY`), so
+every consumer (equilibria, characteristic speeds, kernels, the twin's flux, the observer,
+the identification) reads them from the same definition:
 
 ``power`` (the paper's eq. (3))
     Ve_i(AO) = V_i (1 - (AO / AO_max,i)^gamma_i).
@@ -51,13 +51,17 @@ def _power(r: np.ndarray, e: float) -> np.ndarray:
 
 
 def _power_speed(v_free: float, ao_max: float, gamma: float, ao: np.ndarray) -> np.ndarray:
-    """V (1 - (AO / AO_max)^gamma), m/s."""
+    """V (1 - (AO / AO_max)^gamma), m/s; finite at AO = 0 for every gamma > 0."""
     return v_free * (1.0 - _power(ao / ao_max, gamma))
 
 
-def _power_slope(v_free: float, ao_max: float, gamma: float, ao: np.ndarray) -> np.ndarray:
-    """d/dAO of :func:`_power_speed` (infinite at AO = 0 when gamma < 1)."""
-    return -v_free * gamma / ao_max * _power(ao / ao_max, gamma - 1.0)
+def _power_terms(v_free: float, ao_max: float, gamma: float,
+                 ao: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The power law's speed and slope dVe/dAO with one power (the twin's hot path; for
+    AO > 0: at AO = 0 with gamma < 1 the slope is infinite)."""
+    r = ao / ao_max
+    pm = _power(r, gamma - 1.0)
+    return v_free * (1.0 - pm * r), -v_free * gamma / ao_max * pm
 
 
 def power_law_speed(ao: ArrayLike, v_free: float, ao_max: float, gamma: float) -> np.ndarray:
@@ -66,59 +70,63 @@ def power_law_speed(ao: ArrayLike, v_free: float, ao_max: float, gamma: float) -
     return _power_speed(v_free, ao_max, gamma, np.maximum(np.asarray(ao, float), 0.0))
 
 
-def _newell_ratio(v_free: float, w: float, ao_jam: float, ao: np.ndarray) -> np.ndarray:
-    """r = V / C(AO) = V AO / (w (AO_jam - AO)): free branch over congested branch."""
-    return v_free * ao / (w * (ao_jam - ao))
+def _newell_terms(v_free: float, w: float, ao_jam: float, n: float,
+                  ao: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The smoothed Newell speed V (1 + r^n)^(-1/n), r = V AO / (w (AO_jam - AO)), and its
+    slope -V r^(n-1) (1 + r^n)^(-1/n-1) dr/dAO (module docstring); finite on
+    [0, AO_jam)."""
+    gap = ao_jam - ao
+    r = v_free * ao / (w * gap)
+    rn1 = _power(r, n - 1.0)
+    base = 1.0 + rn1 * r
+    shrink = base ** (-1.0 / n)
+    return v_free * shrink, -v_free * rn1 * shrink / base * (v_free * ao_jam / (w * gap * gap))
 
 
 def _newell_speed(v_free: float, w: float, ao_jam: float, n: float,
                   ao: np.ndarray) -> np.ndarray:
-    """V (1 + r^n)^(-1/n), m/s (module docstring)."""
-    return v_free * (1.0 + _power(_newell_ratio(v_free, w, ao_jam, ao), n)) ** (-1.0 / n)
+    return _newell_terms(v_free, w, ao_jam, n, ao)[0]
 
 
-def _newell_slope(v_free: float, w: float, ao_jam: float, n: float,
-                  ao: np.ndarray) -> np.ndarray:
-    """d/dAO of :func:`_newell_speed`: -V r^(n-1) (1 + r^n)^(-1/n-1) dr/dAO."""
-    r = _newell_ratio(v_free, w, ao_jam, ao)
-    rn1 = _power(r, n - 1.0)
-    base = 1.0 + rn1 * r
-    dr = v_free * ao_jam / (w * (ao_jam - ao) ** 2)
-    return -v_free * rn1 * base ** (-1.0 / n - 1.0) * dr
-
-
-def _class_args(p: ModelParameters, cls: str) -> tuple[float, ...]:
-    """The arguments of the family's per-class functions, without AO."""
+def _class_args(p: ModelParameters) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """The HV's and the AV's arguments of the family's per-class functions, without AO."""
     if p.family == "power":
-        return (getattr(p, f"v_free_{cls}"), getattr(p, f"ao_max_{cls}"),
-                getattr(p, f"gamma_{cls}"))
-    return (getattr(p, f"v_free_{cls}"), getattr(p, f"wave_speed_{cls}"),
-            getattr(p, f"ao_max_{cls}"), p.corner)
+        return ((p.v_free_h, p.ao_max_h, p.gamma_h), (p.v_free_a, p.ao_max_a, p.gamma_a))
+    return ((p.v_free_h, p.wave_speed_h, p.ao_max_h, p.corner),
+            (p.v_free_a, p.wave_speed_a, p.ao_max_a, p.corner))
 
 
-PerClass = Callable[..., np.ndarray]
-#: family -> (speed, slope), each f(*class arguments, AO): the one definition of each
-_FAMILY: dict[str, tuple[PerClass, PerClass]] = {
-    "power": (_power_speed, _power_slope), "newell": (_newell_speed, _newell_slope)}
+Speed = Callable[..., np.ndarray]
+Terms = Callable[..., tuple[np.ndarray, np.ndarray]]
+#: family -> (speed, speed and slope), each f(*class arguments, AO); the slope is defined
+#: once per family, in its second function
+_FAMILY: dict[str, tuple[Speed, Terms]] = {
+    "power": (_power_speed, _power_terms), "newell": (_newell_speed, _newell_terms)}
 
 
 def speed_of_ao(p: ModelParameters, ao: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
-    """(Ve_h(AO), Ve_a(AO)) in m/s for the family ``p.family``."""
+    """(Ve_h(AO), Ve_a(AO)) in m/s for the family ``p.family`` (a Python float in, floats
+    out: the twin's inlet asks for one state every step)."""
+    if not isinstance(ao, float):
+        ao = np.asarray(ao, float)
+    speed, (h, a) = _FAMILY[p.family][0], _class_args(p)
+    return speed(*h, ao), speed(*a, ao)
+
+
+def speed_terms_of_ao(p: ModelParameters, ao: ArrayLike) -> SpeedTerms:
+    """(Ve_h, Ve_a, dVe_h/dAO, dVe_a/dAO) at ``ao`` (> 0), sharing each class's powers:
+    what the twin's flux needs every step."""
     ao = np.asarray(ao, float)
-    speed = _FAMILY[p.family][0]
-    return speed(*_class_args(p, "h"), ao), speed(*_class_args(p, "a"), ao)
+    terms, (h, a) = _FAMILY[p.family][1], _class_args(p)
+    ve_h, d_h = terms(*h, ao)
+    ve_a, d_a = terms(*a, ao)
+    return ve_h, ve_a, d_h, d_a
 
 
 def dspeed_dao(p: ModelParameters, ao: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """(dVe_h/dAO, dVe_a/dAO) in m/s per unit AO; both negative for 0 < AO < AO_max,i."""
-    ao = np.asarray(ao, float)
-    slope = _FAMILY[p.family][1]
-    return slope(*_class_args(p, "h"), ao), slope(*_class_args(p, "a"), ao)
-
-
-def speed_terms_of_ao(p: ModelParameters, ao: ArrayLike) -> SpeedTerms:
-    """(Ve_h, Ve_a, dVe_h/dAO, dVe_a/dAO) at ``ao``: what the twin's flux needs."""
-    return (*speed_of_ao(p, ao), *dspeed_dao(p, ao))
+    _, _, d_h, d_a = speed_terms_of_ao(p, ao)
+    return d_h, d_a
 
 
 def equilibrium_speeds(p: ModelParameters, rho_h: ArrayLike,

@@ -28,12 +28,12 @@ from arzsumo.errors import ArzsumoError
 from arzsumo.evaluation.premise.travel import wave_speed
 from arzsumo.identify.data import ReplayData
 from arzsumo.identify.diagram import (
-    DIAGRAM_BOUNDS,
     DiagramFit,
     StationaryStates,
     block_states,
     fit_diagram,
 )
+from arzsumo.identify.objective import DEFAULT_BOUNDS
 from arzsumo.model.fd import area_occupancy
 from arzsumo.model.params import FAMILIES, ModelParameters
 from arzsumo.scenario import Scenario
@@ -91,7 +91,7 @@ def diagram_guess(sc: Scenario, family: str, states: StationaryStates,
                            f"{', '.join(FAMILIES)}")
     p, cfg = sc.params, sc.sumo
     ao = float(np.max(area_occupancy(p, states.rho_h, states.rho_a)))
-    jam = min(1.0, max(1.2 * ao, DIAGRAM_BOUNDS["ao_max_h"][0]))
+    jam = min(1.0, max(1.2 * ao, DEFAULT_BOUNDS["ao_max_h"][0]))
     changes: dict[str, float | str] = {
         "family": family, "ao_max_h": jam, "ao_max_a": jam,
         "v_free_h": cfg.hv_max_speed or p.v_free_h, "v_free_a": cfg.av_max_speed or p.v_free_a}

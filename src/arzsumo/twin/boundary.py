@@ -43,7 +43,7 @@ import numpy as np
 from arzsumo.errors import ModelError, require
 from arzsumo.model.characteristic import Linearization
 from arzsumo.model.equilibrium import equilibrium_from_demand
-from arzsumo.model.fd import equilibrium_speeds
+from arzsumo.model.fd import speed_of_ao
 from arzsumo.model.params import ModelParameters
 
 Signal = float | Callable[[float], float]
@@ -133,7 +133,7 @@ class Inlet:
         """Physical flux (4,) of the boundary state at x = 0, and that state (conserved)."""
         rho_h, v_h, rho_a, v_a = self.boundary_primitive(t, z0)
         rho_h, v_h, rho_a, v_a = float(rho_h), float(v_h), float(rho_a), float(v_a)
-        ve_h, ve_a = (float(v) for v in equilibrium_speeds(p, rho_h, rho_a))
+        ve_h, ve_a = speed_of_ao(p, (p.area_h * rho_h + p.area_a * rho_a) / p.road_width)
         y_h, y_a = rho_h * (v_h - ve_h), rho_a * (v_a - ve_a)
         return (np.array([rho_h * v_h, y_h * v_h, rho_a * v_a, y_a * v_a]),
                 np.array([rho_h, y_h, rho_a, y_a]))
