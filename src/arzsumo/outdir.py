@@ -181,9 +181,7 @@ class OutputDir:
                  flag: str = "--out", scratch: bool = True) -> None:
         self.user, self.kind, self.overwrite, self.flag = str(path), kind, overwrite, flag
         self.path = Path(path).expanduser().resolve()
-        if self.path == self.path.parent:
-            raise self.refuse("has no name")
-        self.check()
+        check_target(path, kind, overwrite=overwrite, flag=flag)
         remove_leftovers(self.path)
         self._made = _created_parents(self.path.parent)
         self.tmp = self._claim()
