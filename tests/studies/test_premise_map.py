@@ -11,6 +11,7 @@ import pytest
 
 from arzsumo.evaluation.premise import GateResult
 from arzsumo.studies import premise_map as pm
+from arzsumo.studies import premise_map_points as pmp
 from arzsumo.studies.common import StudyError, shipped_scenario
 from arzsumo.studies.premise_runs import PremiseOptions
 
@@ -38,11 +39,57 @@ def test_every_point_but_today_leaves_the_uncoupled_files_and_names_are_unique()
     assert pm.POINTS[0].set == {}
     for p in pm.POINTS[1:]:
         assert p.set["sumo.min_gap_lat_m"] >= 0.6, p.name
-        assert p.set["sumo.demand_h_veh_h"] < 3750, p.name      # re-mapped demand
+        if not p.mapped:                      # mapped points get theirs from the run
+            assert p.set["sumo.demand_h_veh_h"] < 3750, p.name  # re-mapped demand
+
+
+def test_the_mapping_rule_reproduces_the_coupled_base_mapped_by_hand():
+    """The coupled base was mapped by hand: outflow 3860 veh/h, hold 3900, fill 4400."""
+    d = pmp.mapped_demand(3860 / 3600, 0.18)
+    assert d["demand_h_veh_h"] + d["demand_a_veh_h"] == pytest.approx(3899, abs=1)
+    assert d["fill_demand_h_veh_h"] + d["fill_demand_a_veh_h"] == pytest.approx(4400, abs=1)
+    assert d == pmp.demand(0.18, 1.01 * 3860, 1.14 * 3860)
+    with pytest.raises(StudyError, match="cannot be mapped"):
+        pmp.mapped_demand(float("nan"), 0.18)
+
+
+def test_a_mapped_point_is_held_above_any_discharge_then_at_its_own():
+    p = next(q for q in pm.POINTS if q.name == "idm-flow")
+    assert p.mapped and "sumo.demand_h_veh_h" not in p.set
+    held = pmp.discharge_point(p)
+    assert held.set["sumo.demand_h_veh_h"] + held.set["sumo.demand_a_veh_h"] == 4400
+    assert held.set["sumo.fill_demand_h_veh_h"] == held.set["sumo.demand_h_veh_h"]
+    mapped = pm.mapped_points([p, pm.POINTS[0]], {"idm-flow": 3000 / 3600})
+    assert mapped[1] is pm.POINTS[0]
+    assert mapped[0].set["sumo.demand_h_veh_h"] == round(3030 * 0.82)
+    assert mapped[0].set["sumo.hv_accel_m_s2"] == 1.0           # Flow's IDM kept
+    for q in pmp.share_variants(p):
+        assert q.mapped and q.av_share in (0.3, 0.5) and q.name.startswith("idm-flow@av")
+
+
+def test_discharge_runs_use_a_seed_no_gate_reads_and_a_short_window():
+    runs = pm.discharge_runs(shipped_scenario("default.toml"),
+                             pm.selected_points("coupled,krauss-0.75-s1,eidm"), 600.0)
+    assert [r.run_id for r in runs] == [
+        f"point=krauss-0.75-s1,seed={pmp.MAPPING_SEED},kind=discharge",
+        f"point=eidm,seed={pmp.MAPPING_SEED},kind=discharge"]
+    sumo = runs[0].scenario["sumo"]
+    assert sumo["hv_sigma_step_s"] == 1.0 and sumo["depart_pos_lat"] == "random"
+    assert sumo["demand_h_veh_h"] + sumo["demand_a_veh_h"] == pmp.OVERSATURATED_VEH_H
+    assert runs[0].options["window_s"] == pmp.DISCHARGE_WINDOW_S
+    again = pm.discharge_runs(shipped_scenario("default.toml"),
+                              pm.selected_points("krauss-0.75-s1,eidm"), 600.0,
+                              first={"eidm": 3000 / 3600})
+    assert [r.run_id for r in again] == [f"point=eidm,seed={pmp.MAPPING_SEED},"
+                                         "kind=discharge2"]
+    sumo = again[0].scenario["sumo"]
+    assert sumo["demand_h_veh_h"] + sumo["demand_a_veh_h"] == pytest.approx(3030, abs=1)
+    assert sumo["fill_demand_h_veh_h"] + sumo["fill_demand_a_veh_h"] == pytest.approx(
+        3420, abs=1)
 
 
 def test_the_demand_splits_its_totals_by_the_av_share():
-    d = pm.demand(0.25, hold=4000, fill=4800)
+    d = pmp.demand(0.25, hold=4000, fill=4800)
     assert d == {"demand_h_veh_h": 3000, "demand_a_veh_h": 1000,
                  "fill_demand_h_veh_h": 3600, "fill_demand_a_veh_h": 1200}
 
@@ -127,3 +174,30 @@ def test_one_seed_reads_the_pulse_but_leaves_it_undecided():
     detail = next(g.detail for g in gates if g.name == "pulse")
     # against its own late deviation the decayed pulse reads as decayed within 100 s
     assert detail["late_floor_value"] < 100.0 and "one seed" in detail["reason"]
+
+
+def test_the_theory_columns_are_the_prediction_at_each_seeds_measured_point():
+    """IDM HVs: the table's gain is the mean over seeds of
+    :func:`arzsumo.sumo.stability.predict` at each baseline's densities and HV speed;
+    Krauss has none (NaN)."""
+    from dataclasses import replace
+
+    from arzsumo.scenario import load_scenario
+    from arzsumo.sumo.stability import predict
+
+    sc = load_scenario(shipped_scenario("default.toml"))
+    idm = replace(sc, sumo=sc.sumo.with_(hv_model="IDM"))
+    rows = [{**r, "rho_hv_veh_m": 0.08 + 0.01 * r["seed"], "rho_av_veh_m": 0.02}
+            for r in _map_rows()]
+    _, wide = pm.map_tables(rows, [pm.MapPoint("p", "axis", {})], 1000.0,
+                            fallback_trip=100.0, scenarios={"p": idm})
+    v = float(np.mean(np.array(rows[0]["v_hv"])))     # both seeds' fields: mean 8 m/s
+    want = np.mean([predict(idm.params, idm.sumo, 0.08 + 0.01 * s, 0.02, v)["hv"].gain
+                    for s in (1, 2)])
+    assert wide["gain_hv"].iloc[0] == pytest.approx(want, rel=1e-3)
+    assert wide["gain_hv"].iloc[0] > 1.0                      # IDM at 8 m/s: unstable
+    assert wide["growth_hv"].iloc[0] > wide["gain_hv"].iloc[0]
+    _, krauss = pm.map_tables(rows, [pm.MapPoint("p", "axis", {})], 1000.0,
+                              fallback_trip=100.0, scenarios={"p": sc})
+    assert math.isnan(krauss["gain_hv"].iloc[0]) and krauss["gain_av"].iloc[0] > 1.0
+    assert "max|G| hv" in pm.theory_markdown(wide)

@@ -27,7 +27,7 @@ from __future__ import annotations
 import argparse
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -39,6 +39,7 @@ from arzsumo.evaluation.premise.instability import round_trip_time
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.premise_map import write_map
 from arzsumo.outputs.studies import markdown_table, publish
+from arzsumo.scenario import Scenario
 from arzsumo.studies.common import (
     FORMER_DEFAULT,
     StudyError,
@@ -59,12 +60,23 @@ from arzsumo.studies.premise import (
     operating_gates,
     read_pulse,
     speed_gates,
+    theory_at,
+)
+from arzsumo.studies.premise_map_points import (
+    COUPLED,
+    DISCHARGE_WINDOW_S,
+    MAPPING_SEED,
+    POINTS,
+    MapPoint,
+    discharge_point,
+    with_discharge,
 )
 from arzsumo.studies.premise_runs import (
     PremiseOptions,
     grouped,
     horizon_periods,
     run_premise_group,
+    run_premise_task,
     ungrouped,
 )
 from arzsumo.units import VEH_H_PER_VEH_S, VEH_KM_PER_VEH_M, ms_to_kmh
@@ -76,64 +88,6 @@ PAGE = "premise_map"
 MAP_GATES = ("coupling[hv]", "coupling[av]", "waves[hv]", "waves[av]",
              "amplification[hv]", "amplification[av]", "pulse", "stationary", "inserted",
              "ramp_queue")
-
-
-@dataclass(frozen=True)
-class MapPoint:
-    """One point of the map: ``name`` (its row), ``axis`` (what it varies) and ``set``
-    (sweep ``set`` keys of the base scenario, e.g. ``{"sumo.min_gap_lat_m": 0.6}``)."""
-
-    name: str
-    axis: str
-    set: Mapping[str, Any] = field(default_factory=dict)
-
-    def __post_init__(self) -> None:
-        bad = [k for k in self.set if not k.startswith("sumo.")]
-        if bad or not self.name or "," in self.name or "=" in self.name:
-            raise StudyError(f"map point {self.name!r}: a name without ',' or '=' and "
-                             f"[sumo] keys only (got {bad})")
-
-
-def _point(name: str, axis: str, **keys: Any) -> MapPoint:
-    return MapPoint(name, axis, {f"sumo.{k}": v for k, v in keys.items()})
-
-
-def demand(av_share: float, hold: float = 3900.0, fill: float = 4400.0) -> dict[str, float]:
-    """Hold and fill demands (veh/h, scenario keys) of the totals ``hold`` and ``fill``
-    split by the AV share."""
-    return {"demand_h_veh_h": round(hold * (1 - av_share)),
-            "demand_a_veh_h": round(hold * av_share),
-            "fill_demand_h_veh_h": round(fill * (1 - av_share)),
-            "fill_demand_a_veh_h": round(fill * av_share)}
-
-
-#: the coupled base: SUMO's default lateral gap and SUMO's random free lateral insertion
-#: (no fixed columns, so no file is set up at x = 0), with the demand re-mapped to it:
-#: a hold about 1 % above the section outflow measured there (3860 veh/h, seed 1) and a
-#: fill that congests the section in the 10 min warm-up without filling the approach
-COUPLED = {"min_gap_lat_m": 0.6, "depart_pos_lat": "random_free", **demand(0.18)}
-
-#: the map: today's default, the lateral gap alone (with the fixed columns), one centre
-#: file, then one change at a time from the coupled base
-POINTS: tuple[MapPoint, ...] = (
-    _point("today", "former default"),
-    _point("columns-0.6", "lateral", min_gap_lat_m=0.6, demand_h_veh_h=3350,
-           demand_a_veh_h=750),
-    _point("centre-file", "lateral", min_gap_lat_m=0.6, lat_alignment="center",
-           depart_pos_lat="center", lc_speed_gain=0, demand_h_veh_h=1700,
-           demand_a_veh_h=400, fill_demand_h_veh_h=2300, fill_demand_a_veh_h=700),
-    _point("coupled", "base", **COUPLED),
-    _point("gap-1.0", "lateral", **{**COUPLED, "min_gap_lat_m": 1.0}),
-    _point("sigma-0.9", "car following", **COUPLED, hv_sigma=0.9),
-    _point("action-1.0", "car following", **COUPLED, hv_action_step_s=1.0),
-    _point("idm", "car following", **COUPLED, hv_model="IDM"),
-    _point("down-40", "bottleneck", **COUPLED, down_speed_kmh=40),
-    _point("av-10", "penetration", **{**COUPLED, **demand(0.10)}),
-    _point("av-50", "penetration", **{**COUPLED, **demand(0.50)}),
-    # the one point whose oscillations grew upstream, its demand re-mapped to the outflow
-    # it measured (3340 veh/h): hold 1 % above it
-    _point("av-50-mapped", "penetration", **{**COUPLED, **demand(0.50, 3370, 3900)}),
-)
 
 
 # -- the design ----------------------------------------------------------------------------
@@ -154,6 +108,43 @@ def map_runs(path: Path, points: Sequence[MapPoint], seeds: Sequence[int], warmu
                              options={**opts.for_kind(k), "horizon_periods": n})
                      for k in kinds]
     return runs
+
+
+def discharge_runs(path: Path, points: Sequence[MapPoint], warmup: float,
+                   first: Mapping[str, float] | None = None) -> list[StudyRun]:
+    """Per mapped point one open-loop discharge run on
+    :data:`~arzsumo.studies.premise_map_points.MAPPING_SEED`. Without ``first``, held
+    above any discharge (:func:`~arzsumo.studies.premise_map_points.discharge_point`;
+    IDs ``point=P,seed=S,kind=discharge``). With ``first`` (point -> the q(L) that run
+    measured, veh/s), at the demand that discharge maps to (IDs ``...,kind=discharge2``):
+    a queue held far above its discharge reaches the inlet, where AVs starve at insertion,
+    so the first reading is that of another mix; the second, at the point's own mix
+    with the queue inside the section and approach, is the one the point is mapped by."""
+    from arzsumo.scenario import scenario_from_dict
+
+    runs = []
+    for p in (p for p in points if p.mapped):
+        if first is not None and p.name not in first:
+            continue
+        q = discharge_point(p) if first is None else with_discharge(p, first[p.name])
+        kind = "discharge" if first is None else "discharge2"
+        spec = study_spec(NAME, path, seeds=[MAPPING_SEED],
+                          set={"run.warmup_s": float(warmup), **q.set})
+        for r in design_runs(spec):
+            period = scenario_from_dict(r.scenario, r.source).sumo.control_period
+            n = max(1, round(DISCHARGE_WINDOW_S / period))
+            runs.append(replace(r, run_id=f"point={p.name},{r.run_id},kind={kind}",
+                                columns={"point": p.name, "axis": p.axis, **r.columns},
+                                options={"kind": "baseline", "window_s": DISCHARGE_WINDOW_S,
+                                         "horizon_periods": n}))
+    return runs
+
+
+def mapped_points(points: Sequence[MapPoint], discharges: Mapping[str, float]
+                  ) -> list[MapPoint]:
+    """``points`` with every mapped point's demand set from its measured discharge
+    (``discharges``: point name -> q(L), veh/s)."""
+    return [with_discharge(p, discharges[p.name]) if p.mapped else p for p in points]
 
 
 # -- the analysis (pure) -------------------------------------------------------------------
@@ -240,8 +231,9 @@ def point_measures(rows: Mapping[int, Mapping[str, Mapping[str, Any]]]) -> dict[
     base = [r["baseline"] for r in rows.values()]
 
     def mean(key: str) -> float:    # stored rows hold NaN as None
-        return float(np.nanmean([np.nanmean(np.array(b.get(key, math.nan), dtype=float))
-                                 for b in base]))
+        per_run = [np.array(b.get(key, math.nan), dtype=float) for b in base]
+        means = [float(np.nanmean(a)) for a in per_run if np.isfinite(a).any()]
+        return float(np.mean(means)) if means else math.nan
 
     out = {}
     for c in ("hv", "av"):
@@ -251,12 +243,29 @@ def point_measures(rows: Mapping[int, Mapping[str, Mapping[str, Any]]]) -> dict[
     return out
 
 
+def point_theory(rows: Mapping[int, Mapping[str, Mapping[str, Any]]], sc: Scenario
+                 ) -> dict[str, float]:
+    """The linear string-stability prediction at each seed's measured operating point
+    (:func:`~arzsumo.studies.premise.theory_at`), averaged over seeds: per class the
+    largest gain per vehicle ``gain_*`` and the growth over the section's vehicles
+    ``growth_*`` (NaN for a model without one, e.g. Krauss)."""
+    preds = [theory_at(r["baseline"], sc) for r in rows.values()]
+    out = {}
+    for c in ("hv", "av"):
+        for key, attr in (("gain", "gain"), ("growth", "growth")):
+            vals = [getattr(p[c], attr) for p in preds if c in p]
+            out[f"{key}_{c}"] = float(np.mean(vals)) if vals else math.nan
+    return out
+
+
 def map_tables(rows: Sequence[Mapping[str, Any]], points: Sequence[MapPoint], length: float,
                fallback_trip: float, th: PremiseThresholds | None = None,
-               smooth: float = 30.0) -> tuple[pd.DataFrame, pd.DataFrame]:
+               smooth: float = 30.0, scenarios: Mapping[str, Scenario] | None = None
+               ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """(per point, seed and gate; per point) of the rows of :func:`map_runs`' runs, in
     the order of ``points``; ``fallback_trip``: the pulse's round trip (s) where the HV
-    waves were not measured travelling upstream."""
+    waves were not measured travelling upstream; ``scenarios`` (point name -> its
+    resolved scenario): the theory's columns (:func:`point_theory`)."""
     th = th or PremiseThresholds()
     by: dict[str, dict[int, dict[str, Mapping[str, Any]]]] = {}
     for r in rows:
@@ -282,7 +291,9 @@ def map_tables(rows: Sequence[Mapping[str, Any]], points: Sequence[MapPoint], le
             # a gate left undecided (one seed's pulse) is no pass and no fail: NaN
             row[f"{name}_passed"] = float(np.mean([g.passed for g in decided])) \
                 if decided else math.nan
-        wide.append({**row, **point_measures(by[p.name])})
+        theory = point_theory(by[p.name], scenarios[p.name]) \
+            if scenarios and p.name in scenarios else {}
+        wide.append({**row, **point_measures(by[p.name]), **theory})
     return pd.DataFrame(long), pd.DataFrame(wide)
 
 
@@ -319,22 +330,45 @@ def selected_points(text: str | None) -> list[MapPoint]:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run the map's points (or read them from ``--out``) and write its tables."""
-    from arzsumo.scenario import load_scenario
+    """Map the mapped points' demands to their discharge, run the map's points (or read
+    them from ``--out``) and write its tables."""
+    from arzsumo.scenario import load_scenario, scenario_from_dict
 
     path = args.scenario or shipped_scenario(FORMER_DEFAULT)
     points = selected_points(args.points)
     sc = load_scenario(path)
     opts = PremiseOptions(args.window, args.pulse_s)
-    runs = map_runs(path, points, args.seeds, sc.run.warmup, opts, pulses=not args.no_pulse)
+    mapping = discharge_runs(path, points, sc.run.warmup)
     if args.list:
-        return print_list([r.run_id for r in runs])
+        runs = map_runs(path, points, args.seeds, sc.run.warmup, opts,
+                        pulses=not args.no_pulse)
+        return print_list([r.run_id for r in mapping + runs])
     with resumable_dir(args.out, f"study-{NAME}") as out:
+        discharges: dict[str, float] = {}
+        if mapping:
+            found = run_design(mapping, _discharge_task, out, workers=args.workers,
+                               scheduler=args.scheduler, progress=not args.quiet,
+                               label=f"{NAME} discharge")
+            first = {r["point"]: float(r["outflow_veh_s"]) for r in found}
+            second = run_design(discharge_runs(path, points, sc.run.warmup, first),
+                                _discharge_task, out, workers=args.workers,
+                                scheduler=args.scheduler, progress=not args.quiet,
+                                label=f"{NAME} discharge at the mapped demand")
+            discharges = {r["point"]: float(r["outflow_veh_s"]) for r in second}
+            _print_mapping(found, second)
+        points = mapped_points(points, discharges)
+        runs = map_runs(path, points, args.seeds, sc.run.warmup, opts,
+                        pulses=not args.no_pulse)
         rows = ungrouped(run_design(grouped(runs), _task, out, workers=args.workers,
                                     scheduler=args.scheduler, progress=not args.quiet,
                                     label=NAME))
+        scenarios = {}
+        for r in runs:
+            scenarios.setdefault(r.columns["point"], scenario_from_dict(r.scenario, r.source))
         long, wide = map_tables(rows, points, sc.params.length,
-                                model_speeds(sc).round_trip)
+                                model_speeds(sc).round_trip, scenarios=scenarios)
+        wide["discharge_veh_h"] = [discharges.get(n, math.nan) * VEH_H_PER_VEH_S
+                                   for n in wide["point"]] if len(wide) else []
         files = write_map(out, long, wide, MAP_GATES, plots=plots_wanted(args))
         text = map_markdown(wide)
         if args.docs is not None:
@@ -342,9 +376,33 @@ def run(args: argparse.Namespace) -> int:
                     "Share of seeds on which each premise gate passed, per point of the "
                     f"map, and the measured means (`arzsumo study {NAME}`). Tables: "
                     f"[premise_map_points.csv]({PAGE}/premise_map_points.csv), "
-                    f"[premise_map.csv]({PAGE}/premise_map.csv).\n\n{text}", files)
+                    f"[premise_map.csv]({PAGE}/premise_map.csv).\n\n{text}\n\n"
+                    "Theory beside measurement: the measured amplification per class "
+                    "(upstream over downstream amplitude) and the linear string-stability "
+                    "prediction at the measured operating point (largest gain per "
+                    "vehicle, growth over the section's vehicles; none for Krauss).\n\n"
+                    f"{theory_markdown(wide)}", files)
     print(text)
+    print(theory_markdown(wide))
     return 0
+
+
+def _print_mapping(first: Sequence[Mapping[str, Any]],
+                   second: Sequence[Mapping[str, Any]]) -> None:
+    """One line per mapped point: both discharge readings and what each inserted."""
+    for a, b in zip(first, second, strict=True):
+        print(f"{a['point']}: discharge {a['outflow_veh_s'] * VEH_H_PER_VEH_S:.0f} veh/h "
+              f"held above it ({a['inserted_main'] / a['requested_main']:.0%} inserted), "
+              f"{b['outflow_veh_s'] * VEH_H_PER_VEH_S:.0f} veh/h at the demand it maps to "
+              f"({b['inserted_main'] / b['requested_main']:.0%} inserted)")
+
+
+def _discharge_task(run: StudyRun) -> dict[str, Any]:
+    """A discharge run: its section outflow q(L) (veh/s) and what it inserted."""
+    row = run_premise_task(run)
+    return {"point": run.columns["point"], "outflow_veh_s": row["outflow_veh_s"],
+            "inserted_main": row["inserted_main"], "requested_main": row["requested_main"],
+            "rho_hv_veh_m": row["rho_hv_veh_m"], "rho_av_veh_m": row["rho_av_veh_m"]}
 
 
 def _task(run: StudyRun) -> dict[str, Any]:
@@ -360,3 +418,19 @@ def map_markdown(wide: pd.DataFrame) -> str:
     table = wide[[c for c in cols if c in wide]].rename(
         columns={f"{g}_passed": g for g in MAP_GATES})
     return markdown_table(table, ".3g")
+
+
+def theory_markdown(wide: pd.DataFrame) -> str:
+    """The per-point table of theory beside measurement: the measured amplification and
+    wave speed per class, the predicted gain and growth, the operating point and, for a
+    mapped point, its measured discharge."""
+    cols = ["point", "amplification[hv]_value", "gain_hv", "growth_hv",
+            "amplification[av]_value", "gain_av", "growth_av", "waves[hv]_value",
+            "v_hv_kmh", "rho_hv_veh_km", "rho_av_veh_km", "q_out_veh_h", "discharge_veh_h"]
+    table = wide[[c for c in cols if c in wide]].copy()
+    if "waves[hv]_value" in table:
+        table["waves[hv]_value"] = ms_to_kmh(table["waves[hv]_value"])
+    return markdown_table(table.rename(columns={
+        "amplification[hv]_value": "ampl hv", "amplification[av]_value": "ampl av",
+        "gain_hv": "max|G| hv", "growth_hv": "growth hv", "gain_av": "max|G| av",
+        "growth_av": "growth av", "waves[hv]_value": "wave hv km/h"}), ".3g")

@@ -1,0 +1,167 @@
+"""The premise map's points and the rule that maps each point's demand to its own
+discharge (``arzsumo study premise-map``).
+
+A point changes a few ``[sumo]`` keys of the base scenario. The points of the first map
+(lateral axis, bottleneck, penetration) carry demands set by hand. The car-following
+points are *mapped*: before its gates, each runs one open-loop discharge run on a seed
+of its own (:data:`MAPPING_SEED`, used by no gate), held above any discharge, and its
+fill and hold demands are then set from the section outflow q(L) that run measured, by
+the rule the coupled base was mapped by by hand (:func:`mapped_demand`):
+
+* hold = :data:`HOLD_RATIO` x q(L): about 1 % above the discharge, so the queue stands
+  at the merge and its tail creeps upstream by a few metres a minute;
+* fill = :data:`FILL_RATIO` x q(L) during ``fill_s``: the queue covers the section by
+  the warm-up's end (the coupled base: 4400 against 3860 veh/h).
+
+Demands in veh/h (scenario keys), split by the point's AV share.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+from arzsumo.studies.common import StudyError
+from arzsumo.units import VEH_H_PER_VEH_S
+
+#: the mapping's hold and fill demands over the measured discharge
+HOLD_RATIO, FILL_RATIO = 1.01, 1.14
+#: the seed of the discharge runs: no gate reads it
+MAPPING_SEED = 100
+#: the discharge runs' demand (veh/h, fill and hold): above every point's discharge
+OVERSATURATED_VEH_H = 4400.0
+#: the window over which a discharge run's q(L) is averaged (s, after the warm-up)
+DISCHARGE_WINDOW_S = 300.0
+#: the AV share of the coupled base's demand
+BASE_AV_SHARE = 0.18
+
+
+@dataclass(frozen=True)
+class MapPoint:
+    """One point of the map: ``name`` (its row), ``axis`` (what it varies), ``set``
+    (sweep ``set`` keys of the base scenario, e.g. ``{"sumo.min_gap_lat_m": 0.6}``);
+    ``mapped``: its demand is set from its own measured discharge, split by
+    ``av_share``."""
+
+    name: str
+    axis: str
+    set: Mapping[str, Any] = field(default_factory=dict)
+    mapped: bool = False
+    av_share: float = BASE_AV_SHARE
+
+    def __post_init__(self) -> None:
+        bad = [k for k in self.set if not k.startswith("sumo.")]
+        if bad or not self.name or "," in self.name or "=" in self.name:
+            raise StudyError(f"map point {self.name!r}: a name without ',' or '=' and "
+                             f"[sumo] keys only (got {bad})")
+        if not 0.0 <= self.av_share < 1.0:
+            raise StudyError(f"map point {self.name!r}: av_share = {self.av_share!r} is "
+                             "not allowed: in [0, 1)")
+
+
+def _point(name: str, axis: str, **keys: Any) -> MapPoint:
+    return MapPoint(name, axis, {f"sumo.{k}": v for k, v in keys.items()})
+
+
+def demand(av_share: float, hold: float = 3900.0, fill: float = 4400.0) -> dict[str, float]:
+    """Hold and fill demands (veh/h, scenario keys) of the totals ``hold`` and ``fill``
+    split by the AV share."""
+    return {"demand_h_veh_h": round(hold * (1 - av_share)),
+            "demand_a_veh_h": round(hold * av_share),
+            "fill_demand_h_veh_h": round(fill * (1 - av_share)),
+            "fill_demand_a_veh_h": round(fill * av_share)}
+
+
+def mapped_demand(discharge_veh_s: float, av_share: float) -> dict[str, float]:
+    """The mapping rule: hold and fill (veh/h, scenario keys) of a measured section
+    discharge q(L) (veh/s), :data:`HOLD_RATIO` and :data:`FILL_RATIO` times it."""
+    if not (math.isfinite(discharge_veh_s) and discharge_veh_s > 0):
+        raise StudyError(f"a discharge of {discharge_veh_s!r} veh/s cannot be mapped: the "
+                         "discharge run measured no outflow")
+    q = discharge_veh_s * VEH_H_PER_VEH_S
+    return demand(av_share, HOLD_RATIO * q, FILL_RATIO * q)
+
+
+def discharge_point(p: MapPoint) -> MapPoint:
+    """``p`` held at :data:`OVERSATURATED_VEH_H` through fill and hold: its discharge
+    run."""
+    total = OVERSATURATED_VEH_H
+    return replace(p, set={**p.set, **{f"sumo.{k}": v for k, v in
+                                        demand(p.av_share, total, total).items()}})
+
+
+def with_discharge(p: MapPoint, discharge_veh_s: float) -> MapPoint:
+    """``p`` with the demand :func:`mapped_demand` sets from its discharge (veh/s)."""
+    keys = mapped_demand(discharge_veh_s, p.av_share)
+    return replace(p, set={**p.set, **{f"sumo.{k}": v for k, v in keys.items()}})
+
+
+#: the coupled base: SUMO's default lateral gap and SUMO's random free lateral insertion
+#: (no fixed columns, so no file is set up at x = 0), with the demand re-mapped to it:
+#: a hold about 1 % above the section outflow measured there (3860 veh/h, seed 1) and a
+#: fill that congests the section in the 10 min warm-up without filling the approach
+COUPLED = {"min_gap_lat_m": 0.6, "depart_pos_lat": "random_free", **demand(BASE_AV_SHARE)}
+
+#: the car-following axis' base: the coupled stream, inserted at random lateral places
+#: that keep every vehicle inside the lane (``random_free`` lets a vehicle overhang the
+#: lane's edge, and one that stops on the junction lane at x = 0 can never leave it:
+#: docs/sumo.md), on a 1000 m approach: the queue the mapped fill builds reaches about
+#: 500-700 m upstream of x = 0, and a shorter stretch of free flow at capacity leaves an
+#: unstable stream less room to break down before it reaches the section; the default's
+#: ramp demand (a little above the nominal release rate)
+CAR_FOLLOWING = {"min_gap_lat_m": 0.6, "depart_pos_lat": "random",
+                 "approach_length_m": 1000, "ramp_demand_veh_h": 660}
+
+#: car-following parameter sets as published: Flow's merge benchmark (a 1, b 1.5, T 1)
+#: and Treiber, Hennecke & Helbing (2000: a 0.73, b 1.67, T 1.6); SUMO's own IDM
+#: defaults are the scenario's (a 2.6, b 4.5, T 1)
+FLOW_IDM = {"hv_accel_m_s2": 1.0, "hv_decel_m_s2": 1.5, "hv_tau_s": 1.0}
+TREIBER_IDM = {"hv_accel_m_s2": 0.73, "hv_decel_m_s2": 1.67, "hv_tau_s": 1.6}
+
+
+def _mapped(name: str, av_share: float = BASE_AV_SHARE, **keys: Any) -> MapPoint:
+    return MapPoint(name, "car following (mapped)",
+                    {f"sumo.{k}": v for k, v in {**CAR_FOLLOWING, **keys}.items()},
+                    mapped=True, av_share=av_share)
+
+
+def share_variants(p: MapPoint, shares: tuple[float, ...] = (0.30, 0.50)) -> list[MapPoint]:
+    """``p`` at other AV shares, each mapped to its own discharge (names ``P@avNN``)."""
+    return [replace(p, name=f"{p.name}@av{round(100 * s)}", axis="penetration (mapped)",
+                    av_share=s) for s in shares]
+
+
+#: the map: today's default, the lateral gap alone (with the fixed columns), one centre
+#: file, then one change at a time from the coupled base; then the car-following axis,
+#: every point mapped to its own discharge
+POINTS: tuple[MapPoint, ...] = (
+    _point("today", "former default"),
+    _point("columns-0.6", "lateral", min_gap_lat_m=0.6, demand_h_veh_h=3350,
+           demand_a_veh_h=750),
+    _point("centre-file", "lateral", min_gap_lat_m=0.6, lat_alignment="center",
+           depart_pos_lat="center", lc_speed_gain=0, demand_h_veh_h=1700,
+           demand_a_veh_h=400, fill_demand_h_veh_h=2300, fill_demand_a_veh_h=700),
+    _point("coupled", "base", **COUPLED),
+    _point("gap-1.0", "lateral", **{**COUPLED, "min_gap_lat_m": 1.0}),
+    _point("sigma-0.9", "car following", **COUPLED, hv_sigma=0.9),
+    _point("action-1.0", "car following", **COUPLED, hv_action_step_s=1.0),
+    _point("idm", "car following", **COUPLED, hv_model="IDM"),
+    _point("down-40", "bottleneck", **COUPLED, down_speed_kmh=40),
+    _point("av-10", "penetration", **{**COUPLED, **demand(0.10)}),
+    _point("av-50", "penetration", **{**COUPLED, **demand(0.50)}),
+    # the one point whose oscillations grew upstream, its demand re-mapped to the outflow
+    # it measured (3340 veh/h): hold 1 % above it
+    _point("av-50-mapped", "penetration", **{**COUPLED, **demand(0.50, 3370, 3900)}),
+    _mapped("cf-base"),
+    _mapped("krauss-0.5-s1", hv_sigma=0.5, hv_sigma_step_s=1.0),
+    _mapped("krauss-0.65-s1", hv_sigma=0.65, hv_sigma_step_s=1.0),
+    _mapped("krauss-0.75-s1", hv_sigma=0.75, hv_sigma_step_s=1.0),
+    _mapped("krauss-0.9-s1", hv_sigma=0.9, hv_sigma_step_s=1.0),
+    _mapped("action-0.5", hv_action_step_s=0.5),
+    _mapped("idm-sumo", hv_model="IDM"),
+    _mapped("idm-flow", hv_model="IDM", **FLOW_IDM),
+    _mapped("idm-treiber", hv_model="IDM", **TREIBER_IDM),
+    _mapped("eidm", hv_model="EIDM"),
+)
