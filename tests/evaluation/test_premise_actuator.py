@@ -39,7 +39,7 @@ def _record(k_down: float, k_up: float, delay: float = 8.0, tau: float = 5.0,
 
 
 def test_a_unit_gain_both_ways_passes_and_its_dead_time_is_recovered():
-    g = actuator_gate(_record(-1.0, -1.0))
+    g = actuator_gate(_record(-1.0, -1.0), estimator="steps")
     assert g.name == "actuator" and g.passed and g.threshold == (-1.3, -0.7)
     for d in ("up", "down"):
         fit = g.detail[d]
@@ -53,7 +53,7 @@ def test_a_unit_gain_both_ways_passes_and_its_dead_time_is_recovered():
 
 
 def test_a_weak_gain_both_ways_fails():
-    g = actuator_gate(_record(-0.3, -0.3))
+    g = actuator_gate(_record(-0.3, -0.3), estimator="steps")
     assert not g.passed and g.value == pytest.approx(-0.3, abs=1e-6)
     assert not g.detail["up"]["passed"] and not g.detail["down"]["passed"]
 
@@ -61,7 +61,7 @@ def test_a_weak_gain_both_ways_fails():
 @pytest.mark.parametrize("first", [+1, -1])
 def test_the_asymmetric_meter_of_todays_default_fails(first):
     # down -1.0, up -0.12: more ramp green barely moves the jammed mainline's outflow
-    g = actuator_gate(_record(-1.0, -0.12, first=first))
+    g = actuator_gate(_record(-1.0, -0.12, first=first), estimator="steps")
     assert not g.passed
     assert g.detail["down"]["passed"] and not g.detail["up"]["passed"]
     assert g.detail["down"]["gain"] == pytest.approx(-1.0, abs=1e-6)
@@ -70,14 +70,14 @@ def test_the_asymmetric_meter_of_todays_default_fails(first):
 
 
 def test_a_meter_stepped_one_way_only_fails():
-    g = actuator_gate(_record(-1.0, -1.0, steps=1))
+    g = actuator_gate(_record(-1.0, -1.0, steps=1), estimator="steps")
     assert g.detail["up"]["steps"] == 1 and g.detail["down"]["steps"] == 0
     assert not g.passed and math.isnan(g.detail["down"]["gain"])
 
 
 def test_noisy_counts_pooled_over_seeds_pass_with_an_interval():
     recs = [_record(-1.0, -1.0, noise=0.02, seed=s) for s in range(3)]
-    g = actuator_gate(recs)
+    g = actuator_gate(recs, estimator="steps")
     up = g.detail["up"]
     assert g.passed and up["steps"] == 12
     assert up["gain_low"] < -1.0 < up["gain_high"]
@@ -86,14 +86,14 @@ def test_noisy_counts_pooled_over_seeds_pass_with_an_interval():
 
 
 def test_a_gain_in_range_but_too_uncertain_fails():
-    g = actuator_gate(_record(-1.0, -1.0, noise=0.2, steps=4))
+    g = actuator_gate(_record(-1.0, -1.0, noise=0.2, steps=4), estimator="steps")
     assert (g.detail["up"]["gain_high"] - g.detail["up"]["gain_low"]) / 2 > 0.3
     assert not g.passed
 
 
 def test_the_areas_agree_with_the_least_squares_fit():
     rec = _record(-1.0, -1.0, delay=11.0, tau=7.0, noise=0.005, seed=4)
-    ours = actuator_gate(rec).detail["down"]
+    ours = actuator_gate(rec, estimator="steps").detail["down"]
     data = [StepData(rec.t[(rec.t > t0 - 60) & (rec.t <= t0 + 180)],
                      rec.q[(rec.t > t0 - 60) & (rec.t <= t0 + 180)], t0, -STEP)
             for t0 in rec.step_times[1::2]]
@@ -114,7 +114,8 @@ def test_any_noise_free_fopdt_is_recovered(k, delay, tau):
     # last 60 s, where an unsettled tail exp(-(hold - 60 - delay) / tau) would bias it
     # (e.g. 2e-5 for delay 19 s, tau 15 s, hold 240 s)
     hold = max(240.0, float(np.ceil(60.0 + delay + 15.0 * tau)))   # steps on bin edges
-    g = actuator_gate(_record(k, k, delay=delay, tau=tau, hold=hold, steps=4))
+    g = actuator_gate(_record(k, k, delay=delay, tau=tau, hold=hold, steps=4),
+                      estimator="steps")
     assert g.passed is (lo <= k <= hi)
     # exact at bin edges; within the bin where a fast response rises, to half a bin
     tol = 0.05 if tau >= 3.0 else 0.5

@@ -201,3 +201,19 @@ def test_the_theory_columns_are_the_prediction_at_each_seeds_measured_point():
                               fallback_trip=100.0, scenarios={"p": sc})
     assert math.isnan(krauss["gain_hv"].iloc[0]) and krauss["gain_av"].iloc[0] > 1.0
     assert "max|G| hv" in pm.theory_markdown(wide)
+
+
+def test_a_gridlocked_discharge_run_leaves_its_point_out_and_says_so():
+    def row(point, q_veh_h, inserted):
+        return {"point": point, "outflow_veh_s": q_veh_h / 3600, "inserted_main": inserted,
+                "requested_main": 1000}
+
+    first = [row("a", 3000, 800), row("b", 0.0, 400), row("c", 2500, 700)]
+    assert pmp.flowing(first) == {"a": 3000 / 3600, "c": 2500 / 3600}
+    second = [row("a", 2950, 990), row("c", 100, 300)]
+    assert pmp.flowing(second) == {"a": 2950 / 3600}
+    text = pmp.mapping_lines(first, second).splitlines()
+    assert text[0] == ("a: discharge 3000 veh/h (80% inserted) held above it; 2950 veh/h "
+                       "(99% inserted) at the demand it maps to")
+    assert text[1].startswith("b: discharge 0 veh/h") and "gridlocked" in text[1]
+    assert "gridlocked" in text[2]

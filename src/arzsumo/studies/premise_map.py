@@ -4,7 +4,10 @@ free on the SUMO side (``arzsumo study premise-map``).
 The frame stays fixed (1 km, one 6.5 m lane under the sublane model, HV and AV types,
 the ramp meter at the outlet). Each :class:`MapPoint` changes a few ``[sumo]`` keys of
 the base scenario: the lateral behaviour, the HVs' car following, the downstream
-bottleneck, the AV share and the demand (:data:`POINTS`). Per point and seed an
+bottleneck, the AV share and the demand (:data:`POINTS`). The car-following points
+are first mapped to their own discharge (two discharge runs on a seed no gate reads:
+:mod:`arzsumo.studies.premise_map_points`); a point that gridlocks there is left out.
+Per point and seed an
 open-loop baseline (:mod:`arzsumo.studies.premise_runs`), and on the point's first seed
 the paired pulse; then the gates of ``arzsumo premise`` that these runs decide:
 
@@ -19,7 +22,8 @@ The actuator's staircase and the model's gates are left to ``arzsumo premise`` o
 point the map selects: the staircase costs four times a baseline, and the model is
 identified there. Outputs: ``premise_map.csv`` (one row per point, seed and gate),
 ``premise_map_points.csv`` (per point: the share of seeds each gate passed on, the
-measured speeds, densities and outflow) and ``premise_map.png``.
+measured speeds, densities and outflow, the linear string-stability prediction at the
+measured operating point and the mapped discharge) and ``premise_map.png``.
 """
 
 from __future__ import annotations
@@ -64,24 +68,24 @@ from arzsumo.studies.premise import (
 )
 from arzsumo.studies.premise_map_points import (
     COUPLED,
-    DISCHARGE_WINDOW_S,
-    MAPPING_SEED,
+    NAME,
     POINTS,
     MapPoint,
-    discharge_point,
-    with_discharge,
+    discharge_runs,
+    discharge_task,
+    flowing,
+    mapped_points,
+    mapping_lines,
 )
 from arzsumo.studies.premise_runs import (
     PremiseOptions,
     grouped,
     horizon_periods,
     run_premise_group,
-    run_premise_task,
     ungrouped,
 )
 from arzsumo.units import VEH_H_PER_VEH_S, VEH_KM_PER_VEH_M, ms_to_kmh
 
-NAME = "premise-map"
 #: the results page this study keeps a block of
 PAGE = "premise_map"
 #: the gates the map decides, in the order of its table and figure
@@ -108,43 +112,6 @@ def map_runs(path: Path, points: Sequence[MapPoint], seeds: Sequence[int], warmu
                              options={**opts.for_kind(k), "horizon_periods": n})
                      for k in kinds]
     return runs
-
-
-def discharge_runs(path: Path, points: Sequence[MapPoint], warmup: float,
-                   first: Mapping[str, float] | None = None) -> list[StudyRun]:
-    """Per mapped point one open-loop discharge run on
-    :data:`~arzsumo.studies.premise_map_points.MAPPING_SEED`. Without ``first``, held
-    above any discharge (:func:`~arzsumo.studies.premise_map_points.discharge_point`;
-    IDs ``point=P,seed=S,kind=discharge``). With ``first`` (point -> the q(L) that run
-    measured, veh/s), at the demand that discharge maps to (IDs ``...,kind=discharge2``):
-    a queue held far above its discharge reaches the inlet, where AVs starve at insertion,
-    so the first reading is that of another mix; the second, at the point's own mix
-    with the queue inside the section and approach, is the one the point is mapped by."""
-    from arzsumo.scenario import scenario_from_dict
-
-    runs = []
-    for p in (p for p in points if p.mapped):
-        if first is not None and p.name not in first:
-            continue
-        q = discharge_point(p) if first is None else with_discharge(p, first[p.name])
-        kind = "discharge" if first is None else "discharge2"
-        spec = study_spec(NAME, path, seeds=[MAPPING_SEED],
-                          set={"run.warmup_s": float(warmup), **q.set})
-        for r in design_runs(spec):
-            period = scenario_from_dict(r.scenario, r.source).sumo.control_period
-            n = max(1, round(DISCHARGE_WINDOW_S / period))
-            runs.append(replace(r, run_id=f"point={p.name},{r.run_id},kind={kind}",
-                                columns={"point": p.name, "axis": p.axis, **r.columns},
-                                options={"kind": "baseline", "window_s": DISCHARGE_WINDOW_S,
-                                         "horizon_periods": n}))
-    return runs
-
-
-def mapped_points(points: Sequence[MapPoint], discharges: Mapping[str, float]
-                  ) -> list[MapPoint]:
-    """``points`` with every mapped point's demand set from its measured discharge
-    (``discharges``: point name -> q(L), veh/s)."""
-    return [with_discharge(p, discharges[p.name]) if p.mapped else p for p in points]
 
 
 # -- the analysis (pure) -------------------------------------------------------------------
@@ -345,18 +312,20 @@ def run(args: argparse.Namespace) -> int:
         return print_list([r.run_id for r in mapping + runs])
     with resumable_dir(args.out, f"study-{NAME}") as out:
         discharges: dict[str, float] = {}
+        stuck: list[str] = []
         if mapping:
-            found = run_design(mapping, _discharge_task, out, workers=args.workers,
+            found = run_design(mapping, discharge_task, out, workers=args.workers,
                                scheduler=args.scheduler, progress=not args.quiet,
                                label=f"{NAME} discharge")
-            first = {r["point"]: float(r["outflow_veh_s"]) for r in found}
-            second = run_design(discharge_runs(path, points, sc.run.warmup, first),
-                                _discharge_task, out, workers=args.workers,
+            second = run_design(discharge_runs(path, points, sc.run.warmup,
+                                               flowing(found)),
+                                discharge_task, out, workers=args.workers,
                                 scheduler=args.scheduler, progress=not args.quiet,
                                 label=f"{NAME} discharge at the mapped demand")
-            discharges = {r["point"]: float(r["outflow_veh_s"]) for r in second}
-            _print_mapping(found, second)
-        points = mapped_points(points, discharges)
+            discharges = flowing(second)
+            stuck = [p.name for p in points if p.mapped and p.name not in discharges]
+            print(mapping_lines(found, second))
+        points = mapped_points([p for p in points if p.name not in stuck], discharges)
         runs = map_runs(path, points, args.seeds, sc.run.warmup, opts,
                         pulses=not args.no_pulse)
         rows = ungrouped(run_design(grouped(runs), _task, out, workers=args.workers,
@@ -385,24 +354,6 @@ def run(args: argparse.Namespace) -> int:
     print(text)
     print(theory_markdown(wide))
     return 0
-
-
-def _print_mapping(first: Sequence[Mapping[str, Any]],
-                   second: Sequence[Mapping[str, Any]]) -> None:
-    """One line per mapped point: both discharge readings and what each inserted."""
-    for a, b in zip(first, second, strict=True):
-        print(f"{a['point']}: discharge {a['outflow_veh_s'] * VEH_H_PER_VEH_S:.0f} veh/h "
-              f"held above it ({a['inserted_main'] / a['requested_main']:.0%} inserted), "
-              f"{b['outflow_veh_s'] * VEH_H_PER_VEH_S:.0f} veh/h at the demand it maps to "
-              f"({b['inserted_main'] / b['requested_main']:.0%} inserted)")
-
-
-def _discharge_task(run: StudyRun) -> dict[str, Any]:
-    """A discharge run: its section outflow q(L) (veh/s) and what it inserted."""
-    row = run_premise_task(run)
-    return {"point": run.columns["point"], "outflow_veh_s": row["outflow_veh_s"],
-            "inserted_main": row["inserted_main"], "requested_main": row["requested_main"],
-            "rho_hv_veh_m": row["rho_hv_veh_m"], "rho_av_veh_m": row["rho_av_veh_m"]}
 
 
 def _task(run: StudyRun) -> dict[str, Any]:

@@ -19,13 +19,20 @@ Demands in veh/h (scenario keys), split by the point's AV share.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 from typing import Any
 
-from arzsumo.studies.common import StudyError
+from arzsumo.studies.common import StudyError, study_spec
+from arzsumo.studies.design import StudyRun, design_runs
+from arzsumo.studies.premise_runs import run_premise_task
 from arzsumo.units import VEH_H_PER_VEH_S
 
+NAME = "premise-map"
+#: the least section outflow a discharge run must measure for its point to be mapped:
+#: below it the merge has gridlocked (veh/s)
+MIN_DISCHARGE_VEH_S = 360.0 / VEH_H_PER_VEH_S
 #: the mapping's hold and fill demands over the measured discharge
 HOLD_RATIO, FILL_RATIO = 1.01, 1.14
 #: the seed of the discharge runs: no gate reads it
@@ -165,3 +172,78 @@ POINTS: tuple[MapPoint, ...] = (
     _mapped("idm-treiber", hv_model="IDM", **TREIBER_IDM),
     _mapped("eidm", hv_model="EIDM"),
 )
+
+
+# -- the discharge runs --------------------------------------------------------------------
+def discharge_runs(path: Path, points: Sequence[MapPoint], warmup: float,
+                   first: Mapping[str, float] | None = None) -> list[StudyRun]:
+    """Per mapped point one open-loop discharge run on
+    :data:`~arzsumo.studies.premise_map_points.MAPPING_SEED`. Without ``first``, held
+    above any discharge (:func:`~arzsumo.studies.premise_map_points.discharge_point`;
+    IDs ``point=P,seed=S,kind=discharge``). With ``first`` (point -> the q(L) that run
+    measured, veh/s), at the demand that discharge maps to (IDs ``...,kind=discharge2``):
+    a queue held far above its discharge reaches the inlet, where AVs starve at insertion,
+    so the first reading is that of another mix; the second, at the point's own mix
+    with the queue inside the section and approach, is the one the point is mapped by."""
+    from arzsumo.scenario import scenario_from_dict
+
+    runs = []
+    for p in (p for p in points if p.mapped):
+        if first is not None and p.name not in first:
+            continue
+        q = discharge_point(p) if first is None else with_discharge(p, first[p.name])
+        kind = "discharge" if first is None else "discharge2"
+        spec = study_spec(NAME, path, seeds=[MAPPING_SEED],
+                          set={"run.warmup_s": float(warmup), **q.set})
+        for r in design_runs(spec):
+            period = scenario_from_dict(r.scenario, r.source).sumo.control_period
+            n = max(1, round(DISCHARGE_WINDOW_S / period))
+            runs.append(replace(r, run_id=f"point={p.name},{r.run_id},kind={kind}",
+                                columns={"point": p.name, "axis": p.axis, **r.columns},
+                                options={"kind": "baseline", "window_s": DISCHARGE_WINDOW_S,
+                                         "horizon_periods": n}))
+    return runs
+
+
+def mapped_points(points: Sequence[MapPoint], discharges: Mapping[str, float]
+                  ) -> list[MapPoint]:
+    """``points`` with every mapped point's demand set from its measured discharge
+    (``discharges``: point name -> q(L), veh/s)."""
+    return [with_discharge(p, discharges[p.name]) if p.mapped else p for p in points]
+
+
+def flowing(rows: Sequence[Mapping[str, Any]]) -> dict[str, float]:
+    """Point -> the q(L) its discharge run measured (veh/s), for the points whose
+    section discharged at least :data:`MIN_DISCHARGE_VEH_S` (a gridlocked merge has no
+    operating point to map to)."""
+    return {r["point"]: float(r["outflow_veh_s"]) for r in rows
+            if float(r["outflow_veh_s"]) >= MIN_DISCHARGE_VEH_S}
+
+
+def mapping_lines(first: Sequence[Mapping[str, Any]],
+                  second: Sequence[Mapping[str, Any]]) -> str:
+    """One line per mapped point: both discharge readings and what each inserted, or
+    that the point gridlocked (left out of the gates)."""
+    again = {r["point"]: r for r in second}
+
+    def reading(r: Mapping[str, Any]) -> str:
+        return (f"{r['outflow_veh_s'] * VEH_H_PER_VEH_S:.0f} veh/h "
+                f"({r['inserted_main'] / r['requested_main']:.0%} inserted)")
+
+    lines = []
+    for a in first:
+        b = again.get(a["point"])
+        if b is None or float(b["outflow_veh_s"]) < MIN_DISCHARGE_VEH_S:
+            tail = "gridlocked: no operating point, left out of the gates"
+        else:
+            tail = f"{reading(b)} at the demand it maps to"
+        lines.append(f"{a['point']}: discharge {reading(a)} held above it; {tail}")
+    return "\n".join(lines)
+
+
+def discharge_task(run: StudyRun) -> dict[str, Any]:
+    """A discharge run: its section outflow q(L) (veh/s) and what it inserted."""
+    row = run_premise_task(run)
+    return {"point": run.columns["point"], "outflow_veh_s": row["outflow_veh_s"],
+            "inserted_main": row["inserted_main"], "requested_main": row["requested_main"],
+            "rho_hv_veh_m": row["rho_hv_veh_m"], "rho_av_veh_m": row["rho_av_veh_m"]}

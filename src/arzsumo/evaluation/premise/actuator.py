@@ -36,6 +36,13 @@ from itertools import pairwise
 import numpy as np
 
 from arzsumo.errors import require
+from arzsumo.evaluation.premise.actuator_levels import (
+    SETTLE_S,
+    SIDES,
+    LevelFit,
+    hold_levels,
+    side_fit,
+)
 from arzsumo.evaluation.premise.gates import GateResult, PremiseError, PremiseThresholds
 from arzsumo.evaluation.stats import mean_ci
 
@@ -191,39 +198,62 @@ def _direction_ok(fit: DirectionFit, th: PremiseThresholds) -> bool:
     return bool(in_range and (fit.gain_high - fit.gain_low) / 2 <= th.gain_ci_halfwidth)
 
 
+def _level_ok(fit: LevelFit, th: PremiseThresholds) -> bool:
+    lo, hi = th.gain_range
+    return bool(lo <= fit.gain <= hi and fit.halfwidth <= th.gain_ci_halfwidth)
+
+
 def actuator_gate(records: ActuatorRecord | Sequence[ActuatorRecord],
                   thresholds: PremiseThresholds | None = None,
-                  level_s: float = LEVEL_S) -> GateResult:
-    """Gate 4: dq(L) / dr within ``gain_range`` for steps up *and* down.
+                  level_s: float = LEVEL_S, estimator: str = "levels",
+                  settle_s: float = SETTLE_S) -> GateResult:
+    """Gate 4: dq(L) / dr within ``gain_range`` on both sides of the nominal rate.
 
     Parameters
     ----------
     records : ActuatorRecord or sequence of them
-        One or more runs (e.g. one per seed); their steps are pooled per direction.
+        One or more runs (e.g. one per seed); their levels (or steps) are pooled.
     thresholds : PremiseThresholds, optional
         ``gain_range`` and ``gain_ci_halfwidth`` are used.
     level_s : float
-        Level windows, s.
+        The per-step level windows, s (``estimator = "steps"`` and the dead times).
+    estimator : {"levels", "steps"}
+        ``"levels"``: per side of the nominal rate, the gain regressed on the holds'
+        levels, one intercept per record (:mod:`.actuator_levels`); ``"steps"``: per
+        step direction, the per-step gains pooled (:func:`direction_fit`).
+    settle_s : float
+        ``"levels"``: the part of each hold left out of its level, s.
 
     Returns
     -------
     GateResult
-        Named ``actuator``. ``value``: the pooled gain of the direction farther from the
-        range's middle (1); passed when both directions have steps, each pooled gain lies
-        in the range and, with two steps or more, the half width of its 95 % interval is
-        at most ``gain_ci_halfwidth``. ``detail``: per direction the :class:`DirectionFit`
-        fields and ``passed``; ``steps`` (per step t0_s, dr, dq, gain, direction).
+        Named ``actuator``. ``value``: the gain of the side (or direction) farther from
+        the range's middle (1); passed when both have a gain in the range whose 95 %
+        interval's half width is at most ``gain_ci_halfwidth`` (``"steps"``: with one
+        step, the range alone). ``detail``: ``estimator``; per step direction the
+        :class:`DirectionFit` fields and ``passed`` (``"up"``, ``"down"``: the dead
+        times); with ``"levels"``, ``levels`` per side (the :class:`LevelFit` fields
+        and ``passed``); ``steps`` (per step t0_s, dr, dq, gain, direction).
     """
     th = thresholds or PremiseThresholds()
+    require(estimator in ("levels", "steps"), "estimator", estimator,
+            "'levels' or 'steps'", PremiseError)
     recs = [records] if isinstance(records, ActuatorRecord) else list(records)
     require(len(recs) >= 1, "records", 0, "at least one record", PremiseError)
     steps = [s for rec in recs for s in step_measures(rec, level_s)]
     fits = {d: direction_fit(steps, d) for d in ("up", "down")}
     ok = {d: _direction_ok(f, th) for d, f in fits.items()}
+    detail: dict = {"estimator": estimator,
+                    **{d: {**asdict(f), "passed": ok[d]} for d, f in fits.items()}}
+    gains = {d: f.gain for d, f in fits.items()}
+    if estimator == "levels":
+        levels = [hold_levels(r.t, r.q, r.r, r.step_times, settle_s) for r in recs]
+        sides = {s: side_fit(levels, s) for s in SIDES}
+        ok = {s: _level_ok(f, th) for s, f in sides.items()}
+        detail["levels"] = {s: {**asdict(f), "passed": ok[s]} for s, f in sides.items()}
+        gains = {s: f.gain for s, f in sides.items()}
     mid = sum(th.gain_range) / 2
-    worst = max(fits.values(), key=lambda f: abs(f.gain - mid) if math.isfinite(f.gain)
-                else math.inf)
-    detail = {d: {**asdict(f), "passed": ok[d]} for d, f in fits.items()}
+    worst = max(gains.values(), key=lambda g: abs(g - mid) if math.isfinite(g) else math.inf)
     detail["steps"] = [{"t0_s": s.t0, "dr": s.dr, "dq": s.dq, "gain": s.gain,
                         "direction": s.direction} for s in steps]
-    return GateResult("actuator", worst.gain, th.gain_range, all(ok.values()), detail)
+    return GateResult("actuator", worst, th.gain_range, all(ok.values()), detail)
