@@ -72,3 +72,43 @@ def test_the_u_estimate_design_is_one_run_per_estimator_on_legacy_default():
                                            "loop_spacing_m": 250}
     assert "sensing" not in runs[0].scenario or \
         runs[0].scenario["sensing"].get("kinds") != ["loops", "av_probes"]
+
+
+class FakeEngine:
+    """``map_runs`` of the enkf-noise study without SUMO: the records are made-up paths,
+    every score is the same row; the recording's progress label and every scoring job
+    are kept."""
+
+    def __init__(self) -> None:
+        self.progress: list[str | None] = []
+        self.jobs: list[tuple] = []
+
+    def map_runs(self, fn, tasks, **kwargs):
+        if fn is estimation_layouts.record:
+            self.progress.append(kwargs.get("progress"))
+            return [{"path": f"record-{i}.npz"} for i, _ in enumerate(tasks)]
+        self.jobs += tasks
+        return [{"seed": t[2], "layout": t[3],
+                 **{f"{v}_rel": 0.2 for v in enkf_noise.VARS},
+                 **{f"{v}_spread_rel": 0.1 for v in enkf_noise.VARS}} for t in tasks]
+
+
+@pytest.fixture
+def engine(monkeypatch):
+    fake = FakeEngine()
+    monkeypatch.setattr("arzsumo.sweep.driver.map_runs", fake.map_runs)
+    monkeypatch.setattr(enkf_noise, "map_runs", fake.map_runs)
+    return fake
+
+
+ENKF_QUICK = ("--tune-seeds", "1", "--report-seeds", "2", "--rounds", "0",
+              "--inflation-only", "1.05", "--workers", "1")
+
+
+@pytest.mark.parametrize(("quiet", "progress"), [((), "estimation-layouts: recording"),
+                                                  (("--quiet",), None)])
+def test_enkf_noise_records_with_a_progress_bar_unless_quiet(run_study, engine, tmp_path,
+                                                             quiet, progress):
+    assert run_study("enkf-noise", *ENKF_QUICK, *quiet, "--out", tmp_path / "out") == 0
+    assert engine.progress == [progress]
+

@@ -166,6 +166,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--workers", type=positive_int, metavar="N",
                         help="local processes (default: one per core)")
     parser.add_argument("--scheduler", metavar="ADDRESS", help="record on this Dask scheduler")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
     add_output(parser, NAME, PAGE, plots=False)
 
 
