@@ -112,3 +112,13 @@ def test_enkf_noise_records_with_a_progress_bar_unless_quiet(run_study, engine, 
     assert run_study("enkf-noise", *ENKF_QUICK, *quiet, "--out", tmp_path / "out") == 0
     assert engine.progress == [progress]
 
+
+def test_enkf_noise_reports_the_perfect_model_at_the_inflation_asked_for(run_study, engine,
+                                                                         tmp_path):
+    assert run_study("enkf-noise", *ENKF_QUICK, "--inflation", "1.3",
+                     "--out", tmp_path / "out") == 0
+    reported = [extra for _, _, seed, _, extra in engine.jobs if seed == 2]
+    perfect = [e for e in reported if all(e[k] == 0.0 for k in enkf_noise.KEYS)]
+    noisy = [e for e in reported if e not in perfect]
+    assert perfect and noisy
+    assert {e["estimation.inflation"] for e in perfect + noisy} == {1.3}
