@@ -122,3 +122,24 @@ def test_enkf_noise_reports_the_perfect_model_at_the_inflation_asked_for(run_stu
     noisy = [e for e in reported if e not in perfect]
     assert perfect and noisy
     assert {e["estimation.inflation"] for e in perfect + noisy} == {1.3}
+
+
+def test_loop_speed_station_means_leave_out_a_period_without_a_harmonic_speed():
+    from types import SimpleNamespace
+
+    from arzsumo.studies import loop_speed
+
+    periods, stations = 2, 5                  # the first period (start) is the warm-up's
+    speed = np.full((periods + 1, 2, stations), 10.0)
+    harmonic = np.full((periods + 1, 2, stations), 8.0)
+    harmonic[1, 0, 2] = np.nan                # no harmonic mean there (say, a stopped car)
+    truth = np.zeros((periods, 4, stations))
+    truth[:, 1], truth[:, 3] = 9.0, 9.0
+    rec = SimpleNamespace(start=0, x=np.arange(stations) * 100.0,
+                          loop_x=np.arange(stations) * 100.0, speed=speed,
+                          speed_harmonic=harmonic, truth=lambda: truth)
+    assert loop_speed.station_speeds(rec) == [
+        "v_h at the stations, km/h: time-mean 36.00, harmonic 28.80, probe cells 32.40 "
+        "(5 station-periods)",
+        "v_a at the stations, km/h: time-mean 36.00, harmonic 28.80, probe cells 32.40 "
+        "(6 station-periods)"]
