@@ -24,6 +24,7 @@ from typing import Any
 from arzsumo.argtypes import (  # noqa: F401 (the studies' option types, re-exported)
     SEED_LIMIT,
     fraction,
+    fraction_list,
     non_negative_float,
     non_negative_int,
     number_list,

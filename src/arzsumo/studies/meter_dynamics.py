@@ -40,7 +40,7 @@ from arzsumo.studies.common import (
     add_output,
     add_runs,
     fixed_cycle,
-    number_list,
+    fraction_list,
     plots_wanted,
     positive_float,
     print_list,
@@ -175,9 +175,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="fill and warm-up at green share 0.5, s")
     parser.add_argument("--base", type=positive_float, default=60.0,
                         help="s more at 0.5 before the steps")
-    parser.add_argument("--greens", type=number_list, default=list(GREENS),
-                        help="the green shares of the steps, comma-separated "
-                             f"(default: {','.join(map(str, GREENS))})")
+    # the meter runs green shares in [0, 1] (0: all red, 1: all green); the steps drive
+    # it directly, past the scenario's green_share_min/max, so the option is the check
+    parser.add_argument("--greens", type=fraction_list, default=list(GREENS),
+                        help="the green shares of the steps, comma-separated, each in "
+                             f"[0, 1] (default: {','.join(map(str, GREENS))})")
     parser.add_argument("--hold", type=positive_float, default=102.0,
                         help="s per step (17 cycles of 6 s)")
     parser.add_argument("--pre", type=positive_float, default=60.0,
