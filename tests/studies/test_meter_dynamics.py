@@ -120,3 +120,12 @@ def test_green_shares_the_meter_cannot_run_are_refused_in_one_line(greens, capsy
     assert err == (f"arzsumo: error: --greens = {greens} is not allowed: comma-separated "
                    "numbers in [0, 1] (see 'arzsumo study meter-dynamics --help')\n")
     assert not (tmp_path / "out").exists()
+
+
+def test_list_with_a_series_lists_no_runs_and_fits_nothing(run_study, tmp_path, capsys):
+    path = tmp_path / "series.csv"
+    series().to_csv(path, index=False)
+    assert run_study("meter-dynamics", "--series", path, "--list",
+                     "--out", tmp_path / "out") == 0
+    assert capsys.readouterr().out == f"no runs: --series {path} is read instead\n"
+    assert not (tmp_path / "out").exists()

@@ -168,8 +168,9 @@ def run(args: argparse.Namespace) -> int:
     """Run the missing points (or read ``--from``), write the table and the map."""
     runs = design(args.demands, args.greens, args.sigmas, args.seeds, args.approach,
                   args.warmup, args.measured, args.step, not args.empty_start, args.av_share)
-    if args.list and args.source is None:
-        return print_list([r.run_id for r in runs])
+    if args.list:
+        return print_list([r.run_id for r in runs],
+                          None if args.source is None else ("--from", args.source))
     with resumable_dir(args.out, f"study-{NAME}") as out:
         if args.source is not None:
             df = read_map(args.source)

@@ -195,8 +195,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run the steps (or read ``--series``), fit, write (and publish with ``--docs``)."""
     runs = design(args.seeds, args.warmup, args.base, tuple(args.greens), args.hold)
-    if args.list and args.series is None:
-        return print_list([r.run_id for r in runs])
+    if args.list:
+        return print_list([r.run_id for r in runs],
+                          None if args.series is None else ("--series", args.series))
     with resumable_dir(args.out, f"study-{NAME}") as out:
         if args.series is not None:
             series = read_series(args.series)
