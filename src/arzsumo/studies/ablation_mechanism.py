@@ -36,6 +36,7 @@ from arzsumo.outputs.studies import publish, write_csv, write_text
 from arzsumo.studies import ablation
 from arzsumo.studies.common import RESULTS_DIR, StudyError, add_output, plots_wanted
 from arzsumo.sweep.evaluate import BASELINE
+from arzsumo.units import s_to_h
 
 NAME = "ablation-mechanism"
 #: the results page this study keeps a block of (the ablation's)
@@ -61,8 +62,8 @@ def run_row(step: str, run: Path) -> dict[str, object]:
             "speed_mean_a_kmh": sec["speed_mean_kmh"]["a"],
             "speed_sd_h_kmh": spread.get("h", np.nan), "speed_sd_a_kmh": spread.get("a", np.nan),
             "speed_osc_h_kmh": osc.get("h", np.nan), "speed_osc_a_kmh": osc.get("a", np.nan),
-            "time_loss_veh_h": net["time_loss_s"]["total"] / 3600.0,
-            "ramp_depart_delay_veh_h": net["depart_delay_s"]["ramp"] / 3600.0,
+            "time_loss_veh_h": s_to_h(net["time_loss_s"]["total"]),
+            "ramp_depart_delay_veh_h": s_to_h(net["depart_delay_s"]["ramp"]),
             "plan_changes": s["plan_changes"]}
 
 

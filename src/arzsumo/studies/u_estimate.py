@@ -32,6 +32,7 @@ from arzsumo.studies.common import (
 from arzsumo.sweep.spec import SweepSpec
 from arzsumo.sweep.table import run_dir
 from arzsumo.sweep.worker import FINISHED
+from arzsumo.units import veh_s_to_veh_h
 
 NAME = "u-estimate"
 #: the results page this study keeps a block of
@@ -65,7 +66,7 @@ def series(spec: SweepSpec, out: Path) -> pd.DataFrame:
             p = pd.read_parquet(path, columns=["t_s", "u_continuous"])
             parts.append(pd.DataFrame({"estimator": run.columns["estimator"],
                                        "seed": run.columns["seed"], "t_s": p["t_s"],
-                                       "u_veh_h": p["u_continuous"] * 3600.0}))
+                                       "u_veh_h": veh_s_to_veh_h(p["u_continuous"])}))
     return pd.concat(parts, ignore_index=True) if parts else pd.DataFrame(
         columns=["estimator", "seed", "t_s", "u_veh_h"])
 
