@@ -31,7 +31,14 @@ import pandas as pd
 from arzsumo.evaluation.stats import paired_difference
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, write_csv
-from arzsumo.studies.common import add_output, add_runs, print_list, shipped_scenario, study_spec
+from arzsumo.studies.common import (
+    EXIT_SOME_FAILED,
+    add_output,
+    add_runs,
+    print_list,
+    shipped_scenario,
+    study_spec,
+)
 from arzsumo.units import S_PER_H
 
 NAME = "sumo-options"
@@ -168,4 +175,4 @@ def run(args: argparse.Namespace) -> int:
                     [(p, p.name) for p in files])
     print(text)
     bad = sum(v for k, v in rep.statuses.items() if k != "ok")
-    return 4 if bad else 0
+    return EXIT_SOME_FAILED if bad else 0
