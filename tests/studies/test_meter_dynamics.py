@@ -129,3 +129,17 @@ def test_list_with_a_series_lists_no_runs_and_fits_nothing(run_study, tmp_path, 
                      "--out", tmp_path / "out") == 0
     assert capsys.readouterr().out == f"no runs: --series {path} is read instead\n"
     assert not (tmp_path / "out").exists()
+
+
+def test_a_rerun_without_plots_removes_its_earlier_figure_and_nothing_else(run_study,
+                                                                           tmp_path):
+    path = tmp_path / "series.csv"
+    series().to_csv(path, index=False)
+    out = tmp_path / "out"
+    assert run_study("meter-dynamics", "--series", path, "--out", out) == 0
+    assert (out / "steps.png").is_file()
+    (out / "mine.png").write_bytes(b"the user's")
+    assert run_study("meter-dynamics", "--series", path, "--out", out, "--no-plots") == 0
+    assert not (out / "steps.png").exists()
+    assert (out / "mine.png").read_bytes() == b"the user's"
+    assert (out / "fits.csv").is_file()

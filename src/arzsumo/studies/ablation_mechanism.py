@@ -32,7 +32,7 @@ import numpy as np
 import pandas as pd
 
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.studies import publish, write_csv, write_text
+from arzsumo.outputs.studies import publish, remove_stale_figures, write_csv, write_text
 from arzsumo.studies import ablation
 from arzsumo.studies.common import RESULTS_DIR, StudyError, add_output, plots_wanted
 from arzsumo.sweep.evaluate import BASELINE
@@ -161,7 +161,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Collect, pair, fit; write the tables, figures and (``--docs``) the page."""
-    from arzsumo.outputs.study_figures import write_mechanism_figures
+    from arzsumo.outputs.study_figures import MECHANISM_FIGURES, write_mechanism_figures
 
     root = Path(args.ablation)
     if not root.is_dir():
@@ -179,6 +179,8 @@ def run(args: argparse.Namespace) -> int:
         if plots_wanted(args):
             files += write_mechanism_figures(df[~df["step"].isin(RELEASE_STEPS)], d,
                                              read_levels(args.levels), out)
+        else:
+            remove_stale_figures(*(out / name for name in MECHANISM_FIGURES))
         if args.docs is not None:
             named = [(p, p.name if p.name == "mechanism.csv" else f"mechanism_{p.name}")
                      for p in files]

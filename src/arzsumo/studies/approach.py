@@ -27,7 +27,7 @@ from typing import Any
 import pandas as pd
 
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.studies import publish, write_csv
+from arzsumo.outputs.studies import publish, remove_stale_figures, write_csv
 from arzsumo.studies.common import (
     FORMER_DEFAULT,
     StudyError,
@@ -185,6 +185,8 @@ def run(args: argparse.Namespace) -> int:
 
             files.append(write_approach_map(sub, with_av_share(df), tag, out / "map.png",
                                             SD_MIN_KMH, INSERTED_MIN))
+        else:
+            remove_stale_figures(out / "map.png")
         good = sub[sub["qualifies"]]
         text = (f"{len(df)} runs; {len(good)} of {len(sub)} points of the largest group "
                 "qualify (stationary, congested, stop-and-go, inserted): "

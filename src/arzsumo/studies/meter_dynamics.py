@@ -32,7 +32,7 @@ from typing import Any
 import pandas as pd
 
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.studies import publish, write_csv, write_text
+from arzsumo.outputs.studies import publish, remove_stale_figures, write_csv, write_text
 from arzsumo.studies import meter_fit
 from arzsumo.studies.common import (
     FORMER_DEFAULT,
@@ -147,8 +147,8 @@ def read_series(path: Path) -> pd.DataFrame:
 
 def analyse(series: pd.DataFrame, out: Path, pre: float, settled: float, plots: bool
             ) -> tuple[list[Path], str]:
-    """Fit and write ``fits.csv``, ``levels.csv``, ``tables.md`` (and ``steps.png``);
-    return the files and the tables' text."""
+    """Fit and write ``fits.csv``, ``levels.csv``, ``tables.md`` (and ``steps.png``, else
+    one of an earlier call is removed); return the files and the tables' text."""
     from arzsumo.sumo.green_share import DEFAULT_CURVE
 
     data = meter_fit.by_seed(series)
@@ -165,6 +165,8 @@ def analyse(series: pd.DataFrame, out: Path, pre: float, settled: float, plots: 
                   if r["signal"] == "y" and r["scope"] == "staircase"}
         files.append(write_meter_steps_figure(data, models, meter_fit.ensembles(data, rows),
                                               out / "steps.png"))
+    else:
+        remove_stale_figures(out / "steps.png")
     return files, text
 
 

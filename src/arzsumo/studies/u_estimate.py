@@ -18,7 +18,12 @@ import numpy as np
 import pandas as pd
 
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.studies import markdown_table, publish, write_csv
+from arzsumo.outputs.studies import (
+    markdown_table,
+    publish,
+    remove_stale_figures,
+    write_csv,
+)
 from arzsumo.studies.common import (
     EXIT_SOME_FAILED,
     add_output,
@@ -118,6 +123,8 @@ def run(args: argparse.Namespace) -> int:
                                           strict=True)]
             files.append(write_u_series(lines, f"{args.controller} on legacy_default: the "
                                         "law on raw cells and on estimates", out / "u.png"))
+        else:
+            remove_stale_figures(out / "u.png")
         text = markdown_table(stats, ".0f")
         if args.docs is not None:
             publish(args.docs, PAGE, NAME, "The control law on raw cells and on estimates",
