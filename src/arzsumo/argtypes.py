@@ -90,3 +90,15 @@ def number_list(text: str) -> list[float]:
     if not values or not all(math.isfinite(v) for v in values):
         raise argparse.ArgumentTypeError(f"{text} is not allowed: comma-separated numbers")
     return values
+
+
+def fraction_list(text: str) -> list[float]:
+    """Comma-separated numbers in [0, 1] (shares): ``0.2,0.5,0.8``."""
+    try:
+        values = number_list(text)
+    except argparse.ArgumentTypeError:
+        values = []
+    if not values or not all(0.0 <= v <= 1.0 for v in values):
+        raise argparse.ArgumentTypeError(f"{text} is not allowed: comma-separated numbers "
+                                         "in [0, 1]")
+    return values

@@ -11,7 +11,9 @@ from numpy.typing import ArrayLike
 
 KMH_PER_MS = 3.6
 VEH_KM_PER_VEH_M = 1000.0
-VEH_H_PER_VEH_S = 3600.0
+#: seconds per hour: a time (or a vehicle time, veh s) in hours
+S_PER_H = 3600.0
+VEH_H_PER_VEH_S = S_PER_H
 
 
 def kmh_to_ms(v: ArrayLike) -> np.ndarray | float:
@@ -42,6 +44,11 @@ def veh_h_to_veh_s(q: ArrayLike) -> np.ndarray | float:
 def veh_s_to_veh_h(q: ArrayLike) -> np.ndarray | float:
     """Flow from veh/s to veh/h."""
     return (np.asarray(q, dtype=float) if np.ndim(q) else float(q)) * VEH_H_PER_VEH_S
+
+
+def s_to_h(t: ArrayLike) -> np.ndarray | float:
+    """A time (or a vehicle time: veh s to veh h) from seconds to hours."""
+    return (np.asarray(t, dtype=float) if np.ndim(t) else float(t)) / S_PER_H
 
 
 def ms2_to_kmh2(p: ArrayLike) -> np.ndarray | float:

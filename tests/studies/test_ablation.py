@@ -118,3 +118,29 @@ def test_every_steps_laws_are_sumo_controllers():
 
     laws = {law for s in ablation.STEPS for law in s.laws}
     assert laws == {"alinea", "backstepping", "etc"} and laws < set(controller_names("sumo"))
+
+
+def _finished_runs(path, seeds):
+    pd.DataFrame({"seed": seeds, "status": ["ok"] * len(seeds),
+                  "controller": ["etc"] * len(seeds)}).to_parquet(path)
+
+
+def test_the_report_names_the_seeds_its_steps_ran_on_not_the_default(run_study, tmp_path):
+    out = tmp_path / "abl"
+    out.mkdir()
+    write_marker(out, "study-ablation")
+    row = {"n": 2, "wins": 0, "losses": 0, "diff_ci_low": 0.0, "diff_ci_high": 0.0,
+           "measure": "plan_changes", "controller": "etc", "mean": 12.0, "diff_mean": 12.0}
+    for name in ("identified", "design"):
+        _evaluation(out / name / "evaluation.csv", [row])
+        _finished_runs(out / name / "summaries.parquet", [3, 4])
+        (out / name / "evaluation.md").write_text("# evaluation\n")
+        (out / "steps").mkdir(exist_ok=True)
+        (out / "steps" / f"{name}.toml").write_text(f'name = "ablation-{name}"\n')
+    assert run_study("ablation", "--report", "--out", out, "--docs", tmp_path / "docs") == 0
+    page = (tmp_path / "docs" / "control_in_sumo.md").read_text()
+    assert "is evaluated on seeds 3,4 (`arzsumo study ablation`)" in page
+    _finished_runs(out / "design" / "summaries.parquet", [3, 4, 5])
+    assert run_study("ablation", "--report", "--out", out, "--docs", tmp_path / "docs") == 0
+    page = (tmp_path / "docs" / "control_in_sumo.md").read_text()
+    assert "is evaluated on seeds identified: 3,4; design: 3-5 (`arzsumo" in page

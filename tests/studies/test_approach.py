@@ -89,3 +89,21 @@ def test_the_map_is_drawn_from_a_table(run_study, tmp_path, capsys):
     assert capsys.readouterr().out.strip() == (
         "8 runs; 1 of 4 points of the largest group qualify (stationary, congested, "
         "stop-and-go, inserted): 5664 veh/h at green 0.3")
+
+
+def test_list_with_a_table_lists_no_runs_and_draws_nothing(run_study, tmp_path, capsys):
+    path = tmp_path / "old.csv"
+    _map_rows().to_csv(path, index=False)
+    assert run_study("approach", "--from", path, "--list", "--out", tmp_path / "out") == 0
+    assert capsys.readouterr().out == f"no runs: --from {path} is read instead\n"
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_rerun_without_plots_leaves_no_map_of_the_earlier_table(run_study, tmp_path):
+    path, out = tmp_path / "old.csv", tmp_path / "out"
+    _map_rows().to_csv(path, index=False)
+    assert run_study("approach", "--from", path, "--out", out) == 0
+    assert (out / "map.png").is_file()
+    _map_rows().head(4).to_csv(path, index=False)
+    assert run_study("approach", "--from", path, "--out", out, "--no-plots") == 0
+    assert len(pd.read_csv(out / "map.csv")) == 4 and not (out / "map.png").exists()

@@ -72,3 +72,74 @@ def test_the_u_estimate_design_is_one_run_per_estimator_on_legacy_default():
                                            "loop_spacing_m": 250}
     assert "sensing" not in runs[0].scenario or \
         runs[0].scenario["sensing"].get("kinds") != ["loops", "av_probes"]
+
+
+class FakeEngine:
+    """``map_runs`` of the enkf-noise study without SUMO: the records are made-up paths,
+    every score is the same row; the recording's progress label and every scoring job
+    are kept."""
+
+    def __init__(self) -> None:
+        self.progress: list[str | None] = []
+        self.jobs: list[tuple] = []
+
+    def map_runs(self, fn, tasks, **kwargs):
+        if fn is estimation_layouts.record:
+            self.progress.append(kwargs.get("progress"))
+            return [{"path": f"record-{i}.npz"} for i, _ in enumerate(tasks)]
+        self.jobs += tasks
+        return [{"seed": t[2], "layout": t[3],
+                 **{f"{v}_rel": 0.2 for v in enkf_noise.VARS},
+                 **{f"{v}_spread_rel": 0.1 for v in enkf_noise.VARS}} for t in tasks]
+
+
+@pytest.fixture
+def engine(monkeypatch):
+    fake = FakeEngine()
+    monkeypatch.setattr("arzsumo.sweep.driver.map_runs", fake.map_runs)
+    monkeypatch.setattr(enkf_noise, "map_runs", fake.map_runs)
+    return fake
+
+
+ENKF_QUICK = ("--tune-seeds", "1", "--report-seeds", "2", "--rounds", "0",
+              "--inflation-only", "1.05", "--workers", "1")
+
+
+@pytest.mark.parametrize(("quiet", "progress"), [((), "estimation-layouts: recording"),
+                                                  (("--quiet",), None)])
+def test_enkf_noise_records_with_a_progress_bar_unless_quiet(run_study, engine, tmp_path,
+                                                             quiet, progress):
+    assert run_study("enkf-noise", *ENKF_QUICK, *quiet, "--out", tmp_path / "out") == 0
+    assert engine.progress == [progress]
+
+
+def test_enkf_noise_reports_the_perfect_model_at_the_inflation_asked_for(run_study, engine,
+                                                                         tmp_path):
+    assert run_study("enkf-noise", *ENKF_QUICK, "--inflation", "1.3",
+                     "--out", tmp_path / "out") == 0
+    reported = [extra for _, _, seed, _, extra in engine.jobs if seed == 2]
+    perfect = [e for e in reported if all(e[k] == 0.0 for k in enkf_noise.KEYS)]
+    noisy = [e for e in reported if e not in perfect]
+    assert perfect and noisy
+    assert {e["estimation.inflation"] for e in perfect + noisy} == {1.3}
+
+
+def test_loop_speed_station_means_leave_out_a_period_without_a_harmonic_speed():
+    from types import SimpleNamespace
+
+    from arzsumo.studies import loop_speed
+
+    periods, stations = 2, 5                  # the first period (start) is the warm-up's
+    speed = np.full((periods + 1, 2, stations), 10.0)
+    harmonic = np.full((periods + 1, 2, stations), 8.0)
+    harmonic[1, 0, 2] = np.nan                # no harmonic mean there (say, a stopped car)
+    truth = np.zeros((periods, 4, stations))
+    truth[:, 1], truth[:, 3] = 9.0, 9.0
+    rec = SimpleNamespace(start=0, x=np.arange(stations) * 100.0,
+                          loop_x=np.arange(stations) * 100.0, speed=speed,
+                          speed_harmonic=harmonic, truth=lambda: truth)
+    assert loop_speed.station_speeds(rec) == [
+        "v_h at the stations, km/h: time-mean 36.00, harmonic 28.80, probe cells 32.40 "
+        "(5 station-periods)",
+        "v_a at the stations, km/h: time-mean 36.00, harmonic 28.80, probe cells 32.40 "
+        "(6 station-periods)"]

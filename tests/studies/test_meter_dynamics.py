@@ -108,3 +108,38 @@ def test_one_short_run_in_sumo_records_the_running_plan_every_second():
     assert [(g0, g1) for _, g0, g1 in changes] == [(0.5, 0.8), (0.8, 0.5)]
     assert 36.0 <= changes[0][0] <= 42.0 and 54.0 <= changes[1][0] <= 60.0
     assert got["info"]["collisions"] == 0
+
+
+@pytest.mark.parametrize("greens", ["0.2,1.5", "-0.1", "0.5,nan"])
+def test_green_shares_the_meter_cannot_run_are_refused_in_one_line(greens, capsys, tmp_path):
+    from arzsumo.cli import main
+
+    assert main(["study", "meter-dynamics", "--greens", greens, "--out",
+                 str(tmp_path / "out"), "--list"]) == 2
+    err = capsys.readouterr().err
+    assert err == (f"arzsumo: error: --greens = {greens} is not allowed: comma-separated "
+                   "numbers in [0, 1] (see 'arzsumo study meter-dynamics --help')\n")
+    assert not (tmp_path / "out").exists()
+
+
+def test_list_with_a_series_lists_no_runs_and_fits_nothing(run_study, tmp_path, capsys):
+    path = tmp_path / "series.csv"
+    series().to_csv(path, index=False)
+    assert run_study("meter-dynamics", "--series", path, "--list",
+                     "--out", tmp_path / "out") == 0
+    assert capsys.readouterr().out == f"no runs: --series {path} is read instead\n"
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_rerun_without_plots_removes_its_earlier_figure_and_nothing_else(run_study,
+                                                                           tmp_path):
+    path = tmp_path / "series.csv"
+    series().to_csv(path, index=False)
+    out = tmp_path / "out"
+    assert run_study("meter-dynamics", "--series", path, "--out", out) == 0
+    assert (out / "steps.png").is_file()
+    (out / "mine.png").write_bytes(b"the user's")
+    assert run_study("meter-dynamics", "--series", path, "--out", out, "--no-plots") == 0
+    assert not (out / "steps.png").exists()
+    assert (out / "mine.png").read_bytes() == b"the user's"
+    assert (out / "fits.csv").is_file()

@@ -53,3 +53,12 @@ def test_the_design_is_controllers_x_seeds():
                              [42])
     assert [r.run_id for r in runs] == ["controller=open,seed=42", "controller=etc,seed=42"]
     assert runs[1].scenario["run"]["controller"] == "etc"
+
+
+def test_list_with_run_directories_lists_no_runs_and_reads_nothing(run_study, tmp_path,
+                                                                   capsys):
+    one, two = tmp_path / "a", tmp_path / "b"
+    assert run_study("wave-speed", "--from", one, two, "--list",
+                     "--out", tmp_path / "out") == 0
+    assert capsys.readouterr().out == f"no runs: --from {one} {two} is read instead\n"
+    assert not (tmp_path / "out").exists()

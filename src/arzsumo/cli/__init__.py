@@ -37,7 +37,7 @@ from arzsumo.cli import (
     twin,
 )
 from arzsumo.cli.args import Parser
-from arzsumo.errors import ArzsumoError
+from arzsumo.errors import EXIT_USAGE, ArzsumoError
 from arzsumo.interrupts import EXIT_INTERRUPTED
 
 log = logging.getLogger("arzsumo")
@@ -109,7 +109,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return func(args)
     except ArzsumoError as exc:
         print(f"arzsumo: error: {exc}", file=sys.stderr)
-        return 2
+        return EXIT_USAGE
     except KeyboardInterrupt:
         print("arzsumo: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED

@@ -21,8 +21,7 @@ import numpy as np
 import pandas as pd
 
 from arzsumo.evaluation.stats import StatisticsError, mean_ci, paired_difference
-
-S_PER_H = 3600.0
+from arzsumo.units import S_PER_H
 
 
 @dataclass(frozen=True)

@@ -12,6 +12,7 @@ import pandas as pd
 
 from arzsumo.evaluation.report import MEASURES, Measure, markdown, paired_differences
 from arzsumo.io import atomic_file
+from arzsumo.outputs.studies import remove_stale_figures
 
 CSV, MARKDOWN, FIGURE = "evaluation.csv", "evaluation.md", "paired_differences.png"
 
@@ -21,7 +22,8 @@ def write_evaluation(out: Path, long: pd.DataFrame, runs: pd.DataFrame,
                      measures: Sequence[Measure] = MEASURES,
                      plots: bool = True) -> list[Path]:
     """Write the long table ``long`` (CSV, Markdown under ``header``) and the figure of the
-    per-seed differences of ``runs`` into ``out``; return the paths written."""
+    per-seed differences of ``runs`` into ``out``; return the paths written. Without the
+    figure (``plots`` False, or the open loop alone), one of an earlier call is removed."""
     out = Path(out)
     with atomic_file(out / CSV) as tmp:
         long.to_csv(tmp, index=False)
@@ -31,6 +33,8 @@ def write_evaluation(out: Path, long: pd.DataFrame, runs: pd.DataFrame,
     if plots and len(controllers) > 1:
         written.append(paired_figure(out / FIGURE, long, runs, controllers, baseline,
                                      measures))
+    else:
+        remove_stale_figures(out / FIGURE)
     return written
 
 

@@ -7,6 +7,9 @@ from pathlib import Path
 
 import pandas as pd
 
+#: the figure's file name in the study's output directory
+PENETRATION_FIGURE = "penetration.png"
+
 
 def write_penetration_figure(out: Path, tables: Mapping[str, pd.DataFrame]) -> Path:
     """Draw :func:`arzsumo.plots.penetration.penetration_figure` of ``tables`` (label ->
@@ -14,4 +17,4 @@ def write_penetration_figure(out: Path, tables: Mapping[str, pd.DataFrame]) -> P
     from arzsumo.outputs.figures import save_png
     from arzsumo.plots.penetration import penetration_figure
 
-    return save_png(penetration_figure(tables), Path(out) / "penetration.png")
+    return save_png(penetration_figure(tables), Path(out) / PENETRATION_FIGURE)

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from arzsumo.outputs.studies import write_csv
+from arzsumo.outputs.studies import remove_stale_figures, write_csv
 
 
 def write_map(out: Path, long: pd.DataFrame, wide: pd.DataFrame, gates: Sequence[str],
@@ -22,4 +22,6 @@ def write_map(out: Path, long: pd.DataFrame, wide: pd.DataFrame, gates: Sequence
         from arzsumo.plots.premise_map import premise_map_figure
 
         files.append(save_png(premise_map_figure(wide, gates), out / "premise_map.png"))
+    else:
+        remove_stale_figures(out / "premise_map.png")
     return files

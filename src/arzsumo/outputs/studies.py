@@ -40,6 +40,22 @@ def write_text(text: str, path: Path) -> Path:
     return Path(path)
 
 
+def remove_stale_figures(*paths: Path) -> list[Path]:
+    """Remove the figures ``paths`` (a study's own names in its output directory) that
+    this call did not redraw (``--no-plots``, or nothing to draw), so that none of an
+    earlier call is left beside tables it no longer matches; return those removed.
+
+    Only a regular file goes: a directory or a symbolic link of that name is not the
+    study's figure and is left alone.
+    """
+    removed = []
+    for path in map(Path, paths):
+        if path.is_file() and not path.is_symlink():
+            path.unlink()
+            removed.append(path)
+    return removed
+
+
 def generated_block(name: str, body: str) -> str:
     """The generated block of study ``name``'s page around ``body``."""
     return f"{BEGIN.format(name=name)}\n{body.strip()}\n{END}"

@@ -11,6 +11,8 @@ import pandas as pd
 
 from arzsumo.outputs.figures import save_png
 
+#: the figures of :func:`write_mechanism_figures`
+MECHANISM_FIGURES = ("map.png", "shift.png")
 
 def write_mechanism_figures(runs: pd.DataFrame, pairs: pd.DataFrame,
                             levels: Mapping[float, float], out: Path) -> list[Path]:
@@ -18,8 +20,9 @@ def write_mechanism_figures(runs: pd.DataFrame, pairs: pd.DataFrame,
     (the paired spread change against the mean-speed change of ``pairs``) in ``out``."""
     from arzsumo.plots.ablation import mechanism_map_figure, mechanism_shift_figure
 
-    return [save_png(mechanism_map_figure(runs, levels), Path(out) / "map.png", dpi=120),
-            save_png(mechanism_shift_figure(pairs), Path(out) / "shift.png", dpi=120)]
+    drawn = (mechanism_map_figure(runs, levels), mechanism_shift_figure(pairs))
+    return [save_png(fig, Path(out) / name, dpi=120)
+            for fig, name in zip(drawn, MECHANISM_FIGURES, strict=True)]
 
 
 def write_meter_steps_figure(data: Mapping[int, Mapping[str, np.ndarray]],

@@ -298,7 +298,30 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_output(parser, NAME, PAGE)
 
 
-def _page(out: Path, table: pd.DataFrame, seeds: Sequence[int]) -> tuple[str, list]:
+def step_seeds(out: Path) -> dict[str, list[int]]:
+    """Per step with an evaluation in ``out``, the seeds of its finished runs: those its
+    rows of the table report (``--report`` reads steps run earlier, on their seeds)."""
+    found: dict[str, list[int]] = {}
+    for s in STEPS:
+        runs = out / s.name / "summaries.parquet"
+        if (out / s.name / "evaluation.csv").is_file() and runs.is_file():
+            df = pd.read_parquet(runs, columns=["seed", "status"])
+            found[s.name] = sorted({int(v) for v in df.loc[df["status"].isin(FINISHED),
+                                                            "seed"]})
+    return found
+
+
+def seeds_phrase(by_step: Mapping[str, list[int]]) -> str:
+    """``seeds 1-10`` when every step has the same seeds, else each step's."""
+    distinct = {tuple(v) for v in by_step.values()}
+    if not distinct:
+        return "the seeds of each step's evaluation"
+    if len(distinct) == 1:
+        return f"seeds {seed_text(list(distinct.pop()))}"
+    return "seeds " + "; ".join(f"{name}: {seed_text(v)}" for name, v in by_step.items())
+
+
+def _page(out: Path, table: pd.DataFrame) -> tuple[str, list]:
     """The page body and the files it publishes."""
     files: list = [(out / "ablation.csv", f"{PAGE}.csv")]
     steps = []
@@ -309,7 +332,7 @@ def _page(out: Path, table: pd.DataFrame, seeds: Sequence[int]) -> tuple[str, li
                       (out / "steps" / f"{s.name}.toml", f"steps/{s.name}.toml")]
             steps.append(f"[{s.name}]({PAGE}/{s.name}.md)")
     body = (f"Each step switches on one more change of the default's controller side and "
-            f"is evaluated on seeds {seed_text(list(seeds))} (`arzsumo study ablation`). "
+            f"is evaluated on {seeds_phrase(step_seeds(out))} (`arzsumo study ablation`). "
             f"Cells: mean (controller minus open loop, same seed [95 % t interval]).\n\n"
             f"{markdown(table)}\n\nTable: [{PAGE}.csv]({PAGE}/{PAGE}.csv); the "
             f"evaluations: {', '.join(steps)}; their scenarios in [steps/]({PAGE}/steps/).")
@@ -337,7 +360,7 @@ def run(args: argparse.Namespace) -> int:
         write_csv(table, out / "ablation.csv")
         write_text(markdown(table), out / "ablation.md")
         if args.docs is not None:
-            body, files = _page(out, table, args.seeds)
+            body, files = _page(out, table)
             publish(args.docs, PAGE, NAME, "Control in SUMO", body, files)
     print(markdown(table))
     return 0 if ok else EXIT_SOME_FAILED

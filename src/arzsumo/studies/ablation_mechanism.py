@@ -32,10 +32,11 @@ import numpy as np
 import pandas as pd
 
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.studies import publish, write_csv, write_text
+from arzsumo.outputs.studies import publish, remove_stale_figures, write_csv, write_text
 from arzsumo.studies import ablation
 from arzsumo.studies.common import RESULTS_DIR, StudyError, add_output, plots_wanted
 from arzsumo.sweep.evaluate import BASELINE
+from arzsumo.units import s_to_h
 
 NAME = "ablation-mechanism"
 #: the results page this study keeps a block of (the ablation's)
@@ -61,8 +62,8 @@ def run_row(step: str, run: Path) -> dict[str, object]:
             "speed_mean_a_kmh": sec["speed_mean_kmh"]["a"],
             "speed_sd_h_kmh": spread.get("h", np.nan), "speed_sd_a_kmh": spread.get("a", np.nan),
             "speed_osc_h_kmh": osc.get("h", np.nan), "speed_osc_a_kmh": osc.get("a", np.nan),
-            "time_loss_veh_h": net["time_loss_s"]["total"] / 3600.0,
-            "ramp_depart_delay_veh_h": net["depart_delay_s"]["ramp"] / 3600.0,
+            "time_loss_veh_h": s_to_h(net["time_loss_s"]["total"]),
+            "ramp_depart_delay_veh_h": s_to_h(net["depart_delay_s"]["ramp"]),
             "plan_changes": s["plan_changes"]}
 
 
@@ -160,7 +161,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Collect, pair, fit; write the tables, figures and (``--docs``) the page."""
-    from arzsumo.outputs.study_figures import write_mechanism_figures
+    from arzsumo.outputs.study_figures import MECHANISM_FIGURES, write_mechanism_figures
 
     root = Path(args.ablation)
     if not root.is_dir():
@@ -178,6 +179,8 @@ def run(args: argparse.Namespace) -> int:
         if plots_wanted(args):
             files += write_mechanism_figures(df[~df["step"].isin(RELEASE_STEPS)], d,
                                              read_levels(args.levels), out)
+        else:
+            remove_stale_figures(*(out / name for name in MECHANISM_FIGURES))
         if args.docs is not None:
             named = [(p, p.name if p.name == "mechanism.csv" else f"mechanism_{p.name}")
                      for p in files]

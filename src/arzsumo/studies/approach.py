@@ -27,7 +27,7 @@ from typing import Any
 import pandas as pd
 
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.studies import publish, write_csv
+from arzsumo.outputs.studies import publish, remove_stale_figures, write_csv
 from arzsumo.studies.common import (
     FORMER_DEFAULT,
     StudyError,
@@ -168,8 +168,9 @@ def run(args: argparse.Namespace) -> int:
     """Run the missing points (or read ``--from``), write the table and the map."""
     runs = design(args.demands, args.greens, args.sigmas, args.seeds, args.approach,
                   args.warmup, args.measured, args.step, not args.empty_start, args.av_share)
-    if args.list and args.source is None:
-        return print_list([r.run_id for r in runs])
+    if args.list:
+        return print_list([r.run_id for r in runs],
+                          None if args.source is None else ("--from", args.source))
     with resumable_dir(args.out, f"study-{NAME}") as out:
         if args.source is not None:
             df = read_map(args.source)
@@ -184,6 +185,8 @@ def run(args: argparse.Namespace) -> int:
 
             files.append(write_approach_map(sub, with_av_share(df), tag, out / "map.png",
                                             SD_MIN_KMH, INSERTED_MIN))
+        else:
+            remove_stale_figures(out / "map.png")
         good = sub[sub["qualifies"]]
         text = (f"{len(df)} runs; {len(good)} of {len(sub)} points of the largest group "
                 "qualify (stationary, congested, stop-and-go, inserted): "

@@ -24,6 +24,7 @@ from typing import Any
 from arzsumo.argtypes import (  # noqa: F401 (the studies' option types, re-exported)
     SEED_LIMIT,
     fraction,
+    fraction_list,
     non_negative_float,
     non_negative_int,
     number_list,
@@ -155,8 +156,16 @@ def study_spec(name: str, base: Path, data: dict[str, Any] | None = None, **keys
     return spec if data is None else replace(spec, base_data=data)
 
 
-def print_list(run_ids: list[str]) -> int:
-    """``--list``: one run ID per line; exit code 0."""
+def print_list(run_ids: list[str],
+               read_instead: tuple[str, Path | Sequence[Path]] | None = None) -> int:
+    """``--list``: one run ID per line; exit code 0. ``read_instead``: the option and the
+    file(s) a study reads instead of running (``--series``, ``--from``): then no runs,
+    and one line that says so."""
+    if read_instead is not None:
+        flag, paths = read_instead
+        named = paths if isinstance(paths, Path) else " ".join(map(str, paths))
+        print(f"no runs: {flag} {named} is read instead")
+        return 0
     for run_id in run_ids:
         print(run_id)
     return 0

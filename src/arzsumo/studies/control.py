@@ -39,7 +39,7 @@ from arzsumo.evaluation.report import Measure, evaluate, markdown
 from arzsumo.io import dump_toml, read_toml
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.evaluation import paired_figure
-from arzsumo.outputs.studies import publish, write_csv, write_text
+from arzsumo.outputs.studies import publish, remove_stale_figures, write_csv, write_text
 from arzsumo.resources import shipped_scenarios_dir
 from arzsumo.studies.common import (
     EXIT_SOME_FAILED,
@@ -189,7 +189,7 @@ def write_tables(args: argparse.Namespace, long: pd.DataFrame, runs: pd.DataFram
                       [m for m in MEASURES if m.key in FIGURE and m.key in runs.columns])
         files.append((figure, f"{e}.png"))
     else:
-        figure.unlink(missing_ok=True)
+        remove_stale_figures(figure)
     return files
 
 

@@ -16,9 +16,10 @@ import pandas as pd
 
 from arzsumo.evaluation.report import Measure, per_seed
 from arzsumo.evaluation.stats import PairedComparison, StatisticsError, paired_difference
+from arzsumo.units import S_PER_H
 
 _TTS = Measure("network_whole_demand.time_spent_s.total", "whole-demand time spent",
-               "veh h", 1 / 3600)
+               "veh h", 1 / S_PER_H)
 _TRIGGERS = Measure("triggers", "controller updates", "count")
 _PLANS = Measure("plan_changes", "meter plan changes", "count")
 _DISCOM = Measure("section.J_discom.total", "J_discom", "veh m^2/s^3")

@@ -7,7 +7,7 @@ tenth of its error). This study chooses the additive model-error noise per forec
 of :mod:`arzsumo.studies.estimation_layouts`, made when missing) for one layout
 (``--layout``), then reports on ``--report-seeds`` the normalised error RMSE / mean
 spread per variable (target near 1) and the RMSE, for every EnKF layout, without and
-with the chosen noise.
+with the chosen noise (both at ``--inflation``).
 
 Calibration: starting from ``--start``, each round runs the filter offline on the tuning
 seeds and scales each variable's sd by its normalised error (pooled over seeds, clipped
@@ -127,10 +127,11 @@ def tune(tuner: Tuner, args: argparse.Namespace) -> tuple[np.ndarray, list[str]]
 
 def report(tuner: Tuner, sd: np.ndarray, args: argparse.Namespace
            ) -> tuple[list[dict[str, Any]], list[str]]:
-    """Every EnKF layout on the report seeds, without and with the chosen noise."""
+    """Every EnKF layout on the report seeds, without and with the chosen noise, both at
+    ``--inflation`` (so the lines differ by the noise alone)."""
     out, lines = [], []
     for lay in [name for name, keys in layouts.LAYOUTS.items() if keys]:
-        for label, extra in (("perfect model", settings(np.zeros(4), 1.05)),
+        for label, extra in (("perfect model", settings(np.zeros(4), args.inflation)),
                              ("model noise", settings(sd, args.inflation, args.length))):
             rows = tuner.rows(args.report_seeds, lay, extra)
             lines.append(fmt(rows, f"report {lay}: {label}"))
@@ -155,7 +156,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--start", type=number_list, default=[2.0, 1.0, 1.0, 1.0],
                         help="starting sd: rho_h veh/km, v_h km/h, rho_a veh/km, v_a km/h "
                              "(default: 2,1,1,1)")
-    parser.add_argument("--inflation", type=positive_float, default=1.05)
+    parser.add_argument("--inflation", type=positive_float, default=1.05,
+                        help="the EnKF's inflation in the tuning rounds and in both "
+                             "report settings (perfect model, model noise)")
     parser.add_argument("--length", type=positive_float, default=150.0,
                         help="correlation length of the model noise, m")
     parser.add_argument("--rounds", type=non_negative_int, default=6,
@@ -166,6 +169,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--workers", type=positive_int, metavar="N",
                         help="local processes (default: one per core)")
     parser.add_argument("--scheduler", metavar="ADDRESS", help="record on this Dask scheduler")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
     add_output(parser, NAME, PAGE, plots=False)
 
 

@@ -36,6 +36,7 @@ from arzsumo.studies.common import (
     study_spec,
 )
 from arzsumo.studies.design import StudyRun, design_runs, run_design
+from arzsumo.units import veh_s_to_veh_h
 
 NAME = "fill"
 #: the results page this study keeps a block of
@@ -89,8 +90,8 @@ def run_point(run: StudyRun) -> dict[str, Any]:
     sc = scenario_from_dict(run.scenario, run.source)
     cfg = sc.sumo.with_(horizon=sc.run.warmup + sc.sumo.horizon)
     row: dict[str, Any] = {**dict(run.columns),
-                           "hold_h_veh_h": sc.sumo.demand_h * 3600,
-                           "hold_a_veh_h": sc.sumo.demand_a * 3600, **dict(run.options)}
+                           "hold_h_veh_h": veh_s_to_veh_h(sc.sumo.demand_h),
+                           "hold_a_veh_h": veh_s_to_veh_h(sc.sumo.demand_a), **dict(run.options)}
     row.update(run_measures(sc.params, cfg, sc.run.warmup))
     row["ok"] = int(row["stationary"] and row["lambda4_kmh"] < 0
                     and row["inserted_main"] >= 0.98)

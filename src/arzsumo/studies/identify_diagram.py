@@ -37,6 +37,7 @@ from arzsumo.identify.objective import DEFAULT_BOUNDS
 from arzsumo.model.fd import area_occupancy
 from arzsumo.model.params import FAMILIES, ModelParameters
 from arzsumo.scenario import Scenario
+from arzsumo.units import ms_to_kmh
 
 #: cells and periods of a stationary block (50 m cells, 1 s periods: 100 m x 30 s)
 BLOCK_CELLS, BLOCK_PERIODS = 2, 30
@@ -115,7 +116,7 @@ def fit_stage_one(sc: Scenario, family: str, train: Sequence[ReplayData],
     target = wave if wave is not None else reading.stream
     if not (math.isfinite(target) and target < 0):
         raise ArzsumoError(f"stage 1 needs an upstream wave speed; the training runs read "
-                           f"{target * 3.6:+.1f} km/h; allowed: runs whose waves travel "
+                           f"{ms_to_kmh(target):+.1f} km/h; allowed: runs whose waves travel "
                            "upstream, or --wave-speed-kmh")
     guess = diagram_guess(sc, family, states, target)
     fit = fit_diagram(guess, states, target, operating_point, wave_weight=wave_weight,

@@ -70,7 +70,8 @@ def offsets(rec: Any, sc: Any, loop_speed: str, method: str) -> list[dict[str, A
 
 def station_speeds(rec: Any) -> list[str]:
     """Per class: mean time-mean and harmonic loop speed over the control periods and
-    the interior stations, and the truth's cell speed at those stations (km/h)."""
+    the interior stations, and the truth's cell speed at those stations (km/h); each over
+    the station-periods where all three are known."""
     k = slice(rec.start + 1, None)
     truth = rec.truth()
     cell = np.array([int(np.argmin(np.abs(rec.x - x))) for x in rec.loop_x])
@@ -78,7 +79,8 @@ def station_speeds(rec: Any) -> list[str]:
     for c, name in enumerate(("h", "a")):
         tm, hm = rec.speed[k][:, c, 1:-1], rec.speed_harmonic[k][:, c, 1:-1]
         v = truth[:, 2 * c + 1][:, cell[1:-1]]
-        ok = np.isfinite(tm) & np.isfinite(v)
+        # one set of station-periods for all three means, so they compare like with like
+        ok = np.isfinite(tm) & np.isfinite(hm) & np.isfinite(v)
         tm_kmh, hm_kmh, v_kmh = (ms_to_kmh(a[ok].mean()) for a in (tm, hm, v))
         lines.append(f"v_{name} at the stations, km/h: time-mean {tm_kmh:.2f}, "
                      f"harmonic {hm_kmh:.2f}, probe cells {v_kmh:.2f}"

@@ -32,7 +32,7 @@ from typing import Any
 import pandas as pd
 
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.studies import publish, write_csv, write_text
+from arzsumo.outputs.studies import publish, remove_stale_figures, write_csv, write_text
 from arzsumo.studies import meter_fit
 from arzsumo.studies.common import (
     FORMER_DEFAULT,
@@ -40,7 +40,7 @@ from arzsumo.studies.common import (
     add_output,
     add_runs,
     fixed_cycle,
-    number_list,
+    fraction_list,
     plots_wanted,
     positive_float,
     print_list,
@@ -147,8 +147,8 @@ def read_series(path: Path) -> pd.DataFrame:
 
 def analyse(series: pd.DataFrame, out: Path, pre: float, settled: float, plots: bool
             ) -> tuple[list[Path], str]:
-    """Fit and write ``fits.csv``, ``levels.csv``, ``tables.md`` (and ``steps.png``);
-    return the files and the tables' text."""
+    """Fit and write ``fits.csv``, ``levels.csv``, ``tables.md`` (and ``steps.png``, else
+    one of an earlier call is removed); return the files and the tables' text."""
     from arzsumo.sumo.green_share import DEFAULT_CURVE
 
     data = meter_fit.by_seed(series)
@@ -165,6 +165,8 @@ def analyse(series: pd.DataFrame, out: Path, pre: float, settled: float, plots: 
                   if r["signal"] == "y" and r["scope"] == "staircase"}
         files.append(write_meter_steps_figure(data, models, meter_fit.ensembles(data, rows),
                                               out / "steps.png"))
+    else:
+        remove_stale_figures(out / "steps.png")
     return files, text
 
 
@@ -175,9 +177,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="fill and warm-up at green share 0.5, s")
     parser.add_argument("--base", type=positive_float, default=60.0,
                         help="s more at 0.5 before the steps")
-    parser.add_argument("--greens", type=number_list, default=list(GREENS),
-                        help="the green shares of the steps, comma-separated "
-                             f"(default: {','.join(map(str, GREENS))})")
+    # the meter runs green shares in [0, 1] (0: all red, 1: all green); the steps drive
+    # it directly, past the scenario's green_share_min/max, so the option is the check
+    parser.add_argument("--greens", type=fraction_list, default=list(GREENS),
+                        help="the green shares of the steps, comma-separated, each in "
+                             f"[0, 1] (default: {','.join(map(str, GREENS))})")
     parser.add_argument("--hold", type=positive_float, default=102.0,
                         help="s per step (17 cycles of 6 s)")
     parser.add_argument("--pre", type=positive_float, default=60.0,
@@ -193,8 +197,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run the steps (or read ``--series``), fit, write (and publish with ``--docs``)."""
     runs = design(args.seeds, args.warmup, args.base, tuple(args.greens), args.hold)
-    if args.list and args.series is None:
-        return print_list([r.run_id for r in runs])
+    if args.list:
+        return print_list([r.run_id for r in runs],
+                          None if args.series is None else ("--series", args.series))
     with resumable_dir(args.out, f"study-{NAME}") as out:
         if args.series is not None:
             series = read_series(args.series)

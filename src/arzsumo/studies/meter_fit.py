@@ -23,6 +23,7 @@ import pandas as pd
 
 from arzsumo.identify.step_response import FopdtFit, StepData, fit_fopdt, fopdt_response
 from arzsumo.sumo.green_share import GreenShareCurve
+from arzsumo.units import VEH_H_PER_VEH_S, veh_h_to_veh_s, veh_s_to_veh_h
 
 #: columns of the fit table (units in the names; gains per unit of green share)
 FIT_FIELDS = ["signal", "scope", "seed", "step", "du", "n_steps", "gain_veh_s",
@@ -83,7 +84,8 @@ def row(signal: str, scope: str, seed: Any, step: str, du: Any, n: int, fit: Fop
             "delay_s": fit.delay, "sigma_delay_s": fit.sigma_delay,
             "time_constant_s": fit.time_constant,
             "sigma_time_constant_s": fit.sigma_time_constant,
-            "y0_veh_h": float(np.mean(fit.y0)) * 3600, "residual_sd_veh_s": fit.residual_sd,
+            "y0_veh_h": veh_s_to_veh_h(float(np.mean(fit.y0))),
+            "residual_sd_veh_s": fit.residual_sd,
             "samples": fit.n_samples}
 
 
@@ -130,7 +132,7 @@ def static_levels(data: Series, settled: float) -> dict[float, list[float]]:
         ends = [c[0] for c in ch[1:]] + [float(d["t_s"][-1])]
         for (_, _, g1), end in zip(ch, ends, strict=True):
             keep = (d["t_s"] > end - settled) & (d["t_s"] <= end)
-            out.setdefault(g1, []).append(float(d["y"][keep].mean()) * 3600)
+            out.setdefault(g1, []).append(veh_s_to_veh_h(float(d["y"][keep].mean())))
     return out
 
 
@@ -141,7 +143,7 @@ def levels_table(levels: dict[float, list[float]], curve: GreenShareCurve) -> pd
         v = np.array(levels[g])
         rows.append({"green_share": g, "holds": v.size, "outflow_mean_veh_h": v.mean(),
                      "outflow_sd_veh_h": v.std(ddof=1) if v.size > 1 else 0.0,
-                     "curve_veh_h": curve.outflow_at(g) * 3600})
+                     "curve_veh_h": veh_s_to_veh_h(curve.outflow_at(g))})
     return pd.DataFrame(rows)
 
 
@@ -149,7 +151,7 @@ def staircase_model(d: dict[str, np.ndarray], r: dict[str, Any], pre: float
                     ) -> tuple[np.ndarray, np.ndarray]:
     """The per-seed staircase fit's model (times s, veh/s), from its table row."""
     rec = staircase(d, "y", pre)
-    y = np.full(rec.t.size, r["y0_veh_h"] / 3600)
+    y = np.full(rec.t.size, veh_h_to_veh_s(r["y0_veh_h"]))
     for t0, du in zip(rec.t0, rec.du, strict=True):
         y += fopdt_response(rec.t, 0.0, r["gain_veh_s"], du, t0, r["delay_s"],
                             r["time_constant_s"], 1.0)
@@ -186,14 +188,15 @@ def ensembles(data: Series, rows: list[dict[str, Any]], span: float = 90.0
         lag, mean = ensemble(data, sign, span)
         fit = fopdt_response(lag, 0.0, r["gain_veh_s"], 1.0, 0.0, r["delay_s"],
                              r["time_constant_s"], 6.0)
-        label = (f"fit K={r['gain_veh_s'] * 3600:.0f} veh/h, theta={r['delay_s']:.1f} s, "
+        label = (f"fit K={veh_s_to_veh_h(r['gain_veh_s']):.0f} veh/h, theta={r['delay_s']:.1f} s, "
                  f"T={r['time_constant_s']:.1f} s")
-        out.append((name, lag, mean * 3600, fit * 3600, label))
+        out.append((name, lag, veh_s_to_veh_h(mean), veh_s_to_veh_h(fit), label))
     return out
 
 
 def _fmt(r: dict[str, Any]) -> str:
-    return (f"{r['gain_veh_s'] * 3600:+.0f} +- {r['sigma_gain_veh_s'] * 3600:.0f} | "
+    return (f"{veh_s_to_veh_h(r['gain_veh_s']):+.0f} +- "
+            f"{veh_s_to_veh_h(r['sigma_gain_veh_s']):.0f} | "
             f"{r['delay_s']:.1f} +- {r['sigma_delay_s']:.1f} | "
             f"{r['time_constant_s']:.1f} +- {r['sigma_time_constant_s']:.1f} | "
             f"{r['residual_sd_veh_s']:.2f}")
@@ -220,7 +223,8 @@ def tables(rows: list[dict[str, Any]], levels: pd.DataFrame) -> str:
                    and np.sign(r["du"]) == sign]
             if sel:
                 out.append(f"| {signal} | {name} | {len(sel)} | "
-                           f"{_spread(sel, 'gain_veh_s', 3600)} | {_spread(sel, 'delay_s')} "
+                           f"{_spread(sel, 'gain_veh_s', VEH_H_PER_VEH_S)} | "
+                           f"{_spread(sel, 'delay_s')} "
                            f"| {_spread(sel, 'time_constant_s')} |")
     out += ["", "Static levels (mean of the settled part of each hold), veh/h:", "",
             "| green share | holds | outflow mean | sd | meter curve |", "|---|---|---|---|---|"]

@@ -30,7 +30,14 @@ import pandas as pd
 
 from arzsumo.evaluation.stats import MeanCI, bootstrap_mean_ci, mean_ci
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.studies import markdown_table, publish, write_csv, write_text
+from arzsumo.outputs.penetration import PENETRATION_FIGURE
+from arzsumo.outputs.studies import (
+    markdown_table,
+    publish,
+    remove_stale_figures,
+    write_csv,
+    write_text,
+)
 from arzsumo.resources import shipped_sweeps_dir
 from arzsumo.studies.common import (
     EXIT_SOME_FAILED,
@@ -193,6 +200,8 @@ def _write(tables: dict[str, pd.DataFrame], out: Path, args: argparse.Namespace)
         files.append(write_penetration_figure(out, {SWEEPS[n]: t
                                                     for n, t in tables.items()}))
         text += "\n![ETC against the AV share](penetration.png)\n"
+    else:
+        remove_stale_figures(out / PENETRATION_FIGURE)
     write_text(text, out / "penetration.md")
     if args.docs is not None:
         publish(args.docs, PAGE, NAME, "The controllers on the default in SUMO", text,

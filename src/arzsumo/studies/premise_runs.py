@@ -55,6 +55,7 @@ from arzsumo.studies.design import StudyRun, design_runs
 from arzsumo.sumo.config import SumoConfig, ramp_capacity
 from arzsumo.sumo.fork import BranchFailed
 from arzsumo.sumo.green_share import GreenShareCurve
+from arzsumo.units import VEH_H_PER_VEH_S, veh_s_to_veh_h
 
 log = logging.getLogger(__name__)
 
@@ -83,7 +84,7 @@ class PremiseOptions:
     pulse: float = 25.0
     level: float = 120.0
     levels: int = 8
-    step: float = 200.0 / 3600.0
+    step: float = 200.0 / VEH_H_PER_VEH_S
 
     def for_kind(self, kind: str) -> dict[str, Any]:
         """The options one kind of run depends on (its row is reused while they hold)."""
@@ -97,7 +98,7 @@ class PremiseOptions:
     def as_dict(self) -> dict[str, float | int]:
         """The options with units in their names (s, veh/h)."""
         return {"window_s": self.window, "pulse_s": self.pulse, "level_s": self.level,
-                "levels": self.levels, "step_veh_h": self.step * 3600.0}
+                "levels": self.levels, "step_veh_h": veh_s_to_veh_h(self.step)}
 
 
 # -- the meter's plans (pure: no SUMO) -----------------------------------------------------
@@ -121,10 +122,12 @@ def plan_for_step(cfg: SumoConfig, curve: GreenShareCurve, dr: float) -> float:
     if cfg.meter_mode == "one_per_green":
         plan, lo, hi = cfg.release_rate + dr, cfg.release_rate_min, cfg.release_rate_max
         if not lo <= plan <= hi:
+            step, rate, low, high = (veh_s_to_veh_h(v) for v in (abs(dr), cfg.release_rate,
+                                                                 lo, hi))
             raise PremiseRunError(
-                f"--step-veh-h = {abs(dr) * 3600:g} is not allowed: the release rate "
-                f"{cfg.release_rate * 3600:g} {'+' if dr > 0 else '-'} {abs(dr) * 3600:g} "
-                f"veh/h lies outside the meter's [{lo * 3600:g}, {hi * 3600:g}] veh/h "
+                f"--step-veh-h = {step:g} is not allowed: the release rate "
+                f"{rate:g} {'+' if dr > 0 else '-'} {step:g} "
+                f"veh/h lies outside the meter's [{low:g}, {high:g}] veh/h "
                 "([sumo] release_rate_min_veh_h, release_rate_max_veh_h)")
         return plan
     m = curve.monotone()
@@ -132,10 +135,12 @@ def plan_for_step(cfg: SumoConfig, curve: GreenShareCurve, dr: float) -> float:
     plan = m.green_share_for(q)
     if not (min(m.outflow) <= q <= max(m.outflow)
             and cfg.green_share_min <= plan <= cfg.green_share_max):
+        step, to, low, high = (veh_s_to_veh_h(v) for v in (abs(dr), q, min(m.outflow),
+                                                           max(m.outflow)))
         raise PremiseRunError(
-            f"--step-veh-h = {abs(dr) * 3600:g} is not allowed: the fixed-cycle meter "
-            f"cannot move the mainline outflow to {q * 3600:.0f} veh/h within its meter "
-            f"curve ({min(m.outflow) * 3600:.0f}-{max(m.outflow) * 3600:.0f} veh/h) and "
+            f"--step-veh-h = {step:g} is not allowed: the fixed-cycle meter "
+            f"cannot move the mainline outflow to {to:.0f} veh/h within its meter "
+            f"curve ({low:.0f}-{high:.0f} veh/h) and "
             f"[sumo] green_share_min .. green_share_max")
     return plan
 

@@ -31,7 +31,15 @@ import pandas as pd
 from arzsumo.evaluation.stats import paired_difference
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, write_csv
-from arzsumo.studies.common import add_output, add_runs, print_list, shipped_scenario, study_spec
+from arzsumo.studies.common import (
+    EXIT_SOME_FAILED,
+    add_output,
+    add_runs,
+    print_list,
+    shipped_scenario,
+    study_spec,
+)
+from arzsumo.units import S_PER_H
 
 NAME = "sumo-options"
 PAGE = "sumo_options"
@@ -46,8 +54,8 @@ VARIANTS: dict[str, list[Any]] = {
 }
 #: summary column -> (label, unit factor from SI, unit)
 MEASURES: dict[str, tuple[str, float, str]] = {
-    "network.time_spent_s.total": ("window time spent", 1 / 3600, "veh h"),
-    "network_whole_demand.time_spent_s.total": ("whole-demand time spent", 1 / 3600, "veh h"),
+    "network.time_spent_s.total": ("window time spent", 1 / S_PER_H, "veh h"),
+    "network_whole_demand.time_spent_s.total": ("whole-demand time spent", 1 / S_PER_H, "veh h"),
     "network_whole_demand.ramp_wait_s.p95": ("ramp wait p95", 1.0, "s"),
     "section.speed_mean_kmh.h": ("HV mean speed", 1.0, "km/h"),
     "section.speed_mean_kmh.a": ("AV mean speed", 1.0, "km/h"),
@@ -167,4 +175,4 @@ def run(args: argparse.Namespace) -> int:
                     [(p, p.name) for p in files])
     print(text)
     bad = sum(v for k, v in rep.statuses.items() if k != "ok")
-    return 4 if bad else 0
+    return EXIT_SOME_FAILED if bad else 0

@@ -18,7 +18,12 @@ import numpy as np
 import pandas as pd
 
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.studies import markdown_table, publish, write_csv
+from arzsumo.outputs.studies import (
+    markdown_table,
+    publish,
+    remove_stale_figures,
+    write_csv,
+)
 from arzsumo.studies.common import (
     EXIT_SOME_FAILED,
     add_output,
@@ -32,6 +37,7 @@ from arzsumo.studies.common import (
 from arzsumo.sweep.spec import SweepSpec
 from arzsumo.sweep.table import run_dir
 from arzsumo.sweep.worker import FINISHED
+from arzsumo.units import veh_s_to_veh_h
 
 NAME = "u-estimate"
 #: the results page this study keeps a block of
@@ -65,7 +71,7 @@ def series(spec: SweepSpec, out: Path) -> pd.DataFrame:
             p = pd.read_parquet(path, columns=["t_s", "u_continuous"])
             parts.append(pd.DataFrame({"estimator": run.columns["estimator"],
                                        "seed": run.columns["seed"], "t_s": p["t_s"],
-                                       "u_veh_h": p["u_continuous"] * 3600.0}))
+                                       "u_veh_h": veh_s_to_veh_h(p["u_continuous"])}))
     return pd.concat(parts, ignore_index=True) if parts else pd.DataFrame(
         columns=["estimator", "seed", "t_s", "u_veh_h"])
 
@@ -117,6 +123,8 @@ def run(args: argparse.Namespace) -> int:
                                           strict=True)]
             files.append(write_u_series(lines, f"{args.controller} on legacy_default: the "
                                         "law on raw cells and on estimates", out / "u.png"))
+        else:
+            remove_stale_figures(out / "u.png")
         text = markdown_table(stats, ".0f")
         if args.docs is not None:
             publish(args.docs, PAGE, NAME, "The control law on raw cells and on estimates",

@@ -122,8 +122,9 @@ def run(args: argparse.Namespace) -> int:
     """Run (or read) and write the table of lags and speeds."""
     controllers = [c.strip() for c in args.controllers.split(",") if c.strip()]
     runs = design(args.scenario or shipped_scenario(FORMER_DEFAULT), controllers, args.seeds)
-    if args.list and not args.source:
-        return print_list([r.run_id for r in runs])
+    if args.list:
+        return print_list([r.run_id for r in runs],
+                          ("--from", args.source) if args.source else None)
     with resumable_dir(args.out, f"study-{NAME}") as out:
         if args.source:
             missing = [str(d) for d in args.source if not (Path(d) / "cells.parquet").is_file()]
