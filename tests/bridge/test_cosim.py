@@ -157,7 +157,7 @@ def test_a_run_killed_halfway_leaves_no_complete_results(tmp_path):
                             start_new_session=True)
     deadline = time.time() + 60
     seen = b""
-    while time.time() < deadline and b"20.0%" not in seen:   # well inside the SUMO run
+    while time.time() < deadline and b" control " not in seen:   # inside the SUMO run
         seen += proc.stderr.read1(256) if proc.stderr else b""
     os.killpg(proc.pid, signal.SIGKILL)
     proc.wait(timeout=30)

@@ -29,6 +29,7 @@ from arzsumo.control.registry import controller_names
 
 
 def cmd_run(args: argparse.Namespace) -> int:
+    from arzsumo.bridge.run_progress import WRITING, run_progress
     from arzsumo.bridge.session import default_run_name, prepare_run, run_prepared
     from arzsumo.outdir import OutputDir, check_target
     from arzsumo.outputs.bridge import write_results
@@ -49,8 +50,11 @@ def cmd_run(args: argparse.Namespace) -> int:
         print(prepared.describe())
         return 0
     # the output is checked and claimed before SUMO starts; Ctrl-C or an error removes it
-    with OutputDir(out, "run", overwrite=args.overwrite) as target:
-        session = run_prepared(prepared, progress=not args.quiet, frontend=frontend)
+    bar = run_progress(prepared.settings, prepared.sumo, enabled=not args.quiet,
+                       writing=True)
+    with OutputDir(out, "run", overwrite=args.overwrite) as target, bar:
+        session = run_prepared(prepared, progress=bar, frontend=frontend)
+        bar.enter(WRITING)
         text = path.read_text(encoding="utf-8") + session.resolved_comment()
         _, summ = write_results(session.result, target, text, plots=not args.no_plots)
     if args.json:
