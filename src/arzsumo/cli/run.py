@@ -4,7 +4,8 @@ Checks the scenario and the options as the run would (:func:`arzsumo.bridge.sess
 prepare_run`, and a warm-up that outlasts the scenario's fill phase,
 :func:`arzsumo.cli.scenarios.check_warmup`), claims the output directory, runs SUMO
 (:func:`arzsumo.bridge.session.run_prepared`, on what was checked), writes the results
-and prints the summary table. ``--dry-run`` makes the same checks and prints what the run would do.
+and prints the key columns of the summary (every column: ``summary.csv``). ``--dry-run``
+makes the same checks and prints what the run would do.
 """
 
 from __future__ import annotations
@@ -62,9 +63,10 @@ def cmd_run(args: argparse.Namespace) -> int:
 
         print(json.dumps(json_safe(summ), indent=2))
     else:
-        from arzsumo.bridge.compare import summary_table, updates_line
+        from arzsumo.bridge.compare import key_table, updates_line
+        from arzsumo.outputs.bridge import SUMMARY_CSV
 
-        print(summary_table([summ]))
+        print(key_table(summ, str(out / SUMMARY_CSV)))
         line = updates_line(summ)
         if line:
             print(line)
