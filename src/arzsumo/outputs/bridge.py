@@ -356,5 +356,7 @@ def write_results(res: CoSimResult, out: str | Path | OutputDir, scenario_text: 
         if res.files is not None:   # linked or copied in chunks, never read into memory
             res.files.place(tmp)
         if plots:
-            save_figures(bridge_figures(res), tmp, dpi=100)
+            waves = summ["section"]["speed_wave"]
+            save_figures(bridge_figures(res, {c: waves[c]["speed_kmh"] for c in ("h", "a")}),
+                         tmp, dpi=100)
     return target_of(out), summ
