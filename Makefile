@@ -1,27 +1,43 @@
-# make run  : create .venv if missing, install arzsumo with its extras, run the default job,
-#             then print the control and penetration studies' results from their record store
-# make test : the same set-up, then ruff, the import contracts (lint-imports) and the whole
-#             test suite
+# make run     : create .venv if missing, install arzsumo with its extras, run the default
+#                scenario in SUMO and print its result
+# make test    : the same set-up, then ruff, the import contracts (lint-imports) and the
+#                whole test suite
+# make results : the control and penetration studies' tables, read from the committed
+#                record store (nothing runs; seconds)
 PYTHON ?= python3
 VENV   ?= .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: run test lint bench clean
+.PHONY: run results test lint bench clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --disable-pip-version-check -e '.[test]'
 	touch $(STAMP)
 
-# the default run, then the judged result: the control and penetration studies' tables
-# from the committed record store (nothing runs; seconds)
-RECORDS := docs/readings/control_default/records
+RUN_OUT := results/default-etc-seed42-h450s
 
+# the default scenario in SUMO; its result table is the last thing printed
 run: $(STAMP)
-	$(BIN)/arzsumo run --overwrite
-	$(BIN)/arzsumo study control --report --seeds 1-20 --records $(RECORDS) --quiet
-	$(BIN)/arzsumo study penetration --report --records $(RECORDS) --quiet
+	@echo "make run: the default scenario in SUMO (about 2 min on 2 cores once installed);"
+	@echo "results in $(RUN_OUT)/ (the stored studies' tables: make results)"
+	@$(BIN)/arzsumo run --overwrite --out $(RUN_OUT)
+
+# the judged result: the control and penetration studies' tables, reported from the runs
+# the committed record store holds (made earlier; nothing runs now, seconds)
+RECORDS := docs/readings/control_default/records
+STUDIES := results/studies
+
+results: $(STAMP)
+	@echo "make results: the control and penetration studies, reported from the runs in"
+	@echo "$(RECORDS)/ (made earlier; nothing runs now)"
+	@$(BIN)/arzsumo study control --report --seeds 1-20 --records $(RECORDS) --quiet \
+		--out $(STUDIES)/control
+	@$(BIN)/arzsumo study penetration --report --records $(RECORDS) --quiet \
+		--out $(STUDIES)/penetration
+	@echo "make results: tables and figures in $(STUDIES)/control/ and $(STUDIES)/penetration/"
+	@echo "(what they say: docs/readings/current_result.md)"
 
 test: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks

@@ -118,6 +118,16 @@ def test_the_paper_indices_from_sumo_agree_with_a_recomputation_from_the_cells(s
             assert summ["section"][key]["total"] == pytest.approx(value, rel=1e-9), key
 
 
+def test_the_run_writes_every_column_of_its_table_in_summary_csv(runs):
+    from arzsumo.bridge.compare import COLUMNS, row_of
+
+    for _, path, summ in runs.values():
+        table = pd.read_csv(path / "summary.csv")
+        assert len(table) == 1
+        assert list(table.columns) == list(row_of(summ))
+        assert {c for c, _ in COLUMNS} <= set(table.columns)
+
+
 def test_open_loop_never_touches_the_meter_and_backstepping_updates_every_period(runs):
     assert runs["open"][2]["plan_changes"] == 0
     assert np.all(runs["open"][0].periods["u"] == 0)
@@ -157,7 +167,7 @@ def test_a_run_killed_halfway_leaves_no_complete_results(tmp_path):
                             start_new_session=True)
     deadline = time.time() + 60
     seen = b""
-    while time.time() < deadline and b"20.0%" not in seen:   # well inside the SUMO run
+    while time.time() < deadline and b" control " not in seen:   # inside the SUMO run
         seen += proc.stderr.read1(256) if proc.stderr else b""
     os.killpg(proc.pid, signal.SIGKILL)
     proc.wait(timeout=30)

@@ -72,3 +72,27 @@ def test_no_plots_module_saves_or_opens_files():
                 if name in ("savefig", "open", "write_text", "write_bytes", "mkdir"):
                     found.append(f"{path.name}:{node.lineno}: {name}()")
     assert found == []
+
+
+def test_the_fields_tell_waves_from_vehicles_and_label_the_equilibrium(no_saving):
+    figs = bridge_figures(cosim_result(), {"h": -35.0, "a": float("nan")})
+    fields_h, fields_a = figs["fields_h"], figs["fields_a"]
+    (legend,) = fields_h.legends
+    texts = [t.get_text() for t in legend.get_texts()]
+    assert texts[0] == "waves (speed fluctuations), measured: -35 km/h, upstream"
+    assert texts[1].startswith("vehicles' mean speed: +")
+    assert texts[1].endswith("km/h, downstream; stripes along it move with the vehicles "
+                             "(groups and gaps), not waves")
+    # a wave line and a vehicles' line on each of the 6 panels
+    assert sum(len(ax.lines) for ax in fields_h.axes[:6]) == 12
+    bars = [ax.get_ylabel() for ax in fields_h.axes[6:]]
+    assert bars == ["veh/km; dashed: equilibrium 30", "km/h; dashed: equilibrium 72"]
+    (legend_a,) = fields_a.legends
+    assert legend_a.get_title().get_text() == ("waves (speed fluctuations), measured: no "
+                                               "travel speed resolved")
+    assert [t.get_text()[:20] for t in legend_a.get_texts()] == ["vehicles' mean speed"]
+
+
+def test_without_measured_waves_no_guides_are_drawn(no_saving):
+    fields = bridge_figures(cosim_result())["fields_h"]
+    assert fields.legends == [] and all(len(ax.lines) == 0 for ax in fields.axes[:6])

@@ -46,17 +46,36 @@ COLUMNS: tuple[tuple[str, str], ...] = (
     ("speed_sd_a_kmh", "sd v_a km/h"), ("max_ramp_queue", "max queue veh"),
     ("replay_rho_h_pct", "replay rho_h %"), ("replay_rho_a_pct", "replay rho_a %"),
     ("reference_rho_h_pct", "ref rho_h %"), ("reference_rho_a_pct", "ref rho_a %"))
-#: printed under the text table: what the short headers mean
-LEGEND = ("plan chg: commands asking the meter for a timing other than the one it holds, "
-          "counted when asked (several within one meter cycle all count, the last runs); "
-          "light chg: greens beginning or ending on the ramp light; updates: checks at "
-          "which the controller changed its U (docs/outputs.md, Counts); "
-          "whole TTS: every vehicle of the demand to its arrival; time loss: SUMO's "
-          "timeLoss + depart delay over the window (>= 0); TTT and delay vs V: the section "
-          "(delay vs V = TTT - TMT / V_free with the model's free speeds, negative where "
-          "SUMO drives faster); n: counts; J_discom SI: veh m^2/s^3 + veh m^2/s^5; replay "
-          "and ref rho %: the twin's density error against SUMO, RMSE on 100 m x 10 s "
-          "blocks relative to the equilibrium density, per class")
+#: printed under the text table: what the short headers mean, each part with the columns
+#: it explains (a table that leaves those columns out leaves the part out)
+LEGEND_PARTS: tuple[tuple[tuple[str, ...], str], ...] = (
+    (("plan_changes",), "plan chg: commands asking the meter for a timing other than the "
+                        "one it holds, counted when asked (several within one meter cycle "
+                        "all count, the last runs)"),
+    (("light_changes",), "light chg: greens beginning or ending on the ramp light"),
+    (("triggers",), "updates: checks at which the controller changed its U (docs/outputs.md, "
+                    "Counts)"),
+    (("whole_tts_veh_h",), "whole TTS: every vehicle of the demand to its arrival"),
+    (("network_time_loss_veh_h",), "time loss: SUMO's timeLoss + depart delay over the "
+                                   "window (>= 0)"),
+    (("TTT_veh_h", "delay_veh_h"), "TTT and delay vs V: the section (delay vs V = TTT - "
+                                   "TMT / V_free with the model's free speeds, negative "
+                                   "where SUMO drives faster)"),
+    (("plan_changes", "light_changes", "triggers"), "n: counts"),
+    (("J_discom",), "J_discom SI: veh m^2/s^3 + veh m^2/s^5"),
+    (("replay_rho_h_pct", "replay_rho_a_pct", "reference_rho_h_pct", "reference_rho_a_pct"),
+     "replay and ref rho %: the twin's density error against SUMO, RMSE on 100 m x 10 s "
+     "blocks relative to the equilibrium density, per class"),
+)
+LEGEND = "; ".join(text for _, text in LEGEND_PARTS)
+#: the columns ``arzsumo run`` prints, in order, as many as fit :data:`WIDTH` (every
+#: column is in the run's summary.csv): the judged measures, the meter's and the
+#: controller's counts, the section, the twin
+KEY_COLUMNS = ("controller", "seed", "whole_tts_veh_h", "ramp_wait_p95_s",
+               "network_time_loss_veh_h", "plan_changes", "triggers", "max_ramp_queue",
+               "TTT_veh_h", "replay_rho_h_pct")
+#: characters per printed line
+WIDTH = 100
 #: identity columns that must agree between compared rows (unless mixing is allowed)
 MUST_AGREE = ("kind", "scenario", "horizon_s", "warmup_s")
 #: what each kind of result is, for messages and headers
@@ -163,6 +182,17 @@ def header(df: pd.DataFrame) -> str:
             f"{warm}: {KINDS[first['kind']]}")
 
 
+def _render(df: pd.DataFrame, columns: list[str]) -> str:
+    heads = dict(COLUMNS)
+    body = df[columns].rename(columns=heads)
+    return body.to_string(index=False, float_format=lambda v: f"{v:.3g}")
+
+
+def legend(columns: list[str]) -> str:
+    """The parts of :data:`LEGEND` that explain ``columns``."""
+    return "; ".join(text for cols, text in LEGEND_PARTS if set(cols) & set(columns))
+
+
 def summary_table(summaries: list[dict[str, Any]]) -> str:
     """Text table of results (one row each) under a header line (:func:`header`).
 
@@ -172,9 +202,25 @@ def summary_table(summaries: list[dict[str, Any]]) -> str:
     df = pd.DataFrame([row_of(s) for s in summaries])
     mix = differing(df)
     drop = {c for c in ("scenario", "horizon_s", "warmup_s", "kind") if c not in mix}
-    body = df[[c for c, _ in COLUMNS if c not in drop]].rename(columns=dict(COLUMNS))
-    table = body.to_string(index=False, float_format=lambda v: f"{v:.3g}")
-    return f"{header(df)}\n{table}\n{textwrap.fill(LEGEND, 100)}"
+    table = _render(df, [c for c, _ in COLUMNS if c not in drop])
+    return f"{header(df)}\n{table}\n{textwrap.fill(LEGEND, WIDTH)}"
+
+
+def key_table(summ: dict[str, Any], csv: str) -> str:
+    """One run's result in at most :data:`WIDTH` columns: a header naming the run, the
+    :data:`KEY_COLUMNS` that fit, their legend, and where every column is (``csv``)."""
+    df = pd.DataFrame([row_of(summ)])
+    first = df.iloc[0]
+    title = f"{as_text(first['controller'])}, seed {as_text(first['seed'])}, {header(df)}"
+    shown: list[str] = []
+    for col in KEY_COLUMNS[2:]:           # controller and seed are in the header
+        if max(map(len, _render(df, [*shown, col]).splitlines())) <= WIDTH:
+            shown.append(col)
+    return "\n".join([textwrap.fill(title, WIDTH), _render(df, shown),
+                      textwrap.fill(legend(shown), WIDTH),
+                      textwrap.fill(f"the key measures shown; every column ({len(COLUMNS)}: "
+                                    "also light changes, fuel, discomfort, speed spreads, "
+                                    f"the twins' errors) is in {csv}", WIDTH)])
 
 
 #: the controllers that hold U between events (paper, section 4)
@@ -187,10 +233,10 @@ def updates_line(summ: dict[str, Any]) -> str | None:
     if summ.get("controller") not in EVENT_TRIGGERED or "triggers" not in summ:
         return None
     held = float(summ.get("release_time", math.nan))
-    return (f"{summ['controller']}: U updated at {int(summ['triggers'])} checks, held "
-            f"unchanged for {held:.0f} s of the {float(summ['horizon']):.0f} s window (the "
-            f"continuous law updates at every check; why in SUMO: "
-            f"docs/readings/control_default.md)")
+    return textwrap.fill(
+        f"{summ['controller']}: U updated at {int(summ['triggers'])} checks, held unchanged "
+        f"for {held:.0f} s of the {float(summ['horizon']):.0f} s window (the continuous law "
+        "updates at every check; why in SUMO: docs/readings/control_default.md)", WIDTH)
 
 
 def load_summaries(runs: list[Path]) -> list[dict[str, Any]]:

@@ -62,6 +62,7 @@ from arzsumo.bridge.loop import ClosedLoop
 from arzsumo.bridge.records import Trace, columns, micro_fields
 from arzsumo.bridge.reference import reference_shift
 from arzsumo.bridge.result import CoSimResult
+from arzsumo.bridge.run_progress import CONTROL, MEASURES, run_progress
 from arzsumo.bridge.twins import TwinPair
 from arzsumo.control.alinea import AlineaSettings, ReleaseRates
 from arzsumo.control.base import Controller
@@ -72,7 +73,7 @@ from arzsumo.evaluation.decay import stationary_reference
 from arzsumo.model.characteristic import Linearization, linearize
 from arzsumo.model.equilibrium import Equilibrium
 from arzsumo.model.params import ModelParameters
-from arzsumo.progress import Progress
+from arzsumo.progress import Progress, RunProgress
 from arzsumo.scenario import Scenario
 from arzsumo.scenario.run import RunSettings
 from arzsumo.sumo.config import SumoConfig
@@ -110,7 +111,7 @@ def check_before_start(settings: RunSettings, eq: Equilibrium, at: str | None = 
 
 
 def warm_up(plant: SumoPlant, warmup: float, period: float,
-            bar: Progress) -> list[PeriodMeasurement]:
+            bar: Progress | RunProgress) -> list[PeriodMeasurement]:
     """``warmup`` seconds (rounded up to whole periods, at least one) at the nominal plan."""
     out = []
     for _ in range(max(1, math.ceil(warmup / period - 1e-9))):
@@ -183,7 +184,7 @@ class Warmed:
 
 
 def warm_start(sim: SumoSimulation, scenario: Scenario, settings: RunSettings,
-               cfg: SumoConfig, curve: GreenShareCurve, bar: Progress) -> Warmed:
+               cfg: SumoConfig, curve: GreenShareCurve, bar: RunProgress) -> Warmed:
     """The warm-up in the open ``sim``, and the control window opened at its end."""
     est = scenario.estimation
     plant = SumoPlant(sim, scenario.params.length, cfg, curve, layout=scenario.sensing,
@@ -218,23 +219,26 @@ class OpenRun:
     sim: SumoSimulation
     out_dir: Path          # SUMO's tripinfo, edge data, statistics (and FCD)
     files: RunFiles
-    bar: Progress
+    bar: RunProgress
     placement: str
     wall0: float
 
 
 @contextmanager
 def open_run(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
-             initial_fields: np.ndarray | None = None, *, progress: bool = False,
+             initial_fields: np.ndarray | None = None, *,
+             progress: bool | RunProgress = False,
              frontend: str = "libsumo") -> Iterator[OpenRun]:
     """SUMO started for warm-up plus control horizon with the run's outputs (step 2 of
     the module docstring); its scratch directory goes on leaving, its kept files too
-    when leaving on an error."""
+    when leaving on an error. ``progress``: draw the run's phases on stderr; a
+    :class:`~arzsumo.progress.RunProgress` given is drawn on and left open for the
+    caller's own phases (``arzsumo run`` writing its results)."""
     wall0 = time.perf_counter()
     run_cfg = cfg.with_(horizon=settings.warmup + cfg.horizon)
     initial, placement = place_initial(scenario.params, settings, run_cfg, initial_fields)
-    bar = Progress(run_cfg.horizon, f"{settings.controller} seed {cfg.seed}",
-                   enabled=progress)
+    bar = (progress if isinstance(progress, RunProgress)
+           else run_progress(settings, cfg, enabled=progress))
     net_dir = Path(tempfile.mkdtemp(prefix="arzsumo-net-", dir=scratch_dir()))
     files = RunFiles()
     try:
@@ -246,16 +250,18 @@ def open_run(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
             yield OpenRun(sim, net_dir, files, bar, placement, wall0)
     except BaseException:
         files.remove()
+        bar.abandon()
         raise
     finally:
         shutil.rmtree(net_dir, ignore_errors=True)
-        bar.close()
+        if bar is not progress:
+            bar.close()
 
 
 def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
                      design: EtcDesign, *, initial_fields: np.ndarray | None = None,
                      curve: GreenShareCurve = DEFAULT_CURVE,
-                     progress: bool = False, keep_measurements: bool = False,
+                     progress: bool | RunProgress = False, keep_measurements: bool = False,
                      frontend: str = "libsumo") -> CoSimResult:
     """Run SUMO with the controller of ``settings`` and both twins (module docstring).
 
@@ -263,7 +269,8 @@ def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
     ``settings.start == "placement"``. ``keep_measurements``: keep every period's
     measurement, warm-up included, in ``estimator.measurements`` (for offline estimation,
     :mod:`arzsumo.bridge.sensor_record`). ``frontend``: "libsumo", "traci" or "gui"
-    (watch the run in sumo-gui; :mod:`arzsumo.sumo.frontend`). The run's SUMO
+    (watch the run in sumo-gui; :mod:`arzsumo.sumo.frontend`). ``progress``: as in
+    :func:`open_run`. The run's SUMO
     configuration, and with ``cfg.fcd`` its FCD output, are kept in ``files``
     (:mod:`arzsumo.sumo.run_files`).
     """
@@ -285,7 +292,8 @@ def finish_run(run: OpenRun, warmed: Warmed, scenario: Scenario, settings: RunSe
     meter_summary = {**plant.meter_summary(), "ramp_storage": cfg.ramp_storage}
     timings = {**plant.timings, **c.loop.timings}   # the window's, not the drain's
     t_end = sim.time
-    drained = drain(plant, cfg.drain_max) if cfg.drain_max > 0 else None
+    drained = drain(plant, cfg.drain_max, run.bar) if cfg.drain_max > 0 else None
+    run.bar.enter(MEASURES)
     sim.close()                # SUMO writes the unfinished trips' tripinfo as it closes
     records = c.trace.records
     outlet = round(sum((r.outflow_h + r.outflow_a) * cfg.control_period for r in records))
@@ -321,7 +329,7 @@ def _result(c: Controlled, scenario: Scenario, cfg: SumoConfig, meter: dict[str,
 
 
 def control(warmed: Warmed, scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
-            design: EtcDesign, curve: GreenShareCurve, bar: Progress,
+            design: EtcDesign, curve: GreenShareCurve, bar: RunProgress,
             keep_measurements: bool = False) -> Controlled:
     """The control window from the end of the warm-up (steps 4-6 of the module
     docstring); ``cfg`` has the control horizon."""
@@ -329,6 +337,7 @@ def control(warmed: Warmed, scenario: Scenario, settings: RunSettings, cfg: Sumo
 
     period, est = cfg.control_period, scenario.estimation
     plant, warm = warmed.plant, warmed.warm
+    bar.enter(CONTROL, offset=warm[-1].t)    # solving the kernels is the window's cost
     eq = operating_point(settings, scenario.equilibrium, warm, period)
     lin = linearize(eq)
     kernels = (cached_kernels(lin.system, settings.kernel_cells)

@@ -26,6 +26,8 @@ from dataclasses import dataclass, replace
 
 import pandas as pd
 
+from arzsumo.bridge.run_progress import DRAIN
+from arzsumo.progress import RunProgress
 from arzsumo.sumo.network import NetworkSpec
 from arzsumo.sumo.plant import SumoPlant
 from arzsumo.sumo.whole_demand import ramp_waits, whole_demand_summary
@@ -46,15 +48,22 @@ class Drained:
     gridlock: bool = False
 
 
-def drain(plant: SumoPlant, limit: float) -> Drained:
+def drain(plant: SumoPlant, limit: float, bar: RunProgress | None = None) -> Drained:
     """Step ``plant`` after the control window under the drain policy (module docstring)
-    until no vehicle is in the system or expected, at most ``limit`` seconds."""
+    until no vehicle is in the system or expected, at most ``limit`` seconds; ``bar``
+    counts the vehicles that have left."""
     sim = plant.sim
     t_end = sim.time
     plant.end_window()
     arrived, last_arrival, gridlock = sim.arrived, t_end, False
-    while sim.time - t_end < limit - 1e-9 and sim.lib.simulation.getMinExpectedNumber() > 0:
+    left = sim.lib.simulation.getMinExpectedNumber()
+    if bar is not None:
+        bar.enter(DRAIN, work=left)
+    while sim.time - t_end < limit - 1e-9 and left > 0:
         plant.step()
+        left = sim.lib.simulation.getMinExpectedNumber()
+        if bar is not None:
+            bar.update(bar.timer.phase.work - left)
         if sim.arrived > arrived:
             arrived, last_arrival = sim.arrived, sim.time
         elif sim.time - last_arrival >= STALL_S:

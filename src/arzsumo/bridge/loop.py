@@ -42,7 +42,7 @@ from arzsumo.bridge.records import PeriodRecord, Trace, micro_fields
 from arzsumo.bridge.reference import ReferenceShift
 from arzsumo.bridge.twins import TwinPair
 from arzsumo.control.base import Applied, Command, Controller, MacroState
-from arzsumo.progress import Progress
+from arzsumo.progress import RunProgress
 from arzsumo.sumo.meter import MeterState
 from arzsumo.sumo.plant import SumoPlant
 from arzsumo.sumo.sensor import PeriodMeasurement
@@ -90,7 +90,7 @@ class ClosedLoop:
         self.anti_windup, self.shift = anti_windup, shift
         self.timings = {"controller": 0.0, "twins": 0.0, "estimator": 0.0}
 
-    def run(self, start: PeriodMeasurement, horizon: float, bar: Progress) -> Trace:
+    def run(self, start: PeriodMeasurement, horizon: float, bar: RunProgress) -> Trace:
         """Control from the measurement ``start`` (t = 0) until ``horizon`` seconds."""
         t0, trace = start.t, Trace(start.cells.x, micro_fields(start.cells))
         m, t, told = start, 0.0, None

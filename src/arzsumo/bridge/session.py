@@ -20,6 +20,7 @@ from arzsumo.bridge.result import CoSimResult
 from arzsumo.control.etc import EtcDesign
 from arzsumo.errors import ArzsumoError, ScenarioError
 from arzsumo.model import linearize
+from arzsumo.progress import RunProgress
 from arzsumo.scenario import Scenario
 from arzsumo.scenario.run import RunSettings
 from arzsumo.scenario.sumo import SUMO_KEYS
@@ -232,9 +233,10 @@ def run_in_sumo(sc: Scenario, *, controller: str | None = None, seed: int | None
     return run_prepared(run, progress=progress, frontend=frontend)
 
 
-def run_prepared(run: PreparedRun, *, progress: bool = False,
+def run_prepared(run: PreparedRun, *, progress: bool | RunProgress = False,
                  frontend: str = "libsumo") -> SumoSession:
-    """Run a :class:`PreparedRun` (checked once, by :func:`prepare_run`) in SUMO."""
+    """Run a :class:`PreparedRun` (checked once, by :func:`prepare_run`) in SUMO;
+    ``progress`` as in :func:`arzsumo.bridge.cosim.open_run`."""
     res = run_cosimulation(run.scenario, run.settings, run.sumo, run.design,
                            initial_fields=run.initial, curve=run.curve, progress=progress,
                            frontend=frontend)

@@ -4,7 +4,8 @@ Checks the scenario and the options as the run would (:func:`arzsumo.bridge.sess
 prepare_run`, and a warm-up that outlasts the scenario's fill phase,
 :func:`arzsumo.cli.scenarios.check_warmup`), claims the output directory, runs SUMO
 (:func:`arzsumo.bridge.session.run_prepared`, on what was checked), writes the results
-and prints the summary table. ``--dry-run`` makes the same checks and prints what the run would do.
+and prints the key columns of the summary (every column: ``summary.csv``). ``--dry-run``
+makes the same checks and prints what the run would do.
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ from arzsumo.control.registry import controller_names
 
 
 def cmd_run(args: argparse.Namespace) -> int:
+    from arzsumo.bridge.run_progress import WRITING, run_progress
     from arzsumo.bridge.session import default_run_name, prepare_run, run_prepared
     from arzsumo.outdir import OutputDir, check_target
     from arzsumo.outputs.bridge import write_results
@@ -49,8 +51,11 @@ def cmd_run(args: argparse.Namespace) -> int:
         print(prepared.describe())
         return 0
     # the output is checked and claimed before SUMO starts; Ctrl-C or an error removes it
-    with OutputDir(out, "run", overwrite=args.overwrite) as target:
-        session = run_prepared(prepared, progress=not args.quiet, frontend=frontend)
+    bar = run_progress(prepared.settings, prepared.sumo, enabled=not args.quiet,
+                       writing=True)
+    with OutputDir(out, "run", overwrite=args.overwrite) as target, bar:
+        session = run_prepared(prepared, progress=bar, frontend=frontend)
+        bar.enter(WRITING)
         text = path.read_text(encoding="utf-8") + session.resolved_comment()
         _, summ = write_results(session.result, target, text, plots=not args.no_plots)
     if args.json:
@@ -58,9 +63,10 @@ def cmd_run(args: argparse.Namespace) -> int:
 
         print(json.dumps(json_safe(summ), indent=2))
     else:
-        from arzsumo.bridge.compare import summary_table, updates_line
+        from arzsumo.bridge.compare import key_table, updates_line
+        from arzsumo.outputs.bridge import SUMMARY_CSV
 
-        print(summary_table([summ]))
+        print(key_table(summ, str(out / SUMMARY_CSV)))
         line = updates_line(summ)
         if line:
             print(line)

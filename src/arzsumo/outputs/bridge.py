@@ -11,6 +11,8 @@ Every file, column (with units, stored in the Parquet field metadata from
     cells.parquet     per period and cell: source (micro, replay, reference), t_s, x_m,
                       rho_h, v_h, rho_a, v_a (SI; micro speeds NaN in empty cells)
     summary.json      see :func:`summary`
+    summary.csv       the run's row of ``arzsumo compare``'s table: every column, in human
+                      units (``arzsumo run`` prints the key ones)
     tripinfo.xml.gz   SUMO's tripinfo output (every loaded vehicle, with emissions),
                       compressed; ``arzsumo.sumo.network_measures.read_trips`` reads it
     fcd.xml.gz        with ``[sumo] fcd`` (``--fcd``): SUMO's FCD output, every vehicle
@@ -38,10 +40,12 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
 from arzsumo import __version__
+from arzsumo.bridge.compare import row_of
 from arzsumo.bridge.delay import compensated_delay
 from arzsumo.bridge.estimator import fill_speeds
 from arzsumo.bridge.result import CoSimResult
@@ -67,6 +71,9 @@ from arzsumo.units import ms_to_kmh
 
 #: SUMO's tripinfo output of the run (every loaded vehicle), gzip-compressed
 TRIPINFO_GZ = "tripinfo.xml.gz"
+#: the run's row of ``arzsumo compare``'s table, every column (``arzsumo run`` prints
+#: the key ones)
+SUMMARY_CSV = "summary.csv"
 
 
 def _indices(res: CoSimResult, fields: np.ndarray) -> dict[str, Any]:
@@ -343,10 +350,13 @@ def write_results(res: CoSimResult, out: str | Path | OutputDir, scenario_text: 
         (tmp / "scenario.toml").write_text(scenario_text, encoding="utf-8")
         (tmp / "summary.json").write_text(json.dumps(json_safe(summ), indent=2) + "\n",
                                           encoding="utf-8")
+        pd.DataFrame([row_of(summ)]).to_csv(tmp / SUMMARY_CSV, index=False)
         if res.network is not None:
             (tmp / TRIPINFO_GZ).write_bytes(res.network.tripinfo_gz)
         if res.files is not None:   # linked or copied in chunks, never read into memory
             res.files.place(tmp)
         if plots:
-            save_figures(bridge_figures(res), tmp, dpi=100)
+            waves = summ["section"]["speed_wave"]
+            save_figures(bridge_figures(res, {c: waves[c]["speed_kmh"] for c in ("h", "a")}),
+                         tmp, dpi=100)
     return target_of(out), summ

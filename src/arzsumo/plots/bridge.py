@@ -9,23 +9,69 @@ Nothing is written here: :func:`arzsumo.outputs.figures.save_figures` saves them
 from __future__ import annotations
 
 import textwrap
+from dataclasses import dataclass
 from typing import Any
 
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib import patheffects
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 
 from arzsumo.units import ms_to_kmh, veh_m_to_veh_km, veh_s_to_veh_h
 
 _LABEL = {"h": ("HVs", 0), "a": ("AVs", 2)}
 
 
+@dataclass(frozen=True)
+class TravelGuides:
+    """Two directions drawn on space-time fields so a reader tells them apart: the waves'
+    measured travel speed (km/h, < 0 upstream; NaN when unresolved) and the vehicles' own
+    mean speed (km/h, downstream), along which platoons and density stripes move."""
+
+    wave_kmh: float
+    vehicles_kmh: float
+
+
+def _draw_guides(ax: Axes, x_km: np.ndarray, guides: TravelGuides) -> list[Line2D]:
+    """A line of each speed of ``guides`` through the panel's centre, limits kept."""
+    xlim, ylim = ax.get_xlim(), ax.get_ylim()
+    xc, tc = float(np.mean(xlim)), float(np.mean(ylim))
+    xs = np.linspace(float(x_km.min()), float(x_km.max()), 50)
+    halo = [patheffects.Stroke(linewidth=3.2, foreground="k"), patheffects.Normal()]
+    lines = []
+    for speed, style in ((guides.wave_kmh, "-"), (guides.vehicles_kmh, ":")):
+        if not np.isfinite(speed) or speed == 0:
+            continue
+        (line,) = ax.plot(xs, tc + (xs - xc) / (speed / 3600.0), style, color="w", lw=1.6,
+                          path_effects=halo)
+        lines.append(line)
+    ax.set_xlim(xlim)
+    ax.set_ylim(ylim)
+    return lines
+
+
+def guide_labels(guides: TravelGuides) -> tuple[str, str]:
+    """Legend texts of the wave line and of the vehicles' line."""
+    wave = ("waves (speed fluctuations), measured: no travel speed resolved"
+            if not np.isfinite(guides.wave_kmh) else
+            f"waves (speed fluctuations), measured: {guides.wave_kmh:+.0f} km/h, "
+            f"{'upstream' if guides.wave_kmh < 0 else 'downstream'}")
+    vehicles = (f"vehicles' mean speed: {guides.vehicles_kmh:+.0f} km/h, downstream; "
+                "stripes along it move with the vehicles (groups and gaps), not waves")
+    return wave, vehicles
+
+
 def side_by_side_figure(t: np.ndarray, x: np.ndarray, panels: dict[str, np.ndarray],
-                        cls: str, star: tuple[float, float], title: str = "") -> Figure:
+                        cls: str, star: tuple[float, float], title: str = "",
+                        guides: TravelGuides | None = None) -> Figure:
     """Density (veh/km, top) and speed (km/h, bottom) of one class for each source.
 
     ``panels`` maps a source name to fields (n_t, 4, n_x) in SI; colour scales are shared
-    per row so the sources compare directly; empty or stopped cells are grey.
+    per row so the sources compare directly; empty or stopped cells are grey; the dashed
+    mark on each colour bar is the equilibrium (``star``, veh/m and m/s). ``guides``
+    draws the waves' and the vehicles' directions on every panel, with a legend.
     """
     label, k = _LABEL[cls]
     names = list(panels)
@@ -49,8 +95,17 @@ def side_by_side_figure(t: np.ndarray, x: np.ndarray, panels: dict[str, np.ndarr
                 ax.set_xlabel("x (km)")
             if col == 0:
                 ax.set_ylabel("t since control start (s)")
-        bar = fig.colorbar(mesh, ax=axes[row, :], label=unit)
+            if guides is not None:
+                drawn = _draw_guides(ax, x / 1000.0, guides)
+        bar = fig.colorbar(mesh, ax=axes[row, :],
+                           label=f"{unit}; dashed: equilibrium {scale(ref):.0f}")
         bar.ax.axhline(scale(ref), color="k", lw=1, ls="--")
+    if guides is not None and drawn:
+        wave, vehicles = guide_labels(guides)
+        resolved = np.isfinite(guides.wave_kmh)
+        fig.legend(drawn, [wave, vehicles] if resolved else [vehicles],
+                   title=None if resolved else wave, title_fontsize=9,
+                   loc="outside lower center", fontsize=9, facecolor="0.6", framealpha=1.0)
     if title:
         fig.suptitle(title)
     return fig
@@ -91,7 +146,7 @@ def signals_figure(t: np.ndarray, u: np.ndarray, u_cont: np.ndarray, events: np.
     return fig
 
 
-def bridge_figures(res: Any) -> dict[str, Figure]:
+def bridge_figures(res: Any, wave_kmh: dict[str, float] | None = None) -> dict[str, Figure]:
     """The figures of a co-simulation run, by name: ``fields_h``, ``fields_a``, ``control``.
 
     Parameters
@@ -99,6 +154,10 @@ def bridge_figures(res: Any) -> dict[str, Figure]:
     res : CoSimResult
         Read by attribute (:class:`arzsumo.bridge.result.CoSimResult`): fields in SI, the
         equilibrium (veh/m, m/s), the per-period table and the meter's counts.
+    wave_kmh : dict of str to float, optional
+        Per class ("h", "a"), the measured travel speed of SUMO's speed fluctuations, km/h
+        (< 0 upstream; NaN when unresolved): drawn on the fields with the vehicles' mean
+        speed, so that waves and platoons are told apart.
 
     Returns
     -------
@@ -109,8 +168,15 @@ def bridge_figures(res: Any) -> dict[str, Figure]:
     title = f"{res.scenario.name}: {res.settings.controller}, seed {res.sumo.seed}"
     panels = {"SUMO (Edie)": res.micro, "twin replay": res.replay,
               "twin reference": res.reference}
-    figs = {f"fields_{cls}": side_by_side_figure(res.t, res.x, panels, cls, star, title)
-            for cls, star in (("h", (eq.rho_h, eq.v_h)), ("a", (eq.rho_a, eq.v_a)))}
+    figs = {}
+    for cls, star in (("h", (eq.rho_h, eq.v_h)), ("a", (eq.rho_a, eq.v_a))):
+        guides = None
+        if wave_kmh is not None:
+            v = res.micro[:, _LABEL[cls][1] + 1]
+            mean = float(ms_to_kmh(np.nanmean(v))) if np.isfinite(v).any() else np.nan
+            guides = TravelGuides(float(wave_kmh.get(cls, np.nan)), mean)
+        figs[f"fields_{cls}"] = side_by_side_figure(res.t, res.x, panels, cls, star, title,
+                                                    guides)
     p = res.periods
     figs["control"] = signals_figure(p["t"], p["u"], p["u_continuous"],
                                      p["triggered"].astype(bool), p["green_commanded"],
