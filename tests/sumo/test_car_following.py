@@ -69,6 +69,14 @@ def test_each_key_becomes_the_attribute_its_model_reads():
     assert {a.field for a in ATTRIBUTES} <= set(scenario_from_dict({}).sumo.__dataclass_fields__)
 
 
+def test_lane_change_gap_acceptance_is_written_only_when_set():
+    hv, av = _xml({"hv_model": "IDM", "lc_assertive": 3, "lc_impatience": 1})
+    for xml in (hv, av):
+        assert 'lcAssertive="3"' in xml and 'lcImpatience="1"' in xml
+    hv, av = _xml({"hv_model": "IDM"})
+    assert "lcAssertive" not in hv + av and "lcImpatience" not in hv + av
+
+
 @pytest.mark.parametrize(("sumo", "message"), [
     ({"hv_model": "IDM", "hv_sigma": 0.5},
      'x.toml: [sumo] hv_sigma = 0.5 is not read by hv_model = "IDM" (SUMO would ignore '
@@ -84,6 +92,8 @@ def test_each_key_becomes_the_attribute_its_model_reads():
     ({"hv_model": "EIDM", "hv_sigma_gap": 1.5}, "hv_sigma_gap = 1.5 is not allowed: a "
                                                 "number in [0, 1]"),
     ({"hv_accel_m_s2": 0}, "hv_accel_m_s2 = 0 is not allowed"),
+    ({"lc_assertive": 0}, "lc_assertive = 0 is not allowed: a finite number above 0"),
+    ({"lc_impatience": 1.5}, "lc_impatience = 1.5 is not allowed: a number in [0, 1]"),
 ])
 def test_a_key_its_model_does_not_read_or_a_bad_value_is_refused_in_one_line(sumo, message):
     with pytest.raises(ScenarioError) as err:
@@ -94,7 +104,8 @@ def test_a_key_its_model_does_not_read_or_a_bad_value_is_refused_in_one_line(sum
 @pytest.mark.sumo
 @pytest.mark.parametrize("sumo", [{"hv_sigma": 0.75, "hv_sigma_step_s": 1},
                                   {**EIDM, **CACC},
-                                  {"hv_model": "IDM", "hv_delta": 4, "hv_stepping_s": 0.1}])
+                                  {"hv_model": "IDM", "hv_delta": 4, "hv_stepping_s": 0.1,
+                                   "lc_assertive": 3, "lc_impatience": 1}])
 def test_sumo_loads_every_attribute_without_a_warning(sumo, tmp_path):
     """SUMO itself reads the vTypes: no error, no warning about an attribute."""
     hv, av = _xml(sumo)

@@ -148,6 +148,14 @@ SUMO_KEYS: dict[str, Key] = {
                                               "lcSpeedGain), >= 0"),
     "lc_pushy": Key("lc_pushy", doc="willingness to encroach laterally (SUMO lcPushy), in "
                                     "[0, 1]"),
+    "lc_assertive": Key("lc_assertive", doc="both classes: willingness to accept smaller "
+                                            "gaps when changing lanes, > 0; SUMO divides "
+                                            "the required gap by it (SUMO lcAssertive, "
+                                            "default 1; unset: not written)"),
+    "lc_impatience": Key("lc_impatience", doc="both classes: growth of the willingness to "
+                                              "accept smaller gaps while waiting to change "
+                                              "lanes, in [0, 1] (SUMO lcImpatience, "
+                                              "default 0; unset: not written)"),
     "depart_pos_lat": Key("depart_pos_lat", "string", choices=DEPART_POS_LAT,
                           doc="mainline lateral insertion: fixed columns (HVs at the edges, "
                               "AVs at the centre) or a SUMO departPosLat"),

@@ -126,6 +126,11 @@ CAR_FOLLOWING = {"min_gap_lat_m": 0.6, "depart_pos_lat": "random",
 #: defaults are the scenario's (a 2.6, b 4.5, T 1)
 FLOW_IDM = {"hv_accel_m_s2": 1.0, "hv_decel_m_s2": 1.5, "hv_tau_s": 1.0}
 TREIBER_IDM = {"hv_accel_m_s2": 0.73, "hv_decel_m_s2": 1.67, "hv_tau_s": 1.6}
+#: lane changes that accept smaller gaps, and more so while waiting: without them an IDM
+#: ramp vehicle waits at the acceleration lane's end for a gap that never opens, the main
+#: lane's IDM drivers stand behind its overlap, and the merge gridlocks (seed 100: every
+#: IDM point, at its mapped demand too)
+MERGING = {"lc_assertive": 3, "lc_impatience": 1}
 
 
 def _mapped(name: str, av_share: float = BASE_AV_SHARE, **keys: Any) -> MapPoint:
@@ -171,6 +176,9 @@ POINTS: tuple[MapPoint, ...] = (
     _mapped("idm-flow", hv_model="IDM", **FLOW_IDM),
     _mapped("idm-treiber", hv_model="IDM", **TREIBER_IDM),
     _mapped("eidm", hv_model="EIDM"),
+    _mapped("idm-sumo-lc", hv_model="IDM", **MERGING),
+    _mapped("idm-flow-lc", hv_model="IDM", **FLOW_IDM, **MERGING),
+    _mapped("idm-treiber-lc", hv_model="IDM", **TREIBER_IDM, **MERGING),
 )
 
 

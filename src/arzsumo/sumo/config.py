@@ -113,6 +113,12 @@ class SumoConfig:
         Both classes' eagerness for sublane changes (>= 0), for changes that gain speed
         (>= 0) and their willingness to encroach laterally (in [0, 1]): SUMO's
         ``lcSublane``, ``lcSpeedGain``, ``lcPushy``.
+    lc_assertive, lc_impatience : float or None
+        Both classes' acceptance of smaller lane-change gaps (> 0; SUMO divides the
+        required gap by it) and its growth while they wait (in [0, 1]): SUMO's
+        ``lcAssertive`` and ``lcImpatience``, written only when set. Under IDM a ramp
+        vehicle at the acceleration lane's end can otherwise wait for a gap that never
+        opens, and the merge gridlocks (docs/sumo.md).
     depart_pos_lat : str
         Lateral insertion on the mainline: "columns" (default; fixed columns, two HV
         columns at the lane's edges and one AV column at its centre) or a SUMO
@@ -200,6 +206,8 @@ class SumoConfig:
     lc_sublane: float = 1.0
     lc_speed_gain: float = 0.5
     lc_pushy: float = 0.2
+    lc_assertive: float | None = None
+    lc_impatience: float | None = None
     depart_pos_lat: str = "columns"
     hv_tau: float = 1.0
     hv_action_step: float = 0.0
@@ -241,6 +249,12 @@ class SumoConfig:
         for name in ("ramp_av_share", "green_share", "hv_sigma", "green_share_min",
                      "green_share_max", "lc_pushy"):
             unit(name)
+        if self.lc_assertive is not None:
+            require(math.isfinite(self.lc_assertive) and self.lc_assertive > 0,
+                    "lc_assertive", self.lc_assertive, "a finite number above 0",
+                    ScenarioError)
+        if self.lc_impatience is not None:
+            unit("lc_impatience")
         require(self.green_share_min <= self.green_share_max, "green_share_min",
                 self.green_share_min, f"at most green_share_max = {self.green_share_max}",
                 ScenarioError)

@@ -64,7 +64,10 @@ def vehicle_types(params: ModelParameters, cfg: SumoConfig) -> tuple[VehicleType
     sub = (("latAlignment", cfg.lat_alignment), ("minGapLat", f"{cfg.min_gap_lat:.3f}"),
            ("maxSpeedLat", "1.0"), ("lcSublane", f"{cfg.lc_sublane:g}"),
            ("lcPushy", f"{cfg.lc_pushy:g}"), ("lcStrategic", "1.0"), ("lcKeepRight", "0"),
-           ("lcSpeedGain", f"{cfg.lc_speed_gain:g}"))
+           ("lcSpeedGain", f"{cfg.lc_speed_gain:g}"),
+           *(() if cfg.lc_assertive is None else (("lcAssertive", f"{cfg.lc_assertive:g}"),)),
+           *(() if cfg.lc_impatience is None
+             else (("lcImpatience", f"{cfg.lc_impatience:g}"),)))
     length, gap = _geometry(params.spacing_h)
     if cfg.hv_model == "Krauss":
         hv_model: tuple[tuple[str, str], ...] = (("sigma", f"{cfg.hv_sigma:.3f}"),)
