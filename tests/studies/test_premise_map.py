@@ -150,6 +150,22 @@ def test_the_figure_has_a_cell_per_point_and_gate(tables):
     assert len(ax.texts) == len(pm.MAP_GATES)
 
 
+def test_the_theory_figure_puts_each_points_measurement_beside_its_prediction():
+    import pandas as pd
+
+    from arzsumo.plots.premise_map import theory_figure
+
+    wide = pd.DataFrame({"point": ["a", "b"], "amplification[hv]_value": [0.6, 1.4],
+                         "amplification[av]_value": [0.5, 1.2],
+                         "growth_hv": [float("nan"), 6.0], "growth_av": [16.6, 3.0]})
+    ax = theory_figure(wide).axes[0]
+    lines = {ln.get_label(): ln for ln in ax.lines}
+    assert list(lines["HV measured amplification"].get_xdata()) == [0.6, 1.4]
+    assert list(lines["AV predicted growth max|G|^N"].get_xdata()) == [16.6, 3.0]
+    assert ax.get_xscale() == "log" and [t.get_text() for t in ax.get_yticklabels()] == \
+        ["a", "b"]
+
+
 def test_the_pulse_is_judged_within_the_round_trips_that_fit():
     rows = [r for r in _map_rows() if r["kind"] in ("baseline", "pulse")]
     long, _ = pm.map_tables(rows, [pm.MapPoint("p", "axis", {})], 1000.0,

@@ -1,5 +1,6 @@
 """The premise map's files: ``premise_map.csv`` (per point, seed and gate),
-``premise_map_points.csv`` (per point) and ``premise_map.png``."""
+``premise_map_points.csv`` (per point), ``premise_map.png`` (the gates) and
+``premise_map_theory.png`` (theory beside measurement)."""
 
 from __future__ import annotations
 
@@ -19,9 +20,10 @@ def write_map(out: Path, long: pd.DataFrame, wide: pd.DataFrame, gates: Sequence
              write_csv(wide, out / "premise_map_points.csv")]
     if plots and len(wide):
         from arzsumo.outputs.figures import save_png
-        from arzsumo.plots.premise_map import premise_map_figure
+        from arzsumo.plots.premise_map import premise_map_figure, theory_figure
 
         files.append(save_png(premise_map_figure(wide, gates), out / "premise_map.png"))
+        files.append(save_png(theory_figure(wide), out / "premise_map_theory.png"))
     else:
-        remove_stale_figures(out / "premise_map.png")
+        remove_stale_figures(out / "premise_map.png", out / "premise_map_theory.png")
     return files

@@ -29,3 +29,30 @@ def premise_map_figure(wide: pd.DataFrame, gates: Sequence[str]) -> Figure:
     ax.set_title("premise gates passed (share of seeds), open loop", fontsize=9)
     fig.tight_layout()
     return fig
+
+
+def theory_figure(wide: pd.DataFrame) -> Figure:
+    """Theory beside measurement per point of ``wide``: the measured amplification
+    (upstream over downstream amplitude, filled markers) and the linear prediction of the
+    same ratio, the growth max|G|^N over the section's N vehicles (open markers; none
+    for Krauss), per class, on a log scale with the line of no growth."""
+    y = np.arange(len(wide))
+    fig, ax = plt.subplots(figsize=(7.0, 1.4 + 0.36 * len(wide)))
+    for k, (cls, colour) in enumerate((("hv", "tab:blue"), ("av", "tab:orange"))):
+        dy = (k - 0.5) * 0.25
+        measured = wide.get(f"amplification[{cls}]_value", pd.Series(np.nan, wide.index))
+        theory = wide.get(f"growth_{cls}", pd.Series(np.nan, wide.index))
+        ax.plot(measured.to_numpy(float), y + dy, "o", color=colour,
+                label=f"{cls.upper()} measured amplification")
+        ax.plot(theory.to_numpy(float), y + dy, "o", mfc="none", color=colour,
+                label=f"{cls.upper()} predicted growth max|G|^N")
+    ax.axvline(1.0, color="0.3", lw=0.8, ls="--")
+    ax.set_xscale("log")
+    ax.set_yticks(y, list(wide["point"]), fontsize=8)
+    ax.invert_yaxis()
+    ax.set_xlabel("upstream amplitude / downstream amplitude (> 1: grows upstream)")
+    ax.set_title("theory beside measurement: linear string stability at the measured "
+                 "operating point", fontsize=9)
+    ax.legend(fontsize=7, loc="best")
+    fig.tight_layout()
+    return fig
