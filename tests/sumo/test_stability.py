@@ -30,8 +30,9 @@ def test_sumos_acc_gap_law_is_string_unstable_at_its_default_gains():
     """f_s = 0.23, f_v = -0.23, f_dv = 0.07: f_v^2/2 - f_dv f_v - f_s = -0.187 < 0."""
     pred = predict(PARAMS, _cfg(min_gap_lat_m=0.6), *POINT)["av"]
     assert pred.model == "ACC" and pred.stable is False
-    assert pred.vehicles == pytest.approx(123.0)
-    assert pred.growth == pytest.approx(pred.gain ** 123.0)
+    assert pred.vehicles == pytest.approx(22.0)             # the AVs' own, not all 123
+    assert pred.growth == pytest.approx(pred.gain ** 22.0)
+    assert pred.gain == pytest.approx(1.6974, abs=1e-4)
     # weaker spacing feedback, stronger speed feedback: stable
     calm = predict(PARAMS, _cfg(av_gap_gain_space=0.05, av_gap_gain_speed=2.0), *POINT)["av"]
     assert calm.stable is True and calm.gain == 1.0 and calm.growth == 1.0

@@ -6,7 +6,10 @@ net gap of its lateral file: with F files side by side (as many 2 m vehicles as 
 lane holds at the lateral gap), a file carries (rho_h + rho_a) / F vehicles per metre and
 the net gap is F / (rho_h + rho_a) minus the mean vehicle length. The models' partial
 derivatives there give the largest per-vehicle gain max|G| and the growth max|G|^N over
-the N vehicles of the section (:mod:`arzsumo.evaluation.string_stability`):
+the class's own N vehicles on the section (:mod:`arzsumo.evaluation.string_stability`):
+in a mixed chain each follower multiplies the oscillation by its own gain, so the
+section's growth is G_h^N_h G_a^N_a, each class's column its own factor (counting every
+vehicle as an ACC follower would put the AVs' 1.7 per vehicle to the power of all 123):
 
 * IDM and EIDM (EIDM's core is IDM's: its reaction time and estimation errors, which
   destabilise further, are not in the linear model): a = accel, b = decel, T = tau,
@@ -88,23 +91,22 @@ def predict(params: ModelParameters, cfg: SumoConfig, rho_h: float, rho_a: float
     files = lateral_files(cfg.min_gap_lat, params.vehicle_width)
     mean_length = (rho_h * hv.length + rho_a * av.length) / rho
     gap = files / rho - mean_length
-    vehicles = rho * params.length
+    n_h, n_a = rho_h * params.length, rho_a * params.length
     if gap <= 0:
         why = f"no net gap at {rho * 1000:.0f} veh/km in {files} files"
-        return {c: _prediction(m, None, vehicles, why)
-                for c, m in (("hv", cfg.hv_model), ("av", cfg.av_model))}
+        return {"hv": _prediction(cfg.hv_model, None, n_h, why),
+                "av": _prediction(cfg.av_model, None, n_a, why)}
     if cfg.hv_model == "Krauss":
-        hv_pred = _prediction("Krauss", None, vehicles,
-                              "Krauss is not smooth: no linear prediction")
+        hv_pred = _prediction("Krauss", None, n_h, "Krauss is not smooth: no linear prediction")
     else:
         idm = IdmParameters(cfg.hv_accel, cfg.hv_decel, cfg.hv_tau, hv.min_gap, hv.max_speed,
                             cfg.hv_delta or IDM_DELTA)
-        hv_pred = _prediction(cfg.hv_model, idm_partials(idm, gap, v), vehicles)
+        hv_pred = _prediction(cfg.hv_model, idm_partials(idm, gap, v), n_h)
     k_space = cfg.av_gap_gain_space if cfg.av_gap_gain_space is not None \
         else ACC_GAP_GAIN_SPACE
     k_speed = cfg.av_gap_gain_speed if cfg.av_gap_gain_speed is not None \
         else ACC_GAP_GAIN_SPEED
     acc = Partials(k_space, -k_space * AV_TAU, k_speed) if k_space > 0 else None
-    av_pred = _prediction(cfg.av_model, acc, vehicles,
+    av_pred = _prediction(cfg.av_model, acc, n_a,
                           "" if acc else "gap-control gain 0: no gap feedback")
     return {"hv": hv_pred, "av": av_pred}
