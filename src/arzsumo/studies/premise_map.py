@@ -68,6 +68,7 @@ from arzsumo.studies.premise import (
 )
 from arzsumo.studies.premise_map_points import (
     COUPLED,
+    MAPPING_SEED,
     NAME,
     POINTS,
     MapPoint,
@@ -281,6 +282,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="baselines only (the pulse gate is then not measured)")
     add_runs(parser, seeds="1,2")
     add_output(parser, NAME, PAGE)
+    parser.add_argument("--page", default=PAGE, metavar="NAME",
+                        help=f"the results page --docs regenerates, DIR/NAME.md (default: "
+                             f"{PAGE}; e.g. premise_map_car_following for that axis)")
 
 
 def selected_points(text: str | None) -> list[MapPoint]:
@@ -305,27 +309,15 @@ def run(args: argparse.Namespace) -> int:
     points = selected_points(args.points)
     sc = load_scenario(path)
     opts = PremiseOptions(args.window, args.pulse_s)
-    mapping = discharge_runs(path, points, sc.run.warmup)
     if args.list:
         runs = map_runs(path, points, args.seeds, sc.run.warmup, opts,
                         pulses=not args.no_pulse)
+        mapping = discharge_runs(path, points, sc.run.warmup)
         return print_list([r.run_id for r in mapping + runs])
     with resumable_dir(args.out, f"study-{NAME}") as out:
-        discharges: dict[str, float] = {}
-        stuck: list[str] = []
-        if mapping:
-            found = run_design(mapping, discharge_task, out, workers=args.workers,
-                               scheduler=args.scheduler, progress=not args.quiet,
-                               label=f"{NAME} discharge")
-            second = run_design(discharge_runs(path, points, sc.run.warmup,
-                                               flowing(found)),
-                                discharge_task, out, workers=args.workers,
-                                scheduler=args.scheduler, progress=not args.quiet,
-                                label=f"{NAME} discharge at the mapped demand")
-            discharges = flowing(second)
-            stuck = [p.name for p in points if p.mapped and p.name not in discharges]
-            print(mapping_lines(found, second))
-        points = mapped_points([p for p in points if p.name not in stuck], discharges)
+        discharges, mapped_text = _map_demands(args, path, points, sc.run.warmup, out)
+        points = mapped_points([p for p in points if not p.mapped or p.name in discharges],
+                               discharges)
         runs = map_runs(path, points, args.seeds, sc.run.warmup, opts,
                         pulses=not args.no_pulse)
         rows = ungrouped(run_design(grouped(runs), _task, out, workers=args.workers,
@@ -339,21 +331,46 @@ def run(args: argparse.Namespace) -> int:
         wide["discharge_veh_h"] = [discharges.get(n, math.nan) * VEH_H_PER_VEH_S
                                    for n in wide["point"]] if len(wide) else []
         files = write_map(out, long, wide, MAP_GATES, plots=plots_wanted(args))
-        text = map_markdown(wide)
         if args.docs is not None:
-            publish(args.docs, PAGE, NAME, "The premise map",
-                    "Share of seeds on which each premise gate passed, per point of the "
-                    f"map, and the measured means (`arzsumo study {NAME}`). Tables: "
-                    f"[premise_map_points.csv]({PAGE}/premise_map_points.csv), "
-                    f"[premise_map.csv]({PAGE}/premise_map.csv).\n\n{text}\n\n"
-                    "Theory beside measurement: the measured amplification per class "
-                    "(upstream over downstream amplitude) and the linear string-stability "
-                    "prediction at the measured operating point (largest gain per "
-                    "vehicle, growth over the section's vehicles; none for Krauss).\n\n"
-                    f"{theory_markdown(wide)}", files)
-    print(text)
+            publish(args.docs, args.page, NAME, "The premise map",
+                    _page_body(args.page, wide, mapped_text), files)
+    print(map_markdown(wide))
     print(theory_markdown(wide))
     return 0
+
+
+def _map_demands(args: argparse.Namespace, path: Path, points: Sequence[MapPoint],
+                 warmup: float, out: Path) -> tuple[dict[str, float], str]:
+    """The mapped points' two discharge runs: (point -> q(L), veh/s, for the points
+    whose merge did not gridlock; the mapping's lines)."""
+    mapping = discharge_runs(path, points, warmup)
+    if not mapping:
+        return {}, ""
+    kw = {"workers": args.workers, "scheduler": args.scheduler, "progress": not args.quiet}
+    found = run_design(mapping, discharge_task, out, label=f"{NAME} discharge", **kw)
+    second = run_design(discharge_runs(path, points, warmup, flowing(found)),
+                        discharge_task, out, label=f"{NAME} discharge at the mapped demand",
+                        **kw)
+    text = mapping_lines(found, second)
+    print(text)
+    return flowing(second), text
+
+
+def _page_body(page: str, wide: pd.DataFrame, mapped_text: str) -> str:
+    """The results page's generated block: the gates' table, theory beside
+    measurement, and the mapping's discharge readings."""
+    mapping = (f"\n\nThe mapping's discharge runs (seed {MAPPING_SEED}):\n\n"
+               + "\n".join(f"- {line}" for line in mapped_text.splitlines())
+               if mapped_text else "")
+    return ("Share of seeds on which each premise gate passed, per point of the map, and "
+            f"the measured means (`arzsumo study {NAME}`). Tables: "
+            f"[premise_map_points.csv]({page}/premise_map_points.csv), "
+            f"[premise_map.csv]({page}/premise_map.csv).\n\n{map_markdown(wide)}\n\n"
+            "Theory beside measurement: the measured amplification per class (upstream "
+            "over downstream amplitude) and the linear string-stability prediction at the "
+            "measured operating point (largest gain per vehicle, growth over the class's "
+            f"own vehicles on the section; none for Krauss).\n\n{theory_markdown(wide)}"
+            + mapping)
 
 
 def _task(run: StudyRun) -> dict[str, Any]:

@@ -249,12 +249,7 @@ class SumoConfig:
         for name in ("ramp_av_share", "green_share", "hv_sigma", "green_share_min",
                      "green_share_max", "lc_pushy"):
             unit(name)
-        if self.lc_assertive is not None:
-            require(math.isfinite(self.lc_assertive) and self.lc_assertive > 0,
-                    "lc_assertive", self.lc_assertive, "a finite number above 0",
-                    ScenarioError)
-        if self.lc_impatience is not None:
-            unit("lc_impatience")
+        self._check_gap_acceptance()
         require(self.green_share_min <= self.green_share_max, "green_share_min",
                 self.green_share_min, f"at most green_share_max = {self.green_share_max}",
                 ScenarioError)
@@ -345,6 +340,17 @@ class SumoConfig:
     def steps_per_period(self) -> int:
         """SUMO steps per control period."""
         return round(self.control_period / self.step_length)
+
+    def _check_gap_acceptance(self) -> None:
+        """``lc_assertive`` > 0 and ``lc_impatience`` in [0, 1] where set."""
+        if self.lc_assertive is not None:
+            require(math.isfinite(self.lc_assertive) and self.lc_assertive > 0,
+                    "lc_assertive", self.lc_assertive, "a finite number above 0",
+                    ScenarioError)
+        if self.lc_impatience is not None:
+            require(isinstance(self.lc_impatience, int | float)
+                    and 0.0 <= self.lc_impatience <= 1.0, "lc_impatience",
+                    self.lc_impatience, "a number in [0, 1]", ScenarioError)
 
     def with_(self, **changes: Any) -> SumoConfig:
         """A copy with some fields changed (validated again)."""
