@@ -233,3 +233,31 @@ def test_a_gridlocked_discharge_run_leaves_its_point_out_and_says_so():
                        "(99% inserted) at the demand it maps to")
     assert text[1].startswith("b: discharge 0 veh/h") and "gridlocked" in text[1]
     assert "gridlocked" in text[2]
+
+
+def test_the_fill_lacked_the_vehicles_between_the_tail_and_the_margin():
+    """A tail 300 m into the section, free cells at 16 m/s, congested ones at 8 m/s,
+    q = 0.7 veh/s: (300 + 200) m x 0.7 (1/8 - 1/16) veh/m = 21.9 vehicles over 600 s."""
+    x = np.arange(20) * 50.0 + 25.0
+    v = np.where(x < 300.0, 16.0, 8.0)[None, :].repeat(60, axis=0)
+    want = 500.0 * 0.7 * (1 / 8 - 1 / 16) / 600.0
+    assert pmp.fill_shortfall(x, v, 300.0, 0.7, 600.0) == pytest.approx(want)
+    assert pmp.fill_shortfall(x, v, 0.0, 0.7, 600.0) == 0.0
+    d = pmp.mapped_demand(0.7, 0.18, fill_extra_veh_s=want)
+    base = pmp.mapped_demand(0.7, 0.18)
+    assert d["demand_h_veh_h"] == base["demand_h_veh_h"]                  # hold unchanged
+    fill = d["fill_demand_h_veh_h"] + d["fill_demand_a_veh_h"]
+    assert fill == pytest.approx(1.14 * 2520 + want * 3600, abs=1)
+
+
+def test_the_map_reports_the_queue_tail_of_its_worst_seed():
+    rows = _map_rows()
+    for r in rows:
+        if r["kind"] == "baseline" and r["seed"] == 2:
+            v = np.array(r["v_hv"], float)
+            v[:, :4] = 3 * np.nanmean(v)                 # the first 4 cells ride free
+            r["v_hv"] = v.tolist()
+    _, wide = pm.map_tables(rows, [pm.MapPoint("p", "axis", {})], 1000.0,
+                            fallback_trip=100.0)
+    dx = rows[0]["dx_m"]
+    assert wide["queue_tail_m"].iloc[0] == pytest.approx(4 * dx)

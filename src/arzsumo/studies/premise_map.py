@@ -40,6 +40,7 @@ import pandas as pd
 
 from arzsumo.evaluation.premise import GateResult, PremiseThresholds
 from arzsumo.evaluation.premise.instability import round_trip_time
+from arzsumo.evaluation.premise.queue_tail import queue_tail
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.premise_map import write_map
 from arzsumo.outputs.studies import markdown_table, publish
@@ -195,7 +196,10 @@ def _pulse(base: Mapping[str, Any], pulse: Mapping[str, Any], cls: Sequence[str]
 
 def point_measures(rows: Mapping[int, Mapping[str, Mapping[str, Any]]]) -> dict[str, float]:
     """The baselines' means over seeds: class speeds (km/h), densities (veh/km) and the
-    mainline outflow q(L) (veh/h)."""
+    mainline outflow q(L) (veh/h); and the largest queue tail over seeds (m: the free
+    stretch from x = 0, :func:`~arzsumo.evaluation.premise.queue_tail.queue_tail`; the
+    amplification of a seed with a tail reads the passage from free to congested
+    traffic, not a wave's growth)."""
     base = [r["baseline"] for r in rows.values()]
 
     def mean(key: str) -> float:    # stored rows hold NaN as None
@@ -208,6 +212,8 @@ def point_measures(rows: Mapping[int, Mapping[str, Mapping[str, Any]]]) -> dict[
         out[f"v_{c}_kmh"] = float(ms_to_kmh(mean(f"v_{c}")))
         out[f"rho_{c}_veh_km"] = mean(f"rho_{c}_veh_m") * VEH_KM_PER_VEH_M
     out["q_out_veh_h"] = mean("outflow_veh_s") * VEH_H_PER_VEH_S
+    out["queue_tail_m"] = max(queue_tail(np.array(b["x_m"], float),
+                                         np.array(b["v_hv"], float)) for b in base)
     return out
 
 
@@ -315,9 +321,10 @@ def run(args: argparse.Namespace) -> int:
         mapping = discharge_runs(path, points, sc.run.warmup)
         return print_list([r.run_id for r in mapping + runs])
     with resumable_dir(args.out, f"study-{NAME}") as out:
-        discharges, mapped_text = _map_demands(args, path, points, sc.run.warmup, out)
+        discharges, shortfalls, mapped_text = _map_demands(args, path, points,
+                                                           sc.run.warmup, out)
         points = mapped_points([p for p in points if not p.mapped or p.name in discharges],
-                               discharges)
+                               discharges, shortfalls)
         runs = map_runs(path, points, args.seeds, sc.run.warmup, opts,
                         pulses=not args.no_pulse)
         rows = ungrouped(run_design(grouped(runs), _task, out, workers=args.workers,
@@ -340,12 +347,14 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _map_demands(args: argparse.Namespace, path: Path, points: Sequence[MapPoint],
-                 warmup: float, out: Path) -> tuple[dict[str, float], str]:
+                 warmup: float, out: Path
+                 ) -> tuple[dict[str, float], dict[str, float], str]:
     """The mapped points' two discharge runs: (point -> q(L), veh/s, for the points
-    whose merge did not gridlock; the mapping's lines)."""
+    whose merge did not gridlock; point -> the fill's shortfall, veh/s; the mapping's
+    lines)."""
     mapping = discharge_runs(path, points, warmup)
     if not mapping:
-        return {}, ""
+        return {}, {}, ""
     kw = {"workers": args.workers, "scheduler": args.scheduler, "progress": not args.quiet}
     found = run_design(mapping, discharge_task, out, label=f"{NAME} discharge", **kw)
     second = run_design(discharge_runs(path, points, warmup, flowing(found)),
@@ -353,7 +362,8 @@ def _map_demands(args: argparse.Namespace, path: Path, points: Sequence[MapPoint
                         **kw)
     text = mapping_lines(found, second)
     print(text)
-    return flowing(second), text
+    return flowing(second), {r["point"]: float(r.get("fill_shortfall_veh_s", 0.0))
+                             for r in second}, text
 
 
 def _page_body(page: str, wide: pd.DataFrame, mapped_text: str) -> str:
@@ -394,7 +404,8 @@ def theory_markdown(wide: pd.DataFrame) -> str:
     mapped point, its measured discharge."""
     cols = ["point", "amplification[hv]_value", "gain_hv", "growth_hv",
             "amplification[av]_value", "gain_av", "growth_av", "waves[hv]_value",
-            "v_hv_kmh", "rho_hv_veh_km", "rho_av_veh_km", "q_out_veh_h", "discharge_veh_h"]
+            "queue_tail_m", "v_hv_kmh", "rho_hv_veh_km", "rho_av_veh_km", "q_out_veh_h",
+            "discharge_veh_h"]
     table = wide[[c for c in cols if c in wide]].copy()
     if "waves[hv]_value" in table:
         table["waves[hv]_value"] = ms_to_kmh(table["waves[hv]_value"])

@@ -24,6 +24,9 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
+from arzsumo.evaluation.premise.queue_tail import queue_tail
 from arzsumo.studies.common import StudyError, study_spec
 from arzsumo.studies.design import StudyRun, design_runs
 from arzsumo.studies.premise_runs import run_premise_task
@@ -33,6 +36,10 @@ NAME = "premise-map"
 #: the least section outflow a discharge run must measure for its point to be mapped:
 #: below it the merge has gridlocked (veh/s)
 MIN_DISCHARGE_VEH_S = 360.0 / VEH_H_PER_VEH_S
+#: the queue's tail is read over the window's first minute (the state the fill left)
+TAIL_READ_S = 60.0
+#: where the corrected fill aims the queue's tail: this far upstream of x = 0 (m)
+TAIL_MARGIN_M = 200.0
 #: the mapping's hold and fill demands over the measured discharge
 HOLD_RATIO, FILL_RATIO = 1.01, 1.14
 #: the seed of the discharge runs: no gate reads it
@@ -81,14 +88,17 @@ def demand(av_share: float, hold: float = 3900.0, fill: float = 4400.0) -> dict[
             "fill_demand_a_veh_h": round(fill * av_share)}
 
 
-def mapped_demand(discharge_veh_s: float, av_share: float) -> dict[str, float]:
+def mapped_demand(discharge_veh_s: float, av_share: float,
+                  fill_extra_veh_s: float = 0.0) -> dict[str, float]:
     """The mapping rule: hold and fill (veh/h, scenario keys) of a measured section
-    discharge q(L) (veh/s), :data:`HOLD_RATIO` and :data:`FILL_RATIO` times it."""
+    discharge q(L) (veh/s), :data:`HOLD_RATIO` and :data:`FILL_RATIO` times it, the fill
+    raised by ``fill_extra_veh_s`` (the shortfall a run at this rule measured)."""
     if not (math.isfinite(discharge_veh_s) and discharge_veh_s > 0):
         raise StudyError(f"a discharge of {discharge_veh_s!r} veh/s cannot be mapped: the "
                          "discharge run measured no outflow")
     q = discharge_veh_s * VEH_H_PER_VEH_S
-    return demand(av_share, HOLD_RATIO * q, FILL_RATIO * q)
+    return demand(av_share, HOLD_RATIO * q,
+                  FILL_RATIO * q + fill_extra_veh_s * VEH_H_PER_VEH_S)
 
 
 def discharge_point(p: MapPoint) -> MapPoint:
@@ -99,9 +109,10 @@ def discharge_point(p: MapPoint) -> MapPoint:
                                         demand(p.av_share, total, total).items()}})
 
 
-def with_discharge(p: MapPoint, discharge_veh_s: float) -> MapPoint:
+def with_discharge(p: MapPoint, discharge_veh_s: float,
+                   fill_extra_veh_s: float = 0.0) -> MapPoint:
     """``p`` with the demand :func:`mapped_demand` sets from its discharge (veh/s)."""
-    keys = mapped_demand(discharge_veh_s, p.av_share)
+    keys = mapped_demand(discharge_veh_s, p.av_share, fill_extra_veh_s)
     return replace(p, set={**p.set, **{f"sumo.{k}": v for k, v in keys.items()}})
 
 
@@ -214,15 +225,19 @@ def discharge_runs(path: Path, points: Sequence[MapPoint], warmup: float,
             runs.append(replace(r, run_id=f"point={p.name},{r.run_id},kind={kind}",
                                 columns={"point": p.name, "axis": p.axis, **r.columns},
                                 options={"kind": "baseline", "window_s": DISCHARGE_WINDOW_S,
-                                         "horizon_periods": n}))
+                                         "horizon_periods": n,
+                                         **({} if first is None else {"reads": "tail"})}))
     return runs
 
 
-def mapped_points(points: Sequence[MapPoint], discharges: Mapping[str, float]
-                  ) -> list[MapPoint]:
+def mapped_points(points: Sequence[MapPoint], discharges: Mapping[str, float],
+                  shortfalls: Mapping[str, float] | None = None) -> list[MapPoint]:
     """``points`` with every mapped point's demand set from its measured discharge
-    (``discharges``: point name -> q(L), veh/s)."""
-    return [with_discharge(p, discharges[p.name]) if p.mapped else p for p in points]
+    (``discharges``: point name -> q(L), veh/s) and its fill raised by the shortfall its
+    run at the rule measured (``shortfalls``: point name -> veh/s)."""
+    extra = shortfalls or {}
+    return [with_discharge(p, discharges[p.name], extra.get(p.name, 0.0)) if p.mapped
+            else p for p in points]
 
 
 def flowing(rows: Sequence[Mapping[str, Any]]) -> dict[str, float]:
@@ -250,13 +265,43 @@ def mapping_lines(first: Sequence[Mapping[str, Any]],
             tail = "gridlocked: no operating point, left out of the gates"
         else:
             tail = f"{reading(b)} at the demand it maps to"
+            if b.get("queue_tail_m", 0.0) > 0:
+                tail += (f", queue tail {b['queue_tail_m']:.0f} m into the section: fill "
+                         f"+{b['fill_shortfall_veh_s'] * VEH_H_PER_VEH_S:.0f} veh/h")
         lines.append(f"{a['point']}: discharge {reading(a)} held above it; {tail}")
     return "\n".join(lines)
 
 
 def discharge_task(run: StudyRun) -> dict[str, Any]:
-    """A discharge run: its section outflow q(L) (veh/s) and what it inserted."""
+    """A discharge run: its section outflow q(L) (veh/s), what it inserted, and where
+    the queue's tail stood at the warm-up's end with the fill it lacked
+    (:func:`fill_shortfall`)."""
+    from arzsumo.scenario import scenario_from_dict
+
     row = run_premise_task(run)
-    return {"point": run.columns["point"], "outflow_veh_s": row["outflow_veh_s"],
+    q = float(row["outflow_veh_s"])
+    x, v = np.array(row["x_m"], float), np.array(row["v_hv"], float)
+    start = v[:round(TAIL_READ_S / float(row["period_s"]))]
+    fill_s = scenario_from_dict(run.scenario, run.source).sumo.fill_duration
+    tail = queue_tail(x, start)
+    return {"point": run.columns["point"], "outflow_veh_s": q,
             "inserted_main": row["inserted_main"], "requested_main": row["requested_main"],
-            "rho_hv_veh_m": row["rho_hv_veh_m"], "rho_av_veh_m": row["rho_av_veh_m"]}
+            "rho_hv_veh_m": row["rho_hv_veh_m"], "rho_av_veh_m": row["rho_av_veh_m"],
+            "queue_tail_m": tail,
+            "fill_shortfall_veh_s": fill_shortfall(x, start, tail, q, fill_s)}
+
+
+def fill_shortfall(x: np.ndarray, v: np.ndarray, tail: float, q: float,
+                   fill_s: float) -> float:
+    """The fill flow (veh/s) the fill lacked to bring the queue's tail ``tail`` (m inside
+    the section) to :data:`TAIL_MARGIN_M` upstream of x = 0: the stretch times the
+    density step between the congested and the free cells, q (1 / v_c - 1 / v_f), over
+    the fill's ``fill_s`` (s); 0 when the section was congested to x = 0."""
+    if tail <= 0 or fill_s <= 0:
+        return 0.0
+    with np.errstate(invalid="ignore"):
+        means = np.nanmean(v, axis=0)
+    v_f, v_c = np.nanmean(means[x < tail]), np.nanmean(means[x >= tail])
+    if not (np.isfinite(v_f) and np.isfinite(v_c) and v_f > v_c > 0):
+        return 0.0
+    return float((tail + TAIL_MARGIN_M) * q * (1 / v_c - 1 / v_f) / fill_s)

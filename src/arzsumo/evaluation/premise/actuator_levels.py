@@ -61,15 +61,16 @@ class LevelFit:
 def hold_levels(t: np.ndarray, q: np.ndarray, r: np.ndarray, step_times: Sequence[float],
                 settle_s: float = SETTLE_S) -> tuple[np.ndarray, np.ndarray]:
     """(q, r) per hold, lead-in first: the means over each hold's bins that end more
-    than ``settle_s`` after it starts (bin ends ``t``, s; bin means q, r, veh/s)."""
+    than ``settle_s`` (at most half the hold) after it starts (bin ends ``t``, s; bin
+    means q, r, veh/s)."""
     dt = float(t[1] - t[0])
     edges = (float(t[0]) - dt, *step_times, float(t[-1]))
     qs, rs = [], []
     for start, end in pairwise(edges):
-        m = (t > start + settle_s + 1e-9) & (t <= end + 1e-9)
-        require(int(m.sum()) >= 2, "settle_s", settle_s,
-                f"a settling time that leaves two bins of the hold ({start:g}, {end:g}] s",
-                PremiseError)
+        settle = min(settle_s, (end - start) / 2)        # a short hold: its second half
+        m = (t > start + settle + 1e-9) & (t <= end + 1e-9)
+        require(int(m.sum()) >= 2, "step_times", f"a hold ({start:g}, {end:g}] s",
+                "holds of at least four bins", PremiseError)
         qs.append(float(q[m].mean()))
         rs.append(float(r[m].mean()))
     return np.array(qs), np.array(rs)
