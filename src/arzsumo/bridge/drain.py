@@ -53,7 +53,7 @@ def drain(plant: SumoPlant, limit: float) -> Drained:
     t_end = sim.time
     plant.end_window()
     arrived, last_arrival, gridlock = sim.arrived, t_end, False
-    while sim.time - t_end < limit - 1e-9 and sim.lib.simulation.getMinExpectedNumber() > 0:
+    while sim.time - t_end < limit - 1e-9 and plant.expected() > 0:
         plant.step()
         if sim.arrived > arrived:
             arrived, last_arrival = sim.arrived, sim.time

@@ -180,6 +180,10 @@ class SumoPlant:
         m = self.advance()
         return m, self.meter.state()
 
+    def expected(self) -> int:
+        """Vehicles on the network or still to come (SUMO's ``getMinExpectedNumber``)."""
+        return int(self.sim.lib.simulation.getMinExpectedNumber())
+
     def start_window(self, t: float) -> tuple[dict[str, Any], WindowStart]:
         """Open the control window at ``t`` (s): the meter's and the stop line's counts
         since the start (they count anew from now) and the system's state now."""
