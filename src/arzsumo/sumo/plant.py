@@ -1,18 +1,20 @@
 """SUMO as the closed loop's plant: the simulation, its sensor and its meter, stepped as one.
 
 :meth:`SumoPlant.step` is the one step loop of every run: SUMO advances one step, the
-sensor reads it (the only reader of libsumo while SUMO steps) and hands the meter its
-reading; the meter sets the light for the next step. The warm-up, the control window
-(:meth:`SumoPlant.advance`, one control period) and the drain after the window
-(:func:`arzsumo.bridge.drain.drain`) all run through it.
+sensor reads it (the only reader of libsumo while SUMO steps, but for what an open-loop
+run asks to read beside it, :mod:`arzsumo.sumo.period_reads`) and hands the meter its
+reading; the meter sets the light for the next step. The warm-up and the open-loop runs
+(:meth:`SumoPlant.run_open_loop`), the control window (:meth:`SumoPlant.advance`, one
+control period) and the drain after the window (:func:`arzsumo.bridge.drain.drain`) all
+run through it.
 
 :meth:`SumoPlant.run_open_loop` is the one open-loop driver: control periods under a
 schedule of plans, a hook called at each period's end with the period's data
 (:class:`~arzsumo.sumo.period_reads.OpenLoopPeriod`: the sensor's measurement and what
-the run asked to read beside it). Calibration's fixed-plan runs
-(:func:`arzsumo.sumo.runner.run_fixed_meter`), the loop curve and the open-loop studies
-(approach, meter dynamics, premise) run through it; none of them holds the open run's
-module.
+the run asked to read beside it). The closed loop's warm-up, calibration's fixed-plan
+runs (:func:`arzsumo.sumo.runner.run_fixed_meter`), the loop curve and the open-loop
+studies (approach and fill, meter dynamics, premise) run through it; none of them holds
+the open run's module.
 """
 
 from __future__ import annotations
