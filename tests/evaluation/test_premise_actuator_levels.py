@@ -104,7 +104,7 @@ def test_too_few_levels_give_no_interval_and_fail():
 
 def test_a_settling_time_longer_than_a_hold_keeps_the_holds_second_half():
     rec = _staircase(-1.0, -1.0, hold=40.0, delay=2.0, tau=1.0)
-    q, r = hold_levels(rec.t, rec.q, rec.r, rec.step_times, settle_s=200.0)
+    q, _ = hold_levels(rec.t, rec.q, rec.r, rec.step_times, settle_s=200.0)
     assert len(q) == 9 and actuator_gate(rec).detail["levels"]["up"]["gain"] == \
         pytest.approx(-1.0, abs=1e-6)
     with pytest.raises(PremiseError, match="estimator = 'mean' is not allowed"):

@@ -11,7 +11,7 @@ X = np.arange(20) * 50.0 + 25.0                        # 1 km in 50 m cells
 
 def _field(tail_m: float, free=16.0, jam=7.0, periods=60, seed=0):
     rng = np.random.default_rng(seed)
-    v = np.where(X < tail_m, free, jam)[None, :] + rng.normal(0, 1.0, (periods, X.size))
+    v = np.where(tail_m > X, free, jam)[None, :] + rng.normal(0, 1.0, (periods, X.size))
     return v
 
 

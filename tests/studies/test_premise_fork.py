@@ -62,10 +62,10 @@ def test_a_killed_child_runs_again_alone_and_nothing_is_left(plain, monkeypatch,
     monkeypatch.setenv("ARZSUMO_SCRATCH_DIR", str(tmp_path))
     parent, branch = os.getpid(), pr._branch
 
-    def dies_in_the_pulse_child(sc, sim, plant, t0, opt, warm_s):
+    def dies_in_the_pulse_child(sc, plant, t0, opt, warm_s):
         if os.getpid() != parent and opt["kind"] == "pulse":
             os.kill(os.getpid(), signal.SIGKILL)
-        return branch(sc, sim, plant, t0, opt, warm_s)
+        return branch(sc, plant, t0, opt, warm_s)
 
     monkeypatch.setattr(pr, "_branch", dies_in_the_pulse_child)
     # an earlier test in this process may have left an idle thread (Dask's offload

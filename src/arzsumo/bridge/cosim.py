@@ -80,6 +80,7 @@ from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.green_share import DEFAULT_CURVE, GreenShareCurve
 from arzsumo.sumo.network_measures import network_options
 from arzsumo.sumo.paths import scratch_dir
+from arzsumo.sumo.period_reads import OpenLoopPeriod
 from arzsumo.sumo.plant import SumoPlant
 from arzsumo.sumo.run_files import FCD_FILE, RunFiles
 from arzsumo.sumo.sensor import PeriodMeasurement
@@ -112,11 +113,17 @@ def check_before_start(settings: RunSettings, eq: Equilibrium, at: str | None = 
 
 def warm_up(plant: SumoPlant, warmup: float, period: float,
             bar: Progress | RunProgress) -> list[PeriodMeasurement]:
-    """``warmup`` seconds (rounded up to whole periods, at least one) at the nominal plan."""
-    out = []
-    for _ in range(max(1, math.ceil(warmup / period - 1e-9))):
-        out.append(plant.advance())
-        bar.update(out[-1].t)
+    """``warmup`` seconds (rounded up to whole periods, at least one) at the nominal plan:
+    the open loop (:meth:`~arzsumo.sumo.plant.SumoPlant.run_open_loop`), every period's
+    measurement."""
+    out: list[PeriodMeasurement] = []
+
+    def keep(p: OpenLoopPeriod) -> None:
+        if p.measurement is not None:      # the closed loop's sensor always measures
+            out.append(p.measurement)
+            bar.update(p.t)
+
+    plant.run_open_loop(max(1, math.ceil(warmup / period - 1e-9)), keep)
     return out
 
 

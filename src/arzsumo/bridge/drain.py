@@ -56,12 +56,12 @@ def drain(plant: SumoPlant, limit: float, bar: RunProgress | None = None) -> Dra
     t_end = sim.time
     plant.end_window()
     arrived, last_arrival, gridlock = sim.arrived, t_end, False
-    left = sim.lib.simulation.getMinExpectedNumber()
+    left = plant.expected()
     if bar is not None:
         bar.enter(DRAIN, work=left)
     while sim.time - t_end < limit - 1e-9 and left > 0:
         plant.step()
-        left = sim.lib.simulation.getMinExpectedNumber()
+        left = plant.expected()
         if bar is not None:
             bar.update(bar.timer.phase.work - left)
         if sim.arrived > arrived:

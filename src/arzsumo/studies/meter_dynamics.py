@@ -89,7 +89,8 @@ def design(seeds: list[int], warmup: float = 600.0, base: float = 60.0,
 def run_steps(run: StudyRun) -> dict[str, Any]:
     """One open-loop run with the green-share steps: its per-second rows and report."""
     from arzsumo.scenario import scenario_from_dict
-    from arzsumo.sumo.network import RAMP_DN
+    from arzsumo.sumo.network import MAIN
+    from arzsumo.sumo.period_reads import OpenLoopPeriod, OpenLoopReads
     from arzsumo.sumo.plant import SumoPlant
     from arzsumo.sumo.simulation import open_simulation
 
@@ -99,33 +100,27 @@ def run_steps(run: StudyRun) -> dict[str, Any]:
     cfg = sc.sumo.with_(horizon=warmup + sc.sumo.horizon)
     plan = schedule(warmup, opt["base_s"], opt["greens"], opt["hold_s"])
     rows: list[dict[str, Any]] = []
+
+    def keep(p: OpenLoopPeriod) -> None:
+        m = p.measurement
+        if m is None or m.t <= warmup - LEAD_S + 1e-9:
+            return
+        c = m.cells
+        rows.append({"seed": cfg.seed, "t_s": round(c.t, 3),
+                     "g_req": plan[0][1] if p.plan is None else p.plan,
+                     "g_run": p.meter.green_share,
+                     "out_h_veh": round(c.outflow_h * c.window),
+                     "out_a_veh": round(c.outflow_a * c.window),
+                     "in_h_veh": round(c.inflow_h * c.window),
+                     "in_a_veh": round(c.inflow_a * c.window), "ramp_veh": p.ramp_passed,
+                     "n_main_veh": p.vehicles[MAIN], "ramp_queue_veh": m.ramp_queue})
+
     with open_simulation(sc.params, cfg) as sim:
         plant = SumoPlant(sim, sc.params.length, cfg)   # the fixed cycle: cfg's mode
-        meter = plant.meter
-        prev_dn: set[str] = set()
-        ramp, g_req = 0, 0.5
-        while sim.time < cfg.horizon - 1e-9:
-            for start, g in plan:    # asked half a cycle early: runs from ``start``
-                if abs(sim.time - (start - cfg.meter_cycle / 2)) < cfg.step_length / 2:
-                    g_req = g
-                    meter.set_green_share(g)
-            got = plant.step()
-            dn = set(sim.lib.edge.getLastStepVehicleIDs(RAMP_DN))
-            ramp += len(dn - prev_dn)
-            prev_dn = dn
-            if got is None:
-                continue
-            c = got.cells
-            if c.t > warmup - LEAD_S + 1e-9:
-                rows.append({"seed": cfg.seed, "t_s": round(c.t, 3), "g_req": g_req,
-                             "g_run": meter.green_share,
-                             "out_h_veh": round(c.outflow_h * c.window),
-                             "out_a_veh": round(c.outflow_a * c.window),
-                             "in_h_veh": round(c.inflow_h * c.window),
-                             "in_a_veh": round(c.inflow_a * c.window), "ramp_veh": ramp,
-                             "n_main_veh": sim.lib.edge.getLastStepVehicleNumber("main"),
-                             "ramp_queue_veh": got.ramp_queue})
-            ramp = 0
+        # each plan asked half a cycle early: it runs from ``start``, the next cycle start
+        plant.run_open_loop(on_period=keep, until=cfg.horizon, green_shares=True,
+                            plans=[(start - cfg.meter_cycle / 2, g) for start, g in plan],
+                            reads=OpenLoopReads(edges=(MAIN,), ramp_passed=True))
     rep = sim.report
     return {"series": rows, "info": {"seed": cfg.seed, "wall_s": time.perf_counter() - t0,
                                      "collisions": rep.collisions,

@@ -79,15 +79,6 @@ def regime(params: Any, rho_h: float, rho_a: float) -> tuple[float, str]:
     return lam4, "congested" if lam4 < 0 else "free"
 
 
-def queue_end(lib: Any, length: float) -> tuple[int, float]:
-    """Vehicles on the approach and its queue length (m from x = 0 to the farthest
-    upstream vehicle slower than :data:`QUEUED_KMH`)."""
-    ids = lib.edge.getLastStepVehicleIDs("approach")
-    slow = [lib.vehicle.getLanePosition(v) for v in ids
-            if lib.vehicle.getSpeed(v) < kmh_to_ms(QUEUED_KMH)]
-    return len(ids), (length - min(slow)) if slow else 0.0
-
-
 def initial_vehicles(params: Any, cfg: Any) -> list[Any]:
     """A uniform congested section at INIT_RHO_H / INIT_RHO_A and INIT_V_KMH."""
     from arzsumo.sumo.placement import place_vehicles
@@ -104,21 +95,25 @@ def open_loop(params: Any, cfg: Any, warmup: float, initial: list[Any] | None = 
               ) -> tuple[list[Any], list[int], tuple[int, float], int, Any]:
     """One open-loop run (nominal fixed-cycle meter) to ``cfg.horizon`` s: the Edie cells
     and approach counts of every period after ``warmup`` s, the approach's vehicles and
-    queue (m) and the ramp queue at the end, and SUMO's run report."""
+    queue (m from x = 0 to the farthest upstream vehicle slower than :data:`QUEUED_KMH`)
+    and the ramp queue at the end, and SUMO's run report."""
+    from arzsumo.sumo.network import APPROACH
+    from arzsumo.sumo.period_reads import OpenLoopPeriod, OpenLoopReads
     from arzsumo.sumo.plant import SumoPlant
     from arzsumo.sumo.simulation import open_simulation
 
     cells, n_app = [], []
+
+    def keep(p: OpenLoopPeriod) -> None:
+        if p.measurement is not None and p.t > warmup + 1e-9:
+            cells.append(p.measurement.cells)
+            n_app.append(p.vehicles[APPROACH])
+
+    reads = OpenLoopReads(edges=(APPROACH,), queued_below=kmh_to_ms(QUEUED_KMH))
     with open_simulation(params, cfg, initial=initial or []) as sim:
         plant = SumoPlant(sim, params.length, cfg)     # the fixed cycle: cfg's mode
-        while sim.time < cfg.horizon - 1e-9:
-            got = plant.step()
-            if got is not None and got.t > warmup + 1e-9:
-                cells.append(got.cells)
-                n_app.append(sim.lib.edge.getLastStepVehicleNumber("approach"))
-        end = queue_end(sim.lib, cfg.approach_length)
-        ramp_q = plant.sensor.queue
-    return cells, n_app, end, ramp_q, sim.report
+        end = plant.run_open_loop(on_period=keep, until=cfg.horizon, reads=reads)
+    return cells, n_app, end.approach, end.ramp_queue, sim.report
 
 
 def summarise(cells: list[Any], dx: float) -> dict[str, float]:

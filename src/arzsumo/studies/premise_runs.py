@@ -4,7 +4,8 @@ Per seed three open-loop runs of the scenario that share one warm-up (``[run]
 warmup_s``, the fill phase ``[sumo] fill_s`` included) under the nominal meter plan: the
 warm-up runs once, and each run's window runs in a child process forked at its end
 (:mod:`arzsumo.sumo.fork`; bit for bit what three separate runs give), all through the
-one step loop :class:`~arzsumo.sumo.plant.SumoPlant`:
+one step loop :class:`~arzsumo.sumo.plant.SumoPlant` (the windows through its open-loop
+driver, :meth:`~arzsumo.sumo.plant.SumoPlant.run_open_loop`, which reads what they keep):
 
 * ``baseline``: the window (``window_s``) at the nominal plan. Kept: the window's mean
   class densities (veh/m) and mainline outflow q(L) (veh/s); per control period:
@@ -44,7 +45,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from functools import partial
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -56,6 +57,9 @@ from arzsumo.sumo.config import SumoConfig, ramp_capacity
 from arzsumo.sumo.fork import BranchFailed
 from arzsumo.sumo.green_share import GreenShareCurve
 from arzsumo.units import VEH_H_PER_VEH_S, veh_s_to_veh_h
+
+if TYPE_CHECKING:
+    from arzsumo.sumo.plant import SumoPlant
 
 log = logging.getLogger(__name__)
 
@@ -265,7 +269,7 @@ def _simulate(sc: Scenario, opts: Sequence[Mapping[str, Any]], fork: bool) -> li
         plant = SumoPlant(sim, sc.params.length, cfg, meter_curve_of(cfg, sc.source))
         warm = warm_up(plant, sc.run.warmup, period, Progress(1, enabled=False))
         warm_s = time.perf_counter() - wall0
-        branches = [partial(_branch, sc, sim, plant, float(warm[-1].t), o, warm_s)
+        branches = [partial(_branch, sc, plant, float(warm[-1].t), o, warm_s)
                     for o in opts]
         if fork and len(branches) > 1:
             return run_branches(branches)
@@ -288,19 +292,19 @@ class _OpenLoop:
     cfg: SumoConfig
 
 
-def _branch(sc: Scenario, sim: Any, plant: Any, t0: float, opt: Mapping[str, Any],
+def _branch(sc: Scenario, plant: SumoPlant, t0: float, opt: Mapping[str, Any],
             warm_s: float) -> dict[str, Any]:
     """One kind's window after the warm-up, and its row."""
     wall0 = time.perf_counter()
     kind, period = opt["kind"], sc.sumo.control_period
     if kind == "staircase":
-        row = _staircase(sc, sim, plant, t0, opt)
+        row = _staircase(sc, plant, t0, opt)
     else:
         plans: dict[int, float] = {}
         if kind == "pulse":
             plans = {0: least_plan(sc.sumo), _periods(opt["pulse_s"], period):
                      nominal_plan(sc.sumo)}
-        rec = _window(sim, plant, t0, _periods(opt["window_s"], period), plans,
+        rec = _window(plant, t0, _periods(opt["window_s"], period), plans,
                       lateral=kind == "baseline")
         row = _fields_row(rec) if kind == "pulse" else _baseline_row(sc, rec)
         if kind == "pulse":
@@ -310,28 +314,29 @@ def _branch(sc: Scenario, sim: Any, plant: Any, t0: float, opt: Mapping[str, Any
             "wall_s": time.perf_counter() - wall0, "warmup_wall_s": warm_s}
 
 
-def _window(sim: Any, plant: Any, t0: float, periods: int, plans: Mapping[int, float],
+def _window(plant: SumoPlant, t0: float, periods: int, plans: Mapping[int, float],
             lateral: bool) -> _OpenLoop:
-    """``periods`` control periods from the warm-up's end; ``plans``: period index ->
-    plan set at that period's start."""
-    from arzsumo.sumo.lateral import LateralSampler
+    """``periods`` control periods from the warm-up's end at ``t0`` (s); ``plans``: period
+    index -> plan set at that period's start."""
     from arzsumo.sumo.network import MAIN
+    from arzsumo.sumo.period_reads import OpenLoopPeriod, OpenLoopReads
 
     cells, main, releases = [], [], []
-    sampler, seen = LateralSampler(sim.lib), plant.sensor.mainline
+
+    def keep(p: OpenLoopPeriod) -> None:
+        if p.measurement is None:   # pragma: no cover - the premise's sensor measures
+            raise PremiseRunError("the premise runs need the sensor's measurement")
+        cells.append(p.measurement.cells)
+        releases.append(p.releases)
+        main.append(p.vehicles[MAIN])
+
+    cfg = plant.cfg
     plant.meter.start_window()
-    for k in range(periods):
-        if k in plans:
-            plant.meter.set_plan(plans[k])
-        m = plant.advance()
-        cells.append(m.cells)
-        releases.append(plant.meter.releases)
-        main.append(int(sim.lib.edge.getLastStepVehicleNumber(MAIN)))
-        if lateral:   # the sensor's own snapshot call, at the period's last step
-            sampler.sample(m.t, seen.last_ids, seen.last_pos, seen.last_speed,
-                           seen.last_av)
-    return _OpenLoop(t0, cells, main, releases, sampler.record() if lateral else None,
-                     sim.take_report(), plant.meter.summary(), sim.cfg)
+    end = plant.run_open_loop(periods, keep, plans=[(t0 + k * cfg.control_period, plan)
+                                                   for k, plan in plans.items()],
+                              reads=OpenLoopReads(edges=(MAIN,), lateral=lateral))
+    return _OpenLoop(t0, cells, main, releases, end.lateral, plant.sim.take_report(),
+                     plant.meter.summary(), cfg)
 
 
 def _grid(rec: _OpenLoop) -> dict[str, Any]:
@@ -378,7 +383,7 @@ def _baseline_row(sc: Scenario, rec: _OpenLoop) -> dict[str, Any]:
             "max_queue_veh": int(rec.meter["max_queue"]), "ramp_storage_veh": storage}
 
 
-def _staircase(sc: Scenario, sim: Any, plant: Any, t0: float,
+def _staircase(sc: Scenario, plant: SumoPlant, t0: float,
                opt: Mapping[str, Any]) -> dict[str, Any]:
     """The release-rate staircase: q(L), the commanded r and the releases per period."""
     from arzsumo.bridge.session import meter_curve_of
@@ -389,7 +394,7 @@ def _staircase(sc: Scenario, sim: Any, plant: Any, t0: float,
     curve = meter_curve_of(cfg, sc.source)
     dr = float(opt["step_veh_s"])
     plans = {i * per_level: plan_for_step(cfg, curve, s * dr) for i, s in enumerate(steps)}
-    rec = _window(sim, plant, t0, per_level * len(steps), plans, lateral=False)
+    rec = _window(plant, t0, per_level * len(steps), plans, lateral=False)
     rate = np.repeat([cfg.release_rate + s * dr for s in steps], per_level)
     released = np.diff(np.r_[0, rec.releases]) / period
     return {**_grid(rec), "q_veh_s": [c.outflow_h + c.outflow_a for c in rec.cells],

@@ -13,6 +13,9 @@ when a run starts), so the math packages and the CLI stay light.
 * :mod:`~arzsumo.sumo.placement`: macro to micro
 * :mod:`~arzsumo.sumo.meter`, :mod:`~arzsumo.sumo.meter_release`: the ramp-meter actuator
   (fixed cycle; one vehicle per green)
+* :mod:`~arzsumo.sumo.plant`: the run with its sensor and meter, the one step loop and the
+  one open-loop driver (:meth:`~arzsumo.sumo.plant.SumoPlant.run_open_loop`);
+  :mod:`~arzsumo.sumo.period_reads`: what an open-loop run reads beside the sensor
 * :mod:`~arzsumo.sumo.runner`, :mod:`~arzsumo.sumo.calibrate`: open-loop runs, calibration
 
 May import ``kernel_cache``, ``control``, ``model``, ``io``, ``progress``, ``units``,

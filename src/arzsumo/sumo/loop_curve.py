@@ -17,7 +17,7 @@ import numpy as np
 from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.green_share import DEFAULT_CURVE, GreenShareCurve
-from arzsumo.sumo.loops import DownstreamLoop
+from arzsumo.sumo.period_reads import OpenLoopPeriod, OpenLoopReads
 from arzsumo.sumo.plant import SumoPlant
 from arzsumo.sumo.simulation import open_simulation
 
@@ -39,16 +39,17 @@ def record_downstream_loop(params: ModelParameters, cfg: SumoConfig, distance: f
     """Run ``cfg.horizon`` s of open loop (nominal meter; ``curve`` for a fixed-cycle
     meter); the loop's series (module docstring)."""
     t_out, occ, flow = [], [], []
+
+    def keep(p: OpenLoopPeriod) -> None:
+        if p.loop is not None:
+            t_out.append(p.t)
+            occ.append(p.loop[0])
+            flow.append(p.loop[1])
+
     with open_simulation(params, cfg, downstream_loop=distance) as sim:
         # the meter's reading only: the mainline cells are not needed here, the loop is
         plant = SumoPlant(sim, params.length, cfg, curve, measure=False)
-        loop = DownstreamLoop(sim.lib, cfg.step_length, cfg.steps_per_period)
-        while sim.time < cfg.horizon - 1e-9:
-            plant.step()
-            got = loop.observe(sim.time)
-            if got is not None:
-                t_out.append(sim.time)
-                occ.append(got[0])
-                flow.append(got[1])
+        plant.run_open_loop(on_period=keep, until=cfg.horizon,
+                            reads=OpenLoopReads(downstream_loop=True))
     return LoopSeries(np.asarray(t_out), np.asarray(occ), np.asarray(flow),
                       cfg.control_period, cfg.seed)

@@ -19,6 +19,7 @@ from arzsumo.sumo.green_share import DEFAULT_CURVE, GreenShareCurve
 from arzsumo.sumo.measure import MeasurementLog
 from arzsumo.sumo.network import RAMP_UP
 from arzsumo.sumo.paths import SumoError
+from arzsumo.sumo.period_reads import OpenLoopPeriod
 from arzsumo.sumo.plant import SumoPlant
 from arzsumo.sumo.simulation import RunReport, open_simulation
 
@@ -57,13 +58,15 @@ def run_fixed_meter(params: ModelParameters, cfg: SumoConfig, green_share: float
     """
     g = cfg.green_share if green_share is None else green_share
     cfg = cfg.with_(green_share=g)
+    measurements = MeasurementLog()
+
+    def keep(p: OpenLoopPeriod) -> None:
+        if p.measurement is not None:
+            measurements.append(p.measurement.cells)
+
     with open_simulation(params, cfg, initial=initial, net_dir=net_dir) as sim:
         plant = SumoPlant(sim, params.length, cfg, curve, measure=measure)
-        measurements = MeasurementLog()
-        while sim.time < cfg.horizon - 1e-9:
-            got = plant.step()
-            if got is not None:
-                measurements.append(got.cells)
+        plant.run_open_loop(on_period=keep, until=cfg.horizon)
         # ramp vehicles past the meter: inserted minus those still upstream of it
         ramp_passed = sim.inserted_ramp - int(sim.lib.edge.getLastStepVehicleNumber(RAMP_UP))
     if sim.report is None:  # pragma: no cover - close() failed to read SUMO's counts

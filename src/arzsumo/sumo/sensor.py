@@ -23,7 +23,8 @@ One :class:`SumoSensor` per run. After each SUMO step :meth:`SumoSensor.observe`
   (:meth:`SumoSensor.end_window`, the drain), only the meter's reading and fuel and CO2,
 
 and when a control period is complete returns one :class:`PeriodMeasurement`. Nothing
-else in the run reads SUMO while it steps; the meter only writes the traffic light.
+else in the closed loop reads SUMO while it steps (an open-loop study's further reads are
+:mod:`arzsumo.sumo.period_reads`); the meter only writes the traffic light.
 """
 
 from __future__ import annotations
