@@ -188,8 +188,8 @@ def test_next_run_clears_what_a_killed_run_left(tmp_path):
     assert summary["horizon"] == 60 and summary["controller"] == "etc"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r", "tmp"]
     assert sorted(p.name for p in (tmp_path / "r").iterdir()) == [
-        MARKER, "cells.parquet", "periods.parquet", "run.sumocfg", "scenario.toml", "summary.json",
-        "sumo", "tripinfo.xml.gz"]
+        MARKER, "cells.parquet", "periods.parquet", "run.sumocfg", "scenario.toml", "summary.csv",
+        "summary.json", "sumo", "tripinfo.xml.gz"]
     assert list(tmpdir.iterdir()) == []
 
 
