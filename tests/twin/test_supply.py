@@ -71,3 +71,38 @@ def test_limit_scales_every_class_to_the_supply(params):
     np.testing.assert_allclose(out, theta * flux, rtol=0, atol=0)
     occupancy = (p.area_h * out[0] + p.area_a * out[2]) / p.road_width
     assert occupancy == pytest.approx(supply, rel=1e-13)
+
+
+def test_sending_is_the_flux_below_critical_and_the_capacity_above(params):
+    p, cap = params, ReceivingCapacity(params)
+    ao = np.linspace(0.005, 0.999 * p.ao_max, 400)
+    flux = np.array([cap.equilibrium_flux(*_densities(p, a)) for a in ao])
+    sending = np.array([cap.sending(*_densities(p, a)) for a in ao])
+    supply = np.array([cap(*_densities(p, a)) for a in ao])
+    k = int(np.argmax(flux))
+    np.testing.assert_array_equal(sending[:k - 1], flux[:k - 1])   # free flow: exact
+    np.testing.assert_allclose(sending[k + 1:], supply[0], rtol=1e-12)   # the capacity
+    assert np.all(np.diff(sending) >= -1e-12) and np.all(sending >= flux)
+
+
+def test_a_congested_sender_demands_the_capacity(params):
+    """``sender``: a state at equilibrium above critical sends at capacity into an empty
+    cell, and what the receiving cell's supply allows into a congested one."""
+    p, cap = params, ReceivingCapacity(params)
+    queue = _densities(p, 0.8 * p.ao_max)
+    ve_h, ve_a = equilibrium_speeds(p, *queue)
+    own = np.array([queue[0] * ve_h, 0.0, queue[1] * ve_a, 0.0])
+    capacity = cap(*_densities(p, 0.01))
+    out, theta = cap.limit(own, *_densities(p, 0.01), sender=queue)
+    assert theta > 1.0
+    assert (p.area_h * out[0] + p.area_a * out[2]) / p.road_width == pytest.approx(capacity,
+                                                                                  rel=1e-12)
+    dense = _densities(p, 0.9 * p.ao_max)
+    out, theta = cap.limit(own, *dense, sender=queue)
+    assert (p.area_h * out[0] + p.area_a * out[2]) / p.road_width == pytest.approx(
+        cap(*dense), rel=1e-12)
+    free = _densities(p, 0.1)
+    ve_h, ve_a = equilibrium_speeds(p, *free)
+    flux = np.array([free[0] * ve_h, 0.0, free[1] * ve_a, 0.0])
+    out, theta = cap.limit(flux, *_densities(p, 0.05), sender=free)
+    assert out is flux and theta == 1.0                   # a free-flow sender: its flux

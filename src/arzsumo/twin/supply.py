@@ -24,13 +24,21 @@ that is the capacity Phi_max below the critical occupancy and Phi_e(AO) above it
 share that jam occupancy (where they do not, the class with the larger one still moves at
 AO_max, and its share of Phi_e stays positive there).
 
-Limited inlet flux (:meth:`ReceivingCapacity.limit`). The demand is the physical flux f of
-the boundary state (the ghost cell), D = sum_i (a_i / W) f_rho_i. Where D > S the whole
-flux f is scaled by theta = S / D: each class keeps its share of the entering occupancy
-and its vehicles their Lagrangian marker y_i / rho_i (the y-flux scales with the density
-flux). Where D <= S the flux is f itself, to the bit. The limit acts at x = 0 only; the
-interior scheme and the conservation of vehicles are unchanged (the limited flux is the
-flux the stepper counts as inflow).
+The sending function (demand) is the mirror image, the non-decreasing envelope from the
+left: D_e(AO) = max over AO' in (0, AO] of Phi_e(AO'), Phi_e(AO) in free flow and the
+capacity in congestion (a queue sends at capacity).
+
+Limited inlet flux (:meth:`ReceivingCapacity.limit`). The boundary state (the ghost cell)
+carries the physical flux f, in occupancy units F = sum_i (a_i / W) f_rho_i. Its demand
+is F itself or, with ``sender`` (the cell transmission model's sending side), F D_e / Phi_e
+at the boundary state's occupancy and mix: F in free flow, raised to the capacity times
+the state's departure from the diagram in congestion. The flux entering is min(demand, S):
+where that differs from F the whole flux f is scaled by theta = min(demand, S) / F, so
+each class keeps its share of the entering occupancy and its vehicles their Lagrangian
+marker y_i / rho_i (the y-flux scales with the density flux). Where it does not, the flux
+is f itself, to the bit. The limit acts at x = 0 only; the interior scheme and the
+conservation of vehicles are unchanged (the limited flux is the flux the stepper counts as
+inflow).
 """
 
 from __future__ import annotations
@@ -96,6 +104,16 @@ class ReceivingCapacity:
         own = self.equilibrium_flux(rho_h, rho_a)
         return max(own, self._beyond(ao, self._ah * rho_h / ao if ao > 0.0 else 0.5))
 
+    def sending(self, rho_h: float, rho_a: float) -> float:
+        """D_e (m/s) of a cell with densities ``rho_h``, ``rho_a`` (veh/m): Phi_e in free
+        flow, the capacity at its mix in congestion (and at or beyond AO_max)."""
+        rho_h, rho_a = max(float(rho_h), 0.0), max(float(rho_a), 0.0)
+        ao = self.occupancy(rho_h, rho_a)
+        share_h = self._ah * rho_h / ao if ao > 0.0 else 0.5
+        if ao >= self.p.ao_max:
+            return self._below(self.p.ao_max, share_h)
+        return max(self.equilibrium_flux(rho_h, rho_a), self._below(ao, share_h))
+
     def _beyond(self, ao: float, share_h: float) -> float:
         """Largest Phi_e (m/s) on the grid above ``ao`` with the HV share ``share_h``."""
         k = int(np.searchsorted(self._ao, ao, side="right"))
@@ -104,35 +122,60 @@ class ReceivingCapacity:
         mix = share_h * self._flux_h[k:] + (1.0 - share_h) * self._flux_a[k:]
         return float(mix.max())
 
-    def limit(self, flux: np.ndarray, rho_h: float, rho_a: float) -> tuple[np.ndarray, float]:
+    def _below(self, ao: float, share_h: float) -> float:
+        """Largest Phi_e (m/s) on the grid at or below ``ao`` with the HV share ``share_h``."""
+        k = int(np.searchsorted(self._ao, ao, side="right"))
+        if k == 0:
+            return 0.0
+        mix = share_h * self._flux_h[:k] + (1.0 - share_h) * self._flux_a[:k]
+        return float(mix.max())
+
+    def limit(self, flux: np.ndarray, rho_h: float, rho_a: float,
+              sender: tuple[float, float] | None = None) -> tuple[np.ndarray, float]:
         """The inflow ``flux`` (4,) into a cell with densities ``rho_h``, ``rho_a``, limited
-        to the cell's supply.
+        to the cell's supply (and, with ``sender``, raised to a congested sender's demand).
 
         Parameters
         ----------
         flux : ndarray, shape (4,)
-            The demand: the physical flux (rho_h v_h, y_h v_h, rho_a v_a, y_a v_a) of the
-            boundary state, veh/s and veh/s^2.
+            The physical flux (rho_h v_h, y_h v_h, rho_a v_a, y_a v_a) of the boundary
+            state, veh/s and veh/s^2.
         rho_h, rho_a : float
             The receiving cell's densities, veh/m.
+        sender : (float, float), optional
+            The boundary state's densities (veh/m): its demand is then the flux times
+            D_e / Phi_e there (module docstring); without it, the flux.
 
         Returns
         -------
         flux : ndarray, shape (4,)
-            ``flux`` itself where its occupancy demand is within the supply, else
+            ``flux`` itself where the demand is the flux and within the supply, else
             ``theta * flux``.
         theta : float
-            The factor, in [0, 1]; 1.0 where the supply did not bind.
+            The factor (>= 0); 1.0 where neither the supply nor the sender's demand
+            changed the flux.
         """
-        demand = self._ah * float(flux[RHO_H]) + self._aa * float(flux[RHO_A])
-        if demand <= 0.0:
+        carried = self._ah * float(flux[RHO_H]) + self._aa * float(flux[RHO_A])
+        if carried <= 0.0:
             return flux, 1.0
+        demand = carried if sender is None else carried * self._raise(*sender)
         rho_h, rho_a = max(float(rho_h), 0.0), max(float(rho_a), 0.0)
         ao = self.occupancy(rho_h, rho_a)
         if ao < self.p.ao_max and demand <= self.equilibrium_flux(rho_h, rho_a):
-            return flux, 1.0                       # within S >= Phi_e: no grid needed
-        supply = self(rho_h, rho_a)
-        if demand <= supply:
+            entering = demand                      # within S >= Phi_e: no grid needed
+        else:
+            entering = min(demand, self(rho_h, rho_a))
+        if entering == carried:
             return flux, 1.0
-        theta = supply / demand
+        theta = entering / carried
         return theta * flux, theta
+
+    def _raise(self, rho_h: float, rho_a: float) -> float:
+        """D_e / Phi_e of a sender with densities ``rho_h``, ``rho_a``: exactly 1.0 in free
+        flow, the capacity over its own flux in congestion."""
+        own = self.equilibrium_flux(rho_h, rho_a) if self.occupancy(rho_h, rho_a) < \
+            self.p.ao_max else 0.0
+        sending = self.sending(rho_h, rho_a)
+        if sending <= own:
+            return 1.0
+        return sending / own if own > 0.0 else float("inf")
