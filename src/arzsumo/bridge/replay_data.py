@@ -38,8 +38,8 @@ def replay_options_of(settings: RunSettings, inlet: str = "ghost") -> ReplayOpti
     """The numerics of the bridge's twins as :class:`~arzsumo.identify.ReplayOptions`:
     ``[run] twin_cells`` and ``twin_scheme``, the bridge's AO limit (flux, limiter and CFL
     are the twin's defaults in both) and, unless ``inlet`` says otherwise, the bridge's
-    inlet: the ghost cell's flux as it is (``ghost``; ``supply`` limits it to the first
-    cell's receiving capacity, :mod:`arzsumo.identify.replay`)."""
+    inlet: the ghost cell's flux as it is (``ghost``; ``ctm`` and ``supply`` bound it by
+    the first cell's receiving capacity, :mod:`arzsumo.identify.replay`)."""
     return ReplayOptions(cells=settings.twin_cells, scheme=settings.twin_scheme,
                          ao_limit=TWIN_AO_LIMIT, inlet=inlet)
 

@@ -11,10 +11,14 @@ Inlet flux (``ReplayOptions.inlet``). ``ghost`` lets in the physical flux of the
 state, whatever the first cell holds: the SUMO bridge's replay twin does this. When
 SUMO's queue tail reaches x = 0 the held (smoothed) state pairs a queue's density with
 the arriving vehicles' speed, and that flux can fill the first cell past AO_max.
-``supply`` (default) lets in the smaller of that flux and the first cell's receiving
-capacity, the supply of the cell transmission model built on the model's own Ve_i
-(:class:`arzsumo.twin.supply.ReceivingCapacity`): below it the flux is the ghost's to the
-bit, above it every class's flux is scaled by one factor.
+``supply`` lets in the smaller of that flux and the first cell's receiving capacity, the
+supply of the cell transmission model built on the model's own Ve_i
+(:class:`arzsumo.twin.supply.ReceivingCapacity`). ``ctm`` (default) is the cell
+transmission model's whole rule, min(demand, supply): a held state in congestion (above
+the diagram's critical occupancy) demands the capacity (times its own departure from
+the diagram), as a queue upstream of x = 0 would send; in free flow its demand is its
+flux. Where neither bound changes it the flux is the ghost's to the bit (a free-flow
+inlet); otherwise every class's flux is scaled by one factor.
 
 Outlet. The twin's outlet carries q* + U, with q* the flow of its reference equilibrium.
 We take the uniform equilibrium at the spatial means of the initial densities (always
@@ -51,9 +55,10 @@ from arzsumo.twin.supply import ReceivingCapacity
 
 #: an inlet rule of :func:`run_replay`: (held state, first cell's state) -> boundary state
 InletRule = Callable[[np.ndarray, np.ndarray], np.ndarray]
-#: the inlet fluxes of :class:`ReplayOptions`: the held state's flux, or that flux
-#: limited to the first cell's supply (module docstring)
-INLETS = ("supply", "ghost")
+#: the inlet fluxes of :class:`ReplayOptions`: the cell transmission model's min(demand,
+#: supply), the held state's flux limited to the supply, that flux as it is (module
+#: docstring)
+INLETS = ("ctm", "supply", "ghost")
 
 
 @dataclass(frozen=True)
@@ -72,10 +77,11 @@ class ReplayOptions:
         of the parameters being tried, in (0, 1).
     max_steps : int
         Safety limit on the time steps of one replay.
-    inlet : {"supply", "ghost"}
-        The inlet flux: the held state's physical flux limited to the first cell's
-        receiving capacity (``supply``), or that flux as it is (``ghost``, the bridge's
-        replay twin and the replay before the limit); module docstring.
+    inlet : {"ctm", "supply", "ghost"}
+        The inlet flux: min(demand of the held state, supply of the first cell)
+        (``ctm``), the held state's physical flux limited to the supply (``supply``), or
+        that flux as it is (``ghost``, the bridge's replay twin and the replay before the
+        limit); module docstring.
     """
 
     cells: int = 50
@@ -85,7 +91,7 @@ class ReplayOptions:
     cfl: float = 0.9
     ao_limit: float = 0.98
     max_steps: int = 1_000_000
-    inlet: str = "supply"
+    inlet: str = "ctm"
 
     def __post_init__(self) -> None:
         self.solver()                                   # validates the numerics
@@ -109,7 +115,8 @@ class HeldInlet(Inlet):
     The fields of :class:`Inlet` (densities, flow, l4) are not used; ``state`` holds
     (rho_h veh/m, v_h m/s, rho_a veh/m, v_a m/s) and is overwritten in place by :meth:`hold`.
     With ``supply`` the flux of the boundary state is limited to the first cell's
-    receiving capacity; ``theta`` holds the factor of the last flux (1.0: not limited).
+    receiving capacity, with ``sending`` too a congested boundary state demands the
+    capacity; ``theta`` holds the factor of the last flux (1.0: the state's own flux).
     """
 
     state: np.ndarray = field(default_factory=lambda: np.ones(4))
@@ -117,6 +124,8 @@ class HeldInlet(Inlet):
     #: boundary state, each (rho_h, v_h, rho_a, v_a) in SI
     rule: InletRule | None = None
     supply: ReceivingCapacity | None = None
+    #: with ``supply``: a congested boundary state sends at capacity (``ctm``)
+    sending: bool = False
     theta: np.ndarray = field(default_factory=lambda: np.ones(1))
 
     def hold(self, z: np.ndarray) -> None:
@@ -131,7 +140,8 @@ class HeldInlet(Inlet):
         """The boundary state's flux (4,), supply-limited with ``supply``, and the state."""
         flux, qb = super().boundary_flux(p, t, z0)
         if self.supply is not None:
-            flux, self.theta[0] = self.supply.limit(flux, float(z0[0]), float(z0[2]))
+            sender = (float(qb[0]), float(qb[2])) if self.sending else None
+            flux, self.theta[0] = self.supply.limit(flux, float(z0[0]), float(z0[2]), sender)
         return flux, qb
 
 
@@ -158,8 +168,8 @@ class ReplayRun:
     vehicles_in : float
         Vehicles that entered at x = 0 (until the stop, if any).
     inlet_limited : float
-        Seconds during which the first cell's supply, not the held state, set the inflow
-        (inlet ``supply`` only).
+        Seconds during which the first cell's supply or the held state's demand, not the
+        held state's own flux, set the inflow (inlets ``ctm`` and ``supply``).
     """
 
     fields: np.ndarray
@@ -219,8 +229,9 @@ def _stepper(params: ModelParameters, data: ReplayData, options: ReplayOptions,
              ) -> tuple[TwinStepper, HeldInlet]:
     init = admissible(params, on_grid(data.initial, data.x, x_twin), options.ao_limit)
     eq = Equilibrium(params, float(init[0].mean()), float(init[2].mean()))
-    supply = ReceivingCapacity(params) if options.inlet == "supply" else None
-    inlet = HeldInlet(eq.rho_h, eq.rho_a, eq.q, np.zeros(4), rule=rule, supply=supply)
+    supply = ReceivingCapacity(params) if options.inlet != "ghost" else None
+    inlet = HeldInlet(eq.rho_h, eq.rho_a, eq.q, np.zeros(4), rule=rule, supply=supply,
+                      sending=options.inlet == "ctm")
     with _quiet_regime():
         return TwinStepper(eq, init, options.solver(), inlet), inlet
 
@@ -273,14 +284,14 @@ def run_replay(params: ModelParameters, data: ReplayData,
 
 
 class _LimitClock:
-    """Step callback: the seconds in which the inlet's last flux was supply-limited."""
+    """Step callback: the seconds in which the inlet's last flux was not the held state's."""
 
     def __init__(self, inlet: HeldInlet, t0: float) -> None:
         self.inlet, self.t, self.limited = inlet, t0, 0.0
 
     def __call__(self, t: float, q: np.ndarray, vehicles_in: float,
                  vehicles_out: float) -> None:
-        if self.inlet.theta[0] < 1.0:
+        if self.inlet.theta[0] != 1.0:
             self.limited += t - self.t
         self.t = t
 

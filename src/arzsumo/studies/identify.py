@@ -119,9 +119,10 @@ class IdentifySetup:
     #: the family whose diagram stage 1 fits from the windows' stationary states (stage 2
     #: then fits tau_h, tau_a by the replay); None: one replay fit of ``which``
     diagram: str | None = None
-    #: the replay's inlet flux (:data:`arzsumo.identify.replay.INLETS`): ``supply`` limits
-    #: the ghost cell's flux to the first cell's receiving capacity, ``ghost`` does not
-    inlet: str = "supply"
+    #: the replay's inlet flux (:data:`arzsumo.identify.replay.INLETS`): ``ctm`` the cell
+    #: transmission model's min(demand, supply), ``supply`` the ghost cell's flux limited
+    #: to the first cell's receiving capacity, ``ghost`` that flux as it is
+    inlet: str = "ctm"
 
     @property
     def options(self) -> ReplayOptions:
@@ -196,7 +197,7 @@ def make_setup(sc: Scenario, train: Sequence[int], held_out: Sequence[int], *,
                horizon: float | None = None, warmup: float | None = None,
                fit: FitSettings | None = None, workers: int | None = None,
                wave_speed: float | None = None, wave_weight: float = 1.0,
-               diagram: str | None = None, inlet: str = "supply") -> IdentifySetup:
+               diagram: str | None = None, inlet: str = "ctm") -> IdentifySetup:
     """Check everything before SUMO starts: seeds, points, parameter names and bounds."""
     if inlet not in INLETS:
         raise ScenarioError(f"--inlet = {inlet} is not allowed: one of {', '.join(INLETS)}")
