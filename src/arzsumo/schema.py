@@ -276,7 +276,7 @@ IDENTIFY_SUMMARY: dict[str, str] = {
     "settings.horizon_s": "s", "settings.warmup_s": "s", "settings.max_nfev": "count",
     "settings.bootstrap": "count", "settings.workers": "count",
     "settings.replay_cells": "count", "settings.ao_limit": "1", "settings.penalty": "1",
-    "parameters.*.at_bound": TEXT, "parameters.v_free_*.*": "m/s",
+    "settings.replay_inlet": TEXT, "parameters.*.at_bound": TEXT, "parameters.v_free_*.*": "m/s",
     "parameters.ao_max_*.*": "1", "parameters.gamma_*.*": "1", "parameters.tau_*.*": "s",
     "parameters.spacing_*.*": "m", "correlation.*": "1",
     "fit.nfev": "count", "fit.evaluations": "count", "fit.failures": "count",

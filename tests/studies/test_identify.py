@@ -178,6 +178,19 @@ def test_vary_plans_every_seed_at_every_point_of_the_product():
     assert setup.which == ("tau_a", "gamma_h") and setup.options.cells == run.run.twin_cells
 
 
+def test_the_replay_inlet_is_the_cell_transmission_rule_and_the_bridge_keeps_its_own():
+    from arzsumo.bridge.replay_data import replay_options_of
+    from arzsumo.errors import ScenarioError
+    from arzsumo.studies.identify import make_setup
+
+    sc = load_scenario(DEFAULT)
+    assert make_setup(sc, [1], [2], workers=1).options.inlet == "ctm"
+    assert make_setup(sc, [1], [2], workers=1, inlet="ghost").options.inlet == "ghost"
+    assert replay_options_of(sc.run).inlet == "ghost"          # the bridge's replay twin
+    with pytest.raises(ScenarioError, match="--inlet = wall is not allowed: one of ctm, supply"):
+        make_setup(sc, [1], [2], workers=1, inlet="wall")
+
+
 def test_the_fit_starts_from_an_ao_max_that_holds_the_observed_occupancy():
     import numpy as np
 

@@ -15,9 +15,9 @@ what it was compared with:
   meter's outflow (:func:`~arzsumo.bridge.boundary_data.outflow_series`);
 * ``scale``: the run's equilibrium (rho_h*, v_h*, rho_a*, v_a*), for relative errors.
 
-With :func:`replay_options_of` (the run's twin grid, scheme and AO limit),
-:func:`arzsumo.identify.replay` of this data under the run's parameters reproduces the
-bridge's replay field of a run without re-synchronisations (``tests/bridge/
+With :func:`replay_options_of` (the run's twin grid, scheme and AO limit, and the bridge's
+``ghost`` inlet), :func:`arzsumo.identify.replay` of this data under the run's parameters
+reproduces the bridge's replay field of a run without re-synchronisations (``tests/bridge/
 test_replay_data.py`` states the tolerance).
 """
 
@@ -34,12 +34,14 @@ from arzsumo.model.params import ModelParameters
 from arzsumo.scenario.run import RunSettings
 
 
-def replay_options_of(settings: RunSettings) -> ReplayOptions:
+def replay_options_of(settings: RunSettings, inlet: str = "ghost") -> ReplayOptions:
     """The numerics of the bridge's twins as :class:`~arzsumo.identify.ReplayOptions`:
     ``[run] twin_cells`` and ``twin_scheme``, the bridge's AO limit (flux, limiter and CFL
-    are the twin's defaults in both)."""
+    are the twin's defaults in both) and, unless ``inlet`` says otherwise, the bridge's
+    inlet: the ghost cell's flux as it is (``ghost``; ``ctm`` and ``supply`` bound it by
+    the first cell's receiving capacity, :mod:`arzsumo.identify.replay`)."""
     return ReplayOptions(cells=settings.twin_cells, scheme=settings.twin_scheme,
-                         ao_limit=TWIN_AO_LIMIT)
+                         ao_limit=TWIN_AO_LIMIT, inlet=inlet)
 
 
 def replay_data_of(res: CoSimResult, *, params: ModelParameters | None = None,

@@ -44,7 +44,8 @@ def cmd_identify(args: argparse.Namespace) -> int:
                        workers=args.workers,
                        wave_speed=None if args.wave_speed_kmh is None
                        else kmh_to_ms(args.wave_speed_kmh),
-                       wave_weight=args.wave_weight, diagram=args.diagram)
+                       wave_weight=args.wave_weight, diagram=args.diagram,
+                       inlet=args.inlet)
     out = Path(args.out) if args.out else Path("results") / "identify" / path.stem
     runs = len(setup.points) * (len(setup.train_seeds) + len(setup.validate_seeds))
     log.info("identify %s: %d SUMO runs on %d workers, fitting %s", sc.name, runs,
@@ -131,6 +132,12 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="two stages: the fundamental diagram of this family from the "
                         "windows' stationary states and the measured wave speed (stage 1), "
                         "then tau_h, tau_a by the replay with the diagram fixed (stage 2)")
+    p.add_argument("--inlet", choices=("ctm", "supply", "ghost"), default="ctm",
+                   help="the replay's inlet flux from the ghost cell (SUMO's smoothed first "
+                        "cell): the cell transmission model's min(demand, supply) of the "
+                        "first cell (ctm), the ghost's flux limited to that supply "
+                        "(supply), or as it is (ghost: the bridge's replay twin and the "
+                        "earlier results)")
     p.add_argument("--max-nfev", type=positive_int, default=40, metavar="N",
                    help="largest number of least-squares steps (scipy's max_nfev)")
     add_workers(p, "SUMO runs in parallel (default: one per core)")

@@ -7,6 +7,19 @@ fields at ``data.x`` at every period end. This is what the SUMO closed loop does
 replay twin (a ghost-cell inlet and the measured outflow), with the boundary data given
 up front.
 
+Inlet flux (``ReplayOptions.inlet``). ``ghost`` lets in the physical flux of the held
+state, whatever the first cell holds: the SUMO bridge's replay twin does this. When
+SUMO's queue tail reaches x = 0 the held (smoothed) state pairs a queue's density with
+the arriving vehicles' speed, and that flux can fill the first cell past AO_max.
+``supply`` lets in the smaller of that flux and the first cell's receiving capacity, the
+supply of the cell transmission model built on the model's own Ve_i
+(:class:`arzsumo.twin.supply.ReceivingCapacity`). ``ctm`` (default) is the cell
+transmission model's whole rule, min(demand, supply): a held state in congestion (above
+the diagram's critical occupancy) demands the capacity (times its own departure from
+the diagram), as a queue upstream of x = 0 would send; in free flow its demand is its
+flux. Where neither bound changes it the flux is the ghost's to the bit (a free-flow
+inlet); otherwise every class's flux is scaled by one factor.
+
 Outlet. The twin's outlet carries q* + U, with q* the flow of its reference equilibrium.
 We take the uniform equilibrium at the spatial means of the initial densities (always
 admissible, because AO is linear in the densities) and set U_k = outflow_k - q*, so the
@@ -38,9 +51,14 @@ from arzsumo.model.params import ModelParameters
 from arzsumo.twin.boundary import Inlet
 from arzsumo.twin.solver import SolverOptions, TwinStepper, TwinStoppedError
 from arzsumo.twin.state import cell_centres
+from arzsumo.twin.supply import ReceivingCapacity
 
 #: an inlet rule of :func:`run_replay`: (held state, first cell's state) -> boundary state
 InletRule = Callable[[np.ndarray, np.ndarray], np.ndarray]
+#: the inlet fluxes of :class:`ReplayOptions`: the cell transmission model's min(demand,
+#: supply), the held state's flux limited to the supply, that flux as it is (module
+#: docstring)
+INLETS = ("ctm", "supply", "ghost")
 
 
 @dataclass(frozen=True)
@@ -59,6 +77,11 @@ class ReplayOptions:
         of the parameters being tried, in (0, 1).
     max_steps : int
         Safety limit on the time steps of one replay.
+    inlet : {"ctm", "supply", "ghost"}
+        The inlet flux: min(demand of the held state, supply of the first cell)
+        (``ctm``), the held state's physical flux limited to the supply (``supply``), or
+        that flux as it is (``ghost``, the bridge's replay twin and the replay before the
+        limit); module docstring.
     """
 
     cells: int = 50
@@ -68,12 +91,16 @@ class ReplayOptions:
     cfl: float = 0.9
     ao_limit: float = 0.98
     max_steps: int = 1_000_000
+    inlet: str = "ctm"
 
     def __post_init__(self) -> None:
         self.solver()                                   # validates the numerics
         if not 0.0 < self.ao_limit < 1.0:
             raise IdentifyError(f"ao_limit = {self.ao_limit!r} is not allowed: a fraction "
                                 "of AO_max in (0, 1)")
+        if self.inlet not in INLETS:
+            raise IdentifyError(f"inlet = {self.inlet!r} is not allowed: one of "
+                                f"{', '.join(INLETS)}")
 
     def solver(self) -> SolverOptions:
         """The twin's :class:`SolverOptions` for these numerics."""
@@ -87,12 +114,19 @@ class HeldInlet(Inlet):
 
     The fields of :class:`Inlet` (densities, flow, l4) are not used; ``state`` holds
     (rho_h veh/m, v_h m/s, rho_a veh/m, v_a m/s) and is overwritten in place by :meth:`hold`.
+    With ``supply`` the flux of the boundary state is limited to the first cell's
+    receiving capacity, with ``sending`` too a congested boundary state demands the
+    capacity; ``theta`` holds the factor of the last flux (1.0: the state's own flux).
     """
 
     state: np.ndarray = field(default_factory=lambda: np.ones(4))
     #: a boundary rule instead of the ghost cell: (held state, first cell's state) ->
     #: boundary state, each (rho_h, v_h, rho_a, v_a) in SI
     rule: InletRule | None = None
+    supply: ReceivingCapacity | None = None
+    #: with ``supply``: a congested boundary state sends at capacity (``ctm``)
+    sending: bool = False
+    theta: np.ndarray = field(default_factory=lambda: np.ones(1))
 
     def hold(self, z: np.ndarray) -> None:
         """Hold the boundary state ``z`` (4,) from now on."""
@@ -100,6 +134,15 @@ class HeldInlet(Inlet):
 
     def boundary_primitive(self, t: float, z0: np.ndarray) -> np.ndarray:
         return self.state if self.rule is None else self.rule(self.state, z0)
+
+    def boundary_flux(self, p: ModelParameters, t: float,
+                      z0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The boundary state's flux (4,), supply-limited with ``supply``, and the state."""
+        flux, qb = super().boundary_flux(p, t, z0)
+        if self.supply is not None:
+            sender = (float(qb[0]), float(qb[2])) if self.sending else None
+            flux, self.theta[0] = self.supply.limit(flux, float(z0[0]), float(z0[2]), sender)
+        return flux, qb
 
 
 @dataclass(frozen=True)
@@ -122,6 +165,11 @@ class ReplayRun:
     outlet_limited : float
         Seconds during which the arriving flow, not ``data.outflow``, set the outflow (the
         last cell was in free flow and could not deliver it).
+    vehicles_in : float
+        Vehicles that entered at x = 0 (until the stop, if any).
+    inlet_limited : float
+        Seconds during which the first cell's supply or the held state's demand, not the
+        held state's own flux, set the inflow (inlets ``ctm`` and ``supply``).
     """
 
     fields: np.ndarray
@@ -130,6 +178,8 @@ class ReplayRun:
     steps: int
     vehicles_out: float = 0.0
     outlet_limited: float = 0.0
+    vehicles_in: float = 0.0
+    inlet_limited: float = 0.0
 
 
 class _NoRegimeWarning(logging.Filter):
@@ -179,7 +229,9 @@ def _stepper(params: ModelParameters, data: ReplayData, options: ReplayOptions,
              ) -> tuple[TwinStepper, HeldInlet]:
     init = admissible(params, on_grid(data.initial, data.x, x_twin), options.ao_limit)
     eq = Equilibrium(params, float(init[0].mean()), float(init[2].mean()))
-    inlet = HeldInlet(eq.rho_h, eq.rho_a, eq.q, np.zeros(4), rule=rule)
+    supply = ReceivingCapacity(params) if options.inlet != "ghost" else None
+    inlet = HeldInlet(eq.rho_h, eq.rho_a, eq.q, np.zeros(4), rule=rule, supply=supply,
+                      sending=options.inlet == "ctm")
     with _quiet_regime():
         return TwinStepper(eq, init, options.solver(), inlet), inlet
 
@@ -217,15 +269,31 @@ def run_replay(params: ModelParameters, data: ReplayData,
         stepper, inlet = _stepper(params, data, opts, x_twin, inlet_rule)
     except ArzsumoError as exc:                        # start state not representable
         return ReplayRun(out, 0.0, str(exc), 0)
+    clock = _LimitClock(inlet, stepper.t)
     for k in range(data.periods):
         inlet.hold(inlet_states[k])
         try:
-            stepper.advance(float(data.t[k]), float(data.outflow[k]) - stepper.q_star)
+            stepper.advance(float(data.t[k]), float(data.outflow[k]) - stepper.q_star,
+                            clock if inlet.supply is not None else None)
         except TwinStoppedError as exc:
             return ReplayRun(out, exc.t, str(exc), stepper.steps, stepper.outflow,
-                             stepper.outlet_limited_time)
+                             stepper.outlet_limited_time, stepper.inflow, clock.limited)
         out[k] = on_grid(stepper.primitive(), x_twin, data.x)
-    return ReplayRun(out, None, "", stepper.steps, stepper.outflow, stepper.outlet_limited_time)
+    return ReplayRun(out, None, "", stepper.steps, stepper.outflow, stepper.outlet_limited_time,
+                     stepper.inflow, clock.limited)
+
+
+class _LimitClock:
+    """Step callback: the seconds in which the inlet's last flux was not the held state's."""
+
+    def __init__(self, inlet: HeldInlet, t0: float) -> None:
+        self.inlet, self.t, self.limited = inlet, t0, 0.0
+
+    def __call__(self, t: float, q: np.ndarray, vehicles_in: float,
+                 vehicles_out: float) -> None:
+        if self.inlet.theta[0] != 1.0:
+            self.limited += t - self.t
+        self.t = t
 
 
 def replay(params: ModelParameters, data: ReplayData,

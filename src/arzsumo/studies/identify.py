@@ -42,6 +42,7 @@ from arzsumo.identify import (
     ReplayOptions,
     identify,
 )
+from arzsumo.identify.replay import INLETS
 from arzsumo.identify.wave_target import WaveTarget
 from arzsumo.model.equilibrium import Equilibrium
 from arzsumo.model.params import FAMILIES, ModelParameters
@@ -118,11 +119,16 @@ class IdentifySetup:
     #: the family whose diagram stage 1 fits from the windows' stationary states (stage 2
     #: then fits tau_h, tau_a by the replay); None: one replay fit of ``which``
     diagram: str | None = None
+    #: the replay's inlet flux (:data:`arzsumo.identify.replay.INLETS`): ``ctm`` the cell
+    #: transmission model's min(demand, supply), ``supply`` the ghost cell's flux limited
+    #: to the first cell's receiving capacity, ``ghost`` that flux as it is
+    inlet: str = "ctm"
 
     @property
     def options(self) -> ReplayOptions:
-        """The replay twin's numerics: the bridge's (``[run]`` twin_cells, twin_scheme)."""
-        return replay_options_of(self.scenario.run)
+        """The replay twin's numerics: the bridge's (``[run]`` twin_cells, twin_scheme),
+        with the setup's inlet."""
+        return replay_options_of(self.scenario.run, inlet=self.inlet)
 
 
 def _value(text: str) -> Any:
@@ -191,8 +197,10 @@ def make_setup(sc: Scenario, train: Sequence[int], held_out: Sequence[int], *,
                horizon: float | None = None, warmup: float | None = None,
                fit: FitSettings | None = None, workers: int | None = None,
                wave_speed: float | None = None, wave_weight: float = 1.0,
-               diagram: str | None = None) -> IdentifySetup:
+               diagram: str | None = None, inlet: str = "ctm") -> IdentifySetup:
     """Check everything before SUMO starts: seeds, points, parameter names and bounds."""
+    if inlet not in INLETS:
+        raise ScenarioError(f"--inlet = {inlet} is not allowed: one of {', '.join(INLETS)}")
     if diagram is not None and diagram not in FAMILIES:
         raise ScenarioError(f"--diagram = {diagram} is not allowed: one of "
                             f"{', '.join(FAMILIES)}")
@@ -219,7 +227,7 @@ def make_setup(sc: Scenario, train: Sequence[int], held_out: Sequence[int], *,
         WaveTarget(wave_speed, 0.0, 0.0, wave_weight)
     return IdentifySetup(base, sc, tuple(train), tuple(held_out), points, names,
                          fit or FitSettings(), workers or default_workers(), wave_speed,
-                         wave_weight, diagram)
+                         wave_weight, diagram, inlet)
 
 
 def plan(setup: IdentifySetup) -> list[RunTask]:

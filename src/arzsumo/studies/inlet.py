@@ -1,11 +1,15 @@
-"""The replay's inlet: ghost cell against characteristic (``arzsumo study inlet``).
+"""The replay's inlet: ghost cell, its supply-limited and cell-transmission variants,
+characteristic (``arzsumo study inlet``).
 
 The identification's replay holds SUMO's smoothed first-cell state in a ghost cell
-(:class:`arzsumo.identify.replay.HeldInlet`). The alternative here (:func:`characteristic`)
-prescribes three measured quantities (the class densities and the total flow) and takes
-the outgoing lambda_4 Riemann variable from the first cell (the paper's inlet condition,
-as in :class:`arzsumo.twin.boundary.Inlet`), falling back to the measured state where
-that gives a speed outside (0, V]. Both replay the last ``--last`` cached identification
+(:class:`arzsumo.identify.replay.HeldInlet`); ``ghost`` lets in that state's flux as it
+is, ``supply`` limits it to the first cell's receiving capacity, ``ctm`` (the replay's
+default) takes min(demand, supply) (:mod:`arzsumo.twin.supply`). The alternative here
+(:func:`characteristic`, with the ``ghost`` flux) prescribes three measured quantities
+(the class densities and the total flow) and takes the outgoing lambda_4 Riemann
+variable from the first cell (the paper's inlet condition, as in
+:class:`arzsumo.twin.boundary.Inlet`), falling back to the measured state where that
+gives a speed outside (0, V]. All four replay the last ``--last`` cached identification
 runs (``--runs DIR``, by default the cache ``arzsumo identify`` fills) under the
 scenario's parameters, without refitting; the table gives the relative RMSE per variable
 (rho_h, v_h, rho_a, v_a) on the grid and on 100 m x 10 s blocks (with the cache's 50 m x
@@ -37,7 +41,7 @@ from arzsumo.sweep.driver import map_runs
 NAME = "inlet"
 #: the results page this study keeps a block of (the identification's)
 PAGE = "identified_model"
-INLETS = ("ghost", "characteristic")
+INLETS = ("ghost", "supply", "ctm", "characteristic")
 VARIABLES = ("rho_h", "v_h", "rho_a", "v_a")
 #: blocks of the second RMSE: periods x cells (10 s x 100 m on 1 s x 50 m data)
 BLOCK = (10, 2)
@@ -74,7 +78,8 @@ def replay_one(task: tuple[str, str, str]) -> dict[str, Any]:
     if inlet == "characteristic":
         rule = functools.partial(characteristic, l4=linearize(sc.equilibrium).T[3],
                                  v_max=(params.v_free_h, params.v_free_a))
-    opts = ReplayOptions(cells=sc.run.twin_cells, scheme=sc.run.twin_scheme, ao_limit=0.9)
+    opts = ReplayOptions(cells=sc.run.twin_cells, scheme=sc.run.twin_scheme, ao_limit=0.9,
+                         inlet="ghost" if inlet == "characteristic" else inlet)
     with np.load(path) as z:
         data = ReplayData(**{k: z[k] for k in ARRAYS}, name=Path(path).stem[:8])
     run = run_replay(params, data, opts, inlet_rule=rule)
@@ -114,7 +119,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Replay every run under both inlets and write the table."""
+    """Replay every run under every inlet and write the table."""
     from arzsumo.studies.identify_cache import cache_dir
 
     scenario = args.scenario or shipped_scenario(FORMER_DEFAULT)

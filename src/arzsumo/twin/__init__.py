@@ -1,7 +1,8 @@
 """The nonlinear PDE twin: a finite-volume solver of the 4x4 mixed-autonomy ARZ model.
 
 Numerics only, in :mod:`state`, :mod:`flux`, :mod:`source`, :mod:`boundary`,
-:mod:`initial`, :mod:`scheme`, :mod:`solver` and :mod:`metrics`: they may import only
+:mod:`initial`, :mod:`scheme`, :mod:`solver`, :mod:`metrics` and :mod:`supply` (a
+cell's receiving capacity, for a bounded inlet flux): they may import only
 ``control``, ``model``, ``units`` and ``errors`` (the "math" contract in
 ``pyproject.toml``). Scenarios become twin runs elsewhere: the ``[twin]`` and
 ``[initial]`` sections in :mod:`arzsumo.scenario.twin`, the controllers in
