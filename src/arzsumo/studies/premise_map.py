@@ -356,14 +356,23 @@ def _map_demands(args: argparse.Namespace, path: Path, points: Sequence[MapPoint
     if not mapping:
         return {}, {}, ""
     kw = {"workers": args.workers, "scheduler": args.scheduler, "progress": not args.quiet}
-    found = run_design(mapping, discharge_task, out, label=f"{NAME} discharge", **kw)
-    second = run_design(discharge_runs(path, points, warmup, flowing(found)),
-                        discharge_task, out, label=f"{NAME} discharge at the mapped demand",
-                        **kw)
+    found = _labelled(mapping, run_design(mapping, discharge_task, out,
+                                          label=f"{NAME} discharge", **kw))
+    again = discharge_runs(path, points, warmup, flowing(found))
+    second = _labelled(again, run_design(again, discharge_task, out,
+                                         label=f"{NAME} discharge at the mapped demand",
+                                         **kw))
     text = mapping_lines(found, second)
     print(text)
     return flowing(second), {r["point"]: float(r.get("fill_shortfall_veh_s", 0.0))
                              for r in second}, text
+
+
+def _labelled(runs: Sequence[StudyRun], rows: Sequence[Mapping[str, Any]]
+              ) -> list[dict[str, Any]]:
+    """The rows of ``runs`` (in their order) under their runs' point names: a point
+    that shares its base point's discharge runs reads their rows as its own."""
+    return [{**r, "point": run.columns["point"]} for run, r in zip(runs, rows, strict=True)]
 
 
 def _page_body(page: str, wide: pd.DataFrame, mapped_text: str) -> str:

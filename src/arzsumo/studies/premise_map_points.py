@@ -57,13 +57,20 @@ class MapPoint:
     """One point of the map: ``name`` (its row), ``axis`` (what it varies), ``set``
     (sweep ``set`` keys of the base scenario, e.g. ``{"sumo.min_gap_lat_m": 0.6}``);
     ``mapped``: its demand is set from its own measured discharge, split by
-    ``av_share``."""
+    ``av_share``, its fill raised by ``fill_extra_veh_h`` beyond the rule's."""
 
     name: str
     axis: str
     set: Mapping[str, Any] = field(default_factory=dict)
     mapped: bool = False
     av_share: float = BASE_AV_SHARE
+    fill_extra_veh_h: float = 0.0
+
+    @property
+    def mapping_name(self) -> str:
+        """The name its discharge runs are stored under: a fuller fill's point shares
+        its base point's (the same scenario up to the fill the runs set themselves)."""
+        return self.name.split("+fill")[0]
 
     def __post_init__(self) -> None:
         bad = [k for k in self.set if not k.startswith("sumo.")]
@@ -150,6 +157,13 @@ def _mapped(name: str, av_share: float = BASE_AV_SHARE, **keys: Any) -> MapPoint
                     mapped=True, av_share=av_share)
 
 
+def fuller(p: MapPoint, extra_veh_h: float = 150.0) -> MapPoint:
+    """``p`` with ``extra_veh_h`` more fill (name ``P+fillNNN``): on the map's first
+    pass the queue's tail of some points stood inside the section on the gate seeds
+    although the mapping seed's did not."""
+    return replace(p, name=f"{p.name}+fill{round(extra_veh_h)}", fill_extra_veh_h=extra_veh_h)
+
+
 def share_variants(p: MapPoint, shares: tuple[float, ...] = (0.30, 0.50)) -> list[MapPoint]:
     """``p`` at other AV shares, each mapped to its own discharge (names ``P@avNN``)."""
     return [replace(p, name=f"{p.name}@av{round(100 * s)}", axis="penetration (mapped)",
@@ -195,6 +209,8 @@ POINTS: tuple[MapPoint, ...] = (
     _mapped("idm-flow-lc", hv_model="IDM", **FLOW_IDM, **MERGING),
     _mapped("idm-treiber-lc", hv_model="IDM", **TREIBER_IDM, **MERGING),
     *share_variants(UNSTABLE),
+    fuller(UNSTABLE),
+    fuller(_mapped("krauss-0.5-s1", hv_sigma=0.5, hv_sigma_step_s=1.0)),
 )
 
 
@@ -222,7 +238,7 @@ def discharge_runs(path: Path, points: Sequence[MapPoint], warmup: float,
         for r in design_runs(spec):
             period = scenario_from_dict(r.scenario, r.source).sumo.control_period
             n = max(1, round(DISCHARGE_WINDOW_S / period))
-            runs.append(replace(r, run_id=f"point={p.name},{r.run_id},kind={kind}",
+            runs.append(replace(r, run_id=f"point={p.mapping_name},{r.run_id},kind={kind}",
                                 columns={"point": p.name, "axis": p.axis, **r.columns},
                                 options={"kind": "baseline", "window_s": DISCHARGE_WINDOW_S,
                                          "horizon_periods": n,
@@ -236,8 +252,9 @@ def mapped_points(points: Sequence[MapPoint], discharges: Mapping[str, float],
     (``discharges``: point name -> q(L), veh/s) and its fill raised by the shortfall its
     run at the rule measured (``shortfalls``: point name -> veh/s)."""
     extra = shortfalls or {}
-    return [with_discharge(p, discharges[p.name], extra.get(p.name, 0.0)) if p.mapped
-            else p for p in points]
+    return [with_discharge(p, discharges[p.name],
+                           extra.get(p.name, 0.0) + p.fill_extra_veh_h / VEH_H_PER_VEH_S)
+            if p.mapped else p for p in points]
 
 
 def flowing(rows: Sequence[Mapping[str, Any]]) -> dict[str, float]:
