@@ -261,3 +261,16 @@ def test_the_map_reports_the_queue_tail_of_its_worst_seed():
                             fallback_trip=100.0)
     dx = rows[0]["dx_m"]
     assert wide["queue_tail_m"].iloc[0] == pytest.approx(4 * dx)
+
+
+def test_the_fields_figure_draws_each_points_first_seed_and_marks_a_tail():
+    from arzsumo.plots.premise_map import fields_figure
+
+    fields = pm.first_fields(_map_rows())
+    assert list(fields) == ["p"]
+    t, x, v = fields["p"]
+    base = next(r for r in _map_rows() if r["kind"] == "baseline" and r["seed"] == 1)
+    assert t[0] == pytest.approx(base["t_s"][0] - base["t0_s"])
+    assert v[0, 0] == pytest.approx(base["v_hv"][0][0] * 3.6)
+    fig = fields_figure(fields, {"p": 150.0})
+    assert fig.axes[0].get_title() == "p (tail 150 m)" and fig.axes[0].lines

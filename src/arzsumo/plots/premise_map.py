@@ -3,7 +3,7 @@ of seeds each gate passed on."""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 import pandas as pd
@@ -55,4 +55,37 @@ def theory_figure(wide: pd.DataFrame) -> Figure:
                  "operating point", fontsize=9)
     ax.legend(fontsize=7, loc="best")
     fig.tight_layout()
+    return fig
+
+
+def fields_figure(fields: Mapping[str, tuple[np.ndarray, np.ndarray, np.ndarray]],
+                  tails: Mapping[str, float] | None = None) -> Figure:
+    """Per point the HV speed field of its first seed's baseline (``fields``: point ->
+    (t after the warm-up, s; cell centres, m; speeds, periods x cells, km/h)), with the
+    queue's tail (``tails``, m) marked: stop-and-go shows as red stripes running down
+    and to the right in x against t, i.e. upstream; a tail inside the section as a
+    green band at x = 0."""
+    names = list(fields)
+    cols = min(4, max(1, len(names)))
+    rows = int(np.ceil(len(names) / cols))
+    fig, axes = plt.subplots(rows, cols, figsize=(3.4 * cols, 2.6 * rows), sharex=True,
+                             sharey=True, squeeze=False)
+    image = None
+    for ax, name in zip(axes.flat, names, strict=False):
+        t, x, v = fields[name]
+        image = ax.pcolormesh(t, x, np.asarray(v, float).T, cmap="RdYlGn", vmin=0,
+                              vmax=70, shading="auto")
+        tail = (tails or {}).get(name, 0.0)
+        if tail > 0:
+            ax.axhline(tail, color="k", lw=0.8, ls="--")
+        ax.set_title(name + (f" (tail {tail:.0f} m)" if tail > 0 else ""), fontsize=8)
+    for ax in axes.flat[len(names):]:
+        ax.set_visible(False)
+    for ax in axes[-1]:
+        ax.set_xlabel("t after the warm-up (s)", fontsize=8)
+    for ax in axes[:, 0]:
+        ax.set_ylabel("x (m)", fontsize=8)
+    if image is not None:
+        fig.colorbar(image, ax=axes, shrink=0.8, label="HV speed (km/h)")
+    fig.suptitle("the HVs' speeds on the section, first seed, open loop", fontsize=9)
     return fig

@@ -337,7 +337,8 @@ def run(args: argparse.Namespace) -> int:
                                 model_speeds(sc).round_trip, scenarios=scenarios)
         wide["discharge_veh_h"] = [discharges.get(n, math.nan) * VEH_H_PER_VEH_S
                                    for n in wide["point"]] if len(wide) else []
-        files = write_map(out, long, wide, MAP_GATES, plots=plots_wanted(args))
+        files = write_map(out, long, wide, MAP_GATES, plots=plots_wanted(args),
+                          fields=first_fields(rows))
         if args.docs is not None:
             publish(args.docs, args.page, NAME, "The premise map",
                     _page_body(args.page, wide, mapped_text), files)
@@ -366,6 +367,19 @@ def _map_demands(args: argparse.Namespace, path: Path, points: Sequence[MapPoint
     print(text)
     return flowing(second), {r["point"]: float(r.get("fill_shortfall_veh_s", 0.0))
                              for r in second}, text
+
+
+def first_fields(rows: Sequence[Mapping[str, Any]]
+                 ) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """Per point its first seed's baseline HV speed field: (t after the warm-up, s;
+    cell centres, m; speeds, km/h), for the figure."""
+    out: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+    for r in sorted((r for r in rows if r["kind"] == "baseline"), key=lambda r: r["seed"]):
+        if r["point"] not in out:
+            out[r["point"]] = (np.array(r["t_s"], float) - float(r["t0_s"]),
+                               np.array(r["x_m"], float),
+                               ms_to_kmh(np.array(r["v_hv"], float)))
+    return out
 
 
 def _labelled(runs: Sequence[StudyRun], rows: Sequence[Mapping[str, Any]]
