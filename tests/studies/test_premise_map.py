@@ -12,6 +12,7 @@ import pytest
 from arzsumo.evaluation.premise import GateResult
 from arzsumo.studies import premise_map as pm
 from arzsumo.studies import premise_map_points as pmp
+from arzsumo.studies import premise_map_tables as pmt
 from arzsumo.studies.common import StudyError, shipped_scenario
 from arzsumo.studies.premise_runs import PremiseOptions
 
@@ -29,7 +30,7 @@ def _map_rows() -> list[dict]:
 
 @pytest.fixture(scope="module")
 def tables():
-    return pm.map_tables(_map_rows(), [pm.MapPoint("p", "axis", {})], 1000.0,
+    return pmt.map_tables(_map_rows(), [pm.MapPoint("p", "axis", {})], 1000.0,
                          fallback_trip=100.0)
 
 
@@ -119,10 +120,10 @@ def test_the_round_trip_is_the_measured_one():
     base = rows[0]
     wave = GateResult("waves[hv]", WAVE_MS, 0.0, True)
     v = float(np.mean(base["v_hv"]))
-    assert pm.measured_round_trip(base, [wave], 1000.0) == pytest.approx(
+    assert pmt.measured_round_trip(base, [wave], 1000.0) == pytest.approx(
         1000 / v + 1000 / abs(WAVE_MS))
     down = GateResult("waves[hv]", -WAVE_MS, 0.0, False)
-    assert math.isnan(pm.measured_round_trip(base, [down], 1000.0))
+    assert math.isnan(pmt.measured_round_trip(base, [down], 1000.0))
 
 
 def test_the_tables_read_the_synthetic_stream(tables):
@@ -144,10 +145,10 @@ def test_the_tables_read_the_synthetic_stream(tables):
 def test_the_figure_has_a_cell_per_point_and_gate(tables):
     from arzsumo.plots.premise_map import premise_map_figure
 
-    fig = premise_map_figure(tables[1], pm.MAP_GATES)
+    fig = premise_map_figure(tables[1], pmt.MAP_GATES)
     ax = fig.axes[0]
-    assert ax.images[0].get_array().shape == (1, len(pm.MAP_GATES))
-    assert len(ax.texts) == len(pm.MAP_GATES)
+    assert ax.images[0].get_array().shape == (1, len(pmt.MAP_GATES))
+    assert len(ax.texts) == len(pmt.MAP_GATES)
 
 
 def test_the_theory_figure_puts_each_points_measurement_beside_its_prediction():
@@ -168,9 +169,9 @@ def test_the_theory_figure_puts_each_points_measurement_beside_its_prediction():
 
 def test_the_pulse_is_judged_within_the_round_trips_that_fit():
     rows = [r for r in _map_rows() if r["kind"] in ("baseline", "pulse")]
-    long, _ = pm.map_tables(rows, [pm.MapPoint("p", "axis", {})], 1000.0,
+    long, _ = pmt.map_tables(rows, [pm.MapPoint("p", "axis", {})], 1000.0,
                             fallback_trip=100.0,
-                            th=pm.PremiseThresholds(pulse_round_trips=0.9))
+                            th=pmt.PremiseThresholds(pulse_round_trips=0.9))
     pulse = long[long.gate == "pulse"].iloc[0]
     # the pulse decays in 40 s, well within 0.9 x 375 s: a stable stream fails the gate
     assert pulse["value"] < 100.0 and not pulse["passed"]
@@ -178,15 +179,15 @@ def test_the_pulse_is_judged_within_the_round_trips_that_fit():
 
 def test_one_seed_reads_the_pulse_but_leaves_it_undecided():
     rows = [r for r in _map_rows() if r["seed"] == 1]
-    long, _ = pm.map_tables(rows, [pm.MapPoint("p", "axis", {})], 1000.0,
+    long, _ = pmt.map_tables(rows, [pm.MapPoint("p", "axis", {})], 1000.0,
                             fallback_trip=100.0,
-                            th=pm.PremiseThresholds(pulse_round_trips=0.9))
+                            th=pmt.PremiseThresholds(pulse_round_trips=0.9))
     pulse = long[long.gate == "pulse"].iloc[0]
     assert math.isnan(pulse["value"]) and not pulse["passed"]
-    _, wide = pm.map_tables(rows, [pm.MapPoint("p", "axis", {})], 1000.0, fallback_trip=100.0)
+    _, wide = pmt.map_tables(rows, [pm.MapPoint("p", "axis", {})], 1000.0, fallback_trip=100.0)
     assert math.isnan(wide.iloc[0]["pulse_passed"])       # undecided: neither pass nor fail
-    gates = pm.point_gates({1: {r["kind"]: r for r in rows}}, 1000.0,
-                           pm.PremiseThresholds(pulse_round_trips=0.9), 30.0, 100.0)[1]
+    gates = pmt.point_gates({1: {r["kind"]: r for r in rows}}, 1000.0,
+                           pmt.PremiseThresholds(pulse_round_trips=0.9), 30.0, 100.0)[1]
     detail = next(g.detail for g in gates if g.name == "pulse")
     # against its own late deviation the decayed pulse reads as decayed within 100 s
     assert detail["late_floor_value"] < 100.0 and "one seed" in detail["reason"]
@@ -205,7 +206,7 @@ def test_the_theory_columns_are_the_prediction_at_each_seeds_measured_point():
     idm = replace(sc, sumo=sc.sumo.with_(hv_model="IDM"))
     rows = [{**r, "rho_hv_veh_m": 0.08 + 0.01 * r["seed"], "rho_av_veh_m": 0.02}
             for r in _map_rows()]
-    _, wide = pm.map_tables(rows, [pm.MapPoint("p", "axis", {})], 1000.0,
+    _, wide = pmt.map_tables(rows, [pm.MapPoint("p", "axis", {})], 1000.0,
                             fallback_trip=100.0, scenarios={"p": idm})
     v = float(np.mean(np.array(rows[0]["v_hv"])))     # both seeds' fields: mean 8 m/s
     want = np.mean([predict(idm.params, idm.sumo, 0.08 + 0.01 * s, 0.02, v)["hv"].gain
@@ -213,10 +214,10 @@ def test_the_theory_columns_are_the_prediction_at_each_seeds_measured_point():
     assert wide["gain_hv"].iloc[0] == pytest.approx(want, rel=1e-3)
     assert wide["gain_hv"].iloc[0] > 1.0                      # IDM at 8 m/s: unstable
     assert wide["growth_hv"].iloc[0] > wide["gain_hv"].iloc[0]
-    _, krauss = pm.map_tables(rows, [pm.MapPoint("p", "axis", {})], 1000.0,
+    _, krauss = pmt.map_tables(rows, [pm.MapPoint("p", "axis", {})], 1000.0,
                               fallback_trip=100.0, scenarios={"p": sc})
     assert math.isnan(krauss["gain_hv"].iloc[0]) and krauss["gain_av"].iloc[0] > 1.0
-    assert "max|G| hv" in pm.theory_markdown(wide)
+    assert "max|G| hv" in pmt.theory_markdown(wide)
 
 
 def test_a_gridlocked_discharge_run_leaves_its_point_out_and_says_so():
@@ -257,7 +258,7 @@ def test_the_map_reports_the_queue_tail_of_its_worst_seed():
             v = np.array(r["v_hv"], float)
             v[:, :4] = 3 * np.nanmean(v)                 # the first 4 cells ride free
             r["v_hv"] = v.tolist()
-    _, wide = pm.map_tables(rows, [pm.MapPoint("p", "axis", {})], 1000.0,
+    _, wide = pmt.map_tables(rows, [pm.MapPoint("p", "axis", {})], 1000.0,
                             fallback_trip=100.0)
     dx = rows[0]["dx_m"]
     assert wide["queue_tail_m"].iloc[0] == pytest.approx(4 * dx)
@@ -266,9 +267,9 @@ def test_the_map_reports_the_queue_tail_of_its_worst_seed():
 def test_the_fields_figure_draws_each_points_first_seed_and_marks_a_tail():
     from arzsumo.plots.premise_map import fields_figure
 
-    fields = pm.first_fields(_map_rows())
+    fields = pmt.first_fields(_map_rows())
     assert list(fields) == ["p"]
-    t, x, v = fields["p"]
+    t, _, v = fields["p"]
     base = next(r for r in _map_rows() if r["kind"] == "baseline" and r["seed"] == 1)
     assert t[0] == pytest.approx(base["t_s"][0] - base["t0_s"])
     assert v[0, 0] == pytest.approx(base["v_hv"][0][0] * 3.6)
