@@ -211,6 +211,12 @@ POINTS: tuple[MapPoint, ...] = (
     *share_variants(UNSTABLE),
     fuller(UNSTABLE),
     fuller(_mapped("krauss-0.5-s1", hv_sigma=0.5, hv_sigma_step_s=1.0)),
+    # the strongest attempts left: a reaction time equal to the time gap (the first map's
+    # action-1.0 held its size, 1.03, at a demand not its own), and IDM behind a slower
+    # downstream edge, which congests the section at IDM's own discharge
+    _mapped("action-1.0", hv_action_step_s=1.0),
+    fuller(_mapped("action-1.0", hv_action_step_s=1.0)),
+    _mapped("idm-sumo-lc-down30", hv_model="IDM", down_speed_kmh=30, **MERGING),
 )
 
 
