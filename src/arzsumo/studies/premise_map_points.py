@@ -214,8 +214,8 @@ POINTS: tuple[MapPoint, ...] = (
     # the strongest attempts left: a reaction time equal to the time gap (the first map's
     # action-1.0 held its size, 1.03, at a demand not its own), and IDM behind a slower
     # downstream edge, which congests the section at IDM's own discharge
-    _mapped("action-1.0", hv_action_step_s=1.0),
-    fuller(_mapped("action-1.0", hv_action_step_s=1.0)),
+    _mapped("action-1.0-mapped", hv_action_step_s=1.0),
+    fuller(_mapped("action-1.0-mapped", hv_action_step_s=1.0)),
     _mapped("idm-sumo-lc-down30", hv_model="IDM", down_speed_kmh=30, **MERGING),
 )
 
