@@ -226,6 +226,9 @@ def test_cli_reproduce_quick(tmp_path, monkeypatch, capsys):
                             for line in verdicts)
     assert "quick: a smoke test" in captured.out.splitlines()[0]
     assert "open loops for" not in captured.err          # no stray log line
+    # the claims quote the run's own horizon, the report its own grid
+    assert "at 40 s:" in captured.out and "450 s" not in captured.out
+    assert "the grid is 40 cells" in (out / "report.md").read_text(encoding="utf-8")
 
 
 def test_twin_overrides_reach_every_scenario_and_are_validated():

@@ -109,6 +109,13 @@ def _section(title: str, *blocks: str) -> list[str]:
     return [title, ""] + [line for block in blocks for line in (block, "")]
 
 
+def _cells(rep: Reproduction) -> str:
+    """The runs' grid as they ran it ("200"; a quick run's 40; "40-200" when mixed)."""
+    cells = sorted({int(r.summary["config"]["cells"]) for r in rep.records})
+    return "?" if not cells else str(cells[0]) if len(cells) == 1 else \
+        f"{cells[0]}-{cells[-1]}"
+
+
 def _overview(rep: Reproduction) -> list[str]:
     """Title, what was run, how to read the verdicts, and the runs without a baseline."""
     stopped = [f"{r.name}: {r.summary['open_loop_baseline']}" for r in rep.records
@@ -126,8 +133,8 @@ def _overview(rep: Reproduction) -> list[str]:
         "0.05 % in size), **no** = not reproduced. Magnitudes are not expected to match: "
         "the paper does not give the vehicle width d (2.0 m here), the initial amplitude "
         "(2 % stop-and-go here), the aggressive case's speeds and maximum AOs; its 1/4 "
-        "profile fraction is infeasible (0.15 here); the grid is 200 cells (first order "
-        "unless overridden).")
+        f"profile fraction is infeasible (0.15 here); the grid is {_cells(rep)} cells (first "
+        "order unless overridden).")
     baseline = ("Runs without a baseline because they or their open loop left the physical "
                 "domain (kept, marked incomplete): " + "; ".join(stopped) + "." if stopped
                 else "All runs and their open loops completed.")
