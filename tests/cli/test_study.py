@@ -7,8 +7,8 @@ import argparse
 import pytest
 
 from arzsumo.cli import main
+from arzsumo.cli.catalog import STUDIES, Study
 from arzsumo.cli.study import register
-from arzsumo.studies.catalog import STUDIES, Study
 from arzsumo.studies.common import add_output, add_runs
 
 

@@ -6,7 +6,7 @@ import argparse
 
 import pytest
 
-from arzsumo.studies.catalog import STUDIES
+from arzsumo.cli.catalog import STUDIES
 
 
 def parse(name: str, *argv: str) -> argparse.Namespace:

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from arzsumo.studies.catalog import _MODULES, STUDIES, Study
+from arzsumo.cli.catalog import _MODULES, STUDIES, Study
 from arzsumo.studies.common import DOCS_DIR, RESULTS_DIR
 
 from .conftest import parse
@@ -60,11 +60,11 @@ def test_a_bad_option_value_is_refused_by_the_parser(capsys):
 
 
 def test_the_catalog_imports_no_study_until_one_is_used():
-    code = ("import sys, arzsumo.studies.catalog as c; "
+    code = ("import sys, arzsumo.cli.catalog as c; "
             "print(sorted(m for m in sys.modules if m.startswith('arzsumo.studies.')))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True).stdout
-    assert out.strip() == "['arzsumo.studies.catalog']"
+    assert out.strip() == "[]"
     parser = argparse.ArgumentParser()
     STUDIES["fill"].add_arguments(parser)          # imports the study's module
     assert "arzsumo.studies.fill" in sys.modules

@@ -275,3 +275,28 @@ def test_the_fields_figure_draws_each_points_first_seed_and_marks_a_tail():
     assert v[0, 0] == pytest.approx(base["v_hv"][0][0] * 3.6)
     fig = fields_figure(fields, {"p": 150.0})
     assert fig.axes[0].get_title() == "p (tail 150 m)" and fig.axes[0].lines
+
+
+def test_the_study_runs_from_python_with_its_options_and_the_cli_maps_onto_them():
+    """Library code: MapOptions in, run IDs (or a MapResult) out, no argparse; the
+    command line builds the same options."""
+    import argparse
+    from pathlib import Path
+
+    from arzsumo.cli.studies import premise_map as cli
+
+    opts = pm.MapOptions(scenario=shipped_scenario("default.toml"),
+                         points=("coupled", "krauss-0.75-s1"), seeds=(3,), pulses=False)
+    assert pm.design(opts) == [
+        f"point=krauss-0.75-s1,seed={pmp.MAPPING_SEED},kind=discharge",
+        "point=coupled,seed=3,kind=baseline", "point=krauss-0.75-s1,seed=3,kind=baseline"]
+    parser = argparse.ArgumentParser()
+    cli.add_arguments(parser)
+    args = parser.parse_args(["--scenario", str(opts.scenario), "--points",
+                              "coupled,krauss-0.75-s1", "--seeds", "3", "--no-pulse",
+                              "--out", "results/studies/premise-map"])
+    assert cli.options(args) == opts
+    assert cli.options(parser.parse_args(["--out", "x"])).out == Path("x")
+    with pytest.raises(StudyError, match="at least one seed"):
+        pm.MapOptions(seeds=())
+    assert "argparse" not in Path(pm.__file__).read_text(encoding="utf-8")

@@ -1,5 +1,5 @@
 """``arzsumo study NAME [OPTIONS]``: one sub-command per study of
-:data:`arzsumo.studies.catalog.STUDIES`.
+:data:`arzsumo.cli.catalog.STUDIES`.
 
 Each sub-command gets the study's options (``Study.add_arguments``: every study declares
 its own, ``--out`` defaulting to ``results/studies/NAME``, from the shared helpers of
@@ -11,12 +11,12 @@ from __future__ import annotations
 
 import argparse
 
-from arzsumo.studies.catalog import STUDIES, Study
+from arzsumo.cli.catalog import STUDIES, Study
 
 
 def _epilog(studies: dict[str, Study]) -> str:
     if not studies:
-        return "no studies are registered yet (arzsumo.studies.catalog.STUDIES is empty)"
+        return "no studies are registered yet (arzsumo.cli.catalog.STUDIES is empty)"
     return "'arzsumo study NAME --help' shows a study's options."
 
 

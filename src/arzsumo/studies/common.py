@@ -1,4 +1,4 @@
-"""What the studies of :mod:`arzsumo.studies.catalog` share: their command-line options,
+"""What the studies of :mod:`arzsumo.cli.catalog` share: their command-line options,
 their error type, and the base scenarios they start from.
 
 Every study takes ``--out DIR`` (default ``results/studies/<name>``: tables, figures and

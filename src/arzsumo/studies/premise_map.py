@@ -28,10 +28,9 @@ measured operating point and the mapped discharge) and ``premise_map.png``.
 
 from __future__ import annotations
 
-import argparse
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -42,11 +41,8 @@ from arzsumo.outputs.premise_map import write_map
 from arzsumo.outputs.studies import publish
 from arzsumo.studies.common import (
     FORMER_DEFAULT,
+    RESULTS_DIR,
     StudyError,
-    add_output,
-    add_runs,
-    plots_wanted,
-    print_list,
     shipped_scenario,
     study_spec,
 )
@@ -104,63 +100,95 @@ def map_runs(path: Path, points: Sequence[MapPoint], seeds: Sequence[int], warmu
 
 
 # -- the command ---------------------------------------------------------------------------
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """The premise map's options."""
-    parser.add_argument("--scenario", type=Path, metavar="SCENARIO.toml",
-                        help="base scenario every point changes (default: the former "
-                             "default, lateral_files)")
-    parser.add_argument("--points", default=None, metavar="LIST",
-                        help="comma-separated point names (default: all: "
-                             + ", ".join(p.name for p in POINTS) + ")")
-    parser.add_argument("--window", type=float, default=540.0,
-                        help="baseline and pulse window after the warm-up, s")
-    parser.add_argument("--pulse-s", type=float, default=25.0,
-                        help="the pulse: the meter at its least plan this long, s")
-    parser.add_argument("--no-pulse", action="store_true",
-                        help="baselines only (the pulse gate is then not measured)")
-    add_runs(parser, seeds="1,2")
-    add_output(parser, NAME, PAGE)
-    parser.add_argument("--page", default=PAGE, metavar="NAME",
-                        help=f"the results page --docs regenerates, DIR/NAME.md (default: "
-                             f"{PAGE}; e.g. premise_map_car_following for that axis)")
-
-
-def selected_points(text: str | None) -> list[MapPoint]:
-    """The points named in ``text`` (comma-separated; None: all)."""
-    if text is None:
+def selected_points(names: str | Sequence[str] | None) -> list[MapPoint]:
+    """The points named in ``names`` (a sequence, or comma-separated; None: all)."""
+    if names is None:
         return list(POINTS)
     known = {p.name: p for p in POINTS}
-    names = [n.strip() for n in text.split(",") if n.strip()]
-    bad = [n for n in names if n not in known]
-    if bad or not names:
+    text = names if isinstance(names, str) else ",".join(names)
+    wanted = [n.strip() for n in text.split(",") if n.strip()]
+    bad = [n for n in wanted if n not in known]
+    if bad or not wanted:
         raise StudyError(f"--points = {text!r} is not allowed: names among "
                          f"{', '.join(known)}")
-    return [known[n] for n in names]
+    return [known[n] for n in wanted]
 
 
-def run(args: argparse.Namespace) -> int:
+@dataclass(frozen=True)
+class MapOptions:
+    """What a premise map runs and where it writes (SI: s).
+
+    ``scenario``: the base scenario file every point changes (None: the former default);
+    ``points``: point names (None: all of :data:`POINTS`); ``seeds``: the gate seeds (the
+    first also pulsed when ``pulses``); ``window_s``, ``pulse_s``: the baseline and pulse
+    window and the pulse's hold; ``out``: the study's directory (resumable); ``docs``,
+    ``page``: the results page to regenerate (None: none); ``plots``; ``workers``,
+    ``scheduler``, ``progress``: how the runs are run.
+    """
+
+    scenario: Path | None = None
+    points: tuple[str, ...] | None = None
+    seeds: tuple[int, ...] = (1, 2)
+    window_s: float = 540.0
+    pulse_s: float = 25.0
+    pulses: bool = True
+    out: Path = RESULTS_DIR / NAME
+    docs: Path | None = None
+    page: str = PAGE
+    plots: bool = True
+    workers: int | None = None
+    scheduler: str | None = None
+    progress: bool = True
+
+    def __post_init__(self) -> None:
+        if not self.seeds:
+            raise StudyError("seeds = () is not allowed: at least one seed")
+
+
+@dataclass(frozen=True)
+class MapResult:
+    """A map's outcome: the ``points`` as run (their demands mapped), the measured
+    ``discharges`` (point -> q(L), veh/s), the per point, seed and gate table ``long``,
+    the per-point table ``wide``, the mapping's lines and the ``files`` written."""
+
+    points: tuple[MapPoint, ...]
+    discharges: Mapping[str, float]
+    long: pd.DataFrame
+    wide: pd.DataFrame
+    mapping: str
+    files: tuple[Path, ...]
+
+
+def design(opts: MapOptions) -> list[str]:
+    """The run IDs a map would run: the discharge runs, then the gates' runs."""
+    from arzsumo.scenario import load_scenario
+
+    path = opts.scenario or shipped_scenario(FORMER_DEFAULT)
+    points = selected_points(opts.points)
+    warmup = load_scenario(path).run.warmup
+    runs = map_runs(path, points, opts.seeds, warmup, PremiseOptions(opts.window_s,
+                                                                     opts.pulse_s),
+                    pulses=opts.pulses)
+    return [r.run_id for r in discharge_runs(path, points, warmup) + runs]
+
+
+def run_map(opts: MapOptions) -> MapResult:
     """Map the mapped points' demands to their discharge, run the map's points (or read
-    them from ``--out``) and write its tables."""
+    them from ``opts.out``) and write its tables and figures."""
     from arzsumo.scenario import load_scenario, scenario_from_dict
 
-    path = args.scenario or shipped_scenario(FORMER_DEFAULT)
-    points = selected_points(args.points)
+    path = opts.scenario or shipped_scenario(FORMER_DEFAULT)
+    points = selected_points(opts.points)
     sc = load_scenario(path)
-    opts = PremiseOptions(args.window, args.pulse_s)
-    if args.list:
-        runs = map_runs(path, points, args.seeds, sc.run.warmup, opts,
-                        pulses=not args.no_pulse)
-        mapping = discharge_runs(path, points, sc.run.warmup)
-        return print_list([r.run_id for r in mapping + runs])
-    with resumable_dir(args.out, f"study-{NAME}") as out:
-        discharges, shortfalls, mapped_text = _map_demands(args, path, points,
+    with resumable_dir(opts.out, f"study-{NAME}") as out:
+        discharges, shortfalls, mapped_text = _map_demands(opts, path, points,
                                                            sc.run.warmup, out)
         points = mapped_points([p for p in points if not p.mapped or p.name in discharges],
                                discharges, shortfalls)
-        runs = map_runs(path, points, args.seeds, sc.run.warmup, opts,
-                        pulses=not args.no_pulse)
-        rows = ungrouped(run_design(grouped(runs), _task, out, workers=args.workers,
-                                    scheduler=args.scheduler, progress=not args.quiet,
+        runs = map_runs(path, points, opts.seeds, sc.run.warmup,
+                        PremiseOptions(opts.window_s, opts.pulse_s), pulses=opts.pulses)
+        rows = ungrouped(run_design(grouped(runs), _task, out, workers=opts.workers,
+                                    scheduler=opts.scheduler, progress=opts.progress,
                                     label=NAME))
         scenarios = {}
         for r in runs:
@@ -169,17 +197,16 @@ def run(args: argparse.Namespace) -> int:
                                 model_speeds(sc).round_trip, scenarios=scenarios)
         wide["discharge_veh_h"] = [discharges.get(n, math.nan) * VEH_H_PER_VEH_S
                                    for n in wide["point"]] if len(wide) else []
-        files = write_map(out, long, wide, MAP_GATES, plots=plots_wanted(args),
+        files = write_map(out, long, wide, MAP_GATES, plots=opts.plots,
                           fields=first_fields(rows))
-        if args.docs is not None:
-            publish(args.docs, args.page, NAME, "The premise map",
-                    _page_body(args.page, wide, mapped_text), files)
-    print(map_markdown(wide))
-    print(theory_markdown(wide))
-    return 0
+        if opts.docs is not None:
+            publish(opts.docs, opts.page, NAME, "The premise map",
+                    _page_body(opts.page, wide, mapped_text), files)
+    return MapResult(tuple(points), discharges, long, wide, mapped_text,
+                     tuple(Path(f) for f in files))
 
 
-def _map_demands(args: argparse.Namespace, path: Path, points: Sequence[MapPoint],
+def _map_demands(opts: MapOptions, path: Path, points: Sequence[MapPoint],
                  warmup: float, out: Path
                  ) -> tuple[dict[str, float], dict[str, float], str]:
     """The mapped points' two discharge runs: (point -> q(L), veh/s, for the points
@@ -188,7 +215,7 @@ def _map_demands(args: argparse.Namespace, path: Path, points: Sequence[MapPoint
     mapping = discharge_runs(path, points, warmup)
     if not mapping:
         return {}, {}, ""
-    kw = {"workers": args.workers, "scheduler": args.scheduler, "progress": not args.quiet}
+    kw = {"workers": opts.workers, "scheduler": opts.scheduler, "progress": opts.progress}
     found = _labelled(mapping, run_design(mapping, discharge_task, out,
                                           label=f"{NAME} discharge", **kw))
     again = discharge_runs(path, points, warmup, flowing(found))

@@ -15,7 +15,14 @@ invalid, failed or crashed) and raises
 :class:`~arzsumo.errors.ArzsumoError` for bad input. A study's module is imported only
 when its options or its run are asked for.
 
-Use without the CLI::
+A study that is library code (:data:`LIBRARY_STUDIES`) is called from Python with its
+frozen options, no argparse involved::
+
+    from arzsumo.studies.premise_map import MapOptions, run_map
+    result = run_map(MapOptions(points=("coupled",), seeds=(1, 2)))
+
+its command line lives in :mod:`arzsumo.cli.studies`. The others still take a parsed
+command line::
 
     parser = argparse.ArgumentParser()
     study = STUDIES["ablation"]
@@ -93,8 +100,18 @@ _MODULES = {
                                    "share in SUMO, per seed"),
 }
 
+#: the studies that are library code (frozen Options, ``run(options) -> Result``): their
+#: command line is :mod:`arzsumo.cli.studies`'s module of the same name
+LIBRARY_STUDIES = frozenset({"premise-map"})
+
+
+def _command_module(name: str, module: str) -> str:
+    return f"arzsumo.cli.studies.{module}" if name in LIBRARY_STUDIES \
+        else f"arzsumo.studies.{module}"
+
+
 STUDIES: dict[str, Study] = {
-    name: Study(name, text, _lazy(f"arzsumo.studies.{module}", "add_arguments"),
-                _lazy(f"arzsumo.studies.{module}", "run"))
+    name: Study(name, text, _lazy(_command_module(name, module), "add_arguments"),
+                _lazy(_command_module(name, module), "run"))
     for name, (module, text) in _MODULES.items()
 }
