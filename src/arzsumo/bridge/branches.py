@@ -32,7 +32,8 @@ from functools import partial
 from typing import Any, TypeVar
 
 from arzsumo.bridge.cosim import OpenRun, Warmed, finish_run, open_run, warm_start
-from arzsumo.bridge.session import PreparedRun, SumoSession
+from arzsumo.bridge.prepared import PreparedRun
+from arzsumo.bridge.session import SumoSession
 from arzsumo.errors import ArzsumoError
 from arzsumo.io import json_safe
 from arzsumo.scenario.run import WINDOW_ONLY_RUN_KEYS, RunSettings
