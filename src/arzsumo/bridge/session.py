@@ -202,9 +202,7 @@ def run_prepared(run: PreparedRun, *, progress: bool | RunProgress = False,
                  frontend: str = "libsumo") -> SumoSession:
     """Run a :class:`PreparedRun` (checked once, by :func:`prepare_run`) in SUMO;
     ``progress`` as in :func:`arzsumo.bridge.cosim.open_run`."""
-    res = run_cosimulation(run.scenario, run.settings, run.sumo, run.design,
-                           initial_fields=run.initial, curve=run.curve, progress=progress,
-                           frontend=frontend)
+    res = run_cosimulation(run, progress=progress, frontend=frontend)
     return SumoSession(res, run.settings, run.sumo)
 
 
