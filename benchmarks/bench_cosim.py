@@ -12,11 +12,10 @@ from __future__ import annotations
 
 import argparse
 import time
-from dataclasses import replace
 from pathlib import Path
 
 from arzsumo.bridge.cosim import run_cosimulation
-from arzsumo.control.etc import PAPER_DESIGN
+from arzsumo.bridge.session import prepare_run
 from arzsumo.scenario import load_scenario
 from arzsumo.sumo.simulation import open_simulation
 
@@ -38,15 +37,14 @@ def main() -> None:
     ap.add_argument("--horizon", type=float, default=450.0)
     args = ap.parse_args()
     sc = load_scenario(DEFAULT)
-    settings = replace(sc.run, controller=args.controller)
-    cfg = sc.sumo.with_(horizon=args.horizon)
-    total = settings.warmup + args.horizon
-    run_cosimulation(sc, settings, cfg.with_(horizon=10.0), PAPER_DESIGN)   # kernels cached
+    run = prepare_run(sc, controller=args.controller, horizon=args.horizon)
+    total = run.settings.warmup + args.horizon
+    run_cosimulation(prepare_run(sc, controller=args.controller, horizon=10.0))  # kernels
     t_bare, t_co, last = [], [], None
     for _ in range(args.pairs):
-        t_bare.append(bare(sc, cfg, total))
+        t_bare.append(bare(sc, run.sumo, total))
         t0 = time.perf_counter()
-        last = run_cosimulation(sc, settings, cfg, PAPER_DESIGN)
+        last = run_cosimulation(run)
         t_co.append(time.perf_counter() - t0)
     b, c = min(t_bare), min(t_co)
     tm = last.timings

@@ -27,12 +27,12 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 
 import argparse  # noqa: E402
 import time  # noqa: E402
-from dataclasses import replace  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 from arzsumo.bridge.cosim import run_cosimulation  # noqa: E402
-from arzsumo.control.etc import PAPER_DESIGN  # noqa: E402
-from arzsumo.scenario import load_scenario  # noqa: E402
+from arzsumo.bridge.prepared import PreparedRun  # noqa: E402
+from arzsumo.bridge.session import prepare_run  # noqa: E402
+from arzsumo.scenario import Scenario, load_scenario  # noqa: E402
 
 LEGACY = Path(__file__).resolve().parents[1] / "scenarios" / "legacy_default.toml"
 SENSORS = {"sensing.kinds": ["probe", "loops", "av_probes"], "sensing.loop_spacing_m": 250}
@@ -49,22 +49,25 @@ def main() -> None:
     ap.add_argument("--warmup", type=float, default=None, help="s (default: the scenario's)")
     args = ap.parse_args()
     base = load_scenario(args.scenario).with_(SENSORS)
-    runs = {name: base.with_(ch) if ch else base for name, ch in METHODS.items()}
-    settings = replace(base.run, controller=args.controller,
-                       warmup=base.run.warmup if args.warmup is None else args.warmup)
-    cfg = base.sumo.with_(horizon=args.horizon)
-    run_cosimulation(base, settings, cfg.with_(horizon=5.0), PAPER_DESIGN)  # kernels cached
+    def prepared(sc: Scenario, horizon: float) -> PreparedRun:
+        return prepare_run(sc, controller=args.controller, horizon=horizon,
+                           warmup=args.warmup)
+
+    runs = {name: prepared(base.with_(ch) if ch else base, args.horizon)
+            for name, ch in METHODS.items()}
+    run_cosimulation(prepared(base, 5.0))  # kernels cached
     wall: dict[str, list[float]] = {name: [] for name in runs}
     per_period: dict[str, float] = {}
     for _ in range(args.repeats):
-        for name, sc in runs.items():
+        for name, run in runs.items():
             t0 = time.perf_counter()
-            res = run_cosimulation(sc, settings, cfg, PAPER_DESIGN)
+            res = run_cosimulation(run)
             wall[name].append(time.perf_counter() - t0)
             per_period[name] = res.timings["estimator"] / max(1, res.t.size)
     ref = min(wall["none"])
+    warmup = runs["none"].settings.warmup
     print(f"scenario {base.name}, controller {args.controller}, warm-up "
-          f"{settings.warmup:g} s + {args.horizon:g} s control, loops every 250 m + AV "
+          f"{warmup:g} s + {args.horizon:g} s control, loops every 250 m + AV "
           f"probes, best of {args.repeats}, OPENBLAS_NUM_THREADS="
           f"{os.environ['OPENBLAS_NUM_THREADS']}")
     print(f"{'method':<10} {'wall s':>8} {'ratio':>7} {'estimator ms/period':>20}")

@@ -23,7 +23,6 @@ import re
 import subprocess
 import tempfile
 import time
-from dataclasses import replace
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -36,12 +35,12 @@ def cosim(sc, controller: str, seed: int, horizon: float | None, keep: Path | No
     from arzsumo.bridge.cosim import finish_run, open_run, warm_start
     from arzsumo.bridge.session import prepare_run
 
-    run = prepare_run(sc, controller=controller, seed=seed, horizon=horizon)
-    settings, cfg = run.settings, replace(run.sumo, drain_max=0.0)
+    run = prepare_run(sc.with_({"sumo.drain_max_s": 0}), controller=controller, seed=seed,
+                      horizon=horizon)
     t0 = time.perf_counter()
-    with open_run(run.scenario, settings, cfg, run.initial) as opened:
-        warmed = warm_start(opened.sim, run.scenario, settings, cfg, run.curve, opened.bar)
-        res = finish_run(opened, warmed, run.scenario, settings, cfg, run.design, run.curve)
+    with open_run(run) as opened:
+        warmed = warm_start(opened.sim, run, opened.bar)
+        res = finish_run(opened, warmed, run)
         updates, end = opened.sim.vehicle_updates, opened.sim.time
     wall = time.perf_counter() - t0
     if keep is not None:

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import json
 import re
-from dataclasses import replace
 from pathlib import Path
 
 import pandas as pd
@@ -49,17 +48,14 @@ def run_dir(tmp_path_factory):
     """A short closed loop in SUMO (ETC), written as ``arzsumo run`` writes it."""
 
     from arzsumo.bridge.cosim import run_cosimulation
-    from arzsumo.control.etc import PAPER_DESIGN
     from arzsumo.outputs.bridge import write_results
-    from arzsumo.scenario import load_scenario
+    from tests.runs import LEGACY, prepared
 
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv("ARZSUMO_CACHE", str(tmp_path_factory.mktemp("cache")))
-        sc = load_scenario(ROOT / "scenarios" / "legacy_default.toml")
-        settings = replace(sc.run, controller="etc", warmup=20.0,
-                           kernel_cells=40, twin_cells=40)
-        cfg = sc.sumo.with_(horizon=20.0, seed=3)
-        res = run_cosimulation(sc, settings, cfg, PAPER_DESIGN)
+        run = prepared(LEGACY, {"run.kernel_cells": 40, "run.twin_cells": 40},
+                       controller="etc", warmup=20.0, horizon=20.0, seed=3)
+        res = run_cosimulation(run)
         path, summ = write_results(res, tmp_path_factory.mktemp("run") / "run", "# t\n",
                                    plots=False)
     return path, summ

@@ -3,7 +3,6 @@
 
 from __future__ import annotations
 
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -11,10 +10,9 @@ import pyarrow.parquet as pq
 import pytest
 
 from arzsumo.bridge.cosim import run_cosimulation
-from arzsumo.control.etc import PAPER_DESIGN
 from arzsumo.outputs.bridge import write_results
-from arzsumo.scenario import load_scenario
 from arzsumo.sumo.green_share import DEFAULT_CURVE, fixed_cycle_ramp_floor, fixed_cycle_u_range
+from tests.runs import SMALL_GRIDS, prepared
 
 pytestmark = pytest.mark.sumo
 DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "legacy_default.toml"
@@ -23,10 +21,9 @@ TOL = 1e-9
 
 
 def _run(controller, changes):
-    sc = load_scenario(DEFAULT).with_(changes)
-    settings = replace(sc.run, controller=controller, warmup=60.0, kernel_cells=50,
-                       twin_cells=50)
-    return run_cosimulation(sc, settings, sc.sumo.with_(horizon=60.0, seed=42), PAPER_DESIGN)
+    return run_cosimulation(prepared(DEFAULT, {**changes, **SMALL_GRIDS},
+                                     controller=controller, warmup=60.0, horizon=60.0,
+                                     seed=42))
 
 
 @pytest.fixture(scope="module")

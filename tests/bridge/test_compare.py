@@ -7,7 +7,6 @@ import json
 import os
 import subprocess
 import sys
-from dataclasses import replace
 from pathlib import Path
 
 import pandas as pd
@@ -16,10 +15,10 @@ import pytest
 from arzsumo.bridge.compare import bar_title, row_of
 from arzsumo.bridge.cosim import run_cosimulation
 from arzsumo.cli import main
-from arzsumo.control.etc import PAPER_DESIGN
 from arzsumo.outputs.bridge import write_results
 from arzsumo.outputs.compare import compare_runs
 from arzsumo.scenario import load_scenario
+from tests.runs import prepared
 
 DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "legacy_default.toml"
 SRC = str(Path(__file__).resolve().parents[2] / "src")
@@ -49,10 +48,8 @@ def dirs(tmp_path_factory):
                                             ("a1", "alinea", 1, 12.0),
                                             ("a2", "alinea", 2, 12.0),
                                             ("long", "open", 1, 18.0)):
-        settings = replace(sc.run, controller=controller,
-                           warmup=12.0, twin_cells=40)
-        cfg = sc.sumo.with_(horizon=horizon, seed=seed)
-        res = run_cosimulation(sc, settings, cfg, PAPER_DESIGN)
+        res = run_cosimulation(prepared(sc, {"run.twin_cells": 40}, controller=controller,
+                                        warmup=12.0, horizon=horizon, seed=seed))
         out[name] = write_results(res, root / name, "# test\n", plots=False)[0]
     (root / "twin.toml").write_text(TWIN)
     assert main(["twin", str(root / "twin.toml"), "--out", str(root / "twin"), "--no-plots",

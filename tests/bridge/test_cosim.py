@@ -5,7 +5,6 @@ import signal
 import subprocess
 import sys
 import time
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -16,10 +15,10 @@ import pytest
 from arzsumo.bridge.cosim import run_cosimulation
 from arzsumo.bridge.session import prepare_run
 from arzsumo.cli import main
-from arzsumo.control.etc import PAPER_DESIGN
 from arzsumo.errors import ScenarioError
 from arzsumo.outputs.bridge import write_results
 from arzsumo.scenario import load_scenario
+from tests.runs import SMALL_GRIDS, prepared
 
 DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "legacy_default.toml"
 pytestmark = pytest.mark.sumo
@@ -31,10 +30,8 @@ def scenario():
 
 
 def _short(scenario, controller, seed=42, horizon=60.0, warmup=40.0):
-    settings = replace(scenario.run, controller=controller,
-                       warmup=warmup, kernel_cells=50, twin_cells=50)
-    cfg = scenario.sumo.with_(horizon=horizon, seed=seed)
-    return run_cosimulation(scenario, settings, cfg, PAPER_DESIGN)
+    return run_cosimulation(prepared(scenario, SMALL_GRIDS, controller=controller, seed=seed,
+                                     horizon=horizon, warmup=warmup))
 
 
 @pytest.fixture(scope="module")

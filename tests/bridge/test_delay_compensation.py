@@ -5,7 +5,6 @@ from the law's); every command is recomputed here from the state the controller 
 
 from __future__ import annotations
 
-from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -15,13 +14,13 @@ from arzsumo.bridge.delay import compensate
 from arzsumo.bridge.session import prepare_run
 from arzsumo.control.backstepping import Backstepping
 from arzsumo.control.base import MacroState
-from arzsumo.control.etc import PAPER_DESIGN
 from arzsumo.control.predictor import committed, predict_riemann
 from arzsumo.errors import ScenarioError
 from arzsumo.kernel_cache import cached_kernels
 from arzsumo.model.characteristic import linearize
 from arzsumo.outputs.bridge import actuation_summary
 from arzsumo.scenario import load_scenario
+from tests.runs import SMALL_GRIDS, prepared
 
 DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "legacy_default.toml"
 THETA = 12.0
@@ -37,10 +36,9 @@ def cache(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def run(cache):
-    sc = load_scenario(DEFAULT).with_(CHANGES)
-    settings = replace(sc.run, controller="backstepping", warmup=30.0, kernel_cells=50,
-                       twin_cells=50)
-    return run_cosimulation(sc, settings, sc.sumo.with_(horizon=30.0, seed=42), PAPER_DESIGN)
+    return run_cosimulation(prepared(DEFAULT, {**CHANGES, **SMALL_GRIDS},
+                                     controller="backstepping", warmup=30.0, horizon=30.0,
+                                     seed=42))
 
 
 def _law_on_prediction(res, k, delay, column="u_applied"):

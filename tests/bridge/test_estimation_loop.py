@@ -14,7 +14,6 @@ from __future__ import annotations
 import contextlib
 import io
 import math
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -22,9 +21,8 @@ import pytest
 
 from arzsumo.bridge.cosim import run_cosimulation
 from arzsumo.cli import main
-from arzsumo.control.etc import PAPER_DESIGN
 from arzsumo.outputs.bridge import VARIABLES, summary
-from arzsumo.scenario import load_scenario
+from tests.runs import SMALL_GRIDS, prepared
 
 pytestmark = pytest.mark.sumo
 
@@ -33,11 +31,9 @@ LOOPS = {"sensing.kinds": ["loops", "av_probes"], "sensing.loop_spacing_m": 250}
 
 
 def _run(changes, controller, horizon=60.0):
-    sc = load_scenario(DEFAULT).with_(changes) if changes else load_scenario(DEFAULT)
-    settings = replace(sc.run, controller=controller, warmup=40.0, kernel_cells=50,
-                       twin_cells=50)
-    return run_cosimulation(sc, settings, sc.sumo.with_(horizon=horizon, seed=42),
-                            PAPER_DESIGN)
+    return run_cosimulation(prepared(DEFAULT, {**(changes or {}), **SMALL_GRIDS},
+                                     controller=controller, warmup=40.0, horizon=horizon,
+                                     seed=42))
 
 
 @pytest.fixture(scope="module")

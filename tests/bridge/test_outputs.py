@@ -7,7 +7,6 @@ control window's counts.
 """
 
 import json
-from dataclasses import replace
 from itertools import pairwise
 from pathlib import Path
 
@@ -16,11 +15,11 @@ import pyarrow.parquet as pq
 import pytest
 
 from arzsumo.bridge.cosim import run_cosimulation
-from arzsumo.control.etc import PAPER_DESIGN
 from arzsumo.outputs.bridge import write_results
 from arzsumo.scenario import load_scenario
 from arzsumo.sumo.green_share import plan_green_steps
 from arzsumo.sumo.runner import run_fixed_meter
+from tests.runs import SMALL_GRIDS, prepared
 
 DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "legacy_default.toml"
 WARMUP, HORIZON = 30.0, 30.0
@@ -31,15 +30,13 @@ pytestmark = pytest.mark.sumo
 def result(tmp_path_factory):
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv("ARZSUMO_CACHE", str(tmp_path_factory.mktemp("cache")))
-        sc = load_scenario(DEFAULT)
-        settings = replace(sc.run, controller="backstepping",
-                           warmup=WARMUP, kernel_cells=50, twin_cells=50)
-        cfg = sc.sumo.with_(horizon=HORIZON, seed=1)
-        res = run_cosimulation(sc, settings, cfg, PAPER_DESIGN)
+        run = prepared(DEFAULT, SMALL_GRIDS, controller="backstepping", warmup=WARMUP,
+                       horizon=HORIZON, seed=1)
+        res = run_cosimulation(run)
         path, _ = write_results(res, tmp_path_factory.mktemp("run") / "bs", "# test\n",
                                 plots=False)
     summ = json.loads((path / "summary.json").read_text())
-    return cfg, pq.read_table(path / "periods.parquet").to_pandas(), summ
+    return run.sumo, pq.read_table(path / "periods.parquet").to_pandas(), summ
 
 
 def _nominal(cfg) -> int:

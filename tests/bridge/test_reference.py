@@ -3,7 +3,6 @@ deviations from the mean state SUMO held in the warm-up."""
 
 from __future__ import annotations
 
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -18,6 +17,7 @@ from arzsumo.kernel_cache import cached_kernels
 from arzsumo.model.characteristic import linearize
 from arzsumo.outputs.bridge import summary
 from arzsumo.scenario import load_scenario
+from tests.runs import prepared
 
 ROOT = Path(__file__).resolve().parents[2]
 LEGACY = ROOT / "scenarios" / "legacy_default.toml"
@@ -71,12 +71,10 @@ def test_in_sumo_the_first_command_differs_by_the_law_of_the_offset(tmp_path, mo
     sc = load_scenario(LEGACY)
 
     def run(reference: str):
-        s = sc.with_({"estimation.reference": reference,
-                      "estimation.reference_window_s": 30})
-        settings = replace(s.run, controller="backstepping", warmup=60.0, kernel_cells=40,
-                           twin_cells=40)
-        return run_cosimulation(s, settings, s.sumo.with_(horizon=10.0, seed=7),
-                                PAPER_DESIGN)
+        changes = {"estimation.reference": reference, "estimation.reference_window_s": 30,
+                   "run.kernel_cells": 40, "run.twin_cells": 40}
+        return run_cosimulation(prepared(sc, changes, controller="backstepping",
+                                         warmup=60.0, horizon=10.0, seed=7))
 
     plain, shifted = run("equilibrium"), run("warmup")
     assert plain.shift is None and shifted.shift is not None

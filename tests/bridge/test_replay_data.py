@@ -4,7 +4,6 @@ replay twin, given that data, reproduces the bridge's replay twin of the run."""
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -19,7 +18,7 @@ from arzsumo.bridge.boundary_data import (
 )
 from arzsumo.bridge.cosim import run_cosimulation
 from arzsumo.bridge.replay_data import replay_data_of, replay_options_of
-from arzsumo.control.etc import PAPER_DESIGN
+from arzsumo.bridge.session import prepare_run
 from arzsumo.identify import run_replay
 from arzsumo.model.fd import equilibrium_speeds
 from arzsumo.scenario import load_scenario
@@ -34,9 +33,8 @@ TOLERANCE = 1e-9
 def run():
     """60 s of open loop after the scenario's warm-up (seed 5: no re-sync on legacy_default,
     the former default scenario; the test compares up to the first re-sync if any)."""
-    sc = load_scenario(DEFAULT)
-    settings = replace(sc.run, controller="open")
-    return run_cosimulation(sc, settings, sc.sumo.with_(horizon=60.0, seed=5), PAPER_DESIGN)
+    return run_cosimulation(prepare_run(load_scenario(DEFAULT), controller="open",
+                                        horizon=60.0, seed=5))
 
 
 @pytest.mark.sumo

@@ -12,7 +12,6 @@ from __future__ import annotations
 import gzip
 import subprocess
 import xml.etree.ElementTree as ET
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -20,8 +19,8 @@ import pyarrow.parquet as pq
 import pytest
 
 from arzsumo.bridge.cosim import run_cosimulation
+from arzsumo.bridge.session import prepare_run
 from arzsumo.cli import main
-from arzsumo.control.etc import PAPER_DESIGN
 from arzsumo.outputs.bridge import write_results
 from arzsumo.resources import shipped_nets_dir
 from arzsumo.scenario import load_scenario
@@ -139,10 +138,10 @@ def test_traci_gives_the_numbers_of_libsumo(run, monkeypatch, tmp_path):
     out, counts = run
     monkeypatch.setenv("ARZSUMO_CACHE", str(tmp_path / "cache"))
     sc = load_scenario(LEGACY)
-    settings = replace(sc.run, controller="open", warmup=WARMUP)
-    cfg = sc.sumo.with_(horizon=HORIZON, seed=SEED, fcd=True)
+    run = prepare_run(sc, controller="open", warmup=WARMUP, horizon=HORIZON, seed=SEED,
+                      fcd=True)
     traci_counts = _recording(monkeypatch)
-    res = run_cosimulation(sc, settings, cfg, PAPER_DESIGN, frontend="traci")
+    res = run_cosimulation(run, frontend="traci")
     assert traci_counts == counts                               # bit-identical per step
     path, _ = write_results(res, tmp_path / "traci", "# test\n", plots=False)
     assert fcd_steps(path / "fcd.xml.gz") == fcd_steps(out / "fcd.xml.gz")

@@ -2,18 +2,17 @@
 every vehicle on main in it, and the summary's lateral files sharing the samples."""
 
 import json
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from arzsumo.bridge.cosim import run_cosimulation
-from arzsumo.control.etc import PAPER_DESIGN
 from arzsumo.outputs.bridge import write_results
 from arzsumo.scenario import load_scenario
 from arzsumo.sumo.network import MAIN
 from arzsumo.sumo.sensor import SumoSensor
+from tests.runs import prepared
 
 DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "legacy_default.toml"
 WARMUP, HORIZON = 30.0, 40.0
@@ -37,9 +36,8 @@ def run(tmp_path_factory):
         mp.setenv("ARZSUMO_CACHE", str(tmp_path_factory.mktemp("cache")))
         mp.setattr(SumoSensor, "observe", counting)
         sc = load_scenario(DEFAULT)
-        settings = replace(sc.run, controller="open", warmup=WARMUP, twin_cells=40)
-        res = run_cosimulation(sc, settings, sc.sumo.with_(horizon=HORIZON, seed=1),
-                               PAPER_DESIGN)
+        res = run_cosimulation(prepared(sc, {"run.twin_cells": 40}, controller="open",
+                                        warmup=WARMUP, horizon=HORIZON, seed=1))
     path, _ = write_results(res, tmp_path_factory.mktemp("run") / "open", "# t\n",
                             plots=False)
     return res, np.array(on_main), json.loads((path / "summary.json").read_text())

@@ -32,7 +32,8 @@ from functools import partial
 from typing import Any, TypeVar
 
 from arzsumo.bridge.cosim import OpenRun, Warmed, finish_run, open_run, warm_start
-from arzsumo.bridge.session import PreparedRun, SumoSession
+from arzsumo.bridge.prepared import PreparedRun
+from arzsumo.bridge.session import SumoSession
 from arzsumo.errors import ArzsumoError
 from arzsumo.io import json_safe
 from arzsumo.scenario.run import WINDOW_ONLY_RUN_KEYS, RunSettings
@@ -73,9 +74,8 @@ def run_branched(runs: Sequence[PreparedRun], keep: Callable[[SumoSession], T]
         raise BranchError(f"{len(runs)} runs with {len(keys)} different warm-ups; allowed: "
                           "runs that differ in [run] controller only")
     first = runs[0]
-    with open_run(first.scenario, first.settings, first.sumo, first.initial) as run:
-        warmed = warm_start(run.sim, first.scenario, first.settings, first.sumo,
-                            first.curve, run.bar)
+    with open_run(first) as run:
+        warmed = warm_start(run.sim, first, run.bar)
         warm_wall = time.perf_counter() - run.wall0
         return run_branches([partial(_branch, run, warmed, warm_wall, r, i, keep)
                              for i, r in enumerate(runs)])
@@ -90,8 +90,7 @@ def _branch(run: OpenRun, warmed: Warmed, warm_wall: float, prepared: PreparedRu
     mine = replace(run, out_dir=out_dir, files=run.files.copy(under=out_dir),
                    wall0=time.perf_counter() - warm_wall)
     try:
-        result = finish_run(mine, warmed, prepared.scenario, prepared.settings,
-                            prepared.sumo, prepared.design, prepared.curve)
+        result = finish_run(mine, warmed, prepared)
         return keep(SumoSession(result, prepared.settings, prepared.sumo))
     finally:
         mine.files.remove()

@@ -1,8 +1,10 @@
 """The closed loop in SUMO: sense, estimate, decide, actuate; two PDE twins alongside.
 
-Sequence of :func:`run_cosimulation` (``arzsumo run``), on a run that
-:func:`arzsumo.bridge.session.prepare_run` checked once (among others: no PDE controller
-at a free-flow scenario equilibrium, a dead time it can compensate):
+Sequence of :func:`run_cosimulation` (``arzsumo run``), on the run object
+(:class:`~arzsumo.bridge.prepared.PreparedRun`) that
+:func:`arzsumo.bridge.session.prepare_run` made of a scenario and checked once (among
+others: no PDE controller at a free-flow scenario equilibrium, a dead time it can
+compensate); every stage below reads the run's configuration from it alone:
 
 1. (the checks above, not repeated here)
 2. Start SUMO, with vehicles placed from the scenario's ``[initial]`` profile if asked.
@@ -59,14 +61,14 @@ from arzsumo.bridge.delay import check_delay, compensate
 from arzsumo.bridge.drain import drain, whole_demand
 from arzsumo.bridge.estimators import RecordedEstimator, estimation_stage
 from arzsumo.bridge.loop import ClosedLoop
+from arzsumo.bridge.prepared import PreparedRun
 from arzsumo.bridge.records import Trace, columns, micro_fields
 from arzsumo.bridge.reference import reference_shift
 from arzsumo.bridge.result import CoSimResult
 from arzsumo.bridge.run_progress import CONTROL, MEASURES, run_progress
 from arzsumo.bridge.twins import TwinPair
-from arzsumo.control.alinea import AlineaSettings, ReleaseRates
+from arzsumo.control.alinea import ReleaseRates
 from arzsumo.control.base import Controller
-from arzsumo.control.etc import EtcDesign
 from arzsumo.control.registry import ControllerInputs, controller_spec, is_pde
 from arzsumo.errors import ArzsumoError, ScenarioError
 from arzsumo.evaluation.decay import stationary_reference
@@ -77,7 +79,6 @@ from arzsumo.progress import Progress, RunProgress
 from arzsumo.scenario import Scenario
 from arzsumo.scenario.run import RunSettings
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.green_share import DEFAULT_CURVE, GreenShareCurve
 from arzsumo.sumo.network_measures import network_options
 from arzsumo.sumo.paths import scratch_dir
 from arzsumo.sumo.period_reads import OpenLoopPeriod
@@ -150,14 +151,15 @@ def meter_rates(cfg: SumoConfig) -> ReleaseRates:
     return ReleaseRates(cfg.release_rate, cfg.release_rate_min, cfg.release_rate_max)
 
 
-def build_controller(name: str, lin: Linearization, kernels: Any, design: EtcDesign,
-                     settings: RunSettings, cfg: SumoConfig,
-                     alinea: AlineaSettings) -> Controller:
-    """A reset controller of ``name`` for the closed loop (the registry's builder); the
-    ``constant`` controller holds the release rate ``[run] constant_release_veh_h``."""
-    inputs = ControllerInputs(lin, kernels, design,
-                              constant_u=cfg.release_rate - settings.constant_release,
-                              alinea=alinea, rates=meter_rates(cfg),
+def build_controller(name: str, lin: Linearization, kernels: Any,
+                     run: PreparedRun) -> Controller:
+    """A reset controller of ``name`` for the closed loop (the registry's builder), with
+    the run's ``[design]`` and ``[alinea]``; the ``constant`` controller holds the release
+    rate ``[run] constant_release_veh_h``."""
+    cfg = run.sumo
+    inputs = ControllerInputs(lin, kernels, run.design,
+                              constant_u=cfg.release_rate - run.settings.constant_release,
+                              alinea=run.scenario.alinea, rates=meter_rates(cfg),
                               check_period=cfg.control_period)
     ctrl = controller_spec(name, "sumo").build(inputs)
     ctrl.reset()
@@ -190,13 +192,14 @@ class Warmed:
     start: WindowStart
 
 
-def warm_start(sim: SumoSimulation, scenario: Scenario, settings: RunSettings,
-               cfg: SumoConfig, curve: GreenShareCurve, bar: RunProgress) -> Warmed:
-    """The warm-up in the open ``sim``, and the control window opened at its end."""
+def warm_start(sim: SumoSimulation, run: PreparedRun, bar: RunProgress) -> Warmed:
+    """The warm-up of ``run`` in the open ``sim``, and the control window opened at its
+    end."""
+    scenario, cfg = run.scenario, run.sumo
     est = scenario.estimation
-    plant = SumoPlant(sim, scenario.params.length, cfg, curve, layout=scenario.sensing,
+    plant = SumoPlant(sim, scenario.params.length, cfg, run.curve, layout=scenario.sensing,
                       loop_noise=est.loop_noise, probe_noise=est.probe_noise, window=True)
-    warm = warm_up(plant, settings.warmup, cfg.control_period, bar)
+    warm = warm_up(plant, run.settings.warmup, cfg.control_period, bar)
     plant.timings = dict.fromkeys(plant.timings, 0.0)   # time the control window only
     counts, start = plant.start_window(warm[-1].t)
     return Warmed(plant, warm, {**counts, "duration_s": float(warm[-1].t)}, start)
@@ -232,18 +235,18 @@ class OpenRun:
 
 
 @contextmanager
-def open_run(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
-             initial_fields: np.ndarray | None = None, *,
-             progress: bool | RunProgress = False,
+def open_run(run: PreparedRun, *, progress: bool | RunProgress = False,
              frontend: str = "libsumo") -> Iterator[OpenRun]:
-    """SUMO started for warm-up plus control horizon with the run's outputs (step 2 of
+    """SUMO started for the warm-up plus the control horizon of ``run`` with the run's
+    outputs, vehicles placed from ``run.initial`` with ``start = "placement"`` (step 2 of
     the module docstring); its scratch directory goes on leaving, its kept files too
     when leaving on an error. ``progress``: draw the run's phases on stderr; a
     :class:`~arzsumo.progress.RunProgress` given is drawn on and left open for the
     caller's own phases (``arzsumo run`` writing its results)."""
     wall0 = time.perf_counter()
+    scenario, settings, cfg = run.scenario, run.settings, run.sumo
     run_cfg = cfg.with_(horizon=settings.warmup + cfg.horizon)
-    initial, placement = place_initial(scenario.params, settings, run_cfg, initial_fields)
+    initial, placement = place_initial(scenario.params, settings, run_cfg, run.initial)
     bar = (progress if isinstance(progress, RunProgress)
            else run_progress(settings, cfg, enabled=progress))
     net_dir = Path(tempfile.mkdtemp(prefix="arzsumo-net-", dir=scratch_dir()))
@@ -265,53 +268,60 @@ def open_run(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
             bar.close()
 
 
-def run_cosimulation(scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
-                     design: EtcDesign, *, initial_fields: np.ndarray | None = None,
-                     curve: GreenShareCurve = DEFAULT_CURVE,
-                     progress: bool | RunProgress = False, keep_measurements: bool = False,
+def run_cosimulation(run: PreparedRun, *, progress: bool | RunProgress = False,
+                     keep_measurements: bool = False,
                      frontend: str = "libsumo") -> CoSimResult:
-    """Run SUMO with the controller of ``settings`` and both twins (module docstring).
+    """Run SUMO with the controller of ``run`` and both twins (module docstring).
 
-    ``initial_fields`` (4, cells on the micro grid) places vehicles at t = 0 when
-    ``settings.start == "placement"``. ``keep_measurements``: keep every period's
-    measurement, warm-up included, in ``estimator.measurements`` (for offline estimation,
-    :mod:`arzsumo.bridge.sensor_record`). ``frontend``: "libsumo", "traci" or "gui"
-    (watch the run in sumo-gui; :mod:`arzsumo.sumo.frontend`). ``progress``: as in
-    :func:`open_run`. The run's SUMO
-    configuration, and with ``cfg.fcd`` its FCD output, are kept in ``files``
-    (:mod:`arzsumo.sumo.run_files`).
+    Parameters
+    ----------
+    run : PreparedRun
+        What :func:`arzsumo.bridge.session.prepare_run` made of a scenario and the
+        caller's overrides: everything the run is configured by.
+    progress : bool or RunProgress
+        As in :func:`open_run`.
+    keep_measurements : bool
+        Keep every period's measurement, warm-up included, in ``estimator.measurements``
+        (for offline estimation, :mod:`arzsumo.bridge.sensor_record`).
+    frontend : str
+        "libsumo", "traci" or "gui" (watch the run in sumo-gui;
+        :mod:`arzsumo.sumo.frontend`).
+
+    Returns
+    -------
+    CoSimResult
+        The run's records; its SUMO configuration, and with ``[sumo] fcd`` its FCD output,
+        are kept in ``files`` (:mod:`arzsumo.sumo.run_files`).
     """
-    with open_run(scenario, settings, cfg, initial_fields, progress=progress,
-                  frontend=frontend) as run:
-        warmed = warm_start(run.sim, scenario, settings, cfg, curve, run.bar)
-        return finish_run(run, warmed, scenario, settings, cfg, design, curve,
-                          keep_measurements)
+    with open_run(run, progress=progress, frontend=frontend) as opened:
+        warmed = warm_start(opened.sim, run, opened.bar)
+        return finish_run(opened, warmed, run, keep_measurements)
 
 
-def finish_run(run: OpenRun, warmed: Warmed, scenario: Scenario, settings: RunSettings,
-               cfg: SumoConfig, design: EtcDesign, curve: GreenShareCurve,
+def finish_run(opened: OpenRun, warmed: Warmed, run: PreparedRun,
                keep_measurements: bool = False) -> CoSimResult:
-    """From the end of the warm-up: the control window, the drain, SUMO closed, and the
-    network measures read from SUMO's outputs (steps 4-7 of the module docstring)."""
-    sim = run.sim
-    c = control(warmed, scenario, settings, cfg, design, curve, run.bar, keep_measurements)
+    """From the end of the warm-up: the control window of ``run``, the drain, SUMO
+    closed, and the network measures read from SUMO's outputs (steps 4-7 of the module
+    docstring)."""
+    sim, cfg = opened.sim, run.sumo
+    c = control(warmed, run, opened.bar, keep_measurements)
     plant = c.loop.plant
     meter_summary = {**plant.meter_summary(), "ramp_storage": cfg.ramp_storage}
     timings = {**plant.timings, **c.loop.timings}   # the window's, not the drain's
     t_end = sim.time
-    drained = drain(plant, cfg.drain_max, run.bar) if cfg.drain_max > 0 else None
-    run.bar.enter(MEASURES)
+    drained = drain(plant, cfg.drain_max, opened.bar) if cfg.drain_max > 0 else None
+    opened.bar.enter(MEASURES)
     sim.close()                # SUMO writes the unfinished trips' tripinfo as it closes
     records = c.trace.records
     outlet = round(sum((r.outflow_h + r.outflow_a) * cfg.control_period for r in records))
-    network, trips = measure_network(run.out_dir, c.start, t_end, outlet,
+    network, trips = measure_network(opened.out_dir, c.start, t_end, outlet,
                                      drained.end if drained else None, sim.time)
     if drained is not None:
         network = whole_demand(network, trips, plant, drained)
     if cfg.fcd:   # moved, not read: an FCD file is large
-        run.files.adopt(run.out_dir / FCD_FILE, FCD_FILE)
-    return _result(c, scenario, cfg, meter_summary, sim, network, run.placement, run.files,
-                   timings, time.perf_counter() - run.wall0)
+        opened.files.adopt(opened.out_dir / FCD_FILE, FCD_FILE)
+    return _result(c, run.scenario, cfg, meter_summary, sim, network, opened.placement,
+                   opened.files, timings, time.perf_counter() - opened.wall0)
 
 
 def _result(c: Controlled, scenario: Scenario, cfg: SumoConfig, meter: dict[str, Any],
@@ -335,13 +345,13 @@ def _result(c: Controlled, scenario: Scenario, cfg: SumoConfig, meter: dict[str,
                      else None), stationary=c.stationary[0], stationary_band=c.stationary[1])
 
 
-def control(warmed: Warmed, scenario: Scenario, settings: RunSettings, cfg: SumoConfig,
-            design: EtcDesign, curve: GreenShareCurve, bar: RunProgress,
+def control(warmed: Warmed, run: PreparedRun, bar: RunProgress,
             keep_measurements: bool = False) -> Controlled:
-    """The control window from the end of the warm-up (steps 4-6 of the module
-    docstring); ``cfg`` has the control horizon."""
+    """The control window of ``run`` from the end of the warm-up (steps 4-6 of the module
+    docstring); ``run.sumo`` has the control horizon."""
     from arzsumo.kernel_cache import cached_kernels
 
+    scenario, settings, cfg = run.scenario, run.settings, run.sumo
     period, est = cfg.control_period, scenario.estimation
     plant, warm = warmed.plant, warmed.warm
     bar.enter(CONTROL, offset=warm[-1].t)    # solving the kernels is the window's cost
@@ -357,12 +367,10 @@ def control(warmed: Warmed, scenario: Scenario, settings: RunSettings, cfg: Sumo
              if is_pde(acting) and est.reference != "equilibrium" and warm_fields else None)
     if eq is not scenario.equilibrium:     # prepare_run checked the scenario's
         check_delay(scenario, acting, lin.eigenvalues, "measured")
-    ctrl = compensate(build_controller(acting, lin, kernels, design, settings, cfg,
-                                       scenario.alinea), acting, scenario)
+    ctrl = compensate(build_controller(acting, lin, kernels, run), acting, scenario)
     ref_name = settings.controller if is_pde(settings.controller) else "open"
-    ref_ctrl = build_controller(ref_name, lin, kernels, design, settings, cfg,
-                                scenario.alinea)
-    q_nom = curve.outflow_at(cfg.green_share)
+    ref_ctrl = build_controller(ref_name, lin, kernels, run)
+    q_nom = run.curve.outflow_at(cfg.green_share)
     opts = SolverOptions(cells=settings.twin_cells, scheme=settings.twin_scheme,
                          horizon=cfg.horizon, control_period=period)
     twins = TwinPair(eq, lin, warm[-1].cells, opts, settings.smoothing, ref_ctrl, q_nom)

@@ -233,9 +233,7 @@ def record_run(scenario: Scenario, seed: int, warmup: float, horizon: float
     t0 = time.perf_counter()
     sc = scenario.with_({**SUPERSET, "estimation.method": "none"})
     run = prepare_run(sc, controller="open", seed=seed, horizon=horizon, warmup=warmup)
-    res = run_cosimulation(run.scenario, run.settings, run.sumo, run.design,
-                           initial_fields=run.initial, curve=run.curve,
-                           keep_measurements=True)
+    res = run_cosimulation(run, keep_measurements=True)
     ms = res.estimator.measurements if res.estimator is not None else None
     if not ms:
         raise RuntimeError("the run kept no measurements")

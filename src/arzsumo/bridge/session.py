@@ -9,15 +9,15 @@ and runs :func:`arzsumo.bridge.cosim.run_cosimulation`. It writes nothing.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from arzsumo.bridge.cosim import check_before_start, run_cosimulation
 from arzsumo.bridge.delay import check_delay
 from arzsumo.bridge.estimators import acting_controller
+from arzsumo.bridge.prepared import PreparedRun
 from arzsumo.bridge.result import CoSimResult
-from arzsumo.control.etc import EtcDesign
 from arzsumo.errors import ArzsumoError, ScenarioError
 from arzsumo.model import linearize
 from arzsumo.progress import RunProgress
@@ -47,41 +47,6 @@ class SumoSession:
         lines = [f"# {k} = {v!r}" for k, v in self.settings.as_dict().items()]
         return "\n# resolved settings of this run\n" + "\n".join(lines) + \
             f"\n# sumo = {self.sumo!r}\n"
-
-
-@dataclass(frozen=True)
-class PreparedRun:
-    """A run checked and resolved, ready for SUMO: what :func:`prepare_run` returns."""
-
-    scenario: Scenario
-    settings: RunSettings
-    sumo: SumoConfig
-    design: EtcDesign
-    initial: np.ndarray | None = field(default=None, repr=False)
-    curve: GreenShareCurve = DEFAULT_CURVE
-
-    def describe(self) -> str:
-        """What the run would do, in human units (``arzsumo run --dry-run``)."""
-        s, c = self.settings, self.sumo
-        lam4 = ms_to_kmh(linearize(self.scenario.equilibrium).eigenvalues[3])
-        return (f"scenario {self.scenario.name} ({self.scenario.source}): valid\n"
-                f"  controller {s.controller}, start {s.start}, warm-up {s.warmup:g} s + "
-                f"control horizon {c.horizon:g} s, SUMO seed {c.seed}, step {c.step_length:g} s"
-                f"\n  equilibrium {s.equilibrium} (scenario lambda_4 = {lam4:.2f} km/h)"
-                f"\n  {self.sensing()}"
-                + ("\n  SUMO's FCD output kept (fcd.xml.gz)" if c.fcd else ""))
-
-    def sensing(self) -> str:
-        """What the controller reads: the estimator and its sensors (observer-ETC: the
-        boundary loops only, or the inlet speeds of the paper's observer)."""
-        method = self.scenario.estimation.method
-        if self.settings.controller == "observer-etc":
-            if acting_controller(method, "observer-etc") == "observer-etc":
-                return ("observer-etc on the paper's boundary observer: inlet speeds only "
-                        "(no estimator, [estimation] method = none)")
-            return (f"estimation {method} from the boundary loops only (x = 0 and x = L), "
-                    "the ETC acting on that estimate")
-        return f"estimation {method} from sensors {', '.join(self.scenario.sensing.kinds)}"
 
 
 def _seed(seed: int) -> int:
@@ -173,7 +138,7 @@ def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None
         sc = _override(sc, "run.warmup_s", warmup, "--warmup")
     if fcd is not None:
         sc = _override(sc, "sumo.fcd", fcd, "--fcd")
-    settings, cfg, design = sc.run, sc.sumo, sc.design
+    settings, cfg = sc.run, sc.sumo
     ic = seeded(sc.initial, cfg.seed)  # one seed draws all randomness
     _check_model(sc, cfg)
     if settings.equilibrium == "scenario":
@@ -186,7 +151,7 @@ def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None
         xc = (np.arange(n) + 0.5) * cfg.cell_length
         initial = initial_fields(ic, sc.equilibrium, xc)
     curve = meter_curve_of(cfg, sc.source)   # a bad curve file stops the run before SUMO
-    return PreparedRun(sc, settings, cfg, design, initial, curve)
+    return PreparedRun(sc, initial, curve)
 
 
 def default_run_name(sc: Scenario, settings: RunSettings, cfg: SumoConfig) -> str:
@@ -237,9 +202,7 @@ def run_prepared(run: PreparedRun, *, progress: bool | RunProgress = False,
                  frontend: str = "libsumo") -> SumoSession:
     """Run a :class:`PreparedRun` (checked once, by :func:`prepare_run`) in SUMO;
     ``progress`` as in :func:`arzsumo.bridge.cosim.open_run`."""
-    res = run_cosimulation(run.scenario, run.settings, run.sumo, run.design,
-                           initial_fields=run.initial, curve=run.curve, progress=progress,
-                           frontend=frontend)
+    res = run_cosimulation(run, progress=progress, frontend=frontend)
     return SumoSession(res, run.settings, run.sumo)
 
 
