@@ -300,3 +300,20 @@ def test_the_study_runs_from_python_with_its_options_and_the_cli_maps_onto_them(
     with pytest.raises(StudyError, match="at least one seed"):
         pm.MapOptions(seeds=())
     assert "argparse" not in Path(pm.__file__).read_text(encoding="utf-8")
+
+
+def test_a_run_listed_twice_is_run_once_and_read_by_both(tmp_path):
+    """A point and its fuller-fill variant share their discharge runs."""
+    from arzsumo.studies.design import StudyRun, run_design
+
+    calls = []
+
+    def task(run):
+        calls.append(run.run_id)
+        return {"id": run.run_id}
+
+    run = StudyRun("point=a,seed=100,kind=discharge", {"sumo": {}})
+    other = StudyRun("point=b,seed=100,kind=discharge", {"sumo": {}})
+    rows = run_design([run, other, run], task, tmp_path, in_process=True, progress=False)
+    assert calls == [run.run_id, other.run_id]
+    assert rows == [{"id": run.run_id}, {"id": other.run_id}, {"id": run.run_id}]

@@ -106,10 +106,13 @@ def run_design(runs: Sequence[StudyRun], fn: Worker, out: Path, *,
         found = _stored(out, run)
         if found is not None:
             rows[run.run_id] = found
-    todo = [r for r in runs if r.run_id not in rows]
+    # a run listed twice (e.g. a point and its fuller-fill variant share their discharge
+    # runs) is run once; every listing reads its row
     by_id = {r.run_id: r for r in runs}
-    log.info("%s: %d runs, %d finished before, %d to run", label, len(runs),
-             len(runs) - len(todo), len(todo))
+    todo = [r for r in by_id.values() if r.run_id not in rows]
+    before = len(rows)
+    log.info("%s: %d runs, %d finished before, %d to run", label, len(by_id), before,
+             len(todo))
     bar = Progress(len(todo), label, enabled=progress and bool(todo))
 
     def on_done(pair: tuple[str, dict[str, Any]]) -> None:
@@ -118,7 +121,7 @@ def run_design(runs: Sequence[StudyRun], fn: Worker, out: Path, *,
             doc = {"run_id": run_id, "sha256": by_id[run_id].sha256, "row": row}
             tmp.write_text(json.dumps(doc) + "\n", encoding="utf-8")
         rows[run_id] = row
-        bar.update(len(rows) - (len(runs) - len(todo)))
+        bar.update(len(rows) - before)
 
     call = functools.partial(_keyed, fn)
     try:
