@@ -243,6 +243,8 @@ RUN_SUMMARY: dict[str, str] = {
     "actuation.periods": "count", "actuation.saturated_periods": "count",
     "actuation.rate_limited_periods": "count", "actuation.saturated_share": "1",
     "actuation.rate_limited_share": "1", "actuation.delay_compensation": "s",
+    "actuation.meter_gain": "1", "actuation.hold_plan_in_range": "bool",
+    "actuation.trigger_output_noise": "veh/s", "actuation.trigger_dead_band": "veh/s",
     "twin_status.*.resyncs": "count", "twin_status.*.first_resync_s": "s",
     "twin_status.*.first_reason": TEXT,
     "inserted": "veh", "requested": "veh", "waiting": "veh", "arrived": "veh",

@@ -3,6 +3,7 @@ functions, known answers, properties (no SUMO: a meter of the realisations' pure
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import pytest
@@ -175,3 +176,40 @@ def test_the_meter_plan_is_saturated_once_to_its_bounds(mode, u, plan):
     meter = _Meter(cfg)
     command_meter(meter, u, DEFAULT_CURVE.outflow_at(0.5))
     assert meter.planned == [pytest.approx(plan)]
+
+
+def test_a_held_u_keeps_its_plan_until_the_moving_range_leaves_it():
+    # one per green with the ramp bound: the floor moves with the queue (one vehicle is
+    # 1/30 veh/s over a 30 s period). A law holds U = -0.08 veh/s; where the floor is
+    # above it the plan is clipped to the floor. With hold_plan_in_range the plan stays
+    # while it lies in the range and moves only when the floor passes it; without, every
+    # move of the floor moves the plan.
+    cfg = SumoConfig(meter_mode="one_per_green", ramp_demand=500 / 3600, control_period=30)
+    queues = [4, 3, 4, 4, 2, 1, 3]
+    plans = {}
+    for hold in (False, True):
+        meter = _Meter(cfg, queue=queues[0])
+        limits = ActuationLimits.of(ActuationSettings(ramp_bound=True,
+                                                      hold_plan_in_range=hold), 1.0, 30.0)
+        act = MeterActuator(meter, 1.0, False, limits)
+        applied = []
+        for q in queues:
+            meter.queue = q
+            applied.append(act.apply(-0.08).u_applied)
+        plans[hold] = applied
+    lower = [max(one_per_green_u_range(cfg)[0], one_per_green_ramp_floor(cfg, q))
+             for q in queues]
+    assert plans[False] == pytest.approx([max(-0.08, f) for f in lower])
+    want = [-0.08, lower[1], lower[1], lower[1], lower[4], lower[5], lower[5]]
+    assert plans[True] == pytest.approx(want)
+    changes = {h: sum(a != b for a, b in itertools.pairwise(p)) for h, p in plans.items()}
+    assert changes == {False: 5, True: 3}
+
+
+def test_a_held_u_still_completes_its_rate_limited_approach():
+    cfg = SumoConfig(meter_mode="one_per_green")
+    limits = ActuationLimits.of(ActuationSettings(u_rate_max=0.05, hold_plan_in_range=True),
+                                1.0, 1.0)
+    act = MeterActuator(_Meter(cfg), 1.0, False, limits)
+    got = [act.apply(0.12).u_applied for _ in range(4)]
+    assert got == pytest.approx([0.05, 0.10, 0.12, 0.12])

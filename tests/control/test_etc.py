@@ -148,3 +148,30 @@ def test_first_check_is_an_event(lin, kernels):
     assert r.triggered and r.u_bar_held == r.u_bar_continuous
     again = trig.check(1.0, w)               # same state: no discrepancy, no event
     assert not again.triggered and again.d == 0.0
+
+
+def test_output_noise_sd_recovers_white_noise_under_a_slow_signal_and_a_few_steps():
+    from arzsumo.control.etc import output_noise_sd
+    rng = np.random.default_rng(11)
+    t = np.arange(3000.0)
+    noise = 0.05 * rng.standard_normal(t.size)
+    slow = 0.4 * np.sin(2 * np.pi * t / 600.0) + 1e-4 * t          # what a law follows
+    steps = np.where(t > 1500, 0.8, 0.0) + np.where(t > 2200, -0.5, 0.0)
+    assert output_noise_sd(noise) == pytest.approx(0.05, rel=0.06)
+    assert output_noise_sd(noise + slow + steps) == pytest.approx(0.05, rel=0.06)
+    assert output_noise_sd(slow) < 0.1 * 0.05            # its slope, a tenth of the noise
+    assert np.isnan(output_noise_sd(np.array([1.0, np.nan, 2.0])))
+
+
+def test_the_measured_dead_band_is_noise_k_root_two_times_the_output_noise(lin, kernels):
+    import math
+    design = EtcDesign(noise_k=2.5, noise_from_estimate=True)
+    trig = EventTrigger(lin.system, kernels, design)
+    assert trig.dead_band == 0.0                        # not measured yet: the paper's
+    assert trig.set_output_noise(0.01) == pytest.approx(2.5 * math.sqrt(2.0) * 0.01)
+    trig.reset()                                        # a new run keeps the measured band
+    assert trig.dead_band == pytest.approx(2.5 * math.sqrt(2.0) * 0.01)
+    with pytest.raises(ModelError, match="output noise"):
+        trig.set_output_noise(-1.0)
+    with pytest.raises(ModelError, match="noise_from_estimate"):
+        design.with_(noise_sd=(1.0, 1.0, 1.0, 1.0))

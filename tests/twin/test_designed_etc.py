@@ -7,8 +7,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from arzsumo.bridge.trigger_noise import law_output_noise
+from arzsumo.control.base import MacroState
 from arzsumo.control.design import design_for
-from arzsumo.control.etc import PAPER_DESIGN, EventTriggered
+from arzsumo.control.etc import PAPER_DESIGN, EventTriggered, noise_dead_band
 from arzsumo.control.kernels import solve_kernels
 from arzsumo.model import linearize
 from arzsumo.scenario import load_scenario
@@ -81,3 +83,44 @@ def test_designed_etc_triggers_far_less_than_the_papers_on_noise(runs):
     paper, designed = runs["paper"][1], runs["designed"][1]
     assert paper > 250                          # the paper's design triggers on noise
     assert designed < paper / 3
+
+
+def test_the_dead_band_measured_on_the_noisy_state_is_the_one_its_noise_implies():
+    # white noise of a known sd per node: the law's output noise is known in closed form
+    # (noise_dead_band with noise_sd); measured on 600 checks of the noisy equilibrium it
+    # must agree, and the ETC sized by it triggers as rarely as the hand-sized one
+    eq = load_scenario(ROOT / "scenarios/lateral_files.toml").equilibrium
+    lin = linearize(eq)
+    kernels = solve_kernels(lin.system, 50)
+    plain = design_for(lin.system, kernels).design
+    x = (np.arange(50) + 0.5) * eq.params.length / 50
+    one = np.ones_like(x)
+    states = [MacroState(-600.0 + k, x, eq.rho_h * one, eq.v_h * one, eq.rho_a * one,
+                         eq.v_a * one) for k in range(600)]
+    ctrl = NoisyEtc(lin, kernels, plain.with_(noise_from_estimate=True), noise=NOISE)
+    sd = law_output_noise(ctrl, states)
+    assert ctrl.set_output_noise(sd)
+    analytic = noise_dead_band(plain.with_(noise_sd=tuple(NOISE)), ctrl.trigger.law.gain)
+    assert ctrl.trigger.dead_band == pytest.approx(analytic, rel=0.12)
+    clean = NoisyEtc(lin, kernels, plain, noise=0 * NOISE)
+    assert law_output_noise(clean, states) == pytest.approx(0.0, abs=1e-12)
+
+
+def test_the_etc_sized_on_its_measured_noise_triggers_far_less_than_the_papers(runs):
+    eq = load_scenario(ROOT / "scenarios/lateral_files.toml").equilibrium
+    lin = linearize(eq)
+    kernels = solve_kernels(lin.system, 50)
+    design = design_for(lin.system, kernels).design.with_(noise_from_estimate=True)
+    x = (np.arange(50) + 0.5) * eq.params.length / 50
+    one = np.ones_like(x)
+    states = [MacroState(-300.0 + k, x, eq.rho_h * one, eq.v_h * one, eq.rho_a * one,
+                         eq.v_a * one) for k in range(300)]
+    ctrl = NoisyEtc(lin, kernels, design, noise=NOISE)
+    ctrl.set_output_noise(law_output_noise(ctrl, states))
+    opts = SolverOptions(cells=50, horizon=300.0, output_period=10.0)
+    f0 = initial_fields(InitialCondition(kind="sinusoid", amplitude=0.1), eq, x)
+    res = simulate(eq, f0, controller=ctrl, options=opts)
+    star = np.array([eq.rho_h, eq.v_h, eq.rho_a, eq.v_a])[:, None]
+    norm = np.sqrt(np.mean(((res.fields - star) / star) ** 2, axis=(1, 2)))
+    assert res.complete and norm.max() < 2 * norm[0]
+    assert ctrl.log.triggers < runs["paper"][1] / 3

@@ -16,6 +16,14 @@ Between the controller and the meter, the ``[actuation]`` limits
 3. the range again, so the output always lies in it: the range wins over the rate when
    the range moved away from the previous U (the ramp bound moves with the queue).
 
+With ``hold_plan_in_range``, a U the law holds (the same value as at the previous check:
+an ETC between events, a held meter) keeps the U applied in the previous period while
+that U lies in the new range and no rate-limited approach is under way: the ramp bound
+moves with the queue, and clipping the held U to it anew at every period would change the
+meter's plan with no decision of the law. The plan then changes at an event, at a step of
+a rate-limited approach, and when the range leaves the plan (:meth:`MeterActuator.apply`);
+``plan_changes`` counts all three, ``triggers`` the events.
+
 Every limit off (the default) returns the law's U unchanged. While the meter's queue
 override is on (the ramp queue beyond its storage,
 :meth:`~arzsumo.sumo.meter.MeterLight.override`) the range collapses to the override's U,
@@ -35,7 +43,9 @@ import math
 from dataclasses import dataclass
 from typing import NamedTuple
 
-from arzsumo.control.base import Applied
+from arzsumo.control.base import Applied, Controller
+from arzsumo.control.meter_gain import MeterGain
+from arzsumo.control.registry import is_pde
 from arzsumo.scenario.actuation import ActuationSettings
 from arzsumo.sumo.meter import MeterLight
 
@@ -80,6 +90,15 @@ def limit_u(u_raw: float, u_prev: float, lower: float = -INF, upper: float = INF
     return Limited(w, saturated or w != v, rate_limited)
 
 
+def on_meter(ctrl: Controller, acting: str, settings: ActuationSettings) -> Controller:
+    """``ctrl`` asking the meter for U / ``meter_gain`` when ``acting`` is a PDE law and
+    the gain is not 1 (:class:`~arzsumo.control.meter_gain.MeterGain`); ``ctrl`` itself
+    otherwise (ALINEA and the held meter command release rates directly)."""
+    if settings.meter_gain == 1.0 or not is_pde(acting):
+        return ctrl
+    return MeterGain(ctrl, settings.meter_gain)
+
+
 def command_meter(meter: MeterLight, u: float, q_nominal: float) -> float:
     """Command ``meter`` with the outflow deviation ``u`` (veh/s) from ``q_nominal``
     (veh/s): its plan variable for ``u``, saturated to the plan's bounds. Returns the
@@ -92,13 +111,15 @@ def command_meter(meter: MeterLight, u: float, q_nominal: float) -> float:
 class ActuationLimits:
     """The ``[actuation]`` limits in SI for one run (see the module docstring).
 
-    ``u_max`` (veh/s, inf: off), ``rate_step`` (veh/s per control period, inf: off), and
-    ``ramp_bound``: U within the meter's range and above the ramp's floor.
+    ``u_max`` (veh/s, inf: off), ``rate_step`` (veh/s per control period, inf: off),
+    ``ramp_bound``: U within the meter's range and above the ramp's floor, and
+    ``hold_plan``: a held U keeps its plan while it lies in the range.
     """
 
     u_max: float = INF
     rate_step: float = INF
     ramp_bound: bool = False
+    hold_plan: bool = False
 
     @classmethod
     def of(cls, settings: ActuationSettings, q_nominal: float,
@@ -107,7 +128,7 @@ class ActuationLimits:
         period of ``control_period`` s."""
         return cls(settings.u_max_fraction * q_nominal if settings.u_max_fraction else INF,
                    settings.u_rate_max * control_period if settings.u_rate_max else INF,
-                   settings.ramp_bound)
+                   settings.ramp_bound, settings.hold_plan_in_range)
 
     def range(self, meter: MeterLight, q_nominal: float) -> tuple[float, float]:
         """``(lower, upper)`` of U (veh/s) for ``meter`` with its present ramp queue."""
@@ -164,6 +185,8 @@ class MeterActuator:
         self.meter, self.q_nominal, self.hold_nominal = meter, q_nominal, hold_nominal
         self.limits = limits or ActuationLimits()
         self.u_prev = 0.0
+        self.u_raw_prev: float | None = None
+        self.range_prev = (-INF, INF)
 
     def apply(self, u: float) -> Actuation:
         """Command U (veh/s), limited; return what was applied and the green share
@@ -180,10 +203,24 @@ class MeterActuator:
             lower = upper = meter.override_u(self.q_nominal)
             rate_step = INF
         lim = limit_u(u, self.u_prev, lower, upper, rate_step)
+        if self._keeps_plan(u, lower, upper, rate_step):
+            lim = Limited(self.u_prev, lim.saturated, False)
+        else:                  # the range the plan was set under
+            self.range_prev = (lower, upper)
+        self.u_raw_prev = u
         self.u_prev = lim.u_applied
         green = command_meter(meter, lim.u_applied, self.q_nominal)
         return Actuation(u, lim.u_applied, lim.saturated, lim.rate_limited, lower, upper,
                          green, _rate(meter))
+
+
+    def _keeps_plan(self, u: float, lower: float, upper: float, rate_step: float) -> bool:
+        """Whether a held ``u`` keeps the previous U applied (module docstring): held,
+        settled under the range the plan was set under, and inside the new one."""
+        if not self.limits.hold_plan or u != self.u_raw_prev:
+            return False
+        settled = limit_u(u, self.u_prev, *self.range_prev, rate_step).u_applied
+        return settled == self.u_prev and lower <= self.u_prev <= upper
 
 
 def _rate(meter: MeterLight) -> float:

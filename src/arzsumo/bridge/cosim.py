@@ -56,7 +56,7 @@ from typing import Any
 
 import numpy as np
 
-from arzsumo.bridge.actuator import ActuationLimits, MeterActuator
+from arzsumo.bridge.actuator import ActuationLimits, MeterActuator, on_meter
 from arzsumo.bridge.delay import check_delay, compensate
 from arzsumo.bridge.drain import drain, whole_demand
 from arzsumo.bridge.estimators import RecordedEstimator, estimation_stage
@@ -66,6 +66,7 @@ from arzsumo.bridge.records import Trace, columns, micro_fields
 from arzsumo.bridge.reference import reference_shift
 from arzsumo.bridge.result import CoSimResult
 from arzsumo.bridge.run_progress import CONTROL, MEASURES, run_progress
+from arzsumo.bridge.trigger_noise import size_dead_band, warmup_states
 from arzsumo.bridge.twins import TwinPair
 from arzsumo.control.alinea import ReleaseRates
 from arzsumo.control.base import Controller
@@ -220,6 +221,7 @@ class Controlled:
     estimator: RecordedEstimator
     settings: RunSettings
     stationary: tuple[np.ndarray, float]   # the warm-up's state and band (evaluation.decay)
+    trigger_noise: float | None = None     # veh/s: the law's output noise sizing the dead band
 
 
 @dataclass
@@ -342,7 +344,8 @@ def _result(c: Controlled, scenario: Scenario, cfg: SumoConfig, meter: dict[str,
         estimate=np.asarray(c.estimator.fields[1:]), estimator=c.estimator,
         shift=loop.shift, lateral=sensor.lateral.record(), files=files,
         disturbance=(dict(loop.plant.disturbance.applied) if loop.plant.disturbance
-                     else None), stationary=c.stationary[0], stationary_band=c.stationary[1])
+                     else None), stationary=c.stationary[0], stationary_band=c.stationary[1],
+        trigger_noise=c.trigger_noise)
 
 
 def control(warmed: Warmed, run: PreparedRun, bar: RunProgress,
@@ -367,7 +370,11 @@ def control(warmed: Warmed, run: PreparedRun, bar: RunProgress,
              if is_pde(acting) and est.reference != "equilibrium" and warm_fields else None)
     if eq is not scenario.equilibrium:     # prepare_run checked the scenario's
         check_delay(scenario, acting, lin.eigenvalues, "measured")
-    ctrl = compensate(build_controller(acting, lin, kernels, run), acting, scenario)
+    ctrl = on_meter(compensate(build_controller(acting, lin, kernels, run), acting,
+                               scenario), acting, scenario.actuation)
+    trigger_noise = (size_dead_band(ctrl, warmup_states(
+        warm_fields, warm[-1].cells.x, period, est.reference_window, shift))
+        if run.design.noise_from_estimate and is_pde(acting) and warm_fields else None)
     ref_name = settings.controller if is_pde(settings.controller) else "open"
     ref_ctrl = build_controller(ref_name, lin, kernels, run)
     q_nom = run.curve.outflow_at(cfg.green_share)
@@ -385,4 +392,4 @@ def control(warmed: Warmed, run: PreparedRun, bar: RunProgress,
     stationary = stationary_reference(np.stack([micro_fields(m.cells) for m in tail]),
                                       period)
     return Controlled(loop, trace, ref_ctrl, eq, q_nom, warmed.warmup_meter, warmed.start,
-                      estimator, settings, stationary)
+                      estimator, settings, stationary, trigger_noise)

@@ -80,3 +80,6 @@ class CoSimResult:
     #: from: SUMO's cells over the warm-up's last minutes (:mod:`arzsumo.evaluation.decay`)
     stationary: np.ndarray | None = None
     stationary_band: float = float("nan")
+    #: the sd (veh/s) of the acting law's output noise on the warm-up's estimate that sized
+    #: its trigger's dead band (``[design] noise_from_estimate``); None: not measured
+    trigger_noise: float | None = None

@@ -149,6 +149,13 @@ class Controller(ABC):
         """
         return None
 
+    def set_output_noise(self, sd: float) -> bool:
+        """Size an event trigger's dead band from the sd ``sd`` (veh/s) of this law's
+        output noise, measured on the state it will see
+        (:meth:`arzsumo.control.etc.EventTrigger.set_output_noise`). Returns whether the
+        controller has a trigger to size; the default has none."""
+        return False
+
     def actuated(self, u: float) -> None:
         """The meter received ``u`` (veh/s) for the U of the last :meth:`check`.
 

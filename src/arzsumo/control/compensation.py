@@ -51,6 +51,8 @@ class RiemannLaw(Protocol):
 
     def applied(self, u: float, lower: float = -math.inf, upper: float = math.inf) -> None: ...
 
+    def set_output_noise(self, sd: float) -> bool: ...
+
 
 class DelayCompensated(Controller):
     """``inner`` evaluated on the state predicted ``delay`` s ahead (module docstring).
@@ -109,6 +111,10 @@ class DelayCompensated(Controller):
         """The meter received ``u`` (veh/s) for the last check: the prediction uses it."""
         if self.u_bar:
             self.u_bar[-1] = u * self.inner.lin.u_bar_per_u
+
+    def set_output_noise(self, sd: float) -> bool:
+        """Handed to the inner law (its trigger's dead band; veh/s)."""
+        return self.inner.set_output_noise(sd)
 
     def applied(self, u: float, lower: float = -math.inf, upper: float = math.inf) -> None:
         """Anti-windup: handed to the inner law (the ETC's trigger projects on the range)."""

@@ -23,6 +23,18 @@ d_delta = sign(d) max(|d| - delta, 0) instead of d, with delta = noise_k sqrt(2)
 pure noise of that level (|d| <= delta) neither raises m nor triggers. With delta = 0
 this is the paper's mechanism.
 
+Measured dead band (``noise_from_estimate``). Instead of ``noise_sd``, the sd s_U of the
+law's output noise can be measured where the noise arises, on the estimate the controller
+will see: :func:`output_noise_sd` of the continuous law's U-bar over a stretch of checks
+with no control (the closed loop uses the warm-up's last minutes), handed to
+:meth:`EventTrigger.set_output_noise`. delta is then noise_k sqrt(2) s_U as above, with
+no assumption on how the noise is spread over the grid. Against defdynamic: between
+events |d| <= delta + the paper's bound, so the closed loop is the paper's with an input
+perturbation bounded by delta, practically (not asymptotically) stable with an ultimate
+bound that scales with delta (the dead-zone regularisation of event triggering under
+measurement noise, Borgers & Heemels 2014). On a noise-free state s_U -> 0, delta -> 0,
+and the mechanism is the paper's.
+
 Anti-windup. When the actuator limits U to a range [U_lo, U_hi] (saturation:
 :func:`arzsumo.bridge.actuator.limit_u`), the boundary input the plant receives is
 sat(U-bar(t_k)), not control law sam's U-bar(t_k), and a d of dt computed on the raw values
@@ -65,7 +77,9 @@ class EtcDesign:
 
     ``noise_sd`` (m/s, one per scaled Riemann variable, or empty: no dead band) and
     ``noise_k`` (dimensionless) set the noise dead band of the trigger (module docstring);
-    they are not part of the paper's design and the theorems do not see them.
+    ``noise_from_estimate`` asks for the dead band to be measured on the estimate instead
+    (:meth:`EventTrigger.set_output_noise`). They are not part of the paper's design and
+    the theorems do not see them.
     """
 
     zeta: float = 8e-3
@@ -78,6 +92,7 @@ class EtcDesign:
     m0: float = -1e-2
     noise_sd: tuple[float, ...] = ()
     noise_k: float = 2.0
+    noise_from_estimate: bool = False
 
     def __post_init__(self) -> None:
         for name in ("A", "varsigma", "noise_sd"):
@@ -96,6 +111,8 @@ class EtcDesign:
         require(not self.noise_sd or (len(self.noise_sd) == len(self.varsigma) and all(
             math.isfinite(v) and v >= 0 for v in self.noise_sd)), "noise_sd", self.noise_sd,
                 f"{len(self.varsigma)} numbers >= 0 (one per state) or none")
+        require(not (self.noise_sd and self.noise_from_estimate), "noise_from_estimate",
+                self.noise_from_estimate, "false when noise_sd is given (one dead band)")
 
     def with_(self, **changes: object) -> EtcDesign:
         """A validated copy with some fields changed."""
@@ -145,6 +162,22 @@ def noise_dead_band(design: EtcDesign, gain: np.ndarray) -> float:
     return design.noise_k * math.sqrt(2.0 * float(np.sum((sd * gain) ** 2)))
 
 
+def output_noise_sd(u: np.ndarray) -> float:
+    """The sd of the white noise on a series of law outputs ``u`` (any unit), from its
+    successive differences: 1.4826 MAD(diff u) / sqrt(2).
+
+    Differencing removes what moves slowly (the signal the law should follow); the median
+    absolute deviation ignores the few large steps of a real change. NaN with fewer than
+    three finite values.
+    """
+    u = np.asarray(u, float)
+    du = np.diff(u[np.isfinite(u)])
+    if du.size < 2:
+        return math.nan
+    mad = float(np.median(np.abs(du - np.median(du))))
+    return 1.4826 * mad / math.sqrt(2.0)
+
+
 def u_bar_range(lower: float, upper: float, per: float) -> tuple[float, float]:
     """The range ``[lower, upper]`` of U (veh/s) in U-bar units (``per`` = U-bar per U,
     either sign), as ``(low, high)``."""
@@ -177,6 +210,14 @@ class EventTrigger:
         self.b_exp = design.B * math.exp(design.mu * system.length / system.lam_minus)
         self.dead_band = noise_dead_band(design, self.law.gain)
         self.reset()
+
+    def set_output_noise(self, s_u_bar: float) -> float:
+        """Size the dead band from the measured output noise ``s_u_bar`` (sd of U-bar, m/s;
+        module docstring): delta = noise_k sqrt(2) s_U. Returns delta (m/s)."""
+        require(math.isfinite(s_u_bar) and s_u_bar >= 0, "output noise", s_u_bar,
+                "an sd >= 0")
+        self.dead_band = self.design.noise_k * math.sqrt(2.0) * float(s_u_bar)
+        return self.dead_band
 
     def reset(self) -> None:
         self.m = self.design.m0
@@ -238,6 +279,11 @@ class EventTriggered(Controller):
         """Anti-windup: the trigger compares what the actuator delivers in ``[lower,
         upper]`` (veh/s) from the next check on (module docstring)."""
         self.trigger.bounds = u_bar_range(lower, upper, self.lin.u_bar_per_u)
+
+    def set_output_noise(self, sd: float) -> bool:
+        """The trigger's dead band from the sd (veh/s) of this law's output noise."""
+        self.trigger.set_output_noise(sd * abs(self.lin.u_bar_per_u))
+        return True
 
     def check_riemann(self, t: float, w_bar: np.ndarray) -> float:
         """Check on a scaled Riemann state at the kernel nodes; returns the held U-bar."""

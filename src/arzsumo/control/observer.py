@@ -154,6 +154,11 @@ class ObserverEtc(Controller):
                         V=r.V, d=r.d, m=r.m, m_nonnegative=float(r.m >= 0), y=y)
         return r.u_bar_held
 
+    def set_output_noise(self, sd: float) -> bool:
+        """The trigger's dead band from the sd (veh/s) of this law's output noise."""
+        self.trigger.set_output_noise(sd * abs(self.lin.u_bar_per_u))
+        return True
+
     def applied(self, u: float, lower: float = -math.inf, upper: float = math.inf) -> None:
         """Anti-windup: the observer integrates with the applied ``u`` (veh/s) until the
         next check; the trigger compares what is deliverable in ``[lower, upper]``."""

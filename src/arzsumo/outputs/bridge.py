@@ -36,6 +36,7 @@ under ``warmup``, apart, and are not included in the top-level ones.
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 from typing import Any
 
@@ -152,7 +153,11 @@ def actuation_summary(res: CoSimResult) -> dict[str, Any]:
     """The ``[actuation]`` limits used (SI; null: off) and how often they acted: periods
     and shares of the control window's periods saturated and rate limited;
     ``delay_compensation``: the dead time theta (s) the acting law predicted over (0: off,
-    or a controller without a Riemann-state law, :mod:`arzsumo.bridge.delay`)."""
+    or a controller without a Riemann-state law, :mod:`arzsumo.bridge.delay`);
+    ``meter_gain`` and ``hold_plan_in_range`` as in ``[actuation]``;
+    ``trigger_output_noise`` (veh/s): the acting law's output noise on the warm-up's
+    estimate, and ``trigger_dead_band`` (veh/s, in the law's units, noise_k sqrt(2) times
+    it) the dead band it sized (null: not measured, :mod:`arzsumo.bridge.trigger_noise`)."""
     act, per = res.scenario.actuation, res.periods
     n = int(per["t"].size)
     sat, rate = int(np.sum(per["saturated"] > 0)), int(np.sum(per["rate_limited"] > 0))
@@ -165,7 +170,12 @@ def actuation_summary(res: CoSimResult) -> dict[str, Any]:
             "applies": not off, "periods": n, "saturated_periods": sat,
             "rate_limited_periods": rate, "saturated_share": sat / n if n else None,
             "rate_limited_share": rate / n if n else None,
-            "delay_compensation": compensated_delay(res.scenario, res.settings.controller)}
+            "delay_compensation": compensated_delay(res.scenario, res.settings.controller),
+            "meter_gain": act.meter_gain, "hold_plan_in_range": act.hold_plan_in_range,
+            "trigger_output_noise": res.trigger_noise,
+            "trigger_dead_band": (None if res.trigger_noise is None else
+                                  res.scenario.design.noise_k * math.sqrt(2.0)
+                                  * res.trigger_noise)}
 
 
 def warmup_summary(res: CoSimResult) -> dict[str, Any]:

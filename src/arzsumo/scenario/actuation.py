@@ -8,6 +8,8 @@ Every key, its unit and the field of :class:`ActuationSettings` it sets::
     ramp_bound = true             # U within what the meter and the ramp can deliver
     anti_windup = true            # controllers with state see the U actually applied
     delay_compensation_s = 12     # PDE laws act on the state predicted 12 s ahead (0: off)
+    meter_gain = 2                # PDE laws: the outflow moves 2 veh/h per veh/h of release
+    hold_plan_in_range = true     # a held U moves the plan only when the range leaves it
 
 Without the table every limit is off and a run is today's: the meter receives the
 controller's U unchanged (the meter itself still saturates its green share to
@@ -22,6 +24,14 @@ L / max |lambda| at the equilibrium (one boundary reflection at most):
 :func:`check_delay_horizon`. The limits act in
 :func:`arzsumo.bridge.actuator.limit_u`; the ramp bound's rule is in
 :func:`arzsumo.bridge.actuator.ramp_range`.
+
+``meter_gain`` is -dq(L)/dr, the change of the section's outflow per change of the ramp
+release (about 2 on the default's merge, measured by the premise's actuator staircase):
+a PDE law's U is handed to the meter divided by it
+(:class:`arzsumo.control.meter_gain.MeterGain`). ``hold_plan_in_range``: while a law
+holds its U (between an ETC's events, or a held meter), the plan stays where it is as
+long as it lies in the range; it moves only when the range (the ramp bound moves with the
+queue) leaves it (:class:`arzsumo.bridge.actuator.MeterActuator`).
 """
 
 from __future__ import annotations
@@ -56,6 +66,14 @@ ACTUATION_KEYS: dict[str, Key] = {
                                 allowed="a dead time >= 0 s (0: no delay compensation)",
                                 doc="PDE laws (backstepping, etc) act on the state predicted "
                                     "this many s ahead with the U already applied; 0: off"),
+    "meter_gain": Key("meter_gain", allowed="a gain > 0 (1: one released ramp vehicle "
+                                            "takes one mainline slot)",
+                      doc="-dq(L)/dr, the section outflow's change per change of ramp "
+                          "release; PDE laws ask the meter for U / meter_gain (default 1)"),
+    "hold_plan_in_range": Key("hold_plan_in_range", "bool",
+                              doc="a held U keeps the meter's plan while the plan lies in "
+                                  "the range; false: the plan follows the range's clip "
+                                  "at every period (default false)"),
 }
 
 
@@ -67,7 +85,9 @@ class ActuationSettings:
     per s) bounds the change of U between control periods (0: off); ``ramp_bound`` limits
     U to the meter's and the ramp's range; ``anti_windup`` tells the controller the U
     applied (:meth:`arzsumo.control.base.Controller.applied`); ``delay_compensation``
-    (s, 0: off) is the dead time theta the PDE laws predict over.
+    (s, 0: off) is the dead time theta the PDE laws predict over; ``meter_gain``
+    (dimensionless) is -dq(L)/dr; ``hold_plan_in_range`` keeps a held U's plan while it
+    lies in the range.
     """
 
     u_max_fraction: float = 0.0
@@ -75,6 +95,8 @@ class ActuationSettings:
     ramp_bound: bool = False
     anti_windup: bool = True
     delay_compensation: float = 0.0
+    meter_gain: float = 1.0
+    hold_plan_in_range: bool = False
 
     def __post_init__(self) -> None:
         require(math.isfinite(self.u_max_fraction) and 0.0 <= self.u_max_fraction <= 1.0,
@@ -84,6 +106,8 @@ class ActuationSettings:
         require(math.isfinite(self.delay_compensation) and self.delay_compensation >= 0.0,
                 "delay_compensation", self.delay_compensation, "a dead time >= 0 s",
                 ScenarioError)
+        require(math.isfinite(self.meter_gain) and self.meter_gain > 0.0, "meter_gain",
+                self.meter_gain, "a gain > 0", ScenarioError)
 
     @property
     def active(self) -> bool:

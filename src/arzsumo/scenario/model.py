@@ -106,7 +106,12 @@ DESIGN_KEYS: dict[str, Key] = {
                         doc="noise sd of each scaled Riemann variable on the state the ETC "
                             "sees (default: none, no dead band; not in the paper)"),
     "noise_k": Key("noise_k", doc="trigger dead band in noise sds of the trigger error d "
-                                  "(with noise_sd_kmh; not in the paper)"),
+                                  "(with noise_sd_kmh or noise_from_estimate; not in the "
+                                  "paper)"),
+    "noise_from_estimate": Key("noise_from_estimate", "bool",
+                               doc="size the trigger's dead band from the law's output "
+                                   "noise measured on the warm-up's estimate (SUMO runs; "
+                                   "not with noise_sd_kmh; not in the paper)"),
 }
 
 
@@ -204,8 +209,9 @@ def design_toml(design: EtcDesign, comment: str = "") -> str:
         value = getattr(design, spec.field)
         if value == getattr(PAPER_DESIGN, spec.field) and key not in ("mu", "sigma", "zeta"):
             continue
-        user = ([float(f"{v * spec.factor:.6g}") for v in value] if isinstance(value, tuple)
-                else float(f"{value * spec.factor:.6g}"))
+        user = (value if isinstance(value, bool)
+                else [float(f"{v * spec.factor:.6g}") for v in value]
+                if isinstance(value, tuple) else float(f"{value * spec.factor:.6g}"))
         lines.append(f"{key} = {toml_value(user)}")
     return "\n".join(lines) + "\n"
 
