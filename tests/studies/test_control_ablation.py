@@ -8,7 +8,7 @@ import tomllib
 import pandas as pd
 import pytest
 
-from arzsumo.model import characteristic_speeds
+from arzsumo.model import characteristic_speeds, linearize
 from arzsumo.resources import shipped_scenarios_dir
 from arzsumo.scenario import scenario_from_dict
 from arzsumo.studies import control_ablation
@@ -30,6 +30,9 @@ def test_each_step_is_a_valid_scenario_that_changes_one_piece(step):
     full = _flat(experiment_scenario(BASE, "regulation"))
     changed = {k for k, v in _flat(data).items() if full.get(k) != v}
     tables = {k.partition(".")[0] for k in changed}
+    if step == "power-law":                          # the default is the power law
+        assert not changed
+        return
     assert len(tables) == 1, changed                 # one table of the configuration
     if step == "raw-cells":
         assert sc.estimation.method == "none"
@@ -107,3 +110,37 @@ def test_a_step_the_scenario_does_not_admit_is_refused_before_anything_runs(
         run_study("control-ablation", "--steps", "wave-matched", "--control",
                   tmp_path / "none", "--out", tmp_path / "out")
     assert not (tmp_path / "out").exists()
+
+
+NEWELL = tomllib.loads((shipped_scenarios_dir() / "control_newell.toml").read_text(
+    encoding="utf-8"))
+
+
+@pytest.mark.parametrize("step", ["power-law", "paper-trigger", "unit-gain", "dead-band"])
+def test_the_judged_configurations_steps_each_change_what_they_name(step):
+    data = control_ablation.step_scenario(NEWELL, step)
+    sc = scenario_from_dict(data, f"{step}.toml")
+    full = scenario_from_dict(experiment_scenario(NEWELL, "regulation"), "full.toml")
+    assert full.design.noise_from_estimate and full.actuation.meter_gain == 2.0
+    if step == "power-law":
+        lam4 = linearize(sc.equilibrium).eigenvalues[3] * 3.6
+        assert lam4 == pytest.approx(-2.55, abs=0.01)          # the default's model
+        assert linearize(full.equilibrium).eigenvalues[3] * 3.6 == pytest.approx(-32.6,
+                                                                                  abs=0.1)
+        assert sc.design.noise_from_estimate and sc.design.mu != full.design.mu
+        assert sc.actuation == full.actuation
+    if step == "paper-trigger":
+        assert not sc.design.noise_from_estimate
+        assert sc.design.with_(noise_from_estimate=True) == full.design
+    if step == "unit-gain":
+        assert sc.actuation.meter_gain == 1.0 and sc.design == full.design
+    if step == "dead-band":                          # by hand, in place of the measured
+        assert not sc.design.noise_from_estimate and sc.design.noise_sd
+
+
+def test_the_dead_band_step_is_unchanged_on_the_default():
+    # its records in the committed store hold only while the step's scenario is the same
+    data = control_ablation.step_scenario(BASE, "dead-band")
+    want = experiment_scenario(BASE, "regulation")["design"] | {
+        "noise_sd_kmh": list(control_ablation.DEAD_BAND_KMH), "noise_k": 2.0}
+    assert data["design"] == want

@@ -23,6 +23,11 @@ wave-matched        the laws (and twins) on the model whose lambda_4 is SUMO's
                     (:func:`arzsumo.model.wave_match.wave_matched`)
 dead-band           the ETC's trigger with the noise dead band :data:`DEAD_BAND_KMH`
                     (``[design] noise_sd_kmh``; backstepping does not read it)
+power-law           the laws (and twins) on the shipped default's power-law model,
+                    equilibrium and ``[design]`` (:func:`_power_law`)
+paper-trigger       the ETC's trigger as in the paper: no dead band measured on the
+                    estimate (``[design] noise_from_estimate`` off)
+unit-gain           the laws on the paper's unit actuator: ``[actuation] meter_gain`` 1
 ==================  ==============================================================
 
 The steps change the regulation experiment, or with ``--experiment disturbance`` the
@@ -39,6 +44,7 @@ from __future__ import annotations
 
 import argparse
 import tempfile
+import tomllib
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
@@ -122,6 +128,28 @@ def _wave_matched(data: dict) -> dict:
 #: checks at SUMO's noise level (2 %; docs/readings/etc_remedies.md)
 DEAD_BAND_KMH = (5.569, 0.3392, 0.8406, 0.256)
 
+def _band_by_hand(data: dict) -> dict:
+    """``data`` with :data:`DEAD_BAND_KMH` as the ETC's dead band, in place of one measured
+    on the estimate (the two cannot be combined)."""
+    data = _set({"design.noise_sd_kmh": list(DEAD_BAND_KMH), "design.noise_k": 2.0})(data)
+    data["design"].pop("noise_from_estimate", None)
+    return data
+
+
+def _power_law(data: dict) -> dict:
+    """``data`` with the shipped default's ``[model]``, ``[equilibrium]`` and ``[design]``
+    (the paper's power-law diagram, identified on the same stream), the trigger's
+    measured dead band kept where ``data`` asks for it."""
+    default = tomllib.loads((shipped_scenarios_dir() / "default.toml").read_text(
+        encoding="utf-8"))
+    measured = data.get("design", {}).get("noise_from_estimate")
+    for table in ("model", "equilibrium", "design"):
+        data[table] = dict(default[table])
+    if measured is not None:
+        data["design"]["noise_from_estimate"] = measured
+    return data
+
+
 #: step -> (what it changes, the change on the scenario as written, acts on the open loop)
 STEPS: dict[str, tuple[str, Callable[[dict], dict], bool]] = {
     "raw-cells": ("the laws on SUMO's Edie cells (no estimator)",
@@ -144,8 +172,13 @@ STEPS: dict[str, tuple[str, Callable[[dict], dict], bool]] = {
     "wave-matched": (f"the model's lambda_4 at SUMO's wave speed, {WAVE_SPEED_KMH:g} km/h",
                      _wave_matched, False),
     "dead-band": ("the ETC's trigger with a dead band sized to the estimate's noise",
-                  _set({"design.noise_sd_kmh": list(DEAD_BAND_KMH), "design.noise_k": 2.0}),
+                  _band_by_hand, False),
+    "power-law": ("the laws on the default's power-law model and design", _power_law,
                   False),
+    "paper-trigger": ("the ETC's trigger as in the paper (no measured dead band)",
+                      _set({"design.noise_from_estimate": False}), False),
+    "unit-gain": ("the laws on the paper's unit actuator (meter_gain 1)",
+                  _set({"actuation.meter_gain": 1.0}), False),
 }
 #: the measures of the ablation table (keys of the control study's measures)
 KEYS = ("network_whole_demand.time_spent_s.total", "network_whole_demand.ramp_wait_s.p95",
