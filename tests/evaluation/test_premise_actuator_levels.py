@@ -109,3 +109,16 @@ def test_a_settling_time_longer_than_a_hold_keeps_the_holds_second_half():
         pytest.approx(-1.0, abs=1e-6)
     with pytest.raises(PremiseError, match="estimator = 'mean' is not allowed"):
         actuator_gate(_staircase(-1.0, -1.0), estimator="mean")
+
+
+@pytest.mark.parametrize(("low", "high", "want"), [
+    (-1.2, -0.8, "inside"),            # in the range and narrow enough
+    (-1.25, -0.6, "unresolved"),       # straddles the range's upper end
+    (-2.87, -1.66, "outside"),         # the default's up side: wide, but resolved
+    (-0.5, 0.4, "outside"),            # no effect at all is outside too
+    (float("nan"), -1.0, "unresolved"),
+])
+def test_an_interval_outside_the_range_resolves_the_gate_however_wide(low, high, want):
+    from arzsumo.evaluation.premise.actuator import verdict
+    from arzsumo.evaluation.premise.gates import PremiseThresholds
+    assert verdict(low, high, PremiseThresholds()) == want

@@ -103,10 +103,19 @@ def premise_table(gates: Mapping[int, Sequence[GateResult]], verdict: PremiseVer
     if pooled is not None:
         lines.append(f"actuator pooled over the seeds: gain {_num(pooled.value)} "
                      f"({'pass' if pooled.passed else 'FAIL'}; reported, not in the verdict)")
+        lines += [f"  {side}: {_num(f['gain'])} [{_num(f['gain_low'])}, "
+                  f"{_num(f['gain_high'])}], {VERDICT_TEXT[f['verdict']]}"
+                  for side, f in pooled.detail.get("levels", {}).items() if "verdict" in f]
     holds = "holds" if verdict.passed else "does not hold"
     failed = f"; failed: {', '.join(verdict.failed)}" if verdict.failed else ""
     lines += [f"premise {holds}{failed}", f"rule: {verdict.rule}"]
     return "\n".join(lines)
+
+
+#: the actuator interval's verdict (:func:`arzsumo.evaluation.premise.actuator.verdict`)
+VERDICT_TEXT = {"inside": "inside the range: resolved, passes",
+                "outside": "outside the range: resolved, fails",
+                "unresolved": "overlaps the range's edge: not resolved"}
 
 
 def theory_lines(theory: Mapping[int, Mapping[str, Any]]) -> str:

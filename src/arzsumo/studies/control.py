@@ -172,6 +172,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_records(parser)
     add_runs(parser, seeds="1-20")
     add_output(parser, NAME, PAGE)
+    parser.add_argument("--page", default=PAGE, metavar="NAME",
+                        help="the results page --docs regenerates, DIR/NAME.md with its "
+                             "files in DIR/NAME/ (default: %(default)s, the default's)")
 
 
 def write_tables(args: argparse.Namespace, long: pd.DataFrame, runs: pd.DataFrame,
@@ -239,7 +242,9 @@ def run(args: argparse.Namespace) -> int:
                      "its files ride at one speed):\n\n" + files_table(runs, controllers))
         write_text(text, out / "control.md")
         if args.docs is not None:
-            publish(args.docs, PAGE, NAME, "The controllers on the default in SUMO", text,
+            name = base.get("name", "the scenario")
+            title = "the default" if name == "default" else name
+            publish(args.docs, args.page, NAME, f"The controllers on {title} in SUMO", text,
                     files)
     print(text)
     return 0 if ok else EXIT_SOME_FAILED

@@ -198,6 +198,21 @@ def _direction_ok(fit: DirectionFit, th: PremiseThresholds) -> bool:
     return bool(in_range and (fit.gain_high - fit.gain_low) / 2 <= th.gain_ci_halfwidth)
 
 
+def verdict(low: float, high: float, th: PremiseThresholds) -> str:
+    """Whether a gain's 95 % interval ``[low, high]`` decides the gate: ``"inside"`` (in
+    ``gain_range`` and no wider than ``gain_ci_halfwidth`` allows), ``"outside"``
+    (disjoint from the range: the gain is resolved and fails, however wide), else
+    ``"unresolved"``."""
+    lo, hi = th.gain_range
+    if not (math.isfinite(low) and math.isfinite(high)):
+        return "unresolved"
+    if high < lo or low > hi:
+        return "outside"
+    if lo <= low and high <= hi and (high - low) / 2 <= th.gain_ci_halfwidth:
+        return "inside"
+    return "unresolved"
+
+
 def _level_ok(fit: LevelFit, th: PremiseThresholds) -> bool:
     lo, hi = th.gain_range
     return bool(lo <= fit.gain <= hi and fit.halfwidth <= th.gain_ci_halfwidth)
@@ -232,8 +247,9 @@ def actuator_gate(records: ActuatorRecord | Sequence[ActuatorRecord],
         interval's half width is at most ``gain_ci_halfwidth`` (``"steps"``: with one
         step, the range alone). ``detail``: ``estimator``; per step direction the
         :class:`DirectionFit` fields and ``passed`` (``"up"``, ``"down"``: the dead
-        times); with ``"levels"``, ``levels`` per side (the :class:`LevelFit` fields
-        and ``passed``); ``steps`` (per step t0_s, dr, dq, gain, direction).
+        times); with ``"levels"``, ``levels`` per side (the :class:`LevelFit` fields,
+        ``passed`` and the interval's :func:`verdict`); ``steps`` (per step t0_s, dr,
+        dq, gain, direction).
     """
     th = thresholds or PremiseThresholds()
     require(estimator in ("levels", "steps"), "estimator", estimator,
@@ -250,7 +266,9 @@ def actuator_gate(records: ActuatorRecord | Sequence[ActuatorRecord],
         levels = [hold_levels(r.t, r.q, r.r, r.step_times, settle_s) for r in recs]
         sides = {s: side_fit(levels, s) for s in SIDES}
         ok = {s: _level_ok(f, th) for s, f in sides.items()}
-        detail["levels"] = {s: {**asdict(f), "passed": ok[s]} for s, f in sides.items()}
+        detail["levels"] = {s: {**asdict(f), "passed": ok[s],
+                                "verdict": verdict(f.gain_low, f.gain_high, th)}
+                            for s, f in sides.items()}
         gains = {s: f.gain for s, f in sides.items()}
     mid = sum(th.gain_range) / 2
     worst = max(gains.values(), key=lambda g: abs(g - mid) if math.isfinite(g) else math.inf)
