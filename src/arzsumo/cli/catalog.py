@@ -98,11 +98,13 @@ _MODULES = {
                                    "the control study's paired runs"),
     "penetration": ("penetration", "the ETC's triggers and release time against the AV "
                                    "share in SUMO, per seed"),
+    "share-models": ("share_models", "per AV share: the demand mapped to its discharge, the "
+                                     "model identified there, the ETC designed for it"),
 }
 
 #: the studies that are library code (frozen Options, ``run(options) -> Result``): their
 #: command line is :mod:`arzsumo.cli.studies`'s module of the same name
-LIBRARY_STUDIES = frozenset({"premise-map"})
+LIBRARY_STUDIES = frozenset({"premise-map", "share-models"})
 
 
 def _command_module(name: str, module: str) -> str:

@@ -209,18 +209,27 @@ def run_map(opts: MapOptions) -> MapResult:
 def _map_demands(opts: MapOptions, path: Path, points: Sequence[MapPoint],
                  warmup: float, out: Path
                  ) -> tuple[dict[str, float], dict[str, float], str]:
-    """The mapped points' two discharge runs: (point -> q(L), veh/s, for the points
-    whose merge did not gridlock; point -> the fill's shortfall, veh/s; the mapping's
-    lines)."""
+    """:func:`map_demands` with the map's options."""
+    return map_demands(path, points, warmup, out, workers=opts.workers,
+                       scheduler=opts.scheduler, progress=opts.progress)
+
+
+def map_demands(path: Path, points: Sequence[MapPoint], warmup: float, out: Path, *,
+                workers: int | None = None, scheduler: str | None = None,
+                progress: bool = True, label: str = NAME
+                ) -> tuple[dict[str, float], dict[str, float], str]:
+    """The mapped points' two discharge runs on the scenario at ``path`` (kept in
+    ``out``): (point -> q(L), veh/s, for the points whose merge did not gridlock; point
+    -> the fill's shortfall, veh/s; the mapping's lines)."""
     mapping = discharge_runs(path, points, warmup)
     if not mapping:
         return {}, {}, ""
-    kw = {"workers": opts.workers, "scheduler": opts.scheduler, "progress": opts.progress}
+    kw = {"workers": workers, "scheduler": scheduler, "progress": progress}
     found = _labelled(mapping, run_design(mapping, discharge_task, out,
-                                          label=f"{NAME} discharge", **kw))
+                                          label=f"{label} discharge", **kw))
     again = discharge_runs(path, points, warmup, flowing(found))
     second = _labelled(again, run_design(again, discharge_task, out,
-                                         label=f"{NAME} discharge at the mapped demand",
+                                         label=f"{label} discharge at the mapped demand",
                                          **kw))
     text = mapping_lines(found, second)
     print(text)

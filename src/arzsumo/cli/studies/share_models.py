@@ -1,0 +1,56 @@
+"""``arzsumo study share-models``: the command line of :mod:`arzsumo.studies.share_models`,
+mapped onto its :class:`~arzsumo.studies.share_models.ShareOptions`."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from arzsumo.argtypes import positive_int
+from arzsumo.model.params import FAMILIES
+from arzsumo.outputs.studies import markdown_table
+from arzsumo.studies.common import RESULTS_DIR, fraction_list, seed_list
+from arzsumo.studies.share_models import BASE, NAME, ShareOptions, run_share_models
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The study's options."""
+    parser.add_argument("--scenario", type=Path, metavar="SCENARIO.toml",
+                        help=f"the base scenario (default: the shipped {BASE})")
+    parser.add_argument("--shares", type=fraction_list, default=ShareOptions.shares,
+                        metavar="LIST", help="AV shares of the mainline demand (default: "
+                                             "0.1,0.18,0.3,0.5)")
+    parser.add_argument("--train-seeds", type=seed_list, default=seed_list("1-3"),
+                        metavar="LIST", help="identification seeds (default: 1-3)")
+    parser.add_argument("--validate-seeds", type=seed_list, default=seed_list("4-6"),
+                        metavar="LIST", help="held-out seeds (default: 4-6)")
+    parser.add_argument("--diagram", choices=FAMILIES, default="newell",
+                        help="stage 1's diagram family (default: newell)")
+    parser.add_argument("--cells", type=positive_int, default=100,
+                        help="kernel cells of the design (default: 100)")
+    parser.add_argument("--out", type=Path, default=RESULTS_DIR / NAME, metavar="DIR",
+                        help="where the scenarios, reports and runs go; a later call with "
+                             "the same directory reruns only the fits")
+    parser.add_argument("--workers", type=positive_int, metavar="N",
+                        help="local processes (default: one per core)")
+    parser.add_argument("--scheduler", metavar="ADDRESS",
+                        help="run the discharge runs on this Dask scheduler")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def options(args: argparse.Namespace) -> ShareOptions:
+    """The study's options as the command line gave them."""
+    return ShareOptions(scenario=args.scenario, shares=tuple(args.shares),
+                        train_seeds=tuple(args.train_seeds),
+                        validate_seeds=tuple(args.validate_seeds), diagram=args.diagram,
+                        kernel_cells=args.cells, out=args.out, workers=args.workers,
+                        scheduler=args.scheduler, progress=not args.quiet)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Map, identify and design every share; print the table."""
+    result = run_share_models(options(args))
+    print(markdown_table(result.table))
+    for m in result.models:
+        print(f"{m.point}: {m.scenario}")
+    return 0

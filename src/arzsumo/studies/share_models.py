@@ -1,0 +1,218 @@
+"""Per AV share, the stream's own model and design (``arzsumo study share-models``).
+
+A penetration study that keeps one model, one design and one demand for every AV share
+confounds the share with an operating point the model does not describe and a demand
+the section cannot hold (above 30 % AVs the default no longer inserted its demand).
+This study makes, for each share, the scenario the laws are then judged on:
+
+1. **the demand mapped to the share's discharge**: the premise map's two discharge runs
+   on a seed no gate reads (:func:`arzsumo.studies.premise_map.map_demands`), with the
+   mainline demand split by the share; hold 1.01 q(L), fill 1.14 q(L), the fill raised
+   by what the queue's tail lacked (docs/premise.md);
+2. **the model identified there** in two stages (``arzsumo identify --diagram``): the
+   diagram from the stationary states with SUMO's wave speed, then the relaxation
+   times by the replay, validated on held-out seeds
+   (:func:`arzsumo.studies.identify.run_identification`);
+3. **the ETC designed for it** (``design-check --auto``:
+   :func:`arzsumo.control.design.design_for` on the identified equilibrium), keeping
+   the base's dead band settings.
+
+Each share's scenario is written to ``OUT/<point>.toml`` (``av10.toml`` ...), its
+identification report to ``OUT/<point>/identify/``, and one row per share to
+``share_models.csv`` and ``share_models.md``. The SUMO runs are kept (the discharge
+runs in ``OUT/runs``, the identification's in the identification run cache), so a
+second call redoes only the fits.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from arzsumo.errors import require
+from arzsumo.io import dump_toml
+from arzsumo.outdir import resumable_dir
+from arzsumo.outputs.studies import markdown_table, write_csv, write_text
+from arzsumo.studies.common import RESULTS_DIR, StudyError, scenario_data, shipped_scenario
+from arzsumo.studies.premise_map import map_demands
+from arzsumo.studies.premise_map_points import MapPoint, mapped_points
+from arzsumo.units import VEH_H_PER_VEH_S, kmh_to_ms, ms_to_kmh
+
+NAME = "share-models"
+#: the scenario the study maps by default: the judged configuration of the laws
+BASE = "control_newell.toml"
+
+
+@dataclass(frozen=True)
+class ShareOptions:
+    """What ``arzsumo study share-models`` does.
+
+    ``scenario``: the base scenario (None: :data:`BASE`); ``shares``: AV shares of the
+    mainline demand, each in (0, 1); ``train_seeds``, ``validate_seeds``: the
+    identification's seeds (disjoint); ``diagram``: stage 1's family; ``kernel_cells``:
+    the design's kernel grid; ``out``: the study's directory (resumable); ``workers``,
+    ``scheduler``, ``progress``: how the SUMO runs are run.
+    """
+
+    scenario: Path | None = None
+    shares: tuple[float, ...] = (0.10, 0.18, 0.30, 0.50)
+    train_seeds: tuple[int, ...] = (1, 2, 3)
+    validate_seeds: tuple[int, ...] = (4, 5, 6)
+    diagram: str = "newell"
+    kernel_cells: int = 100
+    out: Path = RESULTS_DIR / NAME
+    workers: int | None = None
+    scheduler: str | None = None
+    progress: bool = True
+
+    def __post_init__(self) -> None:
+        require(bool(self.shares) and all(0.0 < s < 1.0 for s in self.shares)
+                and len(set(self.shares)) == len(self.shares), "shares", self.shares,
+                "distinct AV shares in (0, 1)", StudyError)
+        require(bool(self.train_seeds) and bool(self.validate_seeds)
+                and not set(self.train_seeds) & set(self.validate_seeds), "validate_seeds",
+                self.validate_seeds, "seeds disjoint from the training seeds", StudyError)
+        require(self.kernel_cells >= 10, "kernel_cells", self.kernel_cells,
+                "at least 10 cells", StudyError)
+
+
+@dataclass(frozen=True)
+class ShareModel:
+    """One share's outcome: its ``point`` name, ``share``, the mapped ``discharge``
+    (veh/s), the ``scenario`` file written and its ``row`` of the table."""
+
+    point: str
+    share: float
+    discharge: float
+    scenario: Path
+    row: Mapping[str, Any]
+
+
+@dataclass(frozen=True)
+class ShareResult:
+    """The study's outcome: per share a :class:`ShareModel`, the ``table`` (one row per
+    share) and the mapping's lines."""
+
+    models: tuple[ShareModel, ...]
+    table: pd.DataFrame
+    mapping: str
+
+
+def share_points(shares: Sequence[float]) -> list[MapPoint]:
+    """One mapped point per share, named ``av<percent>`` (the base scenario otherwise)."""
+    return [MapPoint(f"av{round(100 * s)}", "av_share", {}, mapped=True, av_share=s)
+            for s in shares]
+
+
+def with_keys(data: Mapping[str, Any], keys: Mapping[str, Any]) -> dict[str, Any]:
+    """``data`` (a scenario as written) with dotted ``table.key`` values set."""
+    out = {k: dict(v) if isinstance(v, Mapping) else v for k, v in data.items()}
+    for dotted, value in keys.items():
+        table, _, key = dotted.partition(".")
+        out.setdefault(table, {})[key] = value
+    return out
+
+
+def run_share_models(opts: ShareOptions) -> ShareResult:
+    """Map, identify and design every share (module docstring); write the scenarios and
+    the table."""
+    from arzsumo.scenario import load_scenario
+
+    path = opts.scenario or shipped_scenario(BASE)
+    base, points = scenario_data(path), share_points(opts.shares)
+    with resumable_dir(opts.out, f"study-{NAME}") as out:
+        discharges, shortfalls, text = map_demands(
+            path, points, load_scenario(path).run.warmup, out, workers=opts.workers,
+            scheduler=opts.scheduler, progress=opts.progress, label=NAME)
+        lost = [p.name for p in points if p.name not in discharges]
+        if lost:
+            raise StudyError(f"shares {', '.join(lost)} gridlocked at the merge in their "
+                             "discharge run: no operating point to identify a model at")
+        models = [_share_model(opts, base, p, discharges[p.name], out)
+                  for p in mapped_points(points, discharges, shortfalls)]
+        table = pd.DataFrame([m.row for m in models])
+        write_csv(table, out / "share_models.csv")
+        write_text(f"# {NAME}\n\n{markdown_table(table)}\n\nThe mapping's discharge runs:"
+                   f"\n\n{text}\n", out / "share_models.md")
+    return ShareResult(tuple(models), table, text)
+
+
+def _share_model(opts: ShareOptions, base: Mapping[str, Any], point: MapPoint,
+                 discharge: float, out: Path) -> ShareModel:
+    """One share: identify the model on its mapped scenario, design the ETC, write both."""
+    from arzsumo.identify import FitSettings
+    from arzsumo.scenario import scenario_from_dict
+    from arzsumo.studies.identify import make_setup, run_identification
+    from arzsumo.studies.identify_report import identified_toml, write_study
+
+    data = with_keys(base, point.set)
+    data["name"] = f"{base.get('name', 'scenario')}_{point.name}"
+    mapped = scenario_from_dict(data, str(out / f"{point.name}-mapped.toml"))
+    setup = make_setup(mapped, opts.train_seeds, opts.validate_seeds,
+                       diagram=opts.diagram, fit=FitSettings(), workers=opts.workers)
+    study = run_identification(setup)
+    write_study(out / point.name / "identify", study, overwrite=True)
+    identified = tomllib.loads(identified_toml(study))
+    design, cannot = _design(identified, base, opts.kernel_cells)
+    identified["design"] = design
+    identified["name"] = data["name"]
+    target = out / f"{point.name}.toml"
+    write_text(_header(point, discharge, cannot) + dump_toml(identified), target)
+    row = _row(point, discharge, study, cannot)
+    return ShareModel(point.name, point.av_share, discharge, target, row)
+
+
+def _design(identified: Mapping[str, Any], base: Mapping[str, Any], cells: int
+            ) -> tuple[dict[str, Any], tuple[str, ...]]:
+    """The ``[design]`` table that ``design-check --auto`` chooses for the identified
+    scenario (the base's dead band settings kept), and the conditions that cannot hold."""
+    from arzsumo.control.design import design_for
+    from arzsumo.kernel_cache import cached_kernels
+    from arzsumo.model.characteristic import linearize
+    from arzsumo.scenario import scenario_from_dict
+    from arzsumo.scenario.model import design_toml
+
+    sc = scenario_from_dict(dict(identified), "identified.toml")
+    lin = linearize(sc.equilibrium)
+    choice = design_for(lin.system, cached_kernels(lin.system, cells), base=sc.design)
+    table = tomllib.loads(design_toml(choice.design))["design"]
+    for key in ("noise_from_estimate", "noise_k"):
+        if key in base.get("design", {}):
+            table[key] = base["design"][key]
+    return table, tuple(choice.cannot_hold)
+
+
+def _header(point: MapPoint, discharge: float, cannot: Sequence[str]) -> str:
+    q = discharge * VEH_H_PER_VEH_S
+    held = "all hold" if not cannot else f"cannot hold: {', '.join(cannot)}"
+    return (f"# Written by `arzsumo study {NAME}`: AV share {point.av_share:g}, the demand "
+            f"mapped to its discharge\n# ({q:.0f} veh/h, seed 100), the model identified "
+            f"there in two stages, [design] by\n# design-check --auto (the theorem's "
+            f"conditions: {held}).\n")
+
+
+def _row(point: MapPoint, discharge: float, study: Any,
+         cannot: Sequence[str]) -> dict[str, Any]:
+    """The table's row of one share (file units)."""
+    from arzsumo.model.characteristic import linearize
+
+    lam4 = (ms_to_kmh(linearize(study.equilibrium).eigenvalues[3])
+            if study.equilibrium is not None else math.nan)
+    gaps = (study.stage_one.wave_gaps("validation", float(kmh_to_ms(lam4)))
+            if study.stage_one is not None and math.isfinite(lam4) else {})
+    blocks = {v: [r.rmse[v]["blocks_relative"] for r in study.validation.runs]
+              for v in ("rho_h", "rho_a")}
+    return {"point": point.name, "av_share": point.av_share,
+            "discharge_veh_h": discharge * VEH_H_PER_VEH_S,
+            **{f"{k}": v for k, v in point.set.items() if "demand" in k},
+            "lambda_4_kmh": lam4, "wave_gap_h": gaps.get("h", math.nan),
+            "wave_gap_a": gaps.get("a", math.nan),
+            "replay_rmse_h_max": max(blocks["rho_h"]),
+            "replay_rmse_a_max": max(blocks["rho_a"]),
+            "design_cannot_hold": "; ".join(cannot) or "-"}

@@ -1,0 +1,47 @@
+"""``arzsumo study share-models``: its points, its options and the design it writes."""
+
+from __future__ import annotations
+
+import tomllib
+
+import pytest
+
+from arzsumo.resources import shipped_scenarios_dir
+from arzsumo.studies.common import StudyError
+from arzsumo.studies.premise_map_points import mapped_demand
+from arzsumo.studies.share_models import ShareOptions, _design, share_points, with_keys
+
+NEWELL = tomllib.loads((shipped_scenarios_dir() / "control_newell.toml").read_text(
+    encoding="utf-8"))
+
+
+def test_each_share_is_a_mapped_point_whose_demand_splits_by_the_share():
+    points = share_points((0.1, 0.18, 0.3, 0.5))
+    assert [p.name for p in points] == ["av10", "av18", "av30", "av50"]
+    assert all(p.mapped and not p.set for p in points)
+    keys = mapped_demand(3860 / 3600, points[3].av_share)      # 50 %: an even split
+    assert keys["demand_h_veh_h"] == keys["demand_a_veh_h"] == round(1.01 * 3860 / 2)
+    data = with_keys(NEWELL, {f"sumo.{k}": v for k, v in keys.items()})
+    assert data["sumo"]["fill_demand_a_veh_h"] == round(1.14 * 3860 / 2)
+    assert NEWELL["sumo"]["demand_a_veh_h"] == 702               # the base is untouched
+
+
+@pytest.mark.parametrize(("changes", "field"), [
+    ({"shares": (0.0, 0.5)}, "shares"), ({"shares": (0.3, 0.3)}, "shares"),
+    ({"shares": ()}, "shares"), ({"validate_seeds": (3, 4)}, "validate_seeds"),
+    ({"kernel_cells": 4}, "kernel_cells")])
+def test_options_that_cannot_make_a_share_model_are_refused(changes, field):
+    with pytest.raises(StudyError, match=field):
+        ShareOptions(**changes)
+
+
+def test_the_design_is_design_check_autos_and_keeps_the_bases_dead_band():
+    # control_newell's [design] was chosen by design-check --auto (100 cells) for this
+    # model: the study's design of the same scenario gives it back to its 6 digits
+    table, cannot = _design(NEWELL, NEWELL, 100)
+    want = NEWELL["design"]
+    for key in ("mu", "sigma", "zeta", "eta", "B"):
+        assert table[key] == pytest.approx(want[key], rel=1e-5), key
+    assert table["A"] == pytest.approx(want["A"], rel=1e-5)
+    assert table["noise_from_estimate"] is True
+    assert len(cannot) == 1                      # esthm #1, as its comment says
