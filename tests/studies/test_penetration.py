@@ -76,7 +76,7 @@ def test_the_tables_hold_every_share_and_the_slopes_with_both_intervals():
 def test_a_report_without_finished_runs_is_refused(tmp_path):
     args = argparse.Namespace(records=tmp_path / "store", report=True, list=False,
                               out=tmp_path / "out", workers=None, scheduler=None,
-                              quiet=True, docs=None, seeds=None)
+                              quiet=True, docs=None, seeds=None, share_models=None)
     with pytest.raises(StudyError, match="no finished runs"):
         pen.run(args)
     assert list(tmp_path.iterdir()) == []          # nothing claimed, nothing written
@@ -106,3 +106,33 @@ def test_the_figure_draws_every_seed_and_the_mean_per_panel():
         assert len(thin) == 2 * 4                           # a thin line per seed
         assert len(means) == 2
         np.testing.assert_allclose(means[0].get_xdata(), [10, 18, 30, 50])
+
+
+def test_the_share_models_sweep_runs_each_shares_own_scenario(tmp_path):
+    import tomllib
+
+    from arzsumo.io import dump_toml
+    from arzsumo.resources import shipped_scenarios_dir
+
+    base = tomllib.loads((shipped_scenarios_dir() / "control_newell.toml").read_text(
+        encoding="utf-8"))
+    shares = {"av10": (0.10, 3500, 390, 70.0), "av50": (0.50, 1950, 1950, 55.0)}
+    for point, (_, hv, av, tau) in shares.items():
+        data = {k: dict(v) if isinstance(v, dict) else v for k, v in base.items()}
+        data["sumo"].update(demand_h_veh_h=hv, demand_a_veh_h=av)
+        data["model"]["tau_h_s"] = tau
+        (tmp_path / f"{point}.toml").write_text(dump_toml(data), encoding="utf-8")
+    pd.DataFrame({"point": ["av50", "av10"], "av_share": [0.5, 0.1]}).to_csv(
+        tmp_path / "share_models.csv", index=False)
+    spec = pen.share_sweep(tmp_path, [3, 4])
+    runs = spec.runs()
+    assert [r.run_id for r in runs] == ["penetration=0.1,seed=3", "penetration=0.1,seed=4",
+                                        "penetration=0.5,seed=3", "penetration=0.5,seed=4"]
+    for r in runs:
+        _, hv, av, tau = shares["av10" if r.columns["penetration"] == 0.1 else "av50"]
+        assert (r.scenario["sumo"]["demand_h_veh_h"], r.scenario["sumo"]["demand_a_veh_h"],
+                r.scenario["model"]["tau_h_s"]) == (hv, av, tau)
+        assert r.scenario["sumo"]["drain_max_s"] == 0 and r.scenario["run"]["controller"] \
+            == "etc"
+    with pytest.raises(StudyError, match=r"share_models\.csv"):
+        pen.share_sweep(tmp_path / "nothing", None)

@@ -11,6 +11,11 @@ shipped sweeps (:data:`SWEEPS`, through the sweep engine; a record store with
   ablation (without it the ETC fires at nearly every check at every share, so its
   triggers cannot fall).
 
+With ``--share-models DIR`` (the output of ``arzsumo study share-models``) the study runs
+instead one sweep built in code, ``penetration_share_models``: the ETC on each share's
+own scenario (the demand mapped to that share's discharge, the model identified there,
+the ETC designed for it; :func:`share_sweep`), with the wave measures beside the claim's.
+
 Each measure's trend is read per seed, the seed being paired across shares: the
 least-squares slope of the measure against the share on that seed, in units per 10
 percentage points, then the mean slope over seeds with its Student t and BCa bootstrap
@@ -58,13 +63,21 @@ NAME, PAGE = "penetration", "control_default"
 #: the shipped sweeps the study runs: name -> what its ETC is
 SWEEPS = {"penetration_sumo": "ETC",
           "penetration_deadband_sumo": "ETC with the noise dead band"}
+#: every sweep's title on the page (the shipped ones and ``--share-models``')
+TITLES = {**SWEEPS, "penetration_share_models": "ETC designed per share, on the demand "
+                                                "mapped to each share's discharge"}
 #: summary key -> (label, unit) of the measures the claim is about
 MEASURES = {"triggers": ("controller updates", "n"),
             "release_time": ("release time", "s"),
             "plan_changes": ("meter plan changes", "n"),
             # the premise's stationary point: a share whose queue spills past x = 0 starves
             # insertion, and its runs are no longer the congested state the law regulates
-            "inserted_fraction_main": ("mainline demand inserted", "share")}
+            "inserted_fraction_main": ("mainline demand inserted", "share"),
+            "section.waves.h.band_power_kmh2": ("HV band power 1-10 min", "(km/h)^2"),
+            "section.waves.a.band_power_kmh2": ("AV band power 1-10 min", "(km/h)^2"),
+            "section.speed_oscillation_kmh.h": ("HV speed oscillation", "km/h")}
+#: the sweep of ``--share-models``: the ETC on each share's own scenario
+SHARE_SWEEP = "penetration_share_models"
 SHARE = "penetration"
 #: the slope's unit of share: 10 percentage points
 PER = 0.10
@@ -81,11 +94,16 @@ def seed_slopes(table: pd.DataFrame, key: str) -> pd.Series:
     return pd.Series(out, name=key, dtype=float)
 
 
+def measures_in(table: pd.DataFrame) -> dict[str, tuple[str, str]]:
+    """The :data:`MEASURES` a table of runs has (earlier sweeps' records lack some)."""
+    return {k: v for k, v in MEASURES.items() if k in table.columns}
+
+
 def level_table(table: pd.DataFrame) -> pd.DataFrame:
     """Per share and measure: mean over seeds with its 95 % t interval, and n."""
     rows = []
     for share, g in table.groupby(SHARE):
-        for key, (label, unit) in MEASURES.items():
+        for key, (label, unit) in measures_in(table).items():
             ci = mean_ci(g[key].to_numpy(float))
             rows.append({"share": share, "measure": label, "unit": unit, "mean": ci.mean,
                          "low": ci.low, "high": ci.high, "n": ci.n})
@@ -95,7 +113,7 @@ def level_table(table: pd.DataFrame) -> pd.DataFrame:
 def slope_table(table: pd.DataFrame) -> pd.DataFrame:
     """Per measure: the mean per-seed slope per 10 points of share, t and BCa intervals."""
     rows = []
-    for key, (label, unit) in MEASURES.items():
+    for key, (label, unit) in measures_in(table).items():
         s = seed_slopes(table, key).to_numpy()
         t, boot = mean_ci(s), bootstrap_mean_ci(s)
         rows.append({"measure": label, "unit": f"{unit} per 10 pt", "slope": t.mean,
@@ -142,15 +160,47 @@ def report(tables: dict[str, pd.DataFrame]) -> str:
              "intervals)."]
     for name, table in tables.items():
         measured, said = claim_text(table)
-        parts += [f"## {SWEEPS[name]} (`{name}`)", f"{measured}: **{said}**",
+        parts += [f"## {TITLES[name]} (`{name}`)", f"{measured}: **{said}**",
                   markdown_table(level_table(table)), markdown_table(slope_table(table))]
     return "\n\n".join(parts) + "\n"
+
+
+def _flat(data: dict) -> dict[str, object]:
+    return {f"{t}.{k}": v for t, table in data.items() if isinstance(table, dict)
+            for k, v in table.items()}
+
+
+def share_sweep(directory: Path, seeds: list[int] | None) -> SweepSpec:
+    """The ETC on each share's scenario of a ``share-models`` output ``directory``: one
+    axis ``penetration`` (the shares of its ``share_models.csv``) whose values set every
+    key in which a share's scenario differs from the first share's; seeds 1-10 unless
+    ``seeds``; the control window only (no drain), as the shipped sweeps."""
+    import tomllib
+
+    from arzsumo.studies.common import study_spec
+
+    index = directory / "share_models.csv"
+    if not index.is_file():
+        raise StudyError(f"--share-models = {directory} has no share_models.csv; allowed: "
+                         "the --out of arzsumo study share-models")
+    rows = pd.read_csv(index).sort_values("av_share")
+    files = [directory / f"{p}.toml" for p in rows["point"]]
+    data = [tomllib.loads(f.read_text(encoding="utf-8")) for f in files]
+    base = _flat(data[0])
+    sets = [{k: v for k, v in _flat(d).items() if base.get(k) != v} for d in data]
+    return study_spec(SHARE_SWEEP, files[0], seeds=seeds or list(range(1, 11)),
+                      set={"sumo.drain_max_s": 0, "run.controller": "etc"},
+                      axis=[{"name": SHARE, "values": [float(v) for v in rows["av_share"]],
+                             "set": sets}])
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """The penetration study's options (the shares are the sweep files')."""
     parser.add_argument("--seeds", type=seed_list, metavar="LIST",
                         help="SUMO seeds, e.g. 1-10 (default: each sweep file's own)")
+    parser.add_argument("--share-models", type=Path, metavar="DIR",
+                        help="run the ETC on each share's own scenario from arzsumo study "
+                             "share-models (its --out) instead of the shipped sweeps")
     add_records(parser)
     add_runs(parser, seeds=None)
     add_output(parser, NAME, PAGE)
@@ -197,7 +247,7 @@ def _write(tables: dict[str, pd.DataFrame], out: Path, args: argparse.Namespace)
     if plots_wanted(args):
         from arzsumo.outputs.penetration import write_penetration_figure
 
-        files.append(write_penetration_figure(out, {SWEEPS[n]: t
+        files.append(write_penetration_figure(out, {TITLES[n]: t
                                                     for n, t in tables.items()}))
         text += "\n![ETC against the AV share](penetration.png)\n"
     else:
@@ -212,8 +262,9 @@ def _write(tables: dict[str, pd.DataFrame], out: Path, args: argparse.Namespace)
 def run(args: argparse.Namespace) -> int:
     """Both sweeps (resumable), then the levels, slopes and verdicts."""
     check_records(args)
-    specs = [with_seeds(load_sweep(shipped_sweeps_dir() / f"{n}.toml"), args.seeds)
-             for n in SWEEPS]
+    specs = ([share_sweep(args.share_models, args.seeds)] if args.share_models else
+             [with_seeds(load_sweep(shipped_sweeps_dir() / f"{n}.toml"), args.seeds)
+              for n in SWEEPS])
     if args.list:
         for spec in specs:
             print(f"{spec.name}: {len(spec.runs())} runs")
