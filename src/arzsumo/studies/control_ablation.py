@@ -180,6 +180,11 @@ STEPS: dict[str, tuple[str, Callable[[dict], dict], bool]] = {
     "unit-gain": ("the laws on the paper's unit actuator (meter_gain 1)",
                   _set({"actuation.meter_gain": 1.0}), False),
 }
+#: the steps run unless ``--steps`` names others: those of the default's configuration
+#: (``power-law``, ``paper-trigger`` and ``unit-gain`` change nothing on the default, whose
+#: model is the power law, whose trigger is the paper's and whose meter gain is 1)
+DEFAULT_STEPS = tuple(s for s in STEPS if s not in ("power-law", "paper-trigger",
+                                                    "unit-gain"))
 #: the measures of the ablation table (keys of the control study's measures)
 KEYS = ("network_whole_demand.time_spent_s.total", "network_whole_demand.ramp_wait_s.p95",
         "section.deviation.deviation_excess_s", "section.deviation.decay_time_s",
@@ -276,8 +281,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--experiment", choices=control.EXPERIMENTS, default="regulation",
                         help="the control study's experiment the steps change "
                              "(default: %(default)s)")
-    parser.add_argument("--steps", default=",".join(STEPS),
-                        help="comma-separated steps (default: %(default)s)")
+    parser.add_argument("--steps", default=",".join(DEFAULT_STEPS),
+                        help="comma-separated steps, of " + ", ".join(STEPS)
+                             + " (default: %(default)s)")
     parser.add_argument("--laws", default=",".join(LAWS),
                         help="comma-separated laws ablated (default: %(default)s)")
     add_records(parser)
