@@ -111,8 +111,11 @@ def test_the_design_pulses_the_first_seed_only():
 def test_bad_points_are_refused():
     with pytest.raises(StudyError, match="--points = 'today,nope' is not allowed: names"):
         pm.selected_points("today,nope")
-    with pytest.raises(StudyError, match="\\[sumo\\] keys only"):
+    with pytest.raises(StudyError, match=r"keys of sumo\., run\.start, .* only"):
         pm.MapPoint("x", "axis", {"run.controller": "etc"})
+    placed = pm.MapPoint("x", "axis", {"run.start": "placement",
+                                       "initial.amplitude": [0.0, 0.0, 0.0, 0.0]})
+    assert placed.set["run.start"] == "placement"        # where vehicles start is allowed
 
 
 def test_the_round_trip_is_the_measured_one():
@@ -317,3 +320,18 @@ def test_a_run_listed_twice_is_run_once_and_read_by_both(tmp_path):
     rows = run_design([run, other, run], task, tmp_path, in_process=True, progress=False)
     assert calls == [run.run_id, other.run_id]
     assert rows == [{"id": run.run_id}, {"id": other.run_id}, {"id": run.run_id}]
+
+
+def test_a_placed_point_starts_uniform_at_its_equilibrium_and_others_unplaced():
+    from arzsumo.resources import shipped_scenarios_dir
+    from arzsumo.scenario import load_scenario
+    from arzsumo.studies.premise_runs import placed_fields
+
+    sc = load_scenario(shipped_scenarios_dir() / "default.toml")
+    assert placed_fields(sc) is None
+    fields = placed_fields(sc.with_(dict(pmp.PLACED)))
+    eq = sc.equilibrium
+    assert fields.shape == (4, 20)                         # 1000 m in 50 m cells
+    np.testing.assert_allclose(fields[0], eq.rho_h, rtol=1e-12)
+    np.testing.assert_allclose(fields[2], eq.rho_a, rtol=1e-12)
+    np.testing.assert_allclose(fields[1], eq.v_h, rtol=1e-12)

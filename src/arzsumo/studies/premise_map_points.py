@@ -52,10 +52,16 @@ DISCHARGE_WINDOW_S = 300.0
 BASE_AV_SHARE = 0.18
 
 
+#: what a point may change: SUMO's side, and where its vehicles start (a section placed
+#: congested at t = 0 about an equilibrium, the ``[initial]`` profile around it)
+POINT_KEYS = ("sumo.", "run.start", "initial.", "equilibrium.")
+
+
 @dataclass(frozen=True)
 class MapPoint:
     """One point of the map: ``name`` (its row), ``axis`` (what it varies), ``set``
-    (sweep ``set`` keys of the base scenario, e.g. ``{"sumo.min_gap_lat_m": 0.6}``);
+    (sweep ``set`` keys of the base scenario, e.g. ``{"sumo.min_gap_lat_m": 0.6}``;
+    :data:`POINT_KEYS`);
     ``mapped``: its demand is set from its own measured discharge, split by
     ``av_share``, its fill raised by ``fill_extra_veh_h`` beyond the rule's."""
 
@@ -73,10 +79,10 @@ class MapPoint:
         return self.name.split("+fill")[0]
 
     def __post_init__(self) -> None:
-        bad = [k for k in self.set if not k.startswith("sumo.")]
+        bad = [k for k in self.set if not k.startswith(POINT_KEYS)]
         if bad or not self.name or "," in self.name or "=" in self.name:
             raise StudyError(f"map point {self.name!r}: a name without ',' or '=' and "
-                             f"[sumo] keys only (got {bad})")
+                             f"keys of {', '.join(POINT_KEYS)} only (got {bad})")
         if not 0.0 <= self.av_share < 1.0:
             raise StudyError(f"map point {self.name!r}: av_share = {self.av_share!r} is "
                              "not allowed: in [0, 1)")
@@ -151,6 +157,20 @@ TREIBER_IDM = {"hv_accel_m_s2": 0.73, "hv_decel_m_s2": 1.67, "hv_tau_s": 1.6}
 MERGING = {"lc_assertive": 3, "lc_impatience": 1}
 
 
+#: the section placed congested at t = 0, uniform at the base's equilibrium (101 HV and 22
+#: AV per km on the default): SUMO inserts a vehicle only where the secure gap of its
+#: car-following model is free at its insertion speed, so insertion cannot fill a queue
+#: as dense as the model holds it (SUMO #9031, and docs/RoadCapacity: "insertion is
+#: usually the limiting factor"); IDM's and a 1 s reaction time's mapped fills left the
+#: queue's tail 275-750 m inside the section
+PLACED = {"run.start": "placement", "initial.amplitude": [0.0, 0.0, 0.0, 0.0]}
+
+
+def placed(p: MapPoint) -> MapPoint:
+    """``p`` with its section placed congested at t = 0 (name ``P-placed``)."""
+    return replace(p, name=f"{p.name}-placed", set={**p.set, **PLACED})
+
+
 def _mapped(name: str, av_share: float = BASE_AV_SHARE, **keys: Any) -> MapPoint:
     return MapPoint(name, "car following (mapped)",
                     {f"sumo.{k}": v for k, v in {**CAR_FOLLOWING, **keys}.items()},
@@ -217,6 +237,11 @@ POINTS: tuple[MapPoint, ...] = (
     _mapped("action-1.0-mapped", hv_action_step_s=1.0),
     fuller(_mapped("action-1.0-mapped", hv_action_step_s=1.0)),
     _mapped("idm-sumo-lc-down30", hv_model="IDM", down_speed_kmh=30, **MERGING),
+    # the same, with the section placed congested at t = 0 (insertion cannot fill it)
+    placed(_mapped("idm-sumo-lc-down30", hv_model="IDM", down_speed_kmh=30, **MERGING)),
+    placed(_mapped("idm-treiber-lc-down20", hv_model="IDM", **TREIBER_IDM,
+                   down_speed_kmh=20, **MERGING)),
+    placed(_mapped("action-1.0-mapped", hv_action_step_s=1.0)),
 )
 
 

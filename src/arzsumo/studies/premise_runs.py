@@ -249,11 +249,25 @@ def _periods(duration: float, period: float) -> int:
     return max(1, round(duration / period))
 
 
+def placed_fields(sc: Scenario) -> np.ndarray | None:
+    """The fields (4, cells) to place vehicles from at t = 0 with ``[run] start =
+    "placement"`` (the ``[initial]`` profile about the scenario's equilibrium on SUMO's
+    cells, as a closed-loop run places them); None otherwise."""
+    from arzsumo.scenario.twin import seeded
+    from arzsumo.twin.initial import initial_fields
+
+    if sc.run.start != "placement":
+        return None
+    n = round(sc.params.length / sc.sumo.cell_length)
+    xc = (np.arange(n) + 0.5) * sc.sumo.cell_length
+    return initial_fields(seeded(sc.initial, sc.sumo.seed), sc.equilibrium, xc)
+
+
 def _simulate(sc: Scenario, opts: Sequence[Mapping[str, Any]], fork: bool) -> list[Any]:
     """The warm-up, then the window of each of ``opts`` (in forked children with
     ``fork`` and more than one, else the one window in this process). The caller checks
     :func:`~arzsumo.sumo.fork.can_fork`."""
-    from arzsumo.bridge.cosim import warm_up
+    from arzsumo.bridge.cosim import place_initial, warm_up
     from arzsumo.bridge.session import meter_curve_of
     from arzsumo.progress import Progress
     from arzsumo.sumo.fork import run_branches
@@ -265,7 +279,9 @@ def _simulate(sc: Scenario, opts: Sequence[Mapping[str, Any]], fork: bool) -> li
     t_w = max(1, math.ceil(sc.run.warmup / period - 1e-9)) * period
     n = max(int(o.get("horizon_periods", 0)) for o in opts)
     cfg = sc.sumo.with_(horizon=t_w + max(n, 1) * period)
-    with open_simulation(sc.params, cfg, downstream_loop=sc.alinea.loop_distance) as sim:
+    initial, _ = place_initial(sc.params, sc.run, cfg, placed_fields(sc))
+    with open_simulation(sc.params, cfg, initial=initial,
+                         downstream_loop=sc.alinea.loop_distance) as sim:
         plant = SumoPlant(sim, sc.params.length, cfg, meter_curve_of(cfg, sc.source))
         warm = warm_up(plant, sc.run.warmup, period, Progress(1, enabled=False))
         warm_s = time.perf_counter() - wall0
