@@ -143,3 +143,29 @@ def test_loop_speed_station_means_leave_out_a_period_without_a_harmonic_speed():
         "(5 station-periods)",
         "v_a at the stations, km/h: time-mean 36.00, harmonic 28.80, probe cells 32.40 "
         "(6 station-periods)"]
+
+
+def test_loop_speed_runs_from_python_with_its_options_and_the_cli_maps_onto_them():
+    """Library code: LoopSpeedOptions in, its design out, no argparse in the study."""
+    import argparse
+    from pathlib import Path
+
+    from arzsumo.cli.studies import loop_speed as cli
+    from arzsumo.studies import loop_speed
+    from arzsumo.studies.common import StudyError
+
+    opts = loop_speed.LoopSpeedOptions(scenario=DEFAULT, seeds=(3, 4), horizon_s=120.0,
+                                       method="enkf")
+    runs = loop_speed.design(opts)
+    assert [r.run_id for r in runs] == ["seed=3", "seed=4"]
+    assert runs[0].scenario["sumo"]["horizon_s"] == 120.0
+    parser = argparse.ArgumentParser()
+    cli.add_arguments(parser)
+    args = parser.parse_args(["--scenario", str(DEFAULT), "--seeds", "3,4", "--horizon",
+                              "120", "--method", "enkf"])
+    assert cli.options(args) == opts
+    with pytest.raises(StudyError, match=r"horizon_s = -1\.0 is not allowed"):
+        loop_speed.LoopSpeedOptions(horizon_s=-1.0)
+    with pytest.raises(StudyError, match="method = 'kalman' is not allowed"):
+        loop_speed.LoopSpeedOptions(method="kalman")
+    assert "argparse" not in Path(loop_speed.__file__).read_text(encoding="utf-8")

@@ -173,11 +173,35 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def recorded(runs: list[StudyRun], args: argparse.Namespace) -> list[str]:
     """The record paths of ``runs``, recording the missing ones on the sweep engine."""
+    return record_paths(runs, workers=args.workers, scheduler=args.scheduler,
+                        progress=not args.quiet)
+
+
+def record_paths(runs: list[StudyRun], *, workers: int | None = None,
+                 scheduler: str | None = None, progress: bool = True) -> list[str]:
+    """The record paths of ``runs``, recording the missing ones on the sweep engine.
+
+    Parameters
+    ----------
+    runs : list of StudyRun
+        The recorded open-loop runs (:func:`design`).
+    workers : int, optional
+        Local processes (default: one per core); ignored with ``scheduler``.
+    scheduler : str, optional
+        A Dask scheduler's address to run on instead.
+    progress : bool, optional
+        Show a progress bar while recording.
+
+    Returns
+    -------
+    list of str
+        The ``.npz`` record of each run, in ``runs``' order.
+    """
     from arzsumo.sweep.driver import map_runs
 
-    done = map_runs(record, runs, workers=args.workers or default_workers(),
-                    scheduler=args.scheduler,
-                    progress=None if args.quiet else f"{NAME}: recording")
+    done = map_runs(record, runs, workers=workers or default_workers(),
+                    scheduler=scheduler,
+                    progress=f"{NAME}: recording" if progress else None)
     return [d["path"] for d in done]
 
 
