@@ -59,7 +59,7 @@ def test_the_enkf_settings_are_scenario_keys_and_a_round_scales_by_the_error():
 
 
 def test_the_u_estimate_design_is_one_run_per_estimator_on_legacy_default():
-    spec = u_estimate.design([42])
+    spec = u_estimate.design(u_estimate.UEstimateOptions(seeds=(42,)))
     runs = spec.runs()
     assert [r.run_id for r in runs] == ["estimator=none,seed=42", "estimator=smoothing,seed=42",
                                         "estimator=enkf,seed=42"]
@@ -169,3 +169,37 @@ def test_loop_speed_runs_from_python_with_its_options_and_the_cli_maps_onto_them
     with pytest.raises(StudyError, match="method = 'kalman' is not allowed"):
         loop_speed.LoopSpeedOptions(method="kalman")
     assert "argparse" not in Path(loop_speed.__file__).read_text(encoding="utf-8")
+
+
+def test_u_estimate_runs_from_python_and_counts_the_runs_that_did_not_finish(monkeypatch,
+                                                                             tmp_path):
+    """run_u_estimate(UEstimateOptions) without SUMO: a failed run of the three gives
+    exit code 4; the command line builds the same options."""
+    import argparse
+    from types import SimpleNamespace
+
+    import pandas as pd
+
+    from arzsumo.cli.studies import u_estimate as cli
+    from arzsumo.studies.common import StudyError
+
+    table = pd.DataFrame({"estimator": ["none", "smoothing", "enkf"], "seed": [7] * 3,
+                          "status": ["ok", "failed", "incomplete"], "plan_changes": [1] * 3})
+    asked = {}
+
+    def fake_sweep(spec, out, **kwargs):
+        asked.update(kwargs, runs=len(spec.runs()))
+        return SimpleNamespace(out=out, table=table)
+
+    monkeypatch.setattr("arzsumo.sweep.driver.run_sweep", fake_sweep)
+    opts = u_estimate.UEstimateOptions(seeds=(7,), out=tmp_path / "out", plots=False)
+    result = u_estimate.run_u_estimate(opts, progress=False)
+    assert (result.code, result.finished, result.runs) == (4, 2, 3)
+    assert (asked["runs"], asked["progress"]) == (3, False)
+    assert [p.name for p in result.files] == ["u_estimate.csv", "u_series.csv"]
+    parser = argparse.ArgumentParser()
+    cli.add_arguments(parser)
+    assert cli.options(parser.parse_args(["--seeds", "7", "--out", str(tmp_path / "out"),
+                                          "--no-plots"])) == opts
+    with pytest.raises(StudyError, match=r"warmup_s = 0\.0 is not allowed"):
+        u_estimate.UEstimateOptions(warmup_s=0.0)
