@@ -27,7 +27,7 @@ def test_the_maps_design_is_demand_x_green_share_without_a_fill():
 
 
 def test_the_fill_design_holds_each_demand_after_the_defaults_fill():
-    runs = fill.design(["3750:850", "3900:950"], [0.5], [0.5], [1, 2, 3])
+    runs = fill.design(fill.FillOptions(holds=("3750:850", "3900:950"), seeds=(1, 2, 3)))
     assert [r.run_id for r in runs][:2] == ["hold=3750_850,green_share=0.5,hv_sigma=0.5,seed=1",
                                             "hold=3750_850,green_share=0.5,hv_sigma=0.5,seed=2"]
     sumo = runs[3].scenario["sumo"]
@@ -36,6 +36,29 @@ def test_the_fill_design_holds_each_demand_after_the_defaults_fill():
                                                              600.0)
     with pytest.raises(StudyError, match="'3900' is not allowed: HV:AV"):
         fill.hold_pair("3900")
+
+
+def test_the_fill_study_takes_its_options_from_python_and_refuses_a_bad_one():
+    """Library code: FillOptions (checked on construction) in, the design out; the
+    command line builds the same options."""
+    import argparse
+    from pathlib import Path
+
+    from arzsumo.cli.studies import fill as cli
+
+    opts = fill.FillOptions(holds=("3750:850", "3900:950"), greens=(0.4, 0.6), seeds=(2,),
+                            fill_s=300.0)
+    runs = fill.design(opts)
+    assert len(runs) == 4 and runs[0].options["fill_s"] == 300.0
+    parser = argparse.ArgumentParser()
+    cli.add_arguments(parser)
+    assert cli.options(parser.parse_args(["--holds", "3750:850", "3900:950", "--greens",
+                                          "0.4,0.6", "--seeds", "2", "--fill", "300"])) == opts
+    with pytest.raises(StudyError, match="'3900' is not allowed: HV:AV"):
+        fill.FillOptions(holds=("3900",))
+    with pytest.raises(StudyError, match=r"step_s = 0\.0 is not allowed: a finite number > 0"):
+        fill.FillOptions(step_s=0.0)
+    assert "argparse" not in Path(fill.__file__).read_text(encoding="utf-8")
 
 
 def test_the_trend_of_a_linear_count_is_its_slope():

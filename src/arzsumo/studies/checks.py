@@ -63,3 +63,9 @@ def all_among(values: Sequence[object], allowed: Collection[object], field: str)
     """At least one value, each one of ``allowed``."""
     require(len(values) > 0 and all(v in allowed for v in values), field, values,
             "at least one of " + ", ".join(map(str, allowed)), StudyError)
+
+
+def numbers(values: Sequence[float], field: str) -> None:
+    """At least one number, each finite."""
+    require(len(values) > 0 and all(math.isfinite(v) for v in values), field, values,
+            "at least one finite number", StudyError)
