@@ -103,7 +103,8 @@ _MODULES = {
 #: the studies that are library code (frozen Options, ``run(options) -> Result``): their
 #: command line is :mod:`arzsumo.cli.studies`'s module of the same name
 LIBRARY_STUDIES = frozenset({"premise-map", "loop-speed", "u-estimate", "inlet",
-                             "held-ramp", "fill", "wave-speed"})
+                             "held-ramp", "fill", "wave-speed",
+                             "meter-delay"})
 
 
 def _command_module(name: str, module: str) -> str:
