@@ -104,7 +104,8 @@ _MODULES = {
 #: command line is :mod:`arzsumo.cli.studies`'s module of the same name
 LIBRARY_STUDIES = frozenset({"premise-map", "loop-speed", "u-estimate", "inlet",
                              "held-ramp", "fill", "wave-speed",
-                             "meter-delay", "sumo-options", "etc-noise"})
+                             "meter-delay", "sumo-options", "etc-noise",
+                             "ablation-mechanism"})
 
 
 def _command_module(name: str, module: str) -> str:
