@@ -203,3 +203,30 @@ def test_u_estimate_runs_from_python_and_counts_the_runs_that_did_not_finish(mon
                                           "--no-plots"])) == opts
     with pytest.raises(StudyError, match=r"warmup_s = 0\.0 is not allowed"):
         u_estimate.UEstimateOptions(warmup_s=0.0)
+
+
+def test_enkf_noise_tunes_from_python_with_its_options(engine, tmp_path):
+    """Library code: EnkfNoiseOptions in, EnkfNoiseResult out. Every fake score has
+    RMSE / spread 2, so one round at gain 1.5 scales each sd by 2 ** 1.5 (2 significant
+    digits); the command line builds the same options."""
+    import argparse
+
+    from arzsumo.cli.studies import enkf_noise as cli
+    from arzsumo.studies.common import StudyError
+
+    opts = enkf_noise.EnkfNoiseOptions(tune_seeds=(1,), report_seeds=(2,), rounds=1,
+                                       inflation_only=(1.05,), workers=1,
+                                       out=tmp_path / "out")
+    result = enkf_noise.run_enkf_noise(opts, progress=False)
+    assert result.sd == (5.7, 2.8, 2.8, 2.8)
+    assert len(result.rows) == 2 * len(enkf_noise.ENKF_LAYOUTS)     # two settings each
+    assert [p.name for p in result.files] == ["enkf_noise.md", "enkf_noise.csv"]
+    parser = argparse.ArgumentParser()
+    cli.add_arguments(parser)
+    assert cli.options(parser.parse_args([*ENKF_QUICK[:4], "--rounds", "1",
+                                          "--inflation-only", "1.05", "--workers", "1",
+                                          "--out", str(tmp_path / "out")])) == opts
+    with pytest.raises(StudyError, match=r"--start = \[1\.0\] is not allowed: 4 sd"):
+        enkf_noise.EnkfNoiseOptions(start=(1.0,))
+    with pytest.raises(StudyError, match="layout = 'full probe' is not allowed"):
+        enkf_noise.EnkfNoiseOptions(layout="full probe")

@@ -105,7 +105,7 @@ _MODULES = {
 LIBRARY_STUDIES = frozenset({"premise-map", "loop-speed", "u-estimate", "inlet",
                              "held-ramp", "fill", "wave-speed",
                              "meter-delay", "sumo-options", "etc-noise",
-                             "ablation-mechanism", "approach"})
+                             "ablation-mechanism", "approach", "enkf-noise"})
 
 
 def _command_module(name: str, module: str) -> str:
