@@ -230,3 +230,36 @@ def test_enkf_noise_tunes_from_python_with_its_options(engine, tmp_path):
         enkf_noise.EnkfNoiseOptions(start=(1.0,))
     with pytest.raises(StudyError, match="layout = 'full probe' is not allowed"):
         enkf_noise.EnkfNoiseOptions(layout="full probe")
+
+
+def test_estimation_layouts_scores_from_python_with_its_options(monkeypatch, tmp_path):
+    """Library code: LayoutsOptions in, LayoutsResult out, without SUMO (records and
+    scores made up: every layout and method of seed s scores s / 10); the command line
+    builds the same options."""
+    import argparse
+
+    from arzsumo.cli.studies import estimation_layouts as cli
+    from arzsumo.studies.common import StudyError
+
+    def fake(fn, tasks, **kwargs):
+        if fn is estimation_layouts.record:
+            return [{"path": f"record-{i}.npz"} for i, _ in enumerate(tasks)]
+        return [[{"layout": layout, "method": "enkf", "seed": t[2],
+                  **{f"{v}_rel": t[2] / 10 for v in estimation_layouts.VARS}}
+                 for layout in estimation_layouts.LAYOUTS] for t in tasks]
+
+    monkeypatch.setattr("arzsumo.sweep.driver.map_runs", fake)
+    opts = estimation_layouts.LayoutsOptions(scenario=DEFAULT, seeds=(1, 2, 3),
+                                             horizon_s=300.0, out=tmp_path / "out")
+    assert [r.run_id for r in estimation_layouts.study_runs(opts)] == [
+        "seed=1", "seed=2", "seed=3"]
+    result = estimation_layouts.run_layouts(opts, progress=False)
+    assert len(result.table) == 3 * len(estimation_layouts.LAYOUTS)
+    assert "| loops 250 m | enkf | 0.200 +- 0.248 |" in result.text
+    parser = argparse.ArgumentParser()
+    cli.add_arguments(parser)
+    assert cli.options(parser.parse_args(["--scenario", str(DEFAULT), "--seeds", "1-3",
+                                          "--horizon", "300", "--out",
+                                          str(tmp_path / "out")])) == opts
+    with pytest.raises(StudyError, match="warmup_s = 0 is not allowed"):
+        estimation_layouts.LayoutsOptions(warmup_s=0)

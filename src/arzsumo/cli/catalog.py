@@ -105,7 +105,8 @@ _MODULES = {
 LIBRARY_STUDIES = frozenset({"premise-map", "loop-speed", "u-estimate", "inlet",
                              "held-ramp", "fill", "wave-speed",
                              "meter-delay", "sumo-options", "etc-noise",
-                             "ablation-mechanism", "approach", "enkf-noise"})
+                             "ablation-mechanism", "approach", "enkf-noise",
+                             "estimation-layouts"})
 
 
 def _command_module(name: str, module: str) -> str:
