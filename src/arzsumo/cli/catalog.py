@@ -106,7 +106,7 @@ LIBRARY_STUDIES = frozenset({"premise-map", "loop-speed", "u-estimate", "inlet",
                              "held-ramp", "fill", "wave-speed",
                              "meter-delay", "sumo-options", "etc-noise",
                              "ablation-mechanism", "approach", "enkf-noise",
-                             "estimation-layouts"})
+                             "estimation-layouts", "meter-dynamics"})
 
 
 def _command_module(name: str, module: str) -> str:
