@@ -106,7 +106,7 @@ LIBRARY_STUDIES = frozenset({"premise-map", "loop-speed", "u-estimate", "inlet",
                              "held-ramp", "fill", "wave-speed",
                              "meter-delay", "sumo-options", "etc-noise",
                              "ablation-mechanism", "approach", "enkf-noise",
-                             "estimation-layouts", "meter-dynamics"})
+                             "estimation-layouts", "meter-dynamics", "ablation"})
 
 
 def _command_module(name: str, module: str) -> str:
