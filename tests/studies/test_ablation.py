@@ -144,3 +144,35 @@ def test_the_report_names_the_seeds_its_steps_ran_on_not_the_default(run_study, 
     assert run_study("ablation", "--report", "--out", out, "--docs", tmp_path / "docs") == 0
     page = (tmp_path / "docs" / "control_in_sumo.md").read_text()
     assert "is evaluated on seeds identified: 3,4; design: 3-5 (`arzsumo" in page
+
+
+def test_the_ablation_reports_from_python_with_its_options(tmp_path):
+    """Library code: AblationOptions in (report only), AblationResult out; its design
+    runs identified first, the command line builds the same options, and an unknown step
+    is refused on construction."""
+    import argparse
+
+    from arzsumo.cli.studies import ablation as cli
+
+    opts = ablation.AblationOptions(steps=("design", "identified"), seeds=(1, 2, 3, 4))
+    assert ablation.design(opts) == [
+        "identified: open, alinea, backstepping, etc on seeds 1-4",
+        "design: etc on seeds 1-4; open loop from identified"]
+    parser = argparse.ArgumentParser()
+    cli.add_arguments(parser)
+    assert cli.options(parser.parse_args(["--steps", "design,identified", "--seeds",
+                                          "1-4"])) == opts
+    out = tmp_path / "abl"
+    out.mkdir()
+    write_marker(out, "study-ablation")
+    base = {"n": 10, "wins": 0, "losses": 0, "diff_ci_low": 10.0, "diff_ci_high": 14.0}
+    _evaluation(out / "identified" / "evaluation.csv", [
+        {**base, "measure": "plan_changes", "controller": "etc", "mean": 12.0,
+         "diff_mean": 12.0}])
+    result = ablation.run_ablation(ablation.AblationOptions(report=True, out=out))
+    assert result.code == 0
+    assert result.table[["step", "controller", "mean"]].values.tolist() == [
+        ["identified", "etc", 12.0]]
+    assert [p.name for p in result.files] == ["ablation.csv", "ablation.md"]
+    with pytest.raises(StudyError, match="--steps: 'best' is not allowed"):
+        ablation.AblationOptions(steps=("identified", "best"))

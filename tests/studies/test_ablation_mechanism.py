@@ -83,3 +83,25 @@ def test_an_ablation_without_identifieds_open_loop_is_refused(ablation_dir):
     df = mech.collect(ablation_dir)
     with pytest.raises(StudyError, match="no open loop of step 'identified'"):
         mech.paired(df[df["step"] != "identified"])
+
+
+def test_the_study_runs_from_python_with_its_options(ablation_dir, tmp_path):
+    """Library code: MechanismOptions in, MechanismResult out; the command line builds
+    the same options."""
+    import argparse
+
+    from arzsumo.cli.studies import ablation_mechanism as cli
+
+    opts = mech.MechanismOptions(ablation=ablation_dir, out=tmp_path / "out", plots=False)
+    result = mech.run_mechanism(opts)
+    assert len(result.runs) == 12 and len(result.paired) == 6
+    assert result.means.loc[("meter", "etc"), "d_section_outflow_veh_h"] == 100.0
+    assert result.means.loc[("estimator", "etc"), "d_section_outflow_veh_h"] == -98.0
+    assert [p.name for p in result.files] == ["mechanism.csv", "at_equal_mean_speed.csv",
+                                              "at_equal_mean_speed.md"]
+    parser = argparse.ArgumentParser()
+    cli.add_arguments(parser)
+    assert cli.options(parser.parse_args(["--ablation", str(ablation_dir), "--out",
+                                          str(tmp_path / "out"), "--no-plots"])) == opts
+    with pytest.raises(StudyError, match="is not a directory"):
+        mech.run_mechanism(mech.MechanismOptions(ablation=tmp_path / "none"))

@@ -12,7 +12,8 @@ from arzsumo.studies.common import StudyError
 
 
 def test_the_maps_design_is_demand_x_green_share_without_a_fill():
-    runs = approach.design([4400, 5664], [0.3, 0.9], [0.5], [1, 2])
+    runs = approach.design(approach.ApproachOptions(demands=(4400, 5664), greens=(0.3, 0.9),
+                                                    sigmas=(0.5,), seeds=(1, 2)))
     assert len(runs) == 8
     assert runs[0].run_id == "demand_veh_h=4400,green_share=0.3,hv_sigma=0.5,seed=1"
     sumo = runs[-1].scenario["sumo"]
@@ -22,12 +23,13 @@ def test_the_maps_design_is_demand_x_green_share_without_a_fill():
             sumo["horizon_s"]) == (0.9, 2, 0.0, 1500.0, 450.0)
     assert runs[-1].scenario["run"]["warmup_s"] == 150.0
     assert runs[0].options["initial"] is True
-    assert len(approach.design([4400, 4800, 5200, 5664, 6000], [0.3, 0.5, 0.7, 0.9], [0.5],
-                               [1])) == 20
+    assert len(approach.design(approach.ApproachOptions(
+        demands=(4400, 4800, 5200, 5664, 6000), greens=(0.3, 0.5, 0.7, 0.9), sigmas=(0.5,),
+        seeds=(1,)))) == 20
 
 
 def test_the_fill_design_holds_each_demand_after_the_defaults_fill():
-    runs = fill.design(["3750:850", "3900:950"], [0.5], [0.5], [1, 2, 3])
+    runs = fill.design(fill.FillOptions(holds=("3750:850", "3900:950"), seeds=(1, 2, 3)))
     assert [r.run_id for r in runs][:2] == ["hold=3750_850,green_share=0.5,hv_sigma=0.5,seed=1",
                                             "hold=3750_850,green_share=0.5,hv_sigma=0.5,seed=2"]
     sumo = runs[3].scenario["sumo"]
@@ -36,6 +38,29 @@ def test_the_fill_design_holds_each_demand_after_the_defaults_fill():
                                                              600.0)
     with pytest.raises(StudyError, match="'3900' is not allowed: HV:AV"):
         fill.hold_pair("3900")
+
+
+def test_the_fill_study_takes_its_options_from_python_and_refuses_a_bad_one():
+    """Library code: FillOptions (checked on construction) in, the design out; the
+    command line builds the same options."""
+    import argparse
+    from pathlib import Path
+
+    from arzsumo.cli.studies import fill as cli
+
+    opts = fill.FillOptions(holds=("3750:850", "3900:950"), greens=(0.4, 0.6), seeds=(2,),
+                            fill_s=300.0)
+    runs = fill.design(opts)
+    assert len(runs) == 4 and runs[0].options["fill_s"] == 300.0
+    parser = argparse.ArgumentParser()
+    cli.add_arguments(parser)
+    assert cli.options(parser.parse_args(["--holds", "3750:850", "3900:950", "--greens",
+                                          "0.4,0.6", "--seeds", "2", "--fill", "300"])) == opts
+    with pytest.raises(StudyError, match="'3900' is not allowed: HV:AV"):
+        fill.FillOptions(holds=("3900",))
+    with pytest.raises(StudyError, match=r"step_s = 0\.0 is not allowed: a finite number > 0"):
+        fill.FillOptions(step_s=0.0)
+    assert "argparse" not in Path(fill.__file__).read_text(encoding="utf-8")
 
 
 def test_the_trend_of_a_linear_count_is_its_slope():
@@ -107,3 +132,25 @@ def test_a_rerun_without_plots_leaves_no_map_of_the_earlier_table(run_study, tmp
     _map_rows().head(4).to_csv(path, index=False)
     assert run_study("approach", "--from", path, "--out", out, "--no-plots") == 0
     assert len(pd.read_csv(out / "map.csv")) == 4 and not (out / "map.png").exists()
+
+
+def test_the_approach_map_is_drawn_from_python_with_its_options(tmp_path):
+    """Library code: ApproachOptions in (a table read instead of SUMO), ApproachResult
+    out; the command line builds the same options, and a bad share names its field."""
+    import argparse
+
+    from arzsumo.cli.studies import approach as cli
+
+    path = tmp_path / "old.csv"
+    _map_rows().to_csv(path, index=False)
+    opts = approach.ApproachOptions(source=path, out=tmp_path / "out", plots=False)
+    result = approach.run_approach(opts)
+    assert (len(result.table), len(result.points), result.qualify) == (8, 4, 1)
+    assert result.files == (tmp_path / "out" / "map.csv",)
+    parser = argparse.ArgumentParser()
+    cli.add_arguments(parser)
+    assert cli.options(parser.parse_args(["--from", str(path), "--out", str(tmp_path / "out"),
+                                          "--no-plots"])) == opts
+    assert not cli.options(parser.parse_args(["--empty-start"])).initial
+    with pytest.raises(StudyError, match=r"av_share = 1\.5 is not allowed: a number in"):
+        approach.ApproachOptions(av_share=1.5)

@@ -59,7 +59,7 @@ def test_the_enkf_settings_are_scenario_keys_and_a_round_scales_by_the_error():
 
 
 def test_the_u_estimate_design_is_one_run_per_estimator_on_legacy_default():
-    spec = u_estimate.design([42])
+    spec = u_estimate.design(u_estimate.UEstimateOptions(seeds=(42,)))
     runs = spec.runs()
     assert [r.run_id for r in runs] == ["estimator=none,seed=42", "estimator=smoothing,seed=42",
                                         "estimator=enkf,seed=42"]
@@ -143,3 +143,123 @@ def test_loop_speed_station_means_leave_out_a_period_without_a_harmonic_speed():
         "(5 station-periods)",
         "v_a at the stations, km/h: time-mean 36.00, harmonic 28.80, probe cells 32.40 "
         "(6 station-periods)"]
+
+
+def test_loop_speed_runs_from_python_with_its_options_and_the_cli_maps_onto_them():
+    """Library code: LoopSpeedOptions in, its design out, no argparse in the study."""
+    import argparse
+    from pathlib import Path
+
+    from arzsumo.cli.studies import loop_speed as cli
+    from arzsumo.studies import loop_speed
+    from arzsumo.studies.common import StudyError
+
+    opts = loop_speed.LoopSpeedOptions(scenario=DEFAULT, seeds=(3, 4), horizon_s=120.0,
+                                       method="enkf")
+    runs = loop_speed.design(opts)
+    assert [r.run_id for r in runs] == ["seed=3", "seed=4"]
+    assert runs[0].scenario["sumo"]["horizon_s"] == 120.0
+    parser = argparse.ArgumentParser()
+    cli.add_arguments(parser)
+    args = parser.parse_args(["--scenario", str(DEFAULT), "--seeds", "3,4", "--horizon",
+                              "120", "--method", "enkf"])
+    assert cli.options(args) == opts
+    with pytest.raises(StudyError, match=r"horizon_s = -1\.0 is not allowed"):
+        loop_speed.LoopSpeedOptions(horizon_s=-1.0)
+    with pytest.raises(StudyError, match="method = 'kalman' is not allowed"):
+        loop_speed.LoopSpeedOptions(method="kalman")
+    assert "argparse" not in Path(loop_speed.__file__).read_text(encoding="utf-8")
+
+
+def test_u_estimate_runs_from_python_and_counts_the_runs_that_did_not_finish(monkeypatch,
+                                                                             tmp_path):
+    """run_u_estimate(UEstimateOptions) without SUMO: a failed run of the three gives
+    exit code 4; the command line builds the same options."""
+    import argparse
+    from types import SimpleNamespace
+
+    import pandas as pd
+
+    from arzsumo.cli.studies import u_estimate as cli
+    from arzsumo.studies.common import StudyError
+
+    table = pd.DataFrame({"estimator": ["none", "smoothing", "enkf"], "seed": [7] * 3,
+                          "status": ["ok", "failed", "incomplete"], "plan_changes": [1] * 3})
+    asked = {}
+
+    def fake_sweep(spec, out, **kwargs):
+        asked.update(kwargs, runs=len(spec.runs()))
+        return SimpleNamespace(out=out, table=table)
+
+    monkeypatch.setattr("arzsumo.sweep.driver.run_sweep", fake_sweep)
+    opts = u_estimate.UEstimateOptions(seeds=(7,), out=tmp_path / "out", plots=False)
+    result = u_estimate.run_u_estimate(opts, progress=False)
+    assert (result.code, result.finished, result.runs) == (4, 2, 3)
+    assert (asked["runs"], asked["progress"]) == (3, False)
+    assert [p.name for p in result.files] == ["u_estimate.csv", "u_series.csv"]
+    parser = argparse.ArgumentParser()
+    cli.add_arguments(parser)
+    assert cli.options(parser.parse_args(["--seeds", "7", "--out", str(tmp_path / "out"),
+                                          "--no-plots"])) == opts
+    with pytest.raises(StudyError, match=r"warmup_s = 0\.0 is not allowed"):
+        u_estimate.UEstimateOptions(warmup_s=0.0)
+
+
+def test_enkf_noise_tunes_from_python_with_its_options(engine, tmp_path):
+    """Library code: EnkfNoiseOptions in, EnkfNoiseResult out. Every fake score has
+    RMSE / spread 2, so one round at gain 1.5 scales each sd by 2 ** 1.5 (2 significant
+    digits); the command line builds the same options."""
+    import argparse
+
+    from arzsumo.cli.studies import enkf_noise as cli
+    from arzsumo.studies.common import StudyError
+
+    opts = enkf_noise.EnkfNoiseOptions(tune_seeds=(1,), report_seeds=(2,), rounds=1,
+                                       inflation_only=(1.05,), workers=1,
+                                       out=tmp_path / "out")
+    result = enkf_noise.run_enkf_noise(opts, progress=False)
+    assert result.sd == (5.7, 2.8, 2.8, 2.8)
+    assert len(result.rows) == 2 * len(enkf_noise.ENKF_LAYOUTS)     # two settings each
+    assert [p.name for p in result.files] == ["enkf_noise.md", "enkf_noise.csv"]
+    parser = argparse.ArgumentParser()
+    cli.add_arguments(parser)
+    assert cli.options(parser.parse_args([*ENKF_QUICK[:4], "--rounds", "1",
+                                          "--inflation-only", "1.05", "--workers", "1",
+                                          "--out", str(tmp_path / "out")])) == opts
+    with pytest.raises(StudyError, match=r"--start = \[1\.0\] is not allowed: 4 sd"):
+        enkf_noise.EnkfNoiseOptions(start=(1.0,))
+    with pytest.raises(StudyError, match="layout = 'full probe' is not allowed"):
+        enkf_noise.EnkfNoiseOptions(layout="full probe")
+
+
+def test_estimation_layouts_scores_from_python_with_its_options(monkeypatch, tmp_path):
+    """Library code: LayoutsOptions in, LayoutsResult out, without SUMO (records and
+    scores made up: every layout and method of seed s scores s / 10); the command line
+    builds the same options."""
+    import argparse
+
+    from arzsumo.cli.studies import estimation_layouts as cli
+    from arzsumo.studies.common import StudyError
+
+    def fake(fn, tasks, **kwargs):
+        if fn is estimation_layouts.record:
+            return [{"path": f"record-{i}.npz"} for i, _ in enumerate(tasks)]
+        return [[{"layout": layout, "method": "enkf", "seed": t[2],
+                  **{f"{v}_rel": t[2] / 10 for v in estimation_layouts.VARS}}
+                 for layout in estimation_layouts.LAYOUTS] for t in tasks]
+
+    monkeypatch.setattr("arzsumo.sweep.driver.map_runs", fake)
+    opts = estimation_layouts.LayoutsOptions(scenario=DEFAULT, seeds=(1, 2, 3),
+                                             horizon_s=300.0, out=tmp_path / "out")
+    assert [r.run_id for r in estimation_layouts.study_runs(opts)] == [
+        "seed=1", "seed=2", "seed=3"]
+    result = estimation_layouts.run_layouts(opts, progress=False)
+    assert len(result.table) == 3 * len(estimation_layouts.LAYOUTS)
+    assert "| loops 250 m | enkf | 0.200 +- 0.248 |" in result.text
+    parser = argparse.ArgumentParser()
+    cli.add_arguments(parser)
+    assert cli.options(parser.parse_args(["--scenario", str(DEFAULT), "--seeds", "1-3",
+                                          "--horizon", "300", "--out",
+                                          str(tmp_path / "out")])) == opts
+    with pytest.raises(StudyError, match="warmup_s = 0 is not allowed"):
+        estimation_layouts.LayoutsOptions(warmup_s=0)

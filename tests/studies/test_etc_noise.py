@@ -68,3 +68,23 @@ def test_a_negative_noise_level_is_refused(run_study, tmp_path):
     with pytest.raises(StudyError, match="--levels"):
         run_study("etc-noise", "--levels", "-1", "--out", tmp_path / "out")
     assert not (tmp_path / "out").exists()
+
+
+def test_the_options_from_python_give_the_design_and_refuse_a_negative_level(tmp_path):
+    """Library code: EtcNoiseOptions in, the design out (level x law x seed); the command
+    line builds the same options."""
+    import argparse
+
+    from arzsumo.cli.studies import etc_noise as cli
+
+    assert len(etc_noise.design(etc_noise.EtcNoiseOptions())) == 8 * 3 * 10
+    opts = etc_noise.EtcNoiseOptions(levels=(0.0, 1.0), seeds=(4, 5), out=tmp_path / "o")
+    lines = etc_noise.design(opts)
+    assert len(lines) == 2 * 3 * 2
+    assert lines[:2] == ["backstepping, noise 0 %, seed 4", "backstepping, noise 0 %, seed 5"]
+    parser = argparse.ArgumentParser()
+    cli.add_arguments(parser)
+    assert cli.options(parser.parse_args(["--levels", "0,1", "--seeds", "4,5", "--out",
+                                          str(tmp_path / "o")])) == opts
+    with pytest.raises(StudyError, match=r"--levels \[0\.5, -1\.0\] is not allowed"):
+        etc_noise.EtcNoiseOptions(levels=(0.5, -1.0))

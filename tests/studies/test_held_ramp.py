@@ -51,3 +51,33 @@ def test_the_report_pairs_each_run_set_with_the_held_ramp():
 def test_without_the_meter_step_the_study_refuses_to_run(run_study, tmp_path):
     with pytest.raises(StudyError, match="has no finished 'meter' step"):
         run_study("held-ramp", "--ablation", tmp_path, "--out", tmp_path / "h")
+
+
+def test_the_study_reports_from_python_with_its_options(tmp_path):
+    """Library code: HeldRampOptions(report=True) reads the two evaluations already there
+    and runs nothing; the command line builds the same options."""
+    import argparse
+
+    from arzsumo.cli.studies import held_ramp as cli
+    from arzsumo.outdir import write_marker
+
+    (tmp_path / "abl" / "meter").mkdir(parents=True)
+    (tmp_path / "out" / "held").mkdir(parents=True)
+    _table({"open": 40000.0, "backstepping": 32800.0, "etc": 36000.0}).to_parquet(
+        tmp_path / "abl" / "meter" / "summaries.parquet")
+    _table({"open": 36000.0}).to_parquet(tmp_path / "out" / "held" / "summaries.parquet")
+    write_marker(tmp_path / "out", "study-held-ramp")          # a held ramp evaluated before
+    opts = held_ramp.HeldRampOptions(ablation=tmp_path / "abl", seeds=(1, 2, 3),
+                                     report=True, out=tmp_path / "out")
+    assert held_ramp.design(opts) == ["held: open on seeds 1-3"]
+    result = held_ramp.run_held_ramp(opts)
+    assert result.code == 0
+    assert "| 12 | +1.11 [+1.11, +1.11] (0/3) |" in result.text
+    assert [p.name for p in result.files] == ["held_comparison.md", "held.toml"]
+    parser = argparse.ArgumentParser()
+    cli.add_arguments(parser)
+    assert cli.options(parser.parse_args(["--ablation", str(tmp_path / "abl"), "--seeds",
+                                          "1-3", "--report", "--out",
+                                          str(tmp_path / "out")])) == opts
+    with pytest.raises(StudyError, match=r"seeds = \(1, 1\) is not allowed"):
+        held_ramp.HeldRampOptions(seeds=(1, 1))

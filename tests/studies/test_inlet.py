@@ -65,3 +65,25 @@ def test_the_study_replays_every_run_under_every_inlet(run_study, cache, tmp_pat
 def test_an_empty_cache_is_refused(run_study, tmp_path):
     with pytest.raises(StudyError, match="holds no cached identification runs"):
         run_study("inlet", "--runs", tmp_path, "--out", tmp_path / "out")
+
+
+def test_the_study_runs_from_python_with_its_options(cache, tmp_path):
+    """Library code: InletOptions in, InletResult out (one run x four inlets); the
+    command line builds the same options, and a bad value names its field."""
+    import argparse
+    import os
+
+    from arzsumo.cli.studies import inlet as cli
+
+    os.utime(cache / "run0xxxx.npz", (2e9, 2e9))                   # now the most recent
+    opts = inlet.InletOptions(runs=cache, last=1, out=tmp_path / "out")
+    result = inlet.run_inlet(opts)
+    assert result.runs == 1 and len(result.table) == len(inlet.INLETS) == 4
+    assert result.table["run"].unique().tolist() == ["run0xxxx"]
+    assert result.files == (tmp_path / "out" / "inlet.csv",)
+    parser = argparse.ArgumentParser()
+    cli.add_arguments(parser)
+    assert cli.options(parser.parse_args(["--runs", str(cache), "--last", "1", "--out",
+                                          str(tmp_path / "out")])) == opts
+    with pytest.raises(StudyError, match="last = 0 is not allowed: an integer >= 1"):
+        inlet.InletOptions(last=0)

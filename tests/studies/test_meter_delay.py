@@ -82,3 +82,28 @@ def test_runs_spread_over_two_outputs_are_paired_across_them(tmp_path):
     _write(second, "open", 5, _periods(seed=99))          # the first directory's counts
     rows = delay_rows([first, second], "regulation", ("held",))
     assert rows["dead_time_s"].tolist() == [30.0]
+
+
+def test_the_study_runs_from_python_with_its_options(tmp_path):
+    """Library code: MeterDelayOptions in, MeterDelayResult out; the command line builds
+    the same options, and a controller the study does not pair is refused by name."""
+    import argparse
+
+    from arzsumo.cli.studies import meter_delay as cli
+
+    runs = tmp_path / "control"
+    for seed, parting in ((1, 26), (2, 28)):
+        _write(runs, "open", seed, _periods(seed=seed))
+        _write(runs, "held", seed, _periods(seed=seed, command=0, outflow=parting))
+    opts = meter_delay.MeterDelayOptions(sumo=(runs,), controllers=("held",),
+                                         out=tmp_path / "out")
+    result = meter_delay.run_meter_delay(opts)
+    assert result.summary["dead time median, s"].tolist() == [27.0]
+    assert [p.name for p in result.files] == ["paired_events.csv", "meter_delay.csv",
+                                              "meter_delay.md"]
+    parser = argparse.ArgumentParser()
+    cli.add_arguments(parser)
+    assert cli.options(parser.parse_args(["--sumo", str(runs), "--controllers", "held",
+                                          "--out", str(tmp_path / "out")])) == opts
+    with pytest.raises(StudyError, match=r"controllers = \('etc',\) is not allowed"):
+        meter_delay.MeterDelayOptions(controllers=("etc",))

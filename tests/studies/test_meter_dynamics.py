@@ -19,7 +19,7 @@ def test_the_schedule_holds_each_green_share_for_the_hold():
 
 
 def test_the_design_is_one_fixed_cycle_run_per_seed_of_the_documented_length():
-    runs = meter_dynamics.design([1, 2, 3])
+    runs = meter_dynamics.design(meter_dynamics.MeterDynamicsOptions(seeds=(1, 2, 3)))
     assert [r.run_id for r in runs] == ["seed=1", "seed=2", "seed=3"]
     sumo, run = runs[2].scenario["sumo"], runs[2].scenario["run"]
     assert (sumo["seed"], sumo["control_period_s"], run["warmup_s"]) == (3, 1.0, 600.0)
@@ -99,7 +99,8 @@ def test_the_study_fits_a_recorded_series_and_publishes_it(run_study, tmp_path):
 
 @pytest.mark.sumo
 def test_one_short_run_in_sumo_records_the_running_plan_every_second():
-    run = meter_dynamics.design([1], warmup=30.0, base=6.0, greens=(0.8, 0.5), hold=18.0)[0]
+    run = meter_dynamics.design(meter_dynamics.MeterDynamicsOptions(
+        seeds=(1,), warmup_s=30.0, base_s=6.0, greens=(0.8, 0.5), hold_s=18.0))[0]
     got = meter_dynamics.run_steps(run)
     rows = pd.DataFrame(got["series"])
     assert rows["t_s"].tolist() == list(range(1, 73))         # 30 + 6 + 2 x 18 s
@@ -143,3 +144,30 @@ def test_a_rerun_without_plots_removes_its_earlier_figure_and_nothing_else(run_s
     assert not (out / "steps.png").exists()
     assert (out / "mine.png").read_bytes() == b"the user's"
     assert (out / "fits.csv").is_file()
+
+
+def test_the_study_fits_a_series_from_python_with_its_options(tmp_path):
+    """Library code: MeterDynamicsOptions in (a series read instead of SUMO),
+    MeterDynamicsResult out; the command line builds the same options, and a green share
+    the meter cannot run is refused naming the field."""
+    import argparse
+
+    from arzsumo.cli.studies import meter_dynamics as cli
+    from arzsumo.studies.common import StudyError
+
+    path = tmp_path / "series.csv"
+    series().to_csv(path, index=False)
+    opts = meter_dynamics.MeterDynamicsOptions(series=path, out=tmp_path / "out",
+                                               plots=False)
+    result = meter_dynamics.run_meter_dynamics(opts)
+    assert len(result.series) == len(series())
+    assert [p.name for p in result.files] == ["series.csv", "fits.csv", "levels.csv",
+                                              "tables.md"]
+    assert pd.read_csv(tmp_path / "out" / "levels.csv")["green_share"].tolist() == \
+        [0.2, 0.5, 0.8]
+    parser = argparse.ArgumentParser()
+    cli.add_arguments(parser)
+    assert cli.options(parser.parse_args(["--series", str(path), "--out",
+                                          str(tmp_path / "out"), "--no-plots"])) == opts
+    with pytest.raises(StudyError, match=r"greens = \(0\.2, 1\.5\) is not allowed"):
+        meter_dynamics.MeterDynamicsOptions(greens=(0.2, 1.5))

@@ -63,3 +63,30 @@ def test_eager_insertion_is_a_scenario_key_that_reaches_sumo():
         assert cmd[cmd.index("--eager-insert") + 1] == flag
     with pytest.raises(ScenarioError, match="eager_insert"):
         sc.with_({"sumo.eager_insert": "no"})
+
+
+def test_the_study_runs_from_python_with_its_options(monkeypatch, tmp_path):
+    """Library code: SumoOptionsOptions in (the design: 6 variants per seed), and without
+    SUMO a sweep with a failed run gives exit code 4 and the comparison of the rest."""
+    from types import SimpleNamespace
+
+    from arzsumo.studies import sumo_options
+    from arzsumo.studies.common import StudyError
+
+    opts = sumo_options.SumoOptionsOptions(seeds=(1, 2), out=tmp_path / "out")
+    assert len(sumo_options.design(opts)) == 6 * 2
+    asked = {}
+
+    def fake_sweep(spec, out, **kwargs):
+        asked["runs"] = len(spec.runs())
+        return SimpleNamespace(table=_table(shift=3600.0, noise=360.0),
+                               statuses={"ok": 20, "failed": 1})
+
+    monkeypatch.setattr("arzsumo.sweep.driver.run_sweep", fake_sweep)
+    result = sumo_options.run_sumo_options(opts, progress=False)
+    assert (result.code, result.statuses["failed"], asked["runs"]) == (4, 1, 12)
+    row = result.table[result.table["variant"] == "lateral_resolution_m=1.3"].iloc[0]
+    assert row["diff_mean"] == pytest.approx(1.0, abs=0.15)
+    assert result.files == (tmp_path / "out" / "sumo_options.csv",)
+    with pytest.raises(StudyError, match=r"seeds = \(\) is not allowed"):
+        sumo_options.SumoOptionsOptions(seeds=())

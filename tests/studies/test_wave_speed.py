@@ -32,7 +32,8 @@ def test_the_peak_lag_gives_the_travel_speed(c, lag):
         assert r["peak_corr"] > 0.9
 
 
-def test_the_study_reads_the_cells_of_run_directories(run_study, tmp_path):
+def _run_dir(tmp_path):
+    """An ``arzsumo run`` result directory whose cells carry a wave at 20 m/s."""
     run = tmp_path / "default-etc-seed42"
     run.mkdir()
     f = wave(20.0)
@@ -42,6 +43,11 @@ def test_the_study_reads_the_cells_of_run_directories(run_study, tmp_path):
                                         enumerate(wave_speed.VARIABLES)}})
                        for src in ("micro", "replay")])
     cells.to_parquet(run / "cells.parquet")
+    return run
+
+
+def test_the_study_reads_the_cells_of_run_directories(run_study, tmp_path):
+    run = _run_dir(tmp_path)
     assert run_study("wave-speed", "--from", run, "--out", tmp_path / "out") == 0
     df = pd.read_csv(tmp_path / "out" / "wave_speed.csv")
     assert len(df) == 4 * 3 and set(df["run"]) == {"default-etc-seed42"}
@@ -49,8 +55,9 @@ def test_the_study_reads_the_cells_of_run_directories(run_study, tmp_path):
 
 
 def test_the_design_is_controllers_x_seeds():
-    runs = wave_speed.design(wave_speed.shipped_scenario("default.toml"), ["open", "etc"],
-                             [42])
+    runs = wave_speed.design(wave_speed.WaveSpeedOptions(
+        scenario=wave_speed.shipped_scenario("default.toml"), controllers=("open", "etc"),
+        seeds=(42,)))
     assert [r.run_id for r in runs] == ["controller=open,seed=42", "controller=etc,seed=42"]
     assert runs[1].scenario["run"]["controller"] == "etc"
 
@@ -62,3 +69,25 @@ def test_list_with_run_directories_lists_no_runs_and_reads_nothing(run_study, tm
                      "--out", tmp_path / "out") == 0
     assert capsys.readouterr().out == f"no runs: --from {one} {two} is read instead\n"
     assert not (tmp_path / "out").exists()
+
+
+def test_the_study_runs_from_python_with_its_options(tmp_path):
+    """Library code: WaveSpeedOptions in, WaveSpeedResult out; the command line builds
+    the same options, and a bad value names its field."""
+    import argparse
+
+    from arzsumo.cli.studies import wave_speed as cli
+    from arzsumo.studies.common import StudyError
+
+    run = _run_dir(tmp_path)
+    opts = wave_speed.WaveSpeedOptions(source=(run,), out=tmp_path / "out")
+    result = wave_speed.run_wave_speed(opts)
+    assert len(result.table) == 4 * 3
+    assert result.table["speed_kmh"].between(68.0, 76.0).all()
+    assert result.files == (tmp_path / "out" / "wave_speed.csv",)
+    parser = argparse.ArgumentParser()
+    cli.add_arguments(parser)
+    assert cli.options(parser.parse_args(["--from", str(run), "--out",
+                                          str(tmp_path / "out")])) == opts
+    with pytest.raises(StudyError, match="workers = 0 is not allowed: an integer >= 1"):
+        wave_speed.WaveSpeedOptions(workers=0)

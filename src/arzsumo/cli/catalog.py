@@ -21,13 +21,16 @@ frozen options, no argparse involved::
     from arzsumo.studies.premise_map import MapOptions, run_map
     result = run_map(MapOptions(points=("coupled",), seeds=(1, 2)))
 
-its command line lives in :mod:`arzsumo.cli.studies`. The others still take a parsed
-command line::
+    from arzsumo.studies.ablation import AblationOptions, design
+    lines = design(AblationOptions(steps=("identified",), seeds=(1, 2)))
+
+its command line lives in :mod:`arzsumo.cli.studies`. The others (control,
+control-ablation, penetration) still take a parsed command line::
 
     parser = argparse.ArgumentParser()
-    study = STUDIES["ablation"]
+    study = STUDIES["control"]
     study.add_arguments(parser)
-    code = study.run(parser.parse_args(["--steps", "identified", "--list"]))
+    code = study.run(parser.parse_args(["--seeds", "1-2", "--list"]))
 """
 
 from __future__ import annotations
@@ -104,7 +107,10 @@ _MODULES = {
 
 #: the studies that are library code (frozen Options, ``run(options) -> Result``): their
 #: command line is :mod:`arzsumo.cli.studies`'s module of the same name
-LIBRARY_STUDIES = frozenset({"premise-map", "share-models"})
+LIBRARY_STUDIES = frozenset({
+    "ablation", "ablation-mechanism", "held-ramp", "meter-dynamics", "approach", "fill",
+    "wave-speed", "inlet", "estimation-layouts", "loop-speed", "enkf-noise", "u-estimate",
+    "premise-map", "sumo-options", "etc-noise", "meter-delay", "share-models"})
 
 
 def _command_module(name: str, module: str) -> str:

@@ -24,8 +24,8 @@ Two figures show the mechanism the ablation table summarises:
 
 from __future__ import annotations
 
-import argparse
 import json
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -34,7 +34,7 @@ import pandas as pd
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, remove_stale_figures, write_csv, write_text
 from arzsumo.studies import ablation
-from arzsumo.studies.common import RESULTS_DIR, StudyError, add_output, plots_wanted
+from arzsumo.studies.common import RESULTS_DIR, StudyError
 from arzsumo.sweep.evaluate import BASELINE
 from arzsumo.units import s_to_h
 
@@ -148,22 +148,71 @@ def read_levels(path: Path | None) -> dict[float, float]:
                     strict=True))
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """The mechanism study's options."""
-    parser.add_argument("--ablation", type=Path, default=RESULTS_DIR / ablation.NAME,
-                        metavar="DIR", help="the ablation directory (arzsumo study "
-                                            "ablation --out)")
-    parser.add_argument("--levels", type=Path, metavar="CSV",
-                        help="static outflow levels of held plans drawn on the map (the "
-                             "levels.csv of arzsumo study meter-dynamics)")
-    add_output(parser, NAME, PAGE)
+#: the per (step, controller) means the study reports beside its table
+MEAN_COLUMNS = ["green_mean", "section_outflow_veh_h", "d_section_outflow_veh_h",
+                "d_speed_mean_h_kmh", "d_speed_sd_h_kmh", "d_speed_mean_a_kmh",
+                "d_speed_sd_a_kmh", "d_time_loss_veh_h"]
 
 
-def run(args: argparse.Namespace) -> int:
-    """Collect, pair, fit; write the tables, figures and (``--docs``) the page."""
+@dataclass(frozen=True)
+class MechanismOptions:
+    """What the mechanism study reads and where it writes.
+
+    Parameters
+    ----------
+    ablation : Path
+        The ablation directory (``arzsumo study ablation --out``).
+    levels : Path, optional
+        Static outflow levels of held plans drawn on the map (the ``levels.csv`` of
+        ``arzsumo study meter-dynamics``; None: none drawn).
+    out : Path
+        The study's directory.
+    docs : Path, optional
+        Also regenerate the study's block of ``docs/PAGE.md`` (None: no page).
+    plots : bool
+        Draw the map and the shift figures.
+    """
+
+    ablation: Path = RESULTS_DIR / ablation.NAME
+    levels: Path | None = None
+    out: Path = RESULTS_DIR / NAME
+    docs: Path | None = None
+    plots: bool = True
+
+
+@dataclass(frozen=True)
+class MechanismResult:
+    """The study's outcome: every ``runs`` row (step, controller, seed), the controller
+    runs ``paired`` with their open loop (``d_`` columns), the spread change at an equal
+    mean speed (``equal``, km/h), the ``means`` per step and controller, the markdown
+    ``text`` and the ``files`` written."""
+
+    runs: pd.DataFrame
+    paired: pd.DataFrame
+    equal: pd.DataFrame
+    means: pd.DataFrame
+    text: str
+    files: tuple[Path, ...]
+
+
+def run_mechanism(opts: MechanismOptions) -> MechanismResult:
+    """Collect, pair, fit; write the tables, figures and (``opts.docs``) the page.
+
+    Parameters
+    ----------
+    opts : MechanismOptions
+        The study's options.
+
+    Returns
+    -------
+    MechanismResult
+        The tables and the files written (``mechanism.csv``,
+        ``at_equal_mean_speed.csv``, ``at_equal_mean_speed.md`` and the figures in
+        ``opts.out``).
+    """
     from arzsumo.outputs.study_figures import MECHANISM_FIGURES, write_mechanism_figures
 
-    root = Path(args.ablation)
+    root = Path(opts.ablation)
     if not root.is_dir():
         raise StudyError(f"--ablation = {str(root)!r} is not a directory; allowed: the --out "
                          "of arzsumo study ablation")
@@ -171,27 +220,23 @@ def run(args: argparse.Namespace) -> int:
     d = paired(df)
     equal = at_equal_mean_speed(d)
     text = equal_markdown(equal)
-    with resumable_dir(args.out, f"study-{NAME}") as out:
+    with resumable_dir(opts.out, f"study-{NAME}") as out:
         files = [write_csv(pd.concat([df[df["controller"] == BASELINE], d]),
                            out / "mechanism.csv"),
                  write_csv(equal, out / "at_equal_mean_speed.csv"),
                  write_text(text, out / "at_equal_mean_speed.md")]
-        if plots_wanted(args):
+        if opts.plots:
             files += write_mechanism_figures(df[~df["step"].isin(RELEASE_STEPS)], d,
-                                             read_levels(args.levels), out)
+                                             read_levels(opts.levels), out)
         else:
             remove_stale_figures(*(out / name for name in MECHANISM_FIGURES))
-        if args.docs is not None:
+        if opts.docs is not None:
             named = [(p, p.name if p.name == "mechanism.csv" else f"mechanism_{p.name}")
                      for p in files]
             figs = "".join(f"\n\n![{n}]({PAGE}/{n})" for p, n in named if p.suffix == ".png")
             body = (f"Runs of the ablation, paired by seed with their open loop (`arzsumo "
                     f"study {NAME}`). Table: [mechanism.csv]({PAGE}/mechanism.csv).\n\n"
                     f"{text}{figs}")
-            publish(args.docs, PAGE, NAME, "Control in SUMO", body, named)
-    cols = ["green_mean", "section_outflow_veh_h", "d_section_outflow_veh_h",
-            "d_speed_mean_h_kmh", "d_speed_sd_h_kmh", "d_speed_mean_a_kmh",
-            "d_speed_sd_a_kmh", "d_time_loss_veh_h"]
-    print(d.groupby(["step", "controller"], sort=False)[cols].mean().round(2).to_string())
-    print(text)
-    return 0
+            publish(opts.docs, PAGE, NAME, "Control in SUMO", body, named)
+    means = d.groupby(["step", "controller"], sort=False)[MEAN_COLUMNS].mean().round(2)
+    return MechanismResult(df, d, equal, means, text, tuple(Path(f) for f in files))

@@ -19,8 +19,8 @@ draws the map of an earlier table instead of running SUMO.
 
 from __future__ import annotations
 
-import argparse
 import time
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -28,17 +28,12 @@ import pandas as pd
 
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, remove_stale_figures, write_csv
+from arzsumo.studies import checks
 from arzsumo.studies.common import (
     FORMER_DEFAULT,
+    RESULTS_DIR,
     StudyError,
-    add_output,
-    add_runs,
     fixed_cycle,
-    fraction,
-    number_list,
-    plots_wanted,
-    positive_float,
-    print_list,
     scenario_data,
     shipped_scenario,
     study_spec,
@@ -58,23 +53,102 @@ INSERTED_MIN = 0.98
 GROUP = ["step_s", "hv_sigma", "warmup_s", "approach_m", "av_share"]
 
 
-def design(demands: list[float], greens: list[float], sigmas: list[float], seeds: list[int],
-           approach: float = 1500.0, warmup: float = 150.0, measured: float = 450.0,
-           step: float = 0.1, initial: bool = True, av_share: float = AV_SHARE
-           ) -> list[StudyRun]:
+@dataclass(frozen=True)
+class ApproachOptions:
+    """What the approach study runs (or reads) and where it writes (SI units in the
+    names).
+
+    Parameters
+    ----------
+    demands : tuple of float
+        Mainline demands HV + AV, veh/h.
+    greens : tuple of float
+        Nominal green shares.
+    sigmas : tuple of float
+        Krauss sigma of the HVs.
+    seeds : tuple of int
+        SUMO seeds.
+    approach_m : float
+        Buffer length before x = 0, m.
+    initial : bool
+        Start with a congested section (False: an empty one).
+    warmup_s, measured_s : float
+        Time not measured, then measured, s.
+    step_s : float
+        SUMO step, s.
+    av_share : float
+        AV share of the mainline demand, in [0, 1].
+    source : Path, optional
+        Draw the map of this table instead of running SUMO.
+    out : Path
+        The study's directory (resumable).
+    docs : Path, optional
+        Also regenerate the study's block of ``docs/PAGE.md`` (None: no page).
+    plots : bool
+        Draw the map.
+    workers : int, optional
+        Local processes (None: one per core); ignored with ``scheduler``.
+    scheduler : str, optional
+        A Dask scheduler's address to run on instead.
+    """
+
+    demands: tuple[float, ...] = (4400.0, 4800.0, 5200.0, 5664.0, 6000.0)
+    greens: tuple[float, ...] = (0.3, 0.5, 0.7, 0.9)
+    sigmas: tuple[float, ...] = (0.5,)
+    seeds: tuple[int, ...] = (1,)
+    approach_m: float = 1500.0
+    initial: bool = True
+    warmup_s: float = 150.0
+    measured_s: float = 450.0
+    step_s: float = 0.1
+    av_share: float = AV_SHARE
+    source: Path | None = None
+    out: Path = RESULTS_DIR / NAME
+    docs: Path | None = None
+    plots: bool = True
+    workers: int | None = None
+    scheduler: str | None = None
+
+    def __post_init__(self) -> None:
+        for field in ("demands", "greens", "sigmas"):
+            checks.numbers(getattr(self, field), field)
+        checks.seeds(self.seeds)
+        for field in ("approach_m", "warmup_s", "measured_s", "step_s"):
+            checks.positive(getattr(self, field), field)
+        checks.fraction(self.av_share, "av_share")
+        checks.count(self.workers, "workers", optional=True)
+
+
+@dataclass(frozen=True)
+class ApproachResult:
+    """The study's outcome: the ``table`` (one row per run), the point means of its
+    largest group (``points``), how many of them ``qualify``, the summary ``text`` and
+    the ``files`` written."""
+
+    table: pd.DataFrame
+    points: pd.DataFrame
+    qualify: int
+    text: str
+    files: tuple[Path, ...]
+
+
+def design(opts: ApproachOptions) -> list[StudyRun]:
     """The runs of the map: demand x green share x sigma x seed."""
     path = shipped_scenario(FORMER_DEFAULT)
+    demands, av_share = list(opts.demands), opts.av_share
     sets = [{"sumo.demand_h_veh_h": d * (1 - av_share), "sumo.demand_a_veh_h": d * av_share}
             for d in demands]
     spec = study_spec(
-        NAME, path, fixed_cycle(scenario_data(path)), seeds=list(seeds),
-        set={"sumo.approach_length_m": approach, "sumo.step_length_s": step,
-             "sumo.fill_s": 0.0, "run.warmup_s": warmup, "sumo.horizon_s": measured},
-        axis=[{"name": "demand_veh_h", "values": list(demands), "set": sets},
-              {"field": "sumo.green_share", "values": list(greens)},
-              {"field": "sumo.hv_sigma", "values": list(sigmas)}])
-    return design_runs(spec, {"initial": initial, "av_share": av_share, "approach_m": approach,
-                              "step_s": step, "warmup_s": warmup, "measured_s": measured})
+        NAME, path, fixed_cycle(scenario_data(path)), seeds=list(opts.seeds),
+        set={"sumo.approach_length_m": opts.approach_m, "sumo.step_length_s": opts.step_s,
+             "sumo.fill_s": 0.0, "run.warmup_s": opts.warmup_s,
+             "sumo.horizon_s": opts.measured_s},
+        axis=[{"name": "demand_veh_h", "values": demands, "set": sets},
+              {"field": "sumo.green_share", "values": list(opts.greens)},
+              {"field": "sumo.hv_sigma", "values": list(opts.sigmas)}])
+    return design_runs(spec, {"initial": opts.initial, "av_share": av_share,
+                              "approach_m": opts.approach_m, "step_s": opts.step_s,
+                              "warmup_s": opts.warmup_s, "measured_s": opts.measured_s})
 
 
 def run_point(run: StudyRun) -> dict[str, Any]:
@@ -140,47 +214,33 @@ def read_map(path: Path) -> pd.DataFrame:
     return df
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """The approach study's options."""
-    parser.add_argument("--demands", type=number_list, default=[4400, 4800, 5200, 5664, 6000],
-                        help="mainline demands HV + AV, veh/h (default: 4400,4800,5200,"
-                             "5664,6000)")
-    parser.add_argument("--greens", type=number_list, default=[0.3, 0.5, 0.7, 0.9],
-                        help="nominal green shares (default: 0.3,0.5,0.7,0.9)")
-    parser.add_argument("--sigmas", type=number_list, default=[0.5],
-                        help="Krauss sigma of the HVs (default: 0.5)")
-    add_runs(parser, seeds="1")
-    parser.add_argument("--approach", type=positive_float, default=1500.0,
-                        help="buffer length before x = 0, m")
-    parser.add_argument("--empty-start", action="store_true",
-                        help="start with an empty section (default: a congested one)")
-    parser.add_argument("--warmup", type=positive_float, default=150.0, help="s not measured")
-    parser.add_argument("--measured", type=positive_float, default=450.0, help="s measured")
-    parser.add_argument("--step", type=positive_float, default=0.1, help="SUMO step, s")
-    parser.add_argument("--av-share", type=fraction, default=AV_SHARE,
-                        help="AV share of the mainline demand (default: 0.275)")
-    parser.add_argument("--from", dest="source", type=Path, metavar="CSV",
-                        help="draw the map of this table instead of running SUMO")
-    add_output(parser, NAME, PAGE)
+def run_approach(opts: ApproachOptions, *, progress: bool = True) -> ApproachResult:
+    """Run the missing points (or read ``opts.source``), write the table and the map.
 
+    Parameters
+    ----------
+    opts : ApproachOptions
+        The study's options.
+    progress : bool, optional
+        Show a progress bar while the runs run.
 
-def run(args: argparse.Namespace) -> int:
-    """Run the missing points (or read ``--from``), write the table and the map."""
-    runs = design(args.demands, args.greens, args.sigmas, args.seeds, args.approach,
-                  args.warmup, args.measured, args.step, not args.empty_start, args.av_share)
-    if args.list:
-        return print_list([r.run_id for r in runs],
-                          None if args.source is None else ("--from", args.source))
-    with resumable_dir(args.out, f"study-{NAME}") as out:
-        if args.source is not None:
-            df = read_map(args.source)
+    Returns
+    -------
+    ApproachResult
+        The table, the largest group's point means and the files written (``map.csv``,
+        ``map.png`` in ``opts.out``).
+    """
+    runs = design(opts)
+    with resumable_dir(opts.out, f"study-{NAME}") as out:
+        if opts.source is not None:
+            df = read_map(opts.source)
         else:
-            df = pd.DataFrame(run_design(runs, run_point, out, workers=args.workers,
-                                         scheduler=args.scheduler, progress=not args.quiet,
+            df = pd.DataFrame(run_design(runs, run_point, out, workers=opts.workers,
+                                         scheduler=opts.scheduler, progress=progress,
                                          label=NAME))
         files = [write_csv(df, out / "map.csv", "%.5g")]
         sub, tag = largest_group(df)
-        if plots_wanted(args):
+        if opts.plots:
             from arzsumo.outputs.study_figures import write_approach_map
 
             files.append(write_approach_map(sub, with_av_share(df), tag, out / "map.png",
@@ -192,10 +252,9 @@ def run(args: argparse.Namespace) -> int:
                 "qualify (stationary, congested, stop-and-go, inserted): "
                 + (", ".join(f"{r.demand_veh_h:.0f} veh/h at green {r.green_share:g}"
                              for r in good.itertuples()) or "none"))
-        if args.docs is not None:
+        if opts.docs is not None:
             body = (f"{text} (`arzsumo study {NAME}`). Table: [{PAGE}.csv]({PAGE}/{PAGE}.csv)."
-                    + (f"\n\n![map]({PAGE}/{PAGE}.png)" if plots_wanted(args) else ""))
-            publish(args.docs, PAGE, NAME, "Where SUMO holds a stationary congested section",
+                    + (f"\n\n![map]({PAGE}/{PAGE}.png)" if opts.plots else ""))
+            publish(opts.docs, PAGE, NAME, "Where SUMO holds a stationary congested section",
                     body, [(p, f"{PAGE}{p.suffix}") for p in files])
-    print(text)
-    return 0
+    return ApproachResult(df, sub, len(good), text, tuple(files))

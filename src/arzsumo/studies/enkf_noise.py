@@ -17,8 +17,8 @@ significant digits. Inflation-only settings (no model noise) are reported beside
 
 from __future__ import annotations
 
-import argparse
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -27,17 +27,13 @@ import pandas as pd
 
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, write_csv, write_text
+from arzsumo.studies import checks
 from arzsumo.studies import estimation_layouts as layouts
 from arzsumo.studies.common import (
     FORMER_DEFAULT,
+    RESULTS_DIR,
     StudyError,
-    add_output,
     file_stem,
-    non_negative_int,
-    number_list,
-    positive_float,
-    positive_int,
-    seed_list,
     shipped_scenario,
 )
 from arzsumo.sweep.driver import default_workers, map_runs
@@ -94,6 +90,94 @@ def fmt(rows: list[dict[str, Any]], label: str) -> str:
             + " | ".join(f"{e:.3f}" for e in rmse) + " |")
 
 
+#: the layouts the EnKF is reported on (and may be tuned on): those with sensors
+ENKF_LAYOUTS = tuple(name for name, keys in layouts.LAYOUTS.items() if keys)
+
+
+@dataclass(frozen=True)
+class EnkfNoiseOptions:
+    """What the study records, tunes and reports, and where it writes (SI: s, m; the sd
+    in veh/km and km/h).
+
+    Parameters
+    ----------
+    scenario : Path, optional
+        The scenario recorded (None: the former default, lateral_files).
+    tune_seeds : tuple of int
+        Seeds the noise is tuned on.
+    report_seeds : tuple of int
+        Held-out seeds reported on (empty: no report).
+    warmup_s, horizon_s : float, optional
+        Warm-up and control horizon, s (None: the scenario's).
+    layout : str
+        The layout tuned on, one of :data:`ENKF_LAYOUTS`.
+    start : tuple of float
+        Starting sd: rho_h veh/km, v_h km/h, rho_a veh/km, v_a km/h.
+    inflation : float
+        The EnKF's inflation in the tuning rounds and in both report settings.
+    length_m : float
+        Correlation length of the model noise, m.
+    rounds : int
+        Calibration rounds (0: report ``start`` as it is).
+    inflation_only : tuple of float
+        Inflations tried without model noise.
+    gain : float
+        Each round scales the sd by its clipped normalised error to this power.
+    out : Path
+        The study's directory (resumable).
+    docs : Path, optional
+        Also regenerate the study's block of ``docs/PAGE.md`` (None: no page).
+    workers : int, optional
+        Local processes (None: one per core).
+    scheduler : str, optional
+        Record on this Dask scheduler.
+    """
+
+    scenario: Path | None = None
+    tune_seeds: tuple[int, ...] = (1, 2)
+    report_seeds: tuple[int, ...] = (3, 4, 5)
+    warmup_s: float | None = None
+    horizon_s: float | None = None
+    layout: str = "loops 250 m + AV probes"
+    start: tuple[float, ...] = (2.0, 1.0, 1.0, 1.0)
+    inflation: float = 1.05
+    length_m: float = 150.0
+    rounds: int = 6
+    inflation_only: tuple[float, ...] = (1.05, 1.3, 2.0)
+    gain: float = 1.5
+    out: Path = RESULTS_DIR / NAME
+    docs: Path | None = None
+    workers: int | None = None
+    scheduler: str | None = None
+
+    def __post_init__(self) -> None:
+        if len(self.start) != 4:
+            raise StudyError(f"--start = {list(self.start)} is not allowed: 4 sd (rho_h "
+                             "veh/km, v_h km/h, rho_a veh/km, v_a km/h)")
+        checks.seeds(self.tune_seeds, "tune_seeds")
+        checks.seeds(self.report_seeds, "report_seeds", empty=True)
+        checks.positive(self.warmup_s, "warmup_s", optional=True)
+        checks.positive(self.horizon_s, "horizon_s", optional=True)
+        checks.among(self.layout, ENKF_LAYOUTS, "layout")
+        for field in ("inflation", "length_m", "gain"):
+            checks.positive(getattr(self, field), field)
+        checks.count(self.rounds, "rounds", least=0)
+        checks.numbers(self.inflation_only, "inflation_only")
+        checks.count(self.workers, "workers", optional=True)
+
+
+@dataclass(frozen=True)
+class EnkfNoiseResult:
+    """The study's outcome: the chosen model-error ``sd`` (rho_h veh/km, v_h km/h, rho_a
+    veh/km, v_a km/h), the report's ``rows`` (per layout, setting and seed), the
+    markdown ``text`` and the ``files`` written."""
+
+    sd: tuple[float, ...]
+    rows: pd.DataFrame
+    text: str
+    files: tuple[Path, ...]
+
+
 class Tuner:
     """Scores settings on the records of some seeds through the sweep engine."""
 
@@ -107,100 +191,78 @@ class Tuner:
         return map_runs(score, jobs, workers=self.workers)
 
 
-def tune(tuner: Tuner, args: argparse.Namespace) -> tuple[np.ndarray, list[str]]:
+def tune(tuner: Tuner, opts: EnkfNoiseOptions) -> tuple[np.ndarray, list[str]]:
     """The inflation-only lines and the calibration rounds on the tuning seeds; the
     chosen sd (veh/km, km/h)."""
     lines = []
-    for infl in args.inflation_only:
-        rows = tuner.rows(args.tune_seeds, args.layout, settings(np.zeros(4), infl))
+    for infl in opts.inflation_only:
+        rows = tuner.rows(opts.tune_seeds, opts.layout, settings(np.zeros(4), infl))
         lines.append(fmt(rows, f"tune: no model noise, inflation {infl:g}"))
-    sd = np.array(args.start, float)
-    for k in range(args.rounds):
-        rows = tuner.rows(args.tune_seeds, args.layout,
-                          settings(sd, args.inflation, args.length))
+    sd = np.array(opts.start, float)
+    for k in range(opts.rounds):
+        rows = tuner.rows(opts.tune_seeds, opts.layout,
+                          settings(sd, opts.inflation, opts.length_m))
         lines.append(fmt(rows, f"tune round {k}: sd " + ", ".join(f"{v:.3g}" for v in sd)))
-        sd = next_sd(sd, rows, args.gain)
-    if args.rounds:
+        sd = next_sd(sd, rows, opts.gain)
+    if opts.rounds:
         sd = np.array([float(f"{v:.2g}") for v in sd])
     return sd, lines
 
 
-def report(tuner: Tuner, sd: np.ndarray, args: argparse.Namespace
+def report(tuner: Tuner, sd: np.ndarray, opts: EnkfNoiseOptions
            ) -> tuple[list[dict[str, Any]], list[str]]:
     """Every EnKF layout on the report seeds, without and with the chosen noise, both at
-    ``--inflation`` (so the lines differ by the noise alone)."""
+    ``opts.inflation`` (so the lines differ by the noise alone)."""
     out, lines = [], []
-    for lay in [name for name, keys in layouts.LAYOUTS.items() if keys]:
-        for label, extra in (("perfect model", settings(np.zeros(4), args.inflation)),
-                             ("model noise", settings(sd, args.inflation, args.length))):
-            rows = tuner.rows(args.report_seeds, lay, extra)
+    for lay in ENKF_LAYOUTS:
+        for label, extra in (("perfect model", settings(np.zeros(4), opts.inflation)),
+                             ("model noise", settings(sd, opts.inflation, opts.length_m))):
+            rows = tuner.rows(opts.report_seeds, lay, extra)
             lines.append(fmt(rows, f"report {lay}: {label}"))
             out += [{**r, "setting": label} for r in rows]
     return out, lines
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """The EnKF noise study's options."""
-    parser.add_argument("--scenario", type=Path, metavar="SCENARIO.toml",
-                        help="scenario recorded (default: the former default, lateral_files)")
-    parser.add_argument("--tune-seeds", type=seed_list, default=[1, 2], metavar="LIST",
-                        help="seeds the noise is tuned on (default: 1,2)")
-    parser.add_argument("--report-seeds", type=seed_list, default=[3, 4, 5], metavar="LIST",
-                        help="held-out seeds reported on (default: 3-5)")
-    parser.add_argument("--warmup", type=positive_float, help="s (default: the scenario's)")
-    parser.add_argument("--horizon", type=positive_float,
-                        help="control horizon, s (default: the scenario's)")
-    parser.add_argument("--layout", default="loops 250 m + AV probes",
-                        choices=[k for k, v in layouts.LAYOUTS.items() if v],
-                        help="the layout tuned on")
-    parser.add_argument("--start", type=number_list, default=[2.0, 1.0, 1.0, 1.0],
-                        help="starting sd: rho_h veh/km, v_h km/h, rho_a veh/km, v_a km/h "
-                             "(default: 2,1,1,1)")
-    parser.add_argument("--inflation", type=positive_float, default=1.05,
-                        help="the EnKF's inflation in the tuning rounds and in both "
-                             "report settings (perfect model, model noise)")
-    parser.add_argument("--length", type=positive_float, default=150.0,
-                        help="correlation length of the model noise, m")
-    parser.add_argument("--rounds", type=non_negative_int, default=6,
-                        help="calibration rounds (0: report --start as it is)")
-    parser.add_argument("--inflation-only", type=number_list, default=[1.05, 1.3, 2.0],
-                        help="inflations tried without model noise (default: 1.05,1.3,2)")
-    parser.add_argument("--gain", type=positive_float, default=1.5)
-    parser.add_argument("--workers", type=positive_int, metavar="N",
-                        help="local processes (default: one per core)")
-    parser.add_argument("--scheduler", metavar="ADDRESS", help="record on this Dask scheduler")
-    parser.add_argument("--quiet", action="store_true", help="no progress bar")
-    add_output(parser, NAME, PAGE, plots=False)
+def run_enkf_noise(opts: EnkfNoiseOptions, *, progress: bool = True) -> EnkfNoiseResult:
+    """Record the missing seeds, tune, report, write the table.
 
+    Parameters
+    ----------
+    opts : EnkfNoiseOptions
+        The study's options.
+    progress : bool, optional
+        Show a progress bar while recording.
 
-def run(args: argparse.Namespace) -> int:
-    """Record the missing seeds, tune, report, write the table."""
-    if len(args.start) != 4:
-        raise StudyError(f"--start = {args.start} is not allowed: 4 sd (rho_h veh/km, v_h "
-                         "km/h, rho_a veh/km, v_a km/h)")
-    seeds = sorted(set(args.tune_seeds) | set(args.report_seeds))
-    runs = layouts.design(args.scenario or shipped_scenario(FORMER_DEFAULT), seeds,
-                          args.warmup, args.horizon)
-    workers = args.workers or default_workers()
-    with resumable_dir(args.out, f"study-{NAME}") as out:
-        paths = layouts.recorded(runs, args)
+    Returns
+    -------
+    EnkfNoiseResult
+        The chosen sd, the report's rows and the files written (``enkf_noise.md``, with
+        report seeds ``enkf_noise.csv``, in ``opts.out``).
+    """
+    seeds = sorted(set(opts.tune_seeds) | set(opts.report_seeds))
+    runs = layouts.design(opts.scenario or shipped_scenario(FORMER_DEFAULT), seeds,
+                          opts.warmup_s, opts.horizon_s)
+    workers = opts.workers or default_workers()
+    with resumable_dir(opts.out, f"study-{NAME}") as out:
+        paths = layouts.record_paths(runs, workers=opts.workers, scheduler=opts.scheduler,
+                                     progress=progress)
         tuner = Tuner({s: (p, dict(r.scenario)) for s, p, r in zip(seeds, paths, runs,
                                                                      strict=True)}, workers)
-        sd, lines = tune(tuner, args)
-        rows, more = report(tuner, sd, args) if args.report_seeds else ([], [])
+        sd, lines = tune(tuner, opts)
+        rows, more = report(tuner, sd, opts) if opts.report_seeds else ([], [])
         head = ("| setting | " + " | ".join(f"RMSE/spread {v}" for v in VARS) + " | "
                 + " | ".join(f"RMSE {v}" for v in VARS) + " |\n|---|" + "---|" * 8)
         chosen = (f"Chosen model-error sd per forecast: {', '.join(f'{v:g}' for v in sd)} "
                   f"(rho_h veh/km, v_h km/h, rho_a veh/km, v_a km/h), inflation "
-                  f"{args.inflation:g}; tuned on seeds {args.tune_seeds}, {args.layout}; "
-                  f"reported on seeds {args.report_seeds}.")
+                  f"{opts.inflation:g}; tuned on seeds {list(opts.tune_seeds)}, "
+                  f"{opts.layout}; reported on seeds {list(opts.report_seeds)}.")
         text = f"{chosen}\n\n{head}\n" + "\n".join(lines + more)
         files: list = [write_text(text, out / "enkf_noise.md")]
         if rows:
             csv = f"{PAGE}_{file_stem(runs[0].scenario.get('name', 'scenario'))}.csv"
             files.append((write_csv(pd.DataFrame(rows), out / "enkf_noise.csv"), csv))
-        if args.docs is not None:
-            publish(args.docs, PAGE, NAME, "The EnKF's model-error noise",
+        if opts.docs is not None:
+            publish(opts.docs, PAGE, NAME, "The EnKF's model-error noise",
                     f"`arzsumo study {NAME}`. {text}", files)
-    print(text)
-    return 0
+    return EnkfNoiseResult(tuple(float(v) for v in sd), pd.DataFrame(rows), text,
+                           tuple(f if isinstance(f, Path) else f[0] for f in files))

@@ -18,12 +18,12 @@ over seeds with 95 % t half-widths. The records are shared with ``loop-speed`` a
 
 from __future__ import annotations
 
-import argparse
 import hashlib
 import json
 import os
 import time
 from collections.abc import Mapping
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -33,13 +33,11 @@ from scipy import stats
 
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, write_csv
+from arzsumo.studies import checks
 from arzsumo.studies.common import (
     FORMER_DEFAULT,
-    add_output,
-    add_runs,
+    RESULTS_DIR,
     file_stem,
-    positive_float,
-    print_list,
     seed_text,
     shipped_scenario,
     study_spec,
@@ -160,51 +158,124 @@ def table(rows: list[dict[str, Any]]) -> str:
     return "\n".join(out)
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """The layout study's options."""
-    parser.add_argument("--scenario", type=Path, metavar="SCENARIO.toml",
-                        help="scenario recorded (default: the former default, lateral_files)")
-    add_runs(parser, seeds="1-5")
-    parser.add_argument("--warmup", type=positive_float, help="s (default: the scenario's)")
-    parser.add_argument("--horizon", type=positive_float,
-                        help="control horizon, s (default: the scenario's)")
-    add_output(parser, NAME, PAGE, plots=False)
+@dataclass(frozen=True)
+class LayoutsOptions:
+    """What the layout study records and scores, and where it writes (SI: s).
+
+    Parameters
+    ----------
+    scenario : Path, optional
+        The scenario recorded (None: the former default, lateral_files).
+    seeds : tuple of int
+        SUMO seeds, one recorded open-loop run each.
+    warmup_s, horizon_s : float, optional
+        Warm-up and control horizon, s (None: the scenario's).
+    out : Path
+        The study's directory (resumable).
+    docs : Path, optional
+        Also regenerate the study's block of ``docs/PAGE.md`` (None: no page).
+    workers : int, optional
+        Local processes (None: one per core); ignored with ``scheduler``.
+    scheduler : str, optional
+        A Dask scheduler's address to run on instead.
+    """
+
+    scenario: Path | None = None
+    seeds: tuple[int, ...] = (1, 2, 3, 4, 5)
+    warmup_s: float | None = None
+    horizon_s: float | None = None
+    out: Path = RESULTS_DIR / NAME
+    docs: Path | None = None
+    workers: int | None = None
+    scheduler: str | None = None
+
+    def __post_init__(self) -> None:
+        checks.seeds(self.seeds)
+        checks.positive(self.warmup_s, "warmup_s", optional=True)
+        checks.positive(self.horizon_s, "horizon_s", optional=True)
+        checks.count(self.workers, "workers", optional=True)
 
 
-def recorded(runs: list[StudyRun], args: argparse.Namespace) -> list[str]:
-    """The record paths of ``runs``, recording the missing ones on the sweep engine."""
+@dataclass(frozen=True)
+class LayoutsResult:
+    """The study's outcome: the ``table`` (one row per layout, method and seed: relative
+    RMSE per variable), the markdown ``text`` of its means over seeds and the ``files``
+    written."""
+
+    table: pd.DataFrame
+    text: str
+    files: tuple[Path, ...]
+
+
+def study_runs(opts: LayoutsOptions) -> list[StudyRun]:
+    """The recorded open-loop runs of the study, one per seed."""
+    return design(opts.scenario or shipped_scenario(FORMER_DEFAULT), list(opts.seeds),
+                  opts.warmup_s, opts.horizon_s)
+
+
+def record_paths(runs: list[StudyRun], *, workers: int | None = None,
+                 scheduler: str | None = None, progress: bool = True) -> list[str]:
+    """The record paths of ``runs``, recording the missing ones on the sweep engine.
+
+    Parameters
+    ----------
+    runs : list of StudyRun
+        The recorded open-loop runs (:func:`design`).
+    workers : int, optional
+        Local processes (default: one per core); ignored with ``scheduler``.
+    scheduler : str, optional
+        A Dask scheduler's address to run on instead.
+    progress : bool, optional
+        Show a progress bar while recording.
+
+    Returns
+    -------
+    list of str
+        The ``.npz`` record of each run, in ``runs``' order.
+    """
     from arzsumo.sweep.driver import map_runs
 
-    done = map_runs(record, runs, workers=args.workers or default_workers(),
-                    scheduler=args.scheduler,
-                    progress=None if args.quiet else f"{NAME}: recording")
+    done = map_runs(record, runs, workers=workers or default_workers(),
+                    scheduler=scheduler,
+                    progress=f"{NAME}: recording" if progress else None)
     return [d["path"] for d in done]
 
 
-def run(args: argparse.Namespace) -> int:
-    """Record the missing seeds, score every layout and method, write the table."""
+def run_layouts(opts: LayoutsOptions, *, progress: bool = True) -> LayoutsResult:
+    """Record the missing seeds, score every layout and method, write the table.
+
+    Parameters
+    ----------
+    opts : LayoutsOptions
+        The study's options.
+    progress : bool, optional
+        Show progress bars while recording and scoring.
+
+    Returns
+    -------
+    LayoutsResult
+        The table, its means and the file written (``layouts.csv`` in ``opts.out``).
+    """
     from arzsumo.sweep.driver import map_runs
 
-    runs = design(args.scenario or shipped_scenario(FORMER_DEFAULT), args.seeds,
-                  args.warmup, args.horizon)
-    if args.list:
-        return print_list([r.run_id for r in runs])
-    with resumable_dir(args.out, f"study-{NAME}") as out:
-        paths = recorded(runs, args)
+    runs = study_runs(opts)
+    with resumable_dir(opts.out, f"study-{NAME}") as out:
+        paths = record_paths(runs, workers=opts.workers, scheduler=opts.scheduler,
+                             progress=progress)
         tasks = [(p, r.scenario, r.scenario["sumo"]["seed"]) for p, r in zip(paths, runs,
                                                                              strict=True)]
-        parts = map_runs(rows_of, tasks, workers=args.workers or default_workers(),
-                         scheduler=args.scheduler,
-                         progress=None if args.quiet else f"{NAME}: scoring")
+        parts = map_runs(rows_of, tasks, workers=opts.workers or default_workers(),
+                         scheduler=opts.scheduler,
+                         progress=f"{NAME}: scoring" if progress else None)
         rows = [row for part in parts for row in part]
-        path = write_csv(pd.DataFrame(rows), out / "layouts.csv")
+        df = pd.DataFrame(rows)
+        path = write_csv(df, out / "layouts.csv")
         text = table(rows)
-        if args.docs is not None:
+        if opts.docs is not None:
             csv = f"{PAGE}_{file_stem(runs[0].scenario.get('name', 'scenario'))}.csv"
-            publish(args.docs, PAGE, NAME, "Estimation error against sensor layout",
+            publish(opts.docs, PAGE, NAME, "Estimation error against sensor layout",
                     f"Relative RMSE of the estimate (1 = the equilibrium value), mean over "
-                    f"seeds {seed_text(args.seeds)} +- 95 % t half-width, open loop "
+                    f"seeds {seed_text(list(opts.seeds))} +- 95 % t half-width, open loop "
                     f"(`arzsumo study {NAME}`). Table: [{csv}]({PAGE}/{csv}).\n\n{text}",
                     [(path, csv)])
-    print(text)
-    return 0
+    return LayoutsResult(df, text, (path,))

@@ -18,10 +18,9 @@ output noise, and how many events the trigger fires at that level.
 
 from __future__ import annotations
 
-import argparse
 import functools
 import logging
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -36,12 +35,11 @@ from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import markdown_table, publish, write_csv, write_text
 from arzsumo.resources import shipped_scenarios_dir
 from arzsumo.scenario import load_scenario
+from arzsumo.studies import checks
 from arzsumo.studies.common import (
+    RESULTS_DIR,
     StudyError,
-    add_output,
-    add_runs,
     number_list,
-    print_list,
     seed_text,
 )
 from arzsumo.units import veh_s_to_veh_h
@@ -77,9 +75,9 @@ def twin_row(task: tuple[Path, str, float, int]) -> dict[str, Any]:
     ctrl = NoisyState(twin_controller(cfg, linearize(sc.equilibrium)), level_pct / 100.0,
                       seed)
     run = run_twin(sc, cfg, controller=ctrl, baseline=False)
-    checks = len(ctrl.log.t)
-    return {"law": law, "noise_pct": level_pct, "seed": seed, "checks": checks,
-            "events": run.triggers, "event_share": run.triggers / max(checks, 1),
+    n_checks = len(ctrl.log.t)
+    return {"law": law, "noise_pct": level_pct, "seed": seed, "checks": n_checks,
+            "events": run.triggers, "event_share": run.triggers / max(n_checks, 1),
             "output_noise_veh_h": output_noise_veh_h(np.asarray(ctrl.log.u_continuous)),
             "final_norm_ratio": float(run.norm[-1] / run.norm[0])}
 
@@ -135,53 +133,113 @@ def readable(table: pd.DataFrame, by: list[str]) -> pd.DataFrame:
     return out.rename(columns={"noise_pct": "noise sd, %"})
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """The study's options."""
-    parser.add_argument("--scenario", type=Path,
-                        default=shipped_scenarios_dir() / "default.toml", metavar="FILE",
-                        help="the scenario whose twin is run (default: the shipped default)")
-    parser.add_argument("--levels", type=number_list, default=number_list(LEVELS_PCT),
-                        metavar="LIST", help="relative noise sd of the fields, %% "
-                                             f"(default: {LEVELS_PCT})")
-    parser.add_argument("--sumo", type=Path, metavar="DIR",
-                        help="the --out of `arzsumo study control`: SUMO's point")
-    add_runs(parser, seeds="1-10")
-    add_output(parser, NAME, PAGE, plots=False)
+@dataclass(frozen=True)
+class EtcNoiseOptions:
+    """What the study runs and reads, and where it writes.
+
+    The scenario is loaded on construction (a bad one stops there, before the levels are
+    checked), so that the options refuse what the study could not run.
+
+    Parameters
+    ----------
+    scenario : Path
+        The scenario whose twin is run.
+    levels : tuple of float
+        Relative noise sd of the fields, % (each >= 0).
+    sumo : Path, optional
+        The ``--out`` of ``arzsumo study control``: SUMO's point (None: the twin only).
+    seeds : tuple of int
+        Noise seeds.
+    out : Path
+        The study's directory.
+    docs : Path, optional
+        Also regenerate the study's block of ``docs/PAGE.md`` (None: no page).
+    workers : int, optional
+        Local processes (None or 1: in this process).
+    """
+
+    scenario: Path = shipped_scenarios_dir() / "default.toml"
+    levels: tuple[float, ...] = tuple(number_list(LEVELS_PCT))
+    sumo: Path | None = None
+    seeds: tuple[int, ...] = tuple(range(1, 11))
+    out: Path = RESULTS_DIR / NAME
+    docs: Path | None = None
+    workers: int | None = None
+
+    def __post_init__(self) -> None:
+        _scenario(self.scenario)                          # bad input stops here
+        if any(level < 0 for level in self.levels):
+            raise StudyError(f"--levels {list(self.levels)} is not allowed: numbers >= 0")
+        checks.seeds(self.seeds)
+        checks.count(self.workers, "workers", optional=True)
 
 
-def run(args: argparse.Namespace) -> int:
-    """Every (law, level, seed) twin run, the tables, SUMO's point."""
+@dataclass(frozen=True)
+class EtcNoiseResult:
+    """The study's outcome: the twin ``runs`` (one row per law, level and seed), their
+    ``twin`` summary per law and level, SUMO's summary per experiment and law (``sumo``;
+    None without ``opts.sumo``), the markdown ``text`` and the ``files`` written."""
+
+    runs: pd.DataFrame
+    twin: pd.DataFrame
+    sumo: pd.DataFrame | None
+    text: str
+    files: tuple[Path, ...]
+
+
+def tasks(opts: EtcNoiseOptions) -> list[tuple[Path, str, float, int]]:
+    """The twin runs: (scenario, law, noise sd in %, noise seed) per level, law and seed."""
+    return [(opts.scenario, law, lv, s) for lv in opts.levels for law in LAWS
+            for s in opts.seeds]
+
+
+def design(opts: EtcNoiseOptions) -> list[str]:
+    """The twin runs, one line each."""
+    return [f"{law}, noise {lv:g} %, seed {s}" for _, law, lv, s in tasks(opts)]
+
+
+def run_etc_noise(opts: EtcNoiseOptions, *, progress: bool = True) -> EtcNoiseResult:
+    """Every (law, level, seed) twin run, the tables, SUMO's point.
+
+    Parameters
+    ----------
+    opts : EtcNoiseOptions
+        The study's options.
+    progress : bool, optional
+        Show a progress bar while the twin runs.
+
+    Returns
+    -------
+    EtcNoiseResult
+        The runs, their summaries and the files written (``twin_runs.csv``,
+        ``twin.csv``, with ``opts.sumo`` ``sumo_runs.csv`` and ``sumo.csv``, and
+        ``etc_noise.md`` in ``opts.out``).
+    """
     from arzsumo.sweep.driver import map_runs
 
-    load_scenario(args.scenario)                          # bad input stops here
-    if any(level < 0 for level in args.levels):
-        raise StudyError(f"--levels {args.levels} is not allowed: numbers >= 0")
-    tasks = [(args.scenario, law, lv, s) for lv in args.levels for law in LAWS
-             for s in args.seeds]
-    if args.list:
-        return print_list([f"{law}, noise {lv:g} %, seed {s}" for _, law, lv, s in tasks])
-    sumo = sumo_rows(args.sumo) if args.sumo else None
-    rows = pd.DataFrame(map_runs(twin_row, tasks, workers=args.workers or 1,
-                                 in_process=not args.workers or args.workers == 1,
-                                 progress=None if args.quiet else NAME))
+    sumo = sumo_rows(opts.sumo) if opts.sumo else None
+    rows = pd.DataFrame(map_runs(twin_row, tasks(opts), workers=opts.workers or 1,
+                                 in_process=not opts.workers or opts.workers == 1,
+                                 progress=NAME if progress else None))
     twin = summary(rows, ["law", "noise_pct"])
-    text = (f"The twin of `{args.scenario.name}`, its laws checked on the state with "
-            f"relative white noise, seeds {seed_text(args.seeds)} (`arzsumo study {NAME}`); "
-            "mean +- 95 % t half-width.\n\n"
+    text = (f"The twin of `{opts.scenario.name}`, its laws checked on the state with "
+            f"relative white noise, seeds {seed_text(list(opts.seeds))} (`arzsumo study "
+            f"{NAME}`); mean +- 95 % t half-width.\n\n"
             + markdown_table(readable(twin, ["law", "noise_pct"])))
-    with resumable_dir(args.out, f"study-{NAME}") as out:
-        write_csv(rows, out / "twin_runs.csv")
+    table = None
+    with resumable_dir(opts.out, f"study-{NAME}") as out:
+        written = [write_csv(rows, out / "twin_runs.csv")]
         files = [(write_csv(twin, out / "twin.csv"), "etc_noise_twin.csv")]
         if sumo is not None:
-            write_csv(sumo, out / "sumo_runs.csv")
+            written.append(write_csv(sumo, out / "sumo_runs.csv"))
             table = summary(sumo, ["experiment", "law"])
             files.append((write_csv(table, out / "sumo.csv"), "etc_noise_sumo.csv"))
             text += ("\n\nThe same laws in SUMO (`--sumo`), per experiment over seeds "
                      f"{seed_text(sorted(sumo['seed'].unique().tolist()))}:\n\n"
                      + markdown_table(readable(table, ["experiment", "law"])))
-        write_text(text, out / "etc_noise.md")
-        if args.docs is not None:
-            publish(args.docs, PAGE, NAME, "The ETC's trigger against the noise of its state",
+        written.append(write_text(text, out / "etc_noise.md"))
+        if opts.docs is not None:
+            publish(opts.docs, PAGE, NAME, "The ETC's trigger against the noise of its state",
                     text, files)
-    print(text)
-    return 0
+    return EtcNoiseResult(rows, twin, table, text,
+                          (*written[:-1], *(p for p, _ in files), written[-1]))

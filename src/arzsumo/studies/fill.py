@@ -13,24 +13,21 @@ own fill and hold (3750:850 veh/h after 4200 + 1300 veh/h for 600 s).
 
 from __future__ import annotations
 
-import argparse
 import time
+from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import pandas as pd
 
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import markdown_table, publish, write_csv
+from arzsumo.studies import checks
 from arzsumo.studies.common import (
     FORMER_DEFAULT,
+    RESULTS_DIR,
     StudyError,
-    add_output,
-    add_runs,
     fixed_cycle,
-    non_negative_float,
-    number_list,
-    positive_float,
-    print_list,
     scenario_data,
     shipped_scenario,
     study_spec,
@@ -59,23 +56,99 @@ def hold_pair(text: str) -> tuple[float, float]:
     return h, a
 
 
-def design(holds: list[str], greens: list[float], sigmas: list[float], seeds: list[int],
-           fill: tuple[float, float, float] = (4200.0, 1300.0, 600.0),
-           approach: float = 2500.0, warmup: float = 600.0, measured: float = 450.0,
-           step: float = 0.1) -> list[StudyRun]:
-    """The runs: hold demand x green share x sigma x seed; ``fill``: (HV veh/h, AV veh/h,
-    duration s) of the fill phase."""
+@dataclass(frozen=True)
+class FillOptions:
+    """What the fill study runs and where it writes (SI units in the names).
+
+    Parameters
+    ----------
+    holds : tuple of str
+        Hold demands ``HV:AV``, veh/h (e.g. ``3750:850``).
+    fill_h_veh_h, fill_a_veh_h : float
+        HV and AV fill demand, veh/h.
+    fill_s : float
+        Fill phase, s.
+    greens : tuple of float
+        Nominal green shares.
+    sigmas : tuple of float
+        Krauss sigma of the HVs.
+    seeds : tuple of int
+        SUMO seeds.
+    approach_m : float
+        Buffer length before x = 0, m.
+    warmup_s, measured_s : float
+        Time not measured, then measured, s.
+    step_s : float
+        SUMO step, s.
+    out : Path
+        The study's directory (resumable).
+    docs : Path, optional
+        Also regenerate the study's block of ``docs/PAGE.md`` (None: no page).
+    workers : int, optional
+        Local processes (None: one per core); ignored with ``scheduler``.
+    scheduler : str, optional
+        A Dask scheduler's address to run on instead.
+    """
+
+    holds: tuple[str, ...] = ("3750:850",)
+    fill_h_veh_h: float = 4200.0
+    fill_a_veh_h: float = 1300.0
+    fill_s: float = 600.0
+    greens: tuple[float, ...] = (0.5,)
+    sigmas: tuple[float, ...] = (0.5,)
+    seeds: tuple[int, ...] = (1,)
+    approach_m: float = 2500.0
+    warmup_s: float = 600.0
+    measured_s: float = 450.0
+    step_s: float = 0.1
+    out: Path = RESULTS_DIR / NAME
+    docs: Path | None = None
+    workers: int | None = None
+    scheduler: str | None = None
+
+    def __post_init__(self) -> None:
+        for h in self.holds:
+            hold_pair(h)
+        for field in ("fill_h_veh_h", "fill_a_veh_h", "fill_s"):
+            checks.non_negative(getattr(self, field), field)
+        for field in ("approach_m", "warmup_s", "measured_s", "step_s"):
+            checks.positive(getattr(self, field), field)
+        checks.numbers(self.greens, "greens")
+        checks.numbers(self.sigmas, "sigmas")
+        checks.seeds(self.seeds)
+        checks.count(self.workers, "workers", optional=True)
+
+
+@dataclass(frozen=True)
+class FillResult:
+    """The study's outcome: the number of ``runs``, of them ``ok`` (stationary, congested,
+    inserted), the ``table`` (one row per run), its markdown ``text`` and the ``files``
+    written."""
+
+    runs: int
+    ok: int
+    table: pd.DataFrame
+    text: str
+    files: tuple[Path, ...]
+
+
+def design(opts: FillOptions) -> list[StudyRun]:
+    """The runs: hold demand x green share x sigma x seed, after the fill phase
+    (``opts.fill_h_veh_h``, ``opts.fill_a_veh_h`` veh/h for ``opts.fill_s`` s)."""
+    fill = (opts.fill_h_veh_h, opts.fill_a_veh_h, opts.fill_s)
+    approach, step = opts.approach_m, opts.step_s
+    warmup, measured = opts.warmup_s, opts.measured_s
     path = shipped_scenario(FORMER_DEFAULT)
-    pairs = [hold_pair(h) for h in holds]
+    pairs = [hold_pair(h) for h in opts.holds]
     spec = study_spec(
-        NAME, path, fixed_cycle(scenario_data(path)), seeds=list(seeds),
+        NAME, path, fixed_cycle(scenario_data(path)), seeds=list(opts.seeds),
         set={"sumo.fill_demand_h_veh_h": fill[0], "sumo.fill_demand_a_veh_h": fill[1],
              "sumo.fill_s": fill[2], "sumo.approach_length_m": approach,
              "sumo.step_length_s": step, "run.warmup_s": warmup, "sumo.horizon_s": measured},
-        axis=[{"name": "hold", "values": list(holds),
+        axis=[{"name": "hold", "values": list(opts.holds),
                "set": [{"sumo.demand_h_veh_h": h, "sumo.demand_a_veh_h": a} for h, a in pairs]},
-              {"field": "sumo.green_share", "values": list(greens)},
-              {"field": "sumo.hv_sigma", "values": list(sigmas)}])
+              {"field": "sumo.green_share", "values": list(opts.greens)},
+              {"field": "sumo.hv_sigma", "values": list(opts.sigmas)}])
     return design_runs(spec, {"fill_h_veh_h": fill[0], "fill_a_veh_h": fill[1],
                               "fill_s": fill[2], "approach_m": approach, "step_s": step,
                               "warmup_s": warmup, "measured_s": measured})
@@ -99,46 +172,32 @@ def run_point(run: StudyRun) -> dict[str, Any]:
     return row
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """The fill study's options."""
-    parser.add_argument("--holds", nargs="+", default=["3750:850"], metavar="HV:AV",
-                        help="hold demands, veh/h")
-    parser.add_argument("--fill-h", type=non_negative_float, default=4200.0,
-                        help="HV fill demand, veh/h")
-    parser.add_argument("--fill-a", type=non_negative_float, default=1300.0,
-                        help="AV fill demand, veh/h")
-    parser.add_argument("--fill", type=non_negative_float, default=600.0,
-                        help="fill phase, s")
-    parser.add_argument("--greens", type=number_list, default=[0.5],
-                        help="nominal green shares (default: 0.5)")
-    parser.add_argument("--sigmas", type=number_list, default=[0.5],
-                        help="Krauss sigma of the HVs (default: 0.5)")
-    add_runs(parser, seeds="1")
-    parser.add_argument("--approach", type=positive_float, default=2500.0,
-                        help="buffer length before x = 0, m")
-    parser.add_argument("--warmup", type=positive_float, default=600.0, help="s not measured")
-    parser.add_argument("--measured", type=positive_float, default=450.0, help="s measured")
-    parser.add_argument("--step", type=positive_float, default=0.1, help="SUMO step, s")
-    add_output(parser, NAME, PAGE, plots=False)
+def run_fill(opts: FillOptions, *, progress: bool = True) -> FillResult:
+    """Run the missing points and write the table (and the page with ``opts.docs``).
 
+    Parameters
+    ----------
+    opts : FillOptions
+        The study's options.
+    progress : bool, optional
+        Show a progress bar while the runs run.
 
-def run(args: argparse.Namespace) -> int:
-    """Run the missing points and write the table (and the page with ``--docs``)."""
-    runs = design(args.holds, args.greens, args.sigmas, args.seeds,
-                  (args.fill_h, args.fill_a, args.fill), args.approach, args.warmup,
-                  args.measured, args.step)
-    if args.list:
-        return print_list([r.run_id for r in runs])
-    with resumable_dir(args.out, f"study-{NAME}") as out:
-        df = pd.DataFrame(run_design(runs, run_point, out, workers=args.workers,
-                                     scheduler=args.scheduler, progress=not args.quiet,
+    Returns
+    -------
+    FillResult
+        The table (one row per run), the points that were ``ok`` and the file written
+        (``fill.csv`` in ``opts.out``).
+    """
+    runs = design(opts)
+    with resumable_dir(opts.out, f"study-{NAME}") as out:
+        df = pd.DataFrame(run_design(runs, run_point, out, workers=opts.workers,
+                                     scheduler=opts.scheduler, progress=progress,
                                      label=NAME))
         path = write_csv(df, out / "fill.csv", "%.5g")
         text = markdown_table(df[[c for c in SHOWN if c in df]])
-        if args.docs is not None:
-            publish(args.docs, PAGE, NAME, "Fill-then-hold demand in SUMO",
+        if opts.docs is not None:
+            publish(opts.docs, PAGE, NAME, "Fill-then-hold demand in SUMO",
                     f"{len(df)} runs (`arzsumo study {NAME}`); {int(df['ok'].sum())} ok. "
                     f"Table: [{PAGE}.csv]({PAGE}/{PAGE}.csv).\n\n{text}",
                     [(path, f"{PAGE}.csv")])
-    print(text)
-    return 0
+    return FillResult(len(df), int(df["ok"].sum()) if "ok" in df else 0, df, text, (path,))

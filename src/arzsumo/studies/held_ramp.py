@@ -16,7 +16,7 @@ identified,meter``); the held ramp's evaluation goes to ``OUT/held``.
 
 from __future__ import annotations
 
-import argparse
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -28,14 +28,11 @@ from arzsumo.evaluation.stats import StatisticsError, paired_difference
 from arzsumo.io import dump_toml
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, write_text
-from arzsumo.studies import ablation
+from arzsumo.studies import ablation, checks
 from arzsumo.studies.common import (
     EXIT_SOME_FAILED,
     RESULTS_DIR,
     StudyError,
-    add_output,
-    add_runs,
-    plots_wanted,
     seed_text,
 )
 from arzsumo.sweep.evaluate import BASELINE, run_evaluation
@@ -97,47 +94,102 @@ def report(meter: pd.DataFrame, held: pd.DataFrame, seeds: list[int]) -> str:
     return "\n".join(lines)
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """The held-ramp study's options."""
-    parser.add_argument("--ablation", type=Path, default=RESULTS_DIR / ablation.NAME,
-                        metavar="DIR", help="the ablation directory holding the meter step")
-    add_runs(parser, seeds="1-10")
-    parser.add_argument("--report", action="store_true",
-                        help="run nothing: the table from the evaluations already there")
-    add_output(parser, NAME, PAGE)
+@dataclass(frozen=True)
+class HeldRampOptions:
+    """What the held-ramp study runs and reads, and where it writes.
+
+    Parameters
+    ----------
+    ablation : Path
+        The ablation directory holding the ``meter`` step.
+    seeds : tuple of int
+        SUMO seeds of the held ramp's open loop, paired with the step's.
+    report : bool
+        Run nothing: the table from the evaluations already there.
+    out : Path
+        The study's directory (resumable).
+    docs : Path, optional
+        Also regenerate the study's block of ``docs/PAGE.md`` (None: no page).
+    plots : bool
+        Draw the held ramp's evaluation figures.
+    workers : int, optional
+        Local processes (None: one per core); ignored with ``scheduler``.
+    scheduler : str, optional
+        A Dask scheduler's address to run on instead.
+    """
+
+    ablation: Path = RESULTS_DIR / ablation.NAME
+    seeds: tuple[int, ...] = tuple(range(1, 11))
+    report: bool = False
+    out: Path = RESULTS_DIR / NAME
+    docs: Path | None = None
+    plots: bool = True
+    workers: int | None = None
+    scheduler: str | None = None
+
+    def __post_init__(self) -> None:
+        checks.seeds(self.seeds)
+        checks.count(self.workers, "workers", optional=True)
 
 
-def run(args: argparse.Namespace) -> int:
-    """Evaluate the held ramp (resumable) and pair the meter step against it."""
-    if args.list:
-        print(f"held: {BASELINE} on seeds {seed_text(args.seeds)}")
-        return 0
-    meter_table = Path(args.ablation) / STEP / "summaries.parquet"
+@dataclass(frozen=True)
+class HeldRampResult:
+    """The study's outcome: the exit ``code`` (0; 4 when a held-ramp run did not
+    finish), the paired table's markdown ``text`` and the ``files`` written."""
+
+    code: int
+    text: str
+    files: tuple[Path, ...]
+
+
+def design(opts: HeldRampOptions) -> list[str]:
+    """The study's one evaluation: the held ramp's open loop on the seeds."""
+    return [f"held: {BASELINE} on seeds {seed_text(list(opts.seeds))}"]
+
+
+def run_held_ramp(opts: HeldRampOptions, *, progress: bool = True) -> HeldRampResult:
+    """Evaluate the held ramp (resumable) and pair the meter step against it.
+
+    Parameters
+    ----------
+    opts : HeldRampOptions
+        The study's options.
+    progress : bool, optional
+        Show a progress bar while the held ramp runs.
+
+    Returns
+    -------
+    HeldRampResult
+        The exit code, the table and the files written (``held.toml``,
+        ``held_comparison.md`` and the held ramp's evaluation in ``opts.out``).
+    """
+    seeds = list(opts.seeds)
+    meter_table = Path(opts.ablation) / STEP / "summaries.parquet"
     if not meter_table.is_file():
-        raise StudyError(f"--ablation = {str(args.ablation)!r} has no finished {STEP!r} step; "
+        raise StudyError(f"--ablation = {str(opts.ablation)!r} has no finished {STEP!r} step; "
                          "allowed: the --out of arzsumo study ablation --steps "
                          f"identified,{STEP}")
     ok = True
-    with resumable_dir(args.out, f"study-{NAME}") as out:
+    with resumable_dir(opts.out, f"study-{NAME}") as out:
         path = write_text(dump_toml(held_scenario()), out / "held.toml")
-        if not args.report:
-            res = run_evaluation(path, [BASELINE], args.seeds, out=out / "held",
-                                 workers=args.workers, scheduler=args.scheduler,
-                                 progress=not args.quiet, plots=plots_wanted(args))
+        if not opts.report:
+            res = run_evaluation(path, [BASELINE], seeds, out=out / "held",
+                                 workers=opts.workers, scheduler=opts.scheduler,
+                                 progress=progress, plots=opts.plots)
             ok = res.sweep is None or bool(res.sweep.table["status"].isin(FINISHED).all())
         held = out / "held" / "summaries.parquet"
         if not held.is_file():
-            raise StudyError(f"--out = {str(args.out)!r} has no held-ramp evaluation yet; "
+            raise StudyError(f"--out = {str(opts.out)!r} has no held-ramp evaluation yet; "
                              "allowed: a run without --report first")
-        text = report(pd.read_parquet(meter_table), pd.read_parquet(held), args.seeds)
+        text = report(pd.read_parquet(meter_table), pd.read_parquet(held), seeds)
         files = [write_text(text, out / "held_comparison.md"), (path, "steps/held.toml")]
         files += [(out / "held" / f"evaluation{x}", f"held{x}") for x in (".csv", ".md")
                   if (out / "held" / f"evaluation{x}").is_file()]
-        if args.docs is not None:
-            publish(args.docs, PAGE, NAME, "Control in SUMO",
-                    f"The `meter` step against the held ramp, seeds {seed_text(args.seeds)}, "
+        if opts.docs is not None:
+            publish(opts.docs, PAGE, NAME, "Control in SUMO",
+                    f"The `meter` step against the held ramp, seeds {seed_text(seeds)}, "
                     f"paired (`arzsumo study {NAME}`); the held ramp's evaluation "
                     f"[held.md]({PAGE}/held.md), its scenario "
                     f"[steps/held.toml]({PAGE}/steps/held.toml).\n\n{text}", files)
-    print(text)
-    return 0 if ok else EXIT_SOME_FAILED
+    return HeldRampResult(0 if ok else EXIT_SOME_FAILED, text,
+                          tuple(f if isinstance(f, Path) else f[0] for f in files))

@@ -18,9 +18,9 @@ scenario's parameters, without refitting; the table gives the relative RMSE per 
 
 from __future__ import annotations
 
-import argparse
 import functools
 import os
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -29,11 +29,11 @@ import pandas as pd
 
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import markdown_table, publish, write_csv
+from arzsumo.studies import checks
 from arzsumo.studies.common import (
     FORMER_DEFAULT,
+    RESULTS_DIR,
     StudyError,
-    add_output,
-    positive_int,
     shipped_scenario,
 )
 from arzsumo.sweep.driver import map_runs
@@ -103,37 +103,76 @@ def cached_runs(folder: Path, last: int) -> list[Path]:
     return files
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """The inlet study's options."""
-    parser.add_argument("--runs", type=Path, metavar="DIR",
-                        help="cached identification runs (default: $ARZSUMO_CACHE/"
-                             "identify-runs)")
-    parser.add_argument("--last", type=positive_int, default=5,
-                        help="replay the most recent N runs")
-    parser.add_argument("--scenario", type=Path, default=None, metavar="SCENARIO.toml",
-                        help="the parameters replayed under (default: the former default, "
-                             "lateral_files)")
-    parser.add_argument("--workers", type=positive_int, default=1, metavar="N",
-                        help="local processes (1: in this process)")
-    add_output(parser, NAME, PAGE, plots=False)
+@dataclass(frozen=True)
+class InletOptions:
+    """What the inlet study replays and where it writes.
+
+    Parameters
+    ----------
+    runs : Path, optional
+        The cached identification runs (None: ``$ARZSUMO_CACHE/identify-runs``).
+    last : int
+        Replay the most recent ``last`` runs.
+    scenario : Path, optional
+        The parameters replayed under (None: the former default, lateral_files).
+    workers : int
+        Local processes (1: in this process).
+    out : Path
+        The study's directory.
+    docs : Path, optional
+        Also regenerate the study's block of ``docs/PAGE.md`` (None: no page).
+    """
+
+    runs: Path | None = None
+    last: int = 5
+    scenario: Path | None = None
+    workers: int = 1
+    out: Path = RESULTS_DIR / NAME
+    docs: Path | None = None
+
+    def __post_init__(self) -> None:
+        checks.count(self.last, "last")
+        checks.count(self.workers, "workers")
 
 
-def run(args: argparse.Namespace) -> int:
-    """Replay every run under every inlet and write the table."""
+@dataclass(frozen=True)
+class InletResult:
+    """The study's outcome: the number of cached ``runs`` replayed, the ``table`` (one
+    row per run and inlet: relative RMSE per variable on the grid and on blocks), its
+    markdown ``text`` and the ``files`` written."""
+
+    runs: int
+    table: pd.DataFrame
+    text: str
+    files: tuple[Path, ...]
+
+
+def run_inlet(opts: InletOptions) -> InletResult:
+    """Replay every run under every inlet and write the table.
+
+    Parameters
+    ----------
+    opts : InletOptions
+        The study's options.
+
+    Returns
+    -------
+    InletResult
+        The table and the file written (``inlet.csv`` in ``opts.out``).
+    """
     from arzsumo.studies.identify_cache import cache_dir
 
-    scenario = args.scenario or shipped_scenario(FORMER_DEFAULT)
-    files = cached_runs(args.runs or cache_dir(), args.last)
+    scenario = opts.scenario or shipped_scenario(FORMER_DEFAULT)
+    files = cached_runs(opts.runs or cache_dir(), opts.last)
     tasks = [(str(f), inlet, str(scenario)) for f in files for inlet in INLETS]
-    rows = map_runs(replay_one, tasks, workers=args.workers, in_process=args.workers == 1)
+    rows = map_runs(replay_one, tasks, workers=opts.workers, in_process=opts.workers == 1)
     df = pd.DataFrame(rows)
     text = markdown_table(df, ".3f")
-    with resumable_dir(args.out, f"study-{NAME}") as out:
+    with resumable_dir(opts.out, f"study-{NAME}") as out:
         path = write_csv(df, out / "inlet.csv")
-        if args.docs is not None:
-            publish(args.docs, PAGE, NAME, "The identified model",
+        if opts.docs is not None:
+            publish(opts.docs, PAGE, NAME, "The identified model",
                     f"The replay's inlet: relative RMSE of {len(files)} cached identification "
                     f"runs replayed under `{Path(scenario).name}` (`arzsumo study {NAME}`). "
                     f"Table: [inlet.csv]({PAGE}/inlet.csv).\n\n{text}", [path])
-    print(text)
-    return 0
+    return InletResult(len(files), df, text, (path,))

@@ -14,7 +14,7 @@ and per class the loops' mean speeds against the truth's cell speeds at the stat
 
 from __future__ import annotations
 
-import argparse
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -23,15 +23,9 @@ import pandas as pd
 
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import markdown_table, publish, write_csv, write_text
-from arzsumo.studies import estimation_layouts
-from arzsumo.studies.common import (
-    FORMER_DEFAULT,
-    add_output,
-    add_runs,
-    positive_float,
-    print_list,
-    shipped_scenario,
-)
+from arzsumo.studies import checks, estimation_layouts
+from arzsumo.studies.common import FORMER_DEFAULT, RESULTS_DIR, shipped_scenario
+from arzsumo.studies.design import StudyRun
 from arzsumo.units import KMH_PER_MS, VEH_KM_PER_VEH_M, ms_to_kmh
 
 NAME = "loop-speed"
@@ -42,6 +36,8 @@ VARS = estimation_layouts.VARS
 FACTOR = (VEH_KM_PER_VEH_M, KMH_PER_MS, VEH_KM_PER_VEH_M, KMH_PER_MS)
 LAYOUT = estimation_layouts.LAYOUTS["loops 250 m + AV probes"]
 LOOP_SPEEDS = ("time_mean", "harmonic")
+#: the estimators replayed (``method``)
+METHODS = ("smoothing", "enkf")
 
 
 def offsets(rec: Any, sc: Any, loop_speed: str, method: str) -> list[dict[str, Any]]:
@@ -88,43 +84,101 @@ def station_speeds(rec: Any) -> list[str]:
     return lines
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """The loop-speed study's options."""
-    parser.add_argument("--scenario", type=Path, metavar="SCENARIO.toml",
-                        help="scenario recorded (default: the former default, lateral_files)")
-    add_runs(parser, seeds="1")
-    parser.add_argument("--horizon", type=positive_float, default=300.0,
-                        help="control horizon recorded, s")
-    parser.add_argument("--method", default="smoothing", choices=("smoothing", "enkf"),
-                        help="the estimator")
-    add_output(parser, NAME, PAGE, plots=False)
+@dataclass(frozen=True)
+class LoopSpeedOptions:
+    """What the loop-speed study records and replays, and where it writes (SI: s).
+
+    Parameters
+    ----------
+    scenario : Path, optional
+        The scenario recorded (None: the former default, lateral_files).
+    seeds : tuple of int
+        SUMO seeds, one recorded open-loop run each.
+    horizon_s : float
+        Control horizon recorded, s.
+    method : str
+        The estimator replayed: ``smoothing`` or ``enkf``.
+    out : Path
+        The study's directory (resumable).
+    docs : Path, optional
+        Also regenerate the study's block of ``docs/PAGE.md`` (None: no page).
+    workers : int, optional
+        Local processes (None: one per core); ignored with ``scheduler``.
+    scheduler : str, optional
+        A Dask scheduler's address to run on instead.
+    """
+
+    scenario: Path | None = None
+    seeds: tuple[int, ...] = (1,)
+    horizon_s: float = 300.0
+    method: str = "smoothing"
+    out: Path = RESULTS_DIR / NAME
+    docs: Path | None = None
+    workers: int | None = None
+    scheduler: str | None = None
+
+    def __post_init__(self) -> None:
+        checks.seeds(self.seeds)
+        checks.positive(self.horizon_s, "horizon_s")
+        checks.among(self.method, METHODS, "method")
+        checks.count(self.workers, "workers", optional=True)
 
 
-def run(args: argparse.Namespace) -> int:
-    """Record (or reuse) the runs, replay both loop speeds, write the table."""
+@dataclass(frozen=True)
+class LoopSpeedResult:
+    """The study's outcome: ``table`` (one row per run, loop speed and variable, report
+    units), the station ``notes`` (one line per run and class), the markdown ``text``
+    printed and published, and the ``files`` written."""
+
+    table: pd.DataFrame
+    notes: tuple[str, ...]
+    text: str
+    files: tuple[Path, ...]
+
+
+def design(opts: LoopSpeedOptions) -> list[StudyRun]:
+    """The recorded open-loop runs, one per seed."""
+    return estimation_layouts.design(opts.scenario or shipped_scenario(FORMER_DEFAULT),
+                                     list(opts.seeds), horizon=opts.horizon_s)
+
+
+def run_loop_speed(opts: LoopSpeedOptions, *, progress: bool = True) -> LoopSpeedResult:
+    """Record (or reuse) the runs, replay both loop speeds, write the table.
+
+    Parameters
+    ----------
+    opts : LoopSpeedOptions
+        The study's options.
+    progress : bool, optional
+        Show a progress bar while recording.
+
+    Returns
+    -------
+    LoopSpeedResult
+        The table, the station notes and the files written (``loop_speed.csv``,
+        ``loop_speed.md`` in ``opts.out``).
+    """
     from arzsumo.bridge.sensor_record import SensorRecord
     from arzsumo.scenario import scenario_from_dict
 
-    runs = estimation_layouts.design(args.scenario or shipped_scenario(FORMER_DEFAULT),
-                                     args.seeds, horizon=args.horizon)
-    if args.list:
-        return print_list([r.run_id for r in runs])
+    runs = design(opts)
     rows, notes = [], []
-    with resumable_dir(args.out, f"study-{NAME}") as out:
-        for r, path in zip(runs, estimation_layouts.recorded(runs, args), strict=True):
+    with resumable_dir(opts.out, f"study-{NAME}") as out:
+        paths = estimation_layouts.record_paths(runs, workers=opts.workers,
+                                                scheduler=opts.scheduler, progress=progress)
+        for r, path in zip(runs, paths, strict=True):
             rec, _ = SensorRecord.load(Path(path))
             sc = scenario_from_dict(r.scenario, r.source)
             for speed in LOOP_SPEEDS:
                 rows += [{"run": r.run_id, **row} for row in offsets(rec, sc, speed,
-                                                                      args.method)]
+                                                                      opts.method)]
             notes += [f"{r.run_id}: {line}" for line in station_speeds(rec)]
         df = pd.DataFrame(rows)
         text = markdown_table(df, ".3f") + "\n\n" + "\n".join(f"- {n}" for n in notes)
         files = [write_csv(df, out / "loop_speed.csv"), write_text(text, out / "loop_speed.md")]
-        if args.docs is not None:
-            publish(args.docs, PAGE, NAME, "Estimation error against sensor layout",
+        if opts.docs is not None:
+            publish(opts.docs, PAGE, NAME, "Estimation error against sensor layout",
                     f"Time-mean against harmonic loop speeds: loops every 250 m + AV probes, "
-                    f"{args.method}, open loop (`arzsumo study {NAME}`). Table: "
+                    f"{opts.method}, open loop (`arzsumo study {NAME}`). Table: "
                     f"[loop_speed.csv]({PAGE}/loop_speed.csv).\n\n{text}", files)
-    print(text)
-    return 0
+    return LoopSpeedResult(df, tuple(notes), text, tuple(Path(f) for f in files))

@@ -19,23 +19,19 @@ dead time the predictor of ``[actuation] delay_compensation_s`` should cover.
 
 from __future__ import annotations
 
-import argparse
 import logging
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
+from arzsumo.errors import require
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import markdown_table, publish, write_csv, write_text
-from arzsumo.studies.common import (
-    RESULTS_DIR,
-    StudyError,
-    add_output,
-    names_among,
-    seed_text,
-)
+from arzsumo.studies import checks
+from arzsumo.studies.common import RESULTS_DIR, StudyError, seed_text
 
 log = logging.getLogger(__name__)
 
@@ -118,36 +114,77 @@ def delay_summary(rows: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(out)
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """The study's options."""
-    parser.add_argument("--sumo", type=Path, metavar="DIR", action="append",
-                        help="the --out of `arzsumo study control`, repeatable: the runs of "
-                             f"several (default: {RESULTS_DIR / 'control'})")
-    parser.add_argument("--experiment", default="regulation",
-                        help="the experiment whose runs are paired (default: regulation)")
-    parser.add_argument("--controllers", default=",".join(PAIRED),
-                        help=f"comma-separated, of {', '.join(PAIRED)} (default: all)")
-    add_output(parser, NAME, PAGE, plots=False)
+@dataclass(frozen=True)
+class MeterDelayOptions:
+    """What the meter-delay study reads and where it writes.
+
+    Parameters
+    ----------
+    sumo : tuple of Path
+        The ``--out`` directories of ``arzsumo study control`` whose runs are paired (a
+        study's runs may be spread over several).
+    experiment : str
+        The experiment whose runs are paired.
+    controllers : tuple of str
+        The controllers read against the open loop, of :data:`PAIRED`.
+    out : Path
+        The study's directory.
+    docs : Path, optional
+        Also regenerate the study's block of ``docs/PAGE.md`` (None: no page).
+    """
+
+    sumo: tuple[Path, ...] = (RESULTS_DIR / "control",)
+    experiment: str = "regulation"
+    controllers: tuple[str, ...] = PAIRED
+    out: Path = RESULTS_DIR / NAME
+    docs: Path | None = None
+
+    def __post_init__(self) -> None:
+        require(len(self.sumo) > 0, "sumo", self.sumo, "at least one directory",
+                StudyError)
+        checks.all_among(self.controllers, PAIRED, "controllers")
 
 
-def run(args: argparse.Namespace) -> int:
-    """The paired events of every seed, their summary, the page block."""
-    controllers = tuple(names_among(args.controllers, PAIRED, "--controllers"))
-    rows = delay_rows(args.sumo or [RESULTS_DIR / "control"], args.experiment, controllers)
+@dataclass(frozen=True)
+class MeterDelayResult:
+    """The study's outcome: the paired ``events`` (one row per controller and seed, s
+    from the start of control), their per-controller ``summary``, the markdown ``text``
+    and the ``files`` written."""
+
+    events: pd.DataFrame
+    summary: pd.DataFrame
+    text: str
+    files: tuple[Path, ...]
+
+
+def run_meter_delay(opts: MeterDelayOptions) -> MeterDelayResult:
+    """The paired events of every seed, their summary, the page block.
+
+    Parameters
+    ----------
+    opts : MeterDelayOptions
+        The study's options.
+
+    Returns
+    -------
+    MeterDelayResult
+        The events, their summary and the files written (``paired_events.csv``,
+        ``meter_delay.csv``, ``meter_delay.md`` in ``opts.out``).
+    """
+    rows = delay_rows(list(opts.sumo), opts.experiment, opts.controllers)
     table = delay_summary(rows)
     seeds = sorted(rows["seed"].unique().tolist())
-    text = (f"Paired runs of `arzsumo study control` ({args.experiment}, seeds "
+    text = (f"Paired runs of `arzsumo study control` ({opts.experiment}, seeds "
             f"{seed_text(seeds)}): the first second after the start of control at which a "
             "controller's run differs from the open loop's in the commanded release rate, "
             "the running light and the mainline outflow at x = L (`arzsumo study "
             f"{NAME}`); dead time = outflow minus command; light to outflow = outflow minus "
             "light.\n\n" + markdown_table(table))
-    with resumable_dir(args.out, f"study-{NAME}") as out:
-        write_csv(rows, out / "paired_events.csv")
+    with resumable_dir(opts.out, f"study-{NAME}") as out:
+        events = write_csv(rows, out / "paired_events.csv")
         files = [(write_csv(table, out / "meter_delay.csv"), "meter_delay.csv")]
-        write_text(text, out / "meter_delay.md")
-        if args.docs is not None:
-            publish(args.docs, PAGE, NAME, "The meter's dead time, from paired runs", text,
+        md = write_text(text, out / "meter_delay.md")
+        if opts.docs is not None:
+            publish(opts.docs, PAGE, NAME, "The meter's dead time, from paired runs", text,
                     files)
-    print(text)
-    return 0
+    return MeterDelayResult(rows, table, text, (events, files[0][0], md))

@@ -24,26 +24,22 @@ CSV`` fits a series recorded earlier instead of running SUMO.
 
 from __future__ import annotations
 
-import argparse
 import time
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import pandas as pd
 
+from arzsumo.errors import require
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, remove_stale_figures, write_csv, write_text
-from arzsumo.studies import meter_fit
+from arzsumo.studies import checks, meter_fit
 from arzsumo.studies.common import (
     FORMER_DEFAULT,
+    RESULTS_DIR,
     StudyError,
-    add_output,
-    add_runs,
     fixed_cycle,
-    fraction_list,
-    plots_wanted,
-    positive_float,
-    print_list,
     scenario_data,
     seed_text,
     shipped_scenario,
@@ -76,14 +72,83 @@ def schedule(warmup: float, base: float, greens: list[float], hold: float
     return out
 
 
-def design(seeds: list[int], warmup: float = 600.0, base: float = 60.0,
-           greens: tuple[float, ...] = GREENS, hold: float = 102.0) -> list[StudyRun]:
+@dataclass(frozen=True)
+class MeterDynamicsOptions:
+    """What the meter-dynamics study runs (or reads), fits and where it writes (SI: s).
+
+    Parameters
+    ----------
+    seeds : tuple of int
+        SUMO seeds, one run each.
+    warmup_s : float
+        Fill and warm-up at green share 0.5, s.
+    base_s : float
+        s more at 0.5 before the steps.
+    greens : tuple of float
+        The green shares of the steps, each in [0, 1] (the steps drive the meter
+        directly, past the scenario's green-share bounds).
+    hold_s : float
+        s per step.
+    pre_s : float
+        s before each change in its fit.
+    settled_s : float
+        Last s of each hold averaged for the static levels.
+    series : Path, optional
+        Fit this series (a ``series.csv`` of this study) instead of running SUMO.
+    out : Path
+        The study's directory (resumable).
+    docs : Path, optional
+        Also regenerate the study's block of ``docs/PAGE.md`` (None: no page).
+    plots : bool
+        Draw the steps' figure.
+    workers : int, optional
+        Local processes (None: one per core); ignored with ``scheduler``.
+    scheduler : str, optional
+        A Dask scheduler's address to run on instead.
+    """
+
+    seeds: tuple[int, ...] = (1, 2, 3)
+    warmup_s: float = 600.0
+    base_s: float = 60.0
+    greens: tuple[float, ...] = GREENS
+    hold_s: float = 102.0
+    pre_s: float = 60.0
+    settled_s: float = 60.0
+    series: Path | None = None
+    out: Path = RESULTS_DIR / NAME
+    docs: Path | None = None
+    plots: bool = True
+    workers: int | None = None
+    scheduler: str | None = None
+
+    def __post_init__(self) -> None:
+        checks.seeds(self.seeds)
+        for field in ("warmup_s", "base_s", "hold_s", "pre_s", "settled_s"):
+            checks.positive(getattr(self, field), field)
+        require(len(self.greens) > 0 and all(0.0 <= g <= 1.0 for g in self.greens),
+                "greens", self.greens, "numbers in [0, 1], at least one", StudyError)
+        checks.count(self.workers, "workers", optional=True)
+
+
+@dataclass(frozen=True)
+class MeterDynamicsResult:
+    """The study's outcome: the per-second ``series`` (one row per second and seed), the
+    fits' markdown ``text`` and the ``files`` written."""
+
+    series: pd.DataFrame
+    text: str
+    files: tuple[Path, ...]
+
+
+def design(opts: MeterDynamicsOptions) -> list[StudyRun]:
     """One run per seed: the default (fixed cycle), 1 s periods, the warm-up and steps."""
     path = shipped_scenario(FORMER_DEFAULT)
-    spec = study_spec(NAME, path, fixed_cycle(scenario_data(path)), seeds=list(seeds),
-                      set={"sumo.control_period_s": 1.0, "run.warmup_s": warmup,
-                           "sumo.horizon_s": base + hold * len(greens)})
-    return design_runs(spec, {"base_s": base, "greens": list(greens), "hold_s": hold})
+    greens = tuple(opts.greens)
+    spec = study_spec(NAME, path, fixed_cycle(scenario_data(path)), seeds=list(opts.seeds),
+                      set={"sumo.control_period_s": 1.0, "run.warmup_s": opts.warmup_s,
+                           "sumo.horizon_s": opts.base_s + opts.hold_s * len(greens)})
+    return design_runs(spec, {"base_s": opts.base_s, "greens": list(greens),
+                              "hold_s": opts.hold_s})
 
 
 def run_steps(run: StudyRun) -> dict[str, Any]:
@@ -165,53 +230,41 @@ def analyse(series: pd.DataFrame, out: Path, pre: float, settled: float, plots: 
     return files, text
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """The meter-dynamics study's options."""
-    add_runs(parser, seeds="1-3")
-    parser.add_argument("--warmup", type=positive_float, default=600.0,
-                        help="fill and warm-up at green share 0.5, s")
-    parser.add_argument("--base", type=positive_float, default=60.0,
-                        help="s more at 0.5 before the steps")
-    # the meter runs green shares in [0, 1] (0: all red, 1: all green); the steps drive
-    # it directly, past the scenario's green_share_min/max, so the option is the check
-    parser.add_argument("--greens", type=fraction_list, default=list(GREENS),
-                        help="the green shares of the steps, comma-separated, each in "
-                             f"[0, 1] (default: {','.join(map(str, GREENS))})")
-    parser.add_argument("--hold", type=positive_float, default=102.0,
-                        help="s per step (17 cycles of 6 s)")
-    parser.add_argument("--pre", type=positive_float, default=60.0,
-                        help="s before each change in its fit")
-    parser.add_argument("--settled", type=positive_float, default=60.0,
-                        help="last s of each hold averaged for the static levels")
-    parser.add_argument("--series", type=Path, metavar="CSV",
-                        help="fit this series (a series.csv of this study) instead of "
-                             "running SUMO")
-    add_output(parser, NAME, PAGE)
+def run_meter_dynamics(opts: MeterDynamicsOptions, *, progress: bool = True
+                       ) -> MeterDynamicsResult:
+    """Run the steps (or read ``opts.series``), fit, write (and publish with
+    ``opts.docs``).
 
+    Parameters
+    ----------
+    opts : MeterDynamicsOptions
+        The study's options.
+    progress : bool, optional
+        Show a progress bar while the runs run.
 
-def run(args: argparse.Namespace) -> int:
-    """Run the steps (or read ``--series``), fit, write (and publish with ``--docs``)."""
-    runs = design(args.seeds, args.warmup, args.base, tuple(args.greens), args.hold)
-    if args.list:
-        return print_list([r.run_id for r in runs],
-                          None if args.series is None else ("--series", args.series))
-    with resumable_dir(args.out, f"study-{NAME}") as out:
-        if args.series is not None:
-            series = read_series(args.series)
+    Returns
+    -------
+    MeterDynamicsResult
+        The series, the fits' tables and the files written (``series.csv``,
+        ``fits.csv``, ``levels.csv``, ``tables.md``, ``steps.png`` in ``opts.out``).
+    """
+    runs = design(opts)
+    with resumable_dir(opts.out, f"study-{NAME}") as out:
+        if opts.series is not None:
+            series = read_series(opts.series)
         else:
-            done = run_design(runs, run_steps, out, workers=args.workers,
-                              scheduler=args.scheduler, progress=not args.quiet, label=NAME)
+            done = run_design(runs, run_steps, out, workers=opts.workers,
+                              scheduler=opts.scheduler, progress=progress, label=NAME)
             series = pd.DataFrame([r for d in done for r in d["series"]], columns=COLUMNS)
         files = [write_csv(series, out / "series.csv")]
-        more, text = analyse(series, out, args.pre, args.settled, plots_wanted(args))
+        more, text = analyse(series, out, opts.pre_s, opts.settled_s, opts.plots)
         files += more
-        if args.docs is not None:
+        if opts.docs is not None:
             seeds = sorted(series["seed"].unique().tolist())
             body = (f"Green-share steps on seeds {seed_text(seeds)} (`arzsumo study {NAME}`): "
                     f"[series]({PAGE}/meter_steps_series.csv), [fits]({PAGE}/meter_steps.csv),"
                     f" [levels]({PAGE}/meter_levels.csv).\n\n{text}"
-                    + (f"\n\n![steps]({PAGE}/meter_steps.png)" if plots_wanted(args) else ""))
-            publish(args.docs, PAGE, NAME, "Meter dynamics in SUMO", body,
+                    + (f"\n\n![steps]({PAGE}/meter_steps.png)" if opts.plots else ""))
+            publish(opts.docs, PAGE, NAME, "Meter dynamics in SUMO", body,
                     [(p, PUBLISHED[p.name]) for p in files])
-    print(text)
-    return 0
+    return MeterDynamicsResult(series, text, tuple(files))

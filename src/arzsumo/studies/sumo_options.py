@@ -21,7 +21,7 @@ default may change only where nothing moves.
 
 from __future__ import annotations
 
-import argparse
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -31,11 +31,10 @@ import pandas as pd
 from arzsumo.evaluation.stats import paired_difference
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, write_csv
+from arzsumo.studies import checks
 from arzsumo.studies.common import (
     EXIT_SOME_FAILED,
-    add_output,
-    add_runs,
-    print_list,
+    RESULTS_DIR,
     shipped_scenario,
     study_spec,
 )
@@ -141,38 +140,93 @@ def markdown(table: pd.DataFrame) -> str:
     return "\n".join(lines)
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """The study's options."""
-    add_runs(parser, seeds="1-10")
-    parser.add_argument("--no-drain", action="store_true",
-                        help="end each run with the control window (faster; no "
-                             "whole-demand measures)")
-    add_output(parser, NAME, PAGE, plots=False)
+@dataclass(frozen=True)
+class SumoOptionsOptions:
+    """What the study runs and where it writes.
+
+    Parameters
+    ----------
+    seeds : tuple of int
+        SUMO seeds, the same for every variant.
+    drain : bool
+        Run each run's drain after the control window (False: end with the window;
+        faster, no whole-demand measures).
+    out : Path
+        The study's directory (resumable).
+    docs : Path, optional
+        Also regenerate the study's block of ``docs/PAGE.md`` (None: no page).
+    workers : int, optional
+        Local processes (None: one per core); ignored with ``scheduler``.
+    scheduler : str, optional
+        A Dask scheduler's address to run on instead.
+    """
+
+    seeds: tuple[int, ...] = tuple(range(1, 11))
+    drain: bool = True
+    out: Path = RESULTS_DIR / NAME
+    docs: Path | None = None
+    workers: int | None = None
+    scheduler: str | None = None
+
+    def __post_init__(self) -> None:
+        checks.seeds(self.seeds)
+        checks.count(self.workers, "workers", optional=True)
 
 
-def run(args: argparse.Namespace) -> int:
-    """Run the missing variants and seeds, write the comparison."""
+@dataclass(frozen=True)
+class SumoOptionsResult:
+    """The study's outcome: the exit ``code`` (0; 4 when a run did not end ``ok``), the
+    run ``statuses`` (status -> runs), the comparison ``table`` (one row per variant and
+    measure), its markdown ``text`` and the ``files`` written."""
+
+    code: int
+    statuses: dict[str, int]
+    table: pd.DataFrame
+    text: str
+    files: tuple[Path, ...]
+
+
+def design(opts: SumoOptionsOptions) -> list[str]:
+    """The run IDs of the study's sweep."""
+    return [r.run_id for r in options_spec(list(opts.seeds), drain=opts.drain).runs()]
+
+
+def run_sumo_options(opts: SumoOptionsOptions, *, progress: bool = True
+                     ) -> SumoOptionsResult:
+    """Run the missing variants and seeds, write the comparison.
+
+    Parameters
+    ----------
+    opts : SumoOptionsOptions
+        The study's options.
+    progress : bool, optional
+        Show a progress bar while the runs run.
+
+    Returns
+    -------
+    SumoOptionsResult
+        The exit code, the statuses, the comparison and the file written
+        (``sumo_options.csv`` in ``opts.out``).
+    """
     from arzsumo.sweep.driver import run_sweep
 
-    spec = options_spec(args.seeds, drain=not args.no_drain)
-    if args.list:
-        return print_list([r.run_id for r in spec.runs()])
-    with resumable_dir(args.out, f"study-{NAME}") as out:
-        rep = run_sweep(spec, Path(out) / "sweep", workers=args.workers,
-                        scheduler=args.scheduler, progress=not args.quiet, plots=False)
-        table = compare(rep.table, drained=not args.no_drain)
+    spec = options_spec(list(opts.seeds), drain=opts.drain)
+    with resumable_dir(opts.out, f"study-{NAME}") as out:
+        rep = run_sweep(spec, Path(out) / "sweep", workers=opts.workers,
+                        scheduler=opts.scheduler, progress=progress, plots=False)
+        table = compare(rep.table, drained=opts.drain)
         files = [write_csv(table, Path(out) / f"{PAGE}.csv")]
         text = markdown(table)
-        if args.docs is not None:
+        if opts.docs is not None:
             body = ("The open loop of the default scenario, one SUMO option changed at a "
                     f"time, paired by seed (`arzsumo study {NAME}`). Each cell: the "
                     "variant minus the shipped options, mean [95 % t interval]; **moves**: "
                     "the interval excludes zero. The first row gives the shipped means."
                     + (" The runs end with the control window (`--no-drain`)."
-                       if args.no_drain else "") + "\n\n"
+                       if not opts.drain else "") + "\n\n"
                     f"{text}\n\nTable: [{PAGE}.csv]({PAGE}/{PAGE}.csv).")
-            publish(args.docs, PAGE, NAME, "What SUMO's options cost and change", body,
+            publish(opts.docs, PAGE, NAME, "What SUMO's options cost and change", body,
                     [(p, p.name) for p in files])
-    print(text)
     bad = sum(v for k, v in rep.statuses.items() if k != "ok")
-    return EXIT_SOME_FAILED if bad else 0
+    return SumoOptionsResult(EXIT_SOME_FAILED if bad else 0, dict(rep.statuses), table,
+                             text, tuple(files))

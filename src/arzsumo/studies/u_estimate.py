@@ -11,7 +11,7 @@ over time.
 
 from __future__ import annotations
 
-import argparse
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -24,13 +24,10 @@ from arzsumo.outputs.studies import (
     remove_stale_figures,
     write_csv,
 )
+from arzsumo.studies import checks
 from arzsumo.studies.common import (
     EXIT_SOME_FAILED,
-    add_output,
-    add_runs,
-    plots_wanted,
-    positive_float,
-    print_list,
+    RESULTS_DIR,
     shipped_scenario,
     study_spec,
 )
@@ -52,12 +49,70 @@ ESTIMATORS = {
 }
 
 
-def design(seeds: list[int], warmup: float = 150.0, horizon: float = 120.0,
-           controller: str = "backstepping") -> SweepSpec:
+@dataclass(frozen=True)
+class UEstimateOptions:
+    """What the study runs and where it writes (SI: s).
+
+    Parameters
+    ----------
+    seeds : tuple of int
+        SUMO seeds, one run per estimator each.
+    warmup_s : float
+        Warm-up before the law acts, s.
+    horizon_s : float
+        Control horizon, s.
+    controller : str
+        The law (a controller with a continuous U).
+    out : Path
+        The study's directory (resumable).
+    docs : Path, optional
+        Also regenerate the study's block of ``docs/PAGE.md`` (None: no page).
+    plots : bool
+        Draw the figure of U over time.
+    workers : int, optional
+        Local processes (None: one per core); ignored with ``scheduler``.
+    scheduler : str, optional
+        A Dask scheduler's address to run on instead.
+    """
+
+    seeds: tuple[int, ...] = (42,)
+    warmup_s: float = 150.0
+    horizon_s: float = 120.0
+    controller: str = "backstepping"
+    out: Path = RESULTS_DIR / NAME
+    docs: Path | None = None
+    plots: bool = True
+    workers: int | None = None
+    scheduler: str | None = None
+
+    def __post_init__(self) -> None:
+        checks.seeds(self.seeds)
+        checks.positive(self.warmup_s, "warmup_s")
+        checks.positive(self.horizon_s, "horizon_s")
+        checks.count(self.workers, "workers", optional=True)
+
+
+@dataclass(frozen=True)
+class UEstimateResult:
+    """The study's outcome: the exit ``code`` (0; 4 when a run did not finish), the
+    ``finished`` runs of ``runs``, the per-run ``table`` (plan changes, U's range and
+    median step, veh/h), the ``series`` of U (veh/h), the markdown ``text`` and the
+    ``files`` written."""
+
+    code: int
+    finished: int
+    runs: int
+    table: pd.DataFrame
+    series: pd.DataFrame
+    text: str
+    files: tuple[Path, ...]
+
+
+def design(opts: UEstimateOptions) -> SweepSpec:
     """The sweep: estimator x seed on ``legacy_default.toml``."""
-    return study_spec(NAME, shipped_scenario("legacy_default.toml"), seeds=list(seeds),
-                      set={"run.controller": controller, "run.warmup_s": warmup,
-                           "sumo.horizon_s": horizon},
+    return study_spec(NAME, shipped_scenario("legacy_default.toml"), seeds=list(opts.seeds),
+                      set={"run.controller": opts.controller, "run.warmup_s": opts.warmup_s,
+                           "sumo.horizon_s": opts.horizon_s},
                       axis=[{"name": "estimator", "values": list(ESTIMATORS),
                              "set": [keys for keys, _ in ESTIMATORS.values()]}])
 
@@ -89,50 +144,56 @@ def statistics(u: pd.DataFrame, runs: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """The study's options."""
-    add_runs(parser, seeds="42")
-    parser.add_argument("--warmup", type=positive_float, default=150.0, help="s")
-    parser.add_argument("--horizon", type=positive_float, default=120.0,
-                        help="control horizon, s")
-    parser.add_argument("--controller", default="backstepping",
-                        help="the law (a controller with a continuous U)")
-    add_output(parser, NAME, PAGE)
+def run_u_estimate(opts: UEstimateOptions, *, progress: bool = True) -> UEstimateResult:
+    """Run the sweep (resumable), then write the table and the figure.
 
+    Parameters
+    ----------
+    opts : UEstimateOptions
+        The study's options.
+    progress : bool, optional
+        Show a progress bar while the runs run.
 
-def run(args: argparse.Namespace) -> int:
-    """Run the sweep (resumable), then write the table and the figure."""
+    Returns
+    -------
+    UEstimateResult
+        The exit code (0, or 4 when a run did not finish), the tables and the files
+        written (``u_estimate.csv``, ``u_series.csv``, ``u.png`` in ``opts.out``).
+    """
     from arzsumo.sweep.driver import run_sweep
 
-    spec = design(args.seeds, args.warmup, args.horizon, args.controller)
-    if args.list:
-        return print_list([r.run_id for r in spec.runs()])
-    with resumable_dir(args.out, f"study-{NAME}") as out:
-        rep = run_sweep(spec, out / "sweep", workers=args.workers, scheduler=args.scheduler,
-                        progress=not args.quiet, plots=False)
+    spec = design(opts)
+    with resumable_dir(opts.out, f"study-{NAME}") as out:
+        rep = run_sweep(spec, out / "sweep", workers=opts.workers, scheduler=opts.scheduler,
+                        progress=progress, plots=False)
         u = series(spec, rep.out)
         stats = statistics(u, rep.table)
         files = [write_csv(stats, out / "u_estimate.csv"), write_csv(u, out / "u_series.csv")]
-        if plots_wanted(args):
-            from arzsumo.outputs.study_figures import write_u_series
-
-            lines = [(f"{ESTIMATORS[r.estimator][1]}, seed {r.seed}: {r.plan_changes} plan "
-                      "changes", g["t_s"].to_numpy(), g["u_veh_h"].to_numpy())
-                     for r, (_, g) in zip(stats.itertuples(),
-                                          u.groupby(["estimator", "seed"], sort=False),
-                                          strict=True)]
-            files.append(write_u_series(lines, f"{args.controller} on legacy_default: the "
-                                        "law on raw cells and on estimates", out / "u.png"))
+        if opts.plots:
+            files.append(_figure(opts.controller, stats, u, out / "u.png"))
         else:
             remove_stale_figures(out / "u.png")
         text = markdown_table(stats, ".0f")
-        if args.docs is not None:
-            publish(args.docs, PAGE, NAME, "The control law on raw cells and on estimates",
+        if opts.docs is not None:
+            publish(opts.docs, PAGE, NAME, "The control law on raw cells and on estimates",
                     f"`arzsumo study {NAME}`. Table: [{PAGE}.csv]({PAGE}/{PAGE}.csv)."
-                    f"\n\n{text}" + (f"\n\n![U]({PAGE}/{PAGE}.png)" if plots_wanted(args)
+                    f"\n\n{text}" + (f"\n\n![U]({PAGE}/{PAGE}.png)" if opts.plots
                                      else ""),
                     [(p, f"{PAGE}{p.suffix}" if p.name != "u_series.csv" else
                       f"{PAGE}_series.csv") for p in files])
-    print(text)
-    ok = rep.table["status"].isin(FINISHED).all()
-    return 0 if ok else EXIT_SOME_FAILED
+    finished = int(rep.table["status"].isin(FINISHED).sum())
+    code = 0 if finished == len(rep.table) else EXIT_SOME_FAILED
+    return UEstimateResult(code, finished, len(rep.table), stats, u, text, tuple(files))
+
+
+def _figure(controller: str, stats: pd.DataFrame, u: pd.DataFrame, path: Path) -> Path:
+    """U over time, one line per run, labelled with its plan changes."""
+    from arzsumo.outputs.study_figures import write_u_series
+
+    lines = [(f"{ESTIMATORS[r.estimator][1]}, seed {r.seed}: {r.plan_changes} plan "
+              "changes", g["t_s"].to_numpy(), g["u_veh_h"].to_numpy())
+             for r, (_, g) in zip(stats.itertuples(),
+                                  u.groupby(["estimator", "seed"], sort=False),
+                                  strict=True)]
+    return write_u_series(lines, f"{controller} on legacy_default: the "
+                          "law on raw cells and on estimates", path)

@@ -16,7 +16,7 @@ lateral_files) for each of ``--controllers`` and ``--seeds``, through the sweep 
 
 from __future__ import annotations
 
-import argparse
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -25,12 +25,11 @@ import pandas as pd
 
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import markdown_table, publish, write_csv
+from arzsumo.studies import checks
 from arzsumo.studies.common import (
     FORMER_DEFAULT,
+    RESULTS_DIR,
     StudyError,
-    add_output,
-    add_runs,
-    print_list,
     shipped_scenario,
     study_spec,
 )
@@ -98,52 +97,98 @@ def run_cells(run: StudyRun) -> dict[str, Any]:
     return {"rows": [{"run": run.run_id, **r} for r in rows]}
 
 
-def design(scenario: Path, controllers: list[str], seeds: list[int]) -> list[StudyRun]:
+@dataclass(frozen=True)
+class WaveSpeedOptions:
+    """What the wave-speed study runs (or reads) and where it writes.
+
+    Parameters
+    ----------
+    scenario : Path, optional
+        The scenario run (None: the former default, lateral_files).
+    controllers : tuple of str
+        The controllers, one run each per seed.
+    seeds : tuple of int
+        SUMO seeds.
+    source : tuple of Path
+        ``arzsumo run`` result directories read instead of running SUMO (empty: run).
+    out : Path
+        The study's directory (resumable).
+    docs : Path, optional
+        Also regenerate the study's block of ``docs/PAGE.md`` (None: no page).
+    workers : int, optional
+        Local processes (None: one per core); ignored with ``scheduler``.
+    scheduler : str, optional
+        A Dask scheduler's address to run on instead.
+    """
+
+    scenario: Path | None = None
+    controllers: tuple[str, ...] = ("open", "etc")
+    seeds: tuple[int, ...] = (42,)
+    source: tuple[Path, ...] = ()
+    out: Path = RESULTS_DIR / NAME
+    docs: Path | None = None
+    workers: int | None = None
+    scheduler: str | None = None
+
+    def __post_init__(self) -> None:
+        checks.seeds(self.seeds)
+        checks.count(self.workers, "workers", optional=True)
+
+
+@dataclass(frozen=True)
+class WaveSpeedResult:
+    """The study's outcome: the ``table`` (one row per run, variable and cell pair: the
+    peak lag, s, and the speed it implies, km/h), its markdown ``text`` and the
+    ``files`` written."""
+
+    table: pd.DataFrame
+    text: str
+    files: tuple[Path, ...]
+
+
+def design(opts: WaveSpeedOptions) -> list[StudyRun]:
     """One run per controller and seed."""
-    spec = study_spec(NAME, scenario, seeds=list(seeds),
+    spec = study_spec(NAME, opts.scenario or shipped_scenario(FORMER_DEFAULT),
+                      seeds=list(opts.seeds),
                       axis=[{"field": "run.controller", "name": "controller",
-                             "values": list(controllers)}])
+                             "values": list(opts.controllers)}])
     return design_runs(spec)
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """The wave-speed study's options."""
-    parser.add_argument("--scenario", type=Path, metavar="SCENARIO.toml",
-                        help="scenario run (default: the former default, lateral_files)")
-    parser.add_argument("--controllers", default="open,etc",
-                        help="comma-separated controllers")
-    add_runs(parser, seeds="42")
-    parser.add_argument("--from", dest="source", type=Path, nargs="+", metavar="DIR",
-                        help="read these arzsumo run results instead of running SUMO")
-    add_output(parser, NAME, PAGE, plots=False)
+def run_wave_speed(opts: WaveSpeedOptions, *, progress: bool = True) -> WaveSpeedResult:
+    """Run (or read ``opts.source``) and write the table of lags and speeds.
 
+    Parameters
+    ----------
+    opts : WaveSpeedOptions
+        The study's options.
+    progress : bool, optional
+        Show a progress bar while the runs run.
 
-def run(args: argparse.Namespace) -> int:
-    """Run (or read) and write the table of lags and speeds."""
-    controllers = [c.strip() for c in args.controllers.split(",") if c.strip()]
-    runs = design(args.scenario or shipped_scenario(FORMER_DEFAULT), controllers, args.seeds)
-    if args.list:
-        return print_list([r.run_id for r in runs],
-                          ("--from", args.source) if args.source else None)
-    with resumable_dir(args.out, f"study-{NAME}") as out:
-        if args.source:
-            missing = [str(d) for d in args.source if not (Path(d) / "cells.parquet").is_file()]
+    Returns
+    -------
+    WaveSpeedResult
+        The table and the file written (``wave_speed.csv`` in ``opts.out``).
+    """
+    runs = design(opts)
+    with resumable_dir(opts.out, f"study-{NAME}") as out:
+        if opts.source:
+            missing = [str(d) for d in opts.source if not (Path(d) / "cells.parquet").is_file()]
             if missing:
                 raise StudyError(f"--from: {', '.join(missing)} has no cells.parquet; "
                                  "allowed: arzsumo run result directories")
-            rows = [r for d in args.source for r in from_cells(d)]
+            rows = [r for d in opts.source for r in from_cells(d)]
         else:
-            done = run_design(runs, run_cells, out, workers=args.workers,
-                              scheduler=args.scheduler, progress=not args.quiet, label=NAME)
+            done = run_design(runs, run_cells, out, workers=opts.workers,
+                              scheduler=opts.scheduler, progress=progress, label=NAME)
             rows = [r for d in done for r in d["rows"]]
         df = pd.DataFrame(rows)
         path = write_csv(df, out / "wave_speed.csv")
         text = markdown_table(df, ".3g")
-        if args.docs is not None:
-            publish(args.docs, PAGE, NAME, "Control in SUMO",
+        if opts.docs is not None:
+            publish(opts.docs, PAGE, NAME, "Control in SUMO",
                     f"Lag of the peak cross-correlation of cell fluctuations 250 m apart "
                     f"(> 0: downstream follows) and the speed it implies (`arzsumo study "
                     f"{NAME}`). Table: [wave_speed.csv]({PAGE}/wave_speed.csv).\n\n{text}",
                     [path])
-    print(text)
-    return 0
+    return WaveSpeedResult(df, text, (path,))

@@ -1,0 +1,45 @@
+"""``arzsumo study estimation-layouts``: the command line of
+:mod:`arzsumo.studies.estimation_layouts`, mapped onto its
+:class:`~arzsumo.studies.estimation_layouts.LayoutsOptions`."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from arzsumo.studies.common import add_output, add_runs, positive_float, print_list
+from arzsumo.studies.estimation_layouts import (
+    NAME,
+    PAGE,
+    LayoutsOptions,
+    run_layouts,
+    study_runs,
+)
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The layout study's options."""
+    parser.add_argument("--scenario", type=Path, metavar="SCENARIO.toml",
+                        help="scenario recorded (default: the former default, lateral_files)")
+    add_runs(parser, seeds="1-5")
+    parser.add_argument("--warmup", type=positive_float, help="s (default: the scenario's)")
+    parser.add_argument("--horizon", type=positive_float,
+                        help="control horizon, s (default: the scenario's)")
+    add_output(parser, NAME, PAGE, plots=False)
+
+
+def options(args: argparse.Namespace) -> LayoutsOptions:
+    """The study's options as the command line gave them."""
+    return LayoutsOptions(scenario=args.scenario, seeds=tuple(args.seeds),
+                          warmup_s=args.warmup, horizon_s=args.horizon, out=args.out,
+                          docs=args.docs, workers=args.workers, scheduler=args.scheduler)
+
+
+def run(args: argparse.Namespace) -> int:
+    """``--list``: the runs; otherwise record the missing seeds, score every layout and
+    method, write the table and print it."""
+    opts = options(args)
+    if args.list:
+        return print_list([r.run_id for r in study_runs(opts)])
+    print(run_layouts(opts, progress=not args.quiet).text)
+    return 0

@@ -1,0 +1,42 @@
+"""``arzsumo study sumo-options``: the command line of :mod:`arzsumo.studies.sumo_options`,
+mapped onto its :class:`~arzsumo.studies.sumo_options.SumoOptionsOptions`."""
+
+from __future__ import annotations
+
+import argparse
+
+from arzsumo.studies.common import add_output, add_runs, print_list
+from arzsumo.studies.sumo_options import (
+    NAME,
+    PAGE,
+    SumoOptionsOptions,
+    design,
+    run_sumo_options,
+)
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The study's options."""
+    add_runs(parser, seeds="1-10")
+    parser.add_argument("--no-drain", action="store_true",
+                        help="end each run with the control window (faster; no "
+                             "whole-demand measures)")
+    add_output(parser, NAME, PAGE, plots=False)
+
+
+def options(args: argparse.Namespace) -> SumoOptionsOptions:
+    """The study's options as the command line gave them."""
+    return SumoOptionsOptions(seeds=tuple(args.seeds), drain=not args.no_drain,
+                              out=args.out, docs=args.docs, workers=args.workers,
+                              scheduler=args.scheduler)
+
+
+def run(args: argparse.Namespace) -> int:
+    """``--list``: the runs; otherwise run the missing variants and seeds, write the
+    comparison and print it."""
+    opts = options(args)
+    if args.list:
+        return print_list(design(opts))
+    result = run_sumo_options(opts, progress=not args.quiet)
+    print(result.text)
+    return result.code
