@@ -101,12 +101,12 @@ def check_keys(table: Mapping[str, Any], allowed: set[str] | Mapping[str, Any],
     unknown = [k for k in table if k not in allowed]
     if unknown:
         what = "key" if len(unknown) == 1 else "keys"
-        named = ", ".join(repr(k) + _did_you_mean(k, allowed) for k in unknown)
+        named = ", ".join(repr(k) + did_you_mean(k, allowed) for k in unknown)
         raise ScenarioError(f"{at} unknown {what} {named}; "
                             f"allowed: {', '.join(sorted(allowed))}")
 
 
-def _did_you_mean(key: str, allowed: Iterable[str]) -> str:
+def did_you_mean(key: str, allowed: Iterable[str]) -> str:
     """`` (did you mean 'x'?)`` for the closest allowed name, or "" when none is close."""
     close = difflib.get_close_matches(str(key), [str(a) for a in allowed], n=1, cutoff=0.75)
     return f" (did you mean {close[0]!r}?)" if close else ""

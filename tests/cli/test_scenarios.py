@@ -63,8 +63,9 @@ def test_run_twin_and_sweep_take_a_name_from_any_directory(tmp_path, monkeypatch
 def test_an_unknown_name_is_one_line_naming_the_shipped_ones():
     code, out, err = cli("twin", "defualt")
     assert code == 2 and out == "" and err.count("\n") == 1
-    assert err.startswith("arzsumo: error: scenario = 'defualt' does not exist: neither a "
-                          "file nor a shipped name; allowed: a TOML file or one of default, ")
+    assert err.startswith("arzsumo: error: scenario = 'defualt' (did you mean 'default'?) "
+                          "does not exist: neither a file nor a shipped name; allowed: a TOML "
+                          "file or one of default, ")
     assert "legacy_default" in err and "'arzsumo list'" in err
 
 

@@ -20,6 +20,7 @@ from arzsumo.resources import (
     shipped_names,
 )
 from arzsumo.scenario import Scenario, load_scenario, scenario_from_preset
+from arzsumo.tables import did_you_mean
 
 
 def _resolved(text: str, dirs: tuple[str, ...], field: str) -> Path:
@@ -31,11 +32,11 @@ def _resolved(text: str, dirs: tuple[str, ...], field: str) -> Path:
         return named
     if path.exists():            # a directory: the reader names it
         return path
-    names = ", ".join(shipped_names(dirs[:1]))
+    names = sorted(shipped_names(dirs[:1]), key=lambda n: (n != "default", n))
     more = " or a paper experiment" if len(dirs) > 1 else ""
-    raise ScenarioError(f"{field} = {text!r} does not exist: neither a file nor a shipped "
-                        f"name; allowed: a TOML file or one of {names}{more} ('arzsumo "
-                        "list')")
+    raise ScenarioError(f"{field} = {text!r}{did_you_mean(text, shipped_names(dirs))} does "
+                        "not exist: neither a file nor a shipped name; allowed: a TOML file "
+                        f"or one of {', '.join(names)}{more} ('arzsumo list')")
 
 
 def scenario_file(text: str | None, default: Path | None = None) -> Path:
