@@ -8,8 +8,8 @@ import pytest
 
 from arzsumo.cli import main
 from arzsumo.cli.catalog import STUDIES, Study
+from arzsumo.cli.studies.options import add_output, add_runs
 from arzsumo.cli.study import register
-from arzsumo.studies.common import add_output, add_runs
 
 
 @pytest.fixture

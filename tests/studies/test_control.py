@@ -157,3 +157,19 @@ def test_a_study_whose_runs_all_failed_exits_with_some_failed(run_study, tmp_pat
     assert run_study("control", "--seeds", "1", "--out", tmp_path / "out") == \
         EXIT_SOME_FAILED
     assert not (tmp_path / "out" / "control.md").exists()
+
+
+def test_the_study_is_called_from_python_with_its_options(tmp_path):
+    from arzsumo.studies.control import ControlOptions, design, run_control
+    from arzsumo.studies.recorded import RecordedRuns
+
+    opts = ControlOptions(RecordedRuns((1, 2, 3), report=True), controllers=("etc",),
+                          experiments=("regulation",), out=tmp_path / "none")
+    assert opts.controllers == ("open", "etc")            # the baseline comes first
+    assert design(opts) == ["regulation: open, etc on seeds 1-3"]
+    with pytest.raises(StudyError, match="has no finished runs yet"):
+        run_control(opts)
+    with pytest.raises(StudyError, match="experiments"):
+        ControlOptions(RecordedRuns((1,)), experiments=("rush-hour",))
+    with pytest.raises(StudyError, match="seeds"):
+        RecordedRuns((2, 2))

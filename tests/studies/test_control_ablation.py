@@ -144,3 +144,19 @@ def test_the_dead_band_step_is_unchanged_on_the_default():
     want = experiment_scenario(BASE, "regulation")["design"] | {
         "noise_sd_kmh": list(control_ablation.DEAD_BAND_KMH), "noise_k": 2.0}
     assert data["design"] == want
+
+
+def test_the_ablation_is_called_from_python_with_its_options():
+    from arzsumo.studies.recorded import RecordedRuns
+
+    opts = control_ablation.AblationOptions(RecordedRuns((1, 2)),
+                                            steps=("unit-gain", "paper-trigger"))
+    assert control_ablation.design(opts) == [
+        "unit-gain: the laws on the paper's unit actuator (meter_gain 1); backstepping, "
+        "etc on seeds 1,2",
+        "paper-trigger: the ETC's trigger as in the paper (no measured dead band); "
+        "backstepping, etc on seeds 1,2"]
+    with pytest.raises(StudyError, match="steps"):
+        control_ablation.AblationOptions(RecordedRuns((1,)), steps=("nope",))
+    with pytest.raises(StudyError, match="experiment"):
+        control_ablation.AblationOptions(RecordedRuns((1,)), experiment="rush-hour")

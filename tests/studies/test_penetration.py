@@ -1,6 +1,5 @@
 """The penetration study's trend statistics, on synthetic sweeps whose slopes are known."""
 
-import argparse
 
 import numpy as np
 import pandas as pd
@@ -74,11 +73,10 @@ def test_the_tables_hold_every_share_and_the_slopes_with_both_intervals():
 
 
 def test_a_report_without_finished_runs_is_refused(tmp_path):
-    args = argparse.Namespace(records=tmp_path / "store", report=True, list=False,
-                              out=tmp_path / "out", workers=None, scheduler=None,
-                              quiet=True, docs=None, seeds=None, share_models=None)
+    opts = pen.PenetrationOptions(records=tmp_path / "store", report=True,
+                                  out=tmp_path / "out", progress=False)
     with pytest.raises(StudyError, match="no finished runs"):
-        pen.run(args)
+        pen.run_penetration(opts)
     assert list(tmp_path.iterdir()) == []          # nothing claimed, nothing written
 
 

@@ -24,13 +24,13 @@ frozen options, no argparse involved::
     from arzsumo.studies.ablation import AblationOptions, design
     lines = design(AblationOptions(steps=("identified",), seeds=(1, 2)))
 
-its command line lives in :mod:`arzsumo.cli.studies`. The others (control,
-control-ablation, penetration) still take a parsed command line::
+    from arzsumo.studies.control import ControlOptions, run_control
+    from arzsumo.studies.recorded import RecordedRuns
+    result = run_control(ControlOptions(RecordedRuns(seeds=(1, 2)),
+                                        controllers=("open", "etc")))
 
-    parser = argparse.ArgumentParser()
-    study = STUDIES["control"]
-    study.add_arguments(parser)
-    code = study.run(parser.parse_args(["--seeds", "1-2", "--list"]))
+its command line lives in :mod:`arzsumo.cli.studies`, the options the studies share in
+:mod:`arzsumo.cli.studies.options`. Every study is library code.
 """
 
 from __future__ import annotations
@@ -101,21 +101,18 @@ _MODULES = {
                                    "the control study's paired runs"),
     "penetration": ("penetration", "the ETC's triggers and release time against the AV "
                                    "share in SUMO, per seed"),
-    "share-models": ("share_models", "per AV share: the demand mapped to its discharge, the "
-                                     "model identified there, the ETC designed for it"),
+    "share-models": ("share_models", "per AV share: the demand mapped to its discharge, "
+                                     "the model identified there, the ETC designed"),
 }
 
 #: the studies that are library code (frozen Options, ``run(options) -> Result``): their
 #: command line is :mod:`arzsumo.cli.studies`'s module of the same name
-LIBRARY_STUDIES = frozenset({
-    "ablation", "ablation-mechanism", "held-ramp", "meter-dynamics", "approach", "fill",
-    "wave-speed", "inlet", "estimation-layouts", "loop-speed", "enkf-noise", "u-estimate",
-    "premise-map", "sumo-options", "etc-noise", "meter-delay", "share-models"})
+LIBRARY_STUDIES = frozenset(_MODULES)
 
 
 def _command_module(name: str, module: str) -> str:
-    return f"arzsumo.cli.studies.{module}" if name in LIBRARY_STUDIES \
-        else f"arzsumo.studies.{module}"
+    """The command line of study ``name``: :mod:`arzsumo.cli.studies`'s ``module``."""
+    return f"arzsumo.cli.studies.{module}"
 
 
 STUDIES: dict[str, Study] = {

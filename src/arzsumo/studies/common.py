@@ -14,7 +14,6 @@ draw take ``--no-plots``.
 
 from __future__ import annotations
 
-import argparse
 import copy
 from collections.abc import Sequence
 from dataclasses import replace
@@ -62,42 +61,6 @@ def names_among(text: str, allowed: Sequence[str], flag: str) -> list[str]:
         raise StudyError(f"{flag} = {text!r} is not allowed: a comma-separated list of "
                          f"{', '.join(allowed)}")
     return sorted(set(names), key=list(allowed).index)
-
-
-def add_output(parser: argparse.ArgumentParser, name: str, page: str,
-               plots: bool = True) -> None:
-    """``--out`` (default ``results/studies/NAME``), ``--docs`` (the results page
-    ``page``) and, with ``plots``, ``--no-plots``."""
-    parser.add_argument("--out", type=Path, default=RESULTS_DIR / name, metavar="DIR",
-                        help="where the tables, figures and runs go; a later call with "
-                             "the same directory runs only what is missing")
-    parser.add_argument("--docs", type=Path, nargs="?", const=DOCS_DIR, metavar="DIR",
-                        help=f"also regenerate this study's block of the results page "
-                             f"DIR/{page}.md, its files in DIR/{page}/ (DIR: {DOCS_DIR})")
-    if plots:
-        parser.add_argument("--no-plots", action="store_true", help="skip the figures")
-
-
-def add_runs(parser: argparse.ArgumentParser, seeds: str | None) -> None:
-    """``--seeds`` (default ``seeds``; none when None), ``--workers``, ``--scheduler``,
-    ``--quiet``, ``--list``."""
-    if seeds is not None:
-        parser.add_argument("--seeds", type=seed_list, default=seed_list(seeds),
-                            metavar="LIST", help=f"SUMO seeds, e.g. 1-10 or 1,2,3 "
-                                                 f"(default: {seeds})")
-    parser.add_argument("--workers", type=positive_int, metavar="N",
-                        help="local processes (default: one per core); ignored with "
-                             "--scheduler")
-    parser.add_argument("--scheduler", metavar="ADDRESS",
-                        help="run on this Dask scheduler, e.g. tcp://HOST:8786")
-    parser.add_argument("--quiet", action="store_true", help="no progress bar")
-    parser.add_argument("--list", action="store_true",
-                        help="print the runs of the design and exit")
-
-
-def plots_wanted(args: argparse.Namespace) -> bool:
-    """Whether the study draws its figures (``--no-plots`` not given)."""
-    return not getattr(args, "no_plots", False)
 
 
 # -- base scenarios ------------------------------------------------------------------------

@@ -27,8 +27,9 @@ the paper's claims, and the section's lateral files per controller
 
 from __future__ import annotations
 
-import argparse
 import logging
+from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -41,18 +42,11 @@ from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.evaluation import paired_figure
 from arzsumo.outputs.studies import publish, remove_stale_figures, write_csv, write_text
 from arzsumo.resources import shipped_scenarios_dir
-from arzsumo.studies.common import (
-    EXIT_SOME_FAILED,
-    StudyError,
-    add_output,
-    add_runs,
-    names_among,
-    plots_wanted,
-    seed_text,
-)
+from arzsumo.studies import checks
+from arzsumo.studies.common import RESULTS_DIR, StudyError, seed_text
 from arzsumo.studies.control_claims import claims_table
 from arzsumo.studies.control_files import MIN_SHARE, files_table
-from arzsumo.studies.recorded import add_records, check_records, recorded_evaluation
+from arzsumo.studies.recorded import RecordedRuns, recorded_evaluation
 from arzsumo.sweep.evaluate import BASELINE, check_controllers
 
 log = logging.getLogger(__name__)
@@ -156,29 +150,57 @@ def headline(tables: dict[str, pd.DataFrame]) -> str:
     return "\n".join(lines)
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """The control study's options."""
-    parser.add_argument("--scenario", type=Path,
-                        default=shipped_scenarios_dir() / "default.toml", metavar="FILE",
-                        help="the base scenario (default: the shipped default)")
-    parser.add_argument("--controllers", default=",".join(JUDGED),
-                        help="comma-separated controllers (default: %(default)s)")
-    parser.add_argument("--experiments", default=",".join(EXPERIMENTS),
-                        help="comma-separated, of regulation, disturbance (default: both)")
-    parser.add_argument("--runs-from", type=Path, action="append", default=[],
-                        metavar="DIR", help="an earlier evaluation or sweep (repeatable): "
-                        "a controller whose runs on all the seeds are there is taken from "
-                        "there (arzsumo evaluate --runs-from)")
-    add_records(parser)
-    add_runs(parser, seeds="1-20")
-    add_output(parser, NAME, PAGE)
-    parser.add_argument("--page", default=PAGE, metavar="NAME",
-                        help="the results page --docs regenerates, DIR/NAME.md with its "
-                             "files in DIR/NAME/ (default: %(default)s, the default's)")
+@dataclass(frozen=True)
+class ControlOptions:
+    """What ``arzsumo study control`` runs.
+
+    ``scenario``: the base scenario file (None: the shipped default); ``controllers``
+    and ``experiments``: of :data:`JUDGED` (and ALINEA's kin) and :data:`EXPERIMENTS`;
+    ``runs``: the seeds, the record store and how the runs run; ``out``: the study's
+    directory (resumable); ``docs`` and ``page``: the results page to regenerate (None:
+    none); ``plots``: draw the figures.
+    """
+
+    runs: RecordedRuns
+    scenario: Path | None = None
+    controllers: tuple[str, ...] = JUDGED
+    experiments: tuple[str, ...] = EXPERIMENTS
+    out: Path = RESULTS_DIR / NAME
+    docs: Path | None = None
+    page: str = PAGE
+    plots: bool = True
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "controllers", tuple(check_controllers(
+            list(self.controllers))))
+        checks.all_among(self.experiments, EXPERIMENTS, "experiments")
+
+    @property
+    def base(self) -> Path:
+        """The base scenario file."""
+        return self.scenario or shipped_scenarios_dir() / "default.toml"
 
 
-def write_tables(args: argparse.Namespace, long: pd.DataFrame, runs: pd.DataFrame,
-                 controllers: list[str], where: Path) -> list[tuple[Path, str]]:
+@dataclass(frozen=True)
+class ControlResult:
+    """What the study produced: per experiment its table (``tables``: one row per
+    controller and measure), its finished runs (``runs``), the text of ``control.md``,
+    and whether every run finished (``complete``)."""
+
+    tables: dict[str, pd.DataFrame]
+    runs: dict[str, pd.DataFrame]
+    text: str
+    complete: bool
+
+
+def design(opts: ControlOptions) -> list[str]:
+    """One line per experiment: its controllers and seeds (``--list``)."""
+    return [f"{e}: {', '.join(opts.controllers)} on seeds {seed_text(list(opts.runs.seeds))}"
+            for e in opts.experiments]
+
+
+def write_tables(plots: bool, long: pd.DataFrame, runs: pd.DataFrame,
+                 controllers: Sequence[str], where: Path) -> list[tuple[Path, str]]:
     """One experiment's ``control.csv``, ``control.md`` and (plots wanted, two controllers
     or more) ``control.png`` in ``where``; return them as (path, published name). A figure
     not redrawn is removed, so none of an earlier call is left to be published."""
@@ -187,7 +209,7 @@ def write_tables(args: argparse.Namespace, long: pd.DataFrame, runs: pd.DataFram
              (write_text(f"# {e}\n\n{markdown(long, BASELINE)}", where / "control.md"),
               f"{e}.md")]
     figure = where / "control.png"
-    if plots_wanted(args) and len(controllers) > 1:
+    if plots and len(controllers) > 1:
         paired_figure(figure, long, runs, controllers, BASELINE,
                       [m for m in MEASURES if m.key in FIGURE and m.key in runs.columns])
         files.append((figure, f"{e}.png"))
@@ -196,55 +218,57 @@ def write_tables(args: argparse.Namespace, long: pd.DataFrame, runs: pd.DataFram
     return files
 
 
-def run(args: argparse.Namespace) -> int:
+def run_control(opts: ControlOptions) -> ControlResult:
     """Both experiments (resumable), the deviation measures, the tables."""
-    controllers = check_controllers(args.controllers.split(","))
-    experiments = names_among(args.experiments, EXPERIMENTS, "--experiments")
-    _, base = read_toml(args.scenario, "scenario", StudyError)
-    check_records(args)
-    if args.list:
-        for e in experiments:
-            print(f"{e}: {', '.join(controllers)} on seeds {seed_text(args.seeds)}")
-        return 0
+    controllers, runs = list(opts.controllers), opts.runs
+    _, base = read_toml(opts.base, "scenario", StudyError)
     ok, tables, finished_runs, counts, files = True, {}, {}, [], []
-    with resumable_dir(args.out, f"study-{NAME}") as out:
-        for e in experiments:
+    with resumable_dir(opts.out, f"study-{NAME}") as out:
+        for e in opts.experiments:
             path = write_text(dump_toml(experiment_scenario(base, e)),
                               out / "scenarios" / f"{e}.toml")
-            runs, finished = recorded_evaluation(args, path, controllers, out / e)
+            found, finished = recorded_evaluation(runs, path, controllers, out / e)
             ok &= finished
-            counts.append(f"{e}: {len(runs)} of {len(controllers) * len(args.seeds)} runs "
-                          "finished")
-            if runs.empty:      # --report before any run of this experiment finished
+            counts.append(f"{e}: {len(found)} of {len(controllers) * len(runs.seeds)} "
+                          "runs finished")
+            if found.empty:      # a report before any run of this experiment finished
                 log.warning("no finished %s runs yet: its tables are left out", e)
                 continue
-            measures = [m for m in MEASURES if m.key in runs.columns]
-            tables[e] = evaluate(runs, controllers, BASELINE, measures)
-            finished_runs[e] = runs
-            files += write_tables(args, tables[e], runs, controllers, out / e)
-        if not tables and not args.report:
-            log.error("no run finished: no tables; the failures are in %s", args.out)
-            return EXIT_SOME_FAILED
+            measures = [m for m in MEASURES if m.key in found.columns]
+            tables[e] = evaluate(found, controllers, BASELINE, measures)
+            finished_runs[e] = found
+            files += write_tables(opts.plots, tables[e], found, controllers, out / e)
+        if not tables and not runs.report:
+            log.error("no run finished: no tables; the failures are in %s", opts.out)
+            return ControlResult({}, {}, "", False)
         if not tables:
-            raise StudyError(f"--out = {args.out} has no finished runs yet; allowed: a run "
+            raise StudyError(f"--out = {opts.out} has no finished runs yet; allowed: a run "
                              "without --report, or --records with a store that holds some")
-        text = (f"Controllers {', '.join(controllers)} on seeds {seed_text(args.seeds)}, "
-                f"paired against the open loop (`arzsumo study {NAME}`); "
-                + "; ".join(counts) + ".\n\n" + headline(tables))
-        found = claims_table(finished_runs, args.seeds)
-        if found:
-            text += ("\n\nThe paper's section-5 claims, as SUMO tests them (95 % t intervals "
-                     "of the paired differences):\n\n" + found)
-        for e, runs in finished_runs.items():
-            text += (f"\n\nThe section's lateral files, {e} (files holding at least "
-                     f"{MIN_SHARE:.0%} of a class's samples, and the largest gap between "
-                     "their mean speeds: a class-level average is the stream's only while "
-                     "its files ride at one speed):\n\n" + files_table(runs, controllers))
+        text = _page_text(opts, tables, finished_runs, counts)
         write_text(text, out / "control.md")
-        if args.docs is not None:
+        if opts.docs is not None:
             name = base.get("name", "the scenario")
             title = "the default" if name == "default" else name
-            publish(args.docs, args.page, NAME, f"The controllers on {title} in SUMO", text,
+            publish(opts.docs, opts.page, NAME, f"The controllers on {title} in SUMO", text,
                     files)
-    print(text)
-    return 0 if ok else EXIT_SOME_FAILED
+    return ControlResult(tables, finished_runs, text, ok)
+
+
+def _page_text(opts: ControlOptions, tables: dict[str, pd.DataFrame],
+               finished_runs: dict[str, pd.DataFrame], counts: list[str]) -> str:
+    """``control.md``: the headline, the paper's claims, the lateral files."""
+    seeds = list(opts.runs.seeds)
+    text = (f"Controllers {', '.join(opts.controllers)} on seeds {seed_text(seeds)}, "
+            f"paired against the open loop (`arzsumo study {NAME}`); "
+            + "; ".join(counts) + ".\n\n" + headline(tables))
+    found = claims_table(finished_runs, seeds)
+    if found:
+        text += ("\n\nThe paper's section-5 claims, as SUMO tests them (95 % t intervals "
+                 "of the paired differences):\n\n" + found)
+    for e, runs in finished_runs.items():
+        text += (f"\n\nThe section's lateral files, {e} (files holding at least "
+                 f"{MIN_SHARE:.0%} of a class's samples, and the largest gap between "
+                 "their mean speeds: a class-level average is the stream's only while "
+                 "its files ride at one speed):\n\n"
+                 + files_table(runs, list(opts.controllers)))
+    return text

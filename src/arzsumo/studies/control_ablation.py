@@ -42,10 +42,10 @@ minus the open loop.
 
 from __future__ import annotations
 
-import argparse
 import tempfile
 import tomllib
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
@@ -59,17 +59,9 @@ from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, write_text
 from arzsumo.resources import shipped_scenarios_dir
 from arzsumo.scenario import scenario_from_dict
-from arzsumo.studies import control
-from arzsumo.studies.common import (
-    EXIT_SOME_FAILED,
-    RESULTS_DIR,
-    StudyError,
-    add_output,
-    add_runs,
-    names_among,
-    seed_text,
-)
-from arzsumo.studies.recorded import add_records, check_records, recorded_evaluation
+from arzsumo.studies import checks, control
+from arzsumo.studies.common import RESULTS_DIR, StudyError, seed_text
+from arzsumo.studies.recorded import RecordedRuns, recorded_evaluation
 from arzsumo.sweep.evaluate import BASELINE, evaluation_spec
 from arzsumo.sweep.evaluate import KIND as EVALUATION_KIND
 from arzsumo.sweep.records import copy_records, is_store, records_table
@@ -269,26 +261,49 @@ def step_scenarios(base: dict, steps: Sequence[str], experiment: str,
     return out
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """The ablation's options."""
-    parser.add_argument("--scenario", type=Path,
-                        default=shipped_scenarios_dir() / "default.toml", metavar="FILE",
-                        help="the control study's base scenario (default: the shipped "
-                             "default)")
-    parser.add_argument("--control", type=Path, default=RESULTS_DIR / control.NAME,
-                        metavar="DIR", help="the control study's --out, or its record "
-                        "store: its runs of the experiment are the full configuration")
-    parser.add_argument("--experiment", choices=control.EXPERIMENTS, default="regulation",
-                        help="the control study's experiment the steps change "
-                             "(default: %(default)s)")
-    parser.add_argument("--steps", default=",".join(DEFAULT_STEPS),
-                        help="comma-separated steps, of " + ", ".join(STEPS)
-                             + " (default: %(default)s)")
-    parser.add_argument("--laws", default=",".join(LAWS),
-                        help="comma-separated laws ablated (default: %(default)s)")
-    add_records(parser)
-    add_runs(parser, seeds="1-10")
-    add_output(parser, NAME, PAGE, plots=False)
+@dataclass(frozen=True)
+class AblationOptions:
+    """What ``arzsumo study control-ablation`` runs.
+
+    ``runs``: the seeds, the record store and how the runs run; ``scenario``: the control
+    study's base scenario (None: the shipped default); ``control``: the control study's
+    ``--out`` or record store (its runs of ``experiment`` are the full configuration);
+    ``steps`` of :data:`STEPS`, ``laws`` of :data:`LAWS`; ``out``, ``docs``: where the
+    study writes (None: no page).
+    """
+
+    runs: RecordedRuns
+    scenario: Path | None = None
+    control: Path = RESULTS_DIR / control.NAME
+    experiment: str = "regulation"
+    steps: tuple[str, ...] = DEFAULT_STEPS
+    laws: tuple[str, ...] = LAWS
+    out: Path = RESULTS_DIR / NAME
+    docs: Path | None = None
+
+    def __post_init__(self) -> None:
+        checks.among(self.experiment, control.EXPERIMENTS, "experiment")
+        checks.all_among(self.steps, tuple(STEPS), "steps")
+        checks.all_among(self.laws, LAWS, "laws")
+
+    @property
+    def base(self) -> Path:
+        """The control study's base scenario file."""
+        return self.scenario or shipped_scenarios_dir() / "default.toml"
+
+
+@dataclass(frozen=True)
+class AblationResult:
+    """The table (Markdown) and whether every step's runs finished."""
+
+    text: str
+    complete: bool
+
+
+def design(opts: AblationOptions) -> list[str]:
+    """One line per step: what it changes, the laws and seeds (``--list``)."""
+    return [f"{s}: {STEPS[s][0]}; {', '.join(opts.laws)} on seeds "
+            f"{seed_text(list(opts.runs.seeds))}" for s in opts.steps]
 
 
 def full_configuration(runs_dir: Path, scenario: Path, laws: Sequence[str],
@@ -316,27 +331,20 @@ def open_loop_runs(control_runs: Path, runs: Sequence[RunSpec], here: Path) -> P
     return here
 
 
-def run(args: argparse.Namespace) -> int:
+def run_ablation(opts: AblationOptions) -> AblationResult:
     """Every step's evaluation (resumable), then the table against the full configuration."""
-    steps = names_among(args.steps, list(STEPS), "--steps")
-    laws = names_among(args.laws, list(LAWS), "--laws")
-    check_records(args)
-    if args.list:
-        for s in steps:
-            print(f"{s}: {STEPS[s][0]}; {', '.join(laws)} on seeds {seed_text(args.seeds)}")
-        return 0
-    _, base = read_toml(args.scenario, "scenario", StudyError)
-    experiment = args.experiment
-    control_runs = Path(args.control) / experiment
+    steps, laws, seeds = list(opts.steps), list(opts.laws), list(opts.runs.seeds)
+    _, base = read_toml(opts.base, "scenario", StudyError)
+    experiment = opts.experiment
+    control_runs = Path(opts.control) / experiment
     ok, found = True, {}
     with tempfile.TemporaryDirectory() as tmp:     # checked before --out is touched
         exp_path = write_text(dump_toml(control.experiment_scenario(base, experiment)),
                               Path(tmp) / f"{experiment}.toml")
-        scenarios = step_scenarios(base, steps, experiment, str(args.scenario))
-        full = full_configuration(control_runs, exp_path, laws, args.seeds,
-                                  str(args.control))
-        open_runs = evaluation_spec(exp_path, [BASELINE], args.seeds).runs()
-    with resumable_dir(args.out, f"study-{NAME}") as out:
+        scenarios = step_scenarios(base, steps, experiment, str(opts.base))
+        full = full_configuration(control_runs, exp_path, laws, seeds, str(opts.control))
+        open_runs = evaluation_spec(exp_path, [BASELINE], seeds).runs()
+    with resumable_dir(opts.out, f"study-{NAME}") as out:
         baseline = open_loop_runs(control_runs, open_runs,
                                   out / step_name("control-open", experiment))
         for s in steps:
@@ -344,23 +352,22 @@ def run(args: argparse.Namespace) -> int:
             path = write_text(dump_toml(scenarios[s]), out / "steps" / f"{name}.toml")
             own_open = STEPS[s][2]
             runs, finished = recorded_evaluation(
-                args, path, [BASELINE, *laws] if own_open else laws, out / name,
+                opts.runs, path, [BASELINE, *laws] if own_open else laws, out / name,
                 baseline_from=None if own_open else baseline)
             ok &= finished
             if not runs.empty:
                 found[s] = runs
-        text = table(found, full, args.seeds, laws)
+        text = table(found, full, seeds, laws)
         md = write_text(text, out / f"{step_name('ablation', experiment)}.md")
-        if args.docs is not None:
-            publish(args.docs, PAGE, step_name(NAME, experiment),
+        if opts.docs is not None:
+            publish(opts.docs, PAGE, step_name(NAME, experiment),
                     "The controllers on the default in SUMO",
                     f"Ablation of the {experiment} experiment on seeds "
-                    f"{seed_text(args.seeds)}: each step minus the full configuration and "
+                    f"{seed_text(seeds)}: each step minus the full configuration and "
                     f"minus the open loop, paired by seed (`arzsumo study {NAME}`).\n\n"
                     f"{text}", [(md, md.name)])
-    print(text)
-    return 0 if ok else EXIT_SOME_FAILED
+    return AblationResult(text, ok)
 
 
-__all__ = ["NAME", "STEPS", "full_configuration", "run", "step_name", "step_scenario",
-           "table"]
+__all__ = ["NAME", "STEPS", "AblationOptions", "full_configuration", "run_ablation",
+           "step_name", "step_scenario", "table"]

@@ -25,9 +25,8 @@ interval lies below zero and the release time's above (:func:`verdict`).
 
 from __future__ import annotations
 
-import argparse
 import logging
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -44,15 +43,9 @@ from arzsumo.outputs.studies import (
     write_text,
 )
 from arzsumo.resources import shipped_sweeps_dir
-from arzsumo.studies.common import (
-    EXIT_SOME_FAILED,
-    StudyError,
-    add_output,
-    add_runs,
-    plots_wanted,
-    seed_list,
-)
-from arzsumo.studies.recorded import add_records, check_records
+from arzsumo.studies import checks
+from arzsumo.studies.common import RESULTS_DIR, StudyError
+from arzsumo.studies.recorded import check_store
 from arzsumo.sweep.records import copy_records, records_table
 from arzsumo.sweep.spec import SweepSpec, load_sweep
 from arzsumo.sweep.worker import FINISHED
@@ -194,16 +187,56 @@ def share_sweep(directory: Path, seeds: list[int] | None) -> SweepSpec:
                              "set": sets}])
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """The penetration study's options (the shares are the sweep files')."""
-    parser.add_argument("--seeds", type=seed_list, metavar="LIST",
-                        help="SUMO seeds, e.g. 1-10 (default: each sweep file's own)")
-    parser.add_argument("--share-models", type=Path, metavar="DIR",
-                        help="run the ETC on each share's own scenario from arzsumo study "
-                             "share-models (its --out) instead of the shipped sweeps")
-    add_records(parser)
-    add_runs(parser, seeds=None)
-    add_output(parser, NAME, PAGE)
+@dataclass(frozen=True)
+class PenetrationOptions:
+    """What ``arzsumo study penetration`` runs.
+
+    ``seeds``: SUMO seeds (None: each sweep file's own); ``records``, ``report``: the
+    record store and run-nothing (as :class:`~arzsumo.studies.recorded.RecordedRuns`);
+    ``share_models``: the ``--out`` of ``arzsumo study share-models`` (None: the shipped
+    sweeps); ``out``, ``docs``, ``plots``: where and what the study writes;
+    ``workers``, ``scheduler``, ``progress``: how the runs run.
+    """
+
+    seeds: tuple[int, ...] | None = None
+    records: Path | None = None
+    report: bool = False
+    share_models: Path | None = None
+    out: Path = RESULTS_DIR / NAME
+    docs: Path | None = None
+    plots: bool = True
+    workers: int | None = None
+    scheduler: str | None = None
+    progress: bool = True
+
+    def __post_init__(self) -> None:
+        if self.seeds is not None:
+            checks.seeds(self.seeds)
+        check_store(self.records, self.report)
+
+
+@dataclass(frozen=True)
+class PenetrationResult:
+    """Per sweep its finished runs (``tables``), the page's text, and whether every run
+    of every sweep finished (``complete``)."""
+
+    tables: dict[str, pd.DataFrame]
+    text: str
+    complete: bool
+
+
+def specs_of(opts: PenetrationOptions) -> list[SweepSpec]:
+    """The sweeps the study runs."""
+    seeds = None if opts.seeds is None else list(opts.seeds)
+    if opts.share_models is not None:
+        return [share_sweep(opts.share_models, seeds)]
+    return [with_seeds(load_sweep(shipped_sweeps_dir() / f"{n}.toml"), seeds)
+            for n in SWEEPS]
+
+
+def design(opts: PenetrationOptions) -> list[str]:
+    """One line per sweep: its name and number of runs (``--list``)."""
+    return [f"{spec.name}: {len(spec.runs())} runs" for spec in specs_of(opts)]
 
 
 def with_seeds(spec: SweepSpec, seeds: list[int] | None) -> SweepSpec:
@@ -215,20 +248,20 @@ def with_seeds(spec: SweepSpec, seeds: list[int] | None) -> SweepSpec:
     return replace(spec, axes=axes)
 
 
-def _finished(args: argparse.Namespace, spec: SweepSpec, out: Path) -> pd.DataFrame:
-    """The sweep's finished runs in ``out`` or the store; unless ``--report`` the missing
+def _finished(opts: PenetrationOptions, spec: SweepSpec, out: Path) -> pd.DataFrame:
+    """The sweep's finished runs in ``out`` or the store; unless ``report`` the missing
     ones are run first."""
     from arzsumo.sweep.driver import run_sweep
 
-    store = None if args.records is None else args.records / spec.name
+    store = None if opts.records is None else opts.records / spec.name
     places = [out, *([store] if store is not None else [])]
-    if not args.report:
+    if not opts.report:
         with resumable_dir(out, "sweep"):
             if store is not None:
                 copy_records(spec.runs(), store, out)
         try:
-            run_sweep(spec, out, workers=args.workers, scheduler=args.scheduler,
-                      progress=not args.quiet, plots=False)
+            run_sweep(spec, out, workers=opts.workers, scheduler=opts.scheduler,
+                      progress=opts.progress, plots=False)
         finally:
             if store is not None:
                 copy_records(spec.runs(), out, store)
@@ -236,7 +269,7 @@ def _finished(args: argparse.Namespace, spec: SweepSpec, out: Path) -> pd.DataFr
     return table[table["status"].isin(FINISHED)]
 
 
-def _write(tables: dict[str, pd.DataFrame], out: Path, args: argparse.Namespace) -> str:
+def _write(tables: dict[str, pd.DataFrame], out: Path, opts: PenetrationOptions) -> str:
     """Each sweep's CSV (levels and slopes), the figure and the page; return the text."""
     files = []
     for name, table in tables.items():
@@ -244,7 +277,7 @@ def _write(tables: dict[str, pd.DataFrame], out: Path, args: argparse.Namespace)
                                           slope_table(table).assign(kind="slope")]),
                                out / f"{name}.csv"))
     text = report(tables)
-    if plots_wanted(args):
+    if opts.plots:
         from arzsumo.outputs.penetration import write_penetration_figure
 
         files.append(write_penetration_figure(out, {TITLES[n]: t
@@ -253,35 +286,27 @@ def _write(tables: dict[str, pd.DataFrame], out: Path, args: argparse.Namespace)
     else:
         remove_stale_figures(out / PENETRATION_FIGURE)
     write_text(text, out / "penetration.md")
-    if args.docs is not None:
-        publish(args.docs, PAGE, NAME, "The controllers on the default in SUMO", text,
+    if opts.docs is not None:
+        publish(opts.docs, PAGE, NAME, "The controllers on the default in SUMO", text,
                 [(f, f.name) for f in files])
     return text
 
 
-def run(args: argparse.Namespace) -> int:
-    """Both sweeps (resumable), then the levels, slopes and verdicts."""
-    check_records(args)
-    specs = ([share_sweep(args.share_models, args.seeds)] if args.share_models else
-             [with_seeds(load_sweep(shipped_sweeps_dir() / f"{n}.toml"), args.seeds)
-              for n in SWEEPS])
-    if args.list:
-        for spec in specs:
-            print(f"{spec.name}: {len(spec.runs())} runs")
-        return 0
-    if args.report:     # refused before anything is written when there is nothing to read
-        found = {s.name: _finished(args, s, args.out / s.name) for s in specs}
+def run_penetration(opts: PenetrationOptions) -> PenetrationResult:
+    """Every sweep (resumable), then the levels, slopes and verdicts."""
+    specs = specs_of(opts)
+    if opts.report:     # refused before anything is written when there is nothing to read
+        found = {s.name: _finished(opts, s, opts.out / s.name) for s in specs}
         if all(t.empty for t in found.values()):
-            raise StudyError(f"--out = {args.out} has no finished runs yet; allowed: a run "
+            raise StudyError(f"--out = {opts.out} has no finished runs yet; allowed: a run "
                              "without --report, or --records with a store that holds some")
-    with resumable_dir(args.out, f"study-{NAME}") as out:
-        if not args.report:
-            found = {s.name: _finished(args, s, out / s.name) for s in specs}
+    with resumable_dir(opts.out, f"study-{NAME}") as out:
+        if not opts.report:
+            found = {s.name: _finished(opts, s, out / s.name) for s in specs}
         tables = {n: t for n, t in found.items() if not t.empty}
         if not tables:
             raise StudyError(f"no run of {', '.join(found)} finished; the failures are in "
-                             f"{args.out}")
-        text = _write(tables, out, args)
-    print(text)
+                             f"{opts.out}")
+        text = _write(tables, out, opts)
     complete = all(len(found[s.name]) == len(s.runs()) for s in specs)
-    return 0 if complete or args.report else EXIT_SOME_FAILED
+    return PenetrationResult(tables, text, complete or opts.report)

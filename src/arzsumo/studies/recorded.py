@@ -12,15 +12,16 @@ running study.
 
 from __future__ import annotations
 
-import argparse
 import logging
 import os
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
 
 from arzsumo.outdir import resumable_dir
+from arzsumo.studies import checks
 from arzsumo.studies.common import StudyError
 from arzsumo.sweep.evaluate import (
     BASELINE,
@@ -36,73 +37,84 @@ from arzsumo.sweep.worker import FINISHED
 log = logging.getLogger(__name__)
 
 
-def add_records(parser: argparse.ArgumentParser) -> None:
-    """``--report`` and ``--records``."""
-    parser.add_argument("--report", action="store_true",
-                        help="run nothing: the tables from the runs already there "
-                             "(finished so far, while a study is running too)")
-    parser.add_argument("--records", type=Path, metavar="DIR",
-                        help="a store of run records (a table per experiment, "
-                             "DIR/<experiment>/records.jsonl, a line per finished run): "
-                             "the runs it holds are not run again, and every finished run "
-                             "is added to it; kept under version control, it carries the "
-                             "study across machines")
+@dataclass(frozen=True)
+class RecordedRuns:
+    """How a study's evaluations run and where their records live.
+
+    ``seeds``: the SUMO seeds; ``records``: the record store (None: none); ``report``:
+    run nothing, read the tables from the runs already there; ``runs_from``: earlier
+    evaluations or sweeps whose runs are taken instead of run (not with a store or a
+    report); ``workers``, ``scheduler``, ``progress``: how the runs are run.
+
+    A ``records`` that is not a usable directory, and ``runs_from`` beside ``records`` or
+    ``report``, are refused (their runs live elsewhere: neither store nor report would
+    see them), in the command line's terms.
+    """
+
+    seeds: tuple[int, ...]
+    records: Path | None = None
+    report: bool = False
+    runs_from: tuple[Path, ...] = ()
+    workers: int | None = None
+    scheduler: str | None = None
+    progress: bool = True
+
+    def __post_init__(self) -> None:
+        checks.seeds(self.seeds)
+        check_store(self.records, self.report, self.runs_from)
 
 
-def check_records(args: argparse.Namespace) -> None:
-    """Refuse a ``--records`` that is not a usable directory, and ``--runs-from`` beside
-    ``--records`` or ``--report`` (their runs live elsewhere: neither store nor report
-    would see them)."""
-    runs_from = getattr(args, "runs_from", None)
-    if runs_from and (args.records is not None or args.report):
-        flag = "--records" if args.records is not None else "--report"
+def check_store(records: Path | None, report: bool, runs_from: Sequence[Path] = ()) -> None:
+    """Refuse a record store that is not a usable directory, and ``runs_from`` beside a
+    store or a report (:class:`RecordedRuns`), in the command line's terms."""
+    if runs_from and (records is not None or report):
+        flag = "--records" if records is not None else "--report"
         raise StudyError(f"--runs-from = {runs_from[0]} is not allowed with {flag}; "
                          "allowed: one of them")
-    if args.records is None:
+    if records is None:
         return
-    if args.records.exists() and not args.records.is_dir():
-        raise StudyError(f"--records = {args.records} is a file; allowed: a directory "
-                         "(made when missing)")
-    existing = next(p for p in (args.records, *args.records.parents) if p.exists())
-    if not args.report and not os.access(existing, os.W_OK | os.X_OK):
-        raise StudyError(f"--records = {args.records} cannot be written; allowed: a "
-                         "directory this user can write")
+    if records.exists() and not records.is_dir():
+        raise StudyError(f"--records = {records} is a file; allowed: a directory (made "
+                         "when missing)")
+    existing = next(p for p in (records, *records.parents) if p.exists())
+    if not report and not os.access(existing, os.W_OK | os.X_OK):
+        raise StudyError(f"--records = {records} cannot be written; allowed: a directory "
+                         "this user can write")
 
 
-def recorded_evaluation(args: argparse.Namespace, scenario: Path,
+def recorded_evaluation(runs: RecordedRuns, scenario: Path,
                         controllers: Sequence[str], out: Path, *,
                         baseline_from: Path | None = None) -> tuple[pd.DataFrame, bool]:
     """The finished runs of one evaluation of a study, and whether every run finished.
 
-    ``args`` carries the study's ``seeds``, ``workers``, ``scheduler``, ``quiet``,
-    ``report``, ``records`` (the store is ``records/<out's name>``) and ``runs_from``.
-    Unless ``--report``, the evaluation of ``controllers`` on ``scenario`` runs into
-    ``out`` (the store's runs copied in first, every finished run out afterwards);
+    ``runs`` says how (the store is ``records/<out's name>``). Unless ``report``, the
+    evaluation of ``controllers`` on ``scenario`` runs into ``out`` (the store's runs
+    copied in first, every finished run out afterwards);
     ``baseline_from``: the open-loop runs are taken from this earlier evaluation (or a
     store laid out as one) instead of run.
     """
     ours = [c for c in check_controllers(controllers)
             if not (baseline_from is not None and c == BASELINE)]
-    spec_runs = evaluation_spec(scenario, ours, args.seeds).runs()
-    store = None if args.records is None else args.records / out.name
-    if args.report:     # claimed only to hold this evaluation's tables
+    seeds = list(runs.seeds)
+    spec_runs = evaluation_spec(scenario, ours, seeds).runs()
+    store = None if runs.records is None else runs.records / out.name
+    if runs.report:     # claimed only to hold this evaluation's tables
         with resumable_dir(out, EVALUATION_KIND):
-            runs = records_table(spec_runs, out, *([store] if store is not None else []))
+            table = records_table(spec_runs, out, *([store] if store is not None else []))
         if baseline_from is not None:
-            runs = pd.concat([borrowed_baseline(
-                evaluation_spec(scenario, [BASELINE], args.seeds), baseline_from,
-                str(baseline_from)), runs], ignore_index=True)
-        return runs[runs["status"].isin(FINISHED)], True
+            table = pd.concat([borrowed_baseline(
+                evaluation_spec(scenario, [BASELINE], seeds), baseline_from,
+                str(baseline_from)), table], ignore_index=True)
+        return table[table["status"].isin(FINISHED)], True
     if store is not None:
         with resumable_dir(out, EVALUATION_KIND):
             log.info("%d run records taken from %s", copy_records(spec_runs, store, out),
                      store)
     try:
-        res = run_evaluation(scenario, controllers, args.seeds, out=out,
-                             workers=args.workers, scheduler=args.scheduler,
-                             progress=not args.quiet, plots=False,
-                             runs_from=getattr(args, "runs_from", ()),
-                             baseline_from=baseline_from)
+        res = run_evaluation(scenario, controllers, seeds, out=out,
+                             workers=runs.workers, scheduler=runs.scheduler,
+                             progress=runs.progress, plots=False,
+                             runs_from=runs.runs_from, baseline_from=baseline_from)
         return res.runs, res.sweep is None or bool(
             res.sweep.table["status"].isin(FINISHED).all())
     finally:

@@ -38,13 +38,15 @@ import pandas as pd
 from arzsumo.errors import require
 from arzsumo.io import dump_toml
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.studies import markdown_table, write_csv, write_text
+from arzsumo.outputs.studies import markdown_table, publish, write_csv, write_text
 from arzsumo.studies.common import RESULTS_DIR, StudyError, scenario_data, shipped_scenario
 from arzsumo.studies.premise_map import map_demands
 from arzsumo.studies.premise_map_points import MapPoint, mapped_points
 from arzsumo.units import VEH_H_PER_VEH_S, kmh_to_ms, ms_to_kmh
 
 NAME = "share-models"
+#: the results page (``docs/results/PAGE.md``) this study keeps a block of
+PAGE = "share_models"
 #: the scenario the study maps by default: the judged configuration of the laws
 BASE = "control_newell.toml"
 
@@ -57,7 +59,8 @@ class ShareOptions:
     mainline demand, each in (0, 1); ``train_seeds``, ``validate_seeds``: the
     identification's seeds (disjoint); ``diagram``: stage 1's family; ``kernel_cells``:
     the design's kernel grid; ``out``: the study's directory (resumable); ``workers``,
-    ``scheduler``, ``progress``: how the SUMO runs are run.
+    ``scheduler``, ``progress``: how the SUMO runs are run; ``docs``: the results page
+    to regenerate (None: none).
     """
 
     scenario: Path | None = None
@@ -67,6 +70,7 @@ class ShareOptions:
     diagram: str = "newell"
     kernel_cells: int = 100
     out: Path = RESULTS_DIR / NAME
+    docs: Path | None = None
     workers: int | None = None
     scheduler: str | None = None
     progress: bool = True
@@ -119,6 +123,19 @@ def with_keys(data: Mapping[str, Any], keys: Mapping[str, Any]) -> dict[str, Any
     return out
 
 
+def design(opts: ShareOptions) -> list[str]:
+    """What the study runs: per share its discharge runs, then the identification's
+    training and held-out seeds (``--list``)."""
+    from arzsumo.scenario import load_scenario
+    from arzsumo.studies.premise_map_points import discharge_runs
+
+    path = opts.scenario or shipped_scenario(BASE)
+    points = share_points(opts.shares)
+    lines = [r.run_id for r in discharge_runs(path, points, load_scenario(path).run.warmup)]
+    seeds = ",".join(map(str, (*opts.train_seeds, *opts.validate_seeds)))
+    return lines + [f"point={p.name},identify seeds={seeds}" for p in points]
+
+
 def run_share_models(opts: ShareOptions) -> ShareResult:
     """Map, identify and design every share (module docstring); write the scenarios and
     the table."""
@@ -137,9 +154,15 @@ def run_share_models(opts: ShareOptions) -> ShareResult:
         models = [_share_model(opts, base, p, discharges[p.name], out)
                   for p in mapped_points(points, discharges, shortfalls)]
         table = pd.DataFrame([m.row for m in models])
-        write_csv(table, out / "share_models.csv")
-        write_text(f"# {NAME}\n\n{markdown_table(table)}\n\nThe mapping's discharge runs:"
-                   f"\n\n{text}\n", out / "share_models.md")
+        csv = write_csv(table, out / "share_models.csv")
+        body = (f"Per AV share, the demand mapped to its discharge, the model identified "
+                f"there and the ETC designed for it (`arzsumo study {NAME}`; "
+                f"[share_models.csv]({PAGE}/share_models.csv)).\n\n"
+                f"{markdown_table(table)}\n\nThe mapping's discharge runs:\n\n{text}")
+        write_text(body, out / "share_models.md")
+        if opts.docs is not None:
+            publish(opts.docs, PAGE, NAME, "The model and design per AV share", body,
+                    [(csv, csv.name)])
     return ShareResult(tuple(models), table, text)
 
 

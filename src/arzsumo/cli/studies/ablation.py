@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from arzsumo.cli.studies.options import add_output, add_runs, plots_wanted
 from arzsumo.studies.ablation import (
     NAME,
     PAGE,
@@ -14,7 +15,6 @@ from arzsumo.studies.ablation import (
     design,
     run_ablation,
 )
-from arzsumo.studies.common import add_output, add_runs, plots_wanted
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

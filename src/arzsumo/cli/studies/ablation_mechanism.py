@@ -7,9 +7,10 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from arzsumo.cli.studies.options import add_output, plots_wanted
 from arzsumo.studies import ablation
 from arzsumo.studies.ablation_mechanism import NAME, PAGE, MechanismOptions, run_mechanism
-from arzsumo.studies.common import RESULTS_DIR, add_output, plots_wanted
+from arzsumo.studies.common import RESULTS_DIR
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

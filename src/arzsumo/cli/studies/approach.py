@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from arzsumo.cli.studies.options import add_output, add_runs, plots_wanted
 from arzsumo.studies.approach import (
     AV_SHARE,
     NAME,
@@ -14,15 +15,7 @@ from arzsumo.studies.approach import (
     design,
     run_approach,
 )
-from arzsumo.studies.common import (
-    add_output,
-    add_runs,
-    fraction,
-    number_list,
-    plots_wanted,
-    positive_float,
-    print_list,
-)
+from arzsumo.studies.common import fraction, number_list, positive_float, print_list
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -6,8 +6,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from arzsumo.cli.studies.options import add_output
 from arzsumo.studies.common import (
-    add_output,
     non_negative_int,
     number_list,
     positive_float,

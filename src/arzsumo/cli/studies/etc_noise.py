@@ -6,8 +6,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from arzsumo.cli.studies.options import add_output, add_runs
 from arzsumo.resources import shipped_scenarios_dir
-from arzsumo.studies.common import add_output, add_runs, number_list, print_list
+from arzsumo.studies.common import number_list, print_list
 from arzsumo.studies.etc_noise import (
     LEVELS_PCT,
     NAME,

@@ -5,14 +5,8 @@ from __future__ import annotations
 
 import argparse
 
-from arzsumo.studies.common import (
-    add_output,
-    add_runs,
-    non_negative_float,
-    number_list,
-    positive_float,
-    print_list,
-)
+from arzsumo.cli.studies.options import add_output, add_runs
+from arzsumo.studies.common import non_negative_float, number_list, positive_float, print_list
 from arzsumo.studies.fill import NAME, PAGE, FillOptions, design, run_fill
 
 

@@ -6,8 +6,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from arzsumo.cli.studies.options import add_output, add_runs, plots_wanted
 from arzsumo.studies import ablation
-from arzsumo.studies.common import RESULTS_DIR, add_output, add_runs, plots_wanted
+from arzsumo.studies.common import RESULTS_DIR
 from arzsumo.studies.held_ramp import NAME, PAGE, HeldRampOptions, design, run_held_ramp
 
 

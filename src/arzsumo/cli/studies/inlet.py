@@ -6,7 +6,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from arzsumo.studies.common import add_output, positive_int
+from arzsumo.cli.studies.options import add_output
+from arzsumo.studies.common import positive_int
 from arzsumo.studies.inlet import NAME, PAGE, InletOptions, run_inlet
 
 

@@ -6,7 +6,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from arzsumo.studies.common import add_output, add_runs, positive_float, print_list
+from arzsumo.cli.studies.options import add_output, add_runs
+from arzsumo.studies.common import positive_float, print_list
 from arzsumo.studies.loop_speed import (
     METHODS,
     NAME,

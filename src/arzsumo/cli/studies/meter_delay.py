@@ -6,7 +6,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from arzsumo.studies.common import RESULTS_DIR, add_output, names_among
+from arzsumo.cli.studies.options import add_output
+from arzsumo.studies.common import RESULTS_DIR, names_among
 from arzsumo.studies.meter_delay import (
     NAME,
     PAGE,

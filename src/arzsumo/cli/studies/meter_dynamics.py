@@ -7,14 +7,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from arzsumo.studies.common import (
-    add_output,
-    add_runs,
-    fraction_list,
-    plots_wanted,
-    positive_float,
-    print_list,
-)
+from arzsumo.cli.studies.options import add_output, add_runs, plots_wanted
+from arzsumo.studies.common import fraction_list, positive_float, print_list
 from arzsumo.studies.meter_dynamics import (
     GREENS,
     NAME,

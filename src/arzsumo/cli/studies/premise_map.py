@@ -6,7 +6,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from arzsumo.studies.common import add_output, add_runs, plots_wanted, print_list
+from arzsumo.cli.studies.options import add_output, add_runs, plots_wanted
+from arzsumo.studies.common import print_list
 from arzsumo.studies.premise_map import PAGE, MapOptions, design, run_map
 from arzsumo.studies.premise_map_points import NAME, POINTS
 from arzsumo.studies.premise_map_tables import map_markdown, theory_markdown

@@ -7,10 +7,18 @@ import argparse
 from pathlib import Path
 
 from arzsumo.argtypes import positive_int
+from arzsumo.cli.studies.options import add_output, add_runs
 from arzsumo.model.params import FAMILIES
 from arzsumo.outputs.studies import markdown_table
-from arzsumo.studies.common import RESULTS_DIR, fraction_list, seed_list
-from arzsumo.studies.share_models import BASE, NAME, ShareOptions, run_share_models
+from arzsumo.studies.common import fraction_list, print_list, seed_list
+from arzsumo.studies.share_models import (
+    BASE,
+    NAME,
+    PAGE,
+    ShareOptions,
+    design,
+    run_share_models,
+)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -28,14 +36,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="stage 1's diagram family (default: newell)")
     parser.add_argument("--cells", type=positive_int, default=100,
                         help="kernel cells of the design (default: 100)")
-    parser.add_argument("--out", type=Path, default=RESULTS_DIR / NAME, metavar="DIR",
-                        help="where the scenarios, reports and runs go; a later call with "
-                             "the same directory reruns only the fits")
-    parser.add_argument("--workers", type=positive_int, metavar="N",
-                        help="local processes (default: one per core)")
-    parser.add_argument("--scheduler", metavar="ADDRESS",
-                        help="run the discharge runs on this Dask scheduler")
-    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_runs(parser, seeds=None)
+    add_output(parser, NAME, PAGE, plots=False)
 
 
 def options(args: argparse.Namespace) -> ShareOptions:
@@ -43,13 +45,18 @@ def options(args: argparse.Namespace) -> ShareOptions:
     return ShareOptions(scenario=args.scenario, shares=tuple(args.shares),
                         train_seeds=tuple(args.train_seeds),
                         validate_seeds=tuple(args.validate_seeds), diagram=args.diagram,
-                        kernel_cells=args.cells, out=args.out, workers=args.workers,
+                        kernel_cells=args.cells, out=args.out, docs=args.docs,
+                        workers=args.workers,
                         scheduler=args.scheduler, progress=not args.quiet)
 
 
 def run(args: argparse.Namespace) -> int:
-    """Map, identify and design every share; print the table."""
-    result = run_share_models(options(args))
+    """``--list``: the runs; otherwise map, identify and design every share; print the
+    table and the scenarios written."""
+    opts = options(args)
+    if args.list:
+        return print_list(design(opts))
+    result = run_share_models(opts)
     print(markdown_table(result.table))
     for m in result.models:
         print(f"{m.point}: {m.scenario}")

@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import argparse
 
-from arzsumo.studies.common import add_output, add_runs, print_list
+from arzsumo.cli.studies.options import add_output, add_runs
+from arzsumo.studies.common import print_list
 from arzsumo.studies.sumo_options import (
     NAME,
     PAGE,

@@ -5,13 +5,8 @@ from __future__ import annotations
 
 import argparse
 
-from arzsumo.studies.common import (
-    add_output,
-    add_runs,
-    plots_wanted,
-    positive_float,
-    print_list,
-)
+from arzsumo.cli.studies.options import add_output, add_runs, plots_wanted
+from arzsumo.studies.common import positive_float, print_list
 from arzsumo.studies.u_estimate import NAME, PAGE, UEstimateOptions, design, run_u_estimate
 
 

@@ -6,7 +6,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from arzsumo.studies.common import add_output, add_runs, print_list
+from arzsumo.cli.studies.options import add_output, add_runs
+from arzsumo.studies.common import print_list
 from arzsumo.studies.wave_speed import NAME, PAGE, WaveSpeedOptions, design, run_wave_speed
 
 

@@ -1,0 +1,65 @@
+"""``arzsumo study control-ablation``: the command line of
+:mod:`arzsumo.studies.control_ablation`, mapped onto its
+:class:`~arzsumo.studies.control_ablation.AblationOptions`."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from arzsumo.cli.studies.options import add_output, add_records, add_runs, recorded_runs
+from arzsumo.errors import EXIT_SOME_FAILED
+from arzsumo.resources import shipped_scenarios_dir
+from arzsumo.studies import control
+from arzsumo.studies.common import RESULTS_DIR, names_among, print_list
+from arzsumo.studies.control_ablation import (
+    DEFAULT_STEPS,
+    LAWS,
+    NAME,
+    PAGE,
+    STEPS,
+    AblationOptions,
+    design,
+    run_ablation,
+)
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The ablation's options."""
+    parser.add_argument("--scenario", type=Path,
+                        default=shipped_scenarios_dir() / "default.toml", metavar="FILE",
+                        help="the control study's base scenario (default: the shipped "
+                             "default)")
+    parser.add_argument("--control", type=Path, default=RESULTS_DIR / control.NAME,
+                        metavar="DIR", help="the control study's --out, or its record "
+                        "store: its runs of the experiment are the full configuration")
+    parser.add_argument("--experiment", choices=control.EXPERIMENTS, default="regulation",
+                        help="the control study's experiment the steps change "
+                             "(default: %(default)s)")
+    parser.add_argument("--steps", default=",".join(DEFAULT_STEPS),
+                        help="comma-separated steps, of " + ", ".join(STEPS)
+                             + " (default: %(default)s)")
+    parser.add_argument("--laws", default=",".join(LAWS),
+                        help="comma-separated laws ablated (default: %(default)s)")
+    add_records(parser)
+    add_runs(parser, seeds="1-10")
+    add_output(parser, NAME, PAGE, plots=False)
+
+
+def options(args: argparse.Namespace) -> AblationOptions:
+    """The study's options as the command line gave them."""
+    steps = tuple(names_among(args.steps, list(STEPS), "--steps"))
+    laws = tuple(names_among(args.laws, list(LAWS), "--laws"))
+    return AblationOptions(recorded_runs(args), scenario=args.scenario,
+                           control=args.control, experiment=args.experiment, steps=steps,
+                           laws=laws, out=args.out, docs=args.docs)
+
+
+def run(args: argparse.Namespace) -> int:
+    """``--list``: the steps; otherwise run them and print the table."""
+    opts = options(args)
+    if args.list:
+        return print_list(design(opts))
+    result = run_ablation(opts)
+    print(result.text)
+    return 0 if result.complete else EXIT_SOME_FAILED

@@ -1,0 +1,50 @@
+"""``arzsumo study penetration``: the command line of :mod:`arzsumo.studies.penetration`,
+mapped onto its :class:`~arzsumo.studies.penetration.PenetrationOptions`."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from arzsumo.argtypes import seed_list
+from arzsumo.cli.studies.options import add_output, add_records, add_runs, plots_wanted
+from arzsumo.errors import EXIT_SOME_FAILED
+from arzsumo.studies.common import print_list
+from arzsumo.studies.penetration import (
+    NAME,
+    PAGE,
+    PenetrationOptions,
+    design,
+    run_penetration,
+)
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The penetration study's options (the shares are the sweep files')."""
+    parser.add_argument("--seeds", type=seed_list, metavar="LIST",
+                        help="SUMO seeds, e.g. 1-10 (default: each sweep file's own)")
+    parser.add_argument("--share-models", type=Path, metavar="DIR",
+                        help="run the ETC on each share's own scenario from arzsumo study "
+                             "share-models (its --out) instead of the shipped sweeps")
+    add_records(parser)
+    add_runs(parser, seeds=None)
+    add_output(parser, NAME, PAGE)
+
+
+def options(args: argparse.Namespace) -> PenetrationOptions:
+    """The study's options as the command line gave them."""
+    return PenetrationOptions(
+        seeds=None if args.seeds is None else tuple(args.seeds), records=args.records,
+        report=args.report, share_models=args.share_models, out=args.out, docs=args.docs,
+        plots=plots_wanted(args), workers=args.workers, scheduler=args.scheduler,
+        progress=not args.quiet)
+
+
+def run(args: argparse.Namespace) -> int:
+    """``--list``: the sweeps; otherwise run them and print the page."""
+    opts = options(args)
+    if args.list:
+        return print_list(design(opts))
+    result = run_penetration(opts)
+    print(result.text)
+    return 0 if result.complete else EXIT_SOME_FAILED
