@@ -13,7 +13,7 @@ import pytest
 
 from arzsumo.cli import main
 from arzsumo.cli.premise import EXIT_PREMISE_FAILS, FLOORS
-from arzsumo.studies import premise as study
+from arzsumo.studies.premise import study
 
 #: a run of legacy_default short enough for a test: 60 s warm-up, 120 s windows, a 40 s
 #: round trip, a 20 s pulse and a staircase of four 30 s levels after a 30 s lead-in

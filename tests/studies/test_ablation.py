@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 
 from arzsumo.outdir import write_marker
-from arzsumo.studies import ablation
+from arzsumo.studies.ablation import study as ablation
 from arzsumo.studies.common import StudyError
 from arzsumo.sweep.evaluate import OPEN_LOOP_INERT
 

@@ -8,7 +8,7 @@ import json
 import pandas as pd
 import pytest
 
-from arzsumo.studies import ablation_mechanism as mech
+from arzsumo.studies.ablation import mechanism as mech
 from arzsumo.studies.common import StudyError
 
 

@@ -7,8 +7,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from arzsumo.studies import approach, fill, open_loop
 from arzsumo.studies.common import StudyError
+from arzsumo.studies.sumo_map import approach, fill, open_loop
 
 
 def test_the_maps_design_is_demand_x_green_share_without_a_fill():

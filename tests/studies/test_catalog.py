@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from arzsumo.cli.catalog import _MODULES, STUDIES, Study
+from arzsumo.cli.catalog import _MODULES, STUDIES, STUDY_MODULES, Study
 from arzsumo.studies.common import DOCS_DIR, RESULTS_DIR
 
 from .conftest import parse
@@ -31,8 +31,9 @@ def test_the_catalog_lists_the_studies_by_their_names():
 def test_each_study_has_one_line_of_help_and_its_module_the_same_name(name):
     text = STUDIES[name].help
     assert "\n" not in text and 20 < len(text) <= 100 and "issue" not in text.lower()
-    module = importlib.import_module(f"arzsumo.studies.{_MODULES[name][0]}")
-    assert (module.NAME, module.__name__) == (name, f"arzsumo.studies.{_MODULES[name][0]}")
+    module = importlib.import_module(f"arzsumo.studies.{STUDY_MODULES[name]}")
+    assert (module.NAME, module.__name__) == (name, f"arzsumo.studies.{STUDY_MODULES[name]}")
+    assert list(STUDY_MODULES) == list(_MODULES)
 
 
 @pytest.mark.parametrize("name", NAMES)
@@ -67,7 +68,7 @@ def test_the_catalog_imports_no_study_until_one_is_used():
     assert out.strip() == "[]"
     parser = argparse.ArgumentParser()
     STUDIES["fill"].add_arguments(parser)          # imports the study's module
-    assert "arzsumo.studies.fill" in sys.modules
+    assert "arzsumo.studies.sumo_map.fill" in sys.modules
 
 
 @pytest.mark.parametrize("name", NAMES)
@@ -75,7 +76,7 @@ def test_a_study_runs_in_process_and_copies_no_history(name):
     """No subprocess, no sys.path edits, no issue numbers (history is in CHANGELOG.md)."""
     import re
 
-    path = Path(importlib.import_module(f"arzsumo.studies.{_MODULES[name][0]}").__file__)
+    path = Path(importlib.import_module(f"arzsumo.studies.{STUDY_MODULES[name]}").__file__)
     text = path.read_text(encoding="utf-8")
     assert "subprocess" not in text and "sys.path" not in text
     assert not re.search(r"\bissues? \d", text, re.IGNORECASE)
@@ -83,7 +84,7 @@ def test_a_study_runs_in_process_and_copies_no_history(name):
 
 def test_each_study_names_a_results_page_of_the_docs_layout():
     pages = {name: importlib.import_module(f"arzsumo.studies.{m}").PAGE
-             for name, (m, _) in _MODULES.items()}
+             for name, m in STUDY_MODULES.items()}
     assert pages == {"ablation": "control_in_sumo", "ablation-mechanism": "control_in_sumo",
                      "held-ramp": "control_in_sumo", "wave-speed": "control_in_sumo",
                      "meter-dynamics": "meter_dynamics", "approach": "sumo_map",

@@ -16,7 +16,7 @@ import pytest
 from arzsumo.io import dump_toml
 from arzsumo.resources import shipped_scenarios_dir
 from arzsumo.studies.common import StudyError
-from arzsumo.studies.control import DISTURBANCE, experiment_scenario
+from arzsumo.studies.control.study import DISTURBANCE, experiment_scenario
 from arzsumo.sumo.fork import can_fork
 
 DEFAULT = shipped_scenarios_dir() / "default.toml"
@@ -105,7 +105,7 @@ def test_the_study_pairs_both_experiments_and_measures_the_decay(run_study, shor
 
 def test_the_headline_gives_the_open_loops_mean_and_the_paired_differences():
     from arzsumo.evaluation.report import evaluate
-    from arzsumo.studies.control import MEASURES, headline
+    from arzsumo.studies.control.study import MEASURES, headline
 
     key = "network_whole_demand.time_spent_s.total"
     open_s = np.array([100.0, 110.0, 120.0]) * 3600
@@ -160,7 +160,7 @@ def test_a_study_whose_runs_all_failed_exits_with_some_failed(run_study, tmp_pat
 
 
 def test_the_study_is_called_from_python_with_its_options(tmp_path):
-    from arzsumo.studies.control import ControlOptions, design, run_control
+    from arzsumo.studies.control.study import ControlOptions, design, run_control
     from arzsumo.studies.recorded import RecordedRuns
 
     opts = ControlOptions(RecordedRuns((1, 2, 3), report=True), controllers=("etc",),

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pandas as pd
 
-from arzsumo.studies.control_claims import claims, claims_table
+from arzsumo.studies.control.claims import claims, claims_table
 
 SEEDS = [1, 2, 3, 4, 5]
 

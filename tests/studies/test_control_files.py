@@ -4,7 +4,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from arzsumo.studies.control_files import file_indices, files_per_run, files_table
+from arzsumo.studies.control.files import file_indices, files_per_run, files_table
 
 
 def _run(controller: str, seed: int, hv: list[tuple[float | None, float | None]],

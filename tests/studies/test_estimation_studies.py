@@ -7,8 +7,9 @@ import numpy as np
 import pytest
 
 from arzsumo.scenario import load_scenario, scenario_from_dict
-from arzsumo.studies import enkf_noise, estimation_layouts, u_estimate
 from arzsumo.studies.common import shipped_scenario
+from arzsumo.studies.estimation import enkf_noise, u_estimate
+from arzsumo.studies.estimation import layouts as estimation_layouts
 
 DEFAULT = shipped_scenario("default.toml")
 
@@ -127,7 +128,7 @@ def test_enkf_noise_reports_the_perfect_model_at_the_inflation_asked_for(run_stu
 def test_loop_speed_station_means_leave_out_a_period_without_a_harmonic_speed():
     from types import SimpleNamespace
 
-    from arzsumo.studies import loop_speed
+    from arzsumo.studies.estimation import loop_speed
 
     periods, stations = 2, 5                  # the first period (start) is the warm-up's
     speed = np.full((periods + 1, 2, stations), 10.0)
@@ -151,8 +152,8 @@ def test_loop_speed_runs_from_python_with_its_options_and_the_cli_maps_onto_them
     from pathlib import Path
 
     from arzsumo.cli.studies import loop_speed as cli
-    from arzsumo.studies import loop_speed
     from arzsumo.studies.common import StudyError
+    from arzsumo.studies.estimation import loop_speed
 
     opts = loop_speed.LoopSpeedOptions(scenario=DEFAULT, seeds=(3, 4), horizon_s=120.0,
                                        method="enkf")

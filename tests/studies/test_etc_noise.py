@@ -5,8 +5,8 @@ import pandas as pd
 import pytest
 
 from arzsumo.resources import shipped_scenarios_dir
-from arzsumo.studies import etc_noise
 from arzsumo.studies.common import StudyError
+from arzsumo.studies.control import etc_noise
 
 DEFAULT = shipped_scenarios_dir() / "default.toml"
 

@@ -6,7 +6,8 @@ from __future__ import annotations
 import pandas as pd
 import pytest
 
-from arzsumo.studies import ablation, held_ramp
+from arzsumo.studies.ablation import held_ramp
+from arzsumo.studies.ablation import study as ablation
 from arzsumo.studies.common import StudyError
 
 

@@ -158,7 +158,7 @@ def test_an_existing_result_is_kept_without_overwrite(result, capsys):
 
 def test_vary_plans_every_seed_at_every_point_of_the_product():
     from arzsumo.scenario import scenario_from_dict
-    from arzsumo.studies.identify import make_setup, plan
+    from arzsumo.studies.identify.study import make_setup, plan
 
     setup = make_setup(load_scenario(DEFAULT), [1, 2], [7], horizon=60.0, warmup=30.0,
                        vary=["sumo.green_share=0.4,0.6", "sumo.ramp_demand_veh_h=900,1200"],
@@ -181,7 +181,7 @@ def test_vary_plans_every_seed_at_every_point_of_the_product():
 def test_the_replay_inlet_is_the_cell_transmission_rule_and_the_bridge_keeps_its_own():
     from arzsumo.bridge.replay_data import replay_options_of
     from arzsumo.errors import ScenarioError
-    from arzsumo.studies.identify import make_setup
+    from arzsumo.studies.identify.study import make_setup
 
     sc = load_scenario(DEFAULT)
     assert make_setup(sc, [1], [2], workers=1).options.inlet == "ctm"
@@ -196,7 +196,7 @@ def test_the_fit_starts_from_an_ao_max_that_holds_the_observed_occupancy():
 
     from arzsumo.identify import ReplayData
     from arzsumo.model.fd import area_occupancy
-    from arzsumo.studies.identify_scores import start_params
+    from arzsumo.studies.identify.scores import start_params
 
     params = load_scenario(DEFAULT).params                   # AO_max_a 0.56
     rho = np.array([0.120, 8.0, 0.065, 4.0])                 # AO above 0.56

@@ -10,7 +10,7 @@ import pytest
 from arzsumo.identify.data import ReplayData
 from arzsumo.model.fd import equilibrium_speeds
 from arzsumo.scenario import scenario_from_dict
-from arzsumo.studies.identify_diagram import fit_stage_one, read_waves, stationary_states
+from arzsumo.studies.identify.diagram import fit_stage_one, read_waves, stationary_states
 
 MODEL = {"family": "newell", "ao_max_h": 0.62, "ao_max_a": 0.6, "wave_speed_h_kmh": 33,
          "wave_speed_a_kmh": 38, "corner": 6, "v_free_h_kmh": 80, "v_free_a_kmh": 60}

@@ -11,9 +11,9 @@ from arzsumo.identify import ReplayOptions
 from arzsumo.identify.synthetic import SyntheticRun, synthetic_data
 from arzsumo.model.characteristic import linearize
 from arzsumo.scenario import load_scenario
-from arzsumo.studies import inlet
 from arzsumo.studies.common import StudyError, shipped_scenario
-from arzsumo.studies.identify_cache import ARRAYS
+from arzsumo.studies.identify import inlet
+from arzsumo.studies.identify.cache import ARRAYS
 
 DEFAULT = load_scenario(shipped_scenario("lateral_files.toml"))   # the former default
 

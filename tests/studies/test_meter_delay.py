@@ -4,9 +4,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from arzsumo.studies import meter_delay
 from arzsumo.studies.common import StudyError
-from arzsumo.studies.meter_delay import delay_rows, delay_summary, first_difference
+from arzsumo.studies.control import meter_delay
+from arzsumo.studies.control.meter_delay import delay_rows, delay_summary, first_difference
 
 
 def _periods(n: int = 120, seed: int = 0, command: int | None = None,

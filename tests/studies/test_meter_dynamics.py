@@ -7,7 +7,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from arzsumo.studies import meter_dynamics, meter_fit
+from arzsumo.studies.sumo_map import meter_dynamics, meter_fit
 
 #: the response of the made-up series: veh/s per unit of green share, s, s
 GAIN, DELAY, TAU = -0.56, 10.0, 5.0

@@ -6,8 +6,8 @@ import pandas as pd
 import pytest
 
 from arzsumo.evaluation.stats import MeanCI
-from arzsumo.studies import penetration as pen
 from arzsumo.studies.common import StudyError
+from arzsumo.studies.control import penetration as pen
 
 SHARES = (0.10, 0.18, 0.30, 0.50)
 

@@ -10,9 +10,9 @@ import pytest
 
 from arzsumo.evaluation.premise import GateResult
 from arzsumo.scenario import load_scenario
-from arzsumo.studies import premise as study
 from arzsumo.studies.common import shipped_scenario
-from arzsumo.studies.premise_runs import (
+from arzsumo.studies.premise import study
+from arzsumo.studies.premise.runs import (
     KINDS,
     PremiseOptions,
     PremiseRunError,

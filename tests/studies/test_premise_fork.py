@@ -9,8 +9,8 @@ import signal
 
 import pytest
 
-from arzsumo.studies import premise_runs as pr
 from arzsumo.studies.common import shipped_scenario
+from arzsumo.studies.premise import runs as pr
 from arzsumo.sumo import fork
 
 pytestmark = [pytest.mark.sumo, pytest.mark.slow]

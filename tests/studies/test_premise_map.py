@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 
 from arzsumo.evaluation.premise import GateResult
-from arzsumo.studies import premise_map as pm
-from arzsumo.studies import premise_map_points as pmp
-from arzsumo.studies import premise_map_tables as pmt
 from arzsumo.studies.common import StudyError, shipped_scenario
-from arzsumo.studies.premise_runs import PremiseOptions
+from arzsumo.studies.premise import map_points as pmp
+from arzsumo.studies.premise import map_study as pm
+from arzsumo.studies.premise import map_tables as pmt
+from arzsumo.studies.premise.runs import PremiseOptions
 
 from .test_premise import WAVE_MS, _rows
 
@@ -325,7 +325,7 @@ def test_a_run_listed_twice_is_run_once_and_read_by_both(tmp_path):
 def test_a_placed_point_starts_uniform_at_its_equilibrium_and_others_unplaced():
     from arzsumo.resources import shipped_scenarios_dir
     from arzsumo.scenario import load_scenario
-    from arzsumo.studies.premise_runs import placed_fields
+    from arzsumo.studies.premise.runs import placed_fields
 
     sc = load_scenario(shipped_scenarios_dir() / "default.toml")
     assert placed_fields(sc) is None

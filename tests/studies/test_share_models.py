@@ -8,7 +8,7 @@ import pytest
 
 from arzsumo.resources import shipped_scenarios_dir
 from arzsumo.studies.common import StudyError
-from arzsumo.studies.premise_map_points import mapped_demand
+from arzsumo.studies.premise.map_points import mapped_demand
 from arzsumo.studies.share_models import ShareOptions, _design, share_points, with_keys
 
 NEWELL = tomllib.loads((shipped_scenarios_dir() / "control_newell.toml").read_text(

@@ -9,7 +9,7 @@ import pytest
 from arzsumo.errors import ScenarioError
 from arzsumo.resources import shipped_scenarios_dir
 from arzsumo.scenario import load_scenario
-from arzsumo.studies.sumo_options import MEASURES, OPTION, compare, markdown, options_spec
+from arzsumo.studies.sumo_map.sumo_options import MEASURES, OPTION, compare, markdown, options_spec
 from arzsumo.sumo.simulation import SumoSimulation
 
 TTS = "network_whole_demand.time_spent_s.total"
@@ -70,8 +70,8 @@ def test_the_study_runs_from_python_with_its_options(monkeypatch, tmp_path):
     SUMO a sweep with a failed run gives exit code 4 and the comparison of the rest."""
     from types import SimpleNamespace
 
-    from arzsumo.studies import sumo_options
     from arzsumo.studies.common import StudyError
+    from arzsumo.studies.sumo_map import sumo_options
 
     opts = sumo_options.SumoOptionsOptions(seeds=(1, 2), out=tmp_path / "out")
     assert len(sumo_options.design(opts)) == 6 * 2

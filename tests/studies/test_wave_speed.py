@@ -7,7 +7,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from arzsumo.studies import wave_speed
+from arzsumo.studies.sumo_map import wave_speed
 
 X = np.arange(20) * 50.0 + 25.0          # the section's 50 m cells
 T = np.arange(600.0)

@@ -17,7 +17,7 @@ from arzsumo.bridge.session import SumoSession, prepare_run
 from arzsumo.outputs.bridge import periods_table
 from arzsumo.resources import shipped_scenarios_dir
 from arzsumo.scenario import load_scenario
-from arzsumo.studies.meter_delay import first_difference, paired_events
+from arzsumo.studies.control.meter_delay import first_difference, paired_events
 from arzsumo.sumo.fork import BranchFailed, can_fork
 
 pytestmark = [pytest.mark.sumo, pytest.mark.slow,

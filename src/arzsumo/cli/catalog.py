@@ -18,13 +18,13 @@ when its options or its run are asked for.
 A study that is library code (:data:`LIBRARY_STUDIES`) is called from Python with its
 frozen options, no argparse involved::
 
-    from arzsumo.studies.premise_map import MapOptions, run_map
+    from arzsumo.studies.premise.map_study import MapOptions, run_map
     result = run_map(MapOptions(points=("coupled",), seeds=(1, 2)))
 
-    from arzsumo.studies.ablation import AblationOptions, design
+    from arzsumo.studies.ablation.study import AblationOptions, design
     lines = design(AblationOptions(steps=("identified",), seeds=(1, 2)))
 
-    from arzsumo.studies.control import ControlOptions, run_control
+    from arzsumo.studies.control.study import ControlOptions, run_control
     from arzsumo.studies.recorded import RecordedRuns
     result = run_control(ControlOptions(RecordedRuns(seeds=(1, 2)),
                                         controllers=("open", "etc")))
@@ -103,6 +103,21 @@ _MODULES = {
                                    "share in SUMO, per seed"),
     "share-models": ("share_models", "per AV share: the demand mapped to its discharge, "
                                      "the model identified there, the ETC designed"),
+}
+
+#: study name -> its library module under arzsumo.studies (a package per family of
+#: studies; the families import the shared machinery, never each other)
+STUDY_MODULES = {
+    "ablation": "ablation.study", "ablation-mechanism": "ablation.mechanism",
+    "held-ramp": "ablation.held_ramp", "meter-dynamics": "sumo_map.meter_dynamics",
+    "approach": "sumo_map.approach", "fill": "sumo_map.fill",
+    "wave-speed": "sumo_map.wave_speed", "inlet": "identify.inlet",
+    "estimation-layouts": "estimation.layouts", "loop-speed": "estimation.loop_speed",
+    "enkf-noise": "estimation.enkf_noise", "u-estimate": "estimation.u_estimate",
+    "premise-map": "premise.map_study", "sumo-options": "sumo_map.sumo_options",
+    "control": "control.study", "control-ablation": "control.ablation",
+    "etc-noise": "control.etc_noise", "meter-delay": "control.meter_delay",
+    "penetration": "control.penetration", "share-models": "share_models",
 }
 
 #: the studies that are library code (frozen Options, ``run(options) -> Result``): their

@@ -2,8 +2,8 @@
 model identified from open-loop SUMO runs.
 
 Checks the seeds, the ``--vary`` points, the ``--which`` names and the output directory
-before any run, then calls :func:`arzsumo.studies.identify.run_identification` and writes
-the results (:func:`arzsumo.studies.identify_report.write_study`). Exit codes: 0 done,
+before any run, then calls :func:`arzsumo.studies.identify.study.run_identification` and writes
+the results (:func:`arzsumo.studies.identify.report.write_study`). Exit codes: 0 done,
 2 a user error (one line).
 """
 
@@ -25,7 +25,7 @@ from arzsumo.cli.options import add_out, add_overwrite, add_scenario, add_seeds,
 from arzsumo.cli.scenarios import load_named
 
 if TYPE_CHECKING:
-    from arzsumo.studies.identify import IdentifyStudy
+    from arzsumo.studies.identify.study import IdentifyStudy
 
 log = logging.getLogger("arzsumo")
 
@@ -33,8 +33,8 @@ log = logging.getLogger("arzsumo")
 def cmd_identify(args: argparse.Namespace) -> int:
     from arzsumo.identify import FitSettings
     from arzsumo.outdir import OutputDir
-    from arzsumo.studies.identify import make_setup, run_identification
-    from arzsumo.studies.identify_report import write_study
+    from arzsumo.studies.identify.report import write_study
+    from arzsumo.studies.identify.study import make_setup, run_identification
     from arzsumo.units import kmh_to_ms
 
     path, sc = load_named(args.scenario)
@@ -77,7 +77,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
 
 def _print_stage_one(study: IdentifyStudy) -> None:
     """Stage 1's diagram and the wave check on both run sets (km/h)."""
-    from arzsumo.studies.identify_report import stage_lambda_4
+    from arzsumo.studies.identify.report import stage_lambda_4
     from arzsumo.units import ms_to_kmh
 
     one = study.stage_one

@@ -2,9 +2,9 @@
 scenario the stream the paper models?
 
 Per seed a baseline, a paired pulse and a release-rate staircase in SUMO, open loop
-(:mod:`arzsumo.studies.premise_runs`) sharing one warm-up, one task per seed on the sweep
+(:mod:`arzsumo.studies.premise.runs`) sharing one warm-up, one task per seed on the sweep
 engine's local pool or a Dask cluster, resumable in ``OUT/runs``; then every premise gate
-per seed and the verdict over seeds (:mod:`arzsumo.studies.premise`, docs/premise.md); a
+per seed and the verdict over seeds (:mod:`arzsumo.studies.premise.study`, docs/premise.md); a
 table on stdout (or ``--json``) and ``premise.json``, ``premise.csv``, ``premise.png`` in ``--out``.
 Exit codes: 0 the premise holds (every premise gate passes on most seeds; the model's
 gates are reported apart and do not decide), 5 it does not, 2 a user error.
@@ -29,7 +29,7 @@ from arzsumo.cli.options import (
 from arzsumo.cli.scenarios import check_warmup, load_named
 from arzsumo.errors import EXIT_PREMISE_FAILS, ScenarioError
 
-#: the pulse floors of :data:`arzsumo.studies.premise.FLOORS` (kept here: no import of
+#: the pulse floors of :data:`arzsumo.studies.premise.study.FLOORS` (kept here: no import of
 #: the studies when the parser is built)
 FLOORS = ("auto", "seeds", "late", "none")
 
@@ -39,7 +39,8 @@ def cmd_premise(args: argparse.Namespace) -> int:
     from arzsumo.io import dump_toml
     from arzsumo.outdir import resumable_dir
     from arzsumo.outputs.premise import premise_table, theory_lines, write_premise
-    from arzsumo.studies.premise import (
+    from arzsumo.studies.premise.runs import PremiseOptions, check_options
+    from arzsumo.studies.premise.study import (
         AnalysisOptions,
         check_window,
         default_window,
@@ -47,7 +48,6 @@ def cmd_premise(args: argparse.Namespace) -> int:
         report_document,
         run_premise,
     )
-    from arzsumo.studies.premise_runs import PremiseOptions, check_options
 
     path, sc = load_named(args.scenario)
     check_warmup(sc, args.warmup, args.window, args.allow_short_warmup)

@@ -2,7 +2,7 @@
 ``identified.toml``, ``identification.json``, ``fields.png`` and ``scatter.png``, and with
 ``--diagram`` ``diagram.png`` (stage 1's fit against SUMO's stationary states).
 
-Their content is made by :mod:`arzsumo.studies.identify_report`; here the texts are
+Their content is made by :mod:`arzsumo.studies.identify.report`; here the texts are
 written and the figures (:mod:`arzsumo.plots.identify`) drawn from arrays.
 """
 

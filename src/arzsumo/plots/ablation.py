@@ -1,4 +1,4 @@
-"""Figures of the ablation's mechanism (:mod:`arzsumo.studies.ablation_mechanism`): what
+"""Figures of the ablation's mechanism (:mod:`arzsumo.studies.ablation.mechanism`): what
 the green share bought, and the paired shift of speed spread against mean speed."""
 
 from __future__ import annotations

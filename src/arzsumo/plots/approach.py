@@ -1,4 +1,4 @@
-"""The map of the approach study (:mod:`arzsumo.studies.approach`): stationarity,
+"""The map of the approach study (:mod:`arzsumo.studies.sumo_map.approach`): stationarity,
 stop-and-go and regime over mainline demand x green share.
 
 Top: four panels of the demand x green-share grid of one group of runs (seed means):

@@ -1,4 +1,4 @@
-"""The figure of the meter-dynamics study (:mod:`arzsumo.studies.meter_dynamics`): the
+"""The figure of the meter-dynamics study (:mod:`arzsumo.studies.sumo_map.meter_dynamics`): the
 green-share staircase per seed and the mean normalised step response per direction."""
 
 from __future__ import annotations

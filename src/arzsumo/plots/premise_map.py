@@ -14,7 +14,7 @@ from arzsumo.plots import plt
 
 def premise_map_figure(wide: pd.DataFrame, gates: Sequence[str]) -> Figure:
     """Pass shares (0 red .. 1 green, grey: not measured) of ``gates`` per point of
-    ``wide`` (the per-point table of :func:`arzsumo.studies.premise_map.map_tables`)."""
+    ``wide`` (the per-point table of :func:`arzsumo.studies.premise.map_study.map_tables`)."""
     share = np.array([[wide[f"{g}_passed"].iloc[i] for g in gates]
                       for i in range(len(wide))], dtype=float)
     fig, ax = plt.subplots(figsize=(1.0 + 0.75 * len(gates), 1.2 + 0.42 * len(wide)))

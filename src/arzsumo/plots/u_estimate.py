@@ -1,4 +1,4 @@
-"""The figure of :mod:`arzsumo.studies.u_estimate`: the control law's U over time, one
+"""The figure of :mod:`arzsumo.studies.estimation.u_estimate`: the control law's U over time, one
 line per state it acted on."""
 
 from __future__ import annotations

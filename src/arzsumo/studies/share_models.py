@@ -6,13 +6,13 @@ the section cannot hold (above 30 % AVs the default no longer inserted its deman
 This study makes, for each share, the scenario the laws are then judged on:
 
 1. **the demand mapped to the share's discharge**: the premise map's two discharge runs
-   on a seed no gate reads (:func:`arzsumo.studies.premise_map.map_demands`), with the
+   on a seed no gate reads (:func:`arzsumo.studies.premise.map_study.map_demands`), with the
    mainline demand split by the share; hold 1.01 q(L), fill 1.14 q(L), the fill raised
    by what the queue's tail lacked (docs/premise.md);
 2. **the model identified there** in two stages (``arzsumo identify --diagram``): the
    diagram from the stationary states with SUMO's wave speed, then the relaxation
    times by the replay, validated on held-out seeds
-   (:func:`arzsumo.studies.identify.run_identification`);
+   (:func:`arzsumo.studies.identify.study.run_identification`);
 3. **the ETC designed for it** (``design-check --auto``:
    :func:`arzsumo.control.design.design_for` on the identified equilibrium), keeping
    the base's dead band settings.
@@ -40,8 +40,8 @@ from arzsumo.io import dump_toml
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import markdown_table, publish, write_csv, write_text
 from arzsumo.studies.common import RESULTS_DIR, StudyError, scenario_data, shipped_scenario
-from arzsumo.studies.premise_map import map_demands
-from arzsumo.studies.premise_map_points import MapPoint, mapped_points
+from arzsumo.studies.premise.map_points import MapPoint, mapped_points
+from arzsumo.studies.premise.map_study import map_demands
 from arzsumo.units import VEH_H_PER_VEH_S, kmh_to_ms, ms_to_kmh
 
 NAME = "share-models"
@@ -127,7 +127,7 @@ def design(opts: ShareOptions) -> list[str]:
     """What the study runs: per share its discharge runs, then the identification's
     training and held-out seeds (``--list``)."""
     from arzsumo.scenario import load_scenario
-    from arzsumo.studies.premise_map_points import discharge_runs
+    from arzsumo.studies.premise.map_points import discharge_runs
 
     path = opts.scenario or shipped_scenario(BASE)
     points = share_points(opts.shares)
@@ -171,8 +171,8 @@ def _share_model(opts: ShareOptions, base: Mapping[str, Any], point: MapPoint,
     """One share: identify the model on its mapped scenario, design the ETC, write both."""
     from arzsumo.identify import FitSettings
     from arzsumo.scenario import scenario_from_dict
-    from arzsumo.studies.identify import make_setup, run_identification
-    from arzsumo.studies.identify_report import identified_toml, write_study
+    from arzsumo.studies.identify.report import identified_toml, write_study
+    from arzsumo.studies.identify.study import make_setup, run_identification
 
     data = with_keys(base, point.set)
     data["name"] = f"{base.get('name', 'scenario')}_{point.name}"

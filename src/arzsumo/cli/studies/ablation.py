@@ -1,5 +1,5 @@
-"""``arzsumo study ablation``: the command line of :mod:`arzsumo.studies.ablation`, mapped
-onto its :class:`~arzsumo.studies.ablation.AblationOptions`."""
+"""``arzsumo study ablation``: the command line of :mod:`arzsumo.studies.ablation.study`, mapped
+onto its :class:`~arzsumo.studies.ablation.study.AblationOptions`."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import argparse
 from pathlib import Path
 
 from arzsumo.cli.studies.options import add_output, add_runs, plots_wanted
-from arzsumo.studies.ablation import (
+from arzsumo.studies.ablation.study import (
     NAME,
     PAGE,
     STEP_NAMES,

@@ -1,6 +1,6 @@
 """``arzsumo study ablation-mechanism``: the command line of
-:mod:`arzsumo.studies.ablation_mechanism`, mapped onto its
-:class:`~arzsumo.studies.ablation_mechanism.MechanismOptions`."""
+:mod:`arzsumo.studies.ablation.mechanism`, mapped onto its
+:class:`~arzsumo.studies.ablation.mechanism.MechanismOptions`."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import argparse
 from pathlib import Path
 
 from arzsumo.cli.studies.options import add_output, plots_wanted
-from arzsumo.studies import ablation
-from arzsumo.studies.ablation_mechanism import NAME, PAGE, MechanismOptions, run_mechanism
+from arzsumo.studies.ablation import study as ablation
+from arzsumo.studies.ablation.mechanism import NAME, PAGE, MechanismOptions, run_mechanism
 from arzsumo.studies.common import RESULTS_DIR
 
 

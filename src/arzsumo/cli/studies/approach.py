@@ -1,5 +1,5 @@
-"""``arzsumo study approach``: the command line of :mod:`arzsumo.studies.approach`, mapped
-onto its :class:`~arzsumo.studies.approach.ApproachOptions`."""
+"""``arzsumo study approach``: the command line of :mod:`arzsumo.studies.sumo_map.approach`, mapped
+onto its :class:`~arzsumo.studies.sumo_map.approach.ApproachOptions`."""
 
 from __future__ import annotations
 
@@ -7,7 +7,8 @@ import argparse
 from pathlib import Path
 
 from arzsumo.cli.studies.options import add_output, add_runs, plots_wanted
-from arzsumo.studies.approach import (
+from arzsumo.studies.common import fraction, number_list, positive_float, print_list
+from arzsumo.studies.sumo_map.approach import (
     AV_SHARE,
     NAME,
     PAGE,
@@ -15,7 +16,6 @@ from arzsumo.studies.approach import (
     design,
     run_approach,
 )
-from arzsumo.studies.common import fraction, number_list, positive_float, print_list
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

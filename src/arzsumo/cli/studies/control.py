@@ -1,5 +1,5 @@
-"""``arzsumo study control``: the command line of :mod:`arzsumo.studies.control`, mapped
-onto its :class:`~arzsumo.studies.control.ControlOptions`."""
+"""``arzsumo study control``: the command line of :mod:`arzsumo.studies.control.study`, mapped
+onto its :class:`~arzsumo.studies.control.study.ControlOptions`."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ from arzsumo.cli.studies.options import (
 from arzsumo.errors import EXIT_SOME_FAILED
 from arzsumo.resources import shipped_scenarios_dir
 from arzsumo.studies.common import names_among, print_list
-from arzsumo.studies.control import (
+from arzsumo.studies.control.study import (
     EXPERIMENTS,
     JUDGED,
     NAME,

@@ -1,6 +1,6 @@
 """``arzsumo study control-ablation``: the command line of
-:mod:`arzsumo.studies.control_ablation`, mapped onto its
-:class:`~arzsumo.studies.control_ablation.AblationOptions`."""
+:mod:`arzsumo.studies.control.ablation`, mapped onto its
+:class:`~arzsumo.studies.control.ablation.AblationOptions`."""
 
 from __future__ import annotations
 
@@ -10,9 +10,9 @@ from pathlib import Path
 from arzsumo.cli.studies.options import add_output, add_records, add_runs, recorded_runs
 from arzsumo.errors import EXIT_SOME_FAILED
 from arzsumo.resources import shipped_scenarios_dir
-from arzsumo.studies import control
 from arzsumo.studies.common import RESULTS_DIR, names_among, print_list
-from arzsumo.studies.control_ablation import (
+from arzsumo.studies.control import study as control
+from arzsumo.studies.control.ablation import (
     DEFAULT_STEPS,
     LAWS,
     NAME,

@@ -1,5 +1,5 @@
-"""``arzsumo study enkf-noise``: the command line of :mod:`arzsumo.studies.enkf_noise`,
-mapped onto its :class:`~arzsumo.studies.enkf_noise.EnkfNoiseOptions`."""
+"""``arzsumo study enkf-noise``: the command line of :mod:`arzsumo.studies.estimation.enkf_noise`,
+mapped onto its :class:`~arzsumo.studies.estimation.enkf_noise.EnkfNoiseOptions`."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from arzsumo.studies.common import (
     positive_int,
     seed_list,
 )
-from arzsumo.studies.enkf_noise import (
+from arzsumo.studies.estimation.enkf_noise import (
     ENKF_LAYOUTS,
     NAME,
     PAGE,

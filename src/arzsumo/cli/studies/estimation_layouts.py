@@ -1,6 +1,6 @@
 """``arzsumo study estimation-layouts``: the command line of
-:mod:`arzsumo.studies.estimation_layouts`, mapped onto its
-:class:`~arzsumo.studies.estimation_layouts.LayoutsOptions`."""
+:mod:`arzsumo.studies.estimation.layouts`, mapped onto its
+:class:`~arzsumo.studies.estimation.layouts.LayoutsOptions`."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from pathlib import Path
 
 from arzsumo.cli.studies.options import add_output, add_runs
 from arzsumo.studies.common import positive_float, print_list
-from arzsumo.studies.estimation_layouts import (
+from arzsumo.studies.estimation.layouts import (
     NAME,
     PAGE,
     LayoutsOptions,

@@ -1,5 +1,5 @@
-"""``arzsumo study etc-noise``: the command line of :mod:`arzsumo.studies.etc_noise`,
-mapped onto its :class:`~arzsumo.studies.etc_noise.EtcNoiseOptions`."""
+"""``arzsumo study etc-noise``: the command line of :mod:`arzsumo.studies.control.etc_noise`,
+mapped onto its :class:`~arzsumo.studies.control.etc_noise.EtcNoiseOptions`."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from pathlib import Path
 from arzsumo.cli.studies.options import add_output, add_runs
 from arzsumo.resources import shipped_scenarios_dir
 from arzsumo.studies.common import number_list, print_list
-from arzsumo.studies.etc_noise import (
+from arzsumo.studies.control.etc_noise import (
     LEVELS_PCT,
     NAME,
     PAGE,

@@ -1,5 +1,5 @@
-"""``arzsumo study fill``: the command line of :mod:`arzsumo.studies.fill`, mapped onto
-its :class:`~arzsumo.studies.fill.FillOptions`."""
+"""``arzsumo study fill``: the command line of :mod:`arzsumo.studies.sumo_map.fill`, mapped onto
+its :class:`~arzsumo.studies.sumo_map.fill.FillOptions`."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import argparse
 
 from arzsumo.cli.studies.options import add_output, add_runs
 from arzsumo.studies.common import non_negative_float, number_list, positive_float, print_list
-from arzsumo.studies.fill import NAME, PAGE, FillOptions, design, run_fill
+from arzsumo.studies.sumo_map.fill import NAME, PAGE, FillOptions, design, run_fill
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -1,5 +1,5 @@
-"""``arzsumo study held-ramp``: the command line of :mod:`arzsumo.studies.held_ramp`,
-mapped onto its :class:`~arzsumo.studies.held_ramp.HeldRampOptions`."""
+"""``arzsumo study held-ramp``: the command line of :mod:`arzsumo.studies.ablation.held_ramp`,
+mapped onto its :class:`~arzsumo.studies.ablation.held_ramp.HeldRampOptions`."""
 
 from __future__ import annotations
 
@@ -7,9 +7,9 @@ import argparse
 from pathlib import Path
 
 from arzsumo.cli.studies.options import add_output, add_runs, plots_wanted
-from arzsumo.studies import ablation
+from arzsumo.studies.ablation import study as ablation
+from arzsumo.studies.ablation.held_ramp import NAME, PAGE, HeldRampOptions, design, run_held_ramp
 from arzsumo.studies.common import RESULTS_DIR
-from arzsumo.studies.held_ramp import NAME, PAGE, HeldRampOptions, design, run_held_ramp
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -1,5 +1,5 @@
-"""``arzsumo study inlet``: the command line of :mod:`arzsumo.studies.inlet`, mapped onto
-its :class:`~arzsumo.studies.inlet.InletOptions`."""
+"""``arzsumo study inlet``: the command line of :mod:`arzsumo.studies.identify.inlet`, mapped onto
+its :class:`~arzsumo.studies.identify.inlet.InletOptions`."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from pathlib import Path
 
 from arzsumo.cli.studies.options import add_output
 from arzsumo.studies.common import positive_int
-from arzsumo.studies.inlet import NAME, PAGE, InletOptions, run_inlet
+from arzsumo.studies.identify.inlet import NAME, PAGE, InletOptions, run_inlet
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

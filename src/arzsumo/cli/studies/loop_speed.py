@@ -1,5 +1,5 @@
-"""``arzsumo study loop-speed``: the command line of :mod:`arzsumo.studies.loop_speed`,
-mapped onto its :class:`~arzsumo.studies.loop_speed.LoopSpeedOptions`."""
+"""``arzsumo study loop-speed``: the command line of :mod:`arzsumo.studies.estimation.loop_speed`,
+mapped onto its :class:`~arzsumo.studies.estimation.loop_speed.LoopSpeedOptions`."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from pathlib import Path
 
 from arzsumo.cli.studies.options import add_output, add_runs
 from arzsumo.studies.common import positive_float, print_list
-from arzsumo.studies.loop_speed import (
+from arzsumo.studies.estimation.loop_speed import (
     METHODS,
     NAME,
     PAGE,

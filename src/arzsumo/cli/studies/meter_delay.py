@@ -1,5 +1,5 @@
-"""``arzsumo study meter-delay``: the command line of :mod:`arzsumo.studies.meter_delay`,
-mapped onto its :class:`~arzsumo.studies.meter_delay.MeterDelayOptions`."""
+"""``arzsumo study meter-delay``: the command line of :mod:`arzsumo.studies.control.meter_delay`,
+mapped onto its :class:`~arzsumo.studies.control.meter_delay.MeterDelayOptions`."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from pathlib import Path
 
 from arzsumo.cli.studies.options import add_output
 from arzsumo.studies.common import RESULTS_DIR, names_among
-from arzsumo.studies.meter_delay import (
+from arzsumo.studies.control.meter_delay import (
     NAME,
     PAGE,
     PAIRED,

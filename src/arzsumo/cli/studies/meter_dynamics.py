@@ -1,6 +1,6 @@
 """``arzsumo study meter-dynamics``: the command line of
-:mod:`arzsumo.studies.meter_dynamics`, mapped onto its
-:class:`~arzsumo.studies.meter_dynamics.MeterDynamicsOptions`."""
+:mod:`arzsumo.studies.sumo_map.meter_dynamics`, mapped onto its
+:class:`~arzsumo.studies.sumo_map.meter_dynamics.MeterDynamicsOptions`."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from pathlib import Path
 
 from arzsumo.cli.studies.options import add_output, add_runs, plots_wanted
 from arzsumo.studies.common import fraction_list, positive_float, print_list
-from arzsumo.studies.meter_dynamics import (
+from arzsumo.studies.sumo_map.meter_dynamics import (
     GREENS,
     NAME,
     PAGE,

@@ -1,5 +1,5 @@
-"""``arzsumo study penetration``: the command line of :mod:`arzsumo.studies.penetration`,
-mapped onto its :class:`~arzsumo.studies.penetration.PenetrationOptions`."""
+"""``arzsumo study penetration``: the command line of :mod:`arzsumo.studies.control.penetration`,
+mapped onto its :class:`~arzsumo.studies.control.penetration.PenetrationOptions`."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from arzsumo.argtypes import seed_list
 from arzsumo.cli.studies.options import add_output, add_records, add_runs, plots_wanted
 from arzsumo.errors import EXIT_SOME_FAILED
 from arzsumo.studies.common import print_list
-from arzsumo.studies.penetration import (
+from arzsumo.studies.control.penetration import (
     NAME,
     PAGE,
     PenetrationOptions,

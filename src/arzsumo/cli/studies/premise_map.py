@@ -1,5 +1,5 @@
-"""``arzsumo study premise-map``: the command line of :mod:`arzsumo.studies.premise_map`,
-mapped onto its :class:`~arzsumo.studies.premise_map.MapOptions`."""
+"""``arzsumo study premise-map``: the command line of :mod:`arzsumo.studies.premise.map_study`,
+mapped onto its :class:`~arzsumo.studies.premise.map_study.MapOptions`."""
 
 from __future__ import annotations
 
@@ -8,9 +8,9 @@ from pathlib import Path
 
 from arzsumo.cli.studies.options import add_output, add_runs, plots_wanted
 from arzsumo.studies.common import print_list
-from arzsumo.studies.premise_map import PAGE, MapOptions, design, run_map
-from arzsumo.studies.premise_map_points import NAME, POINTS
-from arzsumo.studies.premise_map_tables import map_markdown, theory_markdown
+from arzsumo.studies.premise.map_points import NAME, POINTS
+from arzsumo.studies.premise.map_study import PAGE, MapOptions, design, run_map
+from arzsumo.studies.premise.map_tables import map_markdown, theory_markdown
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -1,5 +1,5 @@
-"""``arzsumo study sumo-options``: the command line of :mod:`arzsumo.studies.sumo_options`,
-mapped onto its :class:`~arzsumo.studies.sumo_options.SumoOptionsOptions`."""
+"""``arzsumo study sumo-options``: the command line of :mod:`arzsumo.studies.sumo_map.sumo_options`,
+mapped onto its :class:`~arzsumo.studies.sumo_map.sumo_options.SumoOptionsOptions`."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import argparse
 
 from arzsumo.cli.studies.options import add_output, add_runs
 from arzsumo.studies.common import print_list
-from arzsumo.studies.sumo_options import (
+from arzsumo.studies.sumo_map.sumo_options import (
     NAME,
     PAGE,
     SumoOptionsOptions,

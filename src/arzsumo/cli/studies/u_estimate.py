@@ -1,5 +1,5 @@
-"""``arzsumo study u-estimate``: the command line of :mod:`arzsumo.studies.u_estimate`,
-mapped onto its :class:`~arzsumo.studies.u_estimate.UEstimateOptions`."""
+"""``arzsumo study u-estimate``: the command line of :mod:`arzsumo.studies.estimation.u_estimate`,
+mapped onto its :class:`~arzsumo.studies.estimation.u_estimate.UEstimateOptions`."""
 
 from __future__ import annotations
 
@@ -7,7 +7,13 @@ import argparse
 
 from arzsumo.cli.studies.options import add_output, add_runs, plots_wanted
 from arzsumo.studies.common import positive_float, print_list
-from arzsumo.studies.u_estimate import NAME, PAGE, UEstimateOptions, design, run_u_estimate
+from arzsumo.studies.estimation.u_estimate import (
+    NAME,
+    PAGE,
+    UEstimateOptions,
+    design,
+    run_u_estimate,
+)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

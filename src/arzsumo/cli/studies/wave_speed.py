@@ -1,5 +1,5 @@
-"""``arzsumo study wave-speed``: the command line of :mod:`arzsumo.studies.wave_speed`,
-mapped onto its :class:`~arzsumo.studies.wave_speed.WaveSpeedOptions`."""
+"""``arzsumo study wave-speed``: the command line of :mod:`arzsumo.studies.sumo_map.wave_speed`,
+mapped onto its :class:`~arzsumo.studies.sumo_map.wave_speed.WaveSpeedOptions`."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from pathlib import Path
 
 from arzsumo.cli.studies.options import add_output, add_runs
 from arzsumo.studies.common import print_list
-from arzsumo.studies.wave_speed import NAME, PAGE, WaveSpeedOptions, design, run_wave_speed
+from arzsumo.studies.sumo_map.wave_speed import NAME, PAGE, WaveSpeedOptions, design, run_wave_speed
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

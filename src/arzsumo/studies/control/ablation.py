@@ -59,8 +59,9 @@ from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, write_text
 from arzsumo.resources import shipped_scenarios_dir
 from arzsumo.scenario import scenario_from_dict
-from arzsumo.studies import checks, control
+from arzsumo.studies import checks
 from arzsumo.studies.common import RESULTS_DIR, StudyError, seed_text
+from arzsumo.studies.control import study as control
 from arzsumo.studies.recorded import RecordedRuns, recorded_evaluation
 from arzsumo.sweep.evaluate import BASELINE, evaluation_spec
 from arzsumo.sweep.evaluate import KIND as EVALUATION_KIND

@@ -3,7 +3,7 @@
 
 ONE open-loop SUMO run of the scenario (default: the former default lateral_files, its fill as
 warm-up + ``--horizon`` s) records the superset of sensors and the truth, cached like the
-records of :mod:`arzsumo.studies.estimation_layouts`. The record holds both loop speeds,
+records of :mod:`arzsumo.studies.estimation.layouts`. The record holds both loop speeds,
 so each ``[sensing] loop_speed`` is an offline pass of the same estimator over the same
 traffic (loops every 250 m + AV probes, ``--method``). Per variable (rho_h, v_h, rho_a,
 v_a; veh/km and km/h over the control periods and cells): the mean of the truth, the mean
@@ -23,9 +23,10 @@ import pandas as pd
 
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import markdown_table, publish, write_csv, write_text
-from arzsumo.studies import checks, estimation_layouts
+from arzsumo.studies import checks
 from arzsumo.studies.common import FORMER_DEFAULT, RESULTS_DIR, shipped_scenario
 from arzsumo.studies.design import StudyRun
+from arzsumo.studies.estimation import layouts as estimation_layouts
 from arzsumo.units import KMH_PER_MS, VEH_KM_PER_VEH_M, ms_to_kmh
 
 NAME = "loop-speed"

@@ -33,7 +33,7 @@ import pandas as pd
 
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, remove_stale_figures, write_csv, write_text
-from arzsumo.studies import ablation
+from arzsumo.studies.ablation import study as ablation
 from arzsumo.studies.common import RESULTS_DIR, StudyError
 from arzsumo.sweep.evaluate import BASELINE
 from arzsumo.units import s_to_h

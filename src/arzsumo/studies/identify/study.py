@@ -47,9 +47,9 @@ from arzsumo.identify.wave_target import WaveTarget
 from arzsumo.model.equilibrium import Equilibrium
 from arzsumo.model.params import FAMILIES, ModelParameters
 from arzsumo.scenario import Scenario, scenario_from_dict
-from arzsumo.studies.identify_cache import load_run, run_key, save_run
-from arzsumo.studies.identify_diagram import STAGE_TWO, StageOne, fit_stage_one, read_waves
-from arzsumo.studies.identify_scores import (
+from arzsumo.studies.identify.cache import load_run, run_key, save_run
+from arzsumo.studies.identify.diagram import STAGE_TWO, StageOne, fit_stage_one, read_waves
+from arzsumo.studies.identify.scores import (
     SetScore,
     ao_floor,
     score_set,

@@ -22,7 +22,7 @@ paired difference against the open loop with Student t and BCa bootstrap interva
 wins and losses), ``OUT/<experiment>/control.png`` (the per-seed paired differences of
 :data:`FIGURE`'s measures), and ``OUT/control.md`` with the headline measures of both,
 the paper's claims, and the section's lateral files per controller
-(:mod:`arzsumo.studies.control_files`).
+(:mod:`arzsumo.studies.control.files`).
 """
 
 from __future__ import annotations
@@ -44,8 +44,8 @@ from arzsumo.outputs.studies import publish, remove_stale_figures, write_csv, wr
 from arzsumo.resources import shipped_scenarios_dir
 from arzsumo.studies import checks
 from arzsumo.studies.common import RESULTS_DIR, StudyError, seed_text
-from arzsumo.studies.control_claims import claims_table
-from arzsumo.studies.control_files import MIN_SHARE, files_table
+from arzsumo.studies.control.claims import claims_table
+from arzsumo.studies.control.files import MIN_SHARE, files_table
 from arzsumo.studies.recorded import RecordedRuns, recorded_evaluation
 from arzsumo.sweep.evaluate import BASELINE, check_controllers
 

@@ -43,7 +43,7 @@ from arzsumo.io import dump_toml
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, write_csv, write_text
 from arzsumo.studies import checks
-from arzsumo.studies.ablation_steps import (  # noqa: F401 (the steps, re-exported)
+from arzsumo.studies.ablation.steps import (  # noqa: F401 (the steps, re-exported)
     IDENTIFIED,
     PREDICTION_S,
     STEP_NAMES,

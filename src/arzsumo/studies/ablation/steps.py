@@ -1,4 +1,4 @@
-"""The steps of the ablation (:mod:`arzsumo.studies.ablation`): what each switches on,
+"""The steps of the ablation (:mod:`arzsumo.studies.ablation.study`): what each switches on,
 the scenario it evaluates, and whose open loop it borrows.
 
 The steps start from the former default scenario (lateral_files) without its controller

@@ -28,7 +28,8 @@ from arzsumo.evaluation.stats import StatisticsError, paired_difference
 from arzsumo.io import dump_toml
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, write_text
-from arzsumo.studies import ablation, checks
+from arzsumo.studies import checks
+from arzsumo.studies.ablation import study as ablation
 from arzsumo.studies.common import (
     EXIT_SOME_FAILED,
     RESULTS_DIR,

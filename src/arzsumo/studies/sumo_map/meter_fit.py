@@ -1,5 +1,5 @@
 """First-order-plus-dead-time fits to the green-share steps of
-:mod:`arzsumo.studies.meter_dynamics`, the static levels, and their tables.
+:mod:`arzsumo.studies.sumo_map.meter_dynamics`, the static levels, and their tables.
 
 The model y = y0 + K du (1 - exp(-(t - t0 - theta) / T))
 (:func:`arzsumo.identify.step_response.fit_fopdt`, 1 s bin means) is fitted to the

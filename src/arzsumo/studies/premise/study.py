@@ -54,7 +54,7 @@ from arzsumo.evaluation.premise import (
 )
 from arzsumo.evaluation.stationarity import count_trend
 from arzsumo.scenario import Scenario
-from arzsumo.studies.premise_runs import CLASSES, KINDS, PremiseOptions, premise_runs
+from arzsumo.studies.premise.runs import CLASSES, KINDS, PremiseOptions, premise_runs
 from arzsumo.sumo.stability import StringPrediction, predict
 
 #: blocks of the amplification gate: s and m
@@ -334,13 +334,13 @@ def run_premise(path: Path, sc: Scenario, seeds: Sequence[int], warmup: float,
                 workers: int | None = None, scheduler: str | None = None,
                 progress: bool = True) -> PremiseReport:
     """Run (or read from ``out/runs``) the premise runs of ``seeds`` and analyse them: a
-    seed's runs share one warm-up (:func:`~arzsumo.studies.premise_runs.grouped`).
+    seed's runs share one warm-up (:func:`~arzsumo.studies.premise.runs.grouped`).
 
     ``path`` is the scenario file of ``sc``; ``warmup`` s; ``out`` the claimed output
     directory; ``workers``/``scheduler`` as :func:`~arzsumo.studies.design.run_design`.
     """
     from arzsumo.studies.design import run_design
-    from arzsumo.studies.premise_runs import grouped, run_premise_group, ungrouped
+    from arzsumo.studies.premise.runs import grouped, run_premise_group, ungrouped
 
     runs = grouped(premise_runs(path, list(seeds), warmup, opts))
     rows = run_design(runs, run_premise_group, out, workers=workers, scheduler=scheduler,
@@ -352,7 +352,7 @@ def check_window(window: float, round_trip: float, trip_given: bool,
                  th: PremiseThresholds | None = None) -> None:
     """Refuse a window the gates cannot use: shorter than 3 blocks of the count trend
     (90 s) or than the pulse gate's two round trips after the pulse (t0: its start)."""
-    from arzsumo.studies.premise_runs import PremiseRunError
+    from arzsumo.studies.premise.runs import PremiseRunError
 
     th = th or PremiseThresholds()
     pulse = th.pulse_round_trips * round_trip

@@ -5,7 +5,7 @@ shipped default scenario's network with its ``approach`` buffer before x = 0. Th
 mainline demand is ``--fill-h`` / ``--fill-a`` veh/h from t = 0 to ``--fill`` s (above
 the merge's discharge: the queue fills the section from the merge), then the hold demand
 of the point (``--holds HV:AV`` veh/h) to the end. After ``--warmup`` s, ``--measured``
-s are measured on ``main`` with the measures of :mod:`arzsumo.studies.open_loop`; a
+s are measured on ``main`` with the measures of :mod:`arzsumo.studies.sumo_map.open_loop`; a
 point is ``ok`` when it is stationary, congested under the model and inserts at least
 98 % of its demand. The design the shipped default was chosen from is the default's
 own fill and hold (3750:850 veh/h after 4200 + 1300 veh/h for 600 s).
@@ -157,7 +157,7 @@ def design(opts: FillOptions) -> list[StudyRun]:
 def run_point(run: StudyRun) -> dict[str, Any]:
     """One fill-then-hold run; its row (units in the column names)."""
     from arzsumo.scenario import scenario_from_dict
-    from arzsumo.studies.open_loop import run_measures
+    from arzsumo.studies.sumo_map.open_loop import run_measures
 
     t0 = time.perf_counter()
     sc = scenario_from_dict(run.scenario, run.source)

@@ -6,9 +6,9 @@ the ramp meter at the outlet). Each :class:`MapPoint` changes a few ``[sumo]`` k
 the base scenario: the lateral behaviour, the HVs' car following, the downstream
 bottleneck, the AV share and the demand (:data:`POINTS`). The car-following points
 are first mapped to their own discharge (two discharge runs on a seed no gate reads:
-:mod:`arzsumo.studies.premise_map_points`); a point that gridlocks there is left out.
+:mod:`arzsumo.studies.premise.map_points`); a point that gridlocks there is left out.
 Per point and seed an
-open-loop baseline (:mod:`arzsumo.studies.premise_runs`), and on the point's first seed
+open-loop baseline (:mod:`arzsumo.studies.premise.runs`), and on the point's first seed
 the paired pulse; then the gates of ``arzsumo premise`` that these runs decide:
 
 * coupling and waves per class, amplification per class (the baseline);
@@ -47,10 +47,7 @@ from arzsumo.studies.common import (
     study_spec,
 )
 from arzsumo.studies.design import StudyRun, design_runs, run_design
-from arzsumo.studies.premise import (
-    model_speeds,
-)
-from arzsumo.studies.premise_map_points import (
+from arzsumo.studies.premise.map_points import (
     MAPPING_SEED,
     NAME,
     POINTS,
@@ -61,19 +58,22 @@ from arzsumo.studies.premise_map_points import (
     mapped_points,
     mapping_lines,
 )
-from arzsumo.studies.premise_map_tables import (
+from arzsumo.studies.premise.map_tables import (
     MAP_GATES,
     first_fields,
     map_markdown,
     map_tables,
     theory_markdown,
 )
-from arzsumo.studies.premise_runs import (
+from arzsumo.studies.premise.runs import (
     PremiseOptions,
     grouped,
     horizon_periods,
     run_premise_group,
     ungrouped,
+)
+from arzsumo.studies.premise.study import (
+    model_speeds,
 )
 from arzsumo.units import VEH_H_PER_VEH_S
 

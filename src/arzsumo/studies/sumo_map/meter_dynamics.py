@@ -17,7 +17,7 @@ next cycle start). Every second, from 120 s before the warm-up's end, it records
 * ``n_main_veh``: vehicles on ``main`` at the end of the second; ``ramp_queue_veh``.
 
 The series (``series.csv``, one row per second and seed) is fitted by
-:mod:`arzsumo.studies.meter_fit`: ``fits.csv`` (one row per fit), ``levels.csv`` (the
+:mod:`arzsumo.studies.sumo_map.meter_fit`: ``fits.csv`` (one row per fit), ``levels.csv`` (the
 static levels against the meter curve), ``tables.md`` and ``steps.png``. ``--series
 CSV`` fits a series recorded earlier instead of running SUMO.
 """
@@ -34,7 +34,7 @@ import pandas as pd
 from arzsumo.errors import require
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, remove_stale_figures, write_csv, write_text
-from arzsumo.studies import checks, meter_fit
+from arzsumo.studies import checks
 from arzsumo.studies.common import (
     FORMER_DEFAULT,
     RESULTS_DIR,
@@ -46,6 +46,7 @@ from arzsumo.studies.common import (
     study_spec,
 )
 from arzsumo.studies.design import StudyRun, design_runs, run_design
+from arzsumo.studies.sumo_map import meter_fit
 
 NAME = "meter-dynamics"
 #: the results page this study keeps a block of

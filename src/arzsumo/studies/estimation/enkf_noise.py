@@ -4,7 +4,7 @@
 On SUMO data the EnKF with a perfect-model ensemble is over-confident (spread about a
 tenth of its error). This study chooses the additive model-error noise per forecast
 (``[estimation] model_sd_*``) on the records of ``--tune-seeds`` (the open-loop records
-of :mod:`arzsumo.studies.estimation_layouts`, made when missing) for one layout
+of :mod:`arzsumo.studies.estimation.layouts`, made when missing) for one layout
 (``--layout``), then reports on ``--report-seeds`` the normalised error RMSE / mean
 spread per variable (target near 1) and the RMSE, for every EnKF layout, without and
 with the chosen noise (both at ``--inflation``).
@@ -28,7 +28,6 @@ import pandas as pd
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, write_csv, write_text
 from arzsumo.studies import checks
-from arzsumo.studies import estimation_layouts as layouts
 from arzsumo.studies.common import (
     FORMER_DEFAULT,
     RESULTS_DIR,
@@ -36,6 +35,7 @@ from arzsumo.studies.common import (
     file_stem,
     shipped_scenario,
 )
+from arzsumo.studies.estimation import layouts
 from arzsumo.sweep.driver import default_workers, map_runs
 
 NAME = "enkf-noise"

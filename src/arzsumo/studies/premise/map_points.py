@@ -29,7 +29,7 @@ import numpy as np
 from arzsumo.evaluation.premise.queue_tail import queue_tail
 from arzsumo.studies.common import StudyError, study_spec
 from arzsumo.studies.design import StudyRun, design_runs
-from arzsumo.studies.premise_runs import run_premise_task
+from arzsumo.studies.premise.runs import run_premise_task
 from arzsumo.units import VEH_H_PER_VEH_S
 
 NAME = "premise-map"
@@ -249,8 +249,8 @@ POINTS: tuple[MapPoint, ...] = (
 def discharge_runs(path: Path, points: Sequence[MapPoint], warmup: float,
                    first: Mapping[str, float] | None = None) -> list[StudyRun]:
     """Per mapped point one open-loop discharge run on
-    :data:`~arzsumo.studies.premise_map_points.MAPPING_SEED`. Without ``first``, held
-    above any discharge (:func:`~arzsumo.studies.premise_map_points.discharge_point`;
+    :data:`~arzsumo.studies.premise.map_points.MAPPING_SEED`. Without ``first``, held
+    above any discharge (:func:`~arzsumo.studies.premise.map_points.discharge_point`;
     IDs ``point=P,seed=S,kind=discharge``). With ``first`` (point -> the q(L) that run
     measured, veh/s), at the demand that discharge maps to (IDs ``...,kind=discharge2``):
     a queue held far above its discharge reaches the inlet, where AVs starve at insertion,

@@ -69,7 +69,7 @@ def replay_one(task: tuple[str, str, str]) -> dict[str, Any]:
     from arzsumo.identify.replay import ReplayOptions, run_replay
     from arzsumo.model.characteristic import linearize
     from arzsumo.scenario import load_scenario
-    from arzsumo.studies.identify_cache import ARRAYS
+    from arzsumo.studies.identify.cache import ARRAYS
 
     path, inlet, scenario = task
     sc = load_scenario(scenario)
@@ -160,7 +160,7 @@ def run_inlet(opts: InletOptions) -> InletResult:
     InletResult
         The table and the file written (``inlet.csv`` in ``opts.out``).
     """
-    from arzsumo.studies.identify_cache import cache_dir
+    from arzsumo.studies.identify.cache import cache_dir
 
     scenario = opts.scenario or shipped_scenario(FORMER_DEFAULT)
     files = cached_runs(opts.runs or cache_dir(), opts.last)

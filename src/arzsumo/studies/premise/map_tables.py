@@ -1,7 +1,7 @@
 """The premise map's tables (pure: rows in, frames out): the gates per point and seed
 from the runs' rows, the per-point measures, the linear theory at each seed's measured
 operating point, and the markdown and figure inputs (``arzsumo study premise-map``,
-:mod:`arzsumo.studies.premise_map`)."""
+:mod:`arzsumo.studies.premise.map_study`)."""
 
 from __future__ import annotations
 
@@ -17,7 +17,8 @@ from arzsumo.evaluation.premise.instability import round_trip_time
 from arzsumo.evaluation.premise.queue_tail import queue_tail
 from arzsumo.outputs.studies import markdown_table
 from arzsumo.scenario import Scenario
-from arzsumo.studies.premise import (
+from arzsumo.studies.premise.map_points import COUPLED, MapPoint
+from arzsumo.studies.premise.study import (
     LATE_SHARE,
     class_fields,
     classes_of,
@@ -27,7 +28,6 @@ from arzsumo.studies.premise import (
     speed_gates,
     theory_at,
 )
-from arzsumo.studies.premise_map_points import COUPLED, MapPoint
 from arzsumo.units import VEH_H_PER_VEH_S, VEH_KM_PER_VEH_M, ms_to_kmh
 
 #: the gates the map decides, in the order of its table and figure
@@ -140,7 +140,7 @@ def point_measures(rows: Mapping[int, Mapping[str, Mapping[str, Any]]]) -> dict[
 def point_theory(rows: Mapping[int, Mapping[str, Mapping[str, Any]]], sc: Scenario
                  ) -> dict[str, float]:
     """The linear string-stability prediction at each seed's measured operating point
-    (:func:`~arzsumo.studies.premise.theory_at`), averaged over seeds: per class the
+    (:func:`~arzsumo.studies.premise.study.theory_at`), averaged over seeds: per class the
     largest gain per vehicle ``gain_*`` and the growth over the section's vehicles
     ``growth_*`` (NaN for a model without one, e.g. Krauss)."""
     preds = [theory_at(r["baseline"], sc) for r in rows.values()]

@@ -6,7 +6,7 @@ phase) of the former default scenario (lateral_files)'s network, with its ``appr
 before x = 0: mainline demand (HV + AV at ``--av-share``) x nominal green share x Krauss
 sigma x seed, started from a congested section (``--empty-start``: from an empty one).
 After ``--warmup`` s, ``--measured`` s are measured on ``main``
-(:mod:`arzsumo.studies.open_loop`: stationarity, densities, speeds, speed sd, flows,
+(:mod:`arzsumo.studies.sumo_map.open_loop`: stationarity, densities, speeds, speed sd, flows,
 insertion, the approach queue, lambda_4 under the scenario's model).
 
 ``map.csv`` has one row per run, ``map.png`` the map: the demand x green-share grid of
@@ -154,7 +154,7 @@ def design(opts: ApproachOptions) -> list[StudyRun]:
 def run_point(run: StudyRun) -> dict[str, Any]:
     """One open-loop run of the map; its row (units in the column names)."""
     from arzsumo.scenario import scenario_from_dict
-    from arzsumo.studies.open_loop import initial_vehicles, run_measures
+    from arzsumo.studies.sumo_map.open_loop import initial_vehicles, run_measures
 
     t0 = time.perf_counter()
     sc = scenario_from_dict(run.scenario, run.source)

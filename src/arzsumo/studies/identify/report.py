@@ -1,5 +1,5 @@
 """The content of an identification's files (``arzsumo identify --out DIR``), from an
-:class:`~arzsumo.studies.identify.IdentifyStudy`; :func:`arzsumo.outputs.identify.
+:class:`~arzsumo.studies.identify.study.IdentifyStudy`; :func:`arzsumo.outputs.identify.
 write_identification` writes them:
 
 ``identified.toml``
@@ -39,8 +39,8 @@ from arzsumo.outdir import OutputDir
 from arzsumo.outputs.identify import DiagramPanel, FieldsPanel, ScatterPanel
 from arzsumo.scenario.model import MODEL_KEYS
 from arzsumo.schema import IDENTIFY_SUMMARY, key_units
-from arzsumo.studies.identify import IdentifyStudy, equilibrium_at, measured_densities
-from arzsumo.studies.identify_scores import SetScore
+from arzsumo.studies.identify.scores import SetScore
+from arzsumo.studies.identify.study import IdentifyStudy, equilibrium_at, measured_densities
 from arzsumo.sumo.vtypes import vehicle_types
 from arzsumo.units import ms_to_kmh, veh_m_to_veh_km
 

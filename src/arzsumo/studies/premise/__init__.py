@@ -1,0 +1,3 @@
+"""The premise gates on open-loop SUMO runs (``arzsumo premise``) and the premise map over
+SUMO's free parameters (``arzsumo study premise-map``).
+"""
