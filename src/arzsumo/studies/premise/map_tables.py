@@ -152,6 +152,15 @@ def point_theory(rows: Mapping[int, Mapping[str, Mapping[str, Any]]], sc: Scenar
     return out
 
 
+def changes_text(keys: Mapping[str, Any]) -> str:
+    """A point's changes as ``key = value``, the ``[sumo]`` keys by their names alone and
+    the coupled base's values left out."""
+    def label(k: str) -> str:
+        return k.removeprefix("sumo.")
+    return "; ".join(f"{label(k)} = {v}" for k, v in keys.items()
+                     if not (k.startswith("sumo.") and COUPLED.get(label(k), object()) == v))
+
+
 def map_tables(rows: Sequence[Mapping[str, Any]], points: Sequence[MapPoint], length: float,
                fallback_trip: float, th: PremiseThresholds | None = None,
                smooth: float = 30.0, scenarios: Mapping[str, Scenario] | None = None
@@ -170,9 +179,7 @@ def map_tables(rows: Sequence[Mapping[str, Any]], points: Sequence[MapPoint], le
             continue
         gates = point_gates(by[p.name], length, th, smooth, fallback_trip)
         row: dict[str, Any] = {"point": p.name, "axis": p.axis,
-                               "changes": "; ".join(f"{k[5:]} = {v}" for k, v in p.set.items()
-                                                    if k[5:] not in COUPLED
-                                                    or COUPLED[k[5:]] != v),
+                               "changes": changes_text(p.set),
                                "seeds": len(gates)}
         for s, gs in gates.items():
             long += [{"point": p.name, "seed": s, "gate": g.name, "value": g.value,
