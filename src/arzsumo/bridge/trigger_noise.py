@@ -8,7 +8,9 @@ measured where the noise arises, before control starts: a copy of the acting con
 is checked on the estimate of the warm-up's last ``reference_window`` seconds, the
 nominal plan applied throughout, and the sd of its continuous output's noise
 (:func:`arzsumo.control.etc.output_noise_sd`) sizes the dead band of the controller that
-will act. The same warm-up gives every controller of a seed the same dead band.
+will act. The warm-up is shared by every controller of a seed, so a law's band on a
+seed is the same in every experiment that forks from it; each law has its own (the
+observer-ETC's estimate is not the ETC's).
 """
 
 from __future__ import annotations
