@@ -172,6 +172,12 @@ def placed(p: MapPoint) -> MapPoint:
     return replace(p, name=f"{p.name}-placed", set={**p.set, **PLACED})
 
 
+def later(p: MapPoint, warmup_s: float) -> MapPoint:
+    """``p`` with its window opening after a warm-up of ``warmup_s`` (name ``P-wNNN``)."""
+    return replace(p, name=f"{p.name}-w{warmup_s:.0f}",
+                   set={**p.set, "run.warmup_s": float(warmup_s)})
+
+
 def _mapped(name: str, av_share: float = BASE_AV_SHARE, **keys: Any) -> MapPoint:
     return MapPoint(name, "car following (mapped)",
                     {f"sumo.{k}": v for k, v in {**CAR_FOLLOWING, **keys}.items()},
@@ -190,6 +196,11 @@ def share_variants(p: MapPoint, shares: tuple[float, ...] = (0.30, 0.50)) -> lis
     return [replace(p, name=f"{p.name}@av{round(100 * s)}", axis="penetration (mapped)",
                     av_share=s) for s in shares]
 
+
+#: IDM at SUMO's defaults with the merge fix, behind a 30 km/h downstream edge, its
+#: section placed congested at t = 0
+IDM_PLACED = placed(_mapped("idm-sumo-lc-down30", hv_model="IDM", down_speed_kmh=30,
+                            **MERGING))
 
 #: the car-following point whose HV oscillations grew upstream on both seeds of the map's
 #: first pass (amplification 1.59, 1.25): the map runs it again at 30 % and 50 % AVs
@@ -244,12 +255,10 @@ POINTS: tuple[MapPoint, ...] = (
                    down_speed_kmh=20, **MERGING)),
     placed(_mapped("action-1.0-mapped", hv_action_step_s=1.0)),
     # IDM's placed queue reached x = 0 some 250 s into the window (amplification 3.7
-    # read across that front): the same point with the window opening 300 s later
-    replace(placed(_mapped("idm-sumo-lc-down30", hv_model="IDM", down_speed_kmh=30,
-                           **MERGING)), name="idm-sumo-lc-down30-placed-w900",
-            set={**placed(_mapped("idm-sumo-lc-down30", hv_model="IDM",
-                                  down_speed_kmh=30, **MERGING)).set,
-                 "run.warmup_s": 900.0}),
+    # read across that front): the same point with the window opening 300 s later, and
+    # 600 s later (at 900 s the section still filled during the window: not stationary)
+    later(IDM_PLACED, 900.0),
+    later(IDM_PLACED, 1200.0),
 )
 
 
