@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Collection, Sequence
+from dataclasses import dataclass
+from pathlib import Path
 
 from arzsumo.argtypes import SEED_LIMIT
 from arzsumo.errors import require
@@ -69,3 +71,17 @@ def numbers(values: Sequence[float], field: str) -> None:
     """At least one number, each finite."""
     require(len(values) > 0 and all(math.isfinite(v) for v in values), field, values,
             "at least one finite number", StudyError)
+
+
+@dataclass(frozen=True)
+class Shared:
+    """The fields every study's options share (their meaning:
+    :data:`~arzsumo.studies.common.SHARED_FIELDS`): ``docs``, ``workers``, ``scheduler``.
+    A study's options subclass it and call ``super().__post_init__()``."""
+
+    docs: Path | None = None
+    workers: int | None = None
+    scheduler: str | None = None
+
+    def __post_init__(self) -> None:
+        count(self.workers, "workers", optional=True)

@@ -43,6 +43,15 @@ from arzsumo.sweep.spec import SweepSpec, sweep_from_dict
 RESULTS_DIR = Path("results") / "studies"
 #: where ``--docs`` publishes a study's page by default, relative to the working directory
 DOCS_DIR = Path("docs") / "results"
+#: the fields every study's frozen options share, and what they mean
+SHARED_FIELDS = {
+    "out": "the study's directory (Path; resumable: a later call runs only what is "
+           "missing)",
+    "docs": "also regenerate the study's block of docs/PAGE.md (Path, or None: no page)",
+    "workers": "local processes (int, or None: one per core); ignored with scheduler",
+    "scheduler": "a Dask scheduler's address to run on instead (str, or None: local)",
+    "progress": "draw a progress bar (bool)",
+}
 #: the ``[sumo]`` keys of the meter realisation (one vehicle per green, with a yellow) that
 #: the shipped default carries; the meter studies and the ablation start from the plain
 #: fixed cycle without them

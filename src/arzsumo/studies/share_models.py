@@ -39,6 +39,7 @@ from arzsumo.errors import require
 from arzsumo.io import dump_toml
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import markdown_table, publish, write_csv, write_text
+from arzsumo.studies import checks
 from arzsumo.studies.common import RESULTS_DIR, StudyError, scenario_data, shipped_scenario
 from arzsumo.studies.premise.map_points import MapPoint, mapped_points
 from arzsumo.studies.premise.map_study import map_demands
@@ -52,7 +53,7 @@ BASE = "control_newell.toml"
 
 
 @dataclass(frozen=True)
-class ShareOptions:
+class ShareOptions(checks.Shared):
     """What ``arzsumo study share-models`` does.
 
     ``scenario``: the base scenario (None: :data:`BASE`); ``shares``: AV shares of the
@@ -70,12 +71,10 @@ class ShareOptions:
     diagram: str = "newell"
     kernel_cells: int = 100
     out: Path = RESULTS_DIR / NAME
-    docs: Path | None = None
-    workers: int | None = None
-    scheduler: str | None = None
     progress: bool = True
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         require(bool(self.shares) and all(0.0 < s < 1.0 for s in self.shares)
                 and len(set(self.shares)) == len(self.shares), "shares", self.shares,
                 "distinct AV shares in (0, 1)", StudyError)

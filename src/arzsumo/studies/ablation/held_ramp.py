@@ -96,7 +96,7 @@ def report(meter: pd.DataFrame, held: pd.DataFrame, seeds: list[int]) -> str:
 
 
 @dataclass(frozen=True)
-class HeldRampOptions:
+class HeldRampOptions(checks.Shared):
     """What the held-ramp study runs and reads, and where it writes.
 
     Parameters
@@ -107,30 +107,22 @@ class HeldRampOptions:
         SUMO seeds of the held ramp's open loop, paired with the step's.
     report : bool
         Run nothing: the table from the evaluations already there.
-    out : Path
-        The study's directory (resumable).
-    docs : Path, optional
-        Also regenerate the study's block of ``docs/PAGE.md`` (None: no page).
     plots : bool
         Draw the held ramp's evaluation figures.
-    workers : int, optional
-        Local processes (None: one per core); ignored with ``scheduler``.
-    scheduler : str, optional
-        A Dask scheduler's address to run on instead.
+
+    ``out``, ``docs``, ``workers``, ``scheduler``: as every study's
+    (:data:`~arzsumo.studies.common.SHARED_FIELDS`).
     """
 
     ablation: Path = RESULTS_DIR / ablation.NAME
     seeds: tuple[int, ...] = tuple(range(1, 11))
     report: bool = False
     out: Path = RESULTS_DIR / NAME
-    docs: Path | None = None
     plots: bool = True
-    workers: int | None = None
-    scheduler: str | None = None
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         checks.seeds(self.seeds)
-        checks.count(self.workers, "workers", optional=True)
 
 
 @dataclass(frozen=True)

@@ -198,10 +198,7 @@ class MechanismResult:
 def run_mechanism(opts: MechanismOptions) -> MechanismResult:
     """Collect, pair, fit; write the tables, figures and (``opts.docs``) the page.
 
-    Parameters
-    ----------
-    opts : MechanismOptions
-        The study's options.
+    ``opts``: the study's :class:`MechanismOptions`.
 
     Returns
     -------

@@ -195,7 +195,7 @@ def _page(out: Path, table: pd.DataFrame) -> tuple[str, list]:
 
 
 @dataclass(frozen=True)
-class AblationOptions:
+class AblationOptions(checks.Shared):
     """What the ablation runs and reads, and where it writes.
 
     Parameters
@@ -208,16 +208,11 @@ class AblationOptions:
         Run nothing: assemble the table from the steps in ``out``.
     legacy : Path, optional
         An earlier ``evaluation.csv`` listed first as step ``legacy``.
-    out : Path
-        The study's directory (resumable).
-    docs : Path, optional
-        Also regenerate the study's block of ``docs/PAGE.md`` (None: no page).
     plots : bool
         Draw the evaluations' figures.
-    workers : int, optional
-        Local processes (None: one per core); ignored with ``scheduler``.
-    scheduler : str, optional
-        A Dask scheduler's address to run on instead.
+
+    ``out``, ``docs``, ``workers``, ``scheduler``: as every study's
+    (:data:`~arzsumo.studies.common.SHARED_FIELDS`).
     """
 
     steps: tuple[str, ...] = STEP_NAMES
@@ -225,16 +220,13 @@ class AblationOptions:
     report: bool = False
     legacy: Path | None = None
     out: Path = RESULTS_DIR / NAME
-    docs: Path | None = None
     plots: bool = True
-    workers: int | None = None
-    scheduler: str | None = None
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         for name in run_order(self.steps):
             step(name)
         checks.seeds(self.seeds)
-        checks.count(self.workers, "workers", optional=True)
 
 
 @dataclass(frozen=True)

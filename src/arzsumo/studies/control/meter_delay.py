@@ -160,10 +160,7 @@ class MeterDelayResult:
 def run_meter_delay(opts: MeterDelayOptions) -> MeterDelayResult:
     """The paired events of every seed, their summary, the page block.
 
-    Parameters
-    ----------
-    opts : MeterDelayOptions
-        The study's options.
+    ``opts``: the study's :class:`MeterDelayOptions`.
 
     Returns
     -------

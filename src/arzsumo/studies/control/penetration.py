@@ -188,7 +188,7 @@ def share_sweep(directory: Path, seeds: list[int] | None) -> SweepSpec:
 
 
 @dataclass(frozen=True)
-class PenetrationOptions:
+class PenetrationOptions(checks.Shared):
     """What ``arzsumo study penetration`` runs.
 
     ``seeds``: SUMO seeds (None: each sweep file's own); ``records``, ``report``: the
@@ -203,13 +203,11 @@ class PenetrationOptions:
     report: bool = False
     share_models: Path | None = None
     out: Path = RESULTS_DIR / NAME
-    docs: Path | None = None
     plots: bool = True
-    workers: int | None = None
-    scheduler: str | None = None
     progress: bool = True
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         if self.seeds is not None:
             checks.seeds(self.seeds)
         check_store(self.records, self.report)

@@ -95,7 +95,7 @@ ENKF_LAYOUTS = tuple(name for name, keys in layouts.LAYOUTS.items() if keys)
 
 
 @dataclass(frozen=True)
-class EnkfNoiseOptions:
+class EnkfNoiseOptions(checks.Shared):
     """What the study records, tunes and reports, and where it writes (SI: s, m; the sd
     in veh/km and km/h).
 
@@ -123,14 +123,13 @@ class EnkfNoiseOptions:
         Inflations tried without model noise.
     gain : float
         Each round scales the sd by its clipped normalised error to this power.
-    out : Path
-        The study's directory (resumable).
-    docs : Path, optional
-        Also regenerate the study's block of ``docs/PAGE.md`` (None: no page).
     workers : int, optional
         Local processes (None: one per core).
     scheduler : str, optional
         Record on this Dask scheduler.
+
+    ``out``, ``docs``: as every study's
+    (:data:`~arzsumo.studies.common.SHARED_FIELDS`).
     """
 
     scenario: Path | None = None
@@ -146,11 +145,9 @@ class EnkfNoiseOptions:
     inflation_only: tuple[float, ...] = (1.05, 1.3, 2.0)
     gain: float = 1.5
     out: Path = RESULTS_DIR / NAME
-    docs: Path | None = None
-    workers: int | None = None
-    scheduler: str | None = None
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         if len(self.start) != 4:
             raise StudyError(f"--start = {list(self.start)} is not allowed: 4 sd (rho_h "
                              "veh/km, v_h km/h, rho_a veh/km, v_a km/h)")
@@ -163,7 +160,6 @@ class EnkfNoiseOptions:
             checks.positive(getattr(self, field), field)
         checks.count(self.rounds, "rounds", least=0)
         checks.numbers(self.inflation_only, "inflation_only")
-        checks.count(self.workers, "workers", optional=True)
 
 
 @dataclass(frozen=True)

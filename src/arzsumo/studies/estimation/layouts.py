@@ -159,7 +159,7 @@ def table(rows: list[dict[str, Any]]) -> str:
 
 
 @dataclass(frozen=True)
-class LayoutsOptions:
+class LayoutsOptions(checks.Shared):
     """What the layout study records and scores, and where it writes (SI: s).
 
     Parameters
@@ -170,14 +170,9 @@ class LayoutsOptions:
         SUMO seeds, one recorded open-loop run each.
     warmup_s, horizon_s : float, optional
         Warm-up and control horizon, s (None: the scenario's).
-    out : Path
-        The study's directory (resumable).
-    docs : Path, optional
-        Also regenerate the study's block of ``docs/PAGE.md`` (None: no page).
-    workers : int, optional
-        Local processes (None: one per core); ignored with ``scheduler``.
-    scheduler : str, optional
-        A Dask scheduler's address to run on instead.
+
+    ``out``, ``docs``, ``workers``, ``scheduler``: as every study's
+    (:data:`~arzsumo.studies.common.SHARED_FIELDS`).
     """
 
     scenario: Path | None = None
@@ -185,15 +180,12 @@ class LayoutsOptions:
     warmup_s: float | None = None
     horizon_s: float | None = None
     out: Path = RESULTS_DIR / NAME
-    docs: Path | None = None
-    workers: int | None = None
-    scheduler: str | None = None
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         checks.seeds(self.seeds)
         checks.positive(self.warmup_s, "warmup_s", optional=True)
         checks.positive(self.horizon_s, "horizon_s", optional=True)
-        checks.count(self.workers, "workers", optional=True)
 
 
 @dataclass(frozen=True)

@@ -86,7 +86,7 @@ def station_speeds(rec: Any) -> list[str]:
 
 
 @dataclass(frozen=True)
-class LoopSpeedOptions:
+class LoopSpeedOptions(checks.Shared):
     """What the loop-speed study records and replays, and where it writes (SI: s).
 
     Parameters
@@ -99,14 +99,9 @@ class LoopSpeedOptions:
         Control horizon recorded, s.
     method : str
         The estimator replayed: ``smoothing`` or ``enkf``.
-    out : Path
-        The study's directory (resumable).
-    docs : Path, optional
-        Also regenerate the study's block of ``docs/PAGE.md`` (None: no page).
-    workers : int, optional
-        Local processes (None: one per core); ignored with ``scheduler``.
-    scheduler : str, optional
-        A Dask scheduler's address to run on instead.
+
+    ``out``, ``docs``, ``workers``, ``scheduler``: as every study's
+    (:data:`~arzsumo.studies.common.SHARED_FIELDS`).
     """
 
     scenario: Path | None = None
@@ -114,15 +109,12 @@ class LoopSpeedOptions:
     horizon_s: float = 300.0
     method: str = "smoothing"
     out: Path = RESULTS_DIR / NAME
-    docs: Path | None = None
-    workers: int | None = None
-    scheduler: str | None = None
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         checks.seeds(self.seeds)
         checks.positive(self.horizon_s, "horizon_s")
         checks.among(self.method, METHODS, "method")
-        checks.count(self.workers, "workers", optional=True)
 
 
 @dataclass(frozen=True)

@@ -50,7 +50,7 @@ ESTIMATORS = {
 
 
 @dataclass(frozen=True)
-class UEstimateOptions:
+class UEstimateOptions(checks.Shared):
     """What the study runs and where it writes (SI: s).
 
     Parameters
@@ -63,16 +63,11 @@ class UEstimateOptions:
         Control horizon, s.
     controller : str
         The law (a controller with a continuous U).
-    out : Path
-        The study's directory (resumable).
-    docs : Path, optional
-        Also regenerate the study's block of ``docs/PAGE.md`` (None: no page).
     plots : bool
         Draw the figure of U over time.
-    workers : int, optional
-        Local processes (None: one per core); ignored with ``scheduler``.
-    scheduler : str, optional
-        A Dask scheduler's address to run on instead.
+
+    ``out``, ``docs``, ``workers``, ``scheduler``: as every study's
+    (:data:`~arzsumo.studies.common.SHARED_FIELDS`).
     """
 
     seeds: tuple[int, ...] = (42,)
@@ -80,16 +75,13 @@ class UEstimateOptions:
     horizon_s: float = 120.0
     controller: str = "backstepping"
     out: Path = RESULTS_DIR / NAME
-    docs: Path | None = None
     plots: bool = True
-    workers: int | None = None
-    scheduler: str | None = None
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         checks.seeds(self.seeds)
         checks.positive(self.warmup_s, "warmup_s")
         checks.positive(self.horizon_s, "horizon_s")
-        checks.count(self.workers, "workers", optional=True)
 
 
 @dataclass(frozen=True)
@@ -147,12 +139,7 @@ def statistics(u: pd.DataFrame, runs: pd.DataFrame) -> pd.DataFrame:
 def run_u_estimate(opts: UEstimateOptions, *, progress: bool = True) -> UEstimateResult:
     """Run the sweep (resumable), then write the table and the figure.
 
-    Parameters
-    ----------
-    opts : UEstimateOptions
-        The study's options.
-    progress : bool, optional
-        Show a progress bar while the runs run.
+    ``opts``: the study's :class:`UEstimateOptions`; ``progress``: draw a progress bar.
 
     Returns
     -------

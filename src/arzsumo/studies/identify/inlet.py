@@ -150,10 +150,7 @@ class InletResult:
 def run_inlet(opts: InletOptions) -> InletResult:
     """Replay every run under every inlet and write the table.
 
-    Parameters
-    ----------
-    opts : InletOptions
-        The study's options.
+    ``opts``: the study's :class:`InletOptions`.
 
     Returns
     -------

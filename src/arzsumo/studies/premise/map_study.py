@@ -39,6 +39,7 @@ import pandas as pd
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.premise_map import write_map
 from arzsumo.outputs.studies import publish
+from arzsumo.studies import checks
 from arzsumo.studies.common import (
     FORMER_DEFAULT,
     RESULTS_DIR,
@@ -115,7 +116,7 @@ def selected_points(names: str | Sequence[str] | None) -> list[MapPoint]:
 
 
 @dataclass(frozen=True)
-class MapOptions:
+class MapOptions(checks.Shared):
     """What a premise map runs and where it writes (SI: s).
 
     ``scenario``: the base scenario file every point changes (None: the former default);
@@ -133,14 +134,12 @@ class MapOptions:
     pulse_s: float = 25.0
     pulses: bool = True
     out: Path = RESULTS_DIR / NAME
-    docs: Path | None = None
     page: str = PAGE
     plots: bool = True
-    workers: int | None = None
-    scheduler: str | None = None
     progress: bool = True
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         if not self.seeds:
             raise StudyError("seeds = () is not allowed: at least one seed")
 

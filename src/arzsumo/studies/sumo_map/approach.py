@@ -54,7 +54,7 @@ GROUP = ["step_s", "hv_sigma", "warmup_s", "approach_m", "av_share"]
 
 
 @dataclass(frozen=True)
-class ApproachOptions:
+class ApproachOptions(checks.Shared):
     """What the approach study runs (or reads) and where it writes (SI units in the
     names).
 
@@ -80,16 +80,11 @@ class ApproachOptions:
         AV share of the mainline demand, in [0, 1].
     source : Path, optional
         Draw the map of this table instead of running SUMO.
-    out : Path
-        The study's directory (resumable).
-    docs : Path, optional
-        Also regenerate the study's block of ``docs/PAGE.md`` (None: no page).
     plots : bool
         Draw the map.
-    workers : int, optional
-        Local processes (None: one per core); ignored with ``scheduler``.
-    scheduler : str, optional
-        A Dask scheduler's address to run on instead.
+
+    ``out``, ``docs``, ``workers``, ``scheduler``: as every study's
+    (:data:`~arzsumo.studies.common.SHARED_FIELDS`).
     """
 
     demands: tuple[float, ...] = (4400.0, 4800.0, 5200.0, 5664.0, 6000.0)
@@ -104,19 +99,16 @@ class ApproachOptions:
     av_share: float = AV_SHARE
     source: Path | None = None
     out: Path = RESULTS_DIR / NAME
-    docs: Path | None = None
     plots: bool = True
-    workers: int | None = None
-    scheduler: str | None = None
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         for field in ("demands", "greens", "sigmas"):
             checks.numbers(getattr(self, field), field)
         checks.seeds(self.seeds)
         for field in ("approach_m", "warmup_s", "measured_s", "step_s"):
             checks.positive(getattr(self, field), field)
         checks.fraction(self.av_share, "av_share")
-        checks.count(self.workers, "workers", optional=True)
 
 
 @dataclass(frozen=True)
@@ -217,12 +209,7 @@ def read_map(path: Path) -> pd.DataFrame:
 def run_approach(opts: ApproachOptions, *, progress: bool = True) -> ApproachResult:
     """Run the missing points (or read ``opts.source``), write the table and the map.
 
-    Parameters
-    ----------
-    opts : ApproachOptions
-        The study's options.
-    progress : bool, optional
-        Show a progress bar while the runs run.
+    ``opts``: the study's :class:`ApproachOptions`; ``progress``: draw a progress bar.
 
     Returns
     -------

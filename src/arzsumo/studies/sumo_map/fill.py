@@ -57,7 +57,7 @@ def hold_pair(text: str) -> tuple[float, float]:
 
 
 @dataclass(frozen=True)
-class FillOptions:
+class FillOptions(checks.Shared):
     """What the fill study runs and where it writes (SI units in the names).
 
     Parameters
@@ -80,14 +80,9 @@ class FillOptions:
         Time not measured, then measured, s.
     step_s : float
         SUMO step, s.
-    out : Path
-        The study's directory (resumable).
-    docs : Path, optional
-        Also regenerate the study's block of ``docs/PAGE.md`` (None: no page).
-    workers : int, optional
-        Local processes (None: one per core); ignored with ``scheduler``.
-    scheduler : str, optional
-        A Dask scheduler's address to run on instead.
+
+    ``out``, ``docs``, ``workers``, ``scheduler``: as every study's
+    (:data:`~arzsumo.studies.common.SHARED_FIELDS`).
     """
 
     holds: tuple[str, ...] = ("3750:850",)
@@ -102,11 +97,9 @@ class FillOptions:
     measured_s: float = 450.0
     step_s: float = 0.1
     out: Path = RESULTS_DIR / NAME
-    docs: Path | None = None
-    workers: int | None = None
-    scheduler: str | None = None
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         for h in self.holds:
             hold_pair(h)
         for field in ("fill_h_veh_h", "fill_a_veh_h", "fill_s"):
@@ -116,7 +109,6 @@ class FillOptions:
         checks.numbers(self.greens, "greens")
         checks.numbers(self.sigmas, "sigmas")
         checks.seeds(self.seeds)
-        checks.count(self.workers, "workers", optional=True)
 
 
 @dataclass(frozen=True)
@@ -175,12 +167,7 @@ def run_point(run: StudyRun) -> dict[str, Any]:
 def run_fill(opts: FillOptions, *, progress: bool = True) -> FillResult:
     """Run the missing points and write the table (and the page with ``opts.docs``).
 
-    Parameters
-    ----------
-    opts : FillOptions
-        The study's options.
-    progress : bool, optional
-        Show a progress bar while the runs run.
+    ``opts``: the study's :class:`FillOptions`; ``progress``: draw a progress bar.
 
     Returns
     -------

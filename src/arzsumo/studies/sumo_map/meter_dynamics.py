@@ -74,7 +74,7 @@ def schedule(warmup: float, base: float, greens: list[float], hold: float
 
 
 @dataclass(frozen=True)
-class MeterDynamicsOptions:
+class MeterDynamicsOptions(checks.Shared):
     """What the meter-dynamics study runs (or reads), fits and where it writes (SI: s).
 
     Parameters
@@ -96,16 +96,11 @@ class MeterDynamicsOptions:
         Last s of each hold averaged for the static levels.
     series : Path, optional
         Fit this series (a ``series.csv`` of this study) instead of running SUMO.
-    out : Path
-        The study's directory (resumable).
-    docs : Path, optional
-        Also regenerate the study's block of ``docs/PAGE.md`` (None: no page).
     plots : bool
         Draw the steps' figure.
-    workers : int, optional
-        Local processes (None: one per core); ignored with ``scheduler``.
-    scheduler : str, optional
-        A Dask scheduler's address to run on instead.
+
+    ``out``, ``docs``, ``workers``, ``scheduler``: as every study's
+    (:data:`~arzsumo.studies.common.SHARED_FIELDS`).
     """
 
     seeds: tuple[int, ...] = (1, 2, 3)
@@ -117,18 +112,15 @@ class MeterDynamicsOptions:
     settled_s: float = 60.0
     series: Path | None = None
     out: Path = RESULTS_DIR / NAME
-    docs: Path | None = None
     plots: bool = True
-    workers: int | None = None
-    scheduler: str | None = None
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         checks.seeds(self.seeds)
         for field in ("warmup_s", "base_s", "hold_s", "pre_s", "settled_s"):
             checks.positive(getattr(self, field), field)
         require(len(self.greens) > 0 and all(0.0 <= g <= 1.0 for g in self.greens),
                 "greens", self.greens, "numbers in [0, 1], at least one", StudyError)
-        checks.count(self.workers, "workers", optional=True)
 
 
 @dataclass(frozen=True)
@@ -236,12 +228,7 @@ def run_meter_dynamics(opts: MeterDynamicsOptions, *, progress: bool = True
     """Run the steps (or read ``opts.series``), fit, write (and publish with
     ``opts.docs``).
 
-    Parameters
-    ----------
-    opts : MeterDynamicsOptions
-        The study's options.
-    progress : bool, optional
-        Show a progress bar while the runs run.
+    ``opts``: the study's :class:`MeterDynamicsOptions`; ``progress``: draw a progress bar.
 
     Returns
     -------

@@ -141,7 +141,7 @@ def markdown(table: pd.DataFrame) -> str:
 
 
 @dataclass(frozen=True)
-class SumoOptionsOptions:
+class SumoOptionsOptions(checks.Shared):
     """What the study runs and where it writes.
 
     Parameters
@@ -151,26 +151,18 @@ class SumoOptionsOptions:
     drain : bool
         Run each run's drain after the control window (False: end with the window;
         faster, no whole-demand measures).
-    out : Path
-        The study's directory (resumable).
-    docs : Path, optional
-        Also regenerate the study's block of ``docs/PAGE.md`` (None: no page).
-    workers : int, optional
-        Local processes (None: one per core); ignored with ``scheduler``.
-    scheduler : str, optional
-        A Dask scheduler's address to run on instead.
+
+    ``out``, ``docs``, ``workers``, ``scheduler``: as every study's
+    (:data:`~arzsumo.studies.common.SHARED_FIELDS`).
     """
 
     seeds: tuple[int, ...] = tuple(range(1, 11))
     drain: bool = True
     out: Path = RESULTS_DIR / NAME
-    docs: Path | None = None
-    workers: int | None = None
-    scheduler: str | None = None
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         checks.seeds(self.seeds)
-        checks.count(self.workers, "workers", optional=True)
 
 
 @dataclass(frozen=True)
@@ -195,12 +187,7 @@ def run_sumo_options(opts: SumoOptionsOptions, *, progress: bool = True
                      ) -> SumoOptionsResult:
     """Run the missing variants and seeds, write the comparison.
 
-    Parameters
-    ----------
-    opts : SumoOptionsOptions
-        The study's options.
-    progress : bool, optional
-        Show a progress bar while the runs run.
+    ``opts``: the study's :class:`SumoOptionsOptions`; ``progress``: draw a progress bar.
 
     Returns
     -------

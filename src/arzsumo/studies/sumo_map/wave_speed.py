@@ -98,7 +98,7 @@ def run_cells(run: StudyRun) -> dict[str, Any]:
 
 
 @dataclass(frozen=True)
-class WaveSpeedOptions:
+class WaveSpeedOptions(checks.Shared):
     """What the wave-speed study runs (or reads) and where it writes.
 
     Parameters
@@ -111,14 +111,9 @@ class WaveSpeedOptions:
         SUMO seeds.
     source : tuple of Path
         ``arzsumo run`` result directories read instead of running SUMO (empty: run).
-    out : Path
-        The study's directory (resumable).
-    docs : Path, optional
-        Also regenerate the study's block of ``docs/PAGE.md`` (None: no page).
-    workers : int, optional
-        Local processes (None: one per core); ignored with ``scheduler``.
-    scheduler : str, optional
-        A Dask scheduler's address to run on instead.
+
+    ``out``, ``docs``, ``workers``, ``scheduler``: as every study's
+    (:data:`~arzsumo.studies.common.SHARED_FIELDS`).
     """
 
     scenario: Path | None = None
@@ -126,13 +121,10 @@ class WaveSpeedOptions:
     seeds: tuple[int, ...] = (42,)
     source: tuple[Path, ...] = ()
     out: Path = RESULTS_DIR / NAME
-    docs: Path | None = None
-    workers: int | None = None
-    scheduler: str | None = None
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         checks.seeds(self.seeds)
-        checks.count(self.workers, "workers", optional=True)
 
 
 @dataclass(frozen=True)
@@ -158,12 +150,7 @@ def design(opts: WaveSpeedOptions) -> list[StudyRun]:
 def run_wave_speed(opts: WaveSpeedOptions, *, progress: bool = True) -> WaveSpeedResult:
     """Run (or read ``opts.source``) and write the table of lags and speeds.
 
-    Parameters
-    ----------
-    opts : WaveSpeedOptions
-        The study's options.
-    progress : bool, optional
-        Show a progress bar while the runs run.
+    ``opts``: the study's :class:`WaveSpeedOptions`; ``progress``: draw a progress bar.
 
     Returns
     -------
