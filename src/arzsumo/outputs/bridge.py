@@ -156,8 +156,9 @@ def actuation_summary(res: CoSimResult) -> dict[str, Any]:
     or a controller without a Riemann-state law, :mod:`arzsumo.bridge.delay`);
     ``meter_gain`` and ``hold_plan_in_range`` as in ``[actuation]``;
     ``trigger_output_noise`` (veh/s): the acting law's output noise on the warm-up's
-    estimate, and ``trigger_dead_band`` (veh/s, in the law's units, noise_k sqrt(2) times
-    it) the dead band it sized (null: not measured, :mod:`arzsumo.bridge.trigger_noise`)."""
+    estimate, and ``trigger_dead_band`` (veh/s, noise_k sqrt(2) times it) the dead band
+    it sized, both as the U the meter is asked for (the law's outflow units over
+    ``meter_gain``; null: not measured, :mod:`arzsumo.bridge.trigger_noise`)."""
     act, per = res.scenario.actuation, res.periods
     n = int(per["t"].size)
     sat, rate = int(np.sum(per["saturated"] > 0)), int(np.sum(per["rate_limited"] > 0))
