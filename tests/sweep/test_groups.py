@@ -116,12 +116,17 @@ def test_a_group_with_a_killed_branch_completes_and_equals_plain_runs(tmp_path):
                             stdin=subprocess.PIPE, stdout=subprocess.PIPE)
     proc.stdin.write(pickle.dumps(group))
     proc.stdin.close()
-    killed, deadline = None, time.monotonic() + 300
+    killed, deadline, seen = None, time.monotonic() + 300, {}
     while killed is None and time.monotonic() < deadline and proc.poll() is None:
+        now = time.monotonic()
         kids = [k for k in _children(proc.pid)   # the first branch, forked after the warm-up
                 if b"arzsumo.sweep.groups" in _cmdline(k)]     # (not netconvert)
-        if kids:
-            killed = kids[0]
+        # a child that still carries the parent's command line 0.5 s on is a branch: one
+        # forked to exec SUMO's tools does so within milliseconds (longer under load, when
+        # killing it would fail the warm-up instead)
+        old = [k for k in kids if now - seen.setdefault(k, now) >= 0.5]
+        if old:
+            killed = old[0]
             os.kill(killed, signal.SIGKILL)
         time.sleep(0.02)
     outcomes = pickle.loads(proc.stdout.read())
