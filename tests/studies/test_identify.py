@@ -136,6 +136,7 @@ def _refused(args: list[str], capsys: pytest.CaptureFixture[str]) -> str:
     ({"--vary": "green_share=0.4"}, "--vary = green_share=0.4 is not allowed: table.key"),
     ({"--vary": "sumo.green_share=0.4,7"}, "--vary sumo.green_share=7: "),
     ({"--bootstrap": "-1"}, "--bootstrap = -1 is not allowed"),
+    ({"--jam-floor": "jam"}, "--jam-floor: invalid choice: 'jam'"),
 ])
 def test_bad_input_exits_2_with_one_line_before_any_run(change, message, tmp_path, capsys):
     args = list(ARGS)

@@ -65,3 +65,25 @@ def test_stage_one_recovers_the_diagram_it_was_made_with(runs):
     assert fit.rmse["h"] < 0.1 and fit.rmse["a"] < 0.1       # m/s: on the curve
     assert fit.lambda_4 == pytest.approx(reading.stream, rel=0.05)
     assert fit.params.tau_h == sc.params.tau_h                # stage 2's business
+
+
+def test_a_jam_floor_above_the_blocks_lets_the_branch_through_them_despite_denser_cells(runs):
+    """Stopped vehicles make single cells far denser than any block: a floor above every
+    cell keeps the jam occupancy there and misses the diagram; the blocks' floor does not."""
+    from arzsumo.model.fd import area_occupancy
+
+    sc, data = runs
+    dense = []
+    for d in data:
+        fields = np.array(d.fields)
+        fields[::97, ::2, ::7] *= 2.2        # a stopped platoon in one cell now and then
+        dense.append(ReplayData(d.t, d.x, fields, d.initial, d.inlet, d.outflow, name=d.name))
+    cells = float(np.max(area_occupancy(sc.params, np.concatenate(
+        [d.fields[:, 0].ravel() for d in dense]), np.concatenate(
+        [d.fields[:, 2].ravel() for d in dense]))))
+    assert cells > 0.62 * 1.1
+    on_blocks, _, _ = fit_stage_one(sc, "newell", dense, RHO)
+    on_cells, _, _ = fit_stage_one(sc, "newell", dense, RHO, floor=cells)
+    assert on_blocks.params.ao_max_h == pytest.approx(0.62, rel=0.05)
+    assert on_cells.params.ao_max_h >= cells
+    assert on_cells.rmse["h"] > 2 * on_blocks.rmse["h"]

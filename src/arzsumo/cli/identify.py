@@ -45,7 +45,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
                        wave_speed=None if args.wave_speed_kmh is None
                        else kmh_to_ms(args.wave_speed_kmh),
                        wave_weight=args.wave_weight, diagram=args.diagram,
-                       inlet=args.inlet)
+                       inlet=args.inlet, jam_floor=args.jam_floor)
     out = Path(args.out) if args.out else Path("results") / "identify" / path.stem
     runs = len(setup.points) * (len(setup.train_seeds) + len(setup.validate_seeds))
     log.info("identify %s: %d SUMO runs on %d workers, fitting %s", sc.name, runs,
@@ -132,6 +132,12 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="two stages: the fundamental diagram of this family from the "
                         "windows' stationary states and the measured wave speed (stage 1), "
                         "then tau_h, tau_a by the replay with the diagram fixed (stage 2)")
+    p.add_argument("--jam-floor", choices=("cells", "blocks"), default="cells",
+                   help="with --diagram, the least jam occupancy stage 1 may fit: above "
+                        "every cell the replay is fed (cells), or above every stationary "
+                        "block (blocks: the congested branch may pass through the blocks "
+                        "where stopped vehicles make denser cells; the replay scales those "
+                        "cells down to its AO limit and identification.json counts them)")
     p.add_argument("--inlet", choices=("ctm", "supply", "ghost"), default="ctm",
                    help="the replay's inlet flux from the ghost cell (SUMO's smoothed first "
                         "cell): the cell transmission model's min(demand, supply) of the "

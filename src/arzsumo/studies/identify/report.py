@@ -237,6 +237,7 @@ def identification_json(study: IdentifyStudy) -> dict[str, Any]:
                      "bootstrap": setup.fit.bootstrap, "workers": setup.workers,
                      "replay_cells": opts.cells, "replay_scheme": opts.scheme,
                      "ao_limit": opts.ao_limit, "replay_inlet": opts.inlet,
+                     "jam_floor": setup.jam_floor,
                      "penalty": PENALTY},
         "parameters": params, "correlation": corr,
         "fit": {"nfev": fit.nfev, "evaluations": fit.evaluations, "failures": fit.failures,

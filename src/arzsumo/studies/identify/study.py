@@ -59,6 +59,13 @@ from arzsumo.sweep.driver import default_workers, map_runs
 
 log = logging.getLogger(__name__)
 ROLES = ("training", "validation")
+#: the least jam occupancy stage 1 may fit. ``cells``: above every cell the replay is fed,
+#: so a replay never leaves the model's domain; ``blocks``: above every stationary block
+#: only, so the diagram's congested branch can pass through the blocks where the densest
+#: cells (stopped vehicles in stop-and-go, the compressed inlet) lie above a jam line
+#: through them; the replay scales such cells down to its AO limit and
+#: ``identification.json`` counts them (``beyond_ao_max``)
+JAM_FLOORS = ("cells", "blocks")
 
 
 @dataclass(frozen=True)
@@ -123,6 +130,9 @@ class IdentifySetup:
     #: transmission model's min(demand, supply), ``supply`` the ghost cell's flux limited
     #: to the first cell's receiving capacity, ``ghost`` that flux as it is
     inlet: str = "ctm"
+    #: the least jam occupancy stage 1 may fit (:data:`JAM_FLOORS`): above every cell the
+    #: replay is fed (``cells``) or above every stationary block (``blocks``)
+    jam_floor: str = "cells"
 
     @property
     def options(self) -> ReplayOptions:
@@ -197,10 +207,14 @@ def make_setup(sc: Scenario, train: Sequence[int], held_out: Sequence[int], *,
                horizon: float | None = None, warmup: float | None = None,
                fit: FitSettings | None = None, workers: int | None = None,
                wave_speed: float | None = None, wave_weight: float = 1.0,
-               diagram: str | None = None, inlet: str = "ctm") -> IdentifySetup:
+               diagram: str | None = None, inlet: str = "ctm",
+               jam_floor: str = "cells") -> IdentifySetup:
     """Check everything before SUMO starts: seeds, points, parameter names and bounds."""
     if inlet not in INLETS:
         raise ScenarioError(f"--inlet = {inlet} is not allowed: one of {', '.join(INLETS)}")
+    if jam_floor not in JAM_FLOORS:
+        raise ScenarioError(f"--jam-floor = {jam_floor} is not allowed: one of "
+                            f"{', '.join(JAM_FLOORS)}")
     if diagram is not None and diagram not in FAMILIES:
         raise ScenarioError(f"--diagram = {diagram} is not allowed: one of "
                             f"{', '.join(FAMILIES)}")
@@ -227,7 +241,7 @@ def make_setup(sc: Scenario, train: Sequence[int], held_out: Sequence[int], *,
         WaveTarget(wave_speed, 0.0, 0.0, wave_weight)
     return IdentifySetup(base, sc, tuple(train), tuple(held_out), points, names,
                          fit or FitSettings(), workers or default_workers(), wave_speed,
-                         wave_weight, diagram, inlet)
+                         wave_weight, diagram, inlet, jam_floor)
 
 
 def plan(setup: IdentifySetup) -> list[RunTask]:
@@ -319,11 +333,13 @@ def run_identification(setup: IdentifySetup) -> IdentifyStudy:
     rho = measured_densities(train)
     stage_one, t_one = None, time.perf_counter()
     if setup.diagram is not None:
-        # the jam occupancy above every cell the replay is fed (at the bridge's AO limit)
+        # cells: the jam occupancy above every cell the replay is fed (at its AO limit);
+        # blocks: above every stationary block only (fit_stage_one's own floor)
+        floor = (ao_floor(setup.scenario.params, train, opts.ao_limit)
+                 if setup.jam_floor == "cells" else None)
         diagram, reading, states = fit_stage_one(
             setup.scenario, setup.diagram, train, rho, wave=setup.wave_speed,
-            wave_weight=setup.wave_weight, bootstrap=setup.fit.bootstrap,
-            floor=ao_floor(setup.scenario.params, train, opts.ao_limit))
+            wave_weight=setup.wave_weight, bootstrap=setup.fit.bootstrap, floor=floor)
         stage_one = StageOne(diagram, states, {"training": reading,
                                                "validation": read_waves(held_out)})
         guess = diagram.params
