@@ -124,3 +124,32 @@ def test_the_etc_sized_on_its_measured_noise_triggers_far_less_than_the_papers(r
     norm = np.sqrt(np.mean(((res.fields - star) / star) ** 2, axis=(1, 2)))
     assert res.complete and norm.max() < 2 * norm[0]
     assert ctrl.log.triggers < runs["paper"][1] / 3
+
+
+def test_only_a_law_with_a_trigger_is_probed_for_its_output_noise(monkeypatch):
+    # the probe copies the law and checks it on the whole reference window: for a law
+    # without a trigger it would measure a noise nothing uses
+    import arzsumo.bridge.trigger_noise as tn
+    from arzsumo.control.backstepping import Backstepping
+    from arzsumo.control.compensation import DelayCompensated
+    from arzsumo.control.meter_gain import MeterGain
+
+    eq = load_scenario(ROOT / "scenarios/lateral_files.toml").equilibrium
+    lin = linearize(eq)
+    kernels = solve_kernels(lin.system, 50)
+    design = design_for(lin.system, kernels).design.with_(noise_from_estimate=True)
+    x = (np.arange(50) + 0.5) * eq.params.length / 50
+    one = np.ones_like(x)
+    states = [MacroState(-30.0 + k, x, eq.rho_h * one, eq.v_h * one, eq.rho_a * one,
+                         eq.v_a * one) for k in range(30)]
+    probed: list[object] = []
+    real = tn.law_output_noise
+    monkeypatch.setattr(tn, "law_output_noise",
+                        lambda ctrl, s: probed.append(ctrl) or real(ctrl, s))
+    plain = Backstepping(lin, kernels)
+    assert not plain.has_trigger and not MeterGain(plain, 2.0).has_trigger
+    assert tn.size_dead_band(MeterGain(plain, 2.0), states) is None and probed == []
+    etc = NoisyEtc(lin, kernels, design, noise=NOISE)
+    wrapped = MeterGain(DelayCompensated(etc, 5.0), 2.0)
+    assert wrapped.has_trigger
+    assert tn.size_dead_band(wrapped, states) is not None and probed == [wrapped]

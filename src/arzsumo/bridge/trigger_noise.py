@@ -50,7 +50,9 @@ def law_output_noise(ctrl: Controller, states: Sequence[MacroState]) -> float:
 def size_dead_band(ctrl: Controller, states: Sequence[MacroState]) -> float | None:
     """Measure the output noise of ``ctrl`` on ``states`` and size its trigger's dead band
     with it; returns the sd (veh/s), None when ``ctrl`` has no trigger or the noise is
-    not measurable."""
+    not measurable (the probe runs only for a law with a trigger)."""
+    if not ctrl.has_trigger:
+        return None
     sd = law_output_noise(ctrl, states)
     if not np.isfinite(sd):
         return None

@@ -149,6 +149,12 @@ class Controller(ABC):
         """
         return None
 
+    @property
+    def has_trigger(self) -> bool:
+        """Whether the law holds U between events (an event trigger to size); the
+        default has none."""
+        return False
+
     def set_output_noise(self, sd: float) -> bool:
         """Size an event trigger's dead band from the sd ``sd`` (veh/s) of this law's
         output noise, measured on the state it will see

@@ -53,6 +53,9 @@ class RiemannLaw(Protocol):
 
     def set_output_noise(self, sd: float) -> bool: ...
 
+    @property
+    def has_trigger(self) -> bool: ...
+
 
 class DelayCompensated(Controller):
     """``inner`` evaluated on the state predicted ``delay`` s ahead (module docstring).
@@ -111,6 +114,11 @@ class DelayCompensated(Controller):
         """The meter received ``u`` (veh/s) for the last check: the prediction uses it."""
         if self.u_bar:
             self.u_bar[-1] = u * self.inner.lin.u_bar_per_u
+
+    @property
+    def has_trigger(self) -> bool:
+        """The inner law's."""
+        return self.inner.has_trigger
 
     def set_output_noise(self, sd: float) -> bool:
         """Handed to the inner law (its trigger's dead band; veh/s)."""

@@ -280,6 +280,11 @@ class EventTriggered(Controller):
         upper]`` (veh/s) from the next check on (module docstring)."""
         self.trigger.bounds = u_bar_range(lower, upper, self.lin.u_bar_per_u)
 
+    @property
+    def has_trigger(self) -> bool:
+        """An event trigger holds U between events."""
+        return True
+
     def set_output_noise(self, sd: float) -> bool:
         """The trigger's dead band from the sd (veh/s) of this law's output noise."""
         self.trigger.set_output_noise(sd * abs(self.lin.u_bar_per_u))

@@ -64,6 +64,11 @@ class MeterGain(Controller):
     def actuated(self, u: float) -> None:
         self.inner.actuated(u * self.gain)
 
+    @property
+    def has_trigger(self) -> bool:
+        """The inner law's."""
+        return self.inner.has_trigger
+
     def set_output_noise(self, sd: float) -> bool:
         """``sd`` in meter units (veh/s), handed on in outflow units."""
         return self.inner.set_output_noise(sd * self.gain)

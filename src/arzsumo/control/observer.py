@@ -154,6 +154,11 @@ class ObserverEtc(Controller):
                         V=r.V, d=r.d, m=r.m, m_nonnegative=float(r.m >= 0), y=y)
         return r.u_bar_held
 
+    @property
+    def has_trigger(self) -> bool:
+        """An event trigger holds U between events."""
+        return True
+
     def set_output_noise(self, sd: float) -> bool:
         """The trigger's dead band from the sd (veh/s) of this law's output noise."""
         self.trigger.set_output_noise(sd * abs(self.lin.u_bar_per_u))
