@@ -205,3 +205,16 @@ def test_the_theory_is_predicted_at_each_seeds_baseline_operating_point():
     text = theory_lines(rep.theory)
     assert "seed 1: hv Krauss: none (Krauss is not smooth" in text
     assert f"av ACC: max|G| {expected['av'].gain:.4f}" in text
+
+
+def test_a_deadlocked_seed_has_no_theory_and_the_report_still_reads_every_seed():
+    """A seed whose HVs stood still for the whole window (a merge deadlock) has no
+    operating point to linearise about; the other seeds keep theirs."""
+    sc = load_scenario(LEGACY)
+    moving, stuck = _rows(1), _rows(2)
+    moving[0] = {**moving[0], "rho_hv_veh_m": 0.1, "rho_av_veh_m": 0.02}
+    zero = np.zeros_like(np.array(stuck[0]["v_hv"])).tolist()
+    stuck[0] = {**stuck[0], "rho_hv_veh_m": 0.18, "rho_av_veh_m": 0.033, "v_hv": zero}
+    rep = study.analyse(moving + stuck, sc, study.AnalysisOptions(round_trip=100.0))
+    assert rep.theory[2] == {} and set(rep.theory[1]) == {"hv", "av"}
+    assert rep.seeds == (1, 2)

@@ -25,6 +25,7 @@ A class without vehicles (fewer than two lateral samples) is not measured. SI un
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -286,10 +287,15 @@ def _series(runs: Mapping[str, Mapping[str, Any]], floor: Mapping[str, float],
 
 def theory_at(base: Mapping[str, Any], sc: Scenario) -> dict[str, StringPrediction]:
     """The prediction at a baseline's mean class densities and HV speed ({} for a row
-    that does not carry the densities)."""
+    that does not carry the densities, or whose HVs stood still: a deadlocked run has no
+    operating point to linearise about)."""
     if "rho_hv_veh_m" not in base or "rho_av_veh_m" not in base:
         return {}
-    v = float(np.nanmean(class_fields(base, ["hv"])["hv"]))
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)      # an all-NaN field
+        v = float(np.nanmean(class_fields(base, ["hv"])["hv"]))
+    if not (math.isfinite(v) and v > 0.0):
+        return {}
     return predict(sc.params, sc.sumo, float(base["rho_hv_veh_m"]),
                    float(base["rho_av_veh_m"]), v)
 
