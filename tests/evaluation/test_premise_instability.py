@@ -159,3 +159,45 @@ def test_bad_pulse_inputs_are_refused():
         pulse_gate(T, base, {"h": pulse["h"]}, DX, T0, ROUND_TRIP)
     with pytest.raises(PremiseError, match="baseline's shape"):
         deviation_norm(np.zeros((3, 4)), np.zeros((3, 5)), DX)
+
+
+def _seeds(response, n: int, noise: float, seed: int = 0):
+    """n seeds of (baseline, pulse) fields: pulse = baseline + response + noise, the
+    noise independent per seed (the runs' decorrelation after the pulse)."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(0.0, 601.0)
+    shape = (t.size, 20)
+    base, puls = [], []
+    for _ in range(n):
+        b = 10.0 + rng.normal(0.0, 1.0, shape)
+        base.append({"hv": b})
+        puls.append({"hv": b + response(t)[:, None] + rng.normal(0.0, noise, shape)})
+    floor = noise * math.sqrt(20 * 50.0)       # D of two runs that differ by the noise only
+    return t, base, puls, [{"hv": floor, "total": floor}] * n
+
+
+@pytest.mark.parametrize(("response", "persists"), [
+    (lambda t: 2.0 * np.ones_like(t), True),         # the pulse's effect stays
+    (lambda t: 2.0 * np.exp(-t / 20.0), False),      # it decays in 20 s
+])
+def test_the_mean_response_over_seeds_reads_what_one_noisy_seed_cannot(response, persists):
+    from arzsumo.evaluation.premise import mean_response_gate
+
+    t, base, puls, floors = _seeds(response, 16, 3.0)
+    mean = mean_response_gate(t, base, puls, 50.0, 0.0, 100.0, floors, smooth_s=30.0)
+    assert mean.name == "pulse_mean" and mean.detail["seeds"] == 16
+    assert mean.detail["floor"]["total"] == pytest.approx(floors[0]["total"] / 4)
+    assert mean.passed is persists
+    if not persists:
+        assert mean.value < 100.0            # decayed within a round trip
+    # one seed: the response (norm 63) is below the noise's floor (95), nothing to read
+    one = pulse_gate(t, base[0], puls[0], 50.0, 0.0, 100.0, floors[0], smooth_s=30.0)
+    assert one.detail["total"]["peak"] < 1.5 * floors[0]["total"]
+
+
+def test_the_mean_response_needs_two_seeds():
+    from arzsumo.evaluation.premise import mean_response_gate
+
+    t, base, puls, floors = _seeds(lambda t: np.zeros_like(t), 1, 1.0)
+    with pytest.raises(PremiseError, match="two or more seeds"):
+        mean_response_gate(t, base, puls, 50.0, 0.0, 100.0, floors)

@@ -218,3 +218,17 @@ def test_a_deadlocked_seed_has_no_theory_and_the_report_still_reads_every_seed()
     rep = study.analyse(moving + stuck, sc, study.AnalysisOptions(round_trip=100.0))
     assert rep.theory[2] == {} and set(rep.theory[1]) == {"hv", "av"}
     assert rep.seeds == (1, 2)
+
+
+def test_the_pooled_readings_leave_out_a_seed_that_did_not_hold_the_operating_point(report):
+    # both synthetic seeds hold it: the pulse's mean response reads them both (the bump
+    # decays in 40 s: the mean response decays too)
+    assert report.pooled_pulse is not None and report.pooled_pulse.detail["seeds"] == 2
+    assert report.pooled_pulse.detail["total"]["decayed"]
+    assert report.pooled_actuator.detail["levels"]["up"]["records"] == 2
+    stuck = _rows(2)
+    stuck[0] = {**stuck[0], "inserted_main": 500}          # half the demand inserted
+    rep = study.analyse(_rows(1) + stuck, load_scenario(LEGACY),
+                        study.AnalysisOptions(round_trip=100.0))
+    assert rep.pooled_actuator.detail["levels"]["up"]["records"] == 1
+    assert math.isnan(rep.pooled_pulse.value) and "1 seed(s)" in rep.pooled_pulse.detail["reason"]

@@ -80,7 +80,8 @@ def cmd_premise(args: argparse.Namespace) -> int:
         print(f"premise {sc.name}: seeds {seeds[0]}-{seeds[-1]}, window {window:g} s, "
               f"round trip T = {report.round_trip:.4g} s, pulse floor: "
               f"{report.floor_method}")
-        print(premise_table(report.gates, report.verdict, report.pooled_actuator))
+        print(premise_table(report.gates, report.verdict, report.pooled_actuator,
+                            report.pooled_pulse))
         if report.theory:
             print(theory_lines(report.theory))
         print("  report: " + ", ".join(str(p) for p in files))

@@ -84,8 +84,10 @@ def _overall(s: SeedSummary) -> str:
 
 
 def premise_table(gates: Mapping[int, Sequence[GateResult]], verdict: PremiseVerdict,
-                  pooled: GateResult | None = None) -> str:
-    """The gates per seed and over seeds as an aligned text table, with the verdict."""
+                  pooled: GateResult | None = None,
+                  pulse_mean: GateResult | None = None) -> str:
+    """The gates per seed and over seeds as an aligned text table, with the verdict and
+    the readings pooled over the seeds (the actuator, the pulse's mean response)."""
     seeds = list(gates)
     by = {s: {g.name: g for g in gates[s]} for s in seeds}
     head = ["gate", "unit", "threshold", *[f"seed {s}" for s in seeds], "seeds passing"]
@@ -106,6 +108,8 @@ def premise_table(gates: Mapping[int, Sequence[GateResult]], verdict: PremiseVer
         lines += [f"  {side}: {_num(f['gain'])} [{_num(f['gain_low'])}, "
                   f"{_num(f['gain_high'])}], {VERDICT_TEXT[f['verdict']]}"
                   for side, f in pooled.detail.get("levels", {}).items() if "verdict" in f]
+    if pulse_mean is not None:
+        lines.append(pulse_mean_line(pulse_mean))
     holds = "holds" if verdict.passed else "does not hold"
     failed = f"; failed: {', '.join(verdict.failed)}" if verdict.failed else ""
     lines += [f"premise {holds}{failed}", f"rule: {verdict.rule}"]
@@ -156,3 +160,17 @@ def write_premise(out: Path, document: Mapping[str, Any],
 
         written.append(save_png(premise_figure(pulses, stairs), out / FIGURE, dpi=100))
     return written
+
+
+def pulse_mean_line(g: GateResult) -> str:
+    """One line on the pulse's mean response over the seeds (s, m/s m^(1/2))."""
+    d = g.detail
+    head = f"pulse, mean response over {d.get('seeds', '?')} seeds: "
+    if "total" not in d:
+        return head + f"not measured ({d.get('reason', 'no reading')})"
+    tot, floor = d["total"], d.get("floor", {}).get("total", math.nan)
+    when = (f"decays {_num(tot['decay_time_s'])} s after the pulse"
+            if tot["decayed"] else f"no decay by {_num(g.threshold)} s")
+    return (head + f"peak {_num(tot['peak'])} at {_num(tot['peak_time_s'])} s over a floor "
+            f"{_num(floor)}, {when} ({'pass' if g.passed else 'FAIL'}; reported, not in "
+            "the verdict)")

@@ -11,7 +11,8 @@ its default and the reason for it (see ``docs/premise.md``).
 2. :func:`wave_gate` (per class): its speed fluctuations travel upstream at one speed;
    :func:`model_wave_gate`: the model's lambda_4 matches that speed.
 3. :func:`amplification_gate` (the amplitude grows upstream) and :func:`pulse_gate`
-   (a paired pulse does not decay within two round trips).
+   (a paired pulse does not decay within two round trips); :func:`mean_response_gate`
+   reads the pulse's response averaged over seeds.
 4. :func:`actuator_gate`: dq(L) / dr near -1 for release-rate steps up and down.
 5. :func:`stationarity_gate`, :func:`inserted_gate`, :func:`ramp_demand_gate`,
    :func:`ramp_queue_gate`: the operating point.
@@ -32,6 +33,7 @@ from arzsumo.evaluation.premise.gates import GateResult, PremiseError, PremiseTh
 from arzsumo.evaluation.premise.instability import (
     amplification_gate,
     deviation_norm,
+    mean_response_gate,
     pulse_gate,
     pulse_response,
     round_trip_time,
@@ -54,7 +56,8 @@ __all__ = [
     "ActuatorRecord", "DirectionFit", "GateResult", "PremiseError", "PremiseThresholds",
     "PremiseVerdict", "SeedSummary", "StepMeasure", "WaveSpeed", "actuator_gate",
     "amplification_gate", "coupling_gate", "deviation_norm", "direction_fit",
-    "inserted_gate", "model_wave_gate", "premise_verdict", "pulse_gate", "pulse_response",
+    "inserted_gate", "mean_response_gate", "model_wave_gate", "premise_verdict",
+    "pulse_gate", "pulse_response",
     "ramp_demand_gate", "ramp_queue_gate", "round_trip_time", "stationarity_gate",
     "step_measures", "summarise_seeds", "wave_gate", "wave_speed", "within_block_share",
 ]

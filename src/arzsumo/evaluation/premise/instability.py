@@ -29,7 +29,8 @@ s, m, m/s; D in m/s m^(1/2).
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+import warnings
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 
@@ -259,3 +260,52 @@ def pulse_gate(t: np.ndarray, baseline: Mapping[str, np.ndarray],
                       bool(total["detectable"] and not total["decayed"]),
                       {"round_trip_s": round_trip, "window_s": window,
                        "smooth_s": smooth_s, **out})
+
+
+def mean_response_gate(t: np.ndarray, baselines: Sequence[Mapping[str, np.ndarray]],
+                       pulses: Sequence[Mapping[str, np.ndarray]], dx: float, t0: float,
+                       round_trip: float, floors: Sequence[Mapping[str, float]],
+                       thresholds: PremiseThresholds | None = None,
+                       smooth_s: float = 0.0) -> GateResult:
+    """Gate 3b pooled over seeds: the pulse's mean response.
+
+    One seed's pulse - baseline is the pulse's response plus the decorrelation of two runs
+    whose vehicles drew other random numbers after the pulse; where that decorrelation
+    reaches the floor within a round trip (Krauss's noise, or a stop-and-go that loses its
+    phase), one seed cannot tell a decay from a dip of the noise. Over N seeds the
+    decorrelation averages out (its norm about F / sqrt(N), F the two-seed floor) and the
+    response does not. The mean difference field per class is read as :func:`pulse_gate`
+    reads one seed, against the floors' mean over the seeds / sqrt(N).
+
+    Parameters
+    ----------
+    t : ndarray (T,)
+        Times of every seed's periods (one grid, the same t0), s.
+    baselines, pulses : sequence of mapping of str to ndarray (T, N)
+        Per seed, per class, the speed fields of its baseline and its pulse run, m/s.
+    floors : sequence of mapping of str to float
+        Per seed the floor of one seed's D per class and ``"total"`` (m/s m^(1/2)).
+    dx, t0, round_trip, thresholds, smooth_s
+        As :func:`pulse_gate`.
+
+    Returns
+    -------
+    GateResult
+        Named ``pulse_mean``; value, threshold and ``passed`` as :func:`pulse_gate` on the
+        mean response; ``detail`` adds ``seeds`` and the floors used.
+    """
+    n = len(baselines)
+    require(n >= 2 and len(pulses) == n and len(floors) == n, "seeds", n,
+            "two or more seeds, each with a baseline, a pulse and a floor", PremiseError)
+    classes = sorted(baselines[0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)       # a cell no seed observed
+        mean = {c: np.nanmean(np.stack([np.asarray(p[c], float) - np.asarray(b[c], float)
+                                        for b, p in zip(baselines, pulses, strict=True)]),
+                              axis=0) for c in classes}
+    keys = [*classes, "total"]
+    floor = {k: float(np.mean([f.get(k, 0.0) for f in floors])) / math.sqrt(n) for k in keys}
+    zero = {c: np.zeros_like(m) for c, m in mean.items()}
+    one = pulse_gate(t, zero, mean, dx, t0, round_trip, floor, thresholds, smooth_s)
+    return GateResult("pulse_mean", one.value, one.threshold, one.passed,
+                      {**one.detail, "seeds": n, "floor": floor})

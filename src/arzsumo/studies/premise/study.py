@@ -55,6 +55,7 @@ from arzsumo.evaluation.premise import (
 )
 from arzsumo.evaluation.stationarity import count_trend
 from arzsumo.scenario import Scenario
+from arzsumo.studies.premise.pooled import held_seeds, pooled_pulse
 from arzsumo.studies.premise.runs import CLASSES, KINDS, PremiseOptions, premise_runs
 from arzsumo.sumo.stability import StringPrediction, predict
 
@@ -136,6 +137,9 @@ class PremiseReport:
     #: measured operating point (:func:`arzsumo.sumo.stability.predict`), the theory
     #: beside the measured amplification and pulse
     theory: Mapping[int, Mapping[str, StringPrediction]] = field(default_factory=dict)
+    #: the pulse's mean response over the seeds that held the operating point
+    #: (:func:`arzsumo.studies.premise.pooled.pooled_pulse`); None in older reports
+    pooled_pulse: GateResult | None = None
 
 
 def gate_from_dict(d: Mapping[str, Any]) -> GateResult:
@@ -324,7 +328,11 @@ def analyse(rows: Sequence[Mapping[str, Any]], sc: Scenario, opts: AnalysisOptio
     seeds = tuple(sorted(by_seed))
     gates = {s: seed_gates(by_seed[s], floor[s], model, trip, sc.params.length,
                            opts.smooth, th) for s in seeds}
-    pooled = actuator_gate([actuator_record(by_seed[s]["staircase"]) for s in seeds], th)
+    held = held_seeds(gates)
+    pooled = (actuator_gate([actuator_record(by_seed[s]["staircase"]) for s in held], th)
+              if held else GateResult("actuator", math.nan, th.gain_range, False,
+                                      {"reason": "no seed held the operating point"}))
+    pulse_mean = pooled_pulse(by_seed, held, floor, trip, opts.smooth, th)
     series = {s: _series(by_seed[s], floor[s], th.pulse_round_trips * trip, opts.smooth)
               for s in seeds}
     return PremiseReport(seeds, gates, premise_verdict([gates[s] for s in seeds], th),
@@ -332,7 +340,8 @@ def analyse(rows: Sequence[Mapping[str, Any]], sc: Scenario, opts: AnalysisOptio
                          {s: _accounting(by_seed[s]) for s in seeds},
                          {s: v[0] for s, v in series.items()},
                          {s: v[1] for s, v in series.items()},
-                         {s: theory_at(by_seed[s]["baseline"], sc) for s in seeds})
+                         {s: theory_at(by_seed[s]["baseline"], sc) for s in seeds},
+                         pulse_mean)
 
 
 def run_premise(path: Path, sc: Scenario, seeds: Sequence[int], warmup: float,
@@ -396,7 +405,9 @@ def report_document(report: PremiseReport, sc: Scenario, path: Path, scenario_te
                         "per_seed": {str(s): dict(v) for s, v in report.floors.items()}},
         "per_seed": [{"seed": s, "gates": [g.as_dict() for g in report.gates[s]]}
                      for s in report.seeds],
-        "pooled": {"actuator": report.pooled_actuator.as_dict()},
+        "pooled": {"actuator": report.pooled_actuator.as_dict(),
+                   **({"pulse_mean": report.pooled_pulse.as_dict()}
+                      if report.pooled_pulse is not None else {})},
         "verdict": report.verdict.as_dict(),
         "runs": {str(s): dict(v) for s, v in report.runs.items()},
         "theory": {str(s): {c: asdict(p) for c, p in v.items()}
