@@ -57,7 +57,7 @@ from arzsumo.io import dump_toml, read_toml
 from arzsumo.model.wave_match import wave_matched
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, write_text
-from arzsumo.resources import shipped_scenarios_dir
+from arzsumo.resources import default_scenario
 from arzsumo.scenario import scenario_from_dict
 from arzsumo.studies import checks
 from arzsumo.studies.common import RESULTS_DIR, StudyError, seed_text
@@ -133,8 +133,7 @@ def _power_law(data: dict) -> dict:
     """``data`` with the shipped default's ``[model]``, ``[equilibrium]`` and ``[design]``
     (the paper's power-law diagram, identified on the same stream), the trigger's
     measured dead band kept where ``data`` asks for it."""
-    default = tomllib.loads((shipped_scenarios_dir() / "default.toml").read_text(
-        encoding="utf-8"))
+    default = tomllib.loads(default_scenario().read_text(encoding="utf-8"))
     measured = data.get("design", {}).get("noise_from_estimate")
     for table in ("model", "equilibrium", "design"):
         data[table] = dict(default[table])
@@ -290,7 +289,7 @@ class AblationOptions:
     @property
     def base(self) -> Path:
         """The control study's base scenario file."""
-        return self.scenario or shipped_scenarios_dir() / "default.toml"
+        return self.scenario or default_scenario()
 
 
 @dataclass(frozen=True)
