@@ -259,26 +259,30 @@ class EventTrigger:
         return CheckResult(self.u_held, u_cont, bool(triggered), V, d, self.m)
 
 
-class EventTriggered(Controller):
-    """Full-state dynamic ETC (control law sam with the mechanism of defdynamic)."""
+class TriggeredLaw(Controller):
+    """A law whose U an :class:`EventTrigger` holds between events: what the full-state
+    (:class:`EventTriggered`) and the observer-based ETC
+    (:class:`arzsumo.control.observer.ObserverEtc`) share.
 
-    name = "etc"
+    Parameters
+    ----------
+    lin : Linearization
+        The linearisation the law and its trigger act on.
+    kernels : Kernels
+        The backstepping kernels on their grid.
+    design : EtcDesign
+        The mechanism's parameters.
+    """
 
     def __init__(self, lin: Linearization, kernels: Kernels,
                  design: EtcDesign = PAPER_DESIGN) -> None:
         super().__init__()
         self.lin = lin
-        self.state_map = StateMap(lin, kernels.x)
         self.trigger = EventTrigger(lin.system, kernels, design)
 
     def reset(self) -> None:
         super().reset()
         self.trigger.reset()
-
-    def applied(self, u: float, lower: float = -math.inf, upper: float = math.inf) -> None:
-        """Anti-windup: the trigger compares what the actuator delivers in ``[lower,
-        upper]`` (veh/s) from the next check on (module docstring)."""
-        self.trigger.bounds = u_bar_range(lower, upper, self.lin.u_bar_per_u)
 
     @property
     def has_trigger(self) -> bool:
@@ -290,13 +294,33 @@ class EventTriggered(Controller):
         self.trigger.set_output_noise(sd * abs(self.lin.u_bar_per_u))
         return True
 
-    def check_riemann(self, t: float, w_bar: np.ndarray) -> float:
-        """Check on a scaled Riemann state at the kernel nodes; returns the held U-bar."""
-        r = self.trigger.check(t, w_bar)
+    def _record(self, t: float, r: CheckResult, **extra: float) -> float:
+        """Log the check ``r`` at ``t`` (s) in U (veh/s), with its diagnostics and
+        ``extra``; returns the held U-bar (m/s)."""
         per = self.lin.u_bar_per_u
         self.log.record(t, r.u_bar_held / per, r.u_bar_continuous / per, r.triggered,
-                        V=r.V, d=r.d, m=r.m, m_nonnegative=float(r.m >= 0))
+                        V=r.V, d=r.d, m=r.m, m_nonnegative=float(r.m >= 0), **extra)
         return r.u_bar_held
+
+
+class EventTriggered(TriggeredLaw):
+    """Full-state dynamic ETC (control law sam with the mechanism of defdynamic)."""
+
+    name = "etc"
+
+    def __init__(self, lin: Linearization, kernels: Kernels,
+                 design: EtcDesign = PAPER_DESIGN) -> None:
+        super().__init__(lin, kernels, design)
+        self.state_map = StateMap(lin, kernels.x)
+
+    def applied(self, u: float, lower: float = -math.inf, upper: float = math.inf) -> None:
+        """Anti-windup: the trigger compares what the actuator delivers in ``[lower,
+        upper]`` (veh/s) from the next check on (module docstring)."""
+        self.trigger.bounds = u_bar_range(lower, upper, self.lin.u_bar_per_u)
+
+    def check_riemann(self, t: float, w_bar: np.ndarray) -> float:
+        """Check on a scaled Riemann state at the kernel nodes; returns the held U-bar."""
+        return self._record(t, self.trigger.check(t, w_bar))
 
     def decide(self, state: MacroState) -> float:
         z = self.state_map.deviations(state)

@@ -39,8 +39,8 @@ import math
 
 import numpy as np
 
-from arzsumo.control.base import Controller, MacroState
-from arzsumo.control.etc import PAPER_DESIGN, EtcDesign, EventTrigger, u_bar_range
+from arzsumo.control.base import MacroState
+from arzsumo.control.etc import PAPER_DESIGN, EtcDesign, TriggeredLaw, u_bar_range
 from arzsumo.control.kernels import Kernels, solve_kernels
 from arzsumo.control.plant import LinearPlant, step_dividing
 from arzsumo.model.characteristic import CharacteristicSystem, Linearization
@@ -115,17 +115,15 @@ class BoundaryObserver:
         return self.estimate
 
 
-class ObserverEtc(Controller):
+class ObserverEtc(TriggeredLaw):
     """Observer-based dynamic ETC: measurement only at the inlet (bs_control_of_etc)."""
 
     name = "observer-etc"
 
     def __init__(self, lin: Linearization, kernels: Kernels,
                  design: EtcDesign = PAPER_DESIGN) -> None:
-        super().__init__()
-        self.lin = lin
+        super().__init__(lin, kernels, design)
         self.observer = BoundaryObserver(lin.system, kernels.n_cells)
-        self.trigger = EventTrigger(lin.system, kernels, design)
         self.u_bar_held = 0.0
         #: U-bar the observer integrates over the next interval: the applied one
         self.u_bar_input = 0.0
@@ -136,7 +134,6 @@ class ObserverEtc(Controller):
     def reset(self) -> None:
         super().reset()
         self.observer.reset()
-        self.trigger.reset()
         self.u_bar_held = self.u_bar_input = 0.0
 
     def measurement_of(self, state: MacroState) -> float:
@@ -149,20 +146,7 @@ class ObserverEtc(Controller):
         estimate = self.observer.advance(t, y, self.u_bar_input)
         r = self.trigger.check(t, estimate)
         self.u_bar_held = self.u_bar_input = r.u_bar_held
-        per = self.lin.u_bar_per_u
-        self.log.record(t, r.u_bar_held / per, r.u_bar_continuous / per, r.triggered,
-                        V=r.V, d=r.d, m=r.m, m_nonnegative=float(r.m >= 0), y=y)
-        return r.u_bar_held
-
-    @property
-    def has_trigger(self) -> bool:
-        """An event trigger holds U between events."""
-        return True
-
-    def set_output_noise(self, sd: float) -> bool:
-        """The trigger's dead band from the sd (veh/s) of this law's output noise."""
-        self.trigger.set_output_noise(sd * abs(self.lin.u_bar_per_u))
-        return True
+        return self._record(t, r, y=y)
 
     def applied(self, u: float, lower: float = -math.inf, upper: float = math.inf) -> None:
         """Anti-windup: the observer integrates with the applied ``u`` (veh/s) until the

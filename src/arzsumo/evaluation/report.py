@@ -120,6 +120,27 @@ def per_seed(runs: pd.DataFrame, measure: Measure, controllers: Sequence[str]) -
     return wide.reindex(columns=list(controllers)).sort_index()
 
 
+
+def seed_values(runs: pd.DataFrame, measure: Measure, controller: str,
+                seeds: Sequence[int]) -> np.ndarray:
+    """``controller``'s ``measure`` on ``seeds``, in that order (its human unit; NaN where
+    missing)."""
+    return per_seed(runs, measure, [controller])[controller].reindex(seeds).to_numpy(float)
+
+
+def paired_cell(treatment: np.ndarray, baseline: np.ndarray, *, lower_is_better: bool = True,
+                bracket_counts: bool = False) -> str:
+    """Treatment minus baseline, paired by seed, as a table cell: the mean difference
+    [95 % t interval] (unit of the data), then the seeds won / lost by the treatment
+    (``(wins/losses)`` with ``bracket_counts``); empty where the pairs are too few."""
+    try:
+        d = paired_difference(treatment, baseline, lower_is_better=lower_is_better)
+    except StatisticsError:
+        return ""
+    counts = f"{d.wins}/{d.losses}"
+    return (f"{d.mean_diff:+.3g} [{d.t.low:+.3g}, {d.t.high:+.3g}] "
+            + (f"({counts})" if bracket_counts else counts))
+
 def _row(measure: Measure, controller: str, values: np.ndarray,
          base: np.ndarray) -> dict[str, object]:
     row: dict[str, object] = {"measure": measure.key, "label": measure.label,

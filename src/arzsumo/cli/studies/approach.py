@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from arzsumo.cli.studies.options import add_output, add_runs, plots_wanted
+from arzsumo.cli.studies.options import add_measured_window, add_output, add_runs, plots_wanted
 from arzsumo.studies.common import fraction, number_list, positive_float, print_list
 from arzsumo.studies.sumo_map.approach import (
     AV_SHARE,
@@ -32,9 +32,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="buffer length before x = 0, m")
     parser.add_argument("--empty-start", action="store_true",
                         help="start with an empty section (default: a congested one)")
-    parser.add_argument("--warmup", type=positive_float, default=150.0, help="s not measured")
-    parser.add_argument("--measured", type=positive_float, default=450.0, help="s measured")
-    parser.add_argument("--step", type=positive_float, default=0.1, help="SUMO step, s")
+    add_measured_window(parser, warmup_s=150.0)
     parser.add_argument("--av-share", type=fraction, default=AV_SHARE,
                         help="AV share of the mainline demand (default: 0.275)")
     parser.add_argument("--from", dest="source", type=Path, metavar="CSV",

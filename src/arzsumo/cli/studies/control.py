@@ -14,7 +14,7 @@ from arzsumo.cli.studies.options import (
     recorded_runs,
 )
 from arzsumo.errors import EXIT_SOME_FAILED
-from arzsumo.resources import shipped_scenarios_dir
+from arzsumo.resources import default_scenario
 from arzsumo.studies.common import names_among, print_list
 from arzsumo.studies.control.study import (
     EXPERIMENTS,
@@ -30,7 +30,7 @@ from arzsumo.studies.control.study import (
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """The control study's options."""
     parser.add_argument("--scenario", type=Path,
-                        default=shipped_scenarios_dir() / "default.toml", metavar="FILE",
+                        default=default_scenario(), metavar="FILE",
                         help="the base scenario (default: the shipped default)")
     parser.add_argument("--controllers", default=",".join(JUDGED),
                         help="comma-separated controllers (default: %(default)s)")

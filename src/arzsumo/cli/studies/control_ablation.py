@@ -9,7 +9,7 @@ from pathlib import Path
 
 from arzsumo.cli.studies.options import add_output, add_records, add_runs, recorded_runs
 from arzsumo.errors import EXIT_SOME_FAILED
-from arzsumo.resources import shipped_scenarios_dir
+from arzsumo.resources import default_scenario
 from arzsumo.studies.common import RESULTS_DIR, names_among, print_list
 from arzsumo.studies.control import study as control
 from arzsumo.studies.control.ablation import (
@@ -27,7 +27,7 @@ from arzsumo.studies.control.ablation import (
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """The ablation's options."""
     parser.add_argument("--scenario", type=Path,
-                        default=shipped_scenarios_dir() / "default.toml", metavar="FILE",
+                        default=default_scenario(), metavar="FILE",
                         help="the control study's base scenario (default: the shipped "
                              "default)")
     parser.add_argument("--control", type=Path, default=RESULTS_DIR / control.NAME,

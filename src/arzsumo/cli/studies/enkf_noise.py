@@ -4,9 +4,8 @@ mapped onto its :class:`~arzsumo.studies.estimation.enkf_noise.EnkfNoiseOptions`
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
-from arzsumo.cli.studies.options import add_output
+from arzsumo.cli.studies.options import add_output, add_scenario_times, add_study_scenario
 from arzsumo.studies.common import (
     non_negative_int,
     number_list,
@@ -25,15 +24,12 @@ from arzsumo.studies.estimation.enkf_noise import (
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """The EnKF noise study's options."""
-    parser.add_argument("--scenario", type=Path, metavar="SCENARIO.toml",
-                        help="scenario recorded (default: the former default, lateral_files)")
+    add_study_scenario(parser)
     parser.add_argument("--tune-seeds", type=seed_list, default=[1, 2], metavar="LIST",
                         help="seeds the noise is tuned on (default: 1,2)")
     parser.add_argument("--report-seeds", type=seed_list, default=[3, 4, 5], metavar="LIST",
                         help="held-out seeds reported on (default: 3-5)")
-    parser.add_argument("--warmup", type=positive_float, help="s (default: the scenario's)")
-    parser.add_argument("--horizon", type=positive_float,
-                        help="control horizon, s (default: the scenario's)")
+    add_scenario_times(parser)
     parser.add_argument("--layout", default="loops 250 m + AV probes",
                         choices=list(ENKF_LAYOUTS), help="the layout tuned on")
     parser.add_argument("--start", type=number_list, default=[2.0, 1.0, 1.0, 1.0],

@@ -5,10 +5,14 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
-from arzsumo.cli.studies.options import add_output, add_runs
-from arzsumo.studies.common import positive_float, print_list
+from arzsumo.cli.studies.options import (
+    add_output,
+    add_runs,
+    add_scenario_times,
+    add_study_scenario,
+)
+from arzsumo.studies.common import print_list
 from arzsumo.studies.estimation.layouts import (
     NAME,
     PAGE,
@@ -20,12 +24,9 @@ from arzsumo.studies.estimation.layouts import (
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """The layout study's options."""
-    parser.add_argument("--scenario", type=Path, metavar="SCENARIO.toml",
-                        help="scenario recorded (default: the former default, lateral_files)")
+    add_study_scenario(parser)
     add_runs(parser, seeds="1-5")
-    parser.add_argument("--warmup", type=positive_float, help="s (default: the scenario's)")
-    parser.add_argument("--horizon", type=positive_float,
-                        help="control horizon, s (default: the scenario's)")
+    add_scenario_times(parser)
     add_output(parser, NAME, PAGE, plots=False)
 
 

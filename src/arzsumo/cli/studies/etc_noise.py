@@ -7,7 +7,7 @@ import argparse
 from pathlib import Path
 
 from arzsumo.cli.studies.options import add_output, add_runs
-from arzsumo.resources import shipped_scenarios_dir
+from arzsumo.resources import default_scenario
 from arzsumo.studies.common import number_list, print_list
 from arzsumo.studies.control.etc_noise import (
     LEVELS_PCT,
@@ -22,7 +22,7 @@ from arzsumo.studies.control.etc_noise import (
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """The study's options."""
     parser.add_argument("--scenario", type=Path,
-                        default=shipped_scenarios_dir() / "default.toml", metavar="FILE",
+                        default=default_scenario(), metavar="FILE",
                         help="the scenario whose twin is run (default: the shipped default)")
     parser.add_argument("--levels", type=number_list, default=number_list(LEVELS_PCT),
                         metavar="LIST", help="relative noise sd of the fields, %% "

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from arzsumo.cli.studies.options import add_output, add_runs
+from arzsumo.cli.studies.options import add_measured_window, add_output, add_runs
 from arzsumo.studies.common import non_negative_float, number_list, positive_float, print_list
 from arzsumo.studies.sumo_map.fill import NAME, PAGE, FillOptions, design, run_fill
 
@@ -27,9 +27,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_runs(parser, seeds="1")
     parser.add_argument("--approach", type=positive_float, default=2500.0,
                         help="buffer length before x = 0, m")
-    parser.add_argument("--warmup", type=positive_float, default=600.0, help="s not measured")
-    parser.add_argument("--measured", type=positive_float, default=450.0, help="s measured")
-    parser.add_argument("--step", type=positive_float, default=0.1, help="SUMO step, s")
+    add_measured_window(parser, warmup_s=600.0)
     add_output(parser, NAME, PAGE, plots=False)
 
 

@@ -4,9 +4,8 @@ mapped onto its :class:`~arzsumo.studies.estimation.loop_speed.LoopSpeedOptions`
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
-from arzsumo.cli.studies.options import add_output, add_runs
+from arzsumo.cli.studies.options import add_output, add_runs, add_study_scenario
 from arzsumo.studies.common import positive_float, print_list
 from arzsumo.studies.estimation.loop_speed import (
     METHODS,
@@ -20,8 +19,7 @@ from arzsumo.studies.estimation.loop_speed import (
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """The loop-speed study's options."""
-    parser.add_argument("--scenario", type=Path, metavar="SCENARIO.toml",
-                        help="scenario recorded (default: the former default, lateral_files)")
+    add_study_scenario(parser)
     add_runs(parser, seeds="1")
     parser.add_argument("--horizon", type=positive_float, default=300.0,
                         help="control horizon recorded, s")

@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from arzsumo.argtypes import positive_int, seed_list
+from arzsumo.argtypes import positive_float, positive_int, seed_list
 from arzsumo.studies.common import DOCS_DIR, RESULTS_DIR
 from arzsumo.studies.recorded import RecordedRuns
 
@@ -23,6 +23,29 @@ def add_output(parser: argparse.ArgumentParser, name: str, page: str,
                              f"DIR/{page}.md, its files in DIR/{page}/ (DIR: {DOCS_DIR})")
     if plots:
         parser.add_argument("--no-plots", action="store_true", help="skip the figures")
+
+
+def add_study_scenario(parser: argparse.ArgumentParser, verb: str = "recorded") -> None:
+    """``--scenario``: the scenario file the study's runs are ``verb`` on (default: the
+    former default, lateral_files)."""
+    parser.add_argument("--scenario", type=Path, metavar="SCENARIO.toml",
+                        help=f"scenario {verb} (default: the former default, lateral_files)")
+
+
+def add_scenario_times(parser: argparse.ArgumentParser) -> None:
+    """``--warmup`` and ``--horizon`` (control horizon), s (default: the scenario's)."""
+    parser.add_argument("--warmup", type=positive_float, help="s (default: the scenario's)")
+    parser.add_argument("--horizon", type=positive_float,
+                        help="control horizon, s (default: the scenario's)")
+
+
+def add_measured_window(parser: argparse.ArgumentParser, warmup_s: float) -> None:
+    """``--warmup`` (default ``warmup_s``) s not measured, then ``--measured`` s measured,
+    at the SUMO step ``--step``, s (an open-loop SUMO map's window)."""
+    parser.add_argument("--warmup", type=positive_float, default=warmup_s,
+                        help="s not measured")
+    parser.add_argument("--measured", type=positive_float, default=450.0, help="s measured")
+    parser.add_argument("--step", type=positive_float, default=0.1, help="SUMO step, s")
 
 
 def add_runs(parser: argparse.ArgumentParser, seeds: str | None) -> None:

@@ -6,15 +6,14 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from arzsumo.cli.studies.options import add_output, add_runs
+from arzsumo.cli.studies.options import add_output, add_runs, add_study_scenario
 from arzsumo.studies.common import print_list
 from arzsumo.studies.sumo_map.wave_speed import NAME, PAGE, WaveSpeedOptions, design, run_wave_speed
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """The wave-speed study's options."""
-    parser.add_argument("--scenario", type=Path, metavar="SCENARIO.toml",
-                        help="scenario run (default: the former default, lateral_files)")
+    add_study_scenario(parser, "run")
     parser.add_argument("--controllers", default="open,etc",
                         help="comma-separated controllers")
     add_runs(parser, seeds="42")

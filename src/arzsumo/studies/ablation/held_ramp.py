@@ -23,8 +23,7 @@ import numpy as np
 import pandas as pd
 
 from arzsumo.evaluation.report import MEASURES as EVALUATION_MEASURES
-from arzsumo.evaluation.report import Measure, per_seed
-from arzsumo.evaluation.stats import StatisticsError, paired_difference
+from arzsumo.evaluation.report import Measure, paired_cell, seed_values
 from arzsumo.io import dump_toml
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, write_text
@@ -71,8 +70,7 @@ def held_scenario() -> dict:
 
 def values(runs: pd.DataFrame, controller: str, m: Measure, seeds: list[int]) -> np.ndarray:
     """``controller``'s measure ``m`` on ``seeds`` from a sweep table (NaN where missing)."""
-    wide = per_seed(runs, m, [controller])
-    return wide[controller].reindex(seeds).to_numpy(float)
+    return seed_values(runs, m, controller, seeds)
 
 
 def report(meter: pd.DataFrame, held: pd.DataFrame, seeds: list[int]) -> str:
@@ -82,14 +80,8 @@ def report(meter: pd.DataFrame, held: pd.DataFrame, seeds: list[int]) -> str:
              + " |", "|---" * (2 + len(SETS)) + "|"]
     for m in measures():
         base = values(held, BASELINE, m, seeds)
-        cells = []
-        for _, ctrl in SETS:
-            try:
-                d = paired_difference(values(meter, ctrl, m, seeds), base)
-                cells.append(f"{d.mean_diff:+.3g} [{d.t.low:+.3g}, {d.t.high:+.3g}] "
-                             f"({d.wins}/{d.losses})")
-            except StatisticsError:
-                cells.append("")
+        cells = [paired_cell(values(meter, ctrl, m, seeds), base, bracket_counts=True)
+                 for _, ctrl in SETS]
         mean = f"{np.nanmean(base):.4g}" if np.isfinite(base).any() else ""
         lines.append(f"| {m.label} ({m.unit}) | {mean} | " + " | ".join(cells) + " |")
     return "\n".join(lines)

@@ -51,13 +51,12 @@ from pathlib import Path
 import pandas as pd
 
 from arzsumo.errors import ArzsumoError
-from arzsumo.evaluation.report import Measure, per_seed
-from arzsumo.evaluation.stats import StatisticsError, paired_difference
+from arzsumo.evaluation.report import Measure, paired_cell, seed_values
 from arzsumo.io import dump_toml, read_toml
 from arzsumo.model.wave_match import wave_matched
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import publish, write_text
-from arzsumo.resources import shipped_scenarios_dir
+from arzsumo.resources import default_scenario
 from arzsumo.scenario import scenario_from_dict
 from arzsumo.studies import checks
 from arzsumo.studies.common import RESULTS_DIR, StudyError, seed_text
@@ -133,8 +132,7 @@ def _power_law(data: dict) -> dict:
     """``data`` with the shipped default's ``[model]``, ``[equilibrium]`` and ``[design]``
     (the paper's power-law diagram, identified on the same stream), the trigger's
     measured dead band kept where ``data`` asks for it."""
-    default = tomllib.loads((shipped_scenarios_dir() / "default.toml").read_text(
-        encoding="utf-8"))
+    default = tomllib.loads(default_scenario().read_text(encoding="utf-8"))
     measured = data.get("design", {}).get("noise_from_estimate")
     for table in ("model", "equilibrium", "design"):
         data[table] = dict(default[table])
@@ -209,17 +207,8 @@ def _cells(a_runs: pd.DataFrame, a: str, b_runs: pd.DataFrame, b: str,
            seeds: list[int]) -> list[str]:
     """Per measure, ``a`` of ``a_runs`` minus ``b`` of ``b_runs``, paired by seed:
     mean [95 % t] wins/losses of ``a`` (empty where there are too few pairs)."""
-    cells = []
-    for m in measures():
-        x = per_seed(a_runs, m, [a])[a].reindex(seeds).to_numpy(float)
-        y = per_seed(b_runs, m, [b])[b].reindex(seeds).to_numpy(float)
-        try:
-            d = paired_difference(x, y, lower_is_better=m.lower_is_better)
-            cells.append(f"{d.mean_diff:+.3g} [{d.t.low:+.3g}, {d.t.high:+.3g}] "
-                         f"{d.wins}/{d.losses}")
-        except StatisticsError:
-            cells.append("")
-    return cells
+    return [paired_cell(seed_values(a_runs, m, a, seeds), seed_values(b_runs, m, b, seeds),
+                        lower_is_better=m.lower_is_better) for m in measures()]
 
 
 def table(steps: dict[str, pd.DataFrame], full: pd.DataFrame, seeds: list[int],
@@ -290,7 +279,7 @@ class AblationOptions:
     @property
     def base(self) -> Path:
         """The control study's base scenario file."""
-        return self.scenario or shipped_scenarios_dir() / "default.toml"
+        return self.scenario or default_scenario()
 
 
 @dataclass(frozen=True)

@@ -41,7 +41,7 @@ from arzsumo.io import dump_toml, read_toml
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.evaluation import paired_figure
 from arzsumo.outputs.studies import publish, remove_stale_figures, write_csv, write_text
-from arzsumo.resources import shipped_scenarios_dir
+from arzsumo.resources import default_scenario
 from arzsumo.studies import checks
 from arzsumo.studies.common import RESULTS_DIR, StudyError, seed_text
 from arzsumo.studies.control.claims import claims_table
@@ -178,7 +178,7 @@ class ControlOptions:
     @property
     def base(self) -> Path:
         """The base scenario file."""
-        return self.scenario or shipped_scenarios_dir() / "default.toml"
+        return self.scenario or default_scenario()
 
 
 @dataclass(frozen=True)

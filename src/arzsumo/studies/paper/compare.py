@@ -90,6 +90,20 @@ def _cells(row: dict[str, Any], key: str, paper: float, ours: float) -> list[str
     return [f"{key}: {why}"] if why else []
 
 
+def _compared_row(label: str, scenario: str, cells: list[tuple[str, float, float]],
+                  extra: dict[str, Any] | None = None) -> dict[str, Any]:
+    """One published row beside ours: per cell ``(column, paper, ours)`` both values
+    (units as the column says) and a verdict, then ``extra``; ``notes`` joins the reasons
+    of the cells not reproduced."""
+    row: dict[str, Any] = {"label": label, "scenario": scenario}
+    notes: list[str] = []
+    for key, paper, ours in cells:
+        notes += _cells(row, key, paper, ours)
+    row.update(extra or {})
+    row["notes"] = " | ".join(dict.fromkeys(notes))
+    return row
+
+
 def performance_table(rep: Reproduction) -> list[dict[str, Any]]:
     """Table diffperformance: relative J_fuel, J_discom, J_TTT (%) and release time (s)."""
     rows = []
@@ -97,16 +111,11 @@ def performance_table(rep: Reproduction) -> list[dict[str, Any]]:
         rec = rep.get(p.scenario)
         if rec is None:
             continue
-        row: dict[str, Any] = {"label": p.label, "scenario": p.scenario}
-        notes: list[str] = []
-        for key in ("J_fuel", "J_discom", "J_TTT"):
-            notes += _cells(row, f"{key}_percent", getattr(p, key),
-                            rec.relative("total", key))
-        row["paper_release_time_s"] = p.release_time
-        row["ours_release_time_s"] = rec.release_time
-        row["ours_triggers"] = rec.triggers
-        row["notes"] = " | ".join(dict.fromkeys(notes))
-        rows.append(row)
+        cells = [(f"{key}_percent", getattr(p, key), rec.relative("total", key))
+                 for key in ("J_fuel", "J_discom", "J_TTT")]
+        rows.append(_compared_row(p.label, p.scenario, cells, {
+            "paper_release_time_s": p.release_time, "ours_release_time_s": rec.release_time,
+            "ours_triggers": rec.triggers}))
     return rows
 
 
@@ -117,13 +126,9 @@ def delay_table(rep: Reproduction) -> list[dict[str, Any]]:
         rec = rep.get(p.scenario)
         if rec is None:
             continue
-        row: dict[str, Any] = {"label": p.label, "scenario": p.scenario}
-        notes: list[str] = []
-        for part, name in (("h", "HV"), ("a", "AV"), ("total", "total")):
-            notes += _cells(row, f"{name}_delay_percent", getattr(p, part),
-                            rec.relative(part, "total_delay"))
-        row["notes"] = " | ".join(dict.fromkeys(notes))
-        rows.append(row)
+        cells = [(f"{name}_delay_percent", getattr(p, part), rec.relative(part, "total_delay"))
+                 for part, name in (("h", "HV"), ("a", "AV"), ("total", "total"))]
+        rows.append(_compared_row(p.label, p.scenario, cells))
     return rows
 
 
