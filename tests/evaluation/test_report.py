@@ -113,3 +113,17 @@ def test_a_run_whose_drain_did_not_empty_the_network_has_no_whole_demand_value()
     long = evaluate(pd.DataFrame(rows), ["open", "etc"], measures=[whole])
     etc = long[long.controller == "etc"].iloc[0]
     assert etc["n"] == 2 and etc["diff_mean"] == pytest.approx(1.0)
+
+
+def test_a_seed_deadlocked_under_every_controller_is_named_and_one_that_is_not_stays():
+    from arzsumo.evaluation.report import deadlocked_seeds
+
+    key = "network_whole_demand.drain.gridlock"
+    runs = pd.DataFrame({
+        "seed": [1, 1, 2, 2, 3, 3],
+        "controller": ["open", "etc"] * 3,
+        key: [False, False, True, True, False, True],   # seed 3: only the ETC gridlocks
+    })
+    assert deadlocked_seeds(runs) == [2]
+    assert deadlocked_seeds(runs.drop(columns=[key])) == []
+    assert deadlocked_seeds(runs.assign(**{key: ["true", "True"] * 3})) == [1, 2, 3]

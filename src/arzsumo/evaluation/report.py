@@ -121,6 +121,21 @@ def per_seed(runs: pd.DataFrame, measure: Measure, controllers: Sequence[str]) -
 
 
 
+def deadlocked_seeds(runs: pd.DataFrame) -> list[int]:
+    """The seeds on which every run's drain ended in a gridlock (SUMO deadlocked under
+    every controller, the open loop included: the stream failed there, not a controller).
+
+    A comparison leaves them out: their measures are a standstill's (band power 0, no
+    whole-demand time), and their zero differences would narrow every interval.
+    """
+    key = f"{_WHOLE}.drain.gridlock"
+    if key not in runs or runs.empty:
+        return []
+    stuck = runs[key].astype(str).str.lower() == "true"
+    every = stuck.groupby(runs["seed"]).all()
+    return sorted(int(s) for s in every[every].index)
+
+
 def seed_values(runs: pd.DataFrame, measure: Measure, controller: str,
                 seeds: Sequence[int]) -> np.ndarray:
     """``controller``'s ``measure`` on ``seeds``, in that order (its human unit; NaN where

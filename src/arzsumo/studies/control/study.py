@@ -36,7 +36,7 @@ import numpy as np
 import pandas as pd
 
 from arzsumo.evaluation.report import MEASURES as EVALUATION_MEASURES
-from arzsumo.evaluation.report import Measure, evaluate, markdown
+from arzsumo.evaluation.report import Measure, deadlocked_seeds, evaluate, markdown
 from arzsumo.io import dump_toml, read_toml
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.evaluation import paired_figure
@@ -231,6 +231,14 @@ def run_control(opts: ControlOptions) -> ControlResult:
             ok &= finished
             counts.append(f"{e}: {len(found)} of {len(controllers) * len(runs.seeds)} "
                           "runs finished")
+            stuck = deadlocked_seeds(found)
+            if stuck:
+                log.warning("%s: seeds %s left out: SUMO deadlocked under every "
+                            "controller", e, seed_text(stuck))
+                counts.append(f"seeds {seed_text(stuck)} left out of the {e} tables "
+                              "(SUMO deadlocked under every controller, the open loop "
+                              "included)")
+                found = found[~found["seed"].isin(stuck)]
             if found.empty:      # a report before any run of this experiment finished
                 log.warning("no finished %s runs yet: its tables are left out", e)
                 continue
