@@ -45,3 +45,25 @@ def test_the_design_is_design_check_autos_and_keeps_the_bases_dead_band():
     assert table["A"] == pytest.approx(want["A"], rel=1e-5)
     assert table["noise_from_estimate"] is True
     assert len(cannot) == 1                      # esthm #1, as its comment says
+
+
+def test_the_idm_streams_model_carries_its_waves_and_its_design_is_design_check_autos():
+    # stop_and_go_idm's model was identified in two stages with the blocks' jam floor:
+    # lambda_4 at its equilibrium within 4 % of SUMO's waves there (-29.8 HV, -30.7 AV
+    # km/h on the held-out seeds); its [design] is design-check --auto's for that model
+    from arzsumo.model.characteristic import characteristic_speeds
+    from arzsumo.scenario import scenario_from_dict
+    from arzsumo.units import ms_to_kmh
+
+    idm = tomllib.loads((shipped_scenarios_dir() / "stop_and_go_idm.toml").read_text(
+        encoding="utf-8"))
+    sc = scenario_from_dict(idm, "stop_and_go_idm.toml")
+    eq = sc.equilibrium
+    lam4 = ms_to_kmh(float(min(characteristic_speeds(sc.params, eq.rho_h, eq.rho_a))))
+    assert lam4 == pytest.approx(-29.33, abs=0.01)
+    assert abs(lam4 - (-30.25)) / 30.25 < 0.04
+    table, cannot = _design(idm, idm, 100)
+    for key in ("mu", "sigma", "zeta", "eta", "B"):
+        assert table[key] == pytest.approx(idm["design"][key], rel=1e-5), key
+    assert table["A"] == pytest.approx(idm["design"]["A"], rel=1e-5)
+    assert len(cannot) == 1                      # esthm #1, as its comment says
