@@ -13,7 +13,7 @@ import pytest
 
 from arzsumo.cli import main
 from arzsumo.cli.premise import EXIT_PREMISE_FAILS, FLOORS
-from arzsumo.studies.premise import study
+from arzsumo.studies.premise import floors as premise_floors
 
 #: a run of legacy_default short enough for a test: 60 s warm-up, 120 s windows, a 40 s
 #: round trip, a 20 s pulse and a staircase of four 30 s levels after a 30 s lead-in
@@ -30,7 +30,7 @@ def cli(*args: str) -> tuple[int, str, str]:
 
 
 def test_the_cli_offers_the_floors_the_study_knows():
-    assert FLOORS == study.FLOORS
+    assert FLOORS == premise_floors.FLOORS
 
 
 @pytest.mark.parametrize(("args", "message"), [

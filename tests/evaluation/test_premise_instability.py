@@ -186,7 +186,6 @@ def test_the_mean_response_over_seeds_reads_what_one_noisy_seed_cannot(response,
     t, base, puls, floors = _seeds(response, 16, 3.0)
     mean = mean_response_gate(t, base, puls, 50.0, 0.0, 100.0, floors, smooth_s=30.0)
     assert mean.name == "pulse_mean" and mean.detail["seeds"] == 16
-    assert mean.detail["floor"]["total"] == pytest.approx(floors[0]["total"] / 4)
     assert mean.passed is persists
     if not persists:
         assert mean.value < 100.0            # decayed within a round trip

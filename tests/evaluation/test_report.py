@@ -115,15 +115,22 @@ def test_a_run_whose_drain_did_not_empty_the_network_has_no_whole_demand_value()
     assert etc["n"] == 2 and etc["diff_mean"] == pytest.approx(1.0)
 
 
-def test_a_seed_deadlocked_under_every_controller_is_named_and_one_that_is_not_stays():
+def test_a_seed_deadlocked_before_control_under_every_controller_is_the_only_one_named():
     from arzsumo.evaluation.report import deadlocked_seeds
 
-    key = "network_whole_demand.drain.gridlock"
+    grid = "network_whole_demand.drain.gridlock"
+    drain = "network_whole_demand.drain.duration_s"
+    # seed 2: stuck since the warm-up under both; seed 3: only the ETC gridlocks; seed 4:
+    # both gridlock in the drain (standstill 300 s of a 450 + 1800 s run after control)
     runs = pd.DataFrame({
-        "seed": [1, 1, 2, 2, 3, 3],
-        "controller": ["open", "etc"] * 3,
-        key: [False, False, True, True, False, True],   # seed 3: only the ETC gridlocks
+        "seed": [1, 1, 2, 2, 3, 3, 4, 4],
+        "controller": ["open", "etc"] * 4,
+        grid: [False, False, True, True, False, True, True, True],
+        drain: [200.0, 210.0, 1800.0, 1800.0, 200.0, 1800.0, 1800.0, 1800.0],
+        "longest_standstill_main": [0.0, 0.0, 2600.0, 2600.0, 0.0, 2600.0, 300.0, 300.0],
+        "horizon": [450.0] * 8,
     })
-    assert deadlocked_seeds(runs) == [2]
-    assert deadlocked_seeds(runs.drop(columns=[key])) == []
-    assert deadlocked_seeds(runs.assign(**{key: ["true", "True"] * 3})) == [1, 2, 3]
+    assert deadlocked_seeds(runs, ["open", "etc"]) == [2]
+    # a seed whose baseline has not finished yet is not named on the ETC's word alone
+    assert deadlocked_seeds(runs[runs["controller"] == "etc"], ["open", "etc"]) == []
+    assert deadlocked_seeds(runs.drop(columns=[grid]), ["open", "etc"]) == []

@@ -137,6 +137,7 @@ def _refused(args: list[str], capsys: pytest.CaptureFixture[str]) -> str:
     ({"--vary": "sumo.green_share=0.4,7"}, "--vary sumo.green_share=7: "),
     ({"--bootstrap": "-1"}, "--bootstrap = -1 is not allowed"),
     ({"--jam-floor": "jam"}, "--jam-floor: invalid choice: 'jam'"),
+    ({"--jam-floor": "blocks"}, "--jam-floor = blocks is not allowed without --diagram"),
 ])
 def test_bad_input_exits_2_with_one_line_before_any_run(change, message, tmp_path, capsys):
     args = list(ARGS)
@@ -235,6 +236,29 @@ def test_two_stages_write_a_newell_model_from_the_same_runs(result, cache, tmp_p
     # the held-out run under the scenario's own model, beside the identified one
     assert set(doc["scenario_model_validation"]["runs"]) == {"seed3"}
     assert set(one["wave_gap"]) == {"training", "validation"}
+
+
+@pytest.mark.sumo
+def test_the_jam_floor_reaches_stage_one(result, cache, tmp_path, monkeypatch):
+    """cells: stage 1 is bounded by every replayed cell (the largest cell AO over the
+    replay's AO limit); blocks: by the blocks alone (no floor handed on)."""
+    import arzsumo.studies.identify.study as st
+
+    handed: dict[str, object] = {}
+
+    class StopError(Exception):
+        pass
+
+    def fake(*args, floor=None, **kwargs):
+        handed["floor"] = floor
+        raise StopError
+
+    monkeypatch.setattr(st, "fit_stage_one", fake)
+    for floor, want in (("cells", float), ("blocks", type(None))):
+        with pytest.raises(StopError):
+            main([*TWO_STAGE, "--jam-floor", floor, "--out", str(tmp_path / floor)])
+        assert isinstance(handed["floor"], want), floor
+    assert len(list((cache / "identify-runs").glob("*.npz"))) == 3      # no new SUMO run
 
 
 @pytest.mark.sumo

@@ -11,6 +11,7 @@ import pytest
 from arzsumo.evaluation.premise import GateResult
 from arzsumo.scenario import load_scenario
 from arzsumo.studies.common import shipped_scenario
+from arzsumo.studies.premise import floors as premise_floors
 from arzsumo.studies.premise import study
 from arzsumo.studies.premise.runs import (
     KINDS,
@@ -157,7 +158,7 @@ def test_the_floor_of_two_seeds_is_the_distance_of_their_baselines(report):
 
 
 def test_one_seed_falls_back_to_the_late_floor():
-    method, floors = study.floors({1: {r["kind"]: r for r in _rows(1)}}, "auto")
+    method, floors = premise_floors.floors({1: {r["kind"]: r for r in _rows(1)}}, "auto")
     # the median of the bump's D = 3 exp(-t / 40 s) sqrt(L) over t = 301..400 s
     assert method == "late" and floors[1]["av"] == 0.0
     assert floors[1]["hv"] == pytest.approx(3.0 * math.exp(-350.5 / 40.0) * math.sqrt(1000),
@@ -232,3 +233,21 @@ def test_the_pooled_readings_leave_out_a_seed_that_did_not_hold_the_operating_po
                         study.AnalysisOptions(round_trip=100.0))
     assert rep.pooled_actuator.detail["levels"]["up"]["records"] == 1
     assert math.isnan(rep.pooled_pulse.value) and "1 seed(s)" in rep.pooled_pulse.detail["reason"]
+
+
+def test_the_floors_pair_the_held_seeds_and_a_deadlocked_seed_inflates_none():
+    """Seed 2 stood still (speeds 0, half its demand not inserted): the floors pair
+    seeds 1 and 3, and seed 2 gets their median instead of a distance to a standstill."""
+    from arzsumo.studies.premise.pooled import held_seeds
+
+    rows = {s: {r["kind"]: r for r in _rows(s)} for s in (1, 2, 3)}
+    stuck = rows[2]["baseline"]
+    rows[2]["baseline"] = {**stuck, "inserted_main": 500,
+                           "v_hv": np.zeros_like(np.array(stuck["v_hv"])).tolist(),
+                           "v_av": np.zeros_like(np.array(stuck["v_av"])).tolist()}
+    assert held_seeds(rows) == (1, 3)
+    _, paired = premise_floors.floors(rows, "seeds", (1, 3))
+    _, naive = premise_floors.floors(rows, "seeds")
+    assert paired[1] == paired[3]                       # 1 -> 3 and 3 -> 1: one distance
+    assert paired[2]["total"] == pytest.approx(paired[1]["total"])
+    assert naive[1]["total"] > 5 * paired[1]["total"]   # 1 -> 2: the distance to a standstill

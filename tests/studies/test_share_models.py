@@ -61,7 +61,6 @@ def test_the_idm_streams_model_carries_its_waves_and_its_design_is_design_check_
     eq = sc.equilibrium
     lam4 = ms_to_kmh(float(min(characteristic_speeds(sc.params, eq.rho_h, eq.rho_a))))
     assert lam4 == pytest.approx(-29.33, abs=0.01)
-    assert abs(lam4 - (-30.25)) / 30.25 < 0.04
     table, cannot = _design(idm, idm, 100)
     for key in ("mu", "sigma", "zeta", "eta", "B"):
         assert table[key] == pytest.approx(idm["design"][key], rel=1e-5), key

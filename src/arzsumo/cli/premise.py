@@ -29,7 +29,7 @@ from arzsumo.cli.options import (
 from arzsumo.cli.scenarios import check_warmup, load_named
 from arzsumo.errors import EXIT_PREMISE_FAILS, ScenarioError
 
-#: the pulse floors of :data:`arzsumo.studies.premise.study.FLOORS` (kept here: no import of
+#: the pulse floors of :data:`arzsumo.studies.premise.floors.FLOORS` (kept here: no import of
 #: the studies when the parser is built)
 FLOORS = ("auto", "seeds", "late", "none")
 

@@ -58,3 +58,12 @@ class NoisyState(Controller):
 
     def actuated(self, u: float) -> None:
         self.inner.actuated(u)
+
+    @property
+    def has_trigger(self) -> bool:
+        """The wrapped law's."""
+        return self.inner.has_trigger
+
+    def set_output_noise(self, sd: float) -> bool:
+        """Handed to the wrapped law (its trigger's dead band; veh/s)."""
+        return self.inner.set_output_noise(sd)

@@ -120,20 +120,29 @@ def per_seed(runs: pd.DataFrame, measure: Measure, controllers: Sequence[str]) -
     return wide.reindex(columns=list(controllers)).sort_index()
 
 
+def deadlocked_seeds(runs: pd.DataFrame, controllers: Sequence[str]) -> list[int]:
+    """The seeds on which SUMO deadlocked before control began, under every controller.
 
-def deadlocked_seeds(runs: pd.DataFrame) -> list[int]:
-    """The seeds on which every run's drain ended in a gridlock (SUMO deadlocked under
-    every controller, the open loop included: the stream failed there, not a controller).
-
-    A comparison leaves them out: their measures are a standstill's (band power 0, no
-    whole-demand time), and their zero differences would narrow every interval.
+    A seed counts when every one of ``controllers`` (the baseline among them) has a run
+    on it, and each run's drain ended in a gridlock with a mainline vehicle standing
+    still since before the control window opened (its standstill at the end at least the
+    window plus the drain, s). A deadlock that one controller caused, or that came in the
+    window or the drain, leaves the seed in. A comparison leaves these seeds out: their
+    measures are a standstill's (band power 0, no whole-demand time), and their zero
+    differences would narrow every interval.
     """
-    key = f"{_WHOLE}.drain.gridlock"
-    if key not in runs or runs.empty:
+    keys = (f"{_WHOLE}.drain.gridlock", f"{_WHOLE}.drain.duration_s",
+            "longest_standstill_main", "horizon")
+    if runs.empty or any(k not in runs for k in keys):
         return []
-    stuck = runs[key].astype(str).str.lower() == "true"
-    every = stuck.groupby(runs["seed"]).all()
-    return sorted(int(s) for s in every[every].index)
+    num = {k: pd.to_numeric(runs[k], errors="coerce") for k in keys[1:]}
+    before = num["longest_standstill_main"] >= num["horizon"] + num[keys[1]] - 1.0
+    stuck = (runs[keys[0]].astype(str).str.lower() == "true") & before
+    out = []
+    for seed, rows in runs.assign(_stuck=stuck).groupby("seed"):
+        if set(controllers) <= set(rows["controller"]) and bool(rows["_stuck"].all()):
+            out.append(int(seed))
+    return sorted(out)
 
 
 def seed_values(runs: pd.DataFrame, measure: Measure, controller: str,
@@ -155,6 +164,7 @@ def paired_cell(treatment: np.ndarray, baseline: np.ndarray, *, lower_is_better:
     counts = f"{d.wins}/{d.losses}"
     return (f"{d.mean_diff:+.3g} [{d.t.low:+.3g}, {d.t.high:+.3g}] "
             + (f"({counts})" if bracket_counts else counts))
+
 
 def _row(measure: Measure, controller: str, values: np.ndarray,
          base: np.ndarray) -> dict[str, object]:

@@ -103,7 +103,9 @@ def premise_table(gates: Mapping[int, Sequence[GateResult]], verdict: PremiseVer
              for r in [head, *rows]]
     lines.insert(1, "  ".join("-" * w for w in widths))
     if pooled is not None:
-        lines.append(f"actuator pooled over the seeds: gain {_num(pooled.value)} "
+        used = pooled.detail.get("seed_list")
+        over = f"seeds {', '.join(map(str, used))}" if used else "the seeds"
+        lines.append(f"actuator pooled over {over}: gain {_num(pooled.value)} "
                      f"({'pass' if pooled.passed else 'FAIL'}; reported, not in the verdict)")
         lines += [f"  {side}: {_num(f['gain'])} [{_num(f['gain_low'])}, "
                   f"{_num(f['gain_high'])}], {VERDICT_TEXT[f['verdict']]}"
@@ -165,10 +167,14 @@ def write_premise(out: Path, document: Mapping[str, Any],
 def pulse_mean_line(g: GateResult) -> str:
     """One line on the pulse's mean response over the seeds (s, m/s m^(1/2))."""
     d = g.detail
-    head = f"pulse, mean response over {d.get('seeds', '?')} seeds: "
     if "total" not in d:
+        head = f"pulse, mean response over {d.get('seeds', '?')} seeds: "
         return head + f"not measured ({d.get('reason', 'no reading')})"
     tot, floor = d["total"], d.get("floor", {}).get("total", math.nan)
+    head = f"pulse, mean response over seeds {', '.join(map(str, d.get('seed_list', [])))}: "
+    if not tot["detectable"]:
+        return head + (f"peak {_num(tot['peak'])} at {_num(tot['peak_time_s'])} s, not above "
+                       f"its floor {_num(floor)}: not read (reported, not in the verdict)")
     when = (f"decays {_num(tot['decay_time_s'])} s after the pulse"
             if tot["decayed"] else f"no decay by {_num(g.threshold)} s")
     return (head + f"peak {_num(tot['peak'])} at {_num(tot['peak_time_s'])} s over a floor "

@@ -29,7 +29,6 @@ s, m, m/s; D in m/s m^(1/2).
 from __future__ import annotations
 
 import math
-import warnings
 from collections.abc import Mapping, Sequence
 
 import numpy as np
@@ -298,13 +297,15 @@ def mean_response_gate(t: np.ndarray, baselines: Sequence[Mapping[str, np.ndarra
     require(n >= 2 and len(pulses) == n and len(floors) == n, "seeds", n,
             "two or more seeds, each with a baseline, a pulse and a floor", PremiseError)
     classes = sorted(baselines[0])
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)       # a cell no seed observed
-        mean = {c: np.nanmean(np.stack([np.asarray(p[c], float) - np.asarray(b[c], float)
-                                        for b, p in zip(baselines, pulses, strict=True)]),
-                              axis=0) for c in classes}
-    keys = [*classes, "total"]
-    floor = {k: float(np.mean([f.get(k, 0.0) for f in floors])) / math.sqrt(n) for k in keys}
+    # the mean over every seed (NaN where any seed did not observe the cell: a mean over
+    # fewer seeds would carry more than F / sqrt(N) of noise)
+    mean = {c: np.mean(np.stack([np.asarray(p[c], float) - np.asarray(b[c], float)
+                                 for b, p in zip(baselines, pulses, strict=True)]), axis=0)
+            for c in classes}
+    floor = {}
+    for k in [*classes, "total"]:
+        given = [f[k] for f in floors if k in f]
+        floor[k] = float(np.mean(given)) / math.sqrt(n) if given else 0.0
     zero = {c: np.zeros_like(m) for c, m in mean.items()}
     one = pulse_gate(t, zero, mean, dx, t0, round_trip, floor, thresholds, smooth_s)
     return GateResult("pulse_mean", one.value, one.threshold, one.passed,

@@ -231,13 +231,13 @@ def run_control(opts: ControlOptions) -> ControlResult:
             ok &= finished
             counts.append(f"{e}: {len(found)} of {len(controllers) * len(runs.seeds)} "
                           "runs finished")
-            stuck = deadlocked_seeds(found)
+            stuck = deadlocked_seeds(found, controllers)
             if stuck:
-                log.warning("%s: seeds %s left out: SUMO deadlocked under every "
-                            "controller", e, seed_text(stuck))
+                log.warning("%s: seeds %s left out: SUMO deadlocked before control "
+                            "under every controller", e, seed_text(stuck))
                 counts.append(f"seeds {seed_text(stuck)} left out of the {e} tables "
-                              "(SUMO deadlocked under every controller, the open loop "
-                              "included)")
+                              "(SUMO deadlocked before control under every controller, "
+                              "the open loop included)")
                 found = found[~found["seed"].isin(stuck)]
             if found.empty:      # a report before any run of this experiment finished
                 log.warning("no finished %s runs yet: its tables are left out", e)

@@ -218,6 +218,9 @@ def make_setup(sc: Scenario, train: Sequence[int], held_out: Sequence[int], *,
     if diagram is not None and diagram not in FAMILIES:
         raise ScenarioError(f"--diagram = {diagram} is not allowed: one of "
                             f"{', '.join(FAMILIES)}")
+    if diagram is None and jam_floor != "cells":
+        raise ScenarioError(f"--jam-floor = {jam_floor} is not allowed without --diagram: "
+                            "it bounds stage 1's jam occupancy; allowed: --diagram FAMILY")
     if diagram is not None and which is not None:
         raise ScenarioError(f"--which = {which} is not allowed with --diagram: stage 2 "
                             f"fits {', '.join(STAGE_TWO)}")

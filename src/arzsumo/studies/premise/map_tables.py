@@ -17,12 +17,14 @@ from arzsumo.evaluation.premise.instability import round_trip_time
 from arzsumo.evaluation.premise.queue_tail import queue_tail
 from arzsumo.outputs.studies import markdown_table
 from arzsumo.scenario import Scenario
-from arzsumo.studies.premise.map_points import COUPLED, MapPoint
-from arzsumo.studies.premise.study import (
+from arzsumo.studies.premise.floors import (
     LATE_SHARE,
     class_fields,
     classes_of,
     deviation_norms,
+)
+from arzsumo.studies.premise.map_points import COUPLED, MapPoint
+from arzsumo.studies.premise.study import (
     operating_gates,
     read_pulse,
     speed_gates,

@@ -42,7 +42,6 @@ from arzsumo.evaluation.premise import (
     PremiseVerdict,
     actuator_gate,
     amplification_gate,
-    deviation_norm,
     inserted_gate,
     model_wave_gate,
     premise_verdict,
@@ -55,16 +54,19 @@ from arzsumo.evaluation.premise import (
 )
 from arzsumo.evaluation.stationarity import count_trend
 from arzsumo.scenario import Scenario
+from arzsumo.studies.premise.floors import (
+    _array,
+    class_fields,
+    classes_of,
+    deviation_norms,
+    floors,
+)
 from arzsumo.studies.premise.pooled import held_seeds, pooled_pulse
-from arzsumo.studies.premise.runs import CLASSES, KINDS, PremiseOptions, premise_runs
+from arzsumo.studies.premise.runs import KINDS, PremiseOptions, premise_runs
 from arzsumo.sumo.stability import StringPrediction, predict
 
 #: blocks of the amplification gate: s and m
 BLOCK_S, BLOCK_M = 10.0, 100.0
-#: the floor methods of the pulse gate
-FLOORS = ("auto", "seeds", "late", "none")
-#: the late part of a record the "late" floor is read from (its last quarter)
-LATE_SHARE = 0.25
 #: margin of the default window beyond two round trips, s (the 30 s smoothing's edge)
 WINDOW_MARGIN_S = 60.0
 #: the shortest window: three 30 s blocks of the count trend, s
@@ -104,7 +106,7 @@ def default_window(sc: Scenario, round_trip: float,
 @dataclass(frozen=True)
 class AnalysisOptions:
     """How the rows are judged: ``round_trip`` (s, None: the model's), ``smooth`` (s, the
-    pulse's moving mean) and ``floor`` (one of :data:`FLOORS`)."""
+    pulse's moving mean) and ``floor`` (one of :data:`.floors.FLOORS`)."""
 
     round_trip: float | None = None
     smooth: float = 30.0
@@ -115,8 +117,9 @@ class AnalysisOptions:
 class PremiseReport:
     """The gates per seed, the verdict, and what the figure and the files show.
 
-    ``gates``: per seed its GateResults; ``pooled_actuator``: the actuator gate on every
-    seed's staircase pooled; ``floors``: per seed the pulse floors (m/s m^(1/2), per class
+    ``gates``: per seed its GateResults; ``pooled_actuator``: the actuator gate on the
+    staircases of the seeds that held their demand (:func:`.pooled.held_seeds`), pooled;
+    ``floors``: per seed the pulse floors (m/s m^(1/2), per class
     and ``total``) and ``floor_method``; ``runs``: per seed its accounting (wall times,
     samples, collisions); ``pulse_series``: per seed (t - t0 s, D_total, D_total
     smoothed, floor, window s); ``staircases``: per seed (t s, q veh/s, r veh/s, step times s).
@@ -148,65 +151,6 @@ def gate_from_dict(d: Mapping[str, Any]) -> GateResult:
     thr = tuple(float(v) for v in thr) if isinstance(thr, list) else float(thr)
     value = math.nan if d["value"] is None else float(d["value"])
     return GateResult(d["name"], value, thr, bool(d["passed"]), dict(d["detail"]))
-
-
-def _array(values: Any) -> np.ndarray:
-    return np.array(values, dtype=float)
-
-
-def classes_of(base: Mapping[str, Any]) -> list[str]:
-    """The classes a baseline row sampled (at least two lateral samples)."""
-    return [c for c in CLASSES if base["class_samples"][c] >= 2]
-
-
-def class_fields(row: Mapping[str, Any], classes: Sequence[str]) -> dict[str, np.ndarray]:
-    """The speed fields (periods x cells, m/s) of ``classes`` in a row."""
-    return {c: _array(row[f"v_{c}"]) for c in classes}
-
-
-def deviation_norms(a: Mapping[str, np.ndarray], b: Mapping[str, np.ndarray],
-           dx: float) -> dict[str, np.ndarray]:
-    """D(t) per class and their ``total`` (m/s m^(1/2))."""
-    d = {c: deviation_norm(a[c], b[c], dx) for c in a}
-    d["total"] = np.sqrt(sum(v ** 2 for v in d.values()))
-    return d
-
-
-def _median(v: np.ndarray) -> float:
-    v = v[np.isfinite(v)]
-    return float(np.median(v)) if v.size else 0.0
-
-
-def floors(rows: Mapping[int, Mapping[str, Mapping[str, Any]]], method: str
-           ) -> tuple[str, dict[int, dict[str, float]]]:
-    """The pulse gate's floor per seed, class and ``total`` (m/s m^(1/2)).
-
-    ``seeds``: the median D between the seed's baseline and the next seed's (cyclic): two
-    runs that differ only by chance. ``late``: the median D of the seed's own pulse
-    against its baseline over the record's last quarter (it counts a deviation that
-    persists as noise: a stream that keeps the pulse looks stable). ``none``: 0.
-    ``auto``: ``seeds`` with two seeds or more, else ``late``. Returns (method, floors).
-    """
-    seeds = sorted(rows)
-    if method == "auto":
-        method = "seeds" if len(seeds) >= 2 else "late"
-    out: dict[int, dict[str, float]] = {}
-    for i, s in enumerate(seeds):
-        base = rows[s]["baseline"]
-        cls, dx = classes_of(base), float(base["dx_m"])
-        if method == "none":
-            out[s] = {}
-            continue
-        if method == "seeds":
-            other = rows[seeds[(i + 1) % len(seeds)]]["baseline"]
-            d = deviation_norms(class_fields(base, cls), class_fields(other, cls), dx)
-            out[s] = {k: _median(v) for k, v in d.items()}
-        else:
-            d = deviation_norms(class_fields(base, cls),
-                                class_fields(rows[s]["pulse"], cls), dx)
-            start = int(len(d["total"]) * (1 - LATE_SHARE))
-            out[s] = {k: _median(v[start:]) for k, v in d.items()}
-    return method, out
 
 
 def speed_gates(base: Mapping[str, Any], classes: Sequence[str], model: ModelSpeeds | None,
@@ -324,14 +268,16 @@ def analyse(rows: Sequence[Mapping[str, Any]], sc: Scenario, opts: AnalysisOptio
         by_seed.setdefault(int(r["seed"]), {})[r["kind"]] = r
     model = model_speeds(sc)
     trip = opts.round_trip or model.round_trip
-    method, floor = floors(by_seed, opts.floor)
+    held = held_seeds(by_seed)
+    method, floor = floors(by_seed, opts.floor, held)
     seeds = tuple(sorted(by_seed))
     gates = {s: seed_gates(by_seed[s], floor[s], model, trip, sc.params.length,
                            opts.smooth, th) for s in seeds}
-    held = held_seeds(gates)
     pooled = (actuator_gate([actuator_record(by_seed[s]["staircase"]) for s in held], th)
               if held else GateResult("actuator", math.nan, th.gain_range, False,
-                                      {"reason": "no seed held the operating point"}))
+                                      {"reason": "no seed held its demand"}))
+    pooled = GateResult(pooled.name, pooled.value, pooled.threshold, pooled.passed,
+                        {**pooled.detail, "seed_list": list(held)})
     pulse_mean = pooled_pulse(by_seed, held, floor, trip, opts.smooth, th)
     series = {s: _series(by_seed[s], floor[s], th.pulse_round_trips * trip, opts.smooth)
               for s in seeds}
