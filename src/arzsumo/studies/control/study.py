@@ -235,9 +235,10 @@ def run_control(opts: ControlOptions) -> ControlResult:
             if stuck:
                 log.warning("%s: seeds %s left out: SUMO deadlocked before control "
                             "under every controller", e, seed_text(stuck))
-                counts.append(f"seeds {seed_text(stuck)} left out of the {e} tables "
-                              "(SUMO deadlocked before control under every controller, "
-                              "the open loop included)")
+                noun = "seeds" if len(stuck) > 1 else "seed"
+                counts.append(f"{noun} {seed_text(stuck)} left out of the {e} tables (SUMO "
+                              "deadlocked before control under every controller, the open "
+                              "loop included)")
                 found = found[~found["seed"].isin(stuck)]
             if found.empty:      # a report before any run of this experiment finished
                 log.warning("no finished %s runs yet: its tables are left out", e)
