@@ -106,15 +106,22 @@ def test_the_dead_band_measured_on_the_noisy_state_is_the_one_its_noise_implies(
     assert law_output_noise(clean, states) == pytest.approx(0.0, abs=1e-12)
 
 
-def test_the_etc_sized_on_its_measured_noise_triggers_far_less_than_the_papers(runs):
+def _noise_designed(periods: int):
+    """lateral_files' equilibrium, its linearisation and kernels (50 cells), the designed
+    ETC with its band from the estimate, and ``periods`` 1 s checks of the equilibrium."""
     eq = load_scenario(ROOT / "scenarios/lateral_files.toml").equilibrium
     lin = linearize(eq)
     kernels = solve_kernels(lin.system, 50)
     design = design_for(lin.system, kernels).design.with_(noise_from_estimate=True)
     x = (np.arange(50) + 0.5) * eq.params.length / 50
     one = np.ones_like(x)
-    states = [MacroState(-300.0 + k, x, eq.rho_h * one, eq.v_h * one, eq.rho_a * one,
-                         eq.v_a * one) for k in range(300)]
+    states = [MacroState(-float(periods) + k, x, eq.rho_h * one, eq.v_h * one,
+                         eq.rho_a * one, eq.v_a * one) for k in range(periods)]
+    return eq, lin, kernels, design, x, states
+
+
+def test_the_etc_sized_on_its_measured_noise_triggers_far_less_than_the_papers(runs):
+    eq, lin, kernels, design, x, states = _noise_designed(300)
     ctrl = NoisyEtc(lin, kernels, design, noise=NOISE)
     ctrl.set_output_noise(law_output_noise(ctrl, states))
     opts = SolverOptions(cells=50, horizon=300.0, output_period=10.0)
@@ -134,14 +141,7 @@ def test_only_a_law_with_a_trigger_is_probed_for_its_output_noise(monkeypatch):
     from arzsumo.control.compensation import DelayCompensated
     from arzsumo.control.meter_gain import MeterGain
 
-    eq = load_scenario(ROOT / "scenarios/lateral_files.toml").equilibrium
-    lin = linearize(eq)
-    kernels = solve_kernels(lin.system, 50)
-    design = design_for(lin.system, kernels).design.with_(noise_from_estimate=True)
-    x = (np.arange(50) + 0.5) * eq.params.length / 50
-    one = np.ones_like(x)
-    states = [MacroState(-30.0 + k, x, eq.rho_h * one, eq.v_h * one, eq.rho_a * one,
-                         eq.v_a * one) for k in range(30)]
+    _, lin, kernels, design, _, states = _noise_designed(30)
     probed: list[object] = []
     real = tn.law_output_noise
     monkeypatch.setattr(tn, "law_output_noise",
