@@ -20,7 +20,7 @@ RUN_OUT := results/default-etc-seed42-h450s
 
 # the default scenario in SUMO; its result table is the last thing printed
 run: $(STAMP)
-	@echo "make run: the default scenario in SUMO (about 2 min on 2 cores once installed);"
+	@echo "make run: the default scenario in SUMO (about 3 min on 2 cores once installed);"
 	@echo "results in $(RUN_OUT)/ (the stored studies' tables: make results)"
 	@$(BIN)/arzsumo run --overwrite --out $(RUN_OUT)
 
