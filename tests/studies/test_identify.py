@@ -268,3 +268,16 @@ def test_which_and_diagram_together_are_refused_in_one_line(cache, tmp_path, cap
     assert code == 2 and "\n" not in err
     assert "--which = tau_h,tau_a is not allowed with --diagram" in err
     assert not (tmp_path / "x").exists()
+
+
+def test_the_cli_offers_the_jam_floors_the_study_knows():
+    import argparse
+
+    from arzsumo.cli.identify import register
+    from arzsumo.studies.identify.study import JAM_FLOORS
+
+    parser = argparse.ArgumentParser()
+    register(parser.add_subparsers())
+    sub = parser._subparsers._group_actions[0].choices["identify"]
+    flag = next(a for a in sub._actions if "--jam-floor" in a.option_strings)
+    assert tuple(flag.choices) == JAM_FLOORS and flag.default == JAM_FLOORS[0]
