@@ -3,6 +3,7 @@ scenario and nothing else; the table pairs each step with the full configuration
 
 from __future__ import annotations
 
+import dataclasses
 import tomllib
 
 import pandas as pd
@@ -116,7 +117,8 @@ NEWELL = tomllib.loads((shipped_scenarios_dir() / "control_newell.toml").read_te
     encoding="utf-8"))
 
 
-@pytest.mark.parametrize("step", ["power-law", "paper-trigger", "unit-gain", "dead-band"])
+@pytest.mark.parametrize("step", ["power-law", "paper-trigger", "unit-gain", "dead-band",
+                                  "quarter-law"])
 def test_the_judged_configurations_steps_each_change_what_they_name(step):
     data = control_ablation.step_scenario(NEWELL, step)
     sc = scenario_from_dict(data, f"{step}.toml")
@@ -134,6 +136,9 @@ def test_the_judged_configurations_steps_each_change_what_they_name(step):
         assert sc.design.with_(noise_from_estimate=True) == full.design
     if step == "unit-gain":
         assert sc.actuation.meter_gain == 1.0 and sc.design == full.design
+    if step == "quarter-law":                        # the meter asked for a quarter
+        assert sc.actuation.meter_gain == 8.0 and sc.design == full.design
+        assert dataclasses.replace(sc.actuation, meter_gain=2.0) == full.actuation
     if step == "dead-band":                          # by hand, in place of the measured
         assert not sc.design.noise_from_estimate and sc.design.noise_sd
 

@@ -28,6 +28,9 @@ power-law           the laws (and twins) on the shipped default's power-law mode
 paper-trigger       the ETC's trigger as in the paper: no dead band measured on the
                     estimate (``[design] noise_from_estimate`` off)
 unit-gain           the laws on the paper's unit actuator: ``[actuation] meter_gain`` 1
+quarter-law         the laws' command to the meter :data:`QUARTER` times smaller
+                    (``[actuation] meter_gain`` times :data:`QUARTER`): their swings
+                    inside the meter's range (:func:`_quarter_law`)
 ==================  ==============================================================
 
 The steps change the regulation experiment, or with ``--experiment disturbance`` the
@@ -141,6 +144,25 @@ def _power_law(data: dict) -> dict:
     return data
 
 
+#: how much smaller ``quarter-law`` makes the laws' command to the meter. On the IDM
+#: stream backstepping asked for an outflow U with sd 430-620 veh/h, 660-950 veh/h of
+#: ramp release at its meter gain 0.65, against a meter whose release spans 660 veh/h
+#: (240-900): saturated 48-70 % of the time (docs/readings/control_idm.md). A quarter of
+#: it, sd 165-240 veh/h of release, mostly lies inside that span.
+QUARTER = 4.0
+
+
+def _quarter_law(data: dict) -> dict:
+    """``data`` with ``[actuation] meter_gain`` :data:`QUARTER` times larger: the laws
+    ask the meter for U / (gain x QUARTER) and are told that what reached the boundary
+    was gain x QUARTER times the release applied, so their anti-windup sees an
+    unsaturated U where the meter was not saturated. The law's loop gain is a quarter
+    of its design's: a detuned law that the meter can carry out, not the paper's."""
+    act = data.setdefault("actuation", {})
+    act["meter_gain"] = float(act.get("meter_gain", 1.0)) * QUARTER
+    return data
+
+
 #: step -> (what it changes, the change on the scenario as written, acts on the open loop)
 STEPS: dict[str, tuple[str, Callable[[dict], dict], bool]] = {
     "raw-cells": ("the laws on SUMO's Edie cells (no estimator)",
@@ -170,12 +192,15 @@ STEPS: dict[str, tuple[str, Callable[[dict], dict], bool]] = {
                       _set({"design.noise_from_estimate": False}), False),
     "unit-gain": ("the laws on the paper's unit actuator (meter_gain 1)",
                   _set({"actuation.meter_gain": 1.0}), False),
+    "quarter-law": (f"the laws' command to the meter {QUARTER:g} times smaller, inside "
+                    "its range", _quarter_law, False),
 }
 #: the steps run unless ``--steps`` names others: those of the default's configuration
 #: (``power-law``, ``paper-trigger`` and ``unit-gain`` change nothing on the default, whose
-#: model is the power law, whose trigger is the paper's and whose meter gain is 1)
+#: model is the power law, whose trigger is the paper's and whose meter gain is 1;
+#: ``quarter-law`` is for a stream where the laws saturate the meter)
 DEFAULT_STEPS = tuple(s for s in STEPS if s not in ("power-law", "paper-trigger",
-                                                    "unit-gain"))
+                                                    "unit-gain", "quarter-law"))
 #: the measures of the ablation table (keys of the control study's measures)
 KEYS = ("network_whole_demand.time_spent_s.total", "network_whole_demand.ramp_wait_s.p95",
         "section.deviation.deviation_excess_s", "section.deviation.decay_time_s",
