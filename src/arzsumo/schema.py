@@ -191,7 +191,8 @@ _SECTION = {"section.window": TEXT, "section.speed_mean_kmh.*": "km/h",
             "section.deviation.decay_time_s": "s",
             "section.deviation.deviation_integral_s": "s",
             "section.deviation.deviation_excess_s": "s", "section.deviation.band": "1",
-            "section.deviation.decayed": "bool"}
+            "section.deviation.decayed": "bool",
+            "section.inlet.rho_*_veh_km": "veh/km", "section.inlet.v_*_kmh": "km/h"}
 
 #: units of the keys of ``arzsumo run``'s summary.json (dotted; ``*`` within a name)
 RUN_SUMMARY: dict[str, str] = {

@@ -68,7 +68,7 @@ from arzsumo.outputs.run_summary import (
 from arzsumo.outputs.waves import waves_summary
 from arzsumo.schema import CELLS, PERIODS, with_units
 from arzsumo.twin.metrics import performance
-from arzsumo.units import ms_to_kmh
+from arzsumo.units import ms_to_kmh, veh_m_to_veh_km
 
 #: SUMO's tripinfo output of the run (every loaded vehicle), gzip-compressed
 TRIPINFO_GZ = "tripinfo.xml.gz"
@@ -242,10 +242,26 @@ def section_summary(res: CoSimResult, micro: dict[str, Any]) -> dict[str, Any]:
     direction (:func:`speed_wave`), the wave measures per class and lateral file
     (:func:`arzsumo.outputs.waves.waves_summary`), the deviation from the warm-up's
     stationary state (:func:`deviation_summary`) and the micro indices ``micro``
-    (:func:`_indices`; also at the top level, kept for compatibility)."""
+    (:func:`_indices`; also at the top level, kept for compatibility) and the inlet's
+    state (:func:`inlet_summary`)."""
     return {"window": SECTION_WINDOW, **res.section_speed, **speed_oscillation(res),
             "speed_wave": speed_wave(res), "waves": waves_summary(res, *_blocks(res)),
-            "deviation": deviation_summary(res), **micro}
+            "deviation": deviation_summary(res), "inlet": inlet_summary(res), **micro}
+
+
+def inlet_summary(res: CoSimResult) -> dict[str, float]:
+    """The state SUMO holds at the section's inlet: the window means of the first Edie
+    cell (x in [0, ``cell_length``]) per class, density in veh/km and speed in km/h
+    (NaN where the cell had no vehicle of the class in any period). What sits upstream
+    of x = 0 (the approach, SUMO's insertion backlog) reaches the section only through
+    this state."""
+    first = res.micro[:, :, 0]
+    mean = {name: float(np.nanmean(first[:, k])) if np.isfinite(first[:, k]).any()
+            else float("nan") for k, name in enumerate(VARIABLES)}
+    return {"rho_h_veh_km": float(veh_m_to_veh_km(mean["rho_h"])),
+            "v_h_kmh": float(ms_to_kmh(mean["v_h"])),
+            "rho_a_veh_km": float(veh_m_to_veh_km(mean["rho_a"])),
+            "v_a_kmh": float(ms_to_kmh(mean["v_a"]))}
 
 
 def deviation_summary(res: CoSimResult) -> dict[str, Any] | None:

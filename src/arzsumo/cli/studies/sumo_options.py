@@ -10,6 +10,7 @@ from arzsumo.studies.common import print_list
 from arzsumo.studies.sumo_map.sumo_options import (
     NAME,
     PAGE,
+    VARIANTS,
     SumoOptionsOptions,
     design,
     run_sumo_options,
@@ -22,12 +23,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-drain", action="store_true",
                         help="end each run with the control window (faster; no "
                              "whole-demand measures)")
+    parser.add_argument("--vary", type=_keys, default=(), metavar="KEYS",
+                        help="comma-separated [sumo] keys varied, of "
+                             + ", ".join(f.split(".", 1)[1] for f in VARIANTS)
+                             + " (default: all)")
     add_output(parser, NAME, PAGE, plots=False)
+
+
+def _keys(text: str) -> tuple[str, ...]:
+    return tuple(k.strip() for k in text.split(",") if k.strip())
 
 
 def options(args: argparse.Namespace) -> SumoOptionsOptions:
     """The study's options as the command line gave them."""
     return SumoOptionsOptions(seeds=tuple(args.seeds), drain=not args.no_drain,
+                              vary=args.vary,
                               out=args.out, docs=args.docs, workers=args.workers,
                               scheduler=args.scheduler)
 

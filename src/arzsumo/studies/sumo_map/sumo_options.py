@@ -6,13 +6,15 @@ Each variant is the default scenario with one ``[sumo]`` key changed (:data:`VAR
 * the lateral resolution (0.5 m as shipped: 13 sublanes of the 6.5 m lane; 0.65 m and
   1.3 m, also divisors of the lane width, as SUMO advises);
 * the HVs' action step (every 0.1 s step as shipped; 0.5 s);
-* the approach length (2500 m as shipped; 1500 m: the queue's tail waits off the
-  network, in SUMO's insertion queue, where it costs nothing per step);
+* the approach length (2500 m as shipped; 1500, 1000 and 500 m: the queue's tail waits
+  off the network, in SUMO's insertion backlog, where it costs nothing per step; its
+  depart delay is charged to the whole demand all the same);
 * SUMO's eager insertion (every waiting vehicle of the virtual queues tried every step
   as shipped; off: only each edge's first).
 
 Every run is an ``arzsumo run`` of the open loop through the sweep engine (its drain
-included unless ``--no-drain``), on the same seeds for every variant. For each variant
+included unless ``--no-drain``), on the same seeds for every variant; ``--vary`` picks the
+options (all by default). The shipped scenario runs once per seed as the baseline. For each variant
 against the shipped one, seed by seed, ``sumo_options.csv`` gives the wall time per run
 and its ratio, and the paired difference of each measure (:data:`MEASURES`) with its
 95 % t interval and whether it moves beyond seed noise (the interval excludes zero). A
@@ -35,20 +37,22 @@ from arzsumo.studies import checks
 from arzsumo.studies.common import (
     EXIT_SOME_FAILED,
     RESULTS_DIR,
+    StudyError,
     shipped_scenario,
     study_spec,
 )
+from arzsumo.sweep.spec import SweepSpec
 from arzsumo.units import S_PER_H
 
 NAME = "sumo-options"
 PAGE = "sumo_options"
 #: the column naming which variant a run is
 OPTION = "option"
-#: the shipped value first (the baseline), then the variants; field -> values
+#: the variants of each option (field -> values; the shipped value is the baseline)
 VARIANTS: dict[str, list[Any]] = {
-    "sumo.lateral_resolution_m": [0.5, 0.65, 1.3],
+    "sumo.lateral_resolution_m": [0.65, 1.3],
     "sumo.hv_action_step_s": [0.5],
-    "sumo.approach_length_m": [1500.0],
+    "sumo.approach_length_m": [1500.0, 1000.0, 500.0],
     "sumo.eager_insert": [False],
 }
 #: summary column -> (label, unit factor from SI, unit)
@@ -60,15 +64,37 @@ MEASURES: dict[str, tuple[str, float, str]] = {
     "section.speed_mean_kmh.a": ("AV mean speed", 1.0, "km/h"),
     "section.waves.h.oscillation_kmh": ("HV oscillation", 1.0, "km/h"),
     "section.waves.a.oscillation_kmh": ("AV oscillation", 1.0, "km/h"),
+    "section.waves.h.band_power_kmh2": ("HV band power", 1.0, "(km/h)^2"),
+    "section.speed_wave.h.speed_kmh": ("HV wave speed", 1.0, "km/h"),
+    "section.inlet.rho_h_veh_km": ("inlet HV density", 1.0, "veh/km"),
+    "section.inlet.v_h_kmh": ("inlet HV speed", 1.0, "km/h"),
+    "rmse_blocks.replay.rho_h.relative": ("HV replay error", 100.0, "%"),
+    "rmse_blocks.replay.rho_a.relative": ("AV replay error", 100.0, "%"),
 }
 WALL = "execution.wall_s"
 
 
-def options_spec(seeds: list[int], scenario: str = "default.toml", drain: bool = True):
-    """The sweep of the study: one axis per option, varied one at a time; without
-    ``drain`` the runs end with the control window (the whole-demand measures then stop
-    there too, and are left out)."""
-    axes = [{"field": f, "values": v, "group": OPTION} for f, v in VARIANTS.items()]
+def shipped_values(scenario: str = "default.toml") -> dict[str, Any]:
+    """The value of every option of :data:`VARIANTS` in the shipped ``scenario`` (field ->
+    value in the file's units; SUMO's default where the file does not set the key). The
+    four options' file units are SI, so the parsed configuration gives them as they are."""
+    from arzsumo.scenario import load_scenario
+    from arzsumo.scenario.sumo import SUMO_KEYS
+
+    cfg = load_scenario(shipped_scenario(scenario)).sumo
+    return {f: getattr(cfg, SUMO_KEYS[f.split(".", 1)[1]].field) for f in VARIANTS}
+
+
+def options_spec(seeds: list[int], scenario: str = "default.toml", drain: bool = True,
+                 vary: tuple[str, ...] = ()):
+    """The sweep of the study: one axis per option of ``vary`` (keys of ``[sumo]``; empty:
+    every option of :data:`VARIANTS`), varied one at a time, the first axis led by its
+    shipped value (the baseline); without ``drain`` the runs end with the control window
+    (the whole-demand measures then stop there too, and are left out)."""
+    fields = [f for f in VARIANTS if not vary or f.split(".", 1)[1] in vary]
+    shipped = shipped_values(scenario)
+    axes = [{"field": f, "values": ([shipped[f]] if i == 0 else []) + VARIANTS[f],
+             "group": OPTION} for i, f in enumerate(fields)]
     fixed: dict[str, Any] = {"run.controller": "open"}
     if not drain:
         fixed["sumo.drain_max_s"] = 0.0
@@ -87,14 +113,15 @@ def variant_of(row: pd.Series) -> str:
     return variant_name(row[OPTION], row[row[OPTION]])
 
 
-def compare(df: pd.DataFrame, drained: bool = True) -> pd.DataFrame:
+def compare(df: pd.DataFrame, drained: bool = True, base_name: str | None = None
+            ) -> pd.DataFrame:
     """One row per variant and measure: the paired difference against the shipped options
-    over the seeds both finished (module docstring); whole-demand measures only when the
-    runs were ``drained``."""
+    ``base_name`` (a :func:`variant_name`; None: the variant of the sweep's first run, the
+    shipped value of its first axis) over the seeds both finished (module docstring);
+    whole-demand measures only when the runs were ``drained``."""
     ok = df[df["status"] == "ok"].copy()
     ok["variant"] = ok.apply(variant_of, axis=1)
-    first = next(iter(VARIANTS))
-    base_name = variant_name(first.split(".", 1)[1], VARIANTS[first][0])
+    base_name = base_name or variant_of(df.iloc[0])
     base = ok[ok["variant"] == base_name].set_index("seed")
     rows = []
     for variant, runs in ok.groupby("variant", sort=False):
@@ -151,6 +178,8 @@ class SumoOptionsOptions(checks.Shared):
     drain : bool
         Run each run's drain after the control window (False: end with the window;
         faster, no whole-demand measures).
+    vary : tuple of str
+        The ``[sumo]`` keys varied (keys of :data:`VARIANTS`; empty: all).
 
     ``out``, ``docs``, ``workers``, ``scheduler``: as every study's
     (:data:`~arzsumo.studies.common.SHARED_FIELDS`).
@@ -158,11 +187,21 @@ class SumoOptionsOptions(checks.Shared):
 
     seeds: tuple[int, ...] = tuple(range(1, 11))
     drain: bool = True
+    vary: tuple[str, ...] = ()
     out: Path = RESULTS_DIR / NAME
 
     def __post_init__(self) -> None:
         super().__post_init__()
         checks.seeds(self.seeds)
+        known = [f.split(".", 1)[1] for f in VARIANTS]
+        bad = [k for k in self.vary if k not in known]
+        if bad or len(set(self.vary)) != len(self.vary):
+            raise StudyError(f"--vary = {','.join(self.vary)} is not allowed: "
+                             f"distinct options of {', '.join(known)}")
+
+    def spec(self) -> SweepSpec:
+        """The study's sweep (:func:`options_spec`)."""
+        return options_spec(list(self.seeds), drain=self.drain, vary=self.vary)
 
 
 @dataclass(frozen=True)
@@ -180,7 +219,7 @@ class SumoOptionsResult:
 
 def design(opts: SumoOptionsOptions) -> list[str]:
     """The run IDs of the study's sweep."""
-    return [r.run_id for r in options_spec(list(opts.seeds), drain=opts.drain).runs()]
+    return [r.run_id for r in opts.spec().runs()]
 
 
 def run_sumo_options(opts: SumoOptionsOptions, *, progress: bool = True
@@ -197,11 +236,13 @@ def run_sumo_options(opts: SumoOptionsOptions, *, progress: bool = True
     """
     from arzsumo.sweep.driver import run_sweep
 
-    spec = options_spec(list(opts.seeds), drain=opts.drain)
+    spec = opts.spec()
     with resumable_dir(opts.out, f"study-{NAME}") as out:
         rep = run_sweep(spec, Path(out) / "sweep", workers=opts.workers,
                         scheduler=opts.scheduler, progress=progress, plots=False)
-        table = compare(rep.table, drained=opts.drain)
+        first = spec.runs()[0]
+        table = compare(rep.table, drained=opts.drain, base_name=variant_name(
+            first.columns[OPTION], first.columns[first.columns[OPTION]]))
         files = [write_csv(table, Path(out) / f"{PAGE}.csv")]
         text = markdown(table)
         if opts.docs is not None:
