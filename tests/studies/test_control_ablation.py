@@ -165,3 +165,18 @@ def test_the_ablation_is_called_from_python_with_its_options():
         control_ablation.AblationOptions(RecordedRuns((1,)), steps=("nope",))
     with pytest.raises(StudyError, match="experiment"):
         control_ablation.AblationOptions(RecordedRuns((1,)), experiment="rush-hour")
+
+
+def test_the_power_law_step_on_a_placed_stream_keeps_its_plant_and_designs_anew():
+    idm = tomllib.loads((shipped_scenarios_dir() / "stop_and_go_idm.toml").read_text(
+        encoding="utf-8"))
+    data = control_ablation.step_scenario(idm, "power-law")
+    full = experiment_scenario(idm, "regulation")
+    for table in ("equilibrium", "sumo", "initial", "run", "actuation"):
+        assert data[table] == full[table]           # the section placed as before
+    sc = scenario_from_dict(data, "power-law.toml")
+    assert sc.params.family == "power"
+    assert linearize(sc.equilibrium).eigenvalues[3] * 3.6 == pytest.approx(-5.66, abs=0.01)
+    assert sc.design.noise_from_estimate
+    assert sc.design.mu == pytest.approx(0.00606868)   # design-check --auto's choice
+    assert sc.design != scenario_from_dict(full, "full.toml").design

@@ -132,16 +132,42 @@ def _band_by_hand(data: dict) -> dict:
 
 
 def _power_law(data: dict) -> dict:
-    """``data`` with the shipped default's ``[model]``, ``[equilibrium]`` and ``[design]``
-    (the paper's power-law diagram, identified on the same stream), the trigger's
-    measured dead band kept where ``data`` asks for it."""
+    """``data`` with the shipped default's ``[model]`` (the paper's power-law diagram,
+    identified on the Krauss stream), the trigger's measured dead band kept where
+    ``data`` asks for it.
+
+    Where the equilibrium places the open loop (``[run] start = "placement"``: the
+    section placed at the ``[equilibrium]`` densities) the equilibrium stays, so that the
+    step does not move the plant, and ``[design]`` is chosen for the power law there as
+    ``arzsumo design-check --auto`` chooses it (:func:`_designed`). Elsewhere the
+    default's ``[equilibrium]`` and ``[design]`` come with its model."""
     default = tomllib.loads(default_scenario().read_text(encoding="utf-8"))
     measured = data.get("design", {}).get("noise_from_estimate")
-    for table in ("model", "equilibrium", "design"):
+    placed = data.get("run", {}).get("start") == "placement"
+    for table in ("model",) if placed else ("model", "equilibrium", "design"):
         data[table] = dict(default[table])
+    if placed:
+        data["design"] = _designed(data)
     if measured is not None:
         data["design"]["noise_from_estimate"] = measured
     return data
+
+
+def _designed(data: dict) -> dict:
+    """The ``[design]`` table that ``design-check --auto`` chooses for the scenario
+    ``data`` on its ``[run] kernel_cells`` (about 3 s the first time; the kernels are
+    cached), to the digits ``design-check`` prints: the same table as long as the
+    kernels give the same design to six digits, and with it the step's records."""
+    from arzsumo.control.design import design_for
+    from arzsumo.kernel_cache import cached_kernels
+    from arzsumo.model import linearize
+    from arzsumo.scenario.model import design_toml
+
+    sc = scenario_from_dict(data)
+    lin = linearize(sc.equilibrium)
+    choice = design_for(lin.system, cached_kernels(lin.system, sc.run.kernel_cells),
+                        base=sc.design)
+    return tomllib.loads(design_toml(choice.design, "power-law step"))["design"]
 
 
 #: how much smaller ``quarter-law`` makes the laws' command to the meter. On the IDM
