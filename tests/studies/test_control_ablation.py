@@ -180,3 +180,17 @@ def test_the_power_law_step_on_a_placed_stream_keeps_its_plant_and_designs_anew(
     assert sc.design.noise_from_estimate
     assert sc.design.mu == pytest.approx(0.00606868)   # design-check --auto's choice
     assert sc.design != scenario_from_dict(full, "full.toml").design
+
+
+def test_the_page_flag_names_the_page_the_table_goes_to(tmp_path):
+    import argparse
+
+    from arzsumo.cli.studies import control_ablation as cli
+
+    parser = argparse.ArgumentParser()
+    cli.add_arguments(parser)
+    args = parser.parse_args(["--docs", str(tmp_path), "--page", "control_idm",
+                              "--steps", "quarter-law", "--seeds", "1,3"])
+    opts = cli.options(args)
+    assert (opts.page, opts.docs, opts.steps) == ("control_idm", tmp_path, ("quarter-law",))
+    assert cli.options(parser.parse_args([])).page == control_ablation.PAGE

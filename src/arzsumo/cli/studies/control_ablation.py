@@ -44,6 +44,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_records(parser)
     add_runs(parser, seeds="1-10")
     add_output(parser, NAME, PAGE, plots=False)
+    parser.add_argument("--page", default=PAGE, metavar="NAME",
+                        help="the results page --docs adds the table to, DIR/NAME.md "
+                             "(default: %(default)s, the default's; the control study's "
+                             "--page of the same scenario)")
 
 
 def options(args: argparse.Namespace) -> AblationOptions:
@@ -52,7 +56,8 @@ def options(args: argparse.Namespace) -> AblationOptions:
     laws = tuple(names_among(args.laws, list(LAWS), "--laws"))
     return AblationOptions(recorded_runs(args), scenario=args.scenario,
                            control=args.control, experiment=args.experiment, steps=steps,
-                           laws=laws, out=args.out, docs=args.docs)
+                           laws=laws, out=args.out, docs=args.docs,
+                           page=args.page)
 
 
 def run(args: argparse.Namespace) -> int:

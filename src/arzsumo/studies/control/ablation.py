@@ -310,7 +310,8 @@ class AblationOptions:
     study's base scenario (None: the shipped default); ``control``: the control study's
     ``--out`` or record store (its runs of ``experiment`` are the full configuration);
     ``steps`` of :data:`STEPS`, ``laws`` of :data:`LAWS`; ``out``, ``docs``: where the
-    study writes (None: no page).
+    study writes (None: no page); ``page``: the results page under ``docs`` that gets
+    the table (the control study's page of the same scenario).
     """
 
     runs: RecordedRuns
@@ -321,6 +322,7 @@ class AblationOptions:
     laws: tuple[str, ...] = LAWS
     out: Path = RESULTS_DIR / NAME
     docs: Path | None = None
+    page: str = PAGE
 
     def __post_init__(self) -> None:
         checks.among(self.experiment, control.EXPERIMENTS, "experiment")
@@ -401,8 +403,8 @@ def run_ablation(opts: AblationOptions) -> AblationResult:
         text = table(found, full, seeds, laws)
         md = write_text(text, out / f"{step_name('ablation', experiment)}.md")
         if opts.docs is not None:
-            publish(opts.docs, PAGE, step_name(NAME, experiment),
-                    "The controllers on the default in SUMO",
+            publish(opts.docs, opts.page, step_name(NAME, experiment),
+                    "The controllers in SUMO",
                     f"Ablation of the {experiment} experiment on seeds "
                     f"{seed_text(seeds)}: each step minus the full configuration and "
                     f"minus the open loop, paired by seed (`arzsumo study {NAME}`).\n\n"
