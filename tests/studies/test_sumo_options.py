@@ -18,7 +18,7 @@ TTS = "network_whole_demand.time_spent_s.total"
 def test_the_design_changes_one_option_at_a_time_on_the_same_seeds():
     spec = options_spec([1, 2, 3])
     runs = spec.runs()
-    assert len(runs) == 8 * 3
+    assert len(runs) == 7 * 3
     base = [r for r in runs if r.run_id.startswith("lateral_resolution_m=0.5,")]
     assert [r.scenario["sumo"]["seed"] for r in base] == [1, 2, 3]
     eager = next(r for r in runs if r.run_id == "eager_insert=false,seed=2")
@@ -30,7 +30,7 @@ def test_the_design_changes_one_option_at_a_time_on_the_same_seeds():
 def test_vary_runs_the_shipped_approach_once_then_each_shorter_one():
     runs = options_spec([1, 2], vary=("approach_length_m",)).runs()
     lengths = [r.scenario["sumo"]["approach_length_m"] for r in runs]
-    assert lengths == [2500.0, 2500.0, 1500.0, 1500.0, 1000.0, 1000.0, 500.0, 500.0]
+    assert lengths == [2500.0, 2500.0, 1500.0, 1500.0, 1000.0, 1000.0]
     assert runs[0].run_id == "approach_length_m=2500,seed=1"     # the shipped baseline
     assert {r.scenario["sumo"]["lateral_resolution_m"] for r in runs} == {0.5}
 
@@ -82,7 +82,7 @@ def test_the_study_runs_from_python_with_its_options(monkeypatch, tmp_path):
     from arzsumo.studies.sumo_map import sumo_options
 
     opts = sumo_options.SumoOptionsOptions(seeds=(1, 2), out=tmp_path / "out")
-    assert len(sumo_options.design(opts)) == 8 * 2
+    assert len(sumo_options.design(opts)) == 7 * 2
     asked = {}
 
     def fake_sweep(spec, out, **kwargs):
@@ -92,7 +92,7 @@ def test_the_study_runs_from_python_with_its_options(monkeypatch, tmp_path):
 
     monkeypatch.setattr("arzsumo.sweep.driver.run_sweep", fake_sweep)
     result = sumo_options.run_sumo_options(opts, progress=False)
-    assert (result.code, result.statuses["failed"], asked["runs"]) == (4, 1, 16)
+    assert (result.code, result.statuses["failed"], asked["runs"]) == (4, 1, 14)
     row = result.table[result.table["variant"] == "lateral_resolution_m=1.3"].iloc[0]
     assert row["diff_mean"] == pytest.approx(1.0, abs=0.15)
     assert result.files == (tmp_path / "out" / "sumo_options.csv",)

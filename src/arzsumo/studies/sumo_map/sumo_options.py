@@ -6,7 +6,7 @@ Each variant is the default scenario with one ``[sumo]`` key changed (:data:`VAR
 * the lateral resolution (0.5 m as shipped: 13 sublanes of the 6.5 m lane; 0.65 m and
   1.3 m, also divisors of the lane width, as SUMO advises);
 * the HVs' action step (every 0.1 s step as shipped; 0.5 s);
-* the approach length (2500 m as shipped; 1500, 1000 and 500 m: the queue's tail waits
+* the approach length (2500 m as shipped; 1500 and 1000 m: the queue's tail waits
   off the network, in SUMO's insertion backlog, where it costs nothing per step; its
   depart delay is charged to the whole demand all the same);
 * SUMO's eager insertion (every waiting vehicle of the virtual queues tried every step
@@ -52,7 +52,7 @@ OPTION = "option"
 VARIANTS: dict[str, list[Any]] = {
     "sumo.lateral_resolution_m": [0.65, 1.3],
     "sumo.hv_action_step_s": [0.5],
-    "sumo.approach_length_m": [1500.0, 1000.0, 500.0],
+    "sumo.approach_length_m": [1500.0, 1000.0],
     "sumo.eager_insert": [False],
 }
 #: summary column -> (label, unit factor from SI, unit)
