@@ -186,10 +186,6 @@ SUMO_KEYS: dict[str, Key] = {
     "fill_demand_a_veh_h": Key("fill_demand_a", factor=VEH_H_PER_VEH_S, allowed=_DEMAND,
                                unit="veh/h", doc="AV flow requested at the mainline "
                                                  "entrance during the fill phase"),
-    "internal_links": Key("internal_links", "bool",
-                          doc="junctions with internal lanes (netconvert's default); "
-                              "false: none, so no vehicle can stand on a junction "
-                              "overhanging its lane (the merge deadlock, docs/sumo.md)"),
     "eager_insert": Key("eager_insert", "bool",
                         doc="try every vehicle waiting for insertion every step (SUMO "
                             "--eager-insert), not only the first of each edge"),

@@ -148,14 +148,6 @@ class SumoConfig:
         demand above then holds from ``fill_duration`` to the end. A fill above the
         bottleneck's discharge builds the congested section fast; the hold
         demand, a little above the discharge, keeps it without filling the approach.
-    internal_links : bool
-        Junctions with internal lanes (netconvert's default, True) or without (False:
-        ``--no-internal-links``, a vehicle passes a junction from one edge's end to the
-        next edge's start). On an internal lane a vehicle cannot move sideways, and one
-        that stops there overhanging its lane cannot leave it (SUMO issue #6106): ramp
-        vehicles that finish their merge overhanging stand on the junction after the
-        acceleration lane for good. Without internal lanes they stand on ``down``, where
-        they can straighten.
     eager_insert : bool
         SUMO's ``--eager-insert``: every vehicle waiting for insertion (the virtual queues
         of the mainline and the ramp) is tried every step, not only each edge's first
@@ -228,7 +220,6 @@ class SumoConfig:
     fill_duration: float = 0.0
     fill_demand_h: float = 0.0
     fill_demand_a: float = 0.0
-    internal_links: bool = True
     eager_insert: bool = True
     fcd: bool = False
 
@@ -291,8 +282,6 @@ class SumoConfig:
         require(isinstance(self.fcd, bool), "fcd", self.fcd, "true or false", ScenarioError)
         require(isinstance(self.eager_insert, bool), "eager_insert", self.eager_insert,
                 "true or false", ScenarioError)
-        require(isinstance(self.internal_links, bool), "internal_links",
-                self.internal_links, "true or false", ScenarioError)
         self._check_behaviour()
 
     def _check_behaviour(self) -> None:

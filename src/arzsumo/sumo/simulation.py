@@ -340,7 +340,7 @@ def network_spec(cfg: SumoConfig) -> NetworkSpec:
     """The network geometry of a run with ``cfg``: the shipped one with the run's
     approach and downstream edge ``down``."""
     return NetworkSpec(approach_length=cfg.approach_length, down_speed=cfg.down_speed,
-                       down_length=cfg.down_length, internal_links=cfg.internal_links)
+                       down_length=cfg.down_length)
 
 
 def network_file(cfg: SumoConfig, net_dir: Path | None, workdir: Path) -> Path:
@@ -356,14 +356,11 @@ def network_file(cfg: SumoConfig, net_dir: Path | None, workdir: Path) -> Path:
     if spec != NetworkSpec() and net_dir is None and not os.environ.get(NETS_ENV):
         return build_network(workdir / "net", spec)
     shipped = NetworkSpec()
-    if (spec.down_speed, spec.down_length, spec.internal_links) != (
-            shipped.down_speed, shipped.down_length, shipped.internal_links):
-        raise SumoError(f"down_speed = {ms_to_kmh(cfg.down_speed):g} km/h, down_length = "
-                        f"{cfg.down_length:g} m and internal_links = "
-                        f"{str(cfg.internal_links).lower()} need a network built for them; "
-                        "allowed: no network directory (the run builds it), or the shipped "
-                        f"{ms_to_kmh(shipped.down_speed):g} km/h, {shipped.down_length:g} m "
-                        "and internal links")
+    if (spec.down_speed, spec.down_length) != (shipped.down_speed, shipped.down_length):
+        raise SumoError(f"down_speed = {ms_to_kmh(cfg.down_speed):g} km/h and down_length = "
+                        f"{cfg.down_length:g} m need a network built for them; allowed: no "
+                        f"network directory (the run builds it), or the shipped "
+                        f"{ms_to_kmh(shipped.down_speed):g} km/h and {shipped.down_length:g} m")
     net = nets_dir(net_dir) / NET_FILE
     have = approach_length_of(net)
     if abs(have - cfg.approach_length) > 1e-6:
