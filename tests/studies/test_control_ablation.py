@@ -105,7 +105,9 @@ def test_a_step_of_the_disturbance_experiment_keeps_the_slowdown_and_its_own_nam
 
 def test_a_step_the_scenario_does_not_admit_is_refused_before_anything_runs(
         run_study, tmp_path, monkeypatch):
-    monkeypatch.setattr(control_ablation, "WAVE_SPEED_KMH", 100.0)   # faster than any car
+    from arzsumo.studies.control import ablation_steps
+
+    monkeypatch.setattr(ablation_steps, "WAVE_SPEED_KMH", 100.0)   # faster than any car
     with pytest.raises(StudyError, match=r"--steps = 'wave-matched' is not allowed on "
                                          r"--scenario = .*out of this model family's reach"):
         run_study("control-ablation", "--steps", "wave-matched", "--control",

@@ -1,0 +1,168 @@
+"""The control-ablation's steps: what each one changes on the experiment's scenario
+(:data:`STEPS`; the table in :mod:`arzsumo.studies.control.ablation`).
+
+Each step is a pure function of the scenario as written (a dict of tables) to the
+scenario with its one change; the study runs them and pairs each with the full
+configuration.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from collections.abc import Callable
+
+from arzsumo.model.wave_match import wave_matched
+from arzsumo.resources import default_scenario
+from arzsumo.scenario import scenario_from_dict
+from arzsumo.units import kmh_to_ms
+
+#: prediction horizon of ``predictor``, s: the dead time from a new plan to the section's
+#: outflow measured on the meter (10-14 s, arzsumo study meter-dynamics)
+PREDICTION_S = 14.0
+#: prediction horizon of ``predictor-measured``, s: the dead time from the held meter's
+#: command to the section's outflow at x = L on the default, 26-27 s on regulation seeds
+#: 11-16 and 26-30 s on disturbance seeds 11-14 (arzsumo study meter-delay)
+MEASURED_DEAD_TIME_S = 27.0
+
+
+def _set(changes: dict[str, object]) -> Callable[[dict], dict]:
+    def apply(data: dict) -> dict:
+        for dotted, value in changes.items():
+            table, _, key = dotted.partition(".")
+            data.setdefault(table, {})[key] = value
+        return data
+    return apply
+
+
+#: SUMO's upstream wave speed on the default, km/h: the HV fluctuations' speed that
+#: ``arzsumo premise`` measured on seeds 6-8, -35 to -39 km/h
+#: (docs/results/premise_coupled.md); the identified model has lambda_4 = -2.55 km/h
+WAVE_SPEED_KMH = -35.0
+
+
+def _wave_matched(data: dict) -> dict:
+    """``data`` with the ``[model]`` of :func:`~arzsumo.model.wave_match.wave_matched`:
+    lambda_4 at the scenario's equilibrium moved to :data:`WAVE_SPEED_KMH`.
+
+    The four values are written with every digit of the root finder's answer, so the
+    step's fingerprint (and its records) hold for as long as numpy and scipy give the
+    same root to the last bit; another answer makes the records stale, and they run
+    again."""
+    sc = scenario_from_dict(data)
+    eq = sc.equilibrium
+    q = wave_matched(sc.params, eq.rho_h, eq.rho_a, float(kmh_to_ms(WAVE_SPEED_KMH)))
+    data.setdefault("model", {}).update(
+        {k: float(getattr(q, k)) for k in ("gamma_h", "gamma_a", "ao_max_h", "ao_max_a")})
+    return data
+
+
+#: the ETC trigger's noise dead band of ``dead-band`` (``[design] noise_sd_kmh``, km/h, one
+#: sd per scaled Riemann variable w_1..w_4): twice the w-bar noise that 1 % relative state
+#: noise puts on the laws' grid, the band that brought the twin's ETC to 0.29 of its
+#: checks at SUMO's noise level (2 %; docs/readings/etc_remedies.md)
+DEAD_BAND_KMH = (5.569, 0.3392, 0.8406, 0.256)
+
+def _band_by_hand(data: dict) -> dict:
+    """``data`` with :data:`DEAD_BAND_KMH` as the ETC's dead band, in place of one measured
+    on the estimate (the two cannot be combined)."""
+    data = _set({"design.noise_sd_kmh": list(DEAD_BAND_KMH), "design.noise_k": 2.0})(data)
+    data["design"].pop("noise_from_estimate", None)
+    return data
+
+
+def _power_law(data: dict) -> dict:
+    """``data`` with the shipped default's ``[model]`` (the paper's power-law diagram,
+    identified on the Krauss stream), the trigger's measured dead band kept where
+    ``data`` asks for it.
+
+    Where the equilibrium places the open loop (``[run] start = "placement"``: the
+    section placed at the ``[equilibrium]`` densities) the equilibrium stays, so that the
+    step does not move the plant, and ``[design]`` is chosen for the power law there as
+    ``arzsumo design-check --auto`` chooses it (:func:`_designed`). Elsewhere the
+    default's ``[equilibrium]`` and ``[design]`` come with its model."""
+    default = tomllib.loads(default_scenario().read_text(encoding="utf-8"))
+    measured = data.get("design", {}).get("noise_from_estimate")
+    placed = data.get("run", {}).get("start") == "placement"
+    for table in ("model",) if placed else ("model", "equilibrium", "design"):
+        data[table] = dict(default[table])
+    if placed:
+        data["design"] = _designed(data)
+    if measured is not None:
+        data["design"]["noise_from_estimate"] = measured
+    return data
+
+
+def _designed(data: dict) -> dict:
+    """The ``[design]`` table that ``design-check --auto`` chooses for the scenario
+    ``data`` on its ``[run] kernel_cells`` (about 3 s the first time; the kernels are
+    cached), to the digits ``design-check`` prints: the same table as long as the
+    kernels give the same design to six digits, and with it the step's records."""
+    from arzsumo.control.design import design_for
+    from arzsumo.kernel_cache import cached_kernels
+    from arzsumo.model import linearize
+    from arzsumo.scenario.model import design_toml
+
+    sc = scenario_from_dict(data)
+    lin = linearize(sc.equilibrium)
+    choice = design_for(lin.system, cached_kernels(lin.system, sc.run.kernel_cells),
+                        base=sc.design)
+    return tomllib.loads(design_toml(choice.design, "power-law step"))["design"]
+
+
+#: how much smaller ``quarter-law`` makes the laws' command to the meter. On the IDM
+#: stream backstepping asked for an outflow U with sd 430-620 veh/h, 660-950 veh/h of
+#: ramp release at its meter gain 0.65, against a meter whose release spans 660 veh/h
+#: (240-900): saturated 48-70 % of the time (docs/readings/control_idm.md). A quarter of
+#: it, sd 165-240 veh/h of release, mostly lies inside that span.
+QUARTER = 4.0
+
+
+def _quarter_law(data: dict) -> dict:
+    """``data`` with ``[actuation] meter_gain`` :data:`QUARTER` times larger: the laws
+    ask the meter for U / (gain x QUARTER) and are told that what reached the boundary
+    was gain x QUARTER times the release applied, so their anti-windup sees an
+    unsaturated U where the meter was not saturated. The law's loop gain is a quarter
+    of its design's: a detuned law that the meter can carry out, not the paper's."""
+    act = data.setdefault("actuation", {})
+    act["meter_gain"] = float(act.get("meter_gain", 1.0)) * QUARTER
+    return data
+
+
+#: step -> (what it changes, the change on the scenario as written, acts on the open loop)
+STEPS: dict[str, tuple[str, Callable[[dict], dict], bool]] = {
+    "raw-cells": ("the laws on SUMO's Edie cells (no estimator)",
+                  _set({"estimation.method": "none"}), False),
+    "equilibrium": ("deviations from the model's equilibrium",
+                    _set({"estimation.reference": "equilibrium"}), False),
+    "no-saturation": ("no bounds on U, no ramp bound, no anti-windup",
+                      _set({"actuation.u_max_fraction": 0.0,
+                            "actuation.u_rate_max_veh_h_s": 0.0,
+                            "actuation.ramp_bound": False, "actuation.anti_windup": False}),
+                      False),
+    "fixed-cycle": ("the meter as a fixed cycle of green shares",
+                    _set({"sumo.meter_mode": "fixed_cycle"}), True),
+    "predictor": (f"the laws on the state predicted {PREDICTION_S:g} s ahead",
+                  _set({"actuation.delay_compensation_s": PREDICTION_S}), False),
+    "predictor-measured": (f"the laws on the state predicted {MEASURED_DEAD_TIME_S:g} s "
+                           "ahead, the meter's dead time measured on the default",
+                           _set({"actuation.delay_compensation_s": MEASURED_DEAD_TIME_S}),
+                           False),
+    "wave-matched": (f"the model's lambda_4 at SUMO's wave speed, {WAVE_SPEED_KMH:g} km/h",
+                     _wave_matched, False),
+    "dead-band": ("the ETC's trigger with a dead band sized to the estimate's noise",
+                  _band_by_hand, False),
+    "power-law": ("the laws on the default's power-law model and design", _power_law,
+                  False),
+    "paper-trigger": ("the ETC's trigger as in the paper (no measured dead band)",
+                      _set({"design.noise_from_estimate": False}), False),
+    "unit-gain": ("the laws on the paper's unit actuator (meter_gain 1)",
+                  _set({"actuation.meter_gain": 1.0}), False),
+    "quarter-law": (f"the laws' command to the meter {QUARTER:g} times smaller, inside "
+                    "its range", _quarter_law, False),
+}
+#: the steps run unless ``--steps`` names others: those of the default's configuration
+#: (``power-law``, ``paper-trigger`` and ``unit-gain`` change nothing on the default, whose
+#: model is the power law, whose trigger is the paper's and whose meter gain is 1;
+#: ``quarter-law`` is for a stream where the laws saturate the meter)
+DEFAULT_STEPS = tuple(s for s in STEPS if s not in ("power-law", "paper-trigger",
+                                                    "unit-gain", "quarter-law"))
