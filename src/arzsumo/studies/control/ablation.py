@@ -34,7 +34,9 @@ quarter-law         the laws' command to the meter :data:`QUARTER` times smaller
 ==================  ==============================================================
 
 The steps and their constants live in :mod:`arzsumo.studies.control.ablation_steps`
-(re-exported here). The steps change the regulation experiment, or with ``--experiment disturbance`` the
+(re-exported here).
+
+The steps change the regulation experiment, or with ``--experiment disturbance`` the
 disturbance experiment (then against the control study's disturbance runs). Each step is
 an evaluation (:func:`~arzsumo.sweep.evaluate.run_evaluation`) into ``OUT/<step>/``
 (``OUT/<step>-disturbance/``). A step that does not act on an open loop borrows the open
