@@ -120,7 +120,7 @@ NEWELL = tomllib.loads((shipped_scenarios_dir() / "control_newell.toml").read_te
 
 
 @pytest.mark.parametrize("step", ["power-law", "paper-trigger", "unit-gain", "dead-band",
-                                  "quarter-law"])
+                                  "quarter-law", "paper-eta"])
 def test_the_judged_configurations_steps_each_change_what_they_name(step):
     data = control_ablation.step_scenario(NEWELL, step)
     sc = scenario_from_dict(data, f"{step}.toml")
@@ -138,6 +138,8 @@ def test_the_judged_configurations_steps_each_change_what_they_name(step):
         assert sc.design.with_(noise_from_estimate=True) == full.design
     if step == "unit-gain":
         assert sc.actuation.meter_gain == 1.0 and sc.design == full.design
+    if step == "paper-eta":                          # m forgets at the paper's rate
+        assert sc.design == full.design.with_(eta=0.9) and sc.actuation == full.actuation
     if step == "quarter-law":                        # the meter asked for a quarter
         assert sc.actuation.meter_gain == 8.0 and sc.design == full.design
         assert dataclasses.replace(sc.actuation, meter_gain=2.0) == full.actuation
@@ -196,3 +198,25 @@ def test_the_page_flag_names_the_page_the_table_goes_to(tmp_path):
     opts = cli.options(args)
     assert (opts.page, opts.docs, opts.steps) == ("control_idm", tmp_path, ("quarter-law",))
     assert cli.options(parser.parse_args([])).page == control_ablation.PAGE
+
+
+def test_the_paper_eta_meets_the_conditions_the_designed_eta_meets():
+    """esthm asks eta >= mu (1 - sigma) - gamma: the paper's faster eta on the IDM stream's
+    design leaves every condition as it was (esthm #1 fails for both, the rest hold)."""
+    from arzsumo.control.design_check import check_design
+    from arzsumo.control.verify import sinusoidal_deviation
+    from arzsumo.kernel_cache import cached_kernels
+    from arzsumo.scenario import load_scenario
+
+    sc = load_scenario(shipped_scenarios_dir() / "stop_and_go_idm.toml")
+    lin = linearize(sc.equilibrium)
+    kernels = cached_kernels(lin.system, sc.run.kernel_cells)
+    w0 = lin.to_riemann(sinusoidal_deviation(lin, kernels.x), kernels.x)
+    alpha_x = (w0[:-1, -1] - w0[:-1, -2]) / kernels.h
+    held = []
+    for eta in (sc.design.eta, control_ablation.PAPER_ETA):
+        report = check_design(lin.system, kernels, sc.design.with_(eta=eta), alpha_x)
+        held.append([(c.label, c.holds) for c in report.conditions])
+    assert sc.design.eta == pytest.approx(sc.design.mu * (1 - sc.design.sigma), rel=1e-4)
+    assert held[0] == held[1]
+    assert [c for c, ok in held[1] if not ok] == ["esthm"]

@@ -31,6 +31,8 @@ unit-gain           the laws on the paper's unit actuator: ``[actuation] meter_g
 quarter-law         the laws' command to the meter :data:`QUARTER` times smaller
                     (``[actuation] meter_gain`` times :data:`QUARTER`): their swings
                     inside the meter's range (``ablation_steps._quarter_law``)
+paper-eta           the ETC's dynamic variable m forgetting at the paper's rate,
+                    ``[design] eta`` = :data:`PAPER_ETA`
 ==================  ==============================================================
 
 The steps and their constants live in :mod:`arzsumo.studies.control.ablation_steps`
@@ -69,6 +71,7 @@ from arzsumo.studies.control.ablation_steps import (
     DEAD_BAND_KMH,
     DEFAULT_STEPS,
     MEASURED_DEAD_TIME_S,
+    PAPER_ETA,
     PREDICTION_S,
     QUARTER,
     STEPS,
@@ -271,6 +274,7 @@ def run_ablation(opts: AblationOptions) -> AblationResult:
     return AblationResult(text, ok)
 
 
-__all__ = ["DEAD_BAND_KMH", "DEFAULT_STEPS", "MEASURED_DEAD_TIME_S", "NAME", "PREDICTION_S",
+__all__ = ["DEAD_BAND_KMH", "DEFAULT_STEPS", "MEASURED_DEAD_TIME_S", "NAME", "PAPER_ETA",
+           "PREDICTION_S",
            "QUARTER", "STEPS", "WAVE_SPEED_KMH", "AblationOptions", "full_configuration",
            "run_ablation", "step_name", "step_scenario", "table"]

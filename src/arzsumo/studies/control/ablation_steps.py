@@ -128,6 +128,15 @@ def _quarter_law(data: dict) -> dict:
     return data
 
 
+#: the rate ``paper-eta`` gives the ETC's dynamic variable m, 1/s: the paper's (PAPER_DESIGN).
+#: ``design-check --auto`` sets eta = mu (1 - sigma), the least esthm allows; where mu is
+#: small (0.0045 1/s on the IDM stream) m then remembers its negative forcing
+#: (-sigma mu V - ...) for 1 / eta = 440 s, and the trigger's threshold
+#: zeta mu sigma V - m outgrows every d the meter can produce. Any larger eta meets the
+#: same conditions (esthm: eta >= mu (1 - sigma) - gamma).
+PAPER_ETA = 0.9
+
+
 #: step -> (what it changes, the change on the scenario as written, acts on the open loop)
 STEPS: dict[str, tuple[str, Callable[[dict], dict], bool]] = {
     "raw-cells": ("the laws on SUMO's Edie cells (no estimator)",
@@ -157,12 +166,16 @@ STEPS: dict[str, tuple[str, Callable[[dict], dict], bool]] = {
                       _set({"design.noise_from_estimate": False}), False),
     "unit-gain": ("the laws on the paper's unit actuator (meter_gain 1)",
                   _set({"actuation.meter_gain": 1.0}), False),
+    "paper-eta": (f"the ETC's m forgetting at the paper's eta = {PAPER_ETA:g} 1/s",
+                  _set({"design.eta": PAPER_ETA}), False),
     "quarter-law": (f"the laws' command to the meter {QUARTER:g} times smaller, inside "
                     "its range", _quarter_law, False),
 }
 #: the steps run unless ``--steps`` names others: those of the default's configuration
 #: (``power-law``, ``paper-trigger`` and ``unit-gain`` change nothing on the default, whose
 #: model is the power law, whose trigger is the paper's and whose meter gain is 1;
-#: ``quarter-law`` is for a stream where the laws saturate the meter)
+#: ``quarter-law`` is for a stream where the laws saturate the meter, ``paper-eta`` for a
+#: design whose eta is small)
 DEFAULT_STEPS = tuple(s for s in STEPS if s not in ("power-law", "paper-trigger",
-                                                    "unit-gain", "quarter-law"))
+                                                    "unit-gain", "quarter-law",
+                                                    "paper-eta"))
