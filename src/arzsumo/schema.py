@@ -87,6 +87,14 @@ PERIODS: dict[str, Column] = {
                                     "(one_per_green; NaN for fixed_cycle)"),
     "override": Column(TEXT, "true where the meter's queue override was on at the period's "
                              "end (ramp queue above ramp_storage_veh: the largest release)"),
+    "trigger_energy": Column("1", "the event trigger's V at this check: the Lyapunov energy "
+                                  "of the state, in the design's scaled units (NaN for a "
+                                  "law without a trigger)"),
+    "trigger_hold_error": Column("1", "the trigger's d: the held U-bar minus the law's "
+                                      "(both within what can be delivered), scaled units"),
+    "trigger_memory": Column("1", "the trigger's dynamic variable m (defdynamic), scaled "
+                                  "units; an event when zeta B e^(mu L/Lambda-) d^2 >= "
+                                  "zeta mu sigma V - m"),
 }
 
 _STATE = {

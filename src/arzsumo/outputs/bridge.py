@@ -51,6 +51,7 @@ from arzsumo.bridge.delay import compensated_delay
 from arzsumo.bridge.estimator import fill_speeds
 from arzsumo.bridge.result import CoSimResult
 from arzsumo.bridge.sensor_record import estimation_scores
+from arzsumo.control.base import ControlLog
 from arzsumo.control.events import release_time
 from arzsumo.evaluation.decay import decay, deviation_norm
 from arzsumo.evaluation.fields import field_rmse, oscillation, wave_travel
@@ -343,11 +344,29 @@ def summary(res: CoSimResult) -> RunSummary:
         settings=res.settings.as_dict(), disturbance=res.disturbance)
 
 
+#: ``periods.parquet`` column -> the event trigger's diagnostic in the controller's log
+TRIGGER_TERMS = {"trigger_energy": "V", "trigger_hold_error": "d", "trigger_memory": "m"}
+
+
+def trigger_terms(log: ControlLog, n: int) -> dict[str, np.ndarray]:
+    """The event trigger's terms at each of the first ``n`` checks (defdynamic): the
+    Lyapunov energy V of the state, the hold error d and the dynamic variable m, in the
+    design's scaled units (:mod:`arzsumo.control.etc`); NaN for a law without a trigger."""
+    out = {}
+    for column, key in TRIGGER_TERMS.items():
+        values = np.full(n, np.nan)
+        logged = np.asarray(log.extra.get(key, ()), float)[:n]
+        values[:logged.size] = logged
+        out[column] = values
+    return out
+
+
 def periods_table(res: CoSimResult) -> pa.Table:
     cols = {"t_s": res.periods["t"]}
     cols.update({k: v for k, v in res.periods.items() if k not in ("t", "controller_s")})
     for flag in ("triggered", "saturated", "rate_limited", "override"):
         cols[flag] = res.periods[flag].astype(bool)
+    cols.update(trigger_terms(res.controller_log, len(cols["t_s"])))
     return with_units(pa.table(cols), PERIODS, "periods")
 
 
