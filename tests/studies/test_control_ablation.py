@@ -220,3 +220,14 @@ def test_the_paper_eta_meets_the_conditions_the_designed_eta_meets():
     assert sc.design.eta == pytest.approx(sc.design.mu * (1 - sc.design.sigma), rel=1e-4)
     assert held[0] == held[1]
     assert [c for c, ok in held[1] if not ok] == ["esthm"]
+
+
+def test_a_model_step_runs_its_own_open_loop_where_the_model_places_the_section():
+    idm = experiment_scenario(tomllib.loads((shipped_scenarios_dir() / "stop_and_go_idm.toml"
+                                             ).read_text(encoding="utf-8")), "regulation")
+    assert control_ablation.own_open_loop("power-law", idm)          # placed: its own
+    assert control_ablation.own_open_loop("wave-matched", idm)
+    assert not control_ablation.own_open_loop("quarter-law", idm)    # the laws only
+    warm = experiment_scenario(BASE, "regulation")                   # warmed up: borrowed
+    assert not control_ablation.own_open_loop("power-law", warm)
+    assert control_ablation.own_open_loop("fixed-cycle", warm)       # the plant itself

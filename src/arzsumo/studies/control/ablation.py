@@ -44,8 +44,9 @@ an evaluation (:func:`~arzsumo.sweep.evaluate.run_evaluation`) into ``OUT/<step>
 (``OUT/<step>-disturbance/``). A step that does not act on an open loop borrows the open
 loop of the control study (``--control DIR``: its ``--out``, or its record store, whose
 open-loop records are then restored into ``OUT/control-open/``); ``fixed-cycle`` changes
-the plant and runs its own. The table gives each step minus the full configuration and
-minus the open loop.
+the plant and runs its own, and so do ``wave-matched`` and ``power-law`` where the
+model's speeds place the section (``ablation_steps.own_open_loop``). The table gives
+each step minus the full configuration and minus the open loop.
 """
 
 from __future__ import annotations
@@ -76,6 +77,7 @@ from arzsumo.studies.control.ablation_steps import (
     QUARTER,
     STEPS,
     WAVE_SPEED_KMH,
+    own_open_loop,
 )
 from arzsumo.studies.recorded import RecordedRuns, recorded_evaluation
 from arzsumo.sweep.evaluate import BASELINE, evaluation_spec
@@ -125,15 +127,17 @@ def _cells(a_runs: pd.DataFrame, a: str, b_runs: pd.DataFrame, b: str,
 
 
 def table(steps: dict[str, pd.DataFrame], full: pd.DataFrame, seeds: list[int],
-          laws: Sequence[str] = LAWS) -> str:
+          laws: Sequence[str] = LAWS, own_open: frozenset[str] | None = None) -> str:
     """Markdown: per step, law and measure, the step minus the full configuration and the
     step minus the open loop of its evaluation, paired by seed (mean [95 % t]
     wins/losses of the step); first, the full configuration minus the open loop, where a
-    step borrowed the control study's open loop."""
+    step borrowed the control study's open loop (``own_open``: the steps that ran their
+    own; None: those :data:`STEPS` flags)."""
     lines = ["| step | law | minus | " + " | ".join(f"{m.label} ({m.unit})"
                                                   for m in measures()) + " |",
              "|---" * (3 + len(KEYS)) + "|"]
-    borrowed = next((r for s, r in steps.items() if not STEPS[s][2]
+    own = own_open if own_open is not None else frozenset(s for s in STEPS if STEPS[s][2])
+    borrowed = next((r for s, r in steps.items() if s not in own
                      and BASELINE in set(r["controller"])), None)
     if borrowed is not None:
         for law in laws:
@@ -252,17 +256,18 @@ def run_ablation(opts: AblationOptions) -> AblationResult:
     with resumable_dir(opts.out, f"study-{NAME}") as out:
         baseline = open_loop_runs(control_runs, open_runs,
                                   out / step_name("control-open", experiment))
+        data = control.experiment_scenario(base, experiment)
+        own = frozenset(s for s in steps if own_open_loop(s, data))
         for s in steps:
             name = step_name(s, experiment)
             path = write_text(dump_toml(scenarios[s]), out / "steps" / f"{name}.toml")
-            own_open = STEPS[s][2]
             runs, finished = recorded_evaluation(
-                opts.runs, path, [BASELINE, *laws] if own_open else laws, out / name,
-                baseline_from=None if own_open else baseline)
+                opts.runs, path, [BASELINE, *laws] if s in own else laws, out / name,
+                baseline_from=None if s in own else baseline)
             ok &= finished
             if not runs.empty:
                 found[s] = runs
-        text = table(found, full, seeds, laws)
+        text = table(found, full, seeds, laws, own)
         md = write_text(text, out / f"{step_name('ablation', experiment)}.md")
         if opts.docs is not None:
             publish(opts.docs, opts.page, step_name(NAME, experiment),
@@ -277,4 +282,4 @@ def run_ablation(opts: AblationOptions) -> AblationResult:
 __all__ = ["DEAD_BAND_KMH", "DEFAULT_STEPS", "MEASURED_DEAD_TIME_S", "NAME", "PAPER_ETA",
            "PREDICTION_S",
            "QUARTER", "STEPS", "WAVE_SPEED_KMH", "AblationOptions", "full_configuration",
-           "run_ablation", "step_name", "step_scenario", "table"]
+           "own_open_loop", "run_ablation", "step_name", "step_scenario", "table"]

@@ -179,3 +179,16 @@ STEPS: dict[str, tuple[str, Callable[[dict], dict], bool]] = {
 DEFAULT_STEPS = tuple(s for s in STEPS if s not in ("power-law", "paper-trigger",
                                                     "unit-gain", "quarter-law",
                                                     "paper-eta"))
+
+
+#: the steps that change ``[model]``: where the model's speeds place the section
+#: (``[run] start = "placement"``) they change the open loop too
+MODEL_STEPS = ("wave-matched", "power-law")
+
+
+def own_open_loop(step: str, experiment: dict) -> bool:
+    """Whether ``step`` on the scenario ``experiment`` (as written) needs an open loop of
+    its own: it changes the plant (:data:`STEPS`' flag), or it changes ``[model]`` on a
+    section placed at the model's equilibrium."""
+    placed = experiment.get("run", {}).get("start") == "placement"
+    return STEPS[step][2] or (placed and step in MODEL_STEPS)
