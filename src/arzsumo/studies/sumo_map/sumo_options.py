@@ -59,6 +59,9 @@ VARIANTS: dict[str, list[Any]] = {
 MEASURES: dict[str, tuple[str, float, str]] = {
     "network.time_spent_s.total": ("window time spent", 1 / S_PER_H, "veh h"),
     "network_whole_demand.time_spent_s.total": ("whole-demand time spent", 1 / S_PER_H, "veh h"),
+    "network_whole_demand.time_loss_s.total": ("whole-demand time loss", 1 / S_PER_H, "veh h"),
+    "network_whole_demand.depart_delay_s.total": ("whole-demand depart delay", 1 / S_PER_H,
+                                                  "veh h"),
     "network_whole_demand.ramp_wait_s.p95": ("ramp wait p95", 1.0, "s"),
     "section.speed_mean_kmh.h": ("HV mean speed", 1.0, "km/h"),
     "section.speed_mean_kmh.a": ("AV mean speed", 1.0, "km/h"),
