@@ -139,8 +139,10 @@ def test_a_group_with_a_killed_branch_completes_and_equals_plain_runs(tmp_path):
     for got, t in zip(outcomes, group.tasks, strict=True):   # both equal plain runs
         plain = execute(t)
         assert _numbers(got.summary) == _numbers(plain.summary)
-        assert _table(got.tables["periods.parquet"]).equals(
-            _table(plain.tables["periods.parquet"]))
+        # as frames: NaN where the other has NaN is equal (the trigger's columns of a
+        # law without a trigger)
+        assert _table(got.tables["periods.parquet"]).to_pandas().equals(
+            _table(plain.tables["periods.parquet"]).to_pandas())
 
 
 @pytest.mark.sumo
