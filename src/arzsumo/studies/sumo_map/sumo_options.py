@@ -6,19 +6,20 @@ Each variant is the default scenario with one ``[sumo]`` key changed (:data:`VAR
 * the lateral resolution (0.5 m as shipped: 13 sublanes of the 6.5 m lane; 0.65 m and
   1.3 m, also divisors of the lane width, as SUMO advises);
 * the HVs' action step (every 0.1 s step as shipped; 0.5 s);
-* the approach length (2500 m as shipped; 1500 and 1000 m: the queue's tail waits
-  off the network, in SUMO's insertion backlog, where it costs nothing per step; its
-  depart delay is charged to the whole demand all the same);
+* the approach length (2500 m as shipped; 1500 and 1000 m: less road upstream of
+  x = 0; a queue that reaches the approach's start waits off the network, in SUMO's
+  insertion backlog, where it costs nothing per step and its depart delay is charged
+  to the whole demand all the same);
 * SUMO's eager insertion (every waiting vehicle of the virtual queues tried every step
   as shipped; off: only each edge's first).
 
 Every run is an ``arzsumo run`` of the open loop through the sweep engine (its drain
-included unless ``--no-drain``), on the same seeds for every variant; ``--vary`` picks the
-options (all by default). The shipped scenario runs once per seed as the baseline. For each variant
-against the shipped one, seed by seed, ``sumo_options.csv`` gives the wall time per run
-and its ratio, and the paired difference of each measure (:data:`MEASURES`) with its
-95 % t interval and whether it moves beyond seed noise (the interval excludes zero). A
-default may change only where nothing moves.
+included unless ``--no-drain``), on the same seeds for every variant; ``--vary`` picks
+the options (all by default), and the shipped scenario runs once per seed as the
+baseline. For each variant against the shipped one, seed by seed, ``sumo_options.csv``
+gives the wall time per run and its ratio, and the paired difference of each measure
+(:data:`MEASURES`) with its 95 % t interval and whether it moves beyond seed noise (the
+interval excludes zero). A default may change only where nothing moves.
 """
 
 from __future__ import annotations
