@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 
 from arzsumo.cli.studies.options import add_output, add_runs
-from arzsumo.studies.common import print_list
+from arzsumo.studies.common import names_among, print_list
 from arzsumo.studies.sumo_map.sumo_options import (
     NAME,
     PAGE,
@@ -23,21 +23,23 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-drain", action="store_true",
                         help="end each run with the control window (faster; no "
                              "whole-demand measures)")
-    parser.add_argument("--vary", type=_keys, default=(), metavar="KEYS",
+    parser.add_argument("--vary", default="", metavar="KEYS",
                         help="comma-separated [sumo] keys varied, of "
                              + ", ".join(f.split(".", 1)[1] for f in VARIANTS)
                              + " (default: all)")
     add_output(parser, NAME, PAGE, plots=False)
 
 
-def _keys(text: str) -> tuple[str, ...]:
-    return tuple(k.strip() for k in text.split(",") if k.strip())
+def _varied(text: str) -> tuple[str, ...]:
+    """The ``--vary`` keys (none given: every option)."""
+    keys = [f.split(".", 1)[1] for f in VARIANTS]
+    return tuple(names_among(text, keys, "--vary")) if text.strip() else ()
 
 
 def options(args: argparse.Namespace) -> SumoOptionsOptions:
     """The study's options as the command line gave them."""
     return SumoOptionsOptions(seeds=tuple(args.seeds), drain=not args.no_drain,
-                              vary=args.vary,
+                              vary=_varied(args.vary),
                               out=args.out, docs=args.docs, workers=args.workers,
                               scheduler=args.scheduler)
 

@@ -247,17 +247,16 @@ def run_ablation(opts: AblationOptions) -> AblationResult:
     experiment = opts.experiment
     control_runs = Path(opts.control) / experiment
     ok, found = True, {}
+    data = control.experiment_scenario(base, experiment)
+    own = frozenset(s for s in steps if own_open_loop(s, data))
     with tempfile.TemporaryDirectory() as tmp:     # checked before --out is touched
-        exp_path = write_text(dump_toml(control.experiment_scenario(base, experiment)),
-                              Path(tmp) / f"{experiment}.toml")
+        exp_path = write_text(dump_toml(data), Path(tmp) / f"{experiment}.toml")
         scenarios = step_scenarios(base, steps, experiment, str(opts.base))
         full = full_configuration(control_runs, exp_path, laws, seeds, str(opts.control))
         open_runs = evaluation_spec(exp_path, [BASELINE], seeds).runs()
     with resumable_dir(opts.out, f"study-{NAME}") as out:
         baseline = open_loop_runs(control_runs, open_runs,
                                   out / step_name("control-open", experiment))
-        data = control.experiment_scenario(base, experiment)
-        own = frozenset(s for s in steps if own_open_loop(s, data))
         for s in steps:
             name = step_name(s, experiment)
             path = write_text(dump_toml(scenarios[s]), out / "steps" / f"{name}.toml")
