@@ -87,6 +87,9 @@ PERIODS: dict[str, Column] = {
                                     "(one_per_green; NaN for fixed_cycle)"),
     "override": Column(TEXT, "true where the meter's queue override was on at the period's "
                              "end (ramp queue above ramp_storage_veh: the largest release)"),
+    "speed_limit": Column("m/s", "speed limit of the edge past the merge commanded after "
+                                 "this check ([actuation] actuator = speed_limit; NaN when "
+                                 "the meter is the actuator)"),
     "trigger_energy": Column("1", "the event trigger's V at this check: the Lyapunov energy "
                                   "of the state, in the design's scaled units (NaN for a "
                                   "law without a trigger)"),
@@ -211,7 +214,8 @@ RUN_SUMMARY: dict[str, str] = {
     "meter.mode": TEXT, "meter.clearance_s": "s", "meter.release_rate": "veh/s",
     "meter.releases": "veh", "meter.greens": "count", "meter.releases_per_green_max": "veh",
     "meter.override_steps": "count", "meter.override_s": "s", "meter.ramp_storage": "veh",
-    "meter.emergency_stops": "count",
+    "meter.emergency_stops": "count", "meter.speed_limit_changes": "count",
+    "meter.speed_limit_m_s": "m/s", "meter.speed_limit_nominal_m_s": "m/s",
     "network_whole_demand": TEXT,      # null without a drain
     "network_whole_demand.complete": "bool", "network_whole_demand.drain.duration_s": "s",
     "network_whole_demand.drain.max_s": "s", "network_whole_demand.drain.hit_limit": "bool",
@@ -254,6 +258,10 @@ RUN_SUMMARY: dict[str, str] = {
     "actuation.rate_limited_share": "1", "actuation.delay_compensation": "s",
     "actuation.meter_gain": "1", "actuation.hold_plan_in_range": "bool",
     "actuation.trigger_output_noise": "veh/s", "actuation.trigger_dead_band": "veh/s",
+    "actuation.actuator": TEXT, "actuation.authority.window_s": "s",
+    "actuation.authority.u_sd": "veh/s", "actuation.authority.outflow_sd": "veh/s",
+    "actuation.authority.gain": "1", "actuation.authority.gain_se": "1",
+    "actuation.authority.windows": "count",
     "twin_status.*.resyncs": "count", "twin_status.*.first_resync_s": "s",
     "twin_status.*.first_reason": TEXT,
     "inserted": "veh", "requested": "veh", "waiting": "veh", "arrived": "veh",

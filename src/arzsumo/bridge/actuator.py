@@ -41,7 +41,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import Any, NamedTuple, Protocol
 
 from arzsumo.control.base import Applied, Controller
 from arzsumo.control.meter_gain import MeterGain
@@ -93,8 +93,9 @@ def limit_u(u_raw: float, u_prev: float, lower: float = -INF, upper: float = INF
 def on_meter(ctrl: Controller, acting: str, settings: ActuationSettings) -> Controller:
     """``ctrl`` asking the meter for U / ``meter_gain`` when ``acting`` is a PDE law and
     the gain is not 1 (:class:`~arzsumo.control.meter_gain.MeterGain`); ``ctrl`` itself
-    otherwise (ALINEA and the held meter command release rates directly)."""
-    if settings.meter_gain == 1.0 or not is_pde(acting):
+    otherwise (ALINEA and the held meter command release rates directly; on the outlet's
+    speed limit the actuator maps U itself, :mod:`arzsumo.bridge.speed_actuator`)."""
+    if settings.meter_gain == 1.0 or not is_pde(acting) or settings.actuator != "meter":
         return ctrl
     return MeterGain(ctrl, settings.meter_gain)
 
@@ -144,7 +145,9 @@ class ActuationLimits:
 class Actuation:
     """One command: the law's U and the U applied (veh/s), the limit flags, the range
     ``[lower, upper]`` (veh/s) in force, the green share commanded and the release rate
-    asked of the meter (veh/s; NaN for a fixed cycle)."""
+    asked of the meter (veh/s; NaN for a fixed cycle), and the outlet's speed limit
+    commanded (m/s; NaN when the meter is the actuator,
+    :mod:`arzsumo.bridge.speed_actuator`)."""
 
     u_raw: float
     u_applied: float
@@ -154,6 +157,7 @@ class Actuation:
     upper: float
     green: float
     release_rate: float = math.nan
+    speed_limit: float = math.nan
 
     def told(self, anti_windup: bool) -> Applied:
         """What the controller is told at its next check: the U applied and, with
@@ -161,6 +165,20 @@ class Actuation:
         if anti_windup:
             return Applied(self.u_applied, self.lower, self.upper)
         return Applied(self.u_applied, anti_windup=False)
+
+
+class Actuator(Protocol):
+    """The actuation stage's interface: the meter (:class:`MeterActuator`) or the outlet's
+    speed limit (:class:`arzsumo.bridge.speed_actuator.SpeedLimitActuator`)."""
+
+    def apply(self, u: float) -> Actuation:
+        """Command U (veh/s), limited; what was applied."""
+
+    def summary(self) -> dict[str, Any]:
+        """The actuator's own counts over the control window, beside the meter's."""
+
+    def restore(self) -> None:
+        """The open loop's command again, for the drain after the window."""
 
 
 class MeterActuator:
@@ -213,6 +231,13 @@ class MeterActuator:
         return Actuation(u, lim.u_applied, lim.saturated, lim.rate_limited, lower, upper,
                          green, _rate(meter))
 
+
+    def summary(self) -> dict[str, Any]:
+        """Nothing beside the meter's own counts."""
+        return {}
+
+    def restore(self) -> None:
+        """Nothing: the drain hands the meter to its own policy."""
 
     def _keeps_plan(self, u: float, lower: float, upper: float, rate_step: float) -> bool:
         """Whether a held ``u`` keeps the previous U applied (module docstring): held,

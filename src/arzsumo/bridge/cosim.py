@@ -56,7 +56,7 @@ from typing import Any
 
 import numpy as np
 
-from arzsumo.bridge.actuator import ActuationLimits, MeterActuator, on_meter
+from arzsumo.bridge.actuator import on_meter
 from arzsumo.bridge.delay import check_delay, compensate
 from arzsumo.bridge.drain import drain, whole_demand
 from arzsumo.bridge.estimators import RecordedEstimator, estimation_stage
@@ -66,6 +66,7 @@ from arzsumo.bridge.records import Trace, columns, micro_fields
 from arzsumo.bridge.reference import reference_shift
 from arzsumo.bridge.result import CoSimResult
 from arzsumo.bridge.run_progress import CONTROL, MEASURES, run_progress
+from arzsumo.bridge.speed_actuator import actuator_for
 from arzsumo.bridge.trigger_noise import size_dead_band, warmup_states
 from arzsumo.bridge.twins import TwinPair
 from arzsumo.control.alinea import ReleaseRates
@@ -308,7 +309,9 @@ def finish_run(opened: OpenRun, warmed: Warmed, run: PreparedRun,
     sim, cfg = opened.sim, run.sumo
     c = control(warmed, run, opened.bar, keep_measurements)
     plant = c.loop.plant
-    meter_summary = {**plant.meter_summary(), "ramp_storage": cfg.ramp_storage}
+    meter_summary = {**plant.meter_summary(), "ramp_storage": cfg.ramp_storage,
+                     **c.loop.actuator.summary()}
+    c.loop.actuator.restore()         # the drain runs the open loop's outlet
     timings = {**plant.timings, **c.loop.timings}   # the window's, not the drain's
     t_end = sim.time
     drained = drain(plant, cfg.drain_max, opened.bar) if cfg.drain_max > 0 else None
@@ -382,8 +385,7 @@ def control(warmed: Warmed, run: PreparedRun, bar: RunProgress,
                          horizon=cfg.horizon, control_period=period)
     twins = TwinPair(eq, lin, warm[-1].cells, opts, settings.smoothing, ref_ctrl, q_nom)
     act = scenario.actuation
-    actuator = MeterActuator(plant.meter, q_nom, settings.controller == "open",
-                             ActuationLimits.of(act, q_nom, period))
+    actuator = actuator_for(plant, q_nom, settings.controller, acting, act, period)
     loop = ClosedLoop(plant, estimator, ctrl, actuator, twins, period, act.anti_windup,
                       shift)
     plant.disturb(scenario.disturbance, warm[-1].t)

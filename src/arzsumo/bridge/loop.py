@@ -36,7 +36,7 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
-from arzsumo.bridge.actuator import Actuation, MeterActuator
+from arzsumo.bridge.actuator import Actuation, Actuator
 from arzsumo.bridge.estimator import Estimator
 from arzsumo.bridge.records import PeriodRecord, Trace, micro_fields
 from arzsumo.bridge.reference import ReferenceShift
@@ -70,8 +70,8 @@ class ClosedLoop:
         Measurement -> the state the controller acts on.
     controller : Controller
         The acting law.
-    actuator : MeterActuator
-        U -> the meter's plan.
+    actuator : Actuator
+        U -> the meter's plan, or the outlet's speed limit.
     twins : TwinPair
         The replay and reference PDE twins beside SUMO.
     period : float
@@ -83,7 +83,7 @@ class ClosedLoop:
     """
 
     def __init__(self, plant: SumoPlant, estimator: Estimator, controller: Controller,
-                 actuator: MeterActuator, twins: TwinPair, period: float,
+                 actuator: Actuator, twins: TwinPair, period: float,
                  anti_windup: bool = True, shift: ReferenceShift | None = None) -> None:
         self.plant, self.estimator, self.controller = plant, estimator, controller
         self.actuator, self.twins, self.period = actuator, twins, period

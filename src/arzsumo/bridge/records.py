@@ -33,7 +33,8 @@ class PeriodRecord:
     and its maximum so far (veh), class in- and outflows of the section, the occupancy
     (fraction) and flow (veh/s) of the loop on ``down`` past the merge nose, the release
     rate the meter was asked for (veh/s; NaN for a fixed-cycle meter), and whether the
-    meter's queue override was on at the period's end (1.0 or 0.0).
+    meter's queue override was on at the period's end (1.0 or 0.0), and the outlet's
+    speed limit commanded after the check (m/s; NaN when the meter is the actuator).
     """
 
     t: float
@@ -60,6 +61,7 @@ class PeriodRecord:
     flow_out_loop: float = float("nan")
     release_rate: float = float("nan")
     override: float = 0.0
+    speed_limit: float = float("nan")
 
     @classmethod
     def of(cls, t: float, command: Command, act: Actuation, u_reference: float,
@@ -78,7 +80,7 @@ class PeriodRecord:
                    controller_s=controller_s, u_raw=command.u, u_applied=act.u_applied,
                    saturated=float(act.saturated), rate_limited=float(act.rate_limited),
                    flow_out_loop=m.flow_out_loop, release_rate=act.release_rate,
-                   override=float(meter.override))
+                   override=float(meter.override), speed_limit=act.speed_limit)
 
 
 def columns(records: list[PeriodRecord]) -> dict[str, np.ndarray]:

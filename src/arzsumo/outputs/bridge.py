@@ -53,6 +53,7 @@ from arzsumo.bridge.result import CoSimResult
 from arzsumo.bridge.sensor_record import estimation_scores
 from arzsumo.control.base import ControlLog
 from arzsumo.control.events import release_time
+from arzsumo.evaluation.authority import authority
 from arzsumo.evaluation.decay import decay, deviation_norm
 from arzsumo.evaluation.fields import field_rmse, oscillation, wave_travel
 from arzsumo.evaluation.stationarity import count_trend
@@ -159,7 +160,11 @@ def actuation_summary(res: CoSimResult) -> dict[str, Any]:
     ``trigger_output_noise`` (veh/s): the acting law's output noise on the warm-up's
     estimate, and ``trigger_dead_band`` (veh/s, noise_k sqrt(2) times it) the dead band
     it sized, both as the U the meter is asked for (the law's outflow units over
-    ``meter_gain``; null: not measured, :mod:`arzsumo.bridge.trigger_noise`)."""
+    ``meter_gain``; null: not measured, :mod:`arzsumo.bridge.trigger_noise`);
+    ``actuator``: what the acting law's U drove (``meter`` or ``speed_limit``), and
+    ``authority``: the sd of the U applied and of the outflow q(L) over 60 s windows
+    (veh/s) and the realised gain, the slope of the one on the other
+    (:mod:`arzsumo.evaluation.authority`)."""
     act, per = res.scenario.actuation, res.periods
     n = int(per["t"].size)
     sat, rate = int(np.sum(per["saturated"] > 0)), int(np.sum(per["rate_limited"] > 0))
@@ -177,7 +182,16 @@ def actuation_summary(res: CoSimResult) -> dict[str, Any]:
             "trigger_output_noise": res.trigger_noise,
             "trigger_dead_band": (None if res.trigger_noise is None else
                                   res.scenario.design.noise_k * math.sqrt(2.0)
-                                  * res.trigger_noise)}
+                                  * res.trigger_noise),
+            "actuator": ("speed_limit" if np.isfinite(per["speed_limit"]).any()
+                         else "meter"),
+            "authority": authority(per["u_applied"], per["outflow_h"] + per["outflow_a"],
+                                   res.sumo.control_period, AUTHORITY_WINDOW_S).as_dict()}
+
+
+#: the window of the authority's means, s: a minute, many meter cycles and less than the
+#: stop-and-go's period
+AUTHORITY_WINDOW_S = 60.0
 
 
 def warmup_summary(res: CoSimResult) -> dict[str, Any]:
@@ -278,7 +292,8 @@ def deviation_summary(res: CoSimResult) -> dict[str, Any] | None:
 #: ``summary.json["meter"]``: keys of the meter's own summary kept there (control window)
 METER_KEYS = ("mode", "clearance_s", "release_rate", "releases", "greens",
               "releases_per_green_max", "override_steps", "override_s", "ramp_storage",
-              "emergency_stops", "emergency_braking")
+              "emergency_stops", "emergency_braking", "speed_limit_changes",
+              "speed_limit_m_s", "speed_limit_nominal_m_s")
 
 
 def meter_summary(res: CoSimResult) -> dict[str, Any]:
@@ -286,7 +301,8 @@ def meter_summary(res: CoSimResult) -> dict[str, Any]:
     (``summary.json["meter"]``): mode, clearance (s), last release rate (veh/s, null for
     the fixed cycle), releases (vehicles crossing the stop line), green intervals begun
     and the most releases in one, override steps, emergency stops and braking at the
-    meter."""
+    meter; with the outlet's speed limit as the actuator, its changes over the window, its
+    last and its nominal limit (m/s; null on the meter)."""
     return {k: res.meter.get(k) for k in METER_KEYS}
 
 

@@ -51,6 +51,7 @@ from arzsumo.scenario.actuation import (
     ActuationSettings,
     actuation_section,
     check_delay_horizon,
+    check_speed_limit,
 )
 from arzsumo.scenario.alinea import ALINEA_KEYS, alinea_section, check_alinea_period
 from arzsumo.scenario.disturbance import DISTURBANCE_KEYS, disturbance_section
@@ -224,6 +225,9 @@ def scenario_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scena
         check_alinea_period(alinea, sumo.control_period, at["alinea"],
                             t["alinea"].get("period_s"))
     disturbance = disturbance_section(t["disturbance"], at["disturbance"])
+    check_speed_limit(actuation, sumo.down_speed,
+                      disturbance.edge if disturbance.active else None, at["actuation"],
+                      t["actuation"])
     sweep = _sweep_section(t["sweep"], at["sweep"])
     default_name = Path(source).stem if source != "<dict>" else preset.name
     return Scenario(_text(data, "name", source, default_name),

@@ -10,6 +10,11 @@ Every key, its unit and the field of :class:`ActuationSettings` it sets::
     delay_compensation_s = 12     # PDE laws act on the state predicted 12 s ahead (0: off)
     meter_gain = 2                # PDE laws: the outflow moves 2 veh/h per veh/h of release
     hold_plan_in_range = true     # a held U moves the plan only when the range leaves it
+    actuator = "speed_limit"      # PDE laws act on the outlet's speed limit, not the meter
+    speed_limit_gain_veh_h_per_kmh = 40   # dq(L)/dv_limit
+    speed_limit_min_kmh = 10      # the limit's range ...
+    speed_limit_max_kmh = 60
+    speed_limit_step_kmh = 1      # ... and its resolution (0: continuous)
 
 Without the table every limit is off and a run is today's: the meter receives the
 controller's U unchanged (the meter itself still saturates its green share to
@@ -32,6 +37,16 @@ a PDE law's U is handed to the meter divided by it
 holds its U (between an ETC's events, or a held meter), the plan stays where it is as
 long as it lies in the range; it moves only when the range (the ramp bound moves with the
 queue) leaves it (:class:`arzsumo.bridge.actuator.MeterActuator`).
+
+``actuator`` names what a PDE law's U drives. ``"meter"`` (the default) is the paper's
+ramp meter. ``"speed_limit"`` is mainstream control at the section's outlet: the speed
+limit of the edge past the merge (``down``, the bottleneck whose discharge sets q(L)) is
+``v_nominal + U / speed_limit_gain`` (:class:`arzsumo.bridge.speed_actuator.SpeedLimitActuator`),
+within ``[speed_limit_min, speed_limit_max]`` and rounded to ``speed_limit_step``; the
+meter keeps its nominal plan. The boundary input is the same q(L) - q* as the paper's;
+only its actuator differs, one whose range is several times the meter's on a stream
+where the ramp's share of the flow is small. ALINEA, PI-ALINEA and the held meter
+command the ramp meter whatever ``actuator`` says.
 """
 
 from __future__ import annotations
@@ -45,7 +60,10 @@ import numpy as np
 
 from arzsumo.errors import ArzsumoError, ScenarioError, require
 from arzsumo.tables import Key, in_user_terms, not_allowed, read_keys
-from arzsumo.units import VEH_H_PER_VEH_S
+from arzsumo.units import KMH_PER_MS, VEH_H_PER_VEH_S, VEH_KM_PER_VEH_M
+
+#: what a PDE law's U can drive
+ACTUATORS = ("meter", "speed_limit")
 
 #: [actuation] key -> ActuationSettings field (SI)
 ACTUATION_KEYS: dict[str, Key] = {
@@ -74,6 +92,26 @@ ACTUATION_KEYS: dict[str, Key] = {
                               doc="a held U keeps the meter's plan while the plan lies in "
                                   "the range; false: the plan follows the range's clip "
                                   "at every period (default false)"),
+    "actuator": Key("actuator", "string", choices=ACTUATORS,
+                    doc="what a PDE law's U drives: the ramp meter, or the speed limit "
+                        "of the edge past the merge (default meter)"),
+    "speed_limit_gain_veh_h_per_kmh": Key(
+        "speed_limit_gain", factor=VEH_KM_PER_VEH_M, unit="veh/h per km/h",
+        allowed="a gain > 0 veh/h per km/h",
+        doc="dq(L)/dv_limit: the section outflow's change per change of the outlet's "
+            "speed limit (actuator = speed_limit)"),
+    "speed_limit_min_kmh": Key("speed_limit_min", factor=KMH_PER_MS, unit="km/h",
+                               allowed="a speed > 0 km/h, below speed_limit_max_kmh",
+                               doc="the outlet's lowest speed limit (actuator = "
+                                   "speed_limit)"),
+    "speed_limit_max_kmh": Key("speed_limit_max", factor=KMH_PER_MS, unit="km/h",
+                               allowed="a speed above speed_limit_min_kmh",
+                               doc="the outlet's highest speed limit (actuator = "
+                                   "speed_limit)"),
+    "speed_limit_step_kmh": Key("speed_limit_step", factor=KMH_PER_MS, unit="km/h",
+                                allowed="a step >= 0 km/h (0: continuous)",
+                                doc="the speed limit's resolution: each limit a whole "
+                                    "number of steps from the nominal (0: continuous)"),
 }
 
 
@@ -87,7 +125,9 @@ class ActuationSettings:
     applied (:meth:`arzsumo.control.base.Controller.applied`); ``delay_compensation``
     (s, 0: off) is the dead time theta the PDE laws predict over; ``meter_gain``
     (dimensionless) is -dq(L)/dr; ``hold_plan_in_range`` keeps a held U's plan while it
-    lies in the range.
+    lies in the range; ``actuator`` what a PDE law's U drives, with the speed limit's
+    ``speed_limit_gain`` (veh/s per m/s = veh/m), range ``speed_limit_min ..
+    speed_limit_max`` (m/s) and resolution ``speed_limit_step`` (m/s, 0: continuous).
     """
 
     u_max_fraction: float = 0.0
@@ -97,6 +137,11 @@ class ActuationSettings:
     delay_compensation: float = 0.0
     meter_gain: float = 1.0
     hold_plan_in_range: bool = False
+    actuator: str = "meter"
+    speed_limit_gain: float = 0.04
+    speed_limit_min: float = 10.0 / KMH_PER_MS
+    speed_limit_max: float = 60.0 / KMH_PER_MS
+    speed_limit_step: float = 0.0
 
     def __post_init__(self) -> None:
         require(math.isfinite(self.u_max_fraction) and 0.0 <= self.u_max_fraction <= 1.0,
@@ -108,6 +153,19 @@ class ActuationSettings:
                 ScenarioError)
         require(math.isfinite(self.meter_gain) and self.meter_gain > 0.0, "meter_gain",
                 self.meter_gain, "a gain > 0", ScenarioError)
+        require(self.actuator in ACTUATORS, "actuator", self.actuator,
+                f"one of {', '.join(ACTUATORS)}", ScenarioError)
+        require(math.isfinite(self.speed_limit_gain) and self.speed_limit_gain > 0.0,
+                "speed_limit_gain", self.speed_limit_gain, "a gain > 0 veh/m",
+                ScenarioError)
+        require(math.isfinite(self.speed_limit_min) and self.speed_limit_min > 0.0,
+                "speed_limit_min", self.speed_limit_min, "a speed > 0 m/s", ScenarioError)
+        require(math.isfinite(self.speed_limit_max)
+                and self.speed_limit_max > self.speed_limit_min, "speed_limit_max",
+                self.speed_limit_max, "a speed above speed_limit_min", ScenarioError)
+        require(math.isfinite(self.speed_limit_step) and self.speed_limit_step >= 0.0,
+                "speed_limit_step", self.speed_limit_step, "a step >= 0 m/s",
+                ScenarioError)
 
     @property
     def active(self) -> bool:
@@ -148,3 +206,22 @@ def check_delay_horizon(settings: ActuationSettings, eigenvalues: np.ndarray, le
                           f"a dead time in [0, {horizon:.4g}) s, shorter than L / max "
                           f"|lambda| at the {why or 'scenario'} equilibrium (one boundary "
                           "reflection at most)")
+
+
+def check_speed_limit(settings: ActuationSettings, down_speed: float, slowed_edge: str | None,
+                      at: str, table: Mapping[str, Any]) -> None:
+    """Refuse a speed-limit actuator whose range leaves out the outlet's own limit
+    ``down_speed`` (m/s, the open loop's), or that shares its edge with a slowdown
+    (``slowed_edge``: the edge a ``[disturbance]`` slows, None without one); one line
+    naming ``at`` (``file: [actuation]``), the key and the value as written."""
+    if settings.actuator != "speed_limit":
+        return
+    if not settings.speed_limit_min <= down_speed <= settings.speed_limit_max:
+        key = ("speed_limit_min_kmh" if down_speed < settings.speed_limit_min
+               else "speed_limit_max_kmh")
+        raise not_allowed(at, key, table.get(key), "a range that holds the outlet's own "
+                          f"limit, [sumo] down_speed_kmh = {down_speed * KMH_PER_MS:g}")
+    if slowed_edge == "down":
+        raise not_allowed(at, "actuator", table.get("actuator"),
+                          "meter while [disturbance] slows the edge past the merge, the "
+                          "speed limit's own edge")

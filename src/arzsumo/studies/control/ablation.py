@@ -33,6 +33,9 @@ quarter-law         the laws' command to the meter :data:`QUARTER` times smaller
                     inside the meter's range (``ablation_steps._quarter_law``)
 paper-eta           the ETC's dynamic variable m forgetting at the paper's rate,
                     ``[design] eta`` = :data:`PAPER_ETA`
+speed-limit         the laws on the outlet's speed limit (mainstream control, the same
+                    boundary input q(L) - q*) instead of the ramp meter
+                    (``[actuation]`` :data:`SPEED_LIMIT`)
 ==================  ==============================================================
 
 The steps and their constants live in :mod:`arzsumo.studies.control.ablation_steps`
@@ -75,6 +78,7 @@ from arzsumo.studies.control.ablation_steps import (
     PAPER_ETA,
     PREDICTION_S,
     QUARTER,
+    SPEED_LIMIT,
     STEPS,
     WAVE_SPEED_KMH,
     own_open_loop,
@@ -280,5 +284,6 @@ def run_ablation(opts: AblationOptions) -> AblationResult:
 
 __all__ = ["DEAD_BAND_KMH", "DEFAULT_STEPS", "MEASURED_DEAD_TIME_S", "NAME", "PAPER_ETA",
            "PREDICTION_S",
-           "QUARTER", "STEPS", "WAVE_SPEED_KMH", "AblationOptions", "full_configuration",
+           "QUARTER", "SPEED_LIMIT", "STEPS", "WAVE_SPEED_KMH", "AblationOptions",
+           "full_configuration",
            "own_open_loop", "run_ablation", "step_name", "step_scenario", "table"]

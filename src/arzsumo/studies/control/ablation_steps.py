@@ -137,6 +137,17 @@ def _quarter_law(data: dict) -> dict:
 PAPER_ETA = 0.9
 
 
+#: ``speed-limit``: the outlet's speed limit as the actuator ([actuation] keys). The gain
+#: is Newell's for IDM at SUMO's defaults behind the 30 km/h outlet: one file's flow
+#: v / (l + s0 + v T) changes by (l + s0) / (l + s0 + v T)^2 = 30 veh/h per km/h there (l
+#: + s0 = 7 m, T = 1 s), and the 6.5 m lane carries about 1.3 files past the merge;
+#: 10-60 km/h in 1 km/h steps, the range U keeps under u_max_fraction as on the meter
+SPEED_LIMIT = {"actuation.actuator": "speed_limit",
+               "actuation.speed_limit_gain_veh_h_per_kmh": 40.0,
+               "actuation.speed_limit_min_kmh": 10.0, "actuation.speed_limit_max_kmh": 60.0,
+               "actuation.speed_limit_step_kmh": 1.0}
+
+
 #: step -> (what it changes, the change on the scenario as written, acts on the open loop)
 STEPS: dict[str, tuple[str, Callable[[dict], dict], bool]] = {
     "raw-cells": ("the laws on SUMO's Edie cells (no estimator)",
@@ -168,6 +179,8 @@ STEPS: dict[str, tuple[str, Callable[[dict], dict], bool]] = {
                   _set({"actuation.meter_gain": 1.0}), False),
     "paper-eta": (f"the ETC's m forgetting at the paper's eta = {PAPER_ETA:g} 1/s",
                   _set({"design.eta": PAPER_ETA}), False),
+    "speed-limit": ("the laws on the outlet's speed limit (mainstream control) instead "
+                    "of the ramp meter", _set(SPEED_LIMIT), False),
     "quarter-law": (f"the laws' command to the meter {QUARTER:g} times smaller, inside "
                     "its range", _quarter_law, False),
 }
@@ -178,7 +191,7 @@ STEPS: dict[str, tuple[str, Callable[[dict], dict], bool]] = {
 #: design whose eta is small)
 DEFAULT_STEPS = tuple(s for s in STEPS if s not in ("power-law", "paper-trigger",
                                                     "unit-gain", "quarter-law",
-                                                    "paper-eta"))
+                                                    "paper-eta", "speed-limit"))
 
 
 #: the steps that change ``[model]``: where the model's speeds place the section
