@@ -91,8 +91,9 @@ PERIODS: dict[str, Column] = {
                                  "this check ([actuation] actuator = speed_limit; NaN when "
                                  "the meter is the actuator)"),
     "trigger_energy": Column("1", "the event trigger's V at this check: the Lyapunov energy "
-                                  "of the state, in the design's scaled units (NaN for a "
-                                  "law without a trigger)"),
+                                  "of the state ([design] trigger_energy = state), or the "
+                                  "least of a state giving the law's U (acted), in the "
+                                  "design's scaled units (NaN for a law without a trigger)"),
     "trigger_hold_error": Column("1", "the trigger's d: the held U-bar minus the law's "
                                       "(both within what can be delivered), scaled units"),
     "trigger_memory": Column("1", "the trigger's dynamic variable m (defdynamic), scaled "

@@ -175,3 +175,41 @@ def test_the_measured_dead_band_is_noise_k_root_two_times_the_output_noise(lin, 
         trig.set_output_noise(-1.0)
     with pytest.raises(ModelError, match="noise_from_estimate"):
         design.with_(noise_sd=(1.0, 1.0, 1.0, 1.0))
+
+
+def test_acted_energy_is_the_least_v_that_gives_the_laws_output(lin, kernels):
+    """V_U = U-bar^2 / (h^T W^-1 h) is the minimum of V over target states with the same
+    U-bar: no random state goes below it, and the minimiser W^-1 h reaches it."""
+    trig = EventTrigger(lin.system, kernels, PAPER_DESIGN.with_(trigger_energy="acted"))
+    per_u2, lyap, law = trig.acted_per_u2, trig.lyapunov, trig.law
+    assert per_u2 == lyap.least_per_u2(law) > 0
+    rng = np.random.default_rng(7)
+    n, size = lin.system.n, kernels.n_cells + 1
+    for _ in range(20):
+        alpha, beta = rng.normal(size=(n, size)), rng.normal(size=size)
+        u = law.u_bar_from_target(alpha, beta)
+        assert lyap(alpha, beta) >= per_u2 * u * u * (1 - 1e-12)
+    h = law.target_gain.copy()
+    h[:n, -1] -= lin.system.R
+    z = h / lyap.weights                                  # W^-1 h
+    u = law.u_bar_from_target(z[:n], z[n])
+    assert lyap(z[:n], z[n]) == pytest.approx(per_u2 * u * u, rel=1e-10)
+    assert EventTrigger(lin.system, kernels).acted_per_u2 == 0.0     # the paper's V
+
+
+def test_acted_trigger_keeps_the_guarantee(lin, kernels, etc_run):
+    """Theorem esthm's decay and Lemma mbound with V_U in defdynamic and mdyna; with the
+    paper's design m's memory dominates both energies, and the runs barely differ."""
+    acted = run_closed_loop(lin, kernels, "etc", period=1.0,
+                            design=PAPER_DESIGN.with_(trigger_energy="acted"))
+    s = acted.summary()
+    assert s["V_ratio"] < 1e-3                                   # V still decays
+    assert acted.log.triggers < 450                              # still event-triggered
+    assert abs(acted.log.triggers - etc_run.log.triggers) <= 0.1 * etc_run.log.triggers
+    m = np.array(acted.log.extra["m"])
+    assert np.all(m[~np.array(acted.log.triggered)] < 0)         # Lemma mbound between events
+
+
+def test_unknown_trigger_energy_is_refused():
+    with pytest.raises(ModelError, match="trigger_energy"):
+        EtcDesign(trigger_energy="output")

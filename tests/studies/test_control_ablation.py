@@ -13,6 +13,7 @@ from arzsumo.model import characteristic_speeds, linearize
 from arzsumo.resources import shipped_scenarios_dir
 from arzsumo.scenario import scenario_from_dict
 from arzsumo.studies.common import StudyError
+from arzsumo.studies.recorded import RecordedRuns
 from arzsumo.studies.control import ablation as control_ablation
 from arzsumo.studies.control.study import experiment_scenario
 
@@ -231,3 +232,21 @@ def test_a_model_step_runs_its_own_open_loop_where_the_model_places_the_section(
     warm = experiment_scenario(BASE, "regulation")                   # warmed up: borrowed
     assert not control_ablation.own_open_loop("power-law", warm)
     assert control_ablation.own_open_loop("fixed-cycle", warm)       # the plant itself
+
+
+def test_joined_steps_make_each_change_in_order():
+    joined = control_ablation.step_scenario(BASE, "speed-limit+acted-trigger")
+    one = control_ablation.step_scenario(BASE, "speed-limit")
+    assert joined["actuation"] == one["actuation"]
+    assert joined["actuation"]["actuator"] == "speed_limit"
+    assert joined["design"]["trigger_energy"] == "acted"
+    assert control_ablation.is_step("speed-limit+acted-trigger")
+    assert not control_ablation.is_step("speed-limit+speed-limit")
+    assert not control_ablation.is_step("speed-limit+vsl")
+    assert control_ablation.describe("speed-limit+acted-trigger").count(" and ") >= 1
+
+
+def test_a_joined_step_of_unknown_parts_is_refused():
+    with pytest.raises(StudyError, match=r"steps = \('predictor\+nothing',\) is not allowed"):
+        control_ablation.AblationOptions(RecordedRuns(seeds=(1,)),
+                                         steps=("predictor+nothing",))

@@ -48,6 +48,23 @@ bounds) d is dt's exactly. The rate limit is left out of the projection: it only
 the held command (as the meter's cycle does), which then arrives; it is no windup. The
 noise dead band acts on the projected d.
 
+The trigger's energy (``trigger_energy``; not in the paper). ``"state"`` (the default) is
+the paper's: defdynamic and mdyna use the V of the whole state. ``"acted"`` uses, in
+both, V_U = U-bar^2 / (h^T W^-1 h), the least V of any target state (alpha, beta) on
+which control_law gives the present U-bar = h^T (alpha, beta) (h: the law's weights in
+target variables, :attr:`BacksteppingLaw.target_gain` with -R at alpha(L); W: V's
+weights). The proofs carry over: Lemma mbound's comparison needs only that the trigger
+and mdyna use the same energy (B e^{mu L/Lambda-} d^2 - mu sigma V_U <= -m / zeta
+between events, so m' <= -(eta + 1/zeta) m - ... and m < 0), and Theorem esthm's
+derivative of V_d = V - m picks up +mu sigma V_U <= mu sigma V from -m', so the same
+decay rate mu (1 - sigma) - gamma holds. The minimal dwell time (Theorem minimalthm)
+is not claimed; checks every Delta seconds bound the event rate anyway. It matters where
+V lies in components the law's integral does not see (an estimate of a stream far from
+the model's equilibrium, with stop-and-go and noise): there the paper's m accumulates
+-sigma mu V and its threshold zeta mu sigma V - m outgrows every d the actuator can
+produce (on SUMO's IDM stream d^2 stays below 0.13 % of sigma mu V), while V_U weighs d
+against the law's own output.
+
 Lemma mbound guarantees m < 0 under continuous monitoring. With periodic checks the
 condition can be violated between checks unseen, so m may creep above zero: every such
 check is counted in the log (``m_nonnegative``), never clamped.
@@ -67,6 +84,9 @@ from arzsumo.control.transform import BacksteppingLaw, BacksteppingTransform
 from arzsumo.errors import ModelError, require
 from arzsumo.model.characteristic import CharacteristicSystem, Linearization
 
+#: what the trigger compares the hold error with (module docstring)
+TRIGGER_ENERGIES = ("state", "acted")
+
 
 @dataclass(frozen=True)
 class EtcDesign:
@@ -79,7 +99,8 @@ class EtcDesign:
     ``noise_k`` (dimensionless) set the noise dead band of the trigger (module docstring);
     ``noise_from_estimate`` asks for the dead band to be measured on the estimate instead
     (:meth:`EventTrigger.set_output_noise`). They are not part of the paper's design and
-    the theorems do not see them.
+    the theorems do not see them. ``trigger_energy`` is the V defdynamic compares d with
+    (module docstring): ``"state"``, the paper's, or ``"acted"``.
     """
 
     zeta: float = 8e-3
@@ -93,6 +114,7 @@ class EtcDesign:
     noise_sd: tuple[float, ...] = ()
     noise_k: float = 2.0
     noise_from_estimate: bool = False
+    trigger_energy: str = "state"
 
     def __post_init__(self) -> None:
         for name in ("A", "varsigma", "noise_sd"):
@@ -111,6 +133,8 @@ class EtcDesign:
         require(not self.noise_sd or (len(self.noise_sd) == len(self.varsigma) and all(
             math.isfinite(v) and v >= 0 for v in self.noise_sd)), "noise_sd", self.noise_sd,
                 f"{len(self.varsigma)} numbers >= 0 (one per state) or none")
+        require(self.trigger_energy in TRIGGER_ENERGIES, "trigger_energy",
+                self.trigger_energy, f"one of {', '.join(TRIGGER_ENERGIES)}")
         require(not (self.noise_sd and self.noise_from_estimate), "noise_from_estimate",
                 self.noise_from_estimate, "false when noise_sd is given (one dead band)")
 
@@ -140,6 +164,15 @@ class Lyapunov:
 
     def __call__(self, alpha: np.ndarray, beta: np.ndarray) -> float:
         return float(np.sum(self.weights[:-1] * alpha**2) + self.weights[-1] @ beta**2)
+
+    def least_per_u2(self, law: BacksteppingLaw) -> float:
+        """1 / (h^T W^-1 h): the least V of a target state on which ``law`` gives U-bar =
+        1 (m/s); V_U = U-bar^2 times it (module docstring). h is the law's weights in
+        target variables; W is V's, positive at every node."""
+        n = law.system.n
+        h = law.target_gain.copy()
+        h[:n, -1] -= law.system.R                       # - R alpha(L)
+        return 1.0 / float(np.sum(h * h / self.weights))
 
 
 def integrate_m(m: float, g0: float, g1: float, eta: float, tau: float) -> float:
@@ -187,7 +220,9 @@ def u_bar_range(lower: float, upper: float, per: float) -> tuple[float, float]:
 
 @dataclass(frozen=True)
 class CheckResult:
-    """Outcome of one check: the held U-bar, the continuous U-bar and diagnostics."""
+    """Outcome of one check: the held U-bar, the continuous U-bar and diagnostics: ``V``
+    the energy the trigger weighed d against (the state's V, or V_U with
+    ``trigger_energy = "acted"``), ``d`` and ``m``."""
 
     u_bar_held: float
     u_bar_continuous: float
@@ -209,6 +244,9 @@ class EventTrigger:
         self.lyapunov = Lyapunov(system, kernels.x, design)
         self.b_exp = design.B * math.exp(design.mu * system.length / system.lam_minus)
         self.dead_band = noise_dead_band(design, self.law.gain)
+        #: V_U per U-bar^2 (``trigger_energy = "acted"``), 0 with the paper's trigger
+        self.acted_per_u2 = (self.lyapunov.least_per_u2(self.law)
+                             if design.trigger_energy == "acted" else 0.0)
         self.reset()
 
     def set_output_noise(self, s_u_bar: float) -> float:
@@ -239,24 +277,26 @@ class EventTrigger:
         alpha, beta = self.transform.forward(w_bar)
         V = self.lyapunov(alpha, beta)
         u_cont = self.law.u_bar(w_bar)
+        # the energy defdynamic and mdyna weigh d against: V, or V_U ("acted")
+        energy = self.acted_per_u2 * u_cont * u_cont if self.acted_per_u2 else V
         if self.u_held is None:                      # t_0: the first execution
             self.u_held, self.t_last = u_cont, t
-            self.g_last = self._forcing(0.0, V, alpha, beta)
-            return CheckResult(u_cont, u_cont, True, V, 0.0, self.m)
+            self.g_last = self._forcing(0.0, energy, alpha, beta)
+            return CheckResult(u_cont, u_cont, True, energy, 0.0, self.m)
         lo, hi = self.bounds                         # anti-windup: what can be delivered
         d = min(max(self.u_held, lo), hi) - min(max(u_cont, lo), hi)
         d_db = math.copysign(max(abs(d) - self.dead_band, 0.0), d)
-        g = self._forcing(d_db, V, alpha, beta)
+        g = self._forcing(d_db, energy, alpha, beta)
         self.m = integrate_m(self.m, self.g_last, g, ds.eta, t - (self.t_last or t))
         self.t_last = t
         triggered = (ds.zeta * self.b_exp * d_db * d_db
-                     >= ds.zeta * ds.mu * ds.sigma * V - self.m) and (
+                     >= ds.zeta * ds.mu * ds.sigma * energy - self.m) and (
             self.dead_band == 0.0 or abs(d) > self.dead_band)
         if triggered:
             self.u_held = u_cont
             g -= self.b_exp * d_db * d_db            # d(t_k+) = 0
         self.g_last = g
-        return CheckResult(self.u_held, u_cont, bool(triggered), V, d, self.m)
+        return CheckResult(self.u_held, u_cont, bool(triggered), energy, d, self.m)
 
 
 class TriggeredLaw(Controller):

@@ -112,6 +112,10 @@ DESIGN_KEYS: dict[str, Key] = {
                                doc="size the trigger's dead band from the law's output "
                                    "noise measured on the warm-up's estimate (SUMO runs; "
                                    "not with noise_sd_kmh; not in the paper)"),
+    "trigger_energy": Key("trigger_energy", "string", choices=("state", "acted"),
+                          doc="the V the trigger compares d with: the state's (state, the "
+                              "paper's) or the least V of a state giving the law's present "
+                              "U (acted; not in the paper, docs/design.md)"),
 }
 
 

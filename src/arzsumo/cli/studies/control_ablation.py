@@ -10,7 +10,7 @@ from pathlib import Path
 from arzsumo.cli.studies.options import add_output, add_records, add_runs, recorded_runs
 from arzsumo.errors import EXIT_SOME_FAILED
 from arzsumo.resources import default_scenario
-from arzsumo.studies.common import RESULTS_DIR, names_among, print_list
+from arzsumo.studies.common import RESULTS_DIR, StudyError, names_among, print_list
 from arzsumo.studies.control import study as control
 from arzsumo.studies.control.ablation import (
     DEFAULT_STEPS,
@@ -20,6 +20,7 @@ from arzsumo.studies.control.ablation import (
     STEPS,
     AblationOptions,
     design,
+    is_step,
     run_ablation,
 )
 
@@ -38,7 +39,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "(default: %(default)s)")
     parser.add_argument("--steps", default=",".join(DEFAULT_STEPS),
                         help="comma-separated steps, of " + ", ".join(STEPS)
-                             + " (default: %(default)s)")
+                             + "; steps joined by + are one step with each change "
+                               "(default: %(default)s)")
     parser.add_argument("--laws", default=",".join(LAWS),
                         help="comma-separated laws ablated (default: %(default)s)")
     add_records(parser)
@@ -52,7 +54,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def options(args: argparse.Namespace) -> AblationOptions:
     """The study's options as the command line gave them."""
-    steps = tuple(names_among(args.steps, list(STEPS), "--steps"))
+    steps = tuple(dict.fromkeys(n.strip() for n in args.steps.split(",") if n.strip()))
+    if not steps or not all(is_step(s) for s in steps):
+        raise StudyError(f"--steps = {args.steps!r} is not allowed: a comma-separated list "
+                         f"of {', '.join(STEPS)}, or several of them joined by +")
     laws = tuple(names_among(args.laws, list(LAWS), "--laws"))
     return AblationOptions(recorded_runs(args), scenario=args.scenario,
                            control=args.control, experiment=args.experiment, steps=steps,

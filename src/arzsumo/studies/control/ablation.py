@@ -36,10 +36,14 @@ paper-eta           the ETC's dynamic variable m forgetting at the paper's rate,
 speed-limit         the laws on the outlet's speed limit (mainstream control, the same
                     boundary input q(L) - q*) instead of the ramp meter
                     (``[actuation]`` :data:`SPEED_LIMIT`)
+acted-trigger       the ETC's trigger and m weighing d against V_U, the least energy of
+                    a state giving the law's U (``[design] trigger_energy = "acted"``)
 ==================  ==============================================================
 
-The steps and their constants live in :mod:`arzsumo.studies.control.ablation_steps`
-(re-exported here).
+Steps joined by ``+`` are one step with each change, in order
+(``speed-limit+acted-trigger``: the ETC with the acted trigger on the outlet's speed
+limit), paired like any other. The steps and their constants live in
+:mod:`arzsumo.studies.control.ablation_steps` (re-exported here).
 
 The steps change the regulation experiment, or with ``--experiment disturbance`` the
 disturbance experiment (then against the control study's disturbance runs). Each step is
@@ -61,7 +65,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from arzsumo.errors import ArzsumoError
+from arzsumo.errors import ArzsumoError, require
 from arzsumo.evaluation.report import Measure, paired_cell, seed_values
 from arzsumo.io import dump_toml, read_toml
 from arzsumo.outdir import resumable_dir
@@ -74,6 +78,7 @@ from arzsumo.studies.control import study as control
 from arzsumo.studies.control.ablation_steps import (
     DEAD_BAND_KMH,
     DEFAULT_STEPS,
+    JOIN,
     MEASURED_DEAD_TIME_S,
     PAPER_ETA,
     PREDICTION_S,
@@ -81,6 +86,9 @@ from arzsumo.studies.control.ablation_steps import (
     SPEED_LIMIT,
     STEPS,
     WAVE_SPEED_KMH,
+    apply_step,
+    describe,
+    is_step,
     own_open_loop,
 )
 from arzsumo.studies.recorded import RecordedRuns, recorded_evaluation
@@ -112,8 +120,8 @@ def step_name(step: str, experiment: str = "regulation") -> str:
 def step_scenario(base: dict, step: str, experiment: str = "regulation") -> dict:
     """The control study's ``experiment`` scenario of ``base`` with ``step``'s change."""
     data = control.experiment_scenario(base, experiment)
-    data = STEPS[step][1]({k: dict(v) if isinstance(v, dict) else v
-                           for k, v in data.items()})
+    data = apply_step(step, {k: dict(v) if isinstance(v, dict) else v
+                             for k, v in data.items()})
     data["name"] = f"{base.get('name', 'scenario')}-ablation-{step_name(step, experiment)}"
     return data
 
@@ -196,7 +204,9 @@ class AblationOptions:
 
     def __post_init__(self) -> None:
         checks.among(self.experiment, control.EXPERIMENTS, "experiment")
-        checks.all_among(self.steps, tuple(STEPS), "steps")
+        require(len(self.steps) > 0 and all(is_step(s) for s in self.steps), "steps",
+                self.steps, "at least one of " + ", ".join(STEPS) + ", or several joined "
+                f"by {JOIN}", StudyError)
         checks.all_among(self.laws, LAWS, "laws")
 
     @property
@@ -215,7 +225,7 @@ class AblationResult:
 
 def design(opts: AblationOptions) -> list[str]:
     """One line per step: what it changes, the laws and seeds (``--list``)."""
-    return [f"{s}: {STEPS[s][0]}; {', '.join(opts.laws)} on seeds "
+    return [f"{s}: {describe(s)}; {', '.join(opts.laws)} on seeds "
             f"{seed_text(list(opts.runs.seeds))}" for s in opts.steps]
 
 
@@ -282,8 +292,26 @@ def run_ablation(opts: AblationOptions) -> AblationResult:
     return AblationResult(text, ok)
 
 
-__all__ = ["DEAD_BAND_KMH", "DEFAULT_STEPS", "MEASURED_DEAD_TIME_S", "NAME", "PAPER_ETA",
-           "PREDICTION_S",
-           "QUARTER", "SPEED_LIMIT", "STEPS", "WAVE_SPEED_KMH", "AblationOptions",
-           "full_configuration",
-           "own_open_loop", "run_ablation", "step_name", "step_scenario", "table"]
+__all__ = [
+    "DEAD_BAND_KMH",
+    "DEFAULT_STEPS",
+    "JOIN",
+    "MEASURED_DEAD_TIME_S",
+    "NAME",
+    "PAPER_ETA",
+    "PREDICTION_S",
+    "QUARTER",
+    "SPEED_LIMIT",
+    "STEPS",
+    "WAVE_SPEED_KMH",
+    "AblationOptions",
+    "apply_step",
+    "describe",
+    "full_configuration",
+    "is_step",
+    "own_open_loop",
+    "run_ablation",
+    "step_name",
+    "step_scenario",
+    "table",
+]

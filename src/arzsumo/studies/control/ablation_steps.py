@@ -181,6 +181,9 @@ STEPS: dict[str, tuple[str, Callable[[dict], dict], bool]] = {
                   _set({"design.eta": PAPER_ETA}), False),
     "speed-limit": ("the laws on the outlet's speed limit (mainstream control) instead "
                     "of the ramp meter", _set(SPEED_LIMIT), False),
+    "acted-trigger": ("the ETC's trigger weighing d against the least energy of a state "
+                      "giving the law's U (trigger_energy = acted)",
+                      _set({"design.trigger_energy": "acted"}), False),
     "quarter-law": (f"the laws' command to the meter {QUARTER:g} times smaller, inside "
                     "its range", _quarter_law, False),
 }
@@ -191,7 +194,8 @@ STEPS: dict[str, tuple[str, Callable[[dict], dict], bool]] = {
 #: design whose eta is small)
 DEFAULT_STEPS = tuple(s for s in STEPS if s not in ("power-law", "paper-trigger",
                                                     "unit-gain", "quarter-law",
-                                                    "paper-eta", "speed-limit"))
+                                                    "paper-eta", "speed-limit",
+                                                    "acted-trigger"))
 
 
 #: the steps that change ``[model]``: where the model's speeds place the section
@@ -201,7 +205,34 @@ MODEL_STEPS = ("wave-matched", "power-law")
 
 def own_open_loop(step: str, experiment: dict) -> bool:
     """Whether ``step`` on the scenario ``experiment`` (as written) needs an open loop of
-    its own: it changes the plant (:data:`STEPS`' flag), or it changes ``[model]`` on a
-    section placed at the model's equilibrium."""
+    its own: one of its parts changes the plant (:data:`STEPS`' flag), or changes
+    ``[model]`` on a section placed at the model's equilibrium."""
     placed = experiment.get("run", {}).get("start") == "placement"
-    return STEPS[step][2] or (placed and step in MODEL_STEPS)
+    return any(STEPS[n][2] or (placed and n in MODEL_STEPS) for n in parts(step))
+
+
+#: joins the steps of a combined step (``speed-limit+acted-trigger``: both changes, in order)
+JOIN = "+"
+
+
+def parts(step: str) -> list[str]:
+    """The registered steps of ``step``, one or several joined by :data:`JOIN`."""
+    return step.split(JOIN)
+
+
+def is_step(step: str) -> bool:
+    """Whether ``step`` is a registered step or several joined by :data:`JOIN`, each once."""
+    names = parts(step)
+    return all(n in STEPS for n in names) and len(set(names)) == len(names)
+
+
+def describe(step: str) -> str:
+    """What ``step`` changes (a combined step: each part's change, joined by "and")."""
+    return " and ".join(STEPS[n][0] for n in parts(step))
+
+
+def apply_step(step: str, data: dict) -> dict:
+    """``data`` (a scenario as written) with ``step``'s changes, part after part."""
+    for name in parts(step):
+        data = STEPS[name][1](data)
+    return data
