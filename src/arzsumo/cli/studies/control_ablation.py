@@ -13,6 +13,7 @@ from arzsumo.resources import default_scenario
 from arzsumo.studies.common import RESULTS_DIR, StudyError, names_among, print_list
 from arzsumo.studies.control import study as control
 from arzsumo.studies.control.ablation import (
+    ALL_LAWS,
     DEFAULT_STEPS,
     LAWS,
     NAME,
@@ -42,7 +43,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              + "; steps joined by + are one step with each change "
                                "(default: %(default)s)")
     parser.add_argument("--laws", default=",".join(LAWS),
-                        help="comma-separated laws ablated (default: %(default)s)")
+                        help="comma-separated laws ablated, of " + ", ".join(ALL_LAWS)
+                             + " (default: %(default)s)")
     add_records(parser)
     add_runs(parser, seeds="1-10")
     add_output(parser, NAME, PAGE, plots=False)
@@ -58,7 +60,7 @@ def options(args: argparse.Namespace) -> AblationOptions:
     if not steps or not all(is_step(s) for s in steps):
         raise StudyError(f"--steps = {args.steps!r} is not allowed: a comma-separated list "
                          f"of {', '.join(STEPS)}, or several of them joined by +")
-    laws = tuple(names_among(args.laws, list(LAWS), "--laws"))
+    laws = tuple(names_among(args.laws, list(ALL_LAWS), "--laws"))
     return AblationOptions(recorded_runs(args), scenario=args.scenario,
                            control=args.control, experiment=args.experiment, steps=steps,
                            laws=laws, out=args.out, docs=args.docs,

@@ -103,6 +103,8 @@ NAME = "control-ablation"
 PAGE = control.PAGE
 #: the laws ablated
 LAWS = ("backstepping", "etc")
+#: the laws a step may be run on (``--laws``): those and the observer-based ETC
+ALL_LAWS = (*LAWS, "observer-etc")
 #: the measures of the ablation table (keys of the control study's measures)
 KEYS = ("network_whole_demand.time_spent_s.total", "network_whole_demand.ramp_wait_s.p95",
         "section.deviation.deviation_excess_s", "section.deviation.decay_time_s",
@@ -187,7 +189,7 @@ class AblationOptions:
     ``runs``: the seeds, the record store and how the runs run; ``scenario``: the control
     study's base scenario (None: the shipped default); ``control``: the control study's
     ``--out`` or record store (its runs of ``experiment`` are the full configuration);
-    ``steps`` of :data:`STEPS`, ``laws`` of :data:`LAWS`; ``out``, ``docs``: where the
+    ``steps`` of :data:`STEPS`, ``laws`` of :data:`ALL_LAWS`; ``out``, ``docs``: where the
     study writes (None: no page); ``page``: the results page under ``docs`` that gets
     the table (the control study's page of the same scenario).
     """
@@ -207,7 +209,7 @@ class AblationOptions:
         require(len(self.steps) > 0 and all(is_step(s) for s in self.steps), "steps",
                 self.steps, "at least one of " + ", ".join(STEPS) + ", or several joined "
                 f"by {JOIN}", StudyError)
-        checks.all_among(self.laws, LAWS, "laws")
+        checks.all_among(self.laws, ALL_LAWS, "laws")
 
     @property
     def base(self) -> Path:
