@@ -79,6 +79,11 @@ def test_the_table_pairs_each_step_with_the_full_configuration():
     assert "| -1 [-1, -1] 3/0 |" in rows[("raw-cells", "backstepping", "open")]
     assert "| -3 [-3, -3] 3/0 |" in rows[("full", "backstepping", "open")]
     assert "| +2 [+2, +2] 0/3 |" in rows[("raw-cells", "backstepping", "full")]
+    # a step run on one law only (--laws etc) shows no rows of the other
+    etc_only = runs({"etc": 100.5})
+    text = control_ablation.table({"raw-cells": etc_only}, full, [1, 2, 3])
+    assert any(x.startswith("| raw-cells | etc") for x in text.splitlines())
+    assert not any(x.startswith("| raw-cells | backstepping") for x in text.splitlines())
 
 
 def test_unknown_steps_and_a_missing_control_study_are_refused(run_study, tmp_path):
@@ -195,9 +200,14 @@ def test_the_page_flag_names_the_page_the_table_goes_to(tmp_path):
     parser = argparse.ArgumentParser()
     cli.add_arguments(parser)
     args = parser.parse_args(["--docs", str(tmp_path), "--page", "control_idm",
-                              "--steps", "quarter-law", "--seeds", "1,3"])
+                              "--steps", "quarter-law,speed-limit+acted-trigger",
+                              "--seeds", "1,3", "--laws", "observer-etc"])
     opts = cli.options(args)
-    assert (opts.page, opts.docs, opts.steps) == ("control_idm", tmp_path, ("quarter-law",))
+    assert (opts.page, opts.docs, opts.steps) == (
+        "control_idm", tmp_path, ("quarter-law", "speed-limit+acted-trigger"))
+    assert opts.laws == ("observer-etc",)
+    with pytest.raises(StudyError, match=r"--steps = 'speed-limit\+nothing' is not allowed"):
+        cli.options(parser.parse_args(["--steps", "speed-limit+nothing"]))
     assert cli.options(parser.parse_args([])).page == control_ablation.PAGE
 
 

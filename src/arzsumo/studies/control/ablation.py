@@ -140,6 +140,13 @@ def _cells(a_runs: pd.DataFrame, a: str, b_runs: pd.DataFrame, b: str,
                         lower_is_better=m.lower_is_better) for m in measures()]
 
 
+def _ran(runs: pd.DataFrame, laws: Sequence[str]) -> list[str]:
+    """The ``laws`` of which ``runs`` (a step's evaluation) holds a finished run: a step
+    run on some laws only (``--laws``, each invocation its own) shows no empty rows."""
+    done = runs.loc[runs["status"].isin(FINISHED)] if "status" in runs.columns else runs
+    return [law for law in laws if law in set(done["controller"])]
+
+
 def table(steps: dict[str, pd.DataFrame], full: pd.DataFrame, seeds: list[int],
           laws: Sequence[str] = LAWS, own_open: frozenset[str] | None = None) -> str:
     """Markdown: per step, law and measure, the step minus the full configuration and the
@@ -158,7 +165,7 @@ def table(steps: dict[str, pd.DataFrame], full: pd.DataFrame, seeds: list[int],
             lines.append(f"| full | {law} | open | "
                          + " | ".join(_cells(full, law, borrowed, BASELINE, seeds)) + " |")
     for step, runs in steps.items():
-        for law in laws:
+        for law in _ran(runs, laws):
             lines.append(f"| {step} | {law} | full | "
                          + " | ".join(_cells(runs, law, full, law, seeds)) + " |")
             if BASELINE in set(runs["controller"]):
