@@ -13,9 +13,9 @@ from arzsumo.model import characteristic_speeds, linearize
 from arzsumo.resources import shipped_scenarios_dir
 from arzsumo.scenario import scenario_from_dict
 from arzsumo.studies.common import StudyError
-from arzsumo.studies.recorded import RecordedRuns
 from arzsumo.studies.control import ablation as control_ablation
 from arzsumo.studies.control.study import experiment_scenario
+from arzsumo.studies.recorded import RecordedRuns
 
 BASE = tomllib.loads((shipped_scenarios_dir() / "default.toml").read_text(encoding="utf-8"))
 
