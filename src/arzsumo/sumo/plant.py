@@ -33,6 +33,7 @@ from arzsumo.sumo.period_reads import OpenLoopEnd, OpenLoopPeriod, OpenLoopReads
 from arzsumo.sumo.sensing import SensorLayout
 from arzsumo.sumo.sensor import PeriodMeasurement, SumoSensor
 from arzsumo.sumo.simulation import SumoSimulation
+from arzsumo.sumo.speed_limit import OutletSpeedLimit
 from arzsumo.sumo.window import WindowStart
 
 #: an open-loop run that reads the sensor only
@@ -175,6 +176,11 @@ class SumoPlant:
                 self.meter.set_plan(plan)
             due += 1
         return due, plan
+
+    def outlet_speed_limit(self) -> OutletSpeedLimit:
+        """The speed limit of the edge past the merge, as an actuator
+        (:mod:`arzsumo.sumo.speed_limit`)."""
+        return OutletSpeedLimit(self.sim.lib)
 
     def run_period(self) -> tuple[PeriodMeasurement, MeterState]:
         """One control period under the meter's present command: the sensor's
