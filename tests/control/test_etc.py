@@ -213,3 +213,33 @@ def test_acted_trigger_keeps_the_guarantee(lin, kernels, etc_run):
 def test_unknown_trigger_energy_is_refused():
     with pytest.raises(ModelError, match="trigger_energy"):
         EtcDesign(trigger_energy="output")
+
+
+def test_band_trigger_fires_exactly_when_the_hold_error_leaves_the_band(lin, kernels):
+    """trigger = band: an event iff |d| > delta, whatever V and m say; with delta = 0 it
+    is backstepping sampled at every check whose law moved."""
+    design = PAPER_DESIGN.with_(trigger="band")
+    run = run_closed_loop(lin, kernels, "etc", period=1.0, horizon=60.0, design=design)
+    assert run.log.triggers == 60                           # delta = 0: every check
+    trig = EventTrigger(lin.system, kernels, design)
+    delta = trig.set_output_noise(0.05)                     # m/s of U-bar
+    rng = np.random.default_rng(1)
+    w = rng.normal(size=(lin.system.n + 1, kernels.n_cells + 1))
+    gain = trig.law.gain
+    first = trig.check(0.0, w)
+    assert first.triggered
+    for k, target in enumerate((0.5 * delta, 0.99 * delta, 1.01 * delta, -2 * delta), 1):
+        # a state whose law differs from the held U-bar by ``target``
+        shift = (first.u_bar_continuous + target - trig.law.u_bar(w)) / np.sum(gain * gain)
+        r = trig.check(float(k), w + shift * gain)
+        assert r.d == pytest.approx(-target, abs=1e-9) or r.triggered
+        assert r.triggered == (abs(target) > delta)
+        if r.triggered:
+            break
+
+
+def test_band_trigger_refuses_an_energy_it_does_not_read():
+    with pytest.raises(ModelError, match="trigger_energy"):
+        EtcDesign(trigger="band", trigger_energy="acted")
+    with pytest.raises(ModelError, match="trigger"):
+        EtcDesign(trigger="static")

@@ -71,3 +71,20 @@ def test_speed_limit_refused_where_it_cannot_act(tables, message):
     with pytest.raises(ScenarioError, match=message) as info:
         scenario_from_dict(tables, "s.toml")
     assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize(("design", "message"), [
+    ({"trigger": "band", "trigger_energy": "acted"},
+     r'^s.toml: \[design\] trigger_energy = "acted" is not allowed: state with trigger = band'),
+    ({"trigger": "static"}, r'^s.toml: \[design\] trigger = "static" is not allowed'),
+])
+def test_the_triggers_keys_are_refused_in_one_line(design, message):
+    with pytest.raises(ScenarioError, match=message) as info:
+        scenario_from_dict({"design": design}, "s.toml")
+    assert "\n" not in str(info.value)
+
+
+def test_the_band_trigger_reads_in():
+    sc = scenario_from_dict({"design": {"trigger": "band", "noise_from_estimate": True}},
+                            "s.toml")
+    assert (sc.design.trigger, sc.design.trigger_energy) == ("band", "state")

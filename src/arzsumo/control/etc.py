@@ -65,6 +65,19 @@ the model's equilibrium, with stop-and-go and noise): there the paper's m accumu
 produce (on SUMO's IDM stream d^2 stays below 0.13 % of sigma mu V), while V_U weighs d
 against the law's own output.
 
+The noise band alone (``trigger = "band"``; not in the paper). An event whenever the
+hold error leaves the noise band, |d| > delta (d projected on the actuator's range, delta
+as above: ``noise_sd`` or ``noise_from_estimate``); V and m are computed and logged but
+decide nothing. It is the static, absolute-threshold trigger of sampled-data practice
+(send-on-delta), sized by the noise rather than by the Lyapunov budget. Against the
+paper: with delta = 0 (a noise-free state) every check whose law moved is an event, and
+the closed loop is continuous backstepping sampled every Delta seconds, whose
+exponential stability the paper proves for the continuous law; with delta > 0 the hold
+error stays within delta between events, an input perturbation bounded by delta, and the
+closed loop is practically stable with an ultimate bound that scales with delta (Borgers
+& Heemels 2014). What it gives up is the paper's saving on a noise-free state: there it
+updates at every check.
+
 Lemma mbound guarantees m < 0 under continuous monitoring. With periodic checks the
 condition can be violated between checks unseen, so m may creep above zero: every such
 check is counted in the log (``m_nonnegative``), never clamped.
@@ -86,6 +99,8 @@ from arzsumo.model.characteristic import CharacteristicSystem, Linearization
 
 #: what the trigger compares the hold error with (module docstring)
 TRIGGER_ENERGIES = ("state", "acted")
+#: the triggering mechanisms: the paper's defdynamic, or the noise band alone
+TRIGGERS = ("defdynamic", "band")
 
 
 @dataclass(frozen=True)
@@ -100,7 +115,8 @@ class EtcDesign:
     ``noise_from_estimate`` asks for the dead band to be measured on the estimate instead
     (:meth:`EventTrigger.set_output_noise`). They are not part of the paper's design and
     the theorems do not see them. ``trigger_energy`` is the V defdynamic compares d with
-    (module docstring): ``"state"``, the paper's, or ``"acted"``.
+    (module docstring): ``"state"``, the paper's, or ``"acted"``; ``trigger`` the
+    mechanism: ``"defdynamic"``, the paper's, or ``"band"``, the noise band alone.
     """
 
     zeta: float = 8e-3
@@ -115,6 +131,7 @@ class EtcDesign:
     noise_k: float = 2.0
     noise_from_estimate: bool = False
     trigger_energy: str = "state"
+    trigger: str = "defdynamic"
 
     def __post_init__(self) -> None:
         for name in ("A", "varsigma", "noise_sd"):
@@ -135,6 +152,11 @@ class EtcDesign:
                 f"{len(self.varsigma)} numbers >= 0 (one per state) or none")
         require(self.trigger_energy in TRIGGER_ENERGIES, "trigger_energy",
                 self.trigger_energy, f"one of {', '.join(TRIGGER_ENERGIES)}")
+        require(self.trigger in TRIGGERS, "trigger", self.trigger,
+                f"one of {', '.join(TRIGGERS)}")
+        require(self.trigger == "defdynamic" or self.trigger_energy == "state",
+                "trigger_energy", self.trigger_energy,
+                "state with trigger = band (the band weighs d against no energy)")
         require(not (self.noise_sd and self.noise_from_estimate), "noise_from_estimate",
                 self.noise_from_estimate, "false when noise_sd is given (one dead band)")
 
@@ -289,9 +311,12 @@ class EventTrigger:
         g = self._forcing(d_db, energy, alpha, beta)
         self.m = integrate_m(self.m, self.g_last, g, ds.eta, t - (self.t_last or t))
         self.t_last = t
-        triggered = (ds.zeta * self.b_exp * d_db * d_db
-                     >= ds.zeta * ds.mu * ds.sigma * energy - self.m) and (
-            self.dead_band == 0.0 or abs(d) > self.dead_band)
+        if ds.trigger == "band":                     # the hold error left the noise band
+            triggered = abs(d) > self.dead_band
+        else:
+            triggered = (ds.zeta * self.b_exp * d_db * d_db
+                         >= ds.zeta * ds.mu * ds.sigma * energy - self.m) and (
+                self.dead_band == 0.0 or abs(d) > self.dead_band)
         if triggered:
             self.u_held = u_cont
             g -= self.b_exp * d_db * d_db            # d(t_k+) = 0

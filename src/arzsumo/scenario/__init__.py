@@ -95,7 +95,7 @@ from arzsumo.twin.initial import InitialCondition
 #: the ETC design parameters that a ``[sweep]`` table may vary (one number each)
 SWEEPABLE = tuple(sorted(set(DESIGN_KEYS) - {"A", "varsigma", "noise_sd_kmh",
                                              "noise_from_estimate",
-                                             "trigger_energy"}))
+                                             "trigger_energy", "trigger"}))
 #: [sweep] key -> DesignSweep field (``arzsumo reproduce``: one ETC run per value)
 SWEEP_KEYS: dict[str, Key] = {
     "parameter": Key("parameter", "string", choices=SWEEPABLE,

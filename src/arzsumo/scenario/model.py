@@ -116,6 +116,10 @@ DESIGN_KEYS: dict[str, Key] = {
                           doc="the V the trigger compares d with: the state's (state, the "
                               "paper's) or the least V of a state giving the law's present "
                               "U (acted; not in the paper, docs/design.md)"),
+    "trigger": Key("trigger", "string", choices=("defdynamic", "band"),
+                   doc="the ETC's mechanism: the paper's dynamic trigger (defdynamic), or "
+                       "an event whenever the hold error leaves the noise band (band; not "
+                       "in the paper, docs/design.md)"),
 }
 
 

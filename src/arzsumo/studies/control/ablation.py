@@ -38,6 +38,8 @@ speed-limit         the laws on the outlet's speed limit (mainstream control, th
                     (``[actuation]`` :data:`SPEED_LIMIT`)
 acted-trigger       the ETC's trigger and m weighing d against V_U, the least energy of
                     a state giving the law's U (``[design] trigger_energy = "acted"``)
+band-trigger        the ETC's events whenever the hold error leaves the noise band
+                    measured on the estimate (``[design] trigger = "band"``)
 ==================  ==============================================================
 
 Steps joined by ``+`` are one step with each change, in order

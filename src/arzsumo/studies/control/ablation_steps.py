@@ -184,6 +184,9 @@ STEPS: dict[str, tuple[str, Callable[[dict], dict], bool]] = {
     "acted-trigger": ("the ETC's trigger weighing d against the least energy of a state "
                       "giving the law's U (trigger_energy = acted)",
                       _set({"design.trigger_energy": "acted"}), False),
+    "band-trigger": ("the ETC's events whenever the hold error leaves the noise band "
+                     "measured on the estimate (trigger = band)",
+                     _set({"design.trigger": "band"}), False),
     "quarter-law": (f"the laws' command to the meter {QUARTER:g} times smaller, inside "
                     "its range", _quarter_law, False),
 }
@@ -195,7 +198,7 @@ STEPS: dict[str, tuple[str, Callable[[dict], dict], bool]] = {
 DEFAULT_STEPS = tuple(s for s in STEPS if s not in ("power-law", "paper-trigger",
                                                     "unit-gain", "quarter-law",
                                                     "paper-eta", "speed-limit",
-                                                    "acted-trigger"))
+                                                    "acted-trigger", "band-trigger"))
 
 
 #: the steps that change ``[model]``: where the model's speeds place the section
