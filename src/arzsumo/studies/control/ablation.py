@@ -40,6 +40,8 @@ acted-trigger       the ETC's trigger and m weighing d against V_U, the least en
                     a state giving the law's U (``[design] trigger_energy = "acted"``)
 band-trigger        the ETC's events whenever the hold error leaves the noise band
                     measured on the estimate (``[design] trigger = "band"``)
+realised-gain       the outlet's speed-limit gain at what backstepping realised there
+                    (:data:`REALISED_SPEED_GAIN`; joined with speed-limit)
 ==================  ==============================================================
 
 Steps joined by ``+`` are one step with each change, in order
@@ -85,6 +87,7 @@ from arzsumo.studies.control.ablation_steps import (
     PAPER_ETA,
     PREDICTION_S,
     QUARTER,
+    REALISED_SPEED_GAIN,
     SPEED_LIMIT,
     STEPS,
     WAVE_SPEED_KMH,
@@ -312,6 +315,7 @@ __all__ = [
     "PAPER_ETA",
     "PREDICTION_S",
     "QUARTER",
+    "REALISED_SPEED_GAIN",
     "SPEED_LIMIT",
     "STEPS",
     "WAVE_SPEED_KMH",
