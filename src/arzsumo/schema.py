@@ -177,7 +177,8 @@ _NETWORK = {"network*.window": TEXT, "network*.begin_s": "s", "network*.end_s": 
 _WAVE_MEASURES = {"oscillation_kmh": "km/h", "band_power_kmh2": "(km/h)^2",
                   "total_variance_kmh2": "(km/h)^2", "band_share": "1",
                   "band_places": "count", "growth_per_km": "1/km",
-                  "amplitude.x_m": "m", "amplitude.sd_kmh": "km/h"}
+                  "short_power_kmh2": "(km/h)^2", "short_share": "1",
+                  "peak_period_s": "s", "amplitude.x_m": "m", "amplitude.sd_kmh": "km/h"}
 _WAVES = {"section.waves.block_m": "m", "section.waves.block_s": "s",
           "section.waves.band_min_s": "s", "section.waves.band_max_s": "s",
           "section.waves.window_s": "s", "section.waves.snapshots": "count",
@@ -331,6 +332,11 @@ IDENTIFY_SUMMARY: dict[str, str] = {
     "scenario_model_validation.*.samples": "count",
     "scenario_model_validation.*.blocks": "count",
     "scenario_model_validation.*": "1",
+    "runs.*.speed_spectrum.*.peak_period_s": "s", "runs.*.speed_spectrum.*": "1",
+    "references": TEXT, "references.triangle.v_free": "m/s",
+    "references.triangle.w": "m/s", "references.triangle.rho_jam": "veh/m",
+    "references.runs.*": "1", "references.model.*": "1",
+    "references.scenario_model.*": "1",
 }
 
 #: scenario-file key suffixes and their units (scenario files name their units)

@@ -10,6 +10,7 @@ from arzsumo.evaluation.waves import (
     file_boundaries,
     growth_upstream,
     lateral_files,
+    peak_period,
     snapshot_blocks,
     speed_spread,
     temporal_sd,
@@ -59,6 +60,28 @@ def test_a_twenty_second_flicker_has_no_power_in_the_band():
     assert p["total_variance"] > 0.3
     assert p["band_power"] < 1e-3 * p["total_variance"]
     assert p["band_share"] < 1e-3
+
+
+def test_a_fifty_second_wave_peaks_at_its_period_in_the_short_band():
+    """The IDM stream's stop-and-go period: on 10 s blocks over 30 min the periodogram's
+    frequencies are k / 1800 s, so 50 s (k = 36) is one of them and the peak is exact."""
+    amp = 3.0
+    blocks = _blocks(_travelling(50.0, amp))
+    w = wave_measures(blocks, 10.0, block_centres(10, 100.0), L)
+    damped = _damped(50.0, amp)
+    assert w.peak_period == pytest.approx(50.0, rel=1e-12)
+    assert w.short_power == pytest.approx(damped ** 2 / 2, rel=0.02)
+    assert w.short_share == pytest.approx(1.0, abs=0.02)
+    assert w.band_share < 0.02                           # nothing at 1-10 min
+    three_minutes = wave_measures(_blocks(_travelling(180.0, amp)), 10.0,
+                                  block_centres(10, 100.0), L)
+    assert three_minutes.peak_period == pytest.approx(180.0, rel=1e-12)
+    assert three_minutes.short_share < 0.02
+
+
+def test_no_place_and_a_standstill_have_no_peak():
+    assert np.isnan(peak_period(np.full((45, 3), np.nan), 10.0))
+    assert np.isnan(peak_period(np.zeros((45, 3)), 10.0))     # a deadlocked section
 
 
 def test_a_steady_profile_has_neither_oscillation_nor_band_power():

@@ -71,8 +71,31 @@ def cmd_identify(args: argparse.Namespace) -> int:
                            f"rho_a {r.rmse['rho_a']['blocks_relative']:.1%}"
                            for r in score.runs)
         print(f"    on 100 m x 10 s blocks (as run and compare print it): {blocks}")
+    _print_references(study)
     print(f"results: {out}")
     return 0
+
+
+def _print_references(study: IdentifyStudy) -> None:
+    """The held-out block errors of Newell's three-detector replay and of the constant
+    equilibrium, beside the model's."""
+    refs = study.references
+    if not refs:
+        return
+    for name, label in (("three_detector", "Newell's three-detector replay"),
+                        ("equilibrium", "the equilibrium everywhere"),
+                        ("place_mean", "each place's own run mean (an oracle)")):
+        blocks = ", ".join(f"{run} rho_h {r[name]['rho_h']:.1%} "
+                           f"rho_a {r[name]['rho_a']:.1%}" for run, r in refs["runs"].items())
+        print(f"    {label}, same blocks: {blocks}")
+    for key, who in (("model", "the identified model's"),
+                     ("scenario_model", f"{study.setup.base.name}'s own model's")):
+        split = "; ".join(f"{run} " + ", ".join(
+            f"{var} bias {d['bias']:.1%} fluctuation {d['fluctuation']:.1%} "
+            f"(correlation {d['correlation']:.2f})" for var, d in parts.items())
+            for run, parts in refs.get(key, {}).items())
+        if split:
+            print(f"    {who} error split: {split}")
 
 
 def _print_stage_one(study: IdentifyStudy) -> None:

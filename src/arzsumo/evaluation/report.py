@@ -73,6 +73,9 @@ MEASURES: tuple[Measure, ...] = (
     *(Measure(f"section.waves.{c}.band_power_kmh2",
               f"section stop-and-go band power (1-10 min), {name}", "(km/h)^2")
       for c, name in _CLASSES),
+    *(Measure(f"section.waves.{c}.short_power_kmh2",
+              f"section short-wave power (20 s-1 min), {name}", "(km/h)^2")
+      for c, name in _CLASSES),
     *(Measure(f"section.waves.{c}.growth_per_km", f"section wave growth upstream, {name}",
               "1/km") for c, name in _CLASSES),
     Measure("plan_changes", "meter plan changes", "count"),

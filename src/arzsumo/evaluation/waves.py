@@ -11,6 +11,8 @@ time of block-mean speeds at each place (blocks of e.g. 100 m x 10 s,
 * :func:`band_power`: the share of that variance in the stop-and-go band (periods of 1 to
   10 min, :data:`STOP_AND_GO_S`), from a Hann-windowed periodogram of each place's
   linearly detrended series;
+* :func:`peak_period`: the period of the places' mean periodogram's peak, and the power
+  in the short waves' band (20 s to 1 min, :data:`SHORT_WAVES_S`);
 * :func:`growth_upstream`: the log-linear slope of the amplitude (the temporal sd) against
   the distance upstream from x = L; > 0 when waves grow as they travel upstream;
 * :func:`file_boundaries` and :func:`snapshot_blocks`: the lateral files of a class, found
@@ -30,6 +32,9 @@ from scipy.signal import periodogram
 
 #: the stop-and-go band: periods from 1 to 10 min, s
 STOP_AND_GO_S = (60.0, 600.0)
+#: the short waves' band: periods from 20 s to 1 min, s (resolved on blocks of <= 10 s);
+#: where the IDM stream's stop-and-go has most of its power (peaks at 43-64 s)
+SHORT_WAVES_S = (20.0, 60.0)
 #: fewest blocks of a place's series for a spectrum; fewest places for a growth slope
 MIN_BLOCKS, MIN_PLACES = 8, 3
 
@@ -73,6 +78,20 @@ def _filled(series: np.ndarray, min_coverage: float) -> np.ndarray | None:
     return np.interp(t, t[ok], series[ok])
 
 
+def _place_spectra(blocks: np.ndarray, dt: float, min_coverage: float
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """Frequencies (F,) and the one-sided periodogram densities (P, F) of each place's
+    series used (NaN filled, linearly detrended, Hann-windowed); P may be 0."""
+    f, psds = np.zeros(0), []
+    for series in np.asarray(blocks, float).T:
+        x = _filled(series, min_coverage)
+        if x is None:
+            continue
+        f, psd = periodogram(x, fs=1.0 / dt, window="hann", detrend="linear")
+        psds.append(psd)
+    return f, np.array(psds).reshape(len(psds), f.size)
+
+
 def band_power(blocks: np.ndarray, dt: float, band: tuple[float, float] = STOP_AND_GO_S,
                min_coverage: float = 0.75) -> dict[str, float]:
     """Spectral power of each place's block series in a band of periods, averaged over places.
@@ -101,22 +120,27 @@ def band_power(blocks: np.ndarray, dt: float, band: tuple[float, float] = STOP_A
         ``band_power`` and ``total_variance`` (means over the places used, (m/s)^2),
         ``band_share`` (their ratio, 1) and ``places`` (places used); NaN without any.
     """
-    lo, hi = 1.0 / band[1], 1.0 / band[0]
-    bands, totals = [], []
-    for series in np.asarray(blocks, float).T:
-        x = _filled(series, min_coverage)
-        if x is None:
-            continue
-        f, psd = periodogram(x, fs=1.0 / dt, window="hann", detrend="linear")
-        df = f[1] - f[0]
-        bands.append(psd[(f >= lo) & (f <= hi)].sum() * df)
-        totals.append(psd[1:].sum() * df)
-    if not bands:
+    f, psd = _place_spectra(blocks, dt, min_coverage)
+    if not psd.shape[0]:
         return {"band_power": np.nan, "total_variance": np.nan, "band_share": np.nan,
                 "places": 0}
-    b, tot = float(np.mean(bands)), float(np.mean(totals))
+    df = f[1] - f[0]
+    inside = (f >= 1.0 / band[1]) & (f <= 1.0 / band[0])
+    b = float(psd[:, inside].sum(axis=1).mean() * df)
+    tot = float(psd[:, 1:].sum(axis=1).mean() * df)
     return {"band_power": b, "total_variance": tot,
-            "band_share": b / tot if tot > 0 else np.nan, "places": len(bands)}
+            "band_share": b / tot if tot > 0 else np.nan, "places": int(psd.shape[0])}
+
+
+def peak_period(blocks: np.ndarray, dt: float, min_coverage: float = 0.75) -> float:
+    """The period (s) at which the places' mean periodogram of ``blocks`` (T, N; as
+    :func:`band_power`) is largest, frequency 0 excluded: the waves' dominant period.
+    NaN without a place, a resolved frequency or any power (a field standing still)."""
+    f, psd = _place_spectra(blocks, dt, min_coverage)
+    if not psd.shape[0] or f.size < 2 or not np.any(psd[:, 1:] > 0):
+        return float("nan")
+    mean = psd[:, 1:].mean(axis=0)
+    return float(1.0 / f[1:][int(np.argmax(mean))])
 
 
 def growth_upstream(x: np.ndarray, amplitude: np.ndarray, length: float) -> float:
@@ -154,7 +178,9 @@ class WaveMeasures:
 
     ``oscillation`` m/s (RMS over places of ``sd``); ``band_power``, ``total_variance``
     (m/s)^2, ``band_share`` 1, ``places`` used by the spectrum; ``x`` block centres, m,
-    and ``sd`` the amplitude there, m/s; ``growth`` 1/m (:func:`growth_upstream`).
+    and ``sd`` the amplitude there, m/s; ``growth`` 1/m (:func:`growth_upstream`);
+    ``short_power`` (m/s)^2 and ``short_share`` 1, the same as the band's in
+    :data:`SHORT_WAVES_S`; ``peak_period`` s (:func:`peak_period`).
     """
 
     oscillation: float
@@ -165,18 +191,24 @@ class WaveMeasures:
     x: np.ndarray
     sd: np.ndarray
     growth: float
+    short_power: float = float("nan")
+    short_share: float = float("nan")
+    peak_period: float = float("nan")
 
 
 def wave_measures(blocks: np.ndarray, dt: float, x: np.ndarray, length: float,
                   band: tuple[float, float] = STOP_AND_GO_S) -> WaveMeasures:
-    """:func:`temporal_sd`, :func:`band_power` and :func:`growth_upstream` of ``blocks``
+    """:func:`temporal_sd`, :func:`band_power` (in ``band`` and in
+    :data:`SHORT_WAVES_S`), :func:`peak_period` and :func:`growth_upstream` of ``blocks``
     (T, N; m/s) with block duration ``dt`` (s), block centres ``x`` (m) and the meter at
     ``length`` (m)."""
     sd = temporal_sd(blocks)
     p = band_power(blocks, dt, band)
+    short = band_power(blocks, dt, SHORT_WAVES_S)
     return WaveMeasures(rms(sd), p["band_power"], p["total_variance"], p["band_share"],
                         int(p["places"]), np.asarray(x, float), sd,
-                        growth_upstream(x, sd, length))
+                        growth_upstream(x, sd, length), short["band_power"],
+                        short["band_share"], peak_period(blocks, dt))
 
 
 def block_centres(places: int, block_m: float) -> np.ndarray:

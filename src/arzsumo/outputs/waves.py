@@ -37,6 +37,8 @@ def measures_kmh(w: WaveMeasures) -> dict[str, Any]:
             "total_variance_kmh2": float(ms2_to_kmh2(w.total_variance)),
             "band_share": w.band_share, "band_places": w.places,
             "growth_per_km": float(per_m_to_per_km(w.growth)),
+            "short_power_kmh2": float(ms2_to_kmh2(w.short_power)),
+            "short_share": w.short_share, "peak_period_s": w.peak_period,
             "amplitude": {"x_m": w.x.tolist(), "sd_kmh": ms_to_kmh(w.sd).tolist()}}
 
 

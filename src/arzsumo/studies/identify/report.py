@@ -30,6 +30,7 @@ import numpy as np
 from arzsumo import __version__
 from arzsumo.control.registry import is_pde
 from arzsumo.evaluation.stationarity import count_trend
+from arzsumo.evaluation.waves import SHORT_WAVES_S, STOP_AND_GO_S, band_power, peak_period
 from arzsumo.identify import VARIABLES, ReplayData
 from arzsumo.identify.diagram import DiagramFit
 from arzsumo.identify.objective import DEFAULT_PENALTY as PENALTY
@@ -192,12 +193,26 @@ def _trend(data: ReplayData) -> dict[str, Any] | None:
         return None
 
 
+def _spectrum(data: ReplayData) -> dict[str, Any]:
+    """Per class, the speed field's dominant period and the shares of its variance in the
+    short waves' band and the stop-and-go band (on the run's cells and periods)."""
+    dt = float(data.t[1] - data.t[0]) if data.t.size > 1 else float(data.t[0])
+    out: dict[str, Any] = {}
+    for cls, row in (("h", 1), ("a", 3)):
+        field = data.fields[:, row, :]
+        out[cls] = {"peak_period_s": peak_period(field, dt),
+                    "short_share": band_power(field, dt, SHORT_WAVES_S)["band_share"],
+                    "band_share": band_power(field, dt, STOP_AND_GO_S)["band_share"]}
+    return out
+
+
 def _runs(study: IdentifyStudy) -> dict[str, Any]:
     return {r.task.run_id: {"role": r.task.role, "seed": r.task.seed,
                             "point": r.task.point.label, "wall_time_s": r.wall_time,
                             "bridge_resyncs": r.resyncs,
                             "inserted_fraction_main": r.delivered,
                             "section_trend": _trend(r.data),
+                            "speed_spectrum": _spectrum(r.data),
                             "mean_rho_h": float(np.nanmean(r.data.fields[:, 0])),
                             "mean_rho_a": float(np.nanmean(r.data.fields[:, 2]))}
             for r in study.runs}
@@ -256,6 +271,7 @@ def identification_json(study: IdentifyStudy) -> dict[str, Any]:
         "stage_one": _stage_one(study),
         "scenario_model_validation": (None if study.scenario_validation is None
                                       else _set_dict(study.scenario_validation)),
+        "references": study.references,
         "wall_time": {f"{k}_s": v for k, v in study.wall.items()},
         "resolved_scenario": dict(setup.scenario.tables),
     }

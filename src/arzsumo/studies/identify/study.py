@@ -49,6 +49,11 @@ from arzsumo.model.params import FAMILIES, ModelParameters
 from arzsumo.scenario import Scenario, scenario_from_dict
 from arzsumo.studies.identify.cache import load_run, run_key, save_run
 from arzsumo.studies.identify.diagram import STAGE_TWO, StageOne, fit_stage_one, read_waves
+from arzsumo.studies.identify.references import (
+    decomposition,
+    reference_scores,
+    reference_triangle,
+)
 from arzsumo.studies.identify.scores import (
     SetScore,
     ao_floor,
@@ -302,6 +307,8 @@ class IdentifyStudy:
     #: stage 1 (``--diagram``) and the scenario's own model scored on the held-out runs
     stage_one: StageOne | None = None
     scenario_validation: SetScore | None = None
+    #: the held-out runs' block errors of the references (:mod:`.references`)
+    references: dict[str, Any] | None = None
 
     def data(self, role: str) -> list[ReplayData]:
         """The ReplayData of the ``training`` or ``validation`` runs."""
@@ -321,6 +328,24 @@ def equilibrium_at(params: ModelParameters, rho: tuple[float, float]) -> Equilib
         return Equilibrium(params, *rho)
     except ArzsumoError:
         return None
+
+
+def _references(params: ModelParameters, train: Sequence[ReplayData],
+                held_out: Sequence[ReplayData], validation: SetScore, own: SetScore
+                ) -> dict[str, Any] | None:
+    """The references' block errors on the held-out runs and the replay error split
+    (:func:`.references.decomposition`) of the identified model (``model``) and of the
+    scenario's own (``scenario_model``), or None where the training runs show no wave to
+    draw the reference's triangle with."""
+    try:
+        refs = reference_scores(reference_triangle(params, train), held_out)
+    except ArzsumoError as exc:
+        log.info("no reference replays: %s", exc)
+        return None
+    for key, score in (("model", validation), ("scenario_model", own)):
+        refs[key] = {r.name: decomposition(d, r.predicted)
+                     for r, d in zip(score.runs, held_out, strict=True)}
+    return refs
 
 
 def run_identification(setup: IdentifySetup) -> IdentifyStudy:
@@ -369,6 +394,7 @@ def run_identification(setup: IdentifySetup) -> IdentifyStudy:
     wall = {"sumo": t1 - t0, "sumo_runs": float(sum(r.wall_time for r in runs)),
             "fit": fit.wall_time, "bootstrap": t3 - t2 - fit.wall_time,
             "stage_one": t_one, "validate": (t4 - t3) + (t2 - t1) - t_one, "total": t4 - t0}
+    own = score_set(setup.scenario.params, held_out, opts)
     return IdentifyStudy(setup, runs, fit, start, training, validation, rho,
-                         equilibrium_at(fit.params, rho), wall, stage_one,
-                         score_set(setup.scenario.params, held_out, opts))
+                         equilibrium_at(fit.params, rho), wall, stage_one, own,
+                         _references(fit.params, train, held_out, validation, own))
