@@ -52,7 +52,8 @@ def test_a_second_identification_reuses_the_cached_runs_and_gives_the_same_fit(
 @pytest.mark.sumo
 def test_writes_the_files_and_a_scenario_that_loads_with_the_identified_values(result):
     out, doc = result
-    for name in ("identified.toml", "identification.json", "fields.png", "scatter.png"):
+    for name in ("identified.toml", "identification.json", "fields.png", "scatter.png",
+                 "spectrum.png"):
         assert (out / name).stat().st_size > 0, name
     sc, base = load_scenario(out / "identified.toml"), load_scenario(DEFAULT)
     for name in ("tau_h", "tau_a"):

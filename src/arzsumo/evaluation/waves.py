@@ -132,15 +132,25 @@ def band_power(blocks: np.ndarray, dt: float, band: tuple[float, float] = STOP_A
             "band_share": b / tot if tot > 0 else np.nan, "places": int(psd.shape[0])}
 
 
+def mean_periodogram(blocks: np.ndarray, dt: float, min_coverage: float = 0.75
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """Periods (s, longest first; frequency 0 left out) and the places' mean one-sided
+    periodogram density ((m/s)^2 s) of ``blocks`` (T, N; as :func:`band_power`); both
+    empty without a place used."""
+    f, psd = _place_spectra(blocks, dt, min_coverage)
+    if not psd.shape[0] or f.size < 2:
+        return np.zeros(0), np.zeros(0)
+    return 1.0 / f[1:], psd[:, 1:].mean(axis=0)
+
+
 def peak_period(blocks: np.ndarray, dt: float, min_coverage: float = 0.75) -> float:
     """The period (s) at which the places' mean periodogram of ``blocks`` (T, N; as
     :func:`band_power`) is largest, frequency 0 excluded: the waves' dominant period.
     NaN without a place, a resolved frequency or any power (a field standing still)."""
-    f, psd = _place_spectra(blocks, dt, min_coverage)
-    if not psd.shape[0] or f.size < 2 or not np.any(psd[:, 1:] > 0):
+    periods, mean = mean_periodogram(blocks, dt, min_coverage)
+    if not np.any(mean > 0):
         return float("nan")
-    mean = psd[:, 1:].mean(axis=0)
-    return float(1.0 / f[1:][int(np.argmax(mean))])
+    return float(periods[int(np.argmax(mean))])
 
 
 def growth_upstream(x: np.ndarray, amplitude: np.ndarray, length: float) -> float:

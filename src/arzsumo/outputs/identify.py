@@ -1,6 +1,7 @@
 """Write an identification (``arzsumo identify --out DIR``) atomically as one directory:
 ``identified.toml``, ``identification.json``, ``fields.png`` and ``scatter.png``, and with
-``--diagram`` ``diagram.png`` (stage 1's fit against SUMO's stationary states).
+``--diagram`` ``diagram.png`` (stage 1's fit against SUMO's stationary states), and
+``spectrum.png`` (where the runs' speed fluctuations lie in time scale).
 
 Their content is made by :mod:`arzsumo.studies.identify.report`; here the texts are
 written and the figures (:mod:`arzsumo.plots.identify`) drawn from arrays.
@@ -19,6 +20,7 @@ from arzsumo.outdir import OutputDir, atomic_dir, target_of
 from arzsumo.outputs.figures import save_png
 from arzsumo.plots.diagram import diagram_figure
 from arzsumo.plots.identify import fields_figure, scatter_figure
+from arzsumo.plots.spectrum import spectrum_figure
 
 #: the marker kind of an identification's directory
 KIND = "identify"
@@ -59,10 +61,19 @@ class DiagramPanel:
     waves: dict[str, float]
 
 
+@dataclass(frozen=True)
+class SpectrumPanel:
+    """``spectrum.png``: per run label and class, (periods s, the places' mean
+    periodogram density (m/s)^2 s) of its speed field, and a title."""
+
+    curves: dict[str, dict[str, tuple[np.ndarray, np.ndarray]]]
+    title: str
+
+
 def write_identification(out: str | os.PathLike[str] | OutputDir, toml_text: str,
                          json_text: str, fields: FieldsPanel, scatter: ScatterPanel, *,
-                         overwrite: bool = False, diagram: DiagramPanel | None = None
-                         ) -> Path:
+                         overwrite: bool = False, diagram: DiagramPanel | None = None,
+                         spectrum: SpectrumPanel | None = None) -> Path:
     """Write the files into ``out`` (a path, or an :class:`~arzsumo.outdir.OutputDir`
     of kind ``identify`` claimed before the runs) and put the directory in place."""
     with atomic_dir(out, KIND, overwrite=overwrite) as tmp:
@@ -75,4 +86,7 @@ def write_identification(out: str | os.PathLike[str] | OutputDir, toml_text: str
         if diagram is not None:
             save_png(diagram_figure(diagram.blocks, diagram.models, diagram.operating_point,
                                     diagram.waves), tmp / "diagram.png", dpi=90)
+        if spectrum is not None:
+            save_png(spectrum_figure(spectrum.curves, spectrum.title), tmp / "spectrum.png",
+                     dpi=90)
     return target_of(out)

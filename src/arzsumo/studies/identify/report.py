@@ -30,14 +30,20 @@ import numpy as np
 from arzsumo import __version__
 from arzsumo.control.registry import is_pde
 from arzsumo.evaluation.stationarity import count_trend
-from arzsumo.evaluation.waves import SHORT_WAVES_S, STOP_AND_GO_S, band_power, peak_period
+from arzsumo.evaluation.waves import (
+    SHORT_WAVES_S,
+    STOP_AND_GO_S,
+    band_power,
+    mean_periodogram,
+    peak_period,
+)
 from arzsumo.identify import VARIABLES, ReplayData
 from arzsumo.identify.diagram import DiagramFit
 from arzsumo.identify.objective import DEFAULT_PENALTY as PENALTY
 from arzsumo.io import dump_toml, json_safe
 from arzsumo.model.characteristic import linearize
 from arzsumo.outdir import OutputDir
-from arzsumo.outputs.identify import DiagramPanel, FieldsPanel, ScatterPanel
+from arzsumo.outputs.identify import DiagramPanel, FieldsPanel, ScatterPanel, SpectrumPanel
 from arzsumo.scenario.model import MODEL_KEYS
 from arzsumo.schema import IDENTIFY_SUMMARY, key_units
 from arzsumo.studies.identify.scores import SetScore
@@ -314,7 +320,21 @@ def write_study(out: str | Path | OutputDir, study: IdentifyStudy, overwrite: bo
     fields, scatter = figures(study)
     text = json.dumps(identification_json(study), indent=2)
     return write_identification(out, identified_toml(study), text, fields, scatter,
-                                overwrite=overwrite, diagram=diagram_panel(study))
+                                overwrite=overwrite, diagram=diagram_panel(study),
+                                spectrum=spectrum_panel(study))
+
+
+def spectrum_panel(study: IdentifyStudy) -> SpectrumPanel:
+    """What ``spectrum.png`` shows: every run's speed spectra per class (a run standing
+    still has none)."""
+    curves = {}
+    for r in study.runs:
+        d = r.data
+        dt = float(d.t[1] - d.t[0]) if d.t.size > 1 else float(d.t[0])
+        curves[f"{r.task.run_id} ({r.task.role})"] = {
+            cls: mean_periodogram(d.fields[:, row, :], dt) for cls, row in (("h", 1), ("a", 3))}
+    return SpectrumPanel(curves, f"{study.setup.base.name}: SUMO's speed fields over the "
+                                 "control window, 50 m cells x 1 s")
 
 
 def diagram_panel(study: IdentifyStudy) -> DiagramPanel | None:

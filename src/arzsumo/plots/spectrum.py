@@ -1,0 +1,48 @@
+"""Where a speed field's fluctuations lie in time scale: the places' mean periodogram.
+
+One panel per class; one curve per run; the stop-and-go band the control studies read
+(1 to 10 min) and the short waves' band (20 s to 1 min) shaded. Takes arrays in SI and
+returns a Figure (power drawn in (km/h)^2 s).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.figure import Figure
+
+from arzsumo.evaluation.waves import SHORT_WAVES_S, STOP_AND_GO_S
+from arzsumo.units import ms2_to_kmh2
+
+NAMES = {"h": "HV", "a": "AV"}
+
+
+def spectrum_figure(curves: Mapping[str, Mapping[str, tuple[np.ndarray, np.ndarray]]],
+                    title: str = "") -> Figure:
+    """The figure (module docstring).
+
+    Parameters
+    ----------
+    curves : mapping
+        Run label -> class (``h``, ``a``) -> (periods s, mean periodogram density
+        (m/s)^2 s), as :func:`arzsumo.evaluation.waves.mean_periodogram` gives them.
+    """
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), layout="constrained", sharey=True)
+    for ax, cls in zip(axes, NAMES, strict=True):
+        for (lo, hi), colour, name in ((SHORT_WAVES_S, "tab:red", "20 s-1 min"),
+                                       (STOP_AND_GO_S, "tab:blue", "1-10 min")):
+            ax.axvspan(lo, hi, color=colour, alpha=0.12, label=name)
+        for label, per_class in curves.items():
+            periods, psd = per_class[cls]
+            if periods.size:
+                ax.loglog(periods, ms2_to_kmh2(psd), lw=1.0, label=label)
+        ax.set_xlabel("period (s)")
+        ax.set_title(f"{NAMES[cls]} speed: places' mean periodogram", fontsize=10)
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0].set_ylabel("power density ((km/h)^2 s)")
+    axes[1].legend(fontsize=7, loc="lower right")
+    if title:
+        fig.suptitle(title)
+    return fig
