@@ -9,12 +9,13 @@ import tomllib
 import pandas as pd
 import pytest
 
+from arzsumo.errors import ScenarioError
 from arzsumo.model import characteristic_speeds, linearize
 from arzsumo.resources import shipped_scenarios_dir
 from arzsumo.scenario import scenario_from_dict
 from arzsumo.studies.common import StudyError
 from arzsumo.studies.control import ablation as control_ablation
-from arzsumo.studies.control.study import experiment_scenario
+from arzsumo.studies.control.study import DISTURBANCE, experiment_scenario
 from arzsumo.studies.recorded import RecordedRuns
 
 BASE = tomllib.loads((shipped_scenarios_dir() / "default.toml").read_text(encoding="utf-8"))
@@ -260,3 +261,21 @@ def test_a_joined_step_of_unknown_parts_is_refused():
     with pytest.raises(StudyError, match=r"steps = \('predictor\+nothing',\) is not allowed"):
         control_ablation.AblationOptions(RecordedRuns(seeds=(1,)),
                                          steps=("predictor+nothing",))
+
+
+def test_the_outlet_limit_meets_its_slowdown_on_the_merge_edge():
+    """The disturbance experiment slows the edge past the merge, the outlet limit's own:
+    refused there in one line; the merge-slowdown experiment slows the merge's edge, the
+    same slowdown otherwise, and runs with the limit."""
+    idm = tomllib.loads((shipped_scenarios_dir() / "stop_and_go_idm.toml").read_text(
+        encoding="utf-8"))
+    with pytest.raises(ScenarioError, match="actuator"):
+        scenario_from_dict(control_ablation.step_scenario(idm, "speed-limit", "disturbance"),
+                           "s.toml")
+    data = control_ablation.step_scenario(idm, "speed-limit", "merge-slowdown")
+    assert data["disturbance"] == {**DISTURBANCE, "edge": "merge"}
+    assert data["name"] == "stop_and_go_idm-ablation-speed-limit-merge-slowdown"
+    sc = scenario_from_dict(data, "s.toml")
+    assert sc.actuation.actuator == "speed_limit" and sc.disturbance.edge == "merge"
+    assert control_ablation.AblationOptions(RecordedRuns((1,)),
+                                            experiment="merge-slowdown").experiment

@@ -17,6 +17,7 @@ from arzsumo.errors import EXIT_SOME_FAILED
 from arzsumo.resources import default_scenario
 from arzsumo.studies.common import names_among, print_list
 from arzsumo.studies.control.study import (
+    ALL_EXPERIMENTS,
     EXPERIMENTS,
     JUDGED,
     NAME,
@@ -35,7 +36,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--controllers", default=",".join(JUDGED),
                         help="comma-separated controllers (default: %(default)s)")
     parser.add_argument("--experiments", default=",".join(EXPERIMENTS),
-                        help="comma-separated, of regulation, disturbance (default: both)")
+                        help="comma-separated, of regulation, disturbance, merge-slowdown "
+                        "(the slowdown on the merge's edge instead of the edge past it; "
+                        "default: regulation,disturbance)")
     parser.add_argument("--runs-from", type=Path, action="append", default=[],
                         metavar="DIR", help="an earlier evaluation or sweep (repeatable): "
                         "a controller whose runs on all the seeds are there is taken from "
@@ -52,7 +55,7 @@ def options(args: argparse.Namespace) -> ControlOptions:
     """The study's options as the command line gave them."""
     return ControlOptions(recorded_runs(args), scenario=args.scenario,
                           controllers=tuple(args.controllers.split(",")),
-                          experiments=tuple(names_among(args.experiments, EXPERIMENTS,
+                          experiments=tuple(names_among(args.experiments, ALL_EXPERIMENTS,
                                                         "--experiments")),
                           out=args.out, docs=args.docs, page=args.page,
                           plots=plots_wanted(args))

@@ -35,7 +35,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--control", type=Path, default=RESULTS_DIR / control.NAME,
                         metavar="DIR", help="the control study's --out, or its record "
                         "store: its runs of the experiment are the full configuration")
-    parser.add_argument("--experiment", choices=control.EXPERIMENTS, default="regulation",
+    parser.add_argument("--experiment", choices=control.ALL_EXPERIMENTS, default="regulation",
                         help="the control study's experiment the steps change "
                              "(default: %(default)s)")
     parser.add_argument("--steps", default=",".join(DEFAULT_STEPS),

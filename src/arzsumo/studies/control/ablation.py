@@ -217,7 +217,7 @@ class AblationOptions:
     page: str = PAGE
 
     def __post_init__(self) -> None:
-        checks.among(self.experiment, control.EXPERIMENTS, "experiment")
+        checks.among(self.experiment, control.ALL_EXPERIMENTS, "experiment")
         require(len(self.steps) > 0 and all(is_step(s) for s in self.steps), "steps",
                 self.steps, "at least one of " + ", ".join(STEPS) + ", or several joined "
                 f"by {JOIN}", StudyError)

@@ -58,12 +58,19 @@ PAGE = "control_default"
 #: least rate won the constant-rate sweep, so it is the held meter), the practitioner's
 #: ALINEA and PI-ALINEA, and the paper's three laws
 JUDGED = ("open", "held", "alinea", "pi-alinea", "backstepping", "etc", "observer-etc")
-#: the experiments, in order
+#: the experiments the study runs unless told, in order
 EXPERIMENTS = ("regulation", "disturbance")
 #: the disturbance experiment's [disturbance] table (scenario units): the edge past the
 #: merge at 10 km/h for 30 s from the start of control
 DISTURBANCE = {"kind": "slowdown", "edge": "down", "speed_kmh": 10.0, "start_s": 0.0,
                "duration_s": 30.0}
+#: every experiment and its [disturbance] (None: regulation). ``merge-slowdown`` is the
+#: same slowdown on the merge's edge, for an actuator that owns the edge past the merge
+#: (the outlet's speed limit, docs/sumo.md)
+DISTURBANCES: dict[str, dict | None] = {
+    "regulation": None, "disturbance": DISTURBANCE,
+    "merge-slowdown": {**DISTURBANCE, "edge": "merge"}}
+ALL_EXPERIMENTS = tuple(DISTURBANCES)
 #: the deviation measures the study adds to the evaluation's (columns of the runs table)
 DEVIATION = (
     Measure("section.deviation.decay_time_s", "decay time to the stationary band", "s"),
@@ -105,8 +112,8 @@ def experiment_scenario(base: dict, experiment: str) -> dict:
     """The scenario (as written) of ``experiment`` on the base scenario ``base``."""
     data = {k: dict(v) if isinstance(v, dict) else v for k, v in base.items()}
     data.pop("disturbance", None)
-    if experiment == "disturbance":
-        data["disturbance"] = dict(DISTURBANCE)
+    if DISTURBANCES[experiment] is not None:
+        data["disturbance"] = dict(DISTURBANCES[experiment])
     data["name"] = f"{base.get('name', 'scenario')}-{experiment}"
     return data
 
@@ -155,7 +162,7 @@ class ControlOptions:
     """What ``arzsumo study control`` runs.
 
     ``scenario``: the base scenario file (None: the shipped default); ``controllers``
-    and ``experiments``: of :data:`JUDGED` (and ALINEA's kin) and :data:`EXPERIMENTS`;
+    and ``experiments``: of :data:`JUDGED` (and ALINEA's kin) and :data:`ALL_EXPERIMENTS`;
     ``runs``: the seeds, the record store and how the runs run; ``out``: the study's
     directory (resumable); ``docs`` and ``page``: the results page to regenerate (None:
     none); ``plots``: draw the figures.
@@ -173,7 +180,7 @@ class ControlOptions:
     def __post_init__(self) -> None:
         object.__setattr__(self, "controllers", tuple(check_controllers(
             list(self.controllers))))
-        checks.all_among(self.experiments, EXPERIMENTS, "experiments")
+        checks.all_among(self.experiments, ALL_EXPERIMENTS, "experiments")
 
     @property
     def base(self) -> Path:
