@@ -85,6 +85,21 @@ def test_the_table_pairs_each_step_with_the_full_configuration():
     text = control_ablation.table({"raw-cells": etc_only}, full, [1, 2, 3])
     assert any(x.startswith("| raw-cells | etc") for x in text.splitlines())
     assert not any(x.startswith("| raw-cells | backstepping") for x in text.splitlines())
+    # without a full configuration: each step against the open loop only
+    text = control_ablation.table({"raw-cells": with_open}, None, [1, 2, 3])
+    rows = {tuple(c.strip() for c in x.split("|")[1:4]): x for x in text.splitlines()}
+    assert "| -1 [-1, -1] 3/0 |" in rows[("raw-cells", "backstepping", "open")]
+    assert not any(k[0] == "full" or k[2] == "full" for k in rows)
+
+
+def test_the_full_configuration_may_come_from_elsewhere_or_not_at_all(run_study, tmp_path):
+    """--full names another store (checked like --control), --without-full needs none;
+    the two together are refused by the command line."""
+    with pytest.raises(StudyError, match=f"--full = '{tmp_path / 'f'}' is not allowed"):
+        run_study("control-ablation", "--full", tmp_path / "f", "--out", tmp_path / "a")
+    with pytest.raises(SystemExit):
+        run_study("control-ablation", "--full", tmp_path, "--without-full",
+                  "--out", tmp_path / "a")
 
 
 def test_unknown_steps_and_a_missing_control_study_are_refused(run_study, tmp_path):

@@ -35,6 +35,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--control", type=Path, default=RESULTS_DIR / control.NAME,
                         metavar="DIR", help="the control study's --out, or its record "
                         "store: its runs of the experiment are the full configuration")
+    full = parser.add_mutually_exclusive_group()
+    full.add_argument("--full", type=Path, metavar="DIR",
+                      help="the full configuration's runs from this --out or record store "
+                           "of the control study instead (the open loop stays --control's)")
+    full.add_argument("--without-full", action="store_true",
+                      help="compare the steps with the open loop only")
     parser.add_argument("--experiment", choices=control.ALL_EXPERIMENTS, default="regulation",
                         help="the control study's experiment the steps change "
                              "(default: %(default)s)")
@@ -62,7 +68,9 @@ def options(args: argparse.Namespace) -> AblationOptions:
                          f"of {', '.join(STEPS)}, or several of them joined by +")
     laws = tuple(names_among(args.laws, list(ALL_LAWS), "--laws"))
     return AblationOptions(recorded_runs(args), scenario=args.scenario,
-                           control=args.control, experiment=args.experiment, steps=steps,
+                           control=args.control, full=args.full,
+                           without_full=args.without_full, experiment=args.experiment,
+                           steps=steps,
                            laws=laws, out=args.out, docs=args.docs,
                            page=args.page)
 

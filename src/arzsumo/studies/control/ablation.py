@@ -152,27 +152,29 @@ def _ran(runs: pd.DataFrame, laws: Sequence[str]) -> list[str]:
     return [law for law in laws if law in set(done["controller"])]
 
 
-def table(steps: dict[str, pd.DataFrame], full: pd.DataFrame, seeds: list[int],
+def table(steps: dict[str, pd.DataFrame], full: pd.DataFrame | None, seeds: list[int],
           laws: Sequence[str] = LAWS, own_open: frozenset[str] | None = None) -> str:
     """Markdown: per step, law and measure, the step minus the full configuration and the
     step minus the open loop of its evaluation, paired by seed (mean [95 % t]
     wins/losses of the step); first, the full configuration minus the open loop, where a
     step borrowed the control study's open loop (``own_open``: the steps that ran their
-    own; None: those :data:`STEPS` flags)."""
+    own; None: those :data:`STEPS` flags). ``full`` None: the steps against the open
+    loop only."""
     lines = ["| step | law | minus | " + " | ".join(f"{m.label} ({m.unit})"
                                                   for m in measures()) + " |",
              "|---" * (3 + len(KEYS)) + "|"]
     own = own_open if own_open is not None else frozenset(s for s in STEPS if STEPS[s][2])
     borrowed = next((r for s, r in steps.items() if s not in own
                      and BASELINE in set(r["controller"])), None)
-    if borrowed is not None:
+    if borrowed is not None and full is not None:
         for law in laws:
             lines.append(f"| full | {law} | open | "
                          + " | ".join(_cells(full, law, borrowed, BASELINE, seeds)) + " |")
     for step, runs in steps.items():
         for law in _ran(runs, laws):
-            lines.append(f"| {step} | {law} | full | "
-                         + " | ".join(_cells(runs, law, full, law, seeds)) + " |")
+            if full is not None:
+                lines.append(f"| {step} | {law} | full | "
+                             + " | ".join(_cells(runs, law, full, law, seeds)) + " |")
             if BASELINE in set(runs["controller"]):
                 lines.append(f"| {step} | {law} | open | "
                              + " | ".join(_cells(runs, law, runs, BASELINE, seeds)) + " |")
@@ -200,7 +202,10 @@ class AblationOptions:
 
     ``runs``: the seeds, the record store and how the runs run; ``scenario``: the control
     study's base scenario (None: the shipped default); ``control``: the control study's
-    ``--out`` or record store (its runs of ``experiment`` are the full configuration);
+    ``--out`` or record store (its runs of ``experiment`` are the full configuration,
+    its open loop the steps' that borrow one); ``full``: where the full configuration's
+    runs are instead (another store of the same study); ``without_full``: compare the
+    steps with the open loop only (no full configuration needed);
     ``steps`` of :data:`STEPS`, ``laws`` of :data:`ALL_LAWS`; ``out``, ``docs``: where the
     study writes (None: no page); ``page``: the results page under ``docs`` that gets
     the table (the control study's page of the same scenario).
@@ -209,6 +214,8 @@ class AblationOptions:
     runs: RecordedRuns
     scenario: Path | None = None
     control: Path = RESULTS_DIR / control.NAME
+    full: Path | None = None
+    without_full: bool = False
     experiment: str = "regulation"
     steps: tuple[str, ...] = DEFAULT_STEPS
     laws: tuple[str, ...] = LAWS
@@ -246,12 +253,12 @@ def design(opts: AblationOptions) -> list[str]:
 def full_configuration(runs_dir: Path, scenario: Path, laws: Sequence[str],
                        seeds: Sequence[int], user: str) -> pd.DataFrame:
     """The finished runs of ``laws`` on ``seeds`` that the control study's directory or
-    store ``runs_dir`` (one experiment's) holds of ``scenario``; a StudyError if one
-    lacks."""
+    store ``runs_dir`` (one experiment's) holds of ``scenario``; a StudyError naming
+    ``user`` (the option as given, ``--control = 'DIR'``) if one lacks."""
     runs = records_table(evaluation_spec(scenario, laws, seeds).runs(), runs_dir)
     missing = runs.loc[~runs["status"].isin(FINISHED), "run_id"].tolist()
     if missing:
-        raise StudyError(f"--control = {user!r} is not allowed: it has no finished "
+        raise StudyError(f"{user} is not allowed: it has no finished "
                          f"{runs_dir.name} run {missing[0]} of this scenario; allowed: the "
                          "--out or the record store of arzsumo study control with these "
                          "laws and seeds")
@@ -280,7 +287,10 @@ def run_ablation(opts: AblationOptions) -> AblationResult:
     with tempfile.TemporaryDirectory() as tmp:     # checked before --out is touched
         exp_path = write_text(dump_toml(data), Path(tmp) / f"{experiment}.toml")
         scenarios = step_scenarios(base, steps, experiment, str(opts.base))
-        full = full_configuration(control_runs, exp_path, laws, seeds, str(opts.control))
+        flag = (f"--full = {str(opts.full)!r}" if opts.full
+                else f"--control = {str(opts.control)!r}")
+        full = None if opts.without_full else full_configuration(
+            Path(opts.full or opts.control) / experiment, exp_path, laws, seeds, flag)
         open_runs = evaluation_spec(exp_path, [BASELINE], seeds).runs()
     with resumable_dir(opts.out, f"study-{NAME}") as out:
         baseline = open_loop_runs(control_runs, open_runs,
