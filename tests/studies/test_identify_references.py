@@ -82,9 +82,10 @@ def test_a_replay_offset_by_a_constant_is_all_bias_and_in_phase():
     shifted[:, 0] += 0.005                                 # 6.25 % of rho_h* = 0.08
     parts = decomposition(run, shifted)
     assert parts["rho_h"]["bias"] == pytest.approx(0.0625, rel=1e-9)
+    assert parts["rho_h"]["offset"] == pytest.approx(0.0625, rel=1e-9)
     assert parts["rho_h"]["fluctuation"] == pytest.approx(0.0, abs=1e-12)
     assert parts["rho_h"]["correlation"] == pytest.approx(1.0, rel=1e-12)
-    assert parts["rho_a"] == pytest.approx({"bias": 0.0, "fluctuation": 0.0,
+    assert parts["rho_a"] == pytest.approx({"offset": 0.0, "bias": 0.0, "fluctuation": 0.0,
                                             "correlation": 1.0}, abs=1e-12)
     # a replay that holds each place's mean: no bias, the run's spread, no phase
     flat = np.broadcast_to(fields.mean(axis=0, keepdims=True), fields.shape).copy()

@@ -91,7 +91,8 @@ def _print_references(study: IdentifyStudy) -> None:
     for key, who in (("model", "the identified model's"),
                      ("scenario_model", f"{study.setup.base.name}'s own model's")):
         split = "; ".join(f"{run} " + ", ".join(
-            f"{var} bias {d['bias']:.1%} fluctuation {d['fluctuation']:.1%} "
+            f"{var} offset {d['offset']:+.1%} bias {d['bias']:.1%} fluctuation "
+            f"{d['fluctuation']:.1%} "
             f"(correlation {d['correlation']:.2f})" for var, d in parts.items())
             for run, parts in refs.get(key, {}).items())
         if split:

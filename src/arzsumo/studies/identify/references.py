@@ -62,11 +62,13 @@ def _density_errors(data: ReplayData, predicted: np.ndarray) -> dict[str, float]
 
 
 def decomposition(data: ReplayData, predicted: np.ndarray) -> dict[str, dict[str, float]]:
-    """A replay's block density error split, per class (``rho_h``, ``rho_a``): ``bias``,
-    the RMS over places of each place's mean error over the run; ``fluctuation``, the RMS
-    of what is left (bias^2 + fluctuation^2 = the error^2, all over the run's equilibrium
-    value); ``correlation`` of the replay's and the run's fluctuations about their places'
-    means (1: the replay follows their phase; 0: it does not)."""
+    """A replay's block density error split, per class (``rho_h``, ``rho_a``): ``offset``,
+    the mean error over every block (signed: < 0, the replay's section is emptier than
+    SUMO's); ``bias``, the RMS over places of each place's mean error over the run;
+    ``fluctuation``, the RMS of what is left (bias^2 + fluctuation^2 = the error^2; all
+    over the run's equilibrium value); ``correlation`` of the replay's and the run's
+    fluctuations about their places' means (1: the replay follows their phase; 0: it
+    does not)."""
     both = np.isfinite(data.fields) & np.isfinite(predicted)
     shape = _block_shape(data)
     obs = block_means(np.where(both, data.fields, np.nan), *shape)
@@ -80,7 +82,8 @@ def decomposition(data: ReplayData, predicted: np.ndarray) -> dict[str, dict[str
         bias = np.nanmean(err, axis=0)
         of, pf = o - np.nanmean(o, axis=0), p - np.nanmean(p, axis=0)
         denom = np.sqrt(np.nansum(of ** 2) * np.nansum(pf ** 2))
-        out[name] = {"bias": float(np.sqrt(np.nanmean(bias ** 2))),
+        out[name] = {"offset": float(np.nanmean(err)),
+                     "bias": float(np.sqrt(np.nanmean(bias ** 2))),
                      "fluctuation": float(np.sqrt(np.nanmean((err - bias) ** 2))),
                      "correlation": float(np.nansum(of * pf) / denom) if denom > 0
                      else float("nan")}
