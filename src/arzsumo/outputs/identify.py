@@ -64,9 +64,11 @@ class DiagramPanel:
 @dataclass(frozen=True)
 class SpectrumPanel:
     """``spectrum.png``: per run label and class, (periods s, the places' mean
-    periodogram density (m/s)^2 s) of its speed field, and a title."""
+    periodogram density (m/s)^2 s) of its speed field, the bands to shade (label ->
+    periods s) and a title."""
 
     curves: dict[str, dict[str, tuple[np.ndarray, np.ndarray]]]
+    bands: dict[str, tuple[float, float]]
     title: str
 
 
@@ -87,6 +89,7 @@ def write_identification(out: str | os.PathLike[str] | OutputDir, toml_text: str
             save_png(diagram_figure(diagram.blocks, diagram.models, diagram.operating_point,
                                     diagram.waves), tmp / "diagram.png", dpi=90)
         if spectrum is not None:
-            save_png(spectrum_figure(spectrum.curves, spectrum.title), tmp / "spectrum.png",
+            save_png(spectrum_figure(spectrum.curves, spectrum.bands, spectrum.title),
+                     tmp / "spectrum.png",
                      dpi=90)
     return target_of(out)

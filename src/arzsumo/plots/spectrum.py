@@ -1,8 +1,8 @@
 """Where a speed field's fluctuations lie in time scale: the places' mean periodogram.
 
-One panel per class; one curve per run; the stop-and-go band the control studies read
-(1 to 10 min) and the short waves' band (20 s to 1 min) shaded. Takes arrays in SI and
-returns a Figure (power drawn in (km/h)^2 s).
+One panel per class; one curve per run; bands of periods shaded (the stop-and-go band
+the control studies read and the short waves' band, as the caller names them). Takes
+arrays in SI and returns a Figure (power drawn in (km/h)^2 s).
 """
 
 from __future__ import annotations
@@ -13,14 +13,15 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 
-from arzsumo.evaluation.waves import SHORT_WAVES_S, STOP_AND_GO_S
 from arzsumo.units import ms2_to_kmh2
 
 NAMES = {"h": "HV", "a": "AV"}
+#: the shading of the bands, in order
+COLOURS = ("tab:red", "tab:blue", "tab:green")
 
 
 def spectrum_figure(curves: Mapping[str, Mapping[str, tuple[np.ndarray, np.ndarray]]],
-                    title: str = "") -> Figure:
+                    bands: Mapping[str, tuple[float, float]], title: str = "") -> Figure:
     """The figure (module docstring).
 
     Parameters
@@ -28,11 +29,12 @@ def spectrum_figure(curves: Mapping[str, Mapping[str, tuple[np.ndarray, np.ndarr
     curves : mapping
         Run label -> class (``h``, ``a``) -> (periods s, mean periodogram density
         (m/s)^2 s), as :func:`arzsumo.evaluation.waves.mean_periodogram` gives them.
+    bands : mapping
+        Label -> (shortest, longest period, s) of each band to shade.
     """
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), layout="constrained", sharey=True)
     for ax, cls in zip(axes, NAMES, strict=True):
-        for (lo, hi), colour, name in ((SHORT_WAVES_S, "tab:red", "20 s-1 min"),
-                                       (STOP_AND_GO_S, "tab:blue", "1-10 min")):
+        for (name, (lo, hi)), colour in zip(bands.items(), COLOURS, strict=False):
             ax.axvspan(lo, hi, color=colour, alpha=0.12, label=name)
         for label, per_class in curves.items():
             periods, psd = per_class[cls]

@@ -20,16 +20,21 @@ scored on the same blocks as the model's replay (:data:`.scores.BLOCK_M`,
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
+from arzsumo.errors import ArzsumoError
 from arzsumo.evaluation.fields import block_means, field_rmse
 from arzsumo.identify import ReplayData
 from arzsumo.identify.three_detector import Triangle, three_detector_fields
 from arzsumo.model.params import ModelParameters
 from arzsumo.studies.identify.diagram import read_waves
-from arzsumo.studies.identify.scores import _block_shape
+from arzsumo.studies.identify.scores import SetScore, _block_shape
+
+log = logging.getLogger(__name__)
 
 #: the references, in the order reports list them
 REFERENCES = ("three_detector", "equilibrium", "place_mean")
@@ -104,3 +109,22 @@ def reference_scores(fd: Triangle, held_out: Sequence[ReplayData]) -> dict[str, 
                         "place_mean": _block_errors(d, means, place)}
     return {"triangle": {"v_free": fd.v_free, "w": fd.w, "rho_jam": fd.rho_jam},
             "runs": runs}
+
+
+def held_out_references(params: ModelParameters, train: Sequence[ReplayData],
+                        held_out: Sequence[ReplayData], validation: SetScore,
+                        own: SetScore) -> dict[str, Any] | None:
+    """``identification.json["references"]``: the references' block errors on the
+    held-out runs (:func:`reference_scores`) and the replay error split
+    (:func:`decomposition`) of the identified model (``model``, its ``validation``
+    scores) and of the scenario's own (``scenario_model``, ``own``); None where the
+    training runs show no wave to draw the reference's triangle with."""
+    try:
+        refs: dict[str, Any] = reference_scores(reference_triangle(params, train), held_out)
+    except ArzsumoError as exc:
+        log.info("no reference replays: %s", exc)
+        return None
+    for key, score in (("model", validation), ("scenario_model", own)):
+        refs[key] = {r.name: decomposition(d, r.predicted)
+                     for r, d in zip(score.runs, held_out, strict=True)}
+    return refs

@@ -333,8 +333,9 @@ def spectrum_panel(study: IdentifyStudy) -> SpectrumPanel:
         dt = float(d.t[1] - d.t[0]) if d.t.size > 1 else float(d.t[0])
         curves[f"{r.task.run_id} ({r.task.role})"] = {
             cls: mean_periodogram(d.fields[:, row, :], dt) for cls, row in (("h", 1), ("a", 3))}
-    return SpectrumPanel(curves, f"{study.setup.base.name}: SUMO's speed fields over the "
-                                 "control window, 50 m cells x 1 s")
+    bands = {"20 s-1 min": SHORT_WAVES_S, "1-10 min": STOP_AND_GO_S}
+    return SpectrumPanel(curves, bands, f"{study.setup.base.name}: SUMO's speed fields "
+                                        "over the control window, 50 m cells x 1 s")
 
 
 def diagram_panel(study: IdentifyStudy) -> DiagramPanel | None:

@@ -49,11 +49,7 @@ from arzsumo.model.params import FAMILIES, ModelParameters
 from arzsumo.scenario import Scenario, scenario_from_dict
 from arzsumo.studies.identify.cache import load_run, run_key, save_run
 from arzsumo.studies.identify.diagram import STAGE_TWO, StageOne, fit_stage_one, read_waves
-from arzsumo.studies.identify.references import (
-    decomposition,
-    reference_scores,
-    reference_triangle,
-)
+from arzsumo.studies.identify.references import held_out_references
 from arzsumo.studies.identify.scores import (
     SetScore,
     ao_floor,
@@ -330,24 +326,6 @@ def equilibrium_at(params: ModelParameters, rho: tuple[float, float]) -> Equilib
         return None
 
 
-def _references(params: ModelParameters, train: Sequence[ReplayData],
-                held_out: Sequence[ReplayData], validation: SetScore, own: SetScore
-                ) -> dict[str, Any] | None:
-    """The references' block errors on the held-out runs and the replay error split
-    (:func:`.references.decomposition`) of the identified model (``model``) and of the
-    scenario's own (``scenario_model``), or None where the training runs show no wave to
-    draw the reference's triangle with."""
-    try:
-        refs = reference_scores(reference_triangle(params, train), held_out)
-    except ArzsumoError as exc:
-        log.info("no reference replays: %s", exc)
-        return None
-    for key, score in (("model", validation), ("scenario_model", own)):
-        refs[key] = {r.name: decomposition(d, r.predicted)
-                     for r, d in zip(score.runs, held_out, strict=True)}
-    return refs
-
-
 def run_identification(setup: IdentifySetup) -> IdentifyStudy:
     """Plan, simulate, fit and validate (module docstring)."""
     t0 = time.perf_counter()
@@ -397,4 +375,4 @@ def run_identification(setup: IdentifySetup) -> IdentifyStudy:
     own = score_set(setup.scenario.params, held_out, opts)
     return IdentifyStudy(setup, runs, fit, start, training, validation, rho,
                          equilibrium_at(fit.params, rho), wall, stage_one, own,
-                         _references(fit.params, train, held_out, validation, own))
+                         held_out_references(fit.params, train, held_out, validation, own))
