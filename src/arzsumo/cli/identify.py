@@ -77,14 +77,14 @@ def cmd_identify(args: argparse.Namespace) -> int:
 
 
 def _print_references(study: IdentifyStudy) -> None:
-    """The held-out block errors of Newell's three-detector replay and of the constant
-    equilibrium, beside the model's."""
+    """The held-out block errors of the references beside the model's, and the replay
+    error splits."""
+    from arzsumo.studies.identify.references import REFERENCES
+
     refs = study.references
     if not refs:
         return
-    for name, label in (("three_detector", "Newell's three-detector replay"),
-                        ("equilibrium", "the equilibrium everywhere"),
-                        ("place_mean", "each place's own run mean (an oracle)")):
+    for name, label in REFERENCES.items():
         blocks = ", ".join(f"{run} rho_h {r[name]['rho_h']:.1%} "
                            f"rho_a {r[name]['rho_a']:.1%}" for run, r in refs["runs"].items())
         print(f"    {label}, same blocks: {blocks}")

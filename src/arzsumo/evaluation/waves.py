@@ -78,10 +78,47 @@ def _filled(series: np.ndarray, min_coverage: float) -> np.ndarray | None:
     return np.interp(t, t[ok], series[ok])
 
 
-def _place_spectra(blocks: np.ndarray, dt: float, min_coverage: float
-                   ) -> tuple[np.ndarray, np.ndarray]:
-    """Frequencies (F,) and the one-sided periodogram densities (P, F) of each place's
-    series used (NaN filled, linearly detrended, Hann-windowed); P may be 0."""
+@dataclass(frozen=True)
+class PlaceSpectra:
+    """The one-sided periodogram densities ``psd`` (P, F; (m/s)^2 s) of each place's
+    series used, at frequencies ``f`` (F,; Hz): what :func:`band_power`,
+    :func:`mean_periodogram` and :func:`peak_period` read. P may be 0."""
+
+    f: np.ndarray
+    psd: np.ndarray
+
+    def band(self, band: tuple[float, float]) -> dict[str, float]:
+        """:func:`band_power`'s result for ``band`` (shortest, longest period, s)."""
+        if not self.psd.shape[0]:
+            return {"band_power": np.nan, "total_variance": np.nan, "band_share": np.nan,
+                    "places": 0}
+        df = self.f[1] - self.f[0]
+        inside = (self.f >= 1.0 / band[1]) & (self.f <= 1.0 / band[0])
+        b = float(self.psd[:, inside].sum(axis=1).mean() * df)
+        tot = float(self.psd[:, 1:].sum(axis=1).mean() * df)
+        return {"band_power": b, "total_variance": tot,
+                "band_share": b / tot if tot > 0 else np.nan,
+                "places": int(self.psd.shape[0])}
+
+    def mean(self) -> tuple[np.ndarray, np.ndarray]:
+        """:func:`mean_periodogram`'s result."""
+        if not self.psd.shape[0] or self.f.size < 2:
+            return np.zeros(0), np.zeros(0)
+        return 1.0 / self.f[1:], self.psd[:, 1:].mean(axis=0)
+
+    def peak_period(self) -> float:
+        """:func:`peak_period`'s result."""
+        periods, mean = self.mean()
+        if not np.any(mean > 0):
+            return float("nan")
+        return float(periods[int(np.argmax(mean))])
+
+
+def place_spectra(blocks: np.ndarray, dt: float, min_coverage: float = 0.75
+                  ) -> PlaceSpectra:
+    """Each place's series of ``blocks`` (T, N; block duration ``dt`` s) with at least
+    ``min_coverage`` finite blocks, NaN filled in time, linearly detrended and
+    Hann-windowed, as its periodogram."""
     f, psds = np.zeros(0), []
     for series in np.asarray(blocks, float).T:
         x = _filled(series, min_coverage)
@@ -89,7 +126,7 @@ def _place_spectra(blocks: np.ndarray, dt: float, min_coverage: float
             continue
         f, psd = periodogram(x, fs=1.0 / dt, window="hann", detrend="linear")
         psds.append(psd)
-    return f, np.array(psds).reshape(len(psds), f.size)
+    return PlaceSpectra(f, np.array(psds).reshape(len(psds), f.size))
 
 
 def band_power(blocks: np.ndarray, dt: float, band: tuple[float, float] = STOP_AND_GO_S,
@@ -120,16 +157,7 @@ def band_power(blocks: np.ndarray, dt: float, band: tuple[float, float] = STOP_A
         ``band_power`` and ``total_variance`` (means over the places used, (m/s)^2),
         ``band_share`` (their ratio, 1) and ``places`` (places used); NaN without any.
     """
-    f, psd = _place_spectra(blocks, dt, min_coverage)
-    if not psd.shape[0]:
-        return {"band_power": np.nan, "total_variance": np.nan, "band_share": np.nan,
-                "places": 0}
-    df = f[1] - f[0]
-    inside = (f >= 1.0 / band[1]) & (f <= 1.0 / band[0])
-    b = float(psd[:, inside].sum(axis=1).mean() * df)
-    tot = float(psd[:, 1:].sum(axis=1).mean() * df)
-    return {"band_power": b, "total_variance": tot,
-            "band_share": b / tot if tot > 0 else np.nan, "places": int(psd.shape[0])}
+    return place_spectra(blocks, dt, min_coverage).band(band)
 
 
 def mean_periodogram(blocks: np.ndarray, dt: float, min_coverage: float = 0.75
@@ -137,20 +165,14 @@ def mean_periodogram(blocks: np.ndarray, dt: float, min_coverage: float = 0.75
     """Periods (s, longest first; frequency 0 left out) and the places' mean one-sided
     periodogram density ((m/s)^2 s) of ``blocks`` (T, N; as :func:`band_power`); both
     empty without a place used."""
-    f, psd = _place_spectra(blocks, dt, min_coverage)
-    if not psd.shape[0] or f.size < 2:
-        return np.zeros(0), np.zeros(0)
-    return 1.0 / f[1:], psd[:, 1:].mean(axis=0)
+    return place_spectra(blocks, dt, min_coverage).mean()
 
 
 def peak_period(blocks: np.ndarray, dt: float, min_coverage: float = 0.75) -> float:
     """The period (s) at which the places' mean periodogram of ``blocks`` (T, N; as
     :func:`band_power`) is largest, frequency 0 excluded: the waves' dominant period.
     NaN without a place, a resolved frequency or any power (a field standing still)."""
-    periods, mean = mean_periodogram(blocks, dt, min_coverage)
-    if not np.any(mean > 0):
-        return float("nan")
-    return float(periods[int(np.argmax(mean))])
+    return place_spectra(blocks, dt, min_coverage).peak_period()
 
 
 def growth_upstream(x: np.ndarray, amplitude: np.ndarray, length: float) -> float:
@@ -213,12 +235,12 @@ def wave_measures(blocks: np.ndarray, dt: float, x: np.ndarray, length: float,
     (T, N; m/s) with block duration ``dt`` (s), block centres ``x`` (m) and the meter at
     ``length`` (m)."""
     sd = temporal_sd(blocks)
-    p = band_power(blocks, dt, band)
-    short = band_power(blocks, dt, SHORT_WAVES_S)
+    spectra = place_spectra(blocks, dt)
+    p, short = spectra.band(band), spectra.band(SHORT_WAVES_S)
     return WaveMeasures(rms(sd), p["band_power"], p["total_variance"], p["band_share"],
                         int(p["places"]), np.asarray(x, float), sd,
                         growth_upstream(x, sd, length), short["band_power"],
-                        short["band_share"], peak_period(blocks, dt))
+                        short["band_share"], spectra.peak_period())
 
 
 def block_centres(places: int, block_m: float) -> np.ndarray:

@@ -80,29 +80,49 @@ def _at(times: np.ndarray, counts: np.ndarray, when: np.ndarray) -> np.ndarray:
     return np.where(when >= 0.0, np.interp(when, times, counts), np.inf)
 
 
-def labels(data: ReplayData, fd: Triangle) -> np.ndarray:
-    """N(x, t) at the cell edges (T, N + 1), label 0 at x = 0 at t = 0 (docstring)."""
-    dx = np.diff(data.x).mean()
-    edges = np.concatenate([[data.x[0] - dx / 2], data.x + dx / 2]) - (data.x[0] - dx / 2)
-    length = edges[-1]
+@dataclass(frozen=True)
+class _Counts:
+    """The counts the method starts from (module docstring), SI."""
+
+    edges: np.ndarray      # cell edges, m from x = 0 (N + 1,)
+    times: np.ndarray      # 0 and the period ends, s (T + 1,)
+    n0: np.ndarray         # N(edge, 0): 0 at x = 0, negative downstream
+    a0: np.ndarray         # the AV count A(edge, 0), likewise
+    up: np.ndarray         # N(0, t) at ``times``: the inflow cumulated
+    a_up: np.ndarray       # A(0, t) at ``times``
+    down: np.ndarray       # N(L, t) at ``times``: N(L, 0) plus the outflow cumulated
+
+
+def _counts(data: ReplayData) -> _Counts:
+    """The initial state's and the boundaries' cumulative counts of ``data``."""
+    dx = float(np.diff(data.x).mean())
+    edges = np.arange(data.x.size + 1) * dx
     times = np.concatenate([[0.0], data.t])
     dt = np.diff(times)
-    rho0 = data.initial[0] + data.initial[2]
-    n0 = np.concatenate([[0.0], -np.cumsum(rho0 * dx)])                    # N(edge, 0)
-    inflow = data.inlet[:, 0] * data.inlet[:, 1] + data.inlet[:, 2] * data.inlet[:, 3]
-    up = _cumulative(inflow, dt, 0.0)
-    down = _cumulative(data.outflow, dt, n0[-1])
-    t, x = data.t[:, None], edges[None, :]
-    from_up = _at(times, up, t - x / fd.v_free)
-    from_down = _at(times, down, t - (length - x) / fd.w) + fd.rho_jam * (length - x)
+    n0 = np.concatenate([[0.0], -np.cumsum((data.initial[0] + data.initial[2]) * dx)])
+    a0 = np.concatenate([[0.0], -np.cumsum(data.initial[2] * dx)])
+    inflow_a = data.inlet[:, 2] * data.inlet[:, 3]
+    inflow = data.inlet[:, 0] * data.inlet[:, 1] + inflow_a
+    return _Counts(edges, times, n0, a0, _cumulative(inflow, dt, 0.0),
+                   _cumulative(inflow_a, dt, 0.0), _cumulative(data.outflow, dt, n0[-1]))
+
+
+def labels(data: ReplayData, fd: Triangle) -> np.ndarray:
+    """N(x, t) at the cell edges (T, N + 1), label 0 at x = 0 at t = 0 (docstring)."""
+    c = _counts(data)
+    length = c.edges[-1]
+    t, x = data.t[:, None], c.edges[None, :]
+    from_up = _at(c.times, c.up, t - x / fd.v_free)
+    from_down = _at(c.times, c.down, t - (length - x) / fd.w) + fd.rho_jam * (length - x)
     # the initial state: N(y, 0) is linear within cells, so the least cost over the
     # origins within reach is at an edge or at an end of the reach
     lo = np.clip(x - fd.v_free * t, 0.0, length)
     hi = np.clip(x + fd.w * t, 0.0, length)
     ends = np.stack([lo, hi], axis=-1)
-    y = np.concatenate([np.broadcast_to(edges, lo.shape + edges.shape), ends], axis=-1)
+    y = np.concatenate([np.broadcast_to(c.edges, lo.shape + c.edges.shape), ends], axis=-1)
     inside = (y >= lo[..., None]) & (y <= hi[..., None])
-    cost = np.interp(y, edges, n0) + fd.capacity * t[..., None] - fd.rho_crit * (x[..., None] - y)
+    cost = (np.interp(y, c.edges, c.n0) + fd.capacity * t[..., None]
+            - fd.rho_crit * (x[..., None] - y))
     from_start = np.where(inside, cost, np.inf).min(axis=-1)
     return np.minimum(np.minimum(from_up, from_down), from_start)
 
@@ -113,14 +133,9 @@ def av_count_of_label(data: ReplayData) -> tuple[np.ndarray, np.ndarray]:
     The initial state's edges carry N(e, 0) and A(e, 0) (both 0 at x = 0, negative
     downstream); labels entered later carry the counts that had crossed x = 0 by then.
     """
-    dx = np.diff(data.x).mean()
-    dt = np.diff(np.concatenate([[0.0], data.t]))
-    n0 = np.concatenate([[0.0], -np.cumsum((data.initial[0] + data.initial[2]) * dx)])
-    a0 = np.concatenate([[0.0], -np.cumsum(data.initial[2] * dx)])
-    inflow = data.inlet[:, 0] * data.inlet[:, 1] + data.inlet[:, 2] * data.inlet[:, 3]
-    n_up = _cumulative(inflow, dt, 0.0)
-    a_up = _cumulative(data.inlet[:, 2] * data.inlet[:, 3], dt, 0.0)
-    return np.concatenate([n0[::-1], n_up[1:]]), np.concatenate([a0[::-1], a_up[1:]])
+    c = _counts(data)
+    return (np.concatenate([c.n0[::-1], c.up[1:]]),
+            np.concatenate([c.a0[::-1], c.a_up[1:]]))
 
 
 def three_detector_fields(data: ReplayData, fd: Triangle) -> np.ndarray:

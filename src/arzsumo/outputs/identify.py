@@ -90,6 +90,5 @@ def write_identification(out: str | os.PathLike[str] | OutputDir, toml_text: str
                                     diagram.waves), tmp / "diagram.png", dpi=90)
         if spectrum is not None:
             save_png(spectrum_figure(spectrum.curves, spectrum.bands, spectrum.title),
-                     tmp / "spectrum.png",
-                     dpi=90)
+                     tmp / "spectrum.png", dpi=90)
     return target_of(out)

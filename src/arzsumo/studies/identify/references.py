@@ -2,7 +2,7 @@
 
 A second-order replay's block error means little alone: part of it is what no replay
 from boundary data can know (the phase of stop-and-go grown inside the section, the
-discreteness of a few vehicles in a 100 m x 10 s block). Two references bracket it, each
+discreteness of a few vehicles in a 100 m x 10 s block). Three references bracket it, each
 scored on the same blocks as the model's replay (:data:`.scores.BLOCK_M`,
 :data:`.scores.BLOCK_S`):
 
@@ -36,8 +36,10 @@ from arzsumo.studies.identify.scores import SetScore, _block_shape
 
 log = logging.getLogger(__name__)
 
-#: the references, in the order reports list them
-REFERENCES = ("three_detector", "equilibrium", "place_mean")
+#: the references and how reports name them, in the order they list them
+REFERENCES = {"three_detector": "Newell's three-detector replay",
+              "equilibrium": "the equilibrium everywhere",
+              "place_mean": "each place's own run mean (an oracle)"}
 
 
 def reference_triangle(params: ModelParameters, training: Sequence[ReplayData]) -> Triangle:

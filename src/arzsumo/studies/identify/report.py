@@ -33,9 +33,8 @@ from arzsumo.evaluation.stationarity import count_trend
 from arzsumo.evaluation.waves import (
     SHORT_WAVES_S,
     STOP_AND_GO_S,
-    band_power,
     mean_periodogram,
-    peak_period,
+    place_spectra,
 )
 from arzsumo.identify import VARIABLES, ReplayData
 from arzsumo.identify.diagram import DiagramFit
@@ -188,13 +187,21 @@ def _equilibrium(study: IdentifyStudy) -> dict[str, Any]:
     return out
 
 
+#: (class, row of its speed in a ReplayData field)
+SPEED_ROWS = (("h", 1), ("a", 3))
+
+
+def _period(data: ReplayData) -> float:
+    """A run's control period, s."""
+    return float(data.t[1] - data.t[0]) if data.t.size > 1 else float(data.t[0])
+
+
 def _trend(data: ReplayData) -> dict[str, Any] | None:
     """The section-count trend of a run's control window (``section_trend`` of a run)."""
     dx = float(data.x[1] - data.x[0])
-    dt = float(data.t[1] - data.t[0]) if data.t.size > 1 else float(data.t[0])
     count = np.nansum(data.fields[:, 0] + data.fields[:, 2], axis=1) * dx
     try:
-        return count_trend(count, dt).as_dict()
+        return count_trend(count, _period(data)).as_dict()
     except ValueError:
         return None
 
@@ -202,13 +209,12 @@ def _trend(data: ReplayData) -> dict[str, Any] | None:
 def _spectrum(data: ReplayData) -> dict[str, Any]:
     """Per class, the speed field's dominant period and the shares of its variance in the
     short waves' band and the stop-and-go band (on the run's cells and periods)."""
-    dt = float(data.t[1] - data.t[0]) if data.t.size > 1 else float(data.t[0])
     out: dict[str, Any] = {}
-    for cls, row in (("h", 1), ("a", 3)):
-        field = data.fields[:, row, :]
-        out[cls] = {"peak_period_s": peak_period(field, dt),
-                    "short_share": band_power(field, dt, SHORT_WAVES_S)["band_share"],
-                    "band_share": band_power(field, dt, STOP_AND_GO_S)["band_share"]}
+    for cls, row in SPEED_ROWS:
+        spectra = place_spectra(data.fields[:, row, :], _period(data))
+        out[cls] = {"peak_period_s": spectra.peak_period(),
+                    "short_share": spectra.band(SHORT_WAVES_S)["band_share"],
+                    "band_share": spectra.band(STOP_AND_GO_S)["band_share"]}
     return out
 
 
@@ -327,12 +333,9 @@ def write_study(out: str | Path | OutputDir, study: IdentifyStudy, overwrite: bo
 def spectrum_panel(study: IdentifyStudy) -> SpectrumPanel:
     """What ``spectrum.png`` shows: every run's speed spectra per class (a run standing
     still has none)."""
-    curves = {}
-    for r in study.runs:
-        d = r.data
-        dt = float(d.t[1] - d.t[0]) if d.t.size > 1 else float(d.t[0])
-        curves[f"{r.task.run_id} ({r.task.role})"] = {
-            cls: mean_periodogram(d.fields[:, row, :], dt) for cls, row in (("h", 1), ("a", 3))}
+    curves = {f"{r.task.run_id} ({r.task.role})": {
+        cls: mean_periodogram(r.data.fields[:, row, :], _period(r.data))
+        for cls, row in SPEED_ROWS} for r in study.runs}
     bands = {"20 s-1 min": SHORT_WAVES_S, "1-10 min": STOP_AND_GO_S}
     return SpectrumPanel(curves, bands, f"{study.setup.base.name}: SUMO's speed fields "
                                         "over the control window, 50 m cells x 1 s")
