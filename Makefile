@@ -32,7 +32,8 @@ STUDIES := results/studies
 results: $(STAMP)
 	@echo "make results: the control and penetration studies, reported from the runs in"
 	@echo "$(RECORDS)/ (made earlier; nothing runs now)"
-	@$(BIN)/arzsumo study control --report --seeds 1-20 --records $(RECORDS) --quiet \
+	@$(BIN)/arzsumo study control --report --scenario scenarios/default_power_law.toml \
+		--seeds 1-20 --records $(RECORDS) --quiet \
 		--out $(STUDIES)/control
 	@$(BIN)/arzsumo study penetration --report --records $(RECORDS) --quiet \
 		--out $(STUDIES)/penetration

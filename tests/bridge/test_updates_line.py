@@ -13,6 +13,12 @@ def test_an_event_triggered_run_reports_its_updates_and_held_time(controller):
                            "of the 450 s window")
 
 
+def test_a_single_update_is_one_check():
+    line = updates_line({"controller": "etc", "triggers": 1, "release_time": 449.0,
+                         "horizon": 450.0})
+    assert line.startswith("etc: U updated at 1 check, held unchanged for 449 s")
+
+
 @pytest.mark.parametrize("summ", [
     {"controller": "backstepping", "triggers": 450, "release_time": 0.0, "horizon": 450.0},
     {"controller": "open", "triggers": 0, "release_time": 450.0, "horizon": 450.0},

@@ -119,7 +119,7 @@ def test_ten_second_delay_plain_law_diverges_compensated_decays(lin, kernels100)
 
 
 @pytest.mark.parametrize(("scenario", "low", "high"), [
-    ("default.toml", 0.7, 1.5), ("control_newell.toml", 6.0, 15.0)])
+    ("default_power_law.toml", 0.7, 1.5), ("control_newell.toml", 6.0, 15.0)])
 def test_the_predictor_multiplies_field_noise_on_the_newell_model(scenario, low, high):
     # why the judged configuration runs without a predictor: independent 3 % noise on
     # each field of each node (an estimate's) reaches the law through w = T z, whose

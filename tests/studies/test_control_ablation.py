@@ -18,7 +18,9 @@ from arzsumo.studies.control import ablation as control_ablation
 from arzsumo.studies.control.study import DISTURBANCE, experiment_scenario
 from arzsumo.studies.recorded import RecordedRuns
 
-BASE = tomllib.loads((shipped_scenarios_dir() / "default.toml").read_text(encoding="utf-8"))
+#: the default stream with the power-law model: the ablation's committed records ran on it
+BASE = tomllib.loads((shipped_scenarios_dir() / "default_power_law.toml").read_text(
+    encoding="utf-8"))
 
 
 def _flat(data: dict) -> dict:
@@ -33,7 +35,7 @@ def test_each_step_is_a_valid_scenario_that_changes_one_piece(step):
     full = _flat(experiment_scenario(BASE, "regulation"))
     changed = {k for k, v in _flat(data).items() if full.get(k) != v}
     tables = {k.partition(".")[0] for k in changed}
-    if step == "power-law":                          # the default is the power law
+    if step == "power-law":                          # the base is the power law
         assert not changed
         return
     assert len(tables) == 1, changed                 # one table of the configuration
@@ -133,6 +135,22 @@ def test_a_step_the_scenario_does_not_admit_is_refused_before_anything_runs(
     with pytest.raises(StudyError, match=r"--steps = 'wave-matched' is not allowed on "
                                          r"--scenario = .*out of this model family's reach"):
         run_study("control-ablation", "--steps", "wave-matched", "--control",
+                  tmp_path / "none", "--scenario", shipped_scenarios_dir()
+                  / "default_power_law.toml", "--out", tmp_path / "out")
+    assert not (tmp_path / "out").exists()
+
+
+def test_on_a_newell_model_wave_matched_is_not_a_default_step_and_is_refused_by_name(
+        run_study, tmp_path):
+    # the Newell family sets its wave speeds directly: no exponents to move
+    newell = tomllib.loads((shipped_scenarios_dir() / "default.toml").read_text("utf-8"))
+    assert newell["model"]["family"] == "newell"
+    assert control_ablation.default_steps(newell) == tuple(
+        s for s in control_ablation.DEFAULT_STEPS if s != "wave-matched")
+    assert control_ablation.default_steps(BASE) == control_ablation.DEFAULT_STEPS
+    with pytest.raises(StudyError, match=r"--steps = 'wave-matched' is not allowed on "
+                                         r"--scenario = .*default.toml: family = 'newell'"):
+        run_study("control-ablation", "--steps", "wave-matched", "--control",
                   tmp_path / "none", "--out", tmp_path / "out")
     assert not (tmp_path / "out").exists()
 
@@ -150,7 +168,7 @@ def test_the_judged_configurations_steps_each_change_what_they_name(step):
     assert full.design.noise_from_estimate and full.actuation.meter_gain == 2.0
     if step == "power-law":
         lam4 = linearize(sc.equilibrium).eigenvalues[3] * 3.6
-        assert lam4 == pytest.approx(-2.55, abs=0.01)          # the default's model
+        assert lam4 == pytest.approx(-2.55, abs=0.01)          # the former default's
         assert linearize(full.equilibrium).eigenvalues[3] * 3.6 == pytest.approx(-32.6,
                                                                                   abs=0.1)
         assert sc.design.noise_from_estimate and sc.design.mu != full.design.mu

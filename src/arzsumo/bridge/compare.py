@@ -233,10 +233,12 @@ def updates_line(summ: dict[str, Any]) -> str | None:
     if summ.get("controller") not in EVENT_TRIGGERED or "triggers" not in summ:
         return None
     held = float(summ.get("release_time", math.nan))
+    n = int(summ["triggers"])
     return textwrap.fill(
-        f"{summ['controller']}: U updated at {int(summ['triggers'])} checks, held unchanged "
-        f"for {held:.0f} s of the {float(summ['horizon']):.0f} s window (the continuous law "
-        "updates at every check; why in SUMO: docs/readings/control_default.md)", WIDTH)
+        f"{summ['controller']}: U updated at {n} check{'' if n == 1 else 's'}, held "
+        f"unchanged for {held:.0f} s of the {float(summ['horizon']):.0f} s window (the "
+        "continuous law updates at every check; the trigger on SUMO's estimate: "
+        "docs/design.md)", WIDTH)
 
 
 def load_summaries(runs: list[Path]) -> list[dict[str, Any]]:

@@ -18,6 +18,7 @@ from arzsumo.studies.control.ablation import (
     LAWS,
     NAME,
     PAGE,
+    POWER_LAW_STEPS,
     STEPS,
     AblationOptions,
     design,
@@ -44,10 +45,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--experiment", choices=control.ALL_EXPERIMENTS, default="regulation",
                         help="the control study's experiment the steps change "
                              "(default: %(default)s)")
-    parser.add_argument("--steps", default=",".join(DEFAULT_STEPS),
+    parser.add_argument("--steps",
                         help="comma-separated steps, of " + ", ".join(STEPS)
                              + "; steps joined by + are one step with each change "
-                               "(default: %(default)s)")
+                               "(default: " + ",".join(DEFAULT_STEPS) + ", without "
+                             + ",".join(POWER_LAW_STEPS) + " on a model that is not the "
+                               "power law)")
     parser.add_argument("--laws", default=",".join(LAWS),
                         help="comma-separated laws ablated, of " + ", ".join(ALL_LAWS)
                              + " (default: %(default)s)")
@@ -62,8 +65,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def options(args: argparse.Namespace) -> AblationOptions:
     """The study's options as the command line gave them."""
-    steps = tuple(dict.fromkeys(n.strip() for n in args.steps.split(",") if n.strip()))
-    if not steps or not all(is_step(s) for s in steps):
+    steps = None if args.steps is None else tuple(
+        dict.fromkeys(n.strip() for n in args.steps.split(",") if n.strip()))
+    if steps is not None and (not steps or not all(is_step(s) for s in steps)):
         raise StudyError(f"--steps = {args.steps!r} is not allowed: a comma-separated list "
                          f"of {', '.join(STEPS)}, or several of them joined by +")
     laws = tuple(names_among(args.laws, list(ALL_LAWS), "--laws"))

@@ -85,6 +85,7 @@ from arzsumo.studies.control.ablation_steps import (
     JOIN,
     MEASURED_DEAD_TIME_S,
     PAPER_ETA,
+    POWER_LAW_STEPS,
     PREDICTION_S,
     QUARTER,
     REALISED_SPEED_GAIN,
@@ -92,6 +93,7 @@ from arzsumo.studies.control.ablation_steps import (
     STEPS,
     WAVE_SPEED_KMH,
     apply_step,
+    default_steps,
     describe,
     is_step,
     own_open_loop,
@@ -206,7 +208,8 @@ class AblationOptions:
     its open loop the steps' that borrow one); ``full``: where the full configuration's
     runs are instead (another store of the same study); ``without_full``: compare the
     steps with the open loop only (no full configuration needed);
-    ``steps`` of :data:`STEPS`, ``laws`` of :data:`ALL_LAWS`; ``out``, ``docs``: where the
+    ``steps`` of :data:`STEPS` (None: the :func:`default_steps` the scenario admits),
+    ``laws`` of :data:`ALL_LAWS`; ``out``, ``docs``: where the
     study writes (None: no page); ``page``: the results page under ``docs`` that gets
     the table (the control study's page of the same scenario).
     """
@@ -217,7 +220,7 @@ class AblationOptions:
     full: Path | None = None
     without_full: bool = False
     experiment: str = "regulation"
-    steps: tuple[str, ...] = DEFAULT_STEPS
+    steps: tuple[str, ...] | None = None
     laws: tuple[str, ...] = LAWS
     out: Path = RESULTS_DIR / NAME
     docs: Path | None = None
@@ -225,7 +228,8 @@ class AblationOptions:
 
     def __post_init__(self) -> None:
         checks.among(self.experiment, control.ALL_EXPERIMENTS, "experiment")
-        require(len(self.steps) > 0 and all(is_step(s) for s in self.steps), "steps",
+        require(self.steps is None
+                or (len(self.steps) > 0 and all(is_step(s) for s in self.steps)), "steps",
                 self.steps, "at least one of " + ", ".join(STEPS) + ", or several joined "
                 f"by {JOIN}", StudyError)
         checks.all_among(self.laws, ALL_LAWS, "laws")
@@ -234,6 +238,12 @@ class AblationOptions:
     def base(self) -> Path:
         """The control study's base scenario file."""
         return self.scenario or default_scenario()
+
+    def chosen_steps(self) -> tuple[str, ...]:
+        """The steps to run: ``steps``, or those the base scenario admits by default."""
+        if self.steps is not None:
+            return self.steps
+        return default_steps(read_toml(self.base, "scenario", StudyError)[1])
 
 
 @dataclass(frozen=True)
@@ -247,7 +257,7 @@ class AblationResult:
 def design(opts: AblationOptions) -> list[str]:
     """One line per step: what it changes, the laws and seeds (``--list``)."""
     return [f"{s}: {describe(s)}; {', '.join(opts.laws)} on seeds "
-            f"{seed_text(list(opts.runs.seeds))}" for s in opts.steps]
+            f"{seed_text(list(opts.runs.seeds))}" for s in opts.chosen_steps()]
 
 
 def full_configuration(runs_dir: Path, scenario: Path, laws: Sequence[str],
@@ -277,7 +287,7 @@ def open_loop_runs(control_runs: Path, runs: Sequence[RunSpec], here: Path) -> P
 
 def run_ablation(opts: AblationOptions) -> AblationResult:
     """Every step's evaluation (resumable), then the table against the full configuration."""
-    steps, laws, seeds = list(opts.steps), list(opts.laws), list(opts.runs.seeds)
+    steps, laws, seeds = list(opts.chosen_steps()), list(opts.laws), list(opts.runs.seeds)
     _, base = read_toml(opts.base, "scenario", StudyError)
     experiment = opts.experiment
     control_runs = Path(opts.control) / experiment
@@ -323,6 +333,7 @@ __all__ = [
     "MEASURED_DEAD_TIME_S",
     "NAME",
     "PAPER_ETA",
+    "POWER_LAW_STEPS",
     "PREDICTION_S",
     "QUARTER",
     "REALISED_SPEED_GAIN",
@@ -331,6 +342,7 @@ __all__ = [
     "WAVE_SPEED_KMH",
     "AblationOptions",
     "apply_step",
+    "default_steps",
     "describe",
     "full_configuration",
     "is_step",

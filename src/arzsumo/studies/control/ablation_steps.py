@@ -12,7 +12,7 @@ import tomllib
 from collections.abc import Callable
 
 from arzsumo.model.wave_match import wave_matched
-from arzsumo.resources import default_scenario
+from arzsumo.resources import shipped_scenarios_dir
 from arzsumo.scenario import scenario_from_dict
 from arzsumo.units import kmh_to_ms
 
@@ -70,17 +70,23 @@ def _band_by_hand(data: dict) -> dict:
     return data
 
 
+#: the shipped scenario whose ``[model]`` the ``power-law`` step puts in: the default
+#: stream with the paper's power-law diagram (the former default)
+POWER_LAW_SCENARIO = "default_power_law.toml"
+
+
 def _power_law(data: dict) -> dict:
-    """``data`` with the shipped default's ``[model]`` (the paper's power-law diagram,
-    identified on the Krauss stream), the trigger's measured dead band kept where
+    """``data`` with :data:`POWER_LAW_SCENARIO`'s ``[model]`` (the paper's power-law
+    diagram, identified on the Krauss stream), the trigger's measured dead band kept where
     ``data`` asks for it.
 
     Where the equilibrium places the open loop (``[run] start = "placement"``: the
     section placed at the ``[equilibrium]`` densities) the equilibrium stays, so that the
     step does not move the plant, and ``[design]`` is chosen for the power law there as
-    ``arzsumo design-check --auto`` chooses it (:func:`_designed`). Elsewhere the
-    default's ``[equilibrium]`` and ``[design]`` come with its model."""
-    default = tomllib.loads(default_scenario().read_text(encoding="utf-8"))
+    ``arzsumo design-check --auto`` chooses it (:func:`_designed`). Elsewhere that
+    scenario's ``[equilibrium]`` and ``[design]`` come with its model."""
+    default = tomllib.loads((shipped_scenarios_dir() / POWER_LAW_SCENARIO).read_text(
+        encoding="utf-8"))
     measured = data.get("design", {}).get("noise_from_estimate")
     placed = data.get("run", {}).get("start") == "placement"
     for table in ("model",) if placed else ("model", "equilibrium", "design"):
@@ -201,9 +207,9 @@ STEPS: dict[str, tuple[str, Callable[[dict], dict], bool]] = {
     "quarter-law": (f"the laws' command to the meter {QUARTER:g} times smaller, inside "
                     "its range", _quarter_law, False),
 }
-#: the steps run unless ``--steps`` names others: those of the default's configuration
-#: (``power-law``, ``paper-trigger`` and ``unit-gain`` change nothing on the default, whose
-#: model is the power law, whose trigger is the paper's and whose meter gain is 1;
+#: the steps run unless ``--steps`` names others (:func:`default_steps`): those of the
+#: default's configuration (``power-law``, ``paper-trigger`` and ``unit-gain`` change
+#: nothing on the power-law model with the paper's trigger and a meter gain of 1;
 #: ``quarter-law`` is for a stream where the laws saturate the meter, ``paper-eta`` for a
 #: design whose eta is small)
 DEFAULT_STEPS = tuple(s for s in STEPS if s not in ("power-law", "paper-trigger",
@@ -211,6 +217,18 @@ DEFAULT_STEPS = tuple(s for s in STEPS if s not in ("power-law", "paper-trigger"
                                                     "paper-eta", "speed-limit",
                                                     "acted-trigger", "band-trigger",
                                                     "realised-gain"))
+
+
+#: the steps that only the paper's power-law family admits (``wave-matched`` moves its
+#: exponents; a Newell-type diagram sets its wave speeds directly)
+POWER_LAW_STEPS = ("wave-matched",)
+
+
+def default_steps(scenario: dict) -> tuple[str, ...]:
+    """:data:`DEFAULT_STEPS` that the scenario ``scenario`` (a parsed file) admits:
+    without :data:`POWER_LAW_STEPS` where its ``[model] family`` is not the power law."""
+    family = scenario.get("model", {}).get("family", "power")
+    return tuple(s for s in DEFAULT_STEPS if family == "power" or s not in POWER_LAW_STEPS)
 
 
 #: the steps that change ``[model]``: where the model's speeds place the section
