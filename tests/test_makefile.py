@@ -3,6 +3,7 @@ and the README says so (its first two commands stay ``make run`` and ``make test
 
 from __future__ import annotations
 
+import argparse
 import re
 from pathlib import Path
 
@@ -46,3 +47,24 @@ def test_the_readme_leads_with_make_run_and_make_test_and_names_make_results() -
     for folder in ("docs/readings/control_default/records/", "results/studies/control/",
                    "results/studies/penetration/"):
         assert folder in paragraph
+
+
+def test_the_stored_studies_are_current_under_the_scenario_make_results_names(
+        tmp_path) -> None:
+    """Every run ``make results`` reports is in the committed store under the scenario the
+    recipe names: a record counts only while its fingerprint (what decides its numbers,
+    not the scenario's name) is that scenario's, so an edit of ``default_power_law.toml``
+    that moved a number would leave the report incomplete here."""
+    from arzsumo.cli.catalog import STUDIES
+
+    control = next(c for c in recipe("results") if "study control" in c)
+    scenario = control.split("--scenario ")[1].split()[0]
+    assert scenario == "scenarios/default_power_law.toml"
+    store = ROOT / "docs" / "readings" / "control_default" / "records"
+    for name, argv in (("control", ["--scenario", str(ROOT / scenario), "--seeds", "1-20"]),
+                       ("penetration", [])):
+        parser = argparse.ArgumentParser(prog=f"arzsumo study {name}")
+        STUDIES[name].add_arguments(parser)
+        args = parser.parse_args([*argv, "--report", "--records", str(store), "--quiet",
+                                  "--out", str(tmp_path / name)])
+        assert STUDIES[name].run(args) == 0, name
