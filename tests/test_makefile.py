@@ -3,7 +3,6 @@ and the README says so (its first two commands stay ``make run`` and ``make test
 
 from __future__ import annotations
 
-import argparse
 import re
 from pathlib import Path
 
@@ -56,6 +55,7 @@ def test_the_stored_studies_are_current_under_the_scenario_make_results_names(
     not the scenario's name) is that scenario's, so an edit of ``default_power_law.toml``
     that moved a number would leave the report incomplete here."""
     from arzsumo.cli.catalog import STUDIES
+    from tests.studies.conftest import parse
 
     control = next(c for c in recipe("results") if "study control" in c)
     scenario = control.split("--scenario ")[1].split()[0]
@@ -63,8 +63,6 @@ def test_the_stored_studies_are_current_under_the_scenario_make_results_names(
     store = ROOT / "docs" / "readings" / "control_default" / "records"
     for name, argv in (("control", ["--scenario", str(ROOT / scenario), "--seeds", "1-20"]),
                        ("penetration", [])):
-        parser = argparse.ArgumentParser(prog=f"arzsumo study {name}")
-        STUDIES[name].add_arguments(parser)
-        args = parser.parse_args([*argv, "--report", "--records", str(store), "--quiet",
-                                  "--out", str(tmp_path / name)])
+        args = parse(name, *argv, "--report", "--records", str(store), "--quiet",
+                     "--out", str(tmp_path / name))
         assert STUDIES[name].run(args) == 0, name

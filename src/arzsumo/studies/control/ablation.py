@@ -287,8 +287,9 @@ def open_loop_runs(control_runs: Path, runs: Sequence[RunSpec], here: Path) -> P
 
 def run_ablation(opts: AblationOptions) -> AblationResult:
     """Every step's evaluation (resumable), then the table against the full configuration."""
-    steps, laws, seeds = list(opts.chosen_steps()), list(opts.laws), list(opts.runs.seeds)
     _, base = read_toml(opts.base, "scenario", StudyError)
+    steps = list(opts.steps if opts.steps is not None else default_steps(base))
+    laws, seeds = list(opts.laws), list(opts.runs.seeds)
     experiment = opts.experiment
     control_runs = Path(opts.control) / experiment
     ok, found = True, {}
