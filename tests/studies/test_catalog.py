@@ -19,7 +19,7 @@ from .conftest import parse
 NAMES = ["ablation", "ablation-mechanism", "held-ramp", "meter-dynamics", "approach", "fill",
          "wave-speed", "inlet", "estimation-layouts", "loop-speed", "enkf-noise",
          "u-estimate", "premise-map", "sumo-options", "control", "control-ablation",
-         "etc-noise", "meter-delay", "penetration", "share-models"]
+         "etc-noise", "meter-delay", "penetration", "share-models", "space-time"]
 
 
 def test_the_catalog_lists_the_studies_by_their_names():
@@ -47,7 +47,7 @@ def test_each_study_writes_under_results_studies_name_and_publishes_on_request(n
 
 @pytest.mark.parametrize("name", [n for n in NAMES if n not in
                                   ("ablation-mechanism", "inlet", "enkf-noise",
-                                   "meter-delay", "share-models")])
+                                   "meter-delay", "share-models", "space-time")])
 def test_studies_that_run_simulations_take_seeds_workers_and_list(name):
     args = parse(name, "--seeds", "3-5", "--workers", "2", "--quiet", "--list")
     assert (args.seeds, args.workers, args.quiet, args.list) == ([3, 4, 5], 2, True, True)
@@ -95,4 +95,5 @@ def test_each_study_names_a_results_page_of_the_docs_layout():
                      "sumo-options": "sumo_options", "control": "control_default",
                      "control-ablation": "control_default", "etc-noise": "control_default",
                      "meter-delay": "control_default",
-                     "penetration": "control_default", "share-models": "share_models"}
+                     "penetration": "control_default", "share-models": "share_models",
+                     "space-time": "control_default"}

@@ -26,10 +26,34 @@ def test_each_share_is_a_mapped_point_whose_demand_splits_by_the_share():
     assert NEWELL["sumo"]["demand_a_veh_h"] == 702               # the base is untouched
 
 
+def test_keys_set_on_the_base_reach_every_share_and_its_mapped_scenario():
+    # a [sumo] key given to the study (SUMO's teleport on a merge that can deadlock) is
+    # part of each share's point, so of its discharge runs and of the scenario written
+    points = share_points((0.1, 0.5), {"sumo.time_to_teleport_s": 300})
+    assert [dict(p.set) for p in points] == [{"sumo.time_to_teleport_s": 300}] * 2
+    data = with_keys(NEWELL, points[1].set)
+    assert data["sumo"]["time_to_teleport_s"] == 300
+    assert "time_to_teleport_s" not in NEWELL["sumo"]
+
+
+def test_the_command_line_reads_a_set_key_as_toml_and_refuses_other_tables():
+    import argparse
+
+    from arzsumo.cli.studies.share_models import sumo_assignment
+
+    assert sumo_assignment("sumo.time_to_teleport_s=300") == ("sumo.time_to_teleport_s", 300)
+    assert sumo_assignment('sumo.hv_model="IDM"') == ("sumo.hv_model", "IDM")
+    for bad in ("run.warmup_s=600", "sumo.x", "sumo.hv_model=IDM", "sumo.a.b=1"):
+        with pytest.raises(argparse.ArgumentTypeError, match="not"):
+            sumo_assignment(bad)
+
+
 @pytest.mark.parametrize(("changes", "field"), [
     ({"shares": (0.0, 0.5)}, "shares"), ({"shares": (0.3, 0.3)}, "shares"),
     ({"shares": ()}, "shares"), ({"validate_seeds": (3, 4)}, "validate_seeds"),
-    ({"kernel_cells": 4}, "kernel_cells")])
+    ({"kernel_cells": 4}, "kernel_cells"), ({"jam_floor": "cell"}, "jam_floor"),
+    ({"wave_weight": -1.0}, "wave_weight"),
+    ({"set": {"run.warmup_s": 600}}, "set")])
 def test_options_that_cannot_make_a_share_model_are_refused(changes, field):
     with pytest.raises(StudyError, match=field):
         ShareOptions(**changes)

@@ -103,6 +103,8 @@ _MODULES = {
                                    "share in SUMO, per seed"),
     "share-models": ("share_models", "per AV share: the demand mapped to its discharge, "
                                      "the model identified there, the ETC designed"),
+    "space-time": ("space_time", "SUMO's speeds and densities under a few controllers of "
+                                 "one seed, side by side"),
 }
 
 #: study name -> its library module under arzsumo.studies (a package per family of
@@ -118,6 +120,7 @@ STUDY_MODULES = {
     "control": "control.study", "control-ablation": "control.ablation",
     "etc-noise": "control.etc_noise", "meter-delay": "control.meter_delay",
     "penetration": "control.penetration", "share-models": "share_models",
+    "space-time": "control.space_time",
 }
 
 #: the studies that are library code (frozen Options, ``run(options) -> Result``): their

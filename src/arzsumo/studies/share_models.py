@@ -29,7 +29,7 @@ from __future__ import annotations
 import math
 import tomllib
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -69,7 +69,10 @@ class ShareOptions(checks.Shared):
     train_seeds: tuple[int, ...] = (1, 2, 3)
     validate_seeds: tuple[int, ...] = (4, 5, 6)
     diagram: str = "newell"
+    jam_floor: str = "cells"
+    wave_weight: float = 1.0
     kernel_cells: int = 100
+    set: Mapping[str, Any] = field(default_factory=dict)
     out: Path = RESULTS_DIR / NAME
     progress: bool = True
 
@@ -81,6 +84,14 @@ class ShareOptions(checks.Shared):
         require(bool(self.train_seeds) and bool(self.validate_seeds)
                 and not set(self.train_seeds) & set(self.validate_seeds), "validate_seeds",
                 self.validate_seeds, "seeds disjoint from the training seeds", StudyError)
+        from arzsumo.studies.identify.study import JAM_FLOORS
+
+        require(self.jam_floor in JAM_FLOORS, "jam_floor", self.jam_floor,
+                f"one of {', '.join(JAM_FLOORS)}", StudyError)
+        require(self.wave_weight >= 0.0, "wave_weight", self.wave_weight,
+                "a weight >= 0", StudyError)
+        require(all(k.startswith("sumo.") for k in self.set), "set", dict(self.set),
+                "keys of the [sumo] table (sumo.KEY)", StudyError)
         require(self.kernel_cells >= 10, "kernel_cells", self.kernel_cells,
                 "at least 10 cells", StudyError)
 
@@ -107,10 +118,12 @@ class ShareResult:
     mapping: str
 
 
-def share_points(shares: Sequence[float]) -> list[MapPoint]:
-    """One mapped point per share, named ``av<percent>`` (the base scenario otherwise)."""
-    return [MapPoint(f"av{round(100 * s)}", "av_share", {}, mapped=True, av_share=s)
-            for s in shares]
+def share_points(shares: Sequence[float],
+                 keys: Mapping[str, Any] | None = None) -> list[MapPoint]:
+    """One mapped point per share, named ``av<percent>``: the base scenario with ``keys``
+    (dotted ``sumo.KEY`` values) set."""
+    return [MapPoint(f"av{round(100 * s)}", "av_share", dict(keys or {}), mapped=True,
+                     av_share=s) for s in shares]
 
 
 def with_keys(data: Mapping[str, Any], keys: Mapping[str, Any]) -> dict[str, Any]:
@@ -129,7 +142,7 @@ def design(opts: ShareOptions) -> list[str]:
     from arzsumo.studies.premise.map_points import discharge_runs
 
     path = opts.scenario or shipped_scenario(BASE)
-    points = share_points(opts.shares)
+    points = share_points(opts.shares, opts.set)
     lines = [r.run_id for r in discharge_runs(path, points, load_scenario(path).run.warmup)]
     seeds = ",".join(map(str, (*opts.train_seeds, *opts.validate_seeds)))
     return lines + [f"point={p.name},identify seeds={seeds}" for p in points]
@@ -141,7 +154,7 @@ def run_share_models(opts: ShareOptions) -> ShareResult:
     from arzsumo.scenario import load_scenario
 
     path = opts.scenario or shipped_scenario(BASE)
-    base, points = scenario_data(path), share_points(opts.shares)
+    base, points = scenario_data(path), share_points(opts.shares, opts.set)
     with resumable_dir(opts.out, f"study-{NAME}") as out:
         discharges, shortfalls, text = map_demands(
             path, points, load_scenario(path).run.warmup, out, workers=opts.workers,
@@ -177,7 +190,8 @@ def _share_model(opts: ShareOptions, base: Mapping[str, Any], point: MapPoint,
     data["name"] = f"{base.get('name', 'scenario')}_{point.name}"
     mapped = scenario_from_dict(data, str(out / f"{point.name}-mapped.toml"))
     setup = make_setup(mapped, opts.train_seeds, opts.validate_seeds,
-                       diagram=opts.diagram, fit=FitSettings(), workers=opts.workers)
+                       diagram=opts.diagram, fit=FitSettings(), workers=opts.workers,
+                       jam_floor=opts.jam_floor, wave_weight=opts.wave_weight)
     study = run_identification(setup)
     write_study(out / point.name / "identify", study, overwrite=True)
     identified = tomllib.loads(identified_toml(study))

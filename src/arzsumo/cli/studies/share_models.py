@@ -4,13 +4,16 @@ mapped onto its :class:`~arzsumo.studies.share_models.ShareOptions`."""
 from __future__ import annotations
 
 import argparse
+import tomllib
 from pathlib import Path
+from typing import Any
 
-from arzsumo.argtypes import positive_int
+from arzsumo.argtypes import non_negative_float, positive_int
 from arzsumo.cli.studies.options import add_output, add_runs
 from arzsumo.model.params import FAMILIES
 from arzsumo.outputs.studies import markdown_table
 from arzsumo.studies.common import fraction_list, print_list, seed_list
+from arzsumo.studies.identify.study import JAM_FLOORS
 from arzsumo.studies.share_models import (
     BASE,
     NAME,
@@ -34,10 +37,34 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         metavar="LIST", help="held-out seeds (default: 4-6)")
     parser.add_argument("--diagram", choices=FAMILIES, default="newell",
                         help="stage 1's diagram family (default: newell)")
+    parser.add_argument("--jam-floor", choices=JAM_FLOORS, default="cells",
+                        help="stage 1's least jam occupancy, as arzsumo identify's "
+                             "(default: cells)")
+    parser.add_argument("--wave-weight", type=non_negative_float, default=1.0,
+                        metavar="W", help="weight of the wave-speed gap in stage 1, as "
+                                          "arzsumo identify's (default: 1)")
+    parser.add_argument("--set", action="append", type=sumo_assignment, default=[],
+                        metavar="sumo.KEY=VALUE",
+                        help="a [sumo] key set on the base scenario at every share, the "
+                             "value as in TOML (e.g. sumo.time_to_teleport_s=300); "
+                             "repeatable")
     parser.add_argument("--cells", type=positive_int, default=100,
                         help="kernel cells of the design (default: 100)")
     add_runs(parser, seeds=None)
     add_output(parser, NAME, PAGE, plots=False)
+
+
+def sumo_assignment(text: str) -> tuple[str, Any]:
+    """``sumo.KEY=VALUE`` as a (key, value) pair, the value read as TOML."""
+    key, eq, value = text.partition("=")
+    if not eq or not key.startswith("sumo.") or key.count(".") != 1:
+        raise argparse.ArgumentTypeError(f"{text!r} is not allowed: sumo.KEY=VALUE")
+    try:
+        return key, tomllib.loads(f"v = {value}")["v"]
+    except tomllib.TOMLDecodeError:
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: the value {value!r} is not a TOML value (a number, "
+            "true/false or a quoted string)") from None
 
 
 def options(args: argparse.Namespace) -> ShareOptions:
@@ -45,7 +72,8 @@ def options(args: argparse.Namespace) -> ShareOptions:
     return ShareOptions(scenario=args.scenario, shares=tuple(args.shares),
                         train_seeds=tuple(args.train_seeds),
                         validate_seeds=tuple(args.validate_seeds), diagram=args.diagram,
-                        kernel_cells=args.cells, out=args.out, docs=args.docs,
+                        jam_floor=args.jam_floor, wave_weight=args.wave_weight,
+                        set=dict(args.set), kernel_cells=args.cells, out=args.out, docs=args.docs,
                         workers=args.workers,
                         scheduler=args.scheduler, progress=not args.quiet)
 

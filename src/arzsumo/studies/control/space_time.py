@@ -1,0 +1,175 @@
+"""SUMO's stop-and-go under two controllers on one seed, side by side (``arzsumo study
+space-time``).
+
+The control study's tables and paired figures say how much a law changes the waves over
+many seeds; they do not show a wave. This study runs a few controllers of one seed of
+one experiment exactly as the control study runs them (the same scenario, experiment and
+seed: the same SUMO run, up to the start of control the same run for every controller),
+keeps each run's results (``OUT/<experiment>-seed<N>/<controller>/``, as ``arzsumo run``
+writes them) and draws SUMO's Edie cells of the control window per class on shared
+colour scales (``OUT/space_time_<experiment>_seed<N>_{hv,av}.png``): density above,
+speed below, one column per controller, so the stop-and-go and what a law does to it can
+be seen. A later call with the same ``--out`` reuses the runs it finds.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+from pathlib import Path
+
+from arzsumo.errors import require
+from arzsumo.io import dump_toml
+from arzsumo.outdir import resumable_dir
+from arzsumo.outputs.studies import publish, write_text
+from arzsumo.resources import default_scenario
+from arzsumo.scenario import Scenario
+from arzsumo.studies import checks
+from arzsumo.studies.common import RESULTS_DIR, StudyError, scenario_data
+from arzsumo.studies.control.study import ALL_EXPERIMENTS, experiment_scenario
+from arzsumo.sweep.evaluate import check_controllers
+
+log = logging.getLogger(__name__)
+
+NAME = "space-time"
+#: the results page (``docs/results/PAGE.md``) this study keeps a block of
+PAGE = "control_default"
+#: the classes drawn: (figure suffix, the class's word)
+CLASSES = (("hv", "HVs"), ("av", "AVs"))
+
+
+@dataclass(frozen=True)
+class SpaceTimeOptions(checks.Shared):
+    """What ``arzsumo study space-time`` runs.
+
+    ``scenario``: the base scenario file (None: the shipped default); ``seed``: the SUMO
+    seed; ``controllers``: two to four of the control study's, drawn left to right;
+    ``experiment``: one of the control study's; ``warmup``, ``horizon``: s (None: the
+    scenario's; shorter only for a quick look, the runs are then not the study's);
+    ``out``: the study's directory (resumable); ``docs``, ``page``: the page to
+    regenerate (None: none); ``progress``: a line per run.
+    """
+
+    scenario: Path | None = None
+    seed: int = 1
+    controllers: tuple[str, ...] = ("open", "etc")
+    experiment: str = "regulation"
+    warmup: float | None = None
+    horizon: float | None = None
+    out: Path = RESULTS_DIR / NAME
+    page: str = PAGE
+    progress: bool = True
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        object.__setattr__(self, "controllers", tuple(check_controllers(
+            list(self.controllers))))
+        require(2 <= len(self.controllers) <= 4
+                and len(set(self.controllers)) == len(self.controllers), "controllers",
+                self.controllers, "two to four distinct controllers", StudyError)
+        checks.all_among((self.experiment,), ALL_EXPERIMENTS, "experiment")
+        require(0 <= self.seed < 2**31, "seed", self.seed, "a seed in [0, 2^31)",
+                StudyError)
+
+    @property
+    def base(self) -> Path:
+        """The base scenario file."""
+        return self.scenario or default_scenario()
+
+
+@dataclass(frozen=True)
+class SpaceTimeResult:
+    """The runs (controller -> its results directory) and the figures written."""
+
+    runs: dict[str, Path]
+    figures: tuple[Path, ...]
+
+
+def run_space_time(opts: SpaceTimeOptions) -> SpaceTimeResult:
+    """Run (or reuse) each controller's run of the seed, then draw the figures."""
+    from arzsumo.outputs.compare import field_figures
+    from arzsumo.scenario import scenario_from_dict
+
+    data = experiment_scenario(scenario_data(opts.base), opts.experiment)
+    sc = scenario_from_dict(data, str(opts.base))
+    label = f"{opts.experiment}-seed{opts.seed}"
+    with resumable_dir(opts.out, f"study-{NAME}") as out:
+        runs = {c: _run(sc, dump_toml(data), c, opts, out / label / c)
+                for c in opts.controllers}
+        eq = sc.equilibrium
+        drawn = field_figures([f"{c} s{opts.seed}" for c in runs], list(runs.values()),
+                              (eq.rho_h, eq.v_h, eq.rho_a, eq.v_a), out / label)
+        if len(drawn) != len(CLASSES):
+            raise StudyError(f"the runs in {out / label} are not on one grid of cells: "
+                             "no figure (remove the directory and run again)")
+        figures = tuple(p.replace(out / f"space_time_{opts.experiment}_seed{opts.seed}_"
+                                        f"{name}.png")
+                        for p, (name, _) in zip(drawn, CLASSES, strict=True))
+        body = _page(opts, str(data.get("name", opts.base.stem)).removesuffix(
+            f"-{opts.experiment}"), figures, runs)
+        write_text(body, out / "space_time.md")
+        if opts.docs is not None:
+            publish(opts.docs, opts.page, NAME, "SUMO's stop-and-go under the controllers",
+                    body, [(f, f.name) for f in figures])
+    return SpaceTimeResult(runs, figures)
+
+
+def _run(sc: Scenario, text: str, controller: str, opts: SpaceTimeOptions,
+         target: Path) -> Path:
+    """``controller``'s run of the seed in ``target`` (kept from an earlier call when its
+    summary is there), as ``arzsumo run`` makes and writes it."""
+    from arzsumo.bridge.session import prepare_run, run_prepared
+    from arzsumo.outputs.bridge import write_results
+
+    if (target / "summary.json").is_file():
+        log.info("%s: %s reused", NAME, target)
+        return target
+    prepared = prepare_run(sc, controller=controller, seed=opts.seed,
+                           horizon=opts.horizon, warmup=opts.warmup)
+    if opts.progress:
+        log.info("%s: %s, seed %d (one SUMO run)", NAME, controller, opts.seed)
+    session = run_prepared(prepared)
+    write_results(session.result, target, text + session.resolved_comment(), plots=False)
+    return target
+
+
+#: the seed's measures under each figure (summary key, label)
+MEASURES = (("section.speed_oscillation_kmh.h", "HV speed oscillation, km/h"),
+            ("section.speed_oscillation_kmh.a", "AV speed oscillation, km/h"),
+            ("section.waves.h.band_power_kmh2", "HV band power 1-10 min, (km/h)^2"),
+            ("triggers", "controller updates"), ("plan_changes", "meter plan changes"))
+
+
+def seed_table(runs: dict[str, Path]) -> str:
+    """Markdown: per controller the seed's :data:`MEASURES`, read from its summary."""
+    import json
+
+    def value(summ: dict, key: str) -> str:
+        for part in key.split("."):
+            summ = summ.get(part, {}) if isinstance(summ, dict) else {}
+        return f"{summ:.3g}" if isinstance(summ, int | float) else "-"
+
+    summaries = {c: json.loads((p / "summary.json").read_text(encoding="utf-8"))
+                 for c, p in runs.items()}
+    lines = ["| controller | " + " | ".join(label for _, label in MEASURES) + " |",
+             "|---" * (1 + len(MEASURES)) + "|"]
+    lines += [f"| {c} | " + " | ".join(value(s, k) for k, _ in MEASURES) + " |"
+              for c, s in summaries.items()]
+    return "\n".join(lines)
+
+
+def _page(opts: SpaceTimeOptions, scenario: str, figures: tuple[Path, ...],
+          runs: dict[str, Path]) -> str:
+    """The page's block: the command, the seed's measures and the figures."""
+    names = ",".join(opts.controllers)
+    cmd = (f"arzsumo study {NAME} --scenario {opts.base} --seed {opts.seed} "
+           f"--controllers {names} --experiment {opts.experiment}")
+    shown = "\n".join(f"![{opts.experiment}, seed {opts.seed}: {word}]({opts.page}/"
+                      f"{f.name})" for f, (_, word) in zip(figures, CLASSES, strict=True))
+    return (f"SUMO's Edie cells over the control window of {scenario}, "
+            f"{opts.experiment} experiment, seed {opts.seed}, under "
+            f"{', '.join(opts.controllers)} (`{cmd}`): density above, speed below, per "
+            f"class on shared colour scales (the dashed mark on a colour bar is the "
+            f"model's equilibrium). Stripes that run up and to the left (x falls as t "
+            f"grows) are waves travelling upstream. The seed's measures:\n\n"
+            f"{seed_table(runs)}\n\n{shown}\n")

@@ -1,0 +1,53 @@
+"""``arzsumo study space-time``: its runs are the user's runs of the same scenario and
+seed, drawn side by side, reused on a second call; bad options are refused."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from arzsumo.bridge.session import run_in_sumo
+from arzsumo.errors import ArzsumoError
+from arzsumo.scenario import load_scenario
+from arzsumo.studies.control.space_time import SpaceTimeOptions, run_space_time
+from tests.runs import ROOT
+
+DEFAULT = ROOT / "scenarios" / "default.toml"
+#: a short look: 60 s of warm-up, 20 s of control
+TIMES = {"warmup": 60.0, "horizon": 20.0}
+
+
+@pytest.mark.parametrize(("changes", "field"), [
+    ({"controllers": ("open",)}, "controllers"),
+    ({"controllers": ("open", "open")}, "controllers"),
+    ({"controllers": ("open", "pid")}, "controllers"),
+    ({"experiment": "slowdown"}, "experiment"), ({"seed": -1}, "seed")])
+def test_options_that_cannot_draw_a_comparison_are_refused(changes, field):
+    with pytest.raises(ArzsumoError, match=field):
+        SpaceTimeOptions(**changes)
+
+
+@pytest.mark.sumo
+def test_the_runs_are_the_users_runs_drawn_side_by_side_and_reused(tmp_path):
+    opts = SpaceTimeOptions(scenario=DEFAULT, seed=3, controllers=("open", "held"),
+                            out=tmp_path / "st", docs=tmp_path / "docs", progress=False,
+                            **TIMES)
+    result = run_space_time(opts)
+    assert [p.name for p in result.figures] == ["space_time_regulation_seed3_hv.png",
+                                                "space_time_regulation_seed3_av.png"]
+    assert all(p.stat().st_size > 20_000 for p in result.figures)
+    assert (tmp_path / "docs" / "control_default" / result.figures[0].name).is_file()
+    assert "space_time_regulation_seed3_av.png" in (
+        tmp_path / "docs" / "control_default.md").read_text(encoding="utf-8")
+    # the study's open loop is `arzsumo run`'s of the same scenario, seed and times
+    own = run_in_sumo(load_scenario(DEFAULT), controller="open", seed=3, **TIMES)
+    cells = pd.read_parquet(result.runs["open"] / "cells.parquet")
+    micro = cells[cells["source"] == "micro"].sort_values(["t_s", "x_m"])
+    rho_h = np.asarray(own.result.micro)[:, 0, :].ravel()
+    assert np.allclose(micro["rho_h"].to_numpy(), rho_h, equal_nan=True)
+    # a second call reuses both runs (nothing of theirs is rewritten)
+    stamps = {c: (p / "summary.json").stat().st_mtime_ns for c, p in result.runs.items()}
+    again = run_space_time(opts)
+    assert {c: (p / "summary.json").stat().st_mtime_ns
+            for c, p in again.runs.items()} == stamps
