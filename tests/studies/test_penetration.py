@@ -134,3 +134,16 @@ def test_the_share_models_sweep_runs_each_shares_own_scenario(tmp_path):
             == "etc"
     with pytest.raises(StudyError, match=r"share_models\.csv"):
         pen.share_sweep(tmp_path / "nothing", None)
+
+
+def test_the_page_goes_where_the_options_name_it(tmp_path):
+    # the IDM stream's penetration belongs on its own reading, not the default's
+    opts = pen.PenetrationOptions(out=tmp_path / "out", docs=tmp_path / "docs",
+                                  page="control_idm", plots=False, progress=False)
+    (tmp_path / "out").mkdir()
+    text = pen._write({pen.SHARE_SWEEP: _sweep(-12.5, 7.0, noise=2.0)}, tmp_path / "out",
+                      opts)
+    page = (tmp_path / "docs" / "control_idm.md").read_text(encoding="utf-8")
+    assert text.strip() in page and "per 10 pt" in page
+    assert (tmp_path / "docs" / "control_idm" / f"{pen.SHARE_SWEEP}.csv").is_file()
+    assert not (tmp_path / "docs" / "control_default.md").exists()

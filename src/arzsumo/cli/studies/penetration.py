@@ -29,6 +29,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_records(parser)
     add_runs(parser, seeds=None)
     add_output(parser, NAME, PAGE)
+    parser.add_argument("--page", default=PAGE,
+                        help=f"the page's name under --docs (default: {PAGE})")
 
 
 def options(args: argparse.Namespace) -> PenetrationOptions:
@@ -36,6 +38,7 @@ def options(args: argparse.Namespace) -> PenetrationOptions:
     return PenetrationOptions(
         seeds=None if args.seeds is None else tuple(args.seeds), records=args.records,
         report=args.report, share_models=args.share_models, out=args.out, docs=args.docs,
+        page=args.page,
         plots=plots_wanted(args), workers=args.workers, scheduler=args.scheduler,
         progress=not args.quiet)
 

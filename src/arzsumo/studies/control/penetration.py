@@ -194,7 +194,8 @@ class PenetrationOptions(checks.Shared):
     ``seeds``: SUMO seeds (None: each sweep file's own); ``records``, ``report``: the
     record store and run-nothing (as :class:`~arzsumo.studies.recorded.RecordedRuns`);
     ``share_models``: the ``--out`` of ``arzsumo study share-models`` (None: the shipped
-    sweeps); ``out``, ``docs``, ``plots``: where and what the study writes;
+    sweeps); ``out``, ``docs``, ``page``, ``plots``: where and what the study writes
+    (``page``: the page under ``docs``);
     ``workers``, ``scheduler``, ``progress``: how the runs run.
     """
 
@@ -203,6 +204,7 @@ class PenetrationOptions(checks.Shared):
     report: bool = False
     share_models: Path | None = None
     out: Path = RESULTS_DIR / NAME
+    page: str = PAGE
     plots: bool = True
     progress: bool = True
 
@@ -285,7 +287,7 @@ def _write(tables: dict[str, pd.DataFrame], out: Path, opts: PenetrationOptions)
         remove_stale_figures(out / PENETRATION_FIGURE)
     write_text(text, out / "penetration.md")
     if opts.docs is not None:
-        publish(opts.docs, PAGE, NAME, "The controllers on the default in SUMO", text,
+        publish(opts.docs, opts.page, NAME, "The controllers in SUMO", text,
                 [(f, f.name) for f in files])
     return text
 
