@@ -8,12 +8,7 @@ from pathlib import Path
 
 from arzsumo.argtypes import non_negative_int, positive_float
 from arzsumo.cli.studies.options import add_output
-from arzsumo.studies.control.space_time import (
-    NAME,
-    PAGE,
-    SpaceTimeOptions,
-    run_space_time,
-)
+from arzsumo.studies.control import space_time as study
 from arzsumo.studies.control.study import ALL_EXPERIMENTS
 
 
@@ -34,14 +29,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--horizon", type=positive_float,
                         help="control horizon, s (default: the scenario's)")
     parser.add_argument("--quiet", action="store_true", help="no line per run")
-    add_output(parser, NAME, PAGE, plots=False)
-    parser.add_argument("--page", default=PAGE,
-                        help=f"the page's name under --docs (default: {PAGE})")
+    add_output(parser, study.NAME, study.PAGE, plots=False)
+    parser.add_argument("--page", default=study.PAGE,
+                        help=f"the page's name under --docs (default: {study.PAGE})")
 
 
-def options(args: argparse.Namespace) -> SpaceTimeOptions:
+def options(args: argparse.Namespace) -> study.SpaceTimeOptions:
     """The study's options as the command line gave them."""
-    return SpaceTimeOptions(
+    return study.SpaceTimeOptions(
         scenario=args.scenario, seed=args.seed,
         controllers=tuple(c.strip() for c in args.controllers.split(",") if c.strip()),
         experiment=args.experiment, warmup=args.warmup, horizon=args.horizon,
@@ -50,7 +45,7 @@ def options(args: argparse.Namespace) -> SpaceTimeOptions:
 
 def run(args: argparse.Namespace) -> int:
     """Run (or reuse) the runs, draw the figures, print where they are."""
-    result = run_space_time(options(args))
+    result = study.run_space_time(options(args))
     for path in result.figures:
         print(f"written: {path}")
     return 0
