@@ -134,6 +134,17 @@ def test_the_share_models_sweep_runs_each_shares_own_scenario(tmp_path):
             == "etc"
     with pytest.raises(StudyError, match=r"share_models\.csv"):
         pen.share_sweep(tmp_path / "nothing", None)
+    # with the open loop: each share and seed twice, sharing one warm-up
+    from arzsumo.sweep.driver import task_of
+    from arzsumo.sweep.groups import share_warmups
+
+    spec = pen.share_sweep(tmp_path, [3], with_open=True)
+    paired = spec.runs()
+    assert [(r.columns["penetration"], r.scenario["run"]["controller"]) for r in paired] \
+        == [(0.1, "etc"), (0.1, "open"), (0.5, "etc"), (0.5, "open")]
+    assert len({r.run_id for r in paired}) == 4
+    groups = share_warmups([task_of(spec, r) for r in paired])
+    assert sorted(len(g.tasks) for g in groups) == [2, 2]
 
 
 def test_the_page_goes_where_the_options_name_it(tmp_path):
@@ -147,3 +158,20 @@ def test_the_page_goes_where_the_options_name_it(tmp_path):
     assert text.strip() in page and "per 10 pt" in page
     assert (tmp_path / "docs" / "control_idm" / f"{pen.SHARE_SWEEP}.csv").is_file()
     assert not (tmp_path / "docs" / "control_default.md").exists()
+
+
+def test_the_paired_table_recovers_the_etcs_effect_per_share():
+    # the ETC's runs are the open loop's plus 3 updates per 10 points of share plus noise
+    # common to both runs of a seed: the paired difference is exact, the levels are not
+    base = _sweep(0.0, 0.0, noise=4.0).assign(controller="open")
+    law = base.assign(controller="etc", triggers=base.triggers + 30 * base.penetration)
+    table = pd.concat([law, base])
+    paired = pen.paired_table(table).set_index(["measure", "share"])
+    for s in SHARES:
+        row = paired.loc[("controller updates", s)]
+        assert row.etc_minus_open == pytest.approx(30 * s) and row.n == 10
+        assert row.high - row.low == pytest.approx(0.0, abs=1e-9)
+    assert pen.paired_table(base).empty                     # no open loop beside the ETC
+    assert pen.of_controller(table, "etc").controller.unique().tolist() == ["etc"]
+    with pytest.raises(StudyError, match="with-open"):
+        pen.PenetrationOptions(with_open=True)

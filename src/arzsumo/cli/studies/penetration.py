@@ -26,6 +26,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--share-models", type=Path, metavar="DIR",
                         help="run the ETC on each share's own scenario from arzsumo study "
                              "share-models (its --out) instead of the shipped sweeps")
+    parser.add_argument("--with-open", action="store_true",
+                        help="with --share-models, the open loop too on the same seeds "
+                             "(sharing each seed's warm-up): the ETC's paired effect per "
+                             "share, and whether the stream's waves still grow there")
     add_records(parser)
     add_runs(parser, seeds=None)
     add_output(parser, NAME, PAGE)
@@ -37,8 +41,8 @@ def options(args: argparse.Namespace) -> PenetrationOptions:
     """The study's options as the command line gave them."""
     return PenetrationOptions(
         seeds=None if args.seeds is None else tuple(args.seeds), records=args.records,
-        report=args.report, share_models=args.share_models, out=args.out, docs=args.docs,
-        page=args.page,
+        report=args.report, share_models=args.share_models, with_open=args.with_open,
+        out=args.out, docs=args.docs, page=args.page,
         plots=plots_wanted(args), workers=args.workers, scheduler=args.scheduler,
         progress=not args.quiet)
 

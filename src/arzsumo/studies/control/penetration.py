@@ -46,6 +46,7 @@ from arzsumo.resources import shipped_sweeps_dir
 from arzsumo.studies import checks
 from arzsumo.studies.common import RESULTS_DIR, StudyError
 from arzsumo.studies.recorded import check_store
+from arzsumo.sweep.evaluate import BASELINE
 from arzsumo.sweep.records import copy_records, records_table
 from arzsumo.sweep.spec import SweepSpec, load_sweep
 from arzsumo.sweep.worker import FINISHED
@@ -68,10 +69,14 @@ MEASURES = {"triggers": ("controller updates", "n"),
             "inserted_fraction_main": ("mainline demand inserted", "share"),
             "section.waves.h.band_power_kmh2": ("HV band power 1-10 min", "(km/h)^2"),
             "section.waves.a.band_power_kmh2": ("AV band power 1-10 min", "(km/h)^2"),
-            "section.speed_oscillation_kmh.h": ("HV speed oscillation", "km/h")}
+            "section.speed_oscillation_kmh.h": ("HV speed oscillation", "km/h"),
+            # the premise at each share: do the stream's waves still grow upstream
+            "section.waves.h.growth_per_km": ("HV wave growth upstream", "1/km")}
 #: the sweep of ``--share-models``: the ETC on each share's own scenario
 SHARE_SWEEP = "penetration_share_models"
 SHARE = "penetration"
+#: the controller axis of ``--with-open``: the law the claim is about and its baseline
+CONTROLLER, LAW = "controller", "etc"
 #: the slope's unit of share: 10 percentage points
 PER = 0.10
 
@@ -145,16 +150,49 @@ def _inserted(table: pd.DataFrame, share: float) -> float:
     return float(table.loc[table[SHARE] == share, "inserted_fraction_main"].mean())
 
 
+def of_controller(table: pd.DataFrame, controller: str) -> pd.DataFrame:
+    """The runs of ``controller`` (a sweep without a controller axis: all of them)."""
+    if CONTROLLER not in table.columns or table[CONTROLLER].nunique() < 2:
+        return table if controller == LAW else table.iloc[0:0]
+    return table[table[CONTROLLER] == controller]
+
+
+def paired_table(table: pd.DataFrame) -> pd.DataFrame:
+    """Per share and measure: the ETC minus the open loop on the same seed, mean with its
+    95 % t interval, and n (empty without open-loop runs)."""
+    law, base = of_controller(table, LAW), of_controller(table, BASELINE)
+    if base.empty:
+        return pd.DataFrame()
+    law, base = law.set_index([SHARE, "seed"]), base.set_index([SHARE, "seed"])
+    rows = []
+    for key, (label, unit) in measures_in(table).items():
+        diff = (law[key].astype(float) - base[key].astype(float)).dropna()
+        for share, d in diff.groupby(level=0):
+            ci = mean_ci(d.to_numpy(float))
+            rows.append({"share": share, "measure": label, "unit": unit,
+                         "etc_minus_open": ci.mean, "low": ci.low, "high": ci.high,
+                         "n": ci.n})
+    return pd.DataFrame(rows)
+
+
 def report(tables: dict[str, pd.DataFrame]) -> str:
-    """The study's page: per sweep the levels, the slopes and the claim's verdict."""
+    """The study's page: per sweep the ETC's levels, slopes and the claim's verdict, and,
+    where the open loop ran on the same seeds, its levels and the paired differences."""
     parts = ["The paper's claim: more AVs at equal inflow, fewer triggers and a longer "
              "release (44 -> 53 %: 245 -> 152 triggers, 206 -> 299 s). Slopes are per "
              "seed, against the share, then averaged over seeds (95 % t and BCa "
              "intervals)."]
     for name, table in tables.items():
-        measured, said = claim_text(table)
+        law = of_controller(table, LAW)
+        measured, said = claim_text(law)
         parts += [f"## {TITLES[name]} (`{name}`)", f"{measured}: **{said}**",
-                  markdown_table(level_table(table)), markdown_table(slope_table(table))]
+                  markdown_table(level_table(law)), markdown_table(slope_table(law))]
+        paired = paired_table(table)
+        if not paired.empty:
+            parts += ["The open loop on the same seeds, its levels per share, then the ETC "
+                      "minus the open loop per share (paired by seed):",
+                      markdown_table(level_table(of_controller(table, BASELINE))),
+                      markdown_table(paired)]
     return "\n\n".join(parts) + "\n"
 
 
@@ -163,11 +201,14 @@ def _flat(data: dict) -> dict[str, object]:
             for k, v in table.items()}
 
 
-def share_sweep(directory: Path, seeds: list[int] | None) -> SweepSpec:
+def share_sweep(directory: Path, seeds: list[int] | None, with_open: bool = False
+                ) -> SweepSpec:
     """The ETC on each share's scenario of a ``share-models`` output ``directory``: one
     axis ``penetration`` (the shares of its ``share_models.csv``) whose values set every
     key in which a share's scenario differs from the first share's; seeds 1-10 unless
-    ``seeds``; the control window only (no drain), as the shipped sweeps."""
+    ``seeds``; the control window only (no drain), as the shipped sweeps. ``with_open``:
+    a second axis ``controller`` adds the open loop on the same seeds (its runs share
+    each seed's warm-up with the ETC's)."""
     import tomllib
 
     from arzsumo.studies.common import study_spec
@@ -181,10 +222,12 @@ def share_sweep(directory: Path, seeds: list[int] | None) -> SweepSpec:
     data = [tomllib.loads(f.read_text(encoding="utf-8")) for f in files]
     base = _flat(data[0])
     sets = [{k: v for k, v in _flat(d).items() if base.get(k) != v} for d in data]
+    axes = [{"name": SHARE, "values": [float(v) for v in rows["av_share"]], "set": sets}]
+    if with_open:
+        axes.append({"name": CONTROLLER, "values": [LAW, BASELINE],
+                     "set": [{"run.controller": c} for c in (LAW, BASELINE)]})
     return study_spec(SHARE_SWEEP, files[0], seeds=seeds or list(range(1, 11)),
-                      set={"sumo.drain_max_s": 0, "run.controller": "etc"},
-                      axis=[{"name": SHARE, "values": [float(v) for v in rows["av_share"]],
-                             "set": sets}])
+                      set={"sumo.drain_max_s": 0, "run.controller": LAW}, axis=axes)
 
 
 @dataclass(frozen=True)
@@ -194,15 +237,17 @@ class PenetrationOptions(checks.Shared):
     ``seeds``: SUMO seeds (None: each sweep file's own); ``records``, ``report``: the
     record store and run-nothing (as :class:`~arzsumo.studies.recorded.RecordedRuns`);
     ``share_models``: the ``--out`` of ``arzsumo study share-models`` (None: the shipped
-    sweeps); ``out``, ``docs``, ``page``, ``plots``: where and what the study writes
-    (``page``: the page under ``docs``);
-    ``workers``, ``scheduler``, ``progress``: how the runs run.
+    sweeps); ``with_open``: the open loop too, on the same seeds (with
+    ``share_models``); ``out``, ``docs``, ``page``, ``plots``: where and what the study
+    writes (``page``: the page under ``docs``); ``workers``, ``scheduler``,
+    ``progress``: how the runs run.
     """
 
     seeds: tuple[int, ...] | None = None
     records: Path | None = None
     report: bool = False
     share_models: Path | None = None
+    with_open: bool = False
     out: Path = RESULTS_DIR / NAME
     page: str = PAGE
     plots: bool = True
@@ -213,6 +258,9 @@ class PenetrationOptions(checks.Shared):
         if self.seeds is not None:
             checks.seeds(self.seeds)
         check_store(self.records, self.report)
+        if self.with_open and self.share_models is None:
+            raise StudyError("--with-open is not allowed without --share-models: the "
+                             "shipped sweeps run the ETC alone")
 
 
 @dataclass(frozen=True)
@@ -229,7 +277,7 @@ def specs_of(opts: PenetrationOptions) -> list[SweepSpec]:
     """The sweeps the study runs."""
     seeds = None if opts.seeds is None else list(opts.seeds)
     if opts.share_models is not None:
-        return [share_sweep(opts.share_models, seeds)]
+        return [share_sweep(opts.share_models, seeds, opts.with_open)]
     return [with_seeds(load_sweep(shipped_sweeps_dir() / f"{n}.toml"), seeds)
             for n in SWEEPS]
 
@@ -273,15 +321,19 @@ def _write(tables: dict[str, pd.DataFrame], out: Path, opts: PenetrationOptions)
     """Each sweep's CSV (levels and slopes), the figure and the page; return the text."""
     files = []
     for name, table in tables.items():
-        files.append(write_csv(pd.concat([level_table(table).assign(kind="level"),
-                                          slope_table(table).assign(kind="slope")]),
+        law = of_controller(table, LAW)
+        files.append(write_csv(pd.concat([level_table(law).assign(kind="level"),
+                                          slope_table(law).assign(kind="slope"),
+                                          paired_table(table).assign(kind="paired")]),
                                out / f"{name}.csv"))
     text = report(tables)
     if opts.plots:
         from arzsumo.outputs.penetration import write_penetration_figure
 
-        files.append(write_penetration_figure(out, {TITLES[n]: t
-                                                    for n, t in tables.items()}))
+        drawn = {TITLES[n]: of_controller(t, LAW) for n, t in tables.items()}
+        drawn |= {f"open loop, {TITLES[n]}": of_controller(t, BASELINE)
+                  for n, t in tables.items() if not of_controller(t, BASELINE).empty}
+        files.append(write_penetration_figure(out, drawn))
         text += "\n![ETC against the AV share](penetration.png)\n"
     else:
         remove_stale_figures(out / PENETRATION_FIGURE)
