@@ -90,3 +90,25 @@ def test_the_idm_streams_model_carries_its_waves_and_its_design_is_design_check_
         assert table[key] == pytest.approx(idm["design"][key], rel=1e-5), key
     assert table["A"] == pytest.approx(idm["design"]["A"], rel=1e-5)
     assert len(cannot) == 1                      # esthm #1, as its comment says
+
+
+def test_the_command_on_the_page_gives_back_the_options():
+    import shlex
+    from pathlib import Path
+
+    from arzsumo.cli.studies.share_models import options
+    from arzsumo.studies.share_models import command
+
+    from .conftest import parse
+
+    opts = ShareOptions(shares=(0.1, 0.5), train_seeds=(1, 2), validate_seeds=(3, 4),
+                        jam_floor="blocks", wave_weight=3.0,
+                        set={"sumo.time_to_teleport_s": 300, "sumo.hv_model": "IDM",
+                             "sumo.fcd": False})
+    line = command(opts, Path("scenarios/stop_and_go_idm.toml"))
+    argv = shlex.split(line)[3:]                      # after "arzsumo study share-models"
+    again = options(parse("share-models", *argv))
+    for field in ("shares", "train_seeds", "validate_seeds", "jam_floor", "wave_weight",
+                  "set", "diagram"):
+        assert getattr(again, field) == getattr(opts, field), field
+    assert again.scenario == Path("scenarios/stop_and_go_idm.toml")

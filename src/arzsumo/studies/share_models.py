@@ -168,14 +168,36 @@ def run_share_models(opts: ShareOptions) -> ShareResult:
         table = pd.DataFrame([m.row for m in models])
         csv = write_csv(table, out / "share_models.csv")
         body = (f"Per AV share, the demand mapped to its discharge, the model identified "
-                f"there and the ETC designed for it (`arzsumo study {NAME}`; "
-                f"[share_models.csv]({PAGE}/share_models.csv)).\n\n"
+                f"there and the ETC designed for it (`{command(opts, path)}`; "
+                f"[share_models.csv]({PAGE}/share_models.csv), each share's scenario "
+                f"beside it: `arzsumo study penetration --share-models "
+                f"{opts.docs or 'DOCS'}/{PAGE}` runs the ETC on them).\n\n"
                 f"{markdown_table(table)}\n\nThe mapping's discharge runs:\n\n{text}")
         write_text(body, out / "share_models.md")
         if opts.docs is not None:
             publish(opts.docs, PAGE, NAME, "The model and design per AV share", body,
-                    [(csv, csv.name)])
+                    [(csv, csv.name), *((m.scenario, m.scenario.name) for m in models)])
     return ShareResult(tuple(models), table, text)
+
+
+def command(opts: ShareOptions, path: Path) -> str:
+    """The command line that makes this study's scenarios."""
+    parts = [f"arzsumo study {NAME} --scenario {path}",
+             f"--shares {','.join(f'{x:g}' for x in opts.shares)}",
+             f"--train-seeds {','.join(map(str, opts.train_seeds))}",
+             f"--validate-seeds {','.join(map(str, opts.validate_seeds))}",
+             f"--diagram {opts.diagram} --jam-floor {opts.jam_floor}",
+             f"--wave-weight {opts.wave_weight:g}",
+             *(f"--set {k}={_toml_value(v)}" for k, v in opts.set.items())]
+    return " ".join(parts)
+
+
+def _toml_value(value: Any) -> str:
+    """``value`` as TOML writes it (a shell quotes a string's quotes away: the page shows
+    them as the command line needs them)."""
+    if isinstance(value, bool):
+        return str(value).lower()
+    return f"'\"{value}\"'" if isinstance(value, str) else f"{value}"
 
 
 def _share_model(opts: ShareOptions, base: Mapping[str, Any], point: MapPoint,
