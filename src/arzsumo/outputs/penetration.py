@@ -11,10 +11,13 @@ import pandas as pd
 PENETRATION_FIGURE = "penetration.png"
 
 
-def write_penetration_figure(out: Path, tables: Mapping[str, pd.DataFrame]) -> Path:
+def write_penetration_figure(out: Path, tables: Mapping[str, pd.DataFrame],
+                             inflow: str = "equal inflow") -> Path:
     """Draw :func:`arzsumo.plots.penetration.penetration_figure` of ``tables`` (label ->
-    finished runs) into ``out/penetration.png``; return its path."""
+    finished runs; ``inflow``: how the demand was set across shares) into
+    ``out/penetration.png``; return its path."""
     from arzsumo.outputs.figures import save_png
     from arzsumo.plots.penetration import penetration_figure
 
-    return save_png(penetration_figure(tables), Path(out) / PENETRATION_FIGURE)
+    return save_png(penetration_figure(tables, inflow=inflow),
+                    Path(out) / PENETRATION_FIGURE)

@@ -17,11 +17,12 @@ PANELS = {"triggers": "controller updates in 450 s",
           "inserted_fraction_main": "mainline demand inserted"}
 
 
-def penetration_figure(tables: Mapping[str, pd.DataFrame], share: str = "penetration"
-                       ) -> Figure:
+def penetration_figure(tables: Mapping[str, pd.DataFrame], share: str = "penetration",
+                       inflow: str = "equal inflow") -> Figure:
     """One panel per :data:`PANELS` key against ``share`` (in %): each table's seeds as
     thin lines, their mean with its 95 % t interval as markers; ``tables``: label ->
-    finished runs (columns ``share``, ``seed`` and the keys)."""
+    finished runs (columns ``share``, ``seed`` and the keys); ``inflow``: how the
+    demand was set across shares (the title says it)."""
     from scipy import stats
 
     fig, axes = plt.subplots(1, len(PANELS), figsize=(4.0 * len(PANELS), 3.4))
@@ -39,7 +40,7 @@ def penetration_figure(tables: Mapping[str, pd.DataFrame], share: str = "penetra
         ax.set_ylabel(text)
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize=8)
-    fig.suptitle("ETC against the AV share in SUMO (equal inflow; thin: one seed)",
+    fig.suptitle(f"ETC against the AV share in SUMO ({inflow}; thin: one seed)",
                  fontsize=10)
     fig.tight_layout()
     return fig

@@ -333,7 +333,9 @@ def _write(tables: dict[str, pd.DataFrame], out: Path, opts: PenetrationOptions)
         drawn = {TITLES[n]: of_controller(t, LAW) for n, t in tables.items()}
         drawn |= {f"open loop, {TITLES[n]}": of_controller(t, BASELINE)
                   for n, t in tables.items() if not of_controller(t, BASELINE).empty}
-        files.append(write_penetration_figure(out, drawn))
+        inflow = ("each share at its own mapped demand" if opts.share_models is not None
+                  else "equal inflow")
+        files.append(write_penetration_figure(out, drawn, inflow))
         text += "\n![ETC against the AV share](penetration.png)\n"
     else:
         remove_stale_figures(out / PENETRATION_FIGURE)
