@@ -3,6 +3,8 @@ seed, drawn side by side, reused on a second call; bad options are refused."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -51,3 +53,9 @@ def test_the_runs_are_the_users_runs_drawn_side_by_side_and_reused(tmp_path):
     again = run_space_time(opts)
     assert {c: (p / "summary.json").stat().st_mtime_ns
             for c, p in again.runs.items()} == stamps
+    # another scenario in the same directory is refused, not drawn from the old runs
+    other = tmp_path / "other.toml"
+    other.write_text(DEFAULT.read_text(encoding="utf-8").replace(
+        "horizon_s = 450", "horizon_s = 400", 1), encoding="utf-8")
+    with pytest.raises(ArzsumoError, match="another scenario"):
+        run_space_time(replace(opts, scenario=other))

@@ -15,6 +15,7 @@ be seen. A later call with the same ``--out`` reuses the runs it finds.
 from __future__ import annotations
 
 import logging
+import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -28,6 +29,7 @@ from arzsumo.studies import checks
 from arzsumo.studies.common import RESULTS_DIR, StudyError, scenario_data
 from arzsumo.studies.control.study import ALL_EXPERIMENTS, experiment_scenario
 from arzsumo.sweep.evaluate import check_controllers
+from arzsumo.sweep.spec import deciding
 
 log = logging.getLogger(__name__)
 
@@ -90,9 +92,11 @@ def run_space_time(opts: SpaceTimeOptions) -> SpaceTimeResult:
     from arzsumo.outputs.compare import field_figures
     from arzsumo.scenario import scenario_from_dict
 
-    data = experiment_scenario(scenario_data(opts.base), opts.experiment)
+    base = scenario_data(opts.base)
+    data = experiment_scenario(base, opts.experiment)
     sc = scenario_from_dict(data, str(opts.base))
-    label = f"{opts.experiment}-seed{opts.seed}"
+    label = f"{opts.experiment}-seed{opts.seed}" + "".join(
+        f"-{k}{v:g}" for k, v in (("w", opts.warmup), ("h", opts.horizon)) if v is not None)
     with resumable_dir(opts.out, f"study-{NAME}") as out:
         runs = {c: _run(sc, dump_toml(data), c, opts, out / label / c)
                 for c in opts.controllers}
@@ -105,8 +109,7 @@ def run_space_time(opts: SpaceTimeOptions) -> SpaceTimeResult:
         figures = tuple(p.replace(out / f"space_time_{opts.experiment}_seed{opts.seed}_"
                                         f"{name}.png")
                         for p, (name, _) in zip(drawn, CLASSES, strict=True))
-        body = _page(opts, str(data.get("name", opts.base.stem)).removesuffix(
-            f"-{opts.experiment}"), figures, runs)
+        body = _page(opts, str(base.get("name", opts.base.stem)), figures, runs)
         write_text(body, out / "space_time.md")
         if opts.docs is not None:
             publish(opts.docs, opts.page, NAME, "SUMO's stop-and-go under the controllers",
@@ -122,6 +125,10 @@ def _run(sc: Scenario, text: str, controller: str, opts: SpaceTimeOptions,
     from arzsumo.outputs.bridge import write_results
 
     if (target / "summary.json").is_file():
+        if not same_tables((target / "scenario.toml").read_text(encoding="utf-8"), text):
+            raise StudyError(f"{target} holds a run of another scenario than "
+                             f"{opts.base}'s {opts.experiment}; allowed: another --out, "
+                             "or remove that run")
         log.info("%s: %s reused", NAME, target)
         return target
     prepared = prepare_run(sc, controller=controller, seed=opts.seed,
@@ -156,6 +163,17 @@ def seed_table(runs: dict[str, Path]) -> str:
     lines += [f"| {c} | " + " | ".join(value(s, k) for k, _ in MEASURES) + " |"
               for c, s in summaries.items()]
     return "\n".join(lines)
+
+
+def same_tables(kept: str, text: str) -> bool:
+    """Whether a kept run's scenario file and ``text`` (a scenario as written) hold the
+    same tables, their labels and the controller (a run's option) aside."""
+    def tables(source: str) -> dict:
+        data = deciding(tomllib.loads(source), "twin")        # without the labels
+        data["run"] = {k: v for k, v in data.get("run", {}).items() if k != "controller"}
+        return data
+
+    return tables(kept) == tables(text)
 
 
 def _page(opts: SpaceTimeOptions, scenario: str, figures: tuple[Path, ...],
