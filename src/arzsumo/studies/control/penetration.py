@@ -71,7 +71,10 @@ MEASURES = {"triggers": ("controller updates", "n"),
             "section.waves.a.band_power_kmh2": ("AV band power 1-10 min", "(km/h)^2"),
             "section.speed_oscillation_kmh.h": ("HV speed oscillation", "km/h"),
             # the premise at each share: do the stream's waves still grow upstream
-            "section.waves.h.growth_per_km": ("HV wave growth upstream", "1/km")}
+            "section.waves.h.growth_per_km": ("HV wave growth upstream", "1/km"),
+            # a share whose merge deadlocked is cleared by SUMO's teleport where the
+            # scenario allows it; each teleport is a jolt in the section's speeds
+            "teleports": ("SUMO teleports", "n")}
 #: the sweep of ``--share-models``: the ETC on each share's own scenario
 SHARE_SWEEP = "penetration_share_models"
 SHARE = "penetration"
