@@ -124,8 +124,9 @@ def test_the_share_models_sweep_runs_each_shares_own_scenario(tmp_path):
         tmp_path / "share_models.csv", index=False)
     spec = pen.share_sweep(tmp_path, [3, 4])
     runs = spec.runs()
-    assert [r.run_id for r in runs] == ["penetration=0.1,seed=3", "penetration=0.1,seed=4",
-                                        "penetration=0.5,seed=3", "penetration=0.5,seed=4"]
+    assert [r.run_id for r in runs] == [
+        "penetration=0.1,controller=etc,seed=3", "penetration=0.1,controller=etc,seed=4",
+        "penetration=0.5,controller=etc,seed=3", "penetration=0.5,controller=etc,seed=4"]
     for r in runs:
         _, hv, av, tau = shares["av10" if r.columns["penetration"] == 0.1 else "av50"]
         assert (r.scenario["sumo"]["demand_h_veh_h"], r.scenario["sumo"]["demand_a_veh_h"],
@@ -143,6 +144,9 @@ def test_the_share_models_sweep_runs_each_shares_own_scenario(tmp_path):
     assert [(r.columns["penetration"], r.scenario["run"]["controller"]) for r in paired] \
         == [(0.1, "etc"), (0.1, "open"), (0.5, "etc"), (0.5, "open")]
     assert len({r.run_id for r in paired}) == 4
+    # the ETC's runs keep their IDs with the open loop beside them (their records too)
+    assert [r.run_id for r in paired if "etc" in r.run_id] == [
+        "penetration=0.1,controller=etc,seed=3", "penetration=0.5,controller=etc,seed=3"]
     groups = share_warmups([task_of(spec, r) for r in paired])
     assert sorted(len(g.tasks) for g in groups) == [2, 2]
 
@@ -171,7 +175,22 @@ def test_the_paired_table_recovers_the_etcs_effect_per_share():
         row = paired.loc[("controller updates", s)]
         assert row.etc_minus_open == pytest.approx(30 * s) and row.n == 10
         assert row.high - row.low == pytest.approx(0.0, abs=1e-9)
-    assert pen.paired_table(base).empty                     # no open loop beside the ETC
+    assert pen.paired_table(law).empty                      # no open loop beside the ETC
     assert pen.of_controller(table, "etc").controller.unique().tolist() == ["etc"]
+    # a store holding the open loop's runs alone has no ETC runs to read a claim from
+    assert pen.of_controller(base, "etc").empty and pen.paired_table(base).empty
+
+
+def test_a_measure_no_seed_of_a_share_could_read_is_left_out_not_fatal():
+    table = _sweep(-12.5, 7.0).assign(**{"section.waves.h.growth_per_km": 0.5})
+    table.loc[table.penetration == 0.5, "section.waves.h.growth_per_km"] = np.nan
+    levels = pen.level_table(table)
+    growth = levels[levels.measure == "HV wave growth upstream"]
+    assert sorted(growth.share) == [0.10, 0.18, 0.30]
+    slope = pen.slope_table(table).set_index("measure").loc["HV wave growth upstream"]
+    assert slope.slope == pytest.approx(0.0, abs=1e-9) and slope.n_seeds == 10
+
+
+def test_the_open_loop_is_asked_for_with_the_share_models_only():
     with pytest.raises(StudyError, match="with-open"):
         pen.PenetrationOptions(with_open=True)

@@ -26,7 +26,7 @@ def test_each_share_is_a_mapped_point_whose_demand_splits_by_the_share():
     assert NEWELL["sumo"]["demand_a_veh_h"] == 702               # the base is untouched
 
 
-def test_keys_set_on_the_base_reach_every_share_and_its_mapped_scenario():
+def test_keys_set_on_the_base_reach_every_shares_point_and_its_scenario_data():
     # a [sumo] key given to the study (SUMO's teleport on a merge that can deadlock) is
     # part of each share's point, so of its discharge runs and of the scenario written
     points = share_points((0.1, 0.5), {"sumo.time_to_teleport_s": 300})
@@ -53,7 +53,10 @@ def test_the_command_line_reads_a_set_key_as_toml_and_refuses_other_tables():
     ({"shares": ()}, "shares"), ({"validate_seeds": (3, 4)}, "validate_seeds"),
     ({"kernel_cells": 4}, "kernel_cells"), ({"jam_floor": "cell"}, "jam_floor"),
     ({"wave_weight": -1.0}, "wave_weight"),
-    ({"set": {"run.warmup_s": 600}}, "set")])
+    ({"sumo_keys": {"run.warmup_s": 600}}, "sumo_keys"),
+    ({"sumo_keys": {"sumo.": 1}}, "sumo_keys"), ({"sumo_keys": {"sumo.a.b": 1}}, "sumo_keys"),
+    ({"sumo_keys": {"sumo.demand_h_veh_h": 2000}}, "demand_h_veh_h"),
+    ({"sumo_keys": (("sumo.seed", 1), ("sumo.seed", 2))}, "sumo_keys")])
 def test_options_that_cannot_make_a_share_model_are_refused(changes, field):
     with pytest.raises(StudyError, match=field):
         ShareOptions(**changes)
@@ -103,12 +106,13 @@ def test_the_command_on_the_page_gives_back_the_options():
 
     opts = ShareOptions(shares=(0.1, 0.5), train_seeds=(1, 2), validate_seeds=(3, 4),
                         jam_floor="blocks", wave_weight=3.0,
-                        set={"sumo.time_to_teleport_s": 300, "sumo.hv_model": "IDM",
-                             "sumo.fcd": False})
+                        kernel_cells=60,
+                        sumo_keys={"sumo.time_to_teleport_s": 300, "sumo.hv_model": "IDM",
+                                   "sumo.fcd": False, "sumo.note": "a b's"})
     line = command(opts, Path("scenarios/stop_and_go_idm.toml"))
     argv = shlex.split(line)[3:]                      # after "arzsumo study share-models"
     again = options(parse("share-models", *argv))
     for field in ("shares", "train_seeds", "validate_seeds", "jam_floor", "wave_weight",
-                  "set", "diagram"):
+                  "sumo_keys", "diagram", "kernel_cells"):
         assert getattr(again, field) == getattr(opts, field), field
     assert again.scenario == Path("scenarios/stop_and_go_idm.toml")

@@ -24,10 +24,19 @@ TIMES = {"warmup": 60.0, "horizon": 20.0}
     ({"controllers": ("open",)}, "controllers"),
     ({"controllers": ("open", "open")}, "controllers"),
     ({"controllers": ("open", "pid")}, "controllers"),
-    ({"experiment": "slowdown"}, "experiment"), ({"seed": -1}, "seed")])
+    ({"controllers": ("etc",)}, "controllers"),
+    ({"controllers": ("open", "etc", "held", "alinea", "pi-alinea")}, "controllers"),
+    ({"experiment": "slowdown"}, "experiment"), ({"seed": -1}, "seed"),
+    ({"warmup": -1.0}, "warmup"), ({"horizon": 0.0}, "horizon"),
+    ({"horizon": float("nan")}, "horizon"), ({"page": "../control"}, "page")])
 def test_options_that_cannot_draw_a_comparison_are_refused(changes, field):
     with pytest.raises(ArzsumoError, match=field):
         SpaceTimeOptions(**changes)
+
+
+def test_the_controllers_are_drawn_in_the_order_given():
+    assert SpaceTimeOptions(controllers=("etc", "open")).controllers == ("etc", "open")
+    assert SpaceTimeOptions(controllers=("etc", "held")).controllers == ("etc", "held")
 
 
 @pytest.mark.sumo
@@ -36,12 +45,14 @@ def test_the_runs_are_the_users_runs_drawn_side_by_side_and_reused(tmp_path):
                             out=tmp_path / "st", docs=tmp_path / "docs", progress=False,
                             **TIMES)
     result = run_space_time(opts)
-    assert [p.name for p in result.figures] == ["space_time_regulation_seed3_hv.png",
-                                                "space_time_regulation_seed3_av.png"]
+    assert [p.name for p in result.figures] == [
+        "space_time_regulation_seed3_w60_h20_hv.png",
+        "space_time_regulation_seed3_w60_h20_av.png"]         # a quick look is named
     assert all(p.stat().st_size > 20_000 for p in result.figures)
     assert (tmp_path / "docs" / "control_default" / result.figures[0].name).is_file()
-    assert "space_time_regulation_seed3_av.png" in (
-        tmp_path / "docs" / "control_default.md").read_text(encoding="utf-8")
+    page = (tmp_path / "docs" / "control_default.md").read_text(encoding="utf-8")
+    assert "space_time_regulation_seed3_w60_h20_av.png" in page
+    assert "--controllers open,held --experiment regulation --warmup 60 --horizon 20" in page
     # the study's open loop is `arzsumo run`'s of the same scenario, seed and times
     own = run_in_sumo(load_scenario(DEFAULT), controller="open", seed=3, **TIMES)
     cells = pd.read_parquet(result.runs["open"] / "cells.parquet")

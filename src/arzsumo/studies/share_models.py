@@ -26,10 +26,13 @@ second call redoes only the fits.
 
 from __future__ import annotations
 
+import json
 import math
+import re
+import shlex
 import tomllib
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -41,7 +44,7 @@ from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.studies import markdown_table, publish, write_csv, write_text
 from arzsumo.studies import checks
 from arzsumo.studies.common import RESULTS_DIR, StudyError, scenario_data, shipped_scenario
-from arzsumo.studies.premise.map_points import MapPoint, mapped_points
+from arzsumo.studies.premise.map_points import MapPoint, demand, mapped_points
 from arzsumo.studies.premise.map_study import map_demands
 from arzsumo.units import VEH_H_PER_VEH_S, kmh_to_ms, ms_to_kmh
 
@@ -50,6 +53,9 @@ NAME = "share-models"
 PAGE = "share_models"
 #: the scenario the study maps by default: the judged configuration of the laws
 BASE = "control_newell.toml"
+#: the [sumo] keys the mapping sets at every share (:func:`~arzsumo.studies.premise.
+#: map_points.demand`): not to be set by hand
+MAPPED_KEYS = tuple(demand(0.5))
 
 
 @dataclass(frozen=True)
@@ -72,7 +78,7 @@ class ShareOptions(checks.Shared):
     jam_floor: str = "cells"
     wave_weight: float = 1.0
     kernel_cells: int = 100
-    set: Mapping[str, Any] = field(default_factory=dict)
+    sumo_keys: tuple[tuple[str, Any], ...] = ()
     out: Path = RESULTS_DIR / NAME
     progress: bool = True
 
@@ -90,8 +96,16 @@ class ShareOptions(checks.Shared):
                 f"one of {', '.join(JAM_FLOORS)}", StudyError)
         require(self.wave_weight >= 0.0, "wave_weight", self.wave_weight,
                 "a weight >= 0", StudyError)
-        require(all(k.startswith("sumo.") for k in self.set), "set", dict(self.set),
-                "keys of the [sumo] table (sumo.KEY)", StudyError)
+        if isinstance(self.sumo_keys, Mapping):     # given as a mapping: kept as pairs
+            object.__setattr__(self, "sumo_keys", tuple(self.sumo_keys.items()))
+        keys = [k for k, _ in self.sumo_keys]
+        require(all(re.fullmatch(r"sumo\.[A-Za-z0-9_]+", k) for k in keys)
+                and len(set(keys)) == len(keys), "sumo_keys", dict(self.sumo_keys),
+                "distinct keys of the [sumo] table (sumo.KEY)", StudyError)
+        mapped = [k for k in keys if k.removeprefix("sumo.") in MAPPED_KEYS]
+        require(not mapped, "sumo_keys", dict(self.sumo_keys),
+                f"keys other than {', '.join(mapped)}: the mapping sets each share's "
+                "demand itself", StudyError)
         require(self.kernel_cells >= 10, "kernel_cells", self.kernel_cells,
                 "at least 10 cells", StudyError)
 
@@ -142,7 +156,7 @@ def design(opts: ShareOptions) -> list[str]:
     from arzsumo.studies.premise.map_points import discharge_runs
 
     path = opts.scenario or shipped_scenario(BASE)
-    points = share_points(opts.shares, opts.set)
+    points = share_points(opts.shares, dict(opts.sumo_keys))
     lines = [r.run_id for r in discharge_runs(path, points, load_scenario(path).run.warmup)]
     seeds = ",".join(map(str, (*opts.train_seeds, *opts.validate_seeds)))
     return lines + [f"point={p.name},identify seeds={seeds}" for p in points]
@@ -154,7 +168,7 @@ def run_share_models(opts: ShareOptions) -> ShareResult:
     from arzsumo.scenario import load_scenario
 
     path = opts.scenario or shipped_scenario(BASE)
-    base, points = scenario_data(path), share_points(opts.shares, opts.set)
+    base, points = scenario_data(path), share_points(opts.shares, dict(opts.sumo_keys))
     with resumable_dir(opts.out, f"study-{NAME}") as out:
         discharges, shortfalls, text = map_demands(
             path, points, load_scenario(path).run.warmup, out, workers=opts.workers,
@@ -187,17 +201,14 @@ def command(opts: ShareOptions, path: Path) -> str:
              f"--train-seeds {','.join(map(str, opts.train_seeds))}",
              f"--validate-seeds {','.join(map(str, opts.validate_seeds))}",
              f"--diagram {opts.diagram} --jam-floor {opts.jam_floor}",
-             f"--wave-weight {opts.wave_weight:g}",
-             *(f"--set {k}={_toml_value(v)}" for k, v in opts.set.items())]
+             f"--wave-weight {opts.wave_weight:g} --cells {opts.kernel_cells}",
+             *(f"--set {shlex.quote(f'{k}={_toml_value(v)}')}" for k, v in opts.sumo_keys)]
     return " ".join(parts)
 
 
 def _toml_value(value: Any) -> str:
-    """``value`` as TOML writes it (a shell quotes a string's quotes away: the page shows
-    them as the command line needs them)."""
-    if isinstance(value, bool):
-        return str(value).lower()
-    return f"'\"{value}\"'" if isinstance(value, str) else f"{value}"
+    """``value`` as a TOML value (a JSON string or array of numbers and strings is one)."""
+    return str(value).lower() if isinstance(value, bool) else json.dumps(value)
 
 
 def _share_model(opts: ShareOptions, base: Mapping[str, Any], point: MapPoint,

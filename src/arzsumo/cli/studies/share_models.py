@@ -73,9 +73,9 @@ def options(args: argparse.Namespace) -> ShareOptions:
                         train_seeds=tuple(args.train_seeds),
                         validate_seeds=tuple(args.validate_seeds), diagram=args.diagram,
                         jam_floor=args.jam_floor, wave_weight=args.wave_weight,
-                        set=dict(args.set), kernel_cells=args.cells, out=args.out, docs=args.docs,
-                        workers=args.workers,
-                        scheduler=args.scheduler, progress=not args.quiet)
+                        sumo_keys=tuple(args.set), kernel_cells=args.cells, out=args.out,
+                        docs=args.docs, workers=args.workers, scheduler=args.scheduler,
+                        progress=not args.quiet)
 
 
 def run(args: argparse.Namespace) -> int:

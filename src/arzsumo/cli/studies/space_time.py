@@ -6,8 +6,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from arzsumo.argtypes import non_negative_int, positive_float
-from arzsumo.cli.studies.options import add_output
+from arzsumo.argtypes import non_negative_int
+from arzsumo.cli.studies.options import add_output, add_scenario_times
 from arzsumo.studies.control import space_time as study
 from arzsumo.studies.control.study import ALL_EXPERIMENTS
 
@@ -23,11 +23,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "open,etc)")
     parser.add_argument("--experiment", choices=ALL_EXPERIMENTS, default="regulation",
                         help="the control study's experiment (default: regulation)")
-    parser.add_argument("--warmup", type=positive_float,
-                        help="s (default: the scenario's; shorter, the runs are not the "
-                             "control study's)")
-    parser.add_argument("--horizon", type=positive_float,
-                        help="control horizon, s (default: the scenario's)")
+    add_scenario_times(parser)      # with other times the runs are not the study's
     parser.add_argument("--quiet", action="store_true", help="no line per run")
     add_output(parser, study.NAME, study.PAGE, plots=False)
     parser.add_argument("--page", default=study.PAGE,

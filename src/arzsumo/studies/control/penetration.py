@@ -100,14 +100,26 @@ def measures_in(table: pd.DataFrame) -> dict[str, tuple[str, str]]:
     return {k: v for k, v in MEASURES.items() if k in table.columns}
 
 
+def finite_ci(values: np.ndarray, boot: bool = False) -> MeanCI | None:
+    """The mean of ``values`` with its 95 % t (``boot``: BCa bootstrap) interval over the
+    finite ones; None when there are none (a wave measure with too few places read)."""
+    a = np.asarray(values, dtype=float)
+    a = a[np.isfinite(a)]
+    if a.size == 0:
+        return None
+    return bootstrap_mean_ci(a) if boot else mean_ci(a)
+
+
 def level_table(table: pd.DataFrame) -> pd.DataFrame:
-    """Per share and measure: mean over seeds with its 95 % t interval, and n."""
+    """Per share and measure: mean over seeds with its 95 % t interval, and n (a measure
+    no seed of a share could read is left out)."""
     rows = []
     for share, g in table.groupby(SHARE):
         for key, (label, unit) in measures_in(table).items():
-            ci = mean_ci(g[key].to_numpy(float))
-            rows.append({"share": share, "measure": label, "unit": unit, "mean": ci.mean,
-                         "low": ci.low, "high": ci.high, "n": ci.n})
+            ci = finite_ci(g[key].to_numpy(float))
+            if ci is not None:
+                rows.append({"share": share, "measure": label, "unit": unit,
+                             "mean": ci.mean, "low": ci.low, "high": ci.high, "n": ci.n})
     return pd.DataFrame(rows)
 
 
@@ -116,7 +128,9 @@ def slope_table(table: pd.DataFrame) -> pd.DataFrame:
     rows = []
     for key, (label, unit) in measures_in(table).items():
         s = seed_slopes(table, key).to_numpy()
-        t, boot = mean_ci(s), bootstrap_mean_ci(s)
+        t, boot = finite_ci(s), finite_ci(s, boot=True)
+        if t is None or boot is None:
+            continue
         rows.append({"measure": label, "unit": f"{unit} per 10 pt", "slope": t.mean,
                      "t_low": t.low, "t_high": t.high, "boot_low": boot.low,
                      "boot_high": boot.high, "n_seeds": t.n})
@@ -154,8 +168,9 @@ def _inserted(table: pd.DataFrame, share: float) -> float:
 
 
 def of_controller(table: pd.DataFrame, controller: str) -> pd.DataFrame:
-    """The runs of ``controller`` (a sweep without a controller axis: all of them)."""
-    if CONTROLLER not in table.columns or table[CONTROLLER].nunique() < 2:
+    """The runs of ``controller`` (every run's summary names its controller; a table
+    without the column holds the ETC's runs alone)."""
+    if CONTROLLER not in table.columns:
         return table if controller == LAW else table.iloc[0:0]
     return table[table[CONTROLLER] == controller]
 
@@ -171,7 +186,9 @@ def paired_table(table: pd.DataFrame) -> pd.DataFrame:
     for key, (label, unit) in measures_in(table).items():
         diff = (law[key].astype(float) - base[key].astype(float)).dropna()
         for share, d in diff.groupby(level=0):
-            ci = mean_ci(d.to_numpy(float))
+            ci = finite_ci(d.to_numpy(float))
+            if ci is None:
+                continue
             rows.append({"share": share, "measure": label, "unit": unit,
                          "etc_minus_open": ci.mean, "low": ci.low, "high": ci.high,
                          "n": ci.n})
@@ -225,10 +242,12 @@ def share_sweep(directory: Path, seeds: list[int] | None, with_open: bool = Fals
     data = [tomllib.loads(f.read_text(encoding="utf-8")) for f in files]
     base = _flat(data[0])
     sets = [{k: v for k, v in _flat(d).items() if base.get(k) != v} for d in data]
-    axes = [{"name": SHARE, "values": [float(v) for v in rows["av_share"]], "set": sets}]
-    if with_open:
-        axes.append({"name": CONTROLLER, "values": [LAW, BASELINE],
-                     "set": [{"run.controller": c} for c in (LAW, BASELINE)]})
+    # the controller axis is there with the ETC alone too, so that its runs keep their
+    # IDs (and records) whether or not the open loop runs beside them
+    controllers = (LAW, BASELINE) if with_open else (LAW,)
+    axes = [{"name": SHARE, "values": [float(v) for v in rows["av_share"]], "set": sets},
+            {"name": CONTROLLER, "values": list(controllers),
+             "set": [{"run.controller": c} for c in controllers]}]
     return study_spec(SHARE_SWEEP, files[0], seeds=seeds or list(range(1, 11)),
                       set={"sumo.drain_max_s": 0, "run.controller": LAW}, axis=axes)
 
@@ -324,9 +343,10 @@ def _write(tables: dict[str, pd.DataFrame], out: Path, opts: PenetrationOptions)
     """Each sweep's CSV (levels and slopes), the figure and the page; return the text."""
     files = []
     for name, table in tables.items():
-        law = of_controller(table, LAW)
+        law, base = of_controller(table, LAW), of_controller(table, BASELINE)
         files.append(write_csv(pd.concat([level_table(law).assign(kind="level"),
                                           slope_table(law).assign(kind="slope"),
+                                          level_table(base).assign(kind="level_open"),
                                           paired_table(table).assign(kind="paired")]),
                                out / f"{name}.csv"))
     text = report(tables)

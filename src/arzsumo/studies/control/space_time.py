@@ -1,24 +1,28 @@
-"""SUMO's stop-and-go under two controllers on one seed, side by side (``arzsumo study
+"""SUMO's stop-and-go under a few controllers on one seed, side by side (``arzsumo study
 space-time``).
 
 The control study's tables and paired figures say how much a law changes the waves over
-many seeds; they do not show a wave. This study runs a few controllers of one seed of
-one experiment exactly as the control study runs them (the same scenario, experiment and
-seed: the same SUMO run, up to the start of control the same run for every controller),
+many seeds; they do not show a wave. This study runs two to four controllers of one seed
+of one experiment as the control study runs them (at the scenario's warm-up and horizon,
+the same SUMO runs; up to the start of control the same run for every controller),
 keeps each run's results (``OUT/<experiment>-seed<N>/<controller>/``, as ``arzsumo run``
 writes them) and draws SUMO's Edie cells of the control window per class on shared
-colour scales (``OUT/space_time_<experiment>_seed<N>_{hv,av}.png``): density above,
-speed below, one column per controller, so the stop-and-go and what a law does to it can
-be seen. A later call with the same ``--out`` reuses the runs it finds.
+colour scales (``OUT/space_time_<experiment>_seed<N>_{hv,av}.png``; an overridden
+warm-up or horizon is named in both, ``_w60_h20``): density above, speed below, one
+column per controller in the order given, so the stop-and-go and what a law does to it
+can be seen. A later call with the same ``--out`` reuses the runs it finds.
 """
 
 from __future__ import annotations
 
 import logging
+import math
+import re
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
+from arzsumo.control.registry import controller_names
 from arzsumo.errors import require
 from arzsumo.io import dump_toml
 from arzsumo.outdir import resumable_dir
@@ -28,7 +32,6 @@ from arzsumo.scenario import Scenario
 from arzsumo.studies import checks
 from arzsumo.studies.common import RESULTS_DIR, StudyError, scenario_data
 from arzsumo.studies.control.study import ALL_EXPERIMENTS, experiment_scenario
-from arzsumo.sweep.evaluate import check_controllers
 from arzsumo.sweep.spec import deciding
 
 log = logging.getLogger(__name__)
@@ -41,15 +44,15 @@ CLASSES = (("hv", "HVs"), ("av", "AVs"))
 
 
 @dataclass(frozen=True)
-class SpaceTimeOptions(checks.Shared):
+class SpaceTimeOptions:
     """What ``arzsumo study space-time`` runs.
 
     ``scenario``: the base scenario file (None: the shipped default); ``seed``: the SUMO
-    seed; ``controllers``: two to four of the control study's, drawn left to right;
+    seed; ``controllers``: two to four distinct SUMO controllers, drawn left to right;
     ``experiment``: one of the control study's; ``warmup``, ``horizon``: s (None: the
-    scenario's; shorter only for a quick look, the runs are then not the study's);
-    ``out``: the study's directory (resumable); ``docs``, ``page``: the page to
-    regenerate (None: none); ``progress``: a line per run.
+    scenario's; with others the runs are not the control study's); ``out``: the study's
+    directory (resumable); ``docs``, ``page``: the page to regenerate (None: none);
+    ``progress``: a line per run.
     """
 
     scenario: Path | None = None
@@ -59,16 +62,24 @@ class SpaceTimeOptions(checks.Shared):
     warmup: float | None = None
     horizon: float | None = None
     out: Path = RESULTS_DIR / NAME
+    docs: Path | None = None
     page: str = PAGE
     progress: bool = True
 
     def __post_init__(self) -> None:
-        super().__post_init__()
-        object.__setattr__(self, "controllers", tuple(check_controllers(
-            list(self.controllers))))
+        allowed = controller_names("sumo")
         require(2 <= len(self.controllers) <= 4
-                and len(set(self.controllers)) == len(self.controllers), "controllers",
-                self.controllers, "two to four distinct controllers", StudyError)
+                and len(set(self.controllers)) == len(self.controllers)
+                and all(c in allowed for c in self.controllers), "controllers",
+                ",".join(self.controllers),
+                f"two to four distinct of {', '.join(allowed)}", StudyError)
+        require(self.warmup is None or (math.isfinite(self.warmup) and self.warmup >= 0),
+                "warmup", self.warmup, "a warm-up >= 0 s", StudyError)
+        require(self.horizon is None or (math.isfinite(self.horizon)
+                                         and self.horizon > 0),
+                "horizon", self.horizon, "a horizon > 0 s", StudyError)
+        require(re.fullmatch(r"[A-Za-z0-9_-]+", self.page) is not None, "page",
+                self.page, "a page name of letters, digits, '_' and '-'", StudyError)
         checks.all_among((self.experiment,), ALL_EXPERIMENTS, "experiment")
         require(0 <= self.seed < 2**31, "seed", self.seed, "a seed in [0, 2^31)",
                 StudyError)
@@ -95,8 +106,9 @@ def run_space_time(opts: SpaceTimeOptions) -> SpaceTimeResult:
     base = scenario_data(opts.base)
     data = experiment_scenario(base, opts.experiment)
     sc = scenario_from_dict(data, str(opts.base))
-    label = f"{opts.experiment}-seed{opts.seed}" + "".join(
-        f"-{k}{v:g}" for k, v in (("w", opts.warmup), ("h", opts.horizon)) if v is not None)
+    times = "".join(f"_{k}{v:g}" for k, v in (("w", opts.warmup), ("h", opts.horizon))
+                    if v is not None)
+    label = f"{opts.experiment}-seed{opts.seed}{times}"
     with resumable_dir(opts.out, f"study-{NAME}") as out:
         runs = {c: _run(sc, dump_toml(data), c, opts, out / label / c)
                 for c in opts.controllers}
@@ -106,8 +118,8 @@ def run_space_time(opts: SpaceTimeOptions) -> SpaceTimeResult:
         if len(drawn) != len(CLASSES):
             raise StudyError(f"the runs in {out / label} are not on one grid of cells: "
                              "no figure (remove the directory and run again)")
-        figures = tuple(p.replace(out / f"space_time_{opts.experiment}_seed{opts.seed}_"
-                                        f"{name}.png")
+        figures = tuple(p.replace(out / f"space_time_{opts.experiment}_seed{opts.seed}"
+                                        f"{times}_{name}.png")
                         for p, (name, _) in zip(drawn, CLASSES, strict=True))
         body = _page(opts, str(base.get("name", opts.base.stem)), figures, runs)
         write_text(body, out / "space_time.md")
@@ -180,8 +192,11 @@ def _page(opts: SpaceTimeOptions, scenario: str, figures: tuple[Path, ...],
           runs: dict[str, Path]) -> str:
     """The page's block: the command, the seed's measures and the figures."""
     names = ",".join(opts.controllers)
+    times = "".join(f" --{k} {v:g}" for k, v in (("warmup", opts.warmup),
+                                                  ("horizon", opts.horizon))
+                    if v is not None)
     cmd = (f"arzsumo study {NAME} --scenario {opts.base} --seed {opts.seed} "
-           f"--controllers {names} --experiment {opts.experiment}")
+           f"--controllers {names} --experiment {opts.experiment}{times}")
     shown = "\n".join(f"![{opts.experiment}, seed {opts.seed}: {word}]({opts.page}/"
                       f"{f.name})" for f, (_, word) in zip(figures, CLASSES, strict=True))
     return (f"SUMO's Edie cells over the control window of {scenario}, "
