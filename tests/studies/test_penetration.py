@@ -47,6 +47,8 @@ def test_a_seed_with_one_share_has_no_slope():
     ((1.0, 9.0), (2.0, 8.0), "no"),            # more triggers with more AVs
     ((-9.0, -1.0), (-8.0, -2.0), "no"),        # shorter release
     ((-9.0, 1.0), (2.0, 8.0), "not resolved"),
+    ((0.0, 0.0), (0.0, 0.0), "no"),            # flat: the same at every share
+    ((0.0, 0.0), (2.0, 8.0), "no"),
 ])
 def test_the_verdict_reads_both_intervals(trig, rel, expected):
     def ci(lo, hi):
@@ -58,6 +60,10 @@ def test_the_paper_direction_is_found_through_seed_noise_and_its_opposite_refuse
     assert pen.claim_text(_sweep(-20.0, 20.0, noise=5.0))[1] == "yes"
     assert pen.claim_text(_sweep(+20.0, -20.0, noise=5.0))[1] == "no"
     assert pen.claim_text(_sweep(0.0, 0.0, noise=5.0))[1] == "not resolved"
+    # an ETC that updates once at every share: a slope of exactly 0, refused
+    flat = _sweep(0.0, 0.0).assign(triggers=1.0, release_time=449.0)
+    assert pen.seed_slopes(flat, "triggers").tolist() == [0.0] * 10
+    assert pen.claim_text(flat)[1] == "no"
 
 
 def test_the_tables_hold_every_share_and_the_slopes_with_both_intervals():
@@ -93,11 +99,13 @@ def test_seeds_replace_the_sweep_files_own_and_keep_the_shares():
 
 
 def test_the_figure_draws_every_seed_and_the_mean_per_panel():
-    from arzsumo.plots.penetration import PANELS, penetration_figure
+    from arzsumo.plots.penetration import PANELS, WAVE_PANELS, penetration_figure
 
     table = _sweep(-12.5, 7.0, noise=2.0, seeds=4)
     fig = penetration_figure({"ETC": table, "ETC with the dead band": table})
-    assert len(fig.axes) == len(PANELS)
+    assert len(fig.axes) == len(PANELS)          # records without the wave measures
+    waves = table.assign(**dict.fromkeys(WAVE_PANELS, 1.0))
+    assert len(penetration_figure({"ETC": waves}).axes) == len(PANELS) + len(WAVE_PANELS)
     for ax in fig.axes:
         means = [line for line in ax.lines if line.get_marker() == "o"]
         thin = [line for line in ax.lines if line.get_alpha() == 0.25]

@@ -90,8 +90,8 @@ def seed_slopes(table: pd.DataFrame, key: str) -> pd.Series:
     out = {}
     for seed, g in table.dropna(subset=[key]).groupby("seed"):
         x, y = g[SHARE].to_numpy(float), g[key].to_numpy(float)
-        if np.unique(x).size >= 2:
-            out[seed] = float(np.polyfit(x, y, 1)[0]) * PER
+        if np.unique(x).size >= 2:      # a constant measure's slope is 0, not round-off
+            out[seed] = float(np.polyfit(x, y, 1)[0]) * PER if np.ptp(y) > 0 else 0.0
     return pd.Series(out, name=key, dtype=float)
 
 
@@ -139,13 +139,19 @@ def slope_table(table: pd.DataFrame) -> pd.DataFrame:
 
 def verdict(triggers: MeanCI, release: MeanCI) -> str:
     """The paper's direction (fewer triggers, longer release with more AVs): "yes" when
-    both intervals lie on its side of zero, "no" when either lies on the other side,
-    else "not resolved"."""
+    both intervals lie on its side of zero, "no" when either lies on the other side or
+    is exactly zero (a measure that does not move with the share at all, e.g. an ETC
+    that updates once at every share), else "not resolved"."""
     if triggers.high < 0 < release.low:
         return "yes"
-    if triggers.low > 0 or release.high < 0:
+    if triggers.low > 0 or release.high < 0 or _exactly_zero(triggers) \
+            or _exactly_zero(release):
         return "no"
     return "not resolved"
+
+
+def _exactly_zero(ci: MeanCI) -> bool:
+    return ci.low == ci.high == 0.0
 
 
 def claim_text(table: pd.DataFrame) -> tuple[str, str]:
@@ -354,7 +360,7 @@ def _write(tables: dict[str, pd.DataFrame], out: Path, opts: PenetrationOptions)
         from arzsumo.outputs.penetration import write_penetration_figure
 
         drawn = {TITLES[n]: of_controller(t, LAW) for n, t in tables.items()}
-        drawn |= {f"open loop, {TITLES[n]}": of_controller(t, BASELINE)
+        drawn |= {f"the open loop on the same seeds ({n})": of_controller(t, BASELINE)
                   for n, t in tables.items() if not of_controller(t, BASELINE).empty}
         inflow = ("each share at its own mapped demand" if opts.share_models is not None
                   else "equal inflow")
