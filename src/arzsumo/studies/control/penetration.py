@@ -360,8 +360,9 @@ def _write(tables: dict[str, pd.DataFrame], out: Path, opts: PenetrationOptions)
         from arzsumo.outputs.penetration import write_penetration_figure
 
         drawn = {TITLES[n]: of_controller(t, LAW) for n, t in tables.items()}
-        drawn |= {f"the open loop on the same seeds ({n})": of_controller(t, BASELINE)
-                  for n, t in tables.items() if not of_controller(t, BASELINE).empty}
+        opened = {n: of_controller(t, BASELINE) for n, t in tables.items()}
+        drawn |= {f"the open loop on the same seeds ({n})": t
+                  for n, t in opened.items() if not t.empty}
         inflow = ("each share at its own mapped demand" if opts.share_models is not None
                   else "equal inflow")
         files.append(write_penetration_figure(out, drawn, inflow))

@@ -26,7 +26,7 @@ from arzsumo.control.registry import controller_names
 from arzsumo.errors import require
 from arzsumo.io import dump_toml
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.studies import publish, write_text
+from arzsumo.outputs.studies import markdown_table, publish, write_text
 from arzsumo.resources import default_scenario
 from arzsumo.scenario import Scenario
 from arzsumo.studies import checks
@@ -110,8 +110,8 @@ def run_space_time(opts: SpaceTimeOptions) -> SpaceTimeResult:
                     if v is not None)
     label = f"{opts.experiment}-seed{opts.seed}{times}"
     with resumable_dir(opts.out, f"study-{NAME}") as out:
-        runs = {c: _run(sc, dump_toml(data), c, opts, out / label / c)
-                for c in opts.controllers}
+        text = dump_toml(data)
+        runs = {c: _run(sc, text, c, opts, out / label / c) for c in opts.controllers}
         eq = sc.equilibrium
         drawn = field_figures([f"{c} s{opts.seed}" for c in runs], list(runs.values()),
                               (eq.rho_h, eq.v_h, eq.rho_a, eq.v_a), out / label)
@@ -163,18 +163,16 @@ def seed_table(runs: dict[str, Path]) -> str:
     """Markdown: per controller the seed's :data:`MEASURES`, read from its summary."""
     import json
 
-    def value(summ: dict, key: str) -> str:
-        for part in key.split("."):
-            summ = summ.get(part, {}) if isinstance(summ, dict) else {}
-        return f"{summ:.3g}" if isinstance(summ, int | float) else "-"
+    import pandas as pd
 
-    summaries = {c: json.loads((p / "summary.json").read_text(encoding="utf-8"))
-                 for c, p in runs.items()}
-    lines = ["| controller | " + " | ".join(label for _, label in MEASURES) + " |",
-             "|---" * (1 + len(MEASURES)) + "|"]
-    lines += [f"| {c} | " + " | ".join(value(s, k) for k, _ in MEASURES) + " |"
-              for c, s in summaries.items()]
-    return "\n".join(lines)
+    from arzsumo.sweep.table import flatten
+
+    rows = []
+    for controller, path in runs.items():
+        flat = flatten(json.loads((path / "summary.json").read_text(encoding="utf-8")))
+        rows.append({"controller": controller,
+                     **{label: flat.get(key) for key, label in MEASURES}})
+    return markdown_table(pd.DataFrame(rows), floats=".3g")
 
 
 def same_tables(kept: str, text: str) -> bool:
