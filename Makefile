@@ -11,9 +11,9 @@ STAMP  := $(VENV)/.installed
 
 .PHONY: run results test lint bench clean
 
-$(STAMP): pyproject.toml
+$(STAMP): pyproject.toml research/pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --disable-pip-version-check -e '.[test]'
+	$(BIN)/python -m pip install --quiet --disable-pip-version-check -e '.[test]' -e research
 	touch $(STAMP)
 
 RUN_OUT := results/default-etc-seed42-h450s
@@ -26,22 +26,27 @@ run: $(STAMP)
 
 # the judged result: the control and penetration studies' tables, reported from the runs
 # the committed record store holds (made earlier; nothing runs now, seconds)
-RECORDS := docs/readings/control_default/records
+RECORDS := research/readings/control_default/records
 STUDIES := results/studies
 
 results: $(STAMP)
 	@echo "make results: the control and penetration studies, reported from the runs in"
-	@echo "$(RECORDS)/ (made earlier; nothing runs now)"
+	@echo "$(RECORDS)/ (made earlier; nothing runs now); the headline rows:"
+	@mkdir -p $(STUDIES)
 	@$(BIN)/arzsumo study control --report --scenario scenarios/default_power_law.toml \
 		--seeds 1-20 --records $(RECORDS) --quiet \
-		--out $(STUDIES)/control
+		--out $(STUDIES)/control > $(STUDIES)/control.md
 	@$(BIN)/arzsumo study penetration --report --records $(RECORDS) --quiet \
-		--out $(STUDIES)/penetration
-	@echo "make results: tables and figures in $(STUDIES)/control/ and $(STUDIES)/penetration/"
-	@echo "(what they say: docs/readings/current_result.md)"
+		--out $(STUDIES)/penetration > $(STUDIES)/penetration.md
+	@head -n 1 $(STUDIES)/control.md
+	@grep -E '^\| (measure|---|whole-demand time spent, total) ' $(STUDIES)/control.md
+	@awk '/section-5 claims/ {f = 1} f {print} f && /^$$/ && n++ {exit}' $(STUDIES)/control.md
+	@echo "make results: every table in $(STUDIES)/control.md and $(STUDIES)/penetration.md,"
+	@echo "figures in $(STUDIES)/control/ and $(STUDIES)/penetration/ (what they say:"
+	@echo "research/readings/current_result.md)"
 
 test: $(STAMP)
-	$(BIN)/ruff check src tests benchmarks
+	$(BIN)/ruff check src tests benchmarks research
 	$(BIN)/lint-imports
 	$(BIN)/python -m pytest -q -n 2
 
@@ -58,7 +63,7 @@ bench: $(STAMP)
 	OPENBLAS_NUM_THREADS=1 $(BIN)/python benchmarks/bench_twin.py --quick
 
 lint: $(STAMP)
-	$(BIN)/ruff check src tests benchmarks
+	$(BIN)/ruff check src tests benchmarks research
 
 clean:
 	rm -rf $(VENV) .pytest_cache .ruff_cache build src/*.egg-info

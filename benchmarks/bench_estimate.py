@@ -25,9 +25,9 @@ from arzsumo.estimate.enkf import BoundaryInput, EnkfOptions, EnsembleKalmanFilt
 from arzsumo.estimate.observations import LoopNoise, ProbeNoise
 from arzsumo.estimate.smoothing import CausalSmoother
 from arzsumo.estimate.synthetic import sample_loops, sample_probes
+from arzsumo.pde import InitialCondition, SolverOptions, TwinStepper, initial_fields
+from arzsumo.pde.state import cell_centres
 from arzsumo.scenario import load_scenario
-from arzsumo.twin import InitialCondition, SolverOptions, TwinStepper, initial_fields
-from arzsumo.twin.state import cell_centres
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -17,9 +17,9 @@ import time
 import numpy as np
 
 from arzsumo.model import PRESETS, equilibrium_from_densities
-from arzsumo.twin import InitialCondition, SolverOptions, initial_fields, simulate
-from arzsumo.twin.metrics import deviation_norm
-from arzsumo.twin.state import cell_centres
+from arzsumo.pde import InitialCondition, SolverOptions, initial_fields, simulate
+from arzsumo.pde.metrics import deviation_norm
+from arzsumo.pde.state import cell_centres
 
 GOAL = 500.0
 

@@ -1,5 +1,5 @@
 """``benchmarks/`` holds benchmarks only (``bench_*.py``; the studies live in
-:mod:`arzsumo.studies`), and every benchmark prints a ratio: against a reference, the
+:mod:`arzsumo_studies`), and every benchmark prints a ratio: against a reference, the
 bare component or real time."""
 
 from __future__ import annotations

@@ -43,7 +43,7 @@ def test_the_readme_leads_with_make_run_and_make_test_and_names_make_results() -
     commands = re.findall(r"^make (\w+)", readme, flags=re.MULTILINE)
     assert commands[:2] == ["run", "test"]
     paragraph = next(p for p in readme.split("\n\n") if p.startswith("`make results`"))
-    for folder in ("docs/readings/control_default/records/", "results/studies/control/",
+    for folder in ("research/readings/control_default/records/", "results/studies/control/",
                    "results/studies/penetration/"):
         assert folder in paragraph
 
@@ -54,13 +54,13 @@ def test_the_stored_studies_are_current_under_the_scenario_make_results_names(
     recipe names: a record counts only while its fingerprint (what decides its numbers,
     not the scenario's name) is that scenario's, so an edit of ``default_power_law.toml``
     that moved a number would leave the report incomplete here."""
-    from arzsumo.cli.catalog import STUDIES
-    from tests.studies.conftest import parse
+    from arzsumo_studies.cli.catalog import STUDIES
+    from research.tests.studies.conftest import parse
 
     control = next(c for c in recipe("results") if "study control" in c)
     scenario = control.split("--scenario ")[1].split()[0]
     assert scenario == "scenarios/default_power_law.toml"
-    store = ROOT / "docs" / "readings" / "control_default" / "records"
+    store = ROOT / "research" / "readings" / "control_default" / "records"
     for name, argv in (("control", ["--scenario", str(ROOT / scenario), "--seeds", "1-20"]),
                        ("penetration", [])):
         args = parse(name, *argv, "--report", "--records", str(store), "--quiet",

@@ -12,7 +12,6 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
-from arzsumo import __version__
 from arzsumo.cli import main
 from arzsumo.schema import (
     CELLS,
@@ -29,6 +28,7 @@ from arzsumo.schema import (
 )
 from arzsumo.sweep import run_sweep, sweep_from_dict
 from arzsumo.sweep.table import flatten, table_columns
+from arzsumo.version import __version__
 from tests.twin.test_config_cli import SHORT
 
 ROOT = Path(__file__).resolve().parents[1]

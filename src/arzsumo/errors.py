@@ -40,6 +40,10 @@ class ScenarioError(ArzsumoError, ValueError):
     """An invalid scenario file, key or value."""
 
 
+class EnvError(ArzsumoError, ValueError):
+    """A bad keyword argument or action of a Gymnasium environment (:mod:`arzsumo.gym`)."""
+
+
 class DemandError(ModelError):
     """A traffic demand the fundamental diagram cannot carry."""
 

@@ -29,9 +29,9 @@ from collections.abc import Iterator
 from pathlib import Path
 from types import TracebackType
 
-from arzsumo import __version__
 from arzsumo.errors import ArzsumoError
 from arzsumo.io import DIR_MODE
+from arzsumo.version import __version__
 
 #: marker file in every results directory
 MARKER = ".arzsumo-result"

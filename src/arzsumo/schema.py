@@ -21,7 +21,7 @@ from typing import NamedTuple
 
 import pyarrow as pa
 
-from arzsumo import __version__
+from arzsumo.version import __version__
 
 #: the note stored with every table
 UNITS_NOTE = ("SI units (veh, m, s); per-column unit and description in the field "

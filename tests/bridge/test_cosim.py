@@ -79,7 +79,7 @@ def _paper_indices_from_cells(path: Path, scenario) -> dict[str, float]:
     from cells.parquet alone: the SUMO cells pivoted to (t, x), empty cells' speeds given
     the equilibrium speed at their densities, integrals by numpy's trapezoid in time."""
     from arzsumo.bridge.estimator import fill_speeds
-    from arzsumo.twin.metrics import B_FUEL
+    from arzsumo.pde.metrics import B_FUEL
 
     cells = pd.read_parquet(path / "cells.parquet")
     micro = cells[cells["source"] == "micro"]

@@ -6,7 +6,6 @@ from __future__ import annotations
 import contextlib
 import io
 import math
-import tempfile
 import tomllib
 from pathlib import Path
 
@@ -176,14 +175,12 @@ def _mutate(data: dict, ops) -> dict:
     return data
 
 
-_TMP = Path(tempfile.mkdtemp(prefix="arzsumo-hypothesis-"))
-
-
 @settings(max_examples=200, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow])
 @given(st.lists(mutation, min_size=1, max_size=4))
-def test_run_validation_accepts_or_refuses_in_one_line(ops):
-    path = _TMP / "mutated.toml"
+def test_run_validation_accepts_or_refuses_in_one_line(tmp_path_factory, ops):
+    # pytest's session directory, removed with the others (nothing left behind at import)
+    path = tmp_path_factory.getbasetemp() / "mutated.toml"
     path.write_text(dump_toml(_mutate(BASE, ops)), encoding="utf-8")
     code, out, err = _run_cli("run", str(path), "--dry-run")   # any traceback fails here
     if code == 0:

@@ -8,14 +8,16 @@ import subprocess
 import sys
 from pathlib import Path
 
-from arzsumo import __version__
 from arzsumo.cli import main
+from arzsumo.version import __version__
 
 PACKAGE = Path(__file__).resolve().parents[2] / "src" / "arzsumo"
-#: the commands of ``arzsumo --help``, in order
-COMMANDS = ["model", "kernels", "verify", "design-check", "twin", "reproduce", "build-net",
-            "calibrate", "run", "compare", "alinea-target", "sweep", "evaluate", "premise",
-            "identify", "list", "study"]
+#: the tool's commands of ``arzsumo --help``, in order: a run first
+TOOL = ["run", "compare", "evaluate", "sweep", "twin", "reproduce", "model", "kernels",
+        "verify", "design-check", "identify", "build-net", "calibrate", "alinea-target",
+        "list"]
+#: then the commands of the installed research package (entry points ``arzsumo.commands``)
+COMMANDS = [*TOOL, "premise", "study"]
 
 
 def test_the_cli_is_a_package_and_no_flat_module_is_left():
@@ -29,6 +31,19 @@ def test_help_lists_every_command_in_order(capsys):
     block = text.split("  COMMAND\n", 1)[1].split("\noptions:")[0]
     listed = re.findall(r"^    (\S+)", block, flags=re.MULTILINE)
     assert listed == COMMANDS
+
+
+def test_without_the_research_package_the_tool_lists_its_own_commands(capsys, monkeypatch):
+    import arzsumo.cli as cli
+
+    monkeypatch.setattr(cli, "plugin_registers", lambda: [])
+    assert main(["--help"]) == 0
+    text = capsys.readouterr().out
+    block = text.split("  COMMAND\n", 1)[1].split("\noptions:")[0]
+    assert re.findall(r"^    (\S+)", block, flags=re.MULTILINE) == TOOL
+    assert text.rstrip().endswith("arzsumo twin default --controller backstepping --out "
+                                  "results/twin-bs")
+    assert main(["study", "control"]) == 2           # refused by the parser: unknown command
 
 
 def test_python_m_arzsumo_runs_the_cli():

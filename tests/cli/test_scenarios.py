@@ -9,8 +9,9 @@ from pathlib import Path
 
 import pytest
 
+from arzsumo.api.scenarios import scenario_file, sweep_file
+from arzsumo.bridge.session import check_warmup
 from arzsumo.cli import main
-from arzsumo.cli.scenarios import check_warmup, scenario_file, sweep_file
 from arzsumo.errors import ScenarioError
 from arzsumo.resources import shipped_named, shipped_scenarios_dir
 from arzsumo.scenario import load_scenario

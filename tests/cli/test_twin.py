@@ -7,8 +7,8 @@ import json
 
 import pytest
 
+from arzsumo.api.runs import twin_controller as twin_controller_of
 from arzsumo.cli import main
-from arzsumo.cli.twin import twin_controller_of
 from arzsumo.scenario import scenario_from_dict
 
 BASE = {"model": {"preset": "paper_base"},

@@ -16,9 +16,9 @@ import pytest
 
 from arzsumo.model.characteristic import linearize
 from arzsumo.model.equilibrium import Equilibrium
+from arzsumo.pde import InitialCondition, Inlet, SolverOptions, TwinStepper, initial_fields
+from arzsumo.pde.state import cell_centres
 from arzsumo.scenario import load_scenario
-from arzsumo.twin import InitialCondition, Inlet, SolverOptions, TwinStepper, initial_fields
-from arzsumo.twin.state import cell_centres
 
 ROOT = Path(__file__).resolve().parents[2]
 HORIZON = 300

@@ -9,8 +9,8 @@ import pytest
 
 from arzsumo.estimate.batch import BatchStepper, project
 from arzsumo.model.characteristic import linearize
-from arzsumo.twin import Inlet, SolverOptions, TwinStepper
-from arzsumo.twin.state import to_conserved, to_primitive
+from arzsumo.pde import Inlet, SolverOptions, TwinStepper
+from arzsumo.pde.state import to_conserved, to_primitive
 from tests.estimate.conftest import default_eq
 
 

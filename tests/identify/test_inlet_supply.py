@@ -13,9 +13,9 @@ from arzsumo.identify.synthetic import SyntheticRun, synthetic_data
 from arzsumo.model import ModelParameters
 from arzsumo.model.equilibrium import Equilibrium
 from arzsumo.model.fd import area_occupancy, speed_of_ao
-from arzsumo.twin import SolverOptions, TwinStepper, TwinStoppedError
-from arzsumo.twin.state import total_vehicles
-from arzsumo.twin.supply import ReceivingCapacity
+from arzsumo.pde import SolverOptions, TwinStepper, TwinStoppedError
+from arzsumo.pde.state import total_vehicles
+from arzsumo.pde.supply import ReceivingCapacity
 
 #: the two-stage identification's smoothed-Newell diagram (equal jam occupancies) with
 #: almost no relaxation, as stage 2 found it

@@ -5,12 +5,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from arzsumo_studies.measures.wave_match import wave_matched
 
 from arzsumo.errors import ModelError, ScenarioError
 from arzsumo.model import PRESETS, ModelParameters, characteristic_speeds
 from arzsumo.model.fd import area_occupancy, speed_of_ao, speed_terms_of_ao
 from arzsumo.model.params import FAMILIES
-from arzsumo.model.wave_match import wave_matched
 from arzsumo.scenario import scenario_from_dict
 from tests.conftest import NEWELL_CHANGES
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import pandas as pd
 
 from arzsumo.outputs.evaluation import FIGURE, write_evaluation
-from arzsumo.outputs.studies import (
+from arzsumo.outputs.pages import (
     END,
     markdown_table,
     merged_page,

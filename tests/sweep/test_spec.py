@@ -80,6 +80,8 @@ def test_one_at_a_time_group_and_multi_field_axis():
      r"value \[0.1\] is not allowed: a number, string or boolean"),
     ({"engine": "vissim"}, 'engine = "vissim" is not allowed: one of twin, sumo'),
     ({"seeds": [1, -1]}, r"seeds = \[1, -1\] is not allowed"),
+    ({"seeds": 0}, r"seeds = 0 is not allowed: a count N >= 1 \(seeds 1..N\)"),
+    ({"seeds": True}, r"seeds = true is not allowed"),
     ({"sets": {}}, "unknown key 'sets'"),
     ({"base": 3}, r"base = 3 is not allowed: a path \(a string\)"),
     ({"description": ["x"]}, r'description = \["x"\] is not allowed: a string'),
@@ -92,6 +94,11 @@ def test_one_at_a_time_group_and_multi_field_axis():
 def test_bad_sweep_files_name_the_key_and_value(data, match):
     with pytest.raises(SweepError, match=match):
         spec_of(**data)
+
+
+def test_a_count_of_seeds_means_seeds_one_to_n():
+    spec = spec_of(seeds=50)
+    assert [dict(r.columns)["seed"] for r in spec.runs()] == list(range(1, 51))
 
 
 def test_shipped_sweep_files_load_and_expand():

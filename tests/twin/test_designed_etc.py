@@ -13,9 +13,9 @@ from arzsumo.control.design import design_for
 from arzsumo.control.etc import PAPER_DESIGN, EventTriggered, noise_dead_band
 from arzsumo.control.kernels import solve_kernels
 from arzsumo.model import linearize
+from arzsumo.pde.initial import InitialCondition, initial_fields
+from arzsumo.pde.solver import SolverOptions, simulate
 from arzsumo.scenario import load_scenario
-from arzsumo.twin.initial import InitialCondition, initial_fields
-from arzsumo.twin.solver import SolverOptions, simulate
 
 ROOT = Path(__file__).resolve().parents[2]
 #: sd of the scaled Riemann variables' fast noise on the smoothed estimate in SUMO

@@ -8,9 +8,9 @@ from arzsumo.control.backstepping import StateMap
 from arzsumo.control.base import MacroState
 from arzsumo.control.plant import LinearPlant
 from arzsumo.model import PRESETS, equilibrium_from_densities, linearize
-from arzsumo.twin.initial import InitialCondition, initial_fields
-from arzsumo.twin.solver import SolverOptions, simulate
-from arzsumo.twin.state import cell_centres
+from arzsumo.pde.initial import InitialCondition, initial_fields
+from arzsumo.pde.solver import SolverOptions, simulate
+from arzsumo.pde.state import cell_centres
 
 
 def test_small_perturbations_follow_the_linear_plant():

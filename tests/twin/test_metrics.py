@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from arzsumo.control.events import release_time
-from arzsumo.twin.metrics import (
+from arzsumo.pde.metrics import (
     B_FUEL,
     acceleration,
     deviation_norm,

@@ -12,8 +12,8 @@ import itertools
 import numpy as np
 import pytest
 
-from arzsumo.twin import InitialCondition, SolverOptions, initial_fields, simulate
-from arzsumo.twin.state import cell_centres
+from arzsumo.pde import InitialCondition, SolverOptions, initial_fields, simulate
+from arzsumo.pde.state import cell_centres
 
 T = 40.0
 AMP = 0.01

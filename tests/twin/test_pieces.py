@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from arzsumo.errors import ModelError
-from arzsumo.twin import InitialCondition, Inlet, initial_fields, outlet_flux
-from arzsumo.twin.flux import (
+from arzsumo.pde import InitialCondition, Inlet, initial_fields, outlet_flux
+from arzsumo.pde.flux import (
     FLUXES,
     LIMITERS,
     muscl_faces,
@@ -17,8 +17,8 @@ from arzsumo.twin.flux import (
     state_speeds,
     waves,
 )
-from arzsumo.twin.source import relax
-from arzsumo.twin.state import (
+from arzsumo.pde.source import relax
+from arzsumo.pde.state import (
     cell_centres,
     domain_violation,
     from_macro_state,

@@ -7,9 +7,9 @@ import pytest
 
 from arzsumo.control.base import ConstantControl, Controller, MacroState
 from arzsumo.errors import ModelError
-from arzsumo.twin import InitialCondition, SolverOptions, initial_fields, simulate
-from arzsumo.twin.metrics import deviation_norm
-from arzsumo.twin.state import cell_centres, total_vehicles
+from arzsumo.pde import InitialCondition, SolverOptions, initial_fields, simulate
+from arzsumo.pde.metrics import deviation_norm
+from arzsumo.pde.state import cell_centres, total_vehicles
 
 
 def _init(eq, cells=200, **ic):
@@ -143,7 +143,7 @@ def test_options_validate_themselves():
 
 def test_inlet_demand_series_sets_the_inflow(base_lin):
     """A class-demand ramp at the inlet: the vehicles entering are its integral."""
-    from arzsumo.twin import Inlet
+    from arzsumo.pde import Inlet
 
     eq = base_lin.equilibrium
     inlet = Inlet.from_demands(base_lin, np.array([0.0, 30.0, 60.0]),
@@ -158,7 +158,7 @@ def test_inlet_demand_series_sets_the_inflow(base_lin):
 
 def test_stepper_advances_and_can_be_reset_from_fields(base_eq):
     """The bridge's building block: advance with a held U, read and replace the state."""
-    from arzsumo.twin import TwinStepper, TwinStoppedError
+    from arzsumo.pde import TwinStepper, TwinStoppedError
 
     eq = base_eq
     st = TwinStepper(eq, _init(eq, cells=100, amplitude=0.02), SolverOptions(cells=100))

@@ -7,7 +7,7 @@ import pytest
 
 from arzsumo.model import PRESETS
 from arzsumo.model.fd import equilibrium_speeds
-from arzsumo.twin.supply import ReceivingCapacity
+from arzsumo.pde.supply import ReceivingCapacity
 
 #: equal jam occupancies (as the two-stage identification gives them)
 NEWELL = {"family": "newell", "ao_max_h": 0.6728, "ao_max_a": 0.6728,

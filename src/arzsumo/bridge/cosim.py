@@ -48,7 +48,7 @@ import math
 import shutil
 import tempfile
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -77,6 +77,8 @@ from arzsumo.evaluation.decay import stationary_reference
 from arzsumo.model.characteristic import Linearization, linearize
 from arzsumo.model.equilibrium import Equilibrium
 from arzsumo.model.params import ModelParameters
+from arzsumo.pde.solver import SolverOptions
+from arzsumo.pde.state import cell_centres
 from arzsumo.progress import Progress, RunProgress
 from arzsumo.scenario import Scenario
 from arzsumo.scenario.run import RunSettings
@@ -89,8 +91,6 @@ from arzsumo.sumo.run_files import FCD_FILE, RunFiles
 from arzsumo.sumo.sensor import PeriodMeasurement
 from arzsumo.sumo.simulation import SumoSimulation, open_simulation
 from arzsumo.sumo.window import NetworkMeasures, WindowStart, measure_network
-from arzsumo.twin.solver import SolverOptions
-from arzsumo.twin.state import cell_centres
 from arzsumo.units import ms_to_kmh
 
 log = logging.getLogger(__name__)
@@ -210,10 +210,10 @@ def warm_start(sim: SumoSimulation, run: PreparedRun, bar: RunProgress) -> Warme
 @dataclass
 class Controlled:
     """What the warm-up and the control window left: the loop (plant, controller, twins),
-    its trace, the design point, the warm-up's meter counts and the window's start."""
+    the design point, the warm-up's meter counts and the window's start; its trace is the
+    loop's (:attr:`trace`)."""
 
     loop: ClosedLoop
-    trace: Trace
     ref_ctrl: Controller
     eq: Equilibrium
     q_nom: float
@@ -223,6 +223,15 @@ class Controlled:
     settings: RunSettings
     stationary: tuple[np.ndarray, float]   # the warm-up's state and band (evaluation.decay)
     trigger_noise: float | None = None     # veh/s: the law's output noise sizing the dead band
+    law: Controller | None = None          # the law built for the run (the loop's, or
+                                           # the one an outside driver stands in for)
+
+    @property
+    def trace(self) -> Trace:
+        """The loop's trace (opened by :meth:`ClosedLoop.begin`)."""
+        if self.loop.trace is None:
+            raise RuntimeError("the control window has not begun (ClosedLoop.begin)")
+        return self.loop.trace
 
 
 @dataclass
@@ -306,8 +315,13 @@ def finish_run(opened: OpenRun, warmed: Warmed, run: PreparedRun,
     """From the end of the warm-up: the control window of ``run``, the drain, SUMO
     closed, and the network measures read from SUMO's outputs (steps 4-7 of the module
     docstring)."""
+    return close_window(opened, control(warmed, run, opened.bar, keep_measurements), run)
+
+
+def close_window(opened: OpenRun, c: Controlled, run: PreparedRun) -> CoSimResult:
+    """After the control window ``c``: the drain, SUMO closed, and the network measures
+    read from SUMO's outputs (step 7 of the module docstring)."""
     sim, cfg = opened.sim, run.sumo
-    c = control(warmed, run, opened.bar, keep_measurements)
     plant = c.loop.plant
     meter_summary = {**plant.meter_summary(), "ramp_storage": cfg.ramp_storage,
                      **c.loop.actuator.summary()}
@@ -320,13 +334,20 @@ def finish_run(opened: OpenRun, warmed: Warmed, run: PreparedRun,
     records = c.trace.records
     outlet = round(sum((r.outflow_h + r.outflow_a) * cfg.control_period for r in records))
     network, trips = measure_network(opened.out_dir, c.start, t_end, outlet,
-                                     drained.end if drained else None, sim.time)
+                                     drained.end if drained else None, sim.time,
+                                     **outlet_edge(cfg))
     if drained is not None:
         network = whole_demand(network, trips, plant, drained)
     if cfg.fcd:   # moved, not read: an FCD file is large
         opened.files.adopt(opened.out_dir / FCD_FILE, FCD_FILE)
     return _result(c, run.scenario, cfg, meter_summary, sim, network, opened.placement,
                    opened.files, timings, time.perf_counter() - opened.wall0)
+
+
+def outlet_edge(cfg: SumoConfig) -> dict[str, str]:
+    """``{"outlet_edge": the last section edge}`` on a user's network; {} on the shipped
+    one (``main``)."""
+    return {} if cfg.layout is None else {"outlet_edge": cfg.layout.section_edges[-1]}
 
 
 def _result(c: Controlled, scenario: Scenario, cfg: SumoConfig, meter: dict[str, Any],
@@ -351,10 +372,27 @@ def _result(c: Controlled, scenario: Scenario, cfg: SumoConfig, meter: dict[str,
         trigger_noise=c.trigger_noise)
 
 
+#: builds the controller the loop checks from the law built for the run (an outside
+#: driver's stand-in, :mod:`arzsumo.gym`); None: the law itself
+InLoop = Callable[[Controller], Controller]
+
+
 def control(warmed: Warmed, run: PreparedRun, bar: RunProgress,
             keep_measurements: bool = False) -> Controlled:
     """The control window of ``run`` from the end of the warm-up (steps 4-6 of the module
     docstring); ``run.sumo`` has the control horizon."""
+    c = open_window(warmed, run, bar, keep_measurements)
+    c.loop.run(warmed.warm[-1], run.sumo.horizon, bar)
+    return c
+
+
+def open_window(warmed: Warmed, run: PreparedRun, bar: RunProgress,
+                keep_measurements: bool = False, in_loop: InLoop | None = None
+                ) -> Controlled:
+    """The control window of ``run`` set up at the end of the warm-up (steps 4-5 of the
+    module docstring), before its first check: the loop (not yet begun), the law built
+    for the run (``Controlled.law``; the loop checks ``in_loop(law)`` when given) and
+    ``Controlled.trace``, the loop's trace once :meth:`ClosedLoop.begin` opened it."""
     from arzsumo.kernel_cache import cached_kernels
 
     scenario, settings, cfg = run.scenario, run.settings, run.sumo
@@ -386,12 +424,11 @@ def control(warmed: Warmed, run: PreparedRun, bar: RunProgress,
     twins = TwinPair(eq, lin, warm[-1].cells, opts, settings.smoothing, ref_ctrl, q_nom)
     act = scenario.actuation
     actuator = actuator_for(plant, q_nom, settings.controller, acting, act, period)
-    loop = ClosedLoop(plant, estimator, ctrl, actuator, twins, period, act.anti_windup,
-                      shift)
+    loop = ClosedLoop(plant, estimator, in_loop(ctrl) if in_loop else ctrl, actuator, twins,
+                      period, act.anti_windup, shift)
     plant.disturb(scenario.disturbance, warm[-1].t)
-    trace = loop.run(warm[-1], cfg.horizon, bar)
     tail = warm[-max(1, round(est.reference_window / period)):]
     stationary = stationary_reference(np.stack([micro_fields(m.cells) for m in tail]),
                                       period)
-    return Controlled(loop, trace, ref_ctrl, eq, q_nom, warmed.warmup_meter, warmed.start,
-                      estimator, settings, stationary, trigger_noise)
+    return Controlled(loop, ref_ctrl, eq, q_nom, warmed.warmup_meter,
+                      warmed.start, estimator, settings, stationary, trigger_noise, ctrl)

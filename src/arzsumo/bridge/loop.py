@@ -25,6 +25,12 @@ returns flows forward only:
 The first check is on the warm-up's last measurement (t = 0). No command follows the
 last check, at the horizon: no period follows it, and a plan change there would never run.
 
+:meth:`ClosedLoop.run` is :meth:`~ClosedLoop.begin`, then per period
+:meth:`~ClosedLoop.estimate`, :meth:`~ClosedLoop.decide` and :meth:`~ClosedLoop.advance`;
+an outside driver (the Gymnasium environment :mod:`arzsumo.gym`) calls the same stages
+one period at a time, with the loop keeping where it is (:attr:`~ClosedLoop.m`,
+:attr:`~ClosedLoop.t`, :attr:`~ClosedLoop.told`, :attr:`~ClosedLoop.trace`).
+
 A detector sample's path: ``SumoSensor.observe`` (libsumo, every step) ->
 ``PeriodMeasurement`` -> ``Estimator.estimate`` -> ``MacroState`` -> ``Controller.step``
 -> ``Command`` -> ``MeterActuator.apply`` (limits, override, the meter's bounds) ->
@@ -89,22 +95,43 @@ class ClosedLoop:
         self.actuator, self.twins, self.period = actuator, twins, period
         self.anti_windup, self.shift = anti_windup, shift
         self.timings = {"controller": 0.0, "twins": 0.0, "estimator": 0.0}
+        # where the window stands (begin, advance): the start's SUMO time (s), the last
+        # measurement, its time from the start of control (s), what the controller is
+        # told at its next check, the trace so far
+        self.t0, self.t = 0.0, 0.0
+        self.told: Applied | None = None
+        self.m: PeriodMeasurement | None = None
+        self.trace: Trace | None = None
 
     def run(self, start: PeriodMeasurement, horizon: float, bar: RunProgress) -> Trace:
         """Control from the measurement ``start`` (t = 0) until ``horizon`` seconds."""
-        t0, trace = start.t, Trace(start.cells.x, micro_fields(start.cells))
-        m, t, told = start, 0.0, None
+        trace = self.begin(start)
         while True:
-            state = self.estimate(m, t)
-            check = self.decide(state, told)
-            if t >= horizon - 1e-9:
+            check = self.decide(self.estimate(self.m, self.t), self.told)
+            if self.t >= horizon - 1e-9:
                 return trace
-            act = self.actuator.apply(check.command.u)
-            told = act.told(self.anti_windup)
-            m, meter = self.plant.run_period()
-            t = m.t - t0
-            self.record(trace, t, check, act, m, meter)
-            bar.update(m.t)
+            self.advance(check)
+            bar.update(self.m.t)
+
+    def begin(self, start: PeriodMeasurement) -> Trace:
+        """Open the window at the measurement ``start`` (t = 0): a new :attr:`trace`, the
+        loop at its first check (:attr:`m` the measurement to estimate from, :attr:`t`
+        0 s, :attr:`told` None)."""
+        self.t0 = start.t
+        self.trace = Trace(start.cells.x, micro_fields(start.cells))
+        self.m, self.t, self.told = start, 0.0, None
+        return self.trace
+
+    def advance(self, check: Check) -> tuple[Actuation, MeterState]:
+        """Actuate the command of ``check``, run one control period in SUMO and record it;
+        the loop then stands at the period's end (:attr:`m`, :attr:`t`, :attr:`told`).
+        Returns what was applied and the meter at the period's end."""
+        act = self.actuator.apply(check.command.u)
+        self.told = act.told(self.anti_windup)
+        m, meter = self.plant.run_period()
+        self.m, self.t = m, m.t - self.t0
+        self.record(self.trace, self.t, check, act, m, meter)
+        return act, meter
 
     def estimate(self, m: PeriodMeasurement, t: float) -> MacroState:
         """The state the controller acts on at ``t`` (s from the start of control)."""
@@ -117,13 +144,17 @@ class ClosedLoop:
         """Check the controller (told what was applied for its last check) and the
         reference twin's controller."""
         c0 = time.perf_counter()
-        command = self.controller.step(self.shift.apply(state) if self.shift else state,
-                                       told)
+        command = self.controller.step(self.acting_on(state), told)
         c1 = time.perf_counter()
         u_reference = self.twins.check_reference()
         self.timings["controller"] += c1 - c0
         self.timings["twins"] += time.perf_counter() - c1
         return Check(state.t, command, u_reference, c1 - c0)
+
+    def acting_on(self, state: MacroState) -> MacroState:
+        """What the controller is handed for the estimate ``state``: minus the warm-up
+        reference when the run has one (:mod:`~arzsumo.bridge.reference`)."""
+        return self.shift.apply(state) if self.shift else state
 
     def record(self, trace: Trace, t: float, check: Check, act: Actuation,
                m: PeriodMeasurement, meter: MeterState) -> None:

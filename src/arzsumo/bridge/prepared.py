@@ -70,7 +70,17 @@ class PreparedRun:
                 f"control horizon {c.horizon:g} s, SUMO seed {c.seed}, step {c.step_length:g} s"
                 f"\n  equilibrium {s.equilibrium} (scenario lambda_4 = {lam4:.2f} km/h)"
                 f"\n  {self.sensing()}"
-                + ("\n  SUMO's FCD output kept (fcd.xml.gz)" if c.fcd else ""))
+                + ("\n  SUMO's FCD output kept (fcd.xml.gz)" if c.fcd else "")
+                + self.network())
+
+    def network(self) -> str:
+        """The user's network of a ``[network]`` table in one line ("" without one)."""
+        lay = self.sumo.layout
+        if lay is None:
+            return ""
+        return (f"\n  network {lay.net_file.name}: section {', '.join(lay.section_edges)} "
+                f"(L = {lay.length:g} m, {lay.lanes} lane(s), W = {lay.width:g} m), meter "
+                f"{lay.meter_tl} on {lay.ramp_edge}, AV types {', '.join(sorted(lay.av_types))}")
 
     def sensing(self) -> str:
         """What the controller reads: the estimator and its sensors (observer-ETC: the

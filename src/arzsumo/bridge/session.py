@@ -18,8 +18,10 @@ from arzsumo.bridge.delay import check_delay
 from arzsumo.bridge.estimators import acting_controller
 from arzsumo.bridge.prepared import PreparedRun
 from arzsumo.bridge.result import CoSimResult
+from arzsumo.bridge.road import with_network
 from arzsumo.errors import ArzsumoError, ScenarioError
 from arzsumo.model import linearize
+from arzsumo.pde.initial import initial_fields
 from arzsumo.progress import RunProgress
 from arzsumo.scenario import Scenario
 from arzsumo.scenario.run import RunSettings
@@ -30,7 +32,6 @@ from arzsumo.sumo.green_share import DEFAULT_CURVE, GreenShareCurve
 from arzsumo.sumo.measure import EdieGrid
 from arzsumo.sumo.network import NetworkSpec
 from arzsumo.tables import in_user_terms, not_allowed, restated, where, written
-from arzsumo.twin.initial import initial_fields
 from arzsumo.units import ms_to_kmh
 
 
@@ -77,7 +78,8 @@ def _override(sc: Scenario, dotted: str, value: object, option: str) -> Scenario
 def _check_model(sc: Scenario, cfg: SumoConfig) -> None:
     """The road is SUMO's mainline, the measurement grid fits it, the characteristic speeds
     are finite."""
-    road = NetworkSpec().length   # the network of `arzsumo build-net`
+    # the network of `arzsumo build-net`, or the section of a [network] table
+    road = NetworkSpec().length if cfg.layout is None else cfg.layout.length
     if abs(sc.params.length - road) > 1e-6:
         raise not_allowed(f"{sc.source}: [model]", "length_m",
                           sc.written("model", "length_m", sc.params.length),
@@ -112,9 +114,33 @@ def _check_estimation(sc: Scenario, settings: RunSettings, from_cli: bool) -> No
                             "the boundary stations; add \"loops\" to [sensing] kinds")
 
 
+def check_warmup(sc: Scenario, warmup: float | None, horizon: float | None,
+                 allow_short: bool) -> None:
+    """Refuse control that starts inside the scenario's fill phase.
+
+    A scenario with ``[sumo] fill_s`` > 0 sends a fill demand from t = 0 until the queue
+    of the merge has filled the section; control is meant to start after it. With a
+    warm-up (``warmup``, s, else ``[run] warmup_s``) shorter than the fill, the control
+    window (``horizon``, s, else ``[sumo] horizon_s``) measures the fill, not the
+    controller: refused in one line naming the values, unless ``allow_short``
+    (``--allow-short-warmup``).
+    """
+    fill = sc.sumo.fill_duration
+    warm = sc.run.warmup if warmup is None else float(warmup)
+    if allow_short or fill <= 0 or warm >= fill:
+        return
+    window = sc.sumo.horizon if horizon is None else float(horizon)
+    given = (f"--warmup = {warm:g}" if warmup is not None else
+             f"{sc.source}: [run] warmup_s = {sc.written('run', 'warmup_s', warm)}")
+    raise ScenarioError(f"{given} is not allowed: the control window ({warm:g}-"
+                        f"{warm + window:g} s) starts inside the fill phase of {sc.name} "
+                        f"([sumo] fill_s = {fill:g} s), so its measures describe the fill; "
+                        f"allowed: a warm-up >= {fill:g} s, or --allow-short-warmup")
+
+
 def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None = None,
                 horizon: float | None = None, warmup: float | None = None,
-                fcd: bool | None = None) -> PreparedRun:
+                fcd: bool | None = None, allow_short_warmup: bool = True) -> PreparedRun:
     """Everything ``arzsumo run`` checks before SUMO starts, without starting it.
 
     Applies the caller's overrides to the ``run`` and ``sumo`` sections of ``sc``
@@ -124,10 +150,14 @@ def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None
     ``[sumo] cell_length_m`` divides the road and that the characteristic speeds are
     finite, refuses a PDE controller at a free-flow scenario equilibrium and a
     ``[actuation] delay_compensation_s`` it cannot apply
-    (:func:`~arzsumo.bridge.delay.check_delay`), and draws the
-    placement profile of ``start = "placement"``. Raises an
+    (:func:`~arzsumo.bridge.delay.check_delay`), refuses a warm-up shorter than the
+    scenario's fill phase when not ``allow_short_warmup`` (:func:`check_warmup`: the public
+    API and the CLI ask for it; the engine's own callers, sweeps and studies, decide
+    their warm-ups themselves), and draws
+    the placement profile of ``start = "placement"``. Raises an
     :class:`arzsumo.errors.ArzsumoError` naming the key or option.
     """
+    base = sc
     if controller is not None:
         sc = _override(sc, "run.controller", controller, "--controller")
     if seed is not None:
@@ -138,6 +168,7 @@ def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None
         sc = _override(sc, "run.warmup_s", warmup, "--warmup")
     if fcd is not None:
         sc = _override(sc, "sumo.fcd", fcd, "--fcd")
+    sc = with_network(sc)     # a [network] table checked with sumolib, L and W from it
     settings, cfg = sc.run, sc.sumo
     ic = seeded(sc.initial, cfg.seed)  # one seed draws all randomness
     _check_model(sc, cfg)
@@ -151,6 +182,7 @@ def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None
         xc = (np.arange(n) + 0.5) * cfg.cell_length
         initial = initial_fields(ic, sc.equilibrium, xc)
     curve = meter_curve_of(cfg, sc.source)   # a bad curve file stops the run before SUMO
+    check_warmup(base, warmup, horizon, allow_short_warmup)
     return PreparedRun(sc, initial, curve)
 
 
@@ -166,7 +198,7 @@ def default_run_name(sc: Scenario, settings: RunSettings, cfg: SumoConfig) -> st
 def run_in_sumo(sc: Scenario, *, controller: str | None = None, seed: int | None = None,
                 horizon: float | None = None, warmup: float | None = None,
                 fcd: bool | None = None, progress: bool = False,
-                frontend: str = "libsumo") -> SumoSession:
+                frontend: str = "libsumo", allow_short_warmup: bool = True) -> SumoSession:
     """Run the closed loop of ``sc`` in SUMO (overrides win over the scenario's tables).
 
     Parameters
@@ -190,11 +222,13 @@ def run_in_sumo(sc: Scenario, *, controller: str | None = None, seed: int | None
     frontend : str
         What drives SUMO: "libsumo" (default), "traci", or "gui" to watch the run in
         sumo-gui (:mod:`arzsumo.sumo.frontend`).
+    allow_short_warmup : bool
+        Allow a warm-up shorter than the scenario's fill phase.
 
     All checks happen in :func:`prepare_run` before SUMO starts.
     """
     run = prepare_run(sc, controller=controller, seed=seed, horizon=horizon, warmup=warmup,
-                      fcd=fcd)
+                      fcd=fcd, allow_short_warmup=allow_short_warmup)
     return run_prepared(run, progress=progress, frontend=frontend)
 
 

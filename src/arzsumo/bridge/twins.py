@@ -30,10 +30,10 @@ from arzsumo.identify.replay import admissible, on_grid
 from arzsumo.model.characteristic import Linearization
 from arzsumo.model.equilibrium import Equilibrium
 from arzsumo.model.params import ModelParameters
+from arzsumo.pde.boundary import Inlet
+from arzsumo.pde.solver import SolverOptions, TwinStepper, TwinStoppedError
+from arzsumo.pde.state import cell_centres
 from arzsumo.sumo.measure import CellData
-from arzsumo.twin.boundary import Inlet
-from arzsumo.twin.solver import SolverOptions, TwinStepper, TwinStoppedError
-from arzsumo.twin.state import cell_centres
 
 log = logging.getLogger(__name__)
 

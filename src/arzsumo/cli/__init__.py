@@ -20,7 +20,6 @@ import sys
 import threading
 from collections.abc import Callable, Sequence
 
-from arzsumo import __version__
 from arzsumo.cli import (
     compare,
     control,
@@ -28,10 +27,8 @@ from arzsumo.cli import (
     identify,
     listing,
     model,
-    premise,
     reproduce,
     run,
-    study,
     sumo,
     sweep,
     twin,
@@ -39,17 +36,38 @@ from arzsumo.cli import (
 from arzsumo.cli.args import Parser
 from arzsumo.errors import EXIT_USAGE, ArzsumoError
 from arzsumo.interrupts import EXIT_INTERRUPTED
+from arzsumo.version import __version__
 
 log = logging.getLogger("arzsumo")
 
 Command = Callable[[argparse.Namespace], int]
 
-#: what adds each command, in the order ``arzsumo --help`` lists them
+#: what adds each command, in the order ``arzsumo --help`` lists them: a run first, then
+#: what compares runs, the twin and the paper, the model and its laws, the network
 REGISTER: tuple[Callable[[argparse._SubParsersAction], None], ...] = (
-    model.register, control.register, twin.register, reproduce.register, sumo.register,
-    run.register, compare.register, sumo.register_alinea_target, sweep.register,
-    evaluate.register, premise.register, identify.register, listing.register,
-    study.register)
+    run.register, compare.register, evaluate.register, sweep.register, twin.register,
+    reproduce.register, model.register, control.register, identify.register,
+    sumo.register, sumo.register_alinea_target, listing.register)
+
+#: entry-point group of packages that add commands of their own (a ``register(sub)``
+#: function each, as the modules of :data:`REGISTER`); listed after the tool's commands
+COMMAND_PLUGINS = "arzsumo.commands"
+
+
+def plugin_registers() -> list[Callable[[argparse._SubParsersAction], None]]:
+    """The ``register`` functions of the installed packages' ``arzsumo.commands`` entry
+    points, by name (none when no such package is installed). One that cannot be
+    imported (its metadata left behind by an uninstalled package) is skipped: the tool's
+    own commands never depend on another package."""
+    from importlib.metadata import entry_points
+
+    registers = []
+    for ep in sorted(entry_points(group=COMMAND_PLUGINS), key=lambda ep: ep.name):
+        try:
+            registers.append(ep.load())
+        except ImportError as exc:
+            log.debug("command %s (%s) not loaded: %s", ep.name, ep.value, exc)
+    return registers
 
 
 EPILOG = """\
@@ -65,11 +83,12 @@ exit codes:
   3    the PDE twin left the physical domain (twin, reproduce: partial results written)
   4    some sweep runs were invalid, failed or crashed (sweep, evaluate: the others
        completed)
-  5    the scenario's premise does not hold (premise: its report written)
   130  interrupted (Ctrl-C)
 
 'arzsumo list' shows the shipped scenario and sweep files; 'arzsumo CMD --help' each
-command's options."""
+command's options. For example:
+  arzsumo run --controller etc --seed 1 --out results/etc-seed1
+  arzsumo twin default --controller backstepping --out results/twin-bs"""
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -81,7 +100,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"arzsumo {__version__}")
     parser.add_argument("-v", "--verbose", action="store_true", help="debug logging")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for register in REGISTER:
+    for register in (*REGISTER, *plugin_registers()):
         register(sub)
     return parser
 
@@ -94,12 +113,20 @@ def _interrupt(signum: int, frame: object) -> None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run ``arzsumo ARGV`` (``sys.argv[1:]`` when None); return the exit code."""
-    parser = build_parser()
+    return run_command(build_parser(), argv, "arzsumo")
+
+
+def run_command(parser: argparse.ArgumentParser, argv: Sequence[str] | None,
+                prog: str) -> int:
+    """Parse ``argv`` with ``parser`` and run the chosen command's ``func``: one line on
+    stderr (``PROG: error: ...``) and exit code 2 for a user error, 130 for Ctrl-C; the
+    logging is configured here (``-v``: debug)."""
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # --help, --version, or a refused argument (one line printed)
         return int(exc.code or 0)
-    logging.basicConfig(level=logging.DEBUG if args.verbose else logging.INFO,
+    logging.basicConfig(level=logging.DEBUG if getattr(args, "verbose", False)
+                        else logging.INFO,
                         format="%(levelname)s %(name)s: %(message)s")
     logging.getLogger("matplotlib").setLevel(logging.WARNING)
     func: Command = args.func
@@ -108,10 +135,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return func(args)
     except ArzsumoError as exc:
-        print(f"arzsumo: error: {exc}", file=sys.stderr)
+        print(f"{prog}: error: {exc}", file=sys.stderr)
         return EXIT_USAGE
     except KeyboardInterrupt:
-        print("arzsumo: interrupted", file=sys.stderr)
+        print(f"{prog}: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
     except BrokenPipeError:  # `arzsumo ... | head`: the reader left; no traceback
         with contextlib.suppress(OSError):
@@ -122,4 +149,4 @@ def main(argv: Sequence[str] | None = None) -> int:
             signal.signal(signal.SIGINT, previous)
 
 
-__all__ = ["build_parser", "main"]
+__all__ = ["build_parser", "main", "run_command"]

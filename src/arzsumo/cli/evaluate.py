@@ -2,9 +2,9 @@
 in SUMO, compared with the open loop seed by seed.
 
 Checks the scenario for every controller (as ``arzsumo run`` would, the warm-up against
-the scenario's fill phase included) before any run, then calls
-:func:`arzsumo.sweep.evaluate.run_evaluation` and prints the headline differences and
-where the report is.
+the scenario's fill phase included) before any run, then calls :func:`arzsumo.evaluate`
+(:func:`arzsumo.api.evaluate.evaluate`) and prints the headline differences and where the
+report is.
 Exit codes: 0 every run finished, 4 some runs were invalid, failed or crashed (the
 report uses the seeds that finished for both members of a pair), 2 a user error.
 """
@@ -14,8 +14,8 @@ from __future__ import annotations
 import argparse
 import shlex
 import sys
-from pathlib import Path
 
+from arzsumo.api.evaluate import default_controllers
 from arzsumo.cli.args import positive_float, positive_int, seed_int
 from arzsumo.cli.options import (
     add_no_plots,
@@ -26,7 +26,6 @@ from arzsumo.cli.options import (
     add_scenario,
     add_warmup,
 )
-from arzsumo.cli.scenarios import check_warmup, load_named
 from arzsumo.errors import EXIT_SOME_FAILED
 
 #: the measures printed, in the report's order: whole-demand time spent, the ramp's
@@ -36,23 +35,22 @@ HEADLINES = ("network_whole_demand.time_spent_s.total", "network_whole_demand.ra
 
 
 def cmd_evaluate(args: argparse.Namespace) -> int:
-    from arzsumo.sweep.evaluate import BASELINE, run_evaluation
+    from arzsumo.api.evaluate import evaluate, seed_list
+    from arzsumo.api.scenarios import scenario_file
+    from arzsumo.sweep.evaluate import BASELINE
 
-    scenario, sc = load_named(args.scenario)
-    check_warmup(sc, args.warmup, args.horizon, args.allow_short_warmup)
-    seeds = list(range(args.seed_start, args.seed_start + args.seeds))
+    scenario = scenario_file(args.scenario)
     controllers = [c.strip() for c in args.controllers.split(",") if c.strip()]
-    out = Path(args.out) if args.out else Path("results") / "evaluate" / scenario.stem
     command = "arzsumo " + " ".join(shlex.quote(a) for a in sys.argv[1:]) \
         if sys.argv[1:2] == ["evaluate"] else ""
-    res = run_evaluation(scenario, controllers, seeds, out=out, horizon=args.horizon,
-                         warmup=args.warmup,
-                         workers=args.workers, scheduler=args.scheduler,
-                         share_warmup=not args.no_shared_warmup,
-                         overwrite=args.overwrite, progress=not args.quiet,
-                         plots=not args.no_plots, command=command,
-                         baseline_from=Path(args.baseline_from) if args.baseline_from else None,
-                         runs_from=[Path(d) for d in args.runs_from or ()])
+    res = evaluate(scenario, controllers=controllers,
+                   seeds=seed_list(args.seeds, args.seed_start), out=args.out,
+                   horizon_s=args.horizon, warmup_s=args.warmup,
+                   allow_short_warmup=args.allow_short_warmup, workers=args.workers,
+                   scheduler=args.scheduler, share_warmup=not args.no_shared_warmup,
+                   overwrite=args.overwrite, progress=not args.quiet,
+                   plots=not args.no_plots, baseline_from=args.baseline_from,
+                   runs_from=args.runs_from or (), command=command)
     rep, bad = res.sweep, None
     if rep is None:
         print(f"evaluate {scenario.name}: every run taken from --runs-from, none executed")
@@ -83,7 +81,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                                    "CI, wins and losses.")
     add_scenario(p)
     p.add_argument("--controllers",
-                   default="open,held,alinea,pi-alinea,backstepping,etc,observer-etc",
+                   default=",".join(default_controllers()),
                    help="comma-separated controllers; open (the baseline) is added first "
                         "when missing")
     p.add_argument("--seeds", type=positive_int, default=20,

@@ -2,8 +2,8 @@
 model identified from open-loop SUMO runs.
 
 Checks the seeds, the ``--vary`` points, the ``--which`` names and the output directory
-before any run, then calls :func:`arzsumo.studies.identify.study.run_identification` and writes
-the results (:func:`arzsumo.studies.identify.report.write_study`). Exit codes: 0 done,
+before any run, then calls :func:`arzsumo.workflows.identify.study.run_identification` and writes
+the results (:func:`arzsumo.workflows.identify.report.write_study`). Exit codes: 0 done,
 2 a user error (one line).
 """
 
@@ -25,7 +25,7 @@ from arzsumo.cli.options import add_out, add_overwrite, add_scenario, add_seeds,
 from arzsumo.cli.scenarios import load_named
 
 if TYPE_CHECKING:
-    from arzsumo.studies.identify.study import IdentifyStudy
+    from arzsumo.workflows.identify.study import IdentifyStudy
 
 log = logging.getLogger("arzsumo")
 
@@ -33,9 +33,9 @@ log = logging.getLogger("arzsumo")
 def cmd_identify(args: argparse.Namespace) -> int:
     from arzsumo.identify import FitSettings
     from arzsumo.outdir import OutputDir
-    from arzsumo.studies.identify.report import write_study
-    from arzsumo.studies.identify.study import make_setup, run_identification
     from arzsumo.units import kmh_to_ms
+    from arzsumo.workflows.identify.report import write_study
+    from arzsumo.workflows.identify.study import make_setup, run_identification
 
     path, sc = load_named(args.scenario)
     setup = make_setup(sc, args.train_seeds, args.validate_seeds, vary=args.vary or (),
@@ -79,7 +79,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
 def _print_references(study: IdentifyStudy) -> None:
     """The held-out block errors of the references beside the model's, and the replay
     error splits."""
-    from arzsumo.studies.identify.references import REFERENCES
+    from arzsumo.workflows.identify.references import REFERENCES
 
     refs = study.references
     if not refs:
@@ -101,8 +101,8 @@ def _print_references(study: IdentifyStudy) -> None:
 
 def _print_stage_one(study: IdentifyStudy) -> None:
     """Stage 1's diagram and the wave check on both run sets (km/h)."""
-    from arzsumo.studies.identify.report import stage_lambda_4
     from arzsumo.units import ms_to_kmh
+    from arzsumo.workflows.identify.report import stage_lambda_4
 
     one = study.stage_one
     if one is None:

@@ -6,7 +6,7 @@ a flag means the same and is checked the same in every command: where results go
 ``--no-plots``), which seeds (``--seed``, ``--seeds``), which scenario (a positional
 ``SCENARIO``, or ``--preset`` | ``--scenario``) and its warm-up (``--warmup``,
 ``--allow-short-warmup``). The studies declare their options in
-:mod:`arzsumo.studies.common` (a room below the CLI).
+:mod:`arzsumo_studies.common` (a room below the CLI).
 """
 
 from __future__ import annotations
@@ -109,7 +109,7 @@ def add_model_source(p: argparse.ArgumentParser, *, preset_help: str = "named mo
 
 def add_warmup(p: argparse.ArgumentParser, help: str) -> None:
     """``--warmup S`` (>= 0 s) and ``--allow-short-warmup``
-    (:func:`arzsumo.cli.scenarios.check_warmup`)."""
+    (:func:`arzsumo.bridge.session.check_warmup`)."""
     p.add_argument("--warmup", type=non_negative_float, help=help)
     p.add_argument("--allow-short-warmup", action="store_true",
                    help="start control before the scenario's fill phase ([sumo] fill_s) "

@@ -1,7 +1,7 @@
 """``arzsumo reproduce [--out DIR] [--quick]``: every experiment of the paper's section 5.
 
-The work is done by :func:`arzsumo.studies.paper.reproduce.reproduce` and
-:func:`arzsumo.studies.paper.report.write_reproduction`. Exit codes: 0 completed, 3 some
+The work is done by :func:`arzsumo.workflows.paper.reproduce.reproduce` and
+:func:`arzsumo.workflows.paper.report.write_reproduction`. Exit codes: 0 completed, 3 some
 runs stopped early (state left the physical domain; partial results written), 2 user
 error.
 """
@@ -18,9 +18,9 @@ from arzsumo.errors import EXIT_INCOMPLETE
 def cmd_reproduce(args: argparse.Namespace) -> int:
     from arzsumo.outdir import OutputDir
     from arzsumo.resources import shipped_scenarios_dir
-    from arzsumo.studies.paper.compare import REPRODUCED, claims
-    from arzsumo.studies.paper.report import write_reproduction
-    from arzsumo.studies.paper.reproduce import reproduce
+    from arzsumo.workflows.paper.compare import REPRODUCED, claims
+    from arzsumo.workflows.paper.report import write_reproduction
+    from arzsumo.workflows.paper.reproduce import reproduce
 
     out = Path(args.out) if args.out else Path("results") / "reproduce"
     with OutputDir(out, "reproduce", overwrite=args.overwrite) as target:

@@ -1,11 +1,10 @@
 """``arzsumo run [SCENARIO]``: one closed loop in SUMO with the PDE twins alongside.
 
-Checks the scenario and the options as the run would (:func:`arzsumo.bridge.session.
-prepare_run`, and a warm-up that outlasts the scenario's fill phase,
-:func:`arzsumo.cli.scenarios.check_warmup`), claims the output directory, runs SUMO
-(:func:`arzsumo.bridge.session.run_prepared`, on what was checked), writes the results
-and prints the key columns of the summary (every column: ``summary.csv``). ``--dry-run``
-makes the same checks and prints what the run would do.
+Checks the scenario and the options as the run would (:func:`arzsumo.api.runs.prepare`:
+every check of :func:`arzsumo.run`), claims the output directory, runs SUMO
+(:func:`arzsumo.api.runs.run_checked`, on what was checked), saves the results
+(:meth:`arzsumo.RunResult.save`) and prints the key columns of the summary (every column:
+``summary.csv``). ``--dry-run`` makes the same checks and prints what the run would do.
 """
 
 from __future__ import annotations
@@ -25,23 +24,23 @@ from arzsumo.cli.options import (
     add_seed,
     add_warmup,
 )
-from arzsumo.cli.scenarios import check_warmup, load_named
+from arzsumo.cli.scenarios import load_named
 from arzsumo.control.registry import controller_names
 
 
 def cmd_run(args: argparse.Namespace) -> int:
+    from arzsumo.api.runs import prepare, run_checked
     from arzsumo.bridge.run_progress import WRITING, run_progress
-    from arzsumo.bridge.session import default_run_name, prepare_run, run_prepared
+    from arzsumo.bridge.session import default_run_name
     from arzsumo.outdir import OutputDir, check_target
-    from arzsumo.outputs.bridge import write_results
     from arzsumo.sumo.frontend import Frontend
 
     # a shipped name or the shipped default is found in the package: any directory will do
-    path, sc = load_named(args.scenario)
+    _, sc = load_named(args.scenario)
     fcd = True if args.fcd else None   # without --fcd the scenario's [sumo] fcd holds
-    prepared = prepare_run(sc, controller=args.controller, seed=args.seed,
-                           horizon=args.horizon, warmup=args.warmup, fcd=fcd)
-    check_warmup(sc, args.warmup, args.horizon, args.allow_short_warmup)
+    prepared = prepare(sc, controller=args.controller, seed=args.seed,
+                       horizon_s=args.horizon, warmup_s=args.warmup, fcd=fcd,
+                       allow_short_warmup=args.allow_short_warmup)
     frontend = "gui" if args.gui else "libsumo"
     Frontend(frontend).check()   # no display or no sumo-gui: one line, before any output
     out = Path(args.out) if args.out else Path("results") / default_run_name(
@@ -54,10 +53,10 @@ def cmd_run(args: argparse.Namespace) -> int:
     bar = run_progress(prepared.settings, prepared.sumo, enabled=not args.quiet,
                        writing=True)
     with OutputDir(out, "run", overwrite=args.overwrite) as target, bar:
-        session = run_prepared(prepared, progress=bar, frontend=frontend)
+        result = run_checked(prepared, progress=bar, frontend=frontend)
         bar.enter(WRITING)
-        text = path.read_text(encoding="utf-8") + session.resolved_comment()
-        _, summ = write_results(session.result, target, text, plots=not args.no_plots)
+        result.save(target, plots=not args.no_plots)
+    summ = result.summary.to_dict()
     if args.json:
         from arzsumo.io import json_safe
 

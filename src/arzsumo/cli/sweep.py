@@ -16,9 +16,9 @@ from arzsumo.errors import EXIT_SOME_FAILED
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
-    from arzsumo.studies.paper.values import paper_points
     from arzsumo.sweep import load_sweep, run_sweep
     from arzsumo.sweep.worker import FINISHED
+    from arzsumo.workflows.paper.values import paper_points
 
     spec = load_sweep(sweep_file(args.sweep))
     if args.list:

@@ -20,7 +20,6 @@ from arzsumo.cli.options import add_json, add_no_plots, add_out, add_overwrite, 
 from arzsumo.cli.scenarios import load_named
 from arzsumo.control.registry import controller_names
 from arzsumo.errors import EXIT_INCOMPLETE
-from arzsumo.scenario import Scenario
 from arzsumo.units import veh_s_to_veh_h
 
 log = logging.getLogger(__name__)
@@ -34,44 +33,23 @@ INDICES = (("J_TTT", "J_TTT", "veh h", 1 / 3600),
            ("J_discom", "J_discom", "veh m^2/s^3 + veh m^2/s^5", 1.0))
 
 
-def twin_controller_of(sc: Scenario, flag: str | None) -> tuple[Scenario, str]:
-    """(scenario whose ``[twin] controller`` is the one to run, where it came from).
-
-    ``flag`` (``--controller``) wins; then a ``[twin] controller`` written in the file;
-    then the ``[run] controller`` written there, when it runs in the twin; else the
-    ``[twin]`` default (the open loop).
-    """
-    run = sc.written("run", "controller")
-    if flag is not None:
-        name, origin = flag, "--controller"
-    elif sc.written("twin", "controller") is not None:
-        return sc, "[twin] controller"
-    elif run is not None and run in controller_names("twin"):
-        name, origin = run, "[run] controller"
-    else:
-        why = f"; [run] controller = {run} does not run in the twin" if run else ""
-        return sc, f"the default{why}"
-    return sc.with_({"twin.controller": name}), origin
-
-
 def cmd_twin(args: argparse.Namespace) -> int:
-    from arzsumo.engines.twin import run_twin
+    from arzsumo.api.runs import twin, twin_controller
     from arzsumo.io import json_safe
     from arzsumo.outdir import OutputDir
-    from arzsumo.outputs.twin import write_run
 
     _, sc = load_named(args.scenario)
-    sc, origin = twin_controller_of(sc, args.controller)
+    sc, origin = twin_controller(sc, args.controller)
     out = Path(args.out) if args.out else Path("results") / "twin" / sc.name
     with OutputDir(out, "twin", overwrite=args.overwrite) as target:  # checked before the run
-        run = run_twin(sc, baseline=not args.no_baseline)
-        write_run(run, target, plots=not args.no_plots)
-    summary = run.summary()
+        result = twin(sc, baseline=not args.no_baseline)
+        result.save(target, plots=not args.no_plots)
+    summary = result.summary.to_dict()
     if args.json:
         print(json.dumps(json_safe(summary), indent=2))
     else:
         print_summary(summary, out, origin)
-    return 0 if run.result.complete else EXIT_INCOMPLETE
+    return 0 if result.complete else EXIT_INCOMPLETE
 
 
 def _index_line(s: dict, key: str, name: str, unit: str, factor: float) -> str:
@@ -92,7 +70,8 @@ def print_summary(s: dict, out: Path, origin: str = "[twin] controller") -> None
     print(f"  status: {s['status']}")
     print(f"  simulated {s['final_time']:.1f} s in {num['wall_time_s']:.2f} s "
           f"({num['speed_up']:.0f}x real time, {num['steps']} steps)")
-    print(f"  relative deviation norm (1): {s['initial_norm']:.4g} -> {s['final_norm']:.4g} "
+    print(f"  relative deviation norm (dimensionless): {s['initial_norm']:.4g} -> "
+          f"{s['final_norm']:.4g} "
           f"(ratio {s['final_norm_ratio']:.3g})")
     print(f"  triggers {s['triggers']}, release time {s['release_time']:.0f} s, "
           f"saturated {s['saturation_time']:.0f} s "

@@ -98,7 +98,20 @@ class ControlLog:
 class Controller(ABC):
     """A ramp-metering controller checked once per control period.
 
-    Subclasses implement :meth:`decide`; :meth:`check` records it in :attr:`log`.
+    Subclasses implement :meth:`decide`, from the estimated macroscopic state
+    (:class:`MacroState`, SI) to U (veh/s); :meth:`check` records it in :attr:`log`
+    (a :meth:`decide` that records nothing itself is recorded as applied and continuous U,
+    an event whenever U changes). The closed loop in SUMO and the twin call
+    :meth:`step` once per control period.
+
+    Examples
+    --------
+    >>> import arzsumo
+    >>> class Proportional(arzsumo.Controller):
+    ...     name = "proportional"
+    ...     def decide(self, state):
+    ...         # meter harder when the section's HVs run slower than at its inlet
+    ...         return 0.02 * float(state.v_h[-1] - state.v_h[0])
     """
 
     #: short name used in outputs ("open", "backstepping", "etc", "observer-etc", "alinea")
@@ -113,7 +126,11 @@ class Controller(ABC):
 
     def check(self, state: MacroState) -> float:
         """Evaluate the controller at a check instant and return U (veh/s) to hold."""
-        return self.decide(state)
+        log, checks = self.log, len(self.log.t)
+        u = float(self.decide(state))
+        if len(log.t) == checks:       # decide kept no record: U applied as decided
+            log.record(state.t, u, u, not checks or u != log.u_applied[-1])
+        return u
 
     def step(self, state: MacroState, applied: Applied | None = None) -> Command:
         """One check of a closed loop with an actuator: take in what was ``applied`` for

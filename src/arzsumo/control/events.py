@@ -20,7 +20,7 @@ def release_time(t: ArrayLike, triggered: ArrayLike, horizon: float) -> float:
         Check times, s, increasing (a :class:`ControlLog`'s ``t``).
     triggered : array_like of bool
         Whether the check updated the control (a log's ``triggered``, or the twin's
-        :func:`arzsumo.twin.metrics.events`).
+        :func:`arzsumo.pde.metrics.events`).
     horizon : float
         End of the run, s.
 

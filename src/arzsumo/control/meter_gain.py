@@ -5,7 +5,7 @@ closed loop realises it by a change of the ramp meter's release,
 r = r_nominal - U_cmd (:func:`arzsumo.sumo.meter_release.release_rate_for`), which
 assumes that one released ramp vehicle takes one mainline slot at the merge:
 dq(L) / dr = -1. SUMO's merge is measured at about -2 (the premise's actuator staircase,
-docs/premise.md): the loop's gain is then twice the one the kernels were designed for.
+research/premise.md): the loop's gain is then twice the one the kernels were designed for.
 
 :class:`MeterGain` hands the meter U_cmd = U / g, so that the outflow moves by the U the
 law asked for, and tells the law what reached the boundary in its own units: g times the

@@ -13,11 +13,19 @@ kernel cache lives above it)::
     ctrl = spec.build(ControllerInputs(lin, kernels, design))
 
 Scenario files are validated when they are read, so an entry must exist before then:
-:func:`register_controller` adds one.
+:func:`register_controller` adds one. Installed packages add theirs through the entry-point
+group ``arzsumo.controllers`` (:data:`PLUGIN_GROUP`), read the first time a name is looked
+up: that is how a controller reaches every process of a sweep (a worker process imports
+the package afresh and never sees a registration made at run time in another process).
+An entry point names a :class:`ControllerSpec`, or a :class:`~arzsumo.control.base.
+Controller` subclass (registered under the entry point's name, built with no argument or
+with the :class:`ControllerInputs`).
 """
 
 from __future__ import annotations
 
+import inspect
+import logging
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -107,6 +115,10 @@ def _alinea(cls: type[Alinea]) -> Builder:
 
 
 REGISTRY: dict[str, ControllerSpec] = {}
+#: entry-point group of the controllers installed packages add
+PLUGIN_GROUP = "arzsumo.controllers"
+_plugins = {"loaded": False}
+log = logging.getLogger(__name__)
 
 
 def register_controller(spec: ControllerSpec, *, replace: bool = False) -> None:
@@ -114,6 +126,49 @@ def register_controller(spec: ControllerSpec, *, replace: bool = False) -> None:
     if spec.name in REGISTRY and not replace:
         raise ValueError(f"controller {spec.name!r} is already registered; pass replace=True")
     REGISTRY[spec.name] = spec
+
+
+def builder_of(factory: Callable[..., Controller]) -> Builder:
+    """A builder from ``factory``: a callable (a :class:`Controller` subclass, say) taking
+    either nothing or the :class:`ControllerInputs`."""
+    try:
+        takes = [p for p in inspect.signature(factory).parameters.values()
+                 if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)
+                 and p.default is p.empty]
+    except (TypeError, ValueError):   # a builtin without a signature: assume the inputs
+        takes = [None]
+    if takes:
+        return factory
+    return lambda inp: factory()
+
+
+def _plugin_spec(name: str, obj: Any) -> ControllerSpec:
+    if isinstance(obj, ControllerSpec):
+        return obj
+    if isinstance(obj, type) and issubclass(obj, Controller):
+        return ControllerSpec(name, builder_of(obj), description=(obj.__doc__ or "").strip()
+                              .split("\n")[0])
+    raise ScenarioError(f"entry point {PLUGIN_GROUP}: {name} = {obj!r} is not allowed: a "
+                        "ControllerSpec or a Controller subclass")
+
+
+def load_plugins() -> None:
+    """Register the controllers of the ``arzsumo.controllers`` entry points (once per
+    process); one already registered under the same name is kept."""
+    if _plugins["loaded"]:
+        return
+    _plugins["loaded"] = True
+    from importlib.metadata import entry_points
+
+    for ep in entry_points(group=PLUGIN_GROUP):
+        if ep.name in REGISTRY:
+            continue
+        try:
+            spec = _plugin_spec(ep.name, ep.load())
+        except ImportError as exc:    # metadata of an uninstalled package: skip it
+            log.warning("controller %s (%s) not loaded: %s", ep.name, ep.value, exc)
+            continue
+        REGISTRY[spec.name] = spec
 
 
 def unregister_controller(name: str) -> None:
@@ -146,6 +201,7 @@ for _spec in (
 
 def controller_names(engine: str | None = None) -> tuple[str, ...]:
     """Registered names, in registration order; ``engine`` "twin" or "sumo" filters."""
+    load_plugins()
     return tuple(n for n, s in REGISTRY.items() if engine is None or getattr(s, engine))
 
 
@@ -156,6 +212,7 @@ def pde_controller_names() -> tuple[str, ...]:
 
 def is_pde(name: str) -> bool:
     """Whether ``name`` is a PDE controller (False for an unknown name)."""
+    load_plugins()
     spec = REGISTRY.get(name)
     return spec is not None and spec.pde
 
@@ -168,6 +225,7 @@ def uses_alinea(name: str) -> bool:
 
 def controller_spec(name: str, engine: str | None = None) -> ControllerSpec:
     """The entry of ``name`` (available to ``engine``); the error lists the allowed names."""
+    load_plugins()
     spec = REGISTRY.get(name)
     if spec is None or (engine is not None and not getattr(spec, engine)):
         raise ScenarioError(f"controller = {name!r} is not allowed: one of "

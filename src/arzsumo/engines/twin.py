@@ -11,25 +11,25 @@ from typing import Any
 
 import numpy as np
 
-from arzsumo import __version__
 from arzsumo.control.base import Controller
 from arzsumo.control.events import release_time
 from arzsumo.control.registry import ControllerInputs, controller_spec
 from arzsumo.kernel_cache import cached_kernels
 from arzsumo.model.characteristic import Linearization, linearize
-from arzsumo.scenario import Scenario
-from arzsumo.scenario.twin import TwinConfig
-from arzsumo.schema import TWIN_SUMMARY, key_units
-from arzsumo.twin.initial import initial_fields
-from arzsumo.twin.metrics import (
+from arzsumo.pde.initial import initial_fields
+from arzsumo.pde.metrics import (
     Performance,
     deviation_norm,
     events,
     performance,
     relative_change,
 )
-from arzsumo.twin.solver import TwinResult, simulate
-from arzsumo.twin.state import cell_centres
+from arzsumo.pde.solver import TwinResult, simulate
+from arzsumo.pde.state import cell_centres
+from arzsumo.scenario import Scenario
+from arzsumo.scenario.twin import TwinConfig
+from arzsumo.schema import TWIN_SUMMARY, key_units
+from arzsumo.version import __version__
 
 
 @dataclass(frozen=True)
@@ -156,7 +156,7 @@ def compare_to_open_loop(run: TwinRun, open_loop: Performance, complete: bool,
         A controlled run.
     open_loop : Performance
         Indices of the open-loop simulation from the same initial fields and solver
-        options (the caller guarantees it; :func:`arzsumo.studies.paper.reproduce.reproduce`
+        options (the caller guarantees it; :func:`arzsumo.workflows.paper.reproduce.reproduce`
         shares one open loop among the controllers of a scenario).
     complete, status
         Whether that open loop completed, and its status message. Indices over

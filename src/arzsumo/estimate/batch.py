@@ -1,17 +1,17 @@
 """A batch of first-order twins advanced together: one vectorised step for all members.
 
 The ensemble Kalman filter advances M copies of the twin every period. Looping over M
-:class:`arzsumo.twin.TwinStepper` objects costs M times the Python overhead of a step;
+:class:`arzsumo.pde.TwinStepper` objects costs M times the Python overhead of a step;
 here the conserved state carries a member axis, ``q`` of shape (4, M, n) (component,
 member, cell), and every operation of the twin's first-order scheme
-(:mod:`arzsumo.twin.scheme`: Strang splitting of the exact relaxation and a forward-Euler
-transport step with the HLL or Rusanov flux of :mod:`arzsumo.twin.flux`) runs once on the
+(:mod:`arzsumo.pde.scheme`: Strang splitting of the exact relaxation and a forward-Euler
+transport step with the HLL or Rusanov flux of :mod:`arzsumo.pde.flux`) runs once on the
 whole batch. The twin's flux functions are reused as they are (they are elementwise in
 the member axis).
 
 Boundaries are those of the SUMO bridge (:class:`arzsumo.bridge.twins.MeasuredInlet`,
 ``TwinPair``): at x = 0 a ghost state (rho_h, v_h, rho_a, v_a) whose physical flux enters,
-per member; at x = L the metered outflow of :func:`arzsumo.twin.boundary.outlet_flux`
+per member; at x = L the metered outflow of :func:`arzsumo.pde.boundary.outlet_flux`
 (split between the classes by their arriving flows, floored by the demand in free
 flow), per member. All members share one time step, the CFL step of the fastest member,
 so member k equals a single twin driven to the same step times (tested to 1e-12).
@@ -26,10 +26,10 @@ import numpy as np
 
 from arzsumo.model.fd import area_occupancy, speed_of_ao
 from arzsumo.model.params import ModelParameters
-from arzsumo.twin.flux import FLUXES, Waves, waves
-from arzsumo.twin.solver import CFL_MAX
-from arzsumo.twin.source import relax
-from arzsumo.twin.state import RHO_A, RHO_H, cell_centres, to_conserved, to_primitive
+from arzsumo.pde.flux import FLUXES, Waves, waves
+from arzsumo.pde.solver import CFL_MAX
+from arzsumo.pde.source import relax
+from arzsumo.pde.state import RHO_A, RHO_H, cell_centres, to_conserved, to_primitive
 
 
 def _sel(w: Waves, idx: slice) -> Waves:
@@ -41,7 +41,7 @@ def _sel(w: Waves, idx: slice) -> Waves:
 def ghost_flux(p: ModelParameters, ghost: np.ndarray) -> np.ndarray:
     """Physical flux (4, M) of primitive ghost states (4, M) at x = 0.
 
-    The same arithmetic as :meth:`arzsumo.twin.boundary.Inlet.boundary_flux`.
+    The same arithmetic as :meth:`arzsumo.pde.boundary.Inlet.boundary_flux`.
     """
     rho_h, v_h, rho_a, v_a = ghost
     ve_h, ve_a = speed_of_ao(p, area_occupancy(p, rho_h, rho_a))
@@ -50,7 +50,7 @@ def ghost_flux(p: ModelParameters, ghost: np.ndarray) -> np.ndarray:
 
 
 def outlet_fluxes(out: Waves, total: np.ndarray) -> np.ndarray:
-    """Outlet flux (4, M) of :func:`arzsumo.twin.boundary.outlet_flux`, per member.
+    """Outlet flux (4, M) of :func:`arzsumo.pde.boundary.outlet_flux`, per member.
 
     ``out`` holds the last cell of each member (arrays (4, M) and (M,)); ``total`` the
     metered outflow q* + U of each member, veh/s.

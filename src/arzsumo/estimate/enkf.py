@@ -41,8 +41,8 @@ from arzsumo.estimate.batch import BatchStepper, project
 from arzsumo.estimate.observations import Estimate, LoopObservation, ProbeObservation
 from arzsumo.model.fd import equilibrium_speeds
 from arzsumo.model.params import ModelParameters
-from arzsumo.twin.flux import FLUXES
-from arzsumo.twin.state import to_conserved, to_primitive
+from arzsumo.pde.flux import FLUXES
+from arzsumo.pde.state import to_conserved, to_primitive
 
 
 @dataclass(frozen=True)

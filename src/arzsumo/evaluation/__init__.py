@@ -8,9 +8,8 @@ network-wide measures from SUMO's own outputs).
   growth upstream, and the lateral files of a class.
 * :mod:`~arzsumo.evaluation.report`: the measures of ``arzsumo evaluate`` and their table
   (per controller: mean and CI; paired difference against the open loop, wins, losses).
-* :mod:`~arzsumo.evaluation.premise`: the premise gates (one coupled stream, waves
-  travelling upstream, open-loop instability, an actuator that moves q(L) both ways, the
-  operating point) and their verdict over seeds.
+* :mod:`~arzsumo.evaluation.travel`: the speed of travel of a field's fluctuations (the
+  lag of the peak cross-correlation between places).
 
 Importing this package imports neither libsumo nor sumolib.
 """

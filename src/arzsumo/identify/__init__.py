@@ -1,6 +1,6 @@
 """Identification of the macroscopic model from replay data.
 
-Pure math: numpy and scipy on top of :mod:`arzsumo.model` and :mod:`arzsumo.twin`; no SUMO,
+Pure math: numpy and scipy on top of :mod:`arzsumo.model` and :mod:`arzsumo.pde`; no SUMO,
 no files, no plots. The SUMO layer turns its runs into :class:`ReplayData` and calls
 :func:`identify` and :func:`validate`.
 

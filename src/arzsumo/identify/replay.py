@@ -1,6 +1,6 @@
 """The replay twin: the nonlinear twin driven by a run's boundary data, sampled like the run.
 
-:func:`run_replay` starts a :class:`arzsumo.twin.TwinStepper` from the data's initial
+:func:`run_replay` starts a :class:`arzsumo.pde.TwinStepper` from the data's initial
 state (interpolated to the twin grid), holds the inlet ghost cell at ``data.inlet[k]``
 and the outlet flow at ``data.outflow[k]`` during period k, and samples the primitive
 fields at ``data.x`` at every period end. This is what the SUMO closed loop does with its
@@ -13,7 +13,7 @@ SUMO's queue tail reaches x = 0 the held (smoothed) state pairs a queue's densit
 the arriving vehicles' speed, and that flux can fill the first cell past AO_max.
 ``supply`` lets in the smaller of that flux and the first cell's receiving capacity, the
 supply of the cell transmission model built on the model's own Ve_i
-(:class:`arzsumo.twin.supply.ReceivingCapacity`). ``ctm`` (default) is the cell
+(:class:`arzsumo.pde.supply.ReceivingCapacity`). ``ctm`` (default) is the cell
 transmission model's whole rule, min(demand, supply): a held state in congestion (above
 the diagram's critical occupancy) demands the capacity (times its own departure from
 the diagram), as a queue upstream of x = 0 would send; in free flow its demand is its
@@ -48,10 +48,10 @@ from arzsumo.identify.data import IdentifyError, ReplayData
 from arzsumo.model.equilibrium import Equilibrium
 from arzsumo.model.fd import area_occupancy
 from arzsumo.model.params import ModelParameters
-from arzsumo.twin.boundary import Inlet
-from arzsumo.twin.solver import SolverOptions, TwinStepper, TwinStoppedError
-from arzsumo.twin.state import cell_centres
-from arzsumo.twin.supply import ReceivingCapacity
+from arzsumo.pde.boundary import Inlet
+from arzsumo.pde.solver import SolverOptions, TwinStepper, TwinStoppedError
+from arzsumo.pde.state import cell_centres
+from arzsumo.pde.supply import ReceivingCapacity
 
 #: an inlet rule of :func:`run_replay`: (held state, first cell's state) -> boundary state
 InletRule = Callable[[np.ndarray, np.ndarray], np.ndarray]
@@ -71,7 +71,7 @@ class ReplayOptions:
         Finite volumes on [0, L] (50 cells of 20 m by default: see
         ``benchmarks/bench_identify.py`` for cost and accuracy against finer grids).
     scheme, flux, limiter, cfl :
-        As :class:`arzsumo.twin.SolverOptions`.
+        As :class:`arzsumo.pde.SolverOptions`.
     ao_limit : float
         Densities of the initial and inlet states are scaled down to AO <= ao_limit AO_max
         of the parameters being tried, in (0, 1).
@@ -191,7 +191,7 @@ class _NoRegimeWarning(logging.Filter):
 
 @contextmanager
 def _quiet_regime() -> Iterator[None]:
-    logger = logging.getLogger("arzsumo.twin.solver")
+    logger = logging.getLogger("arzsumo.pde.solver")
     flt = _NoRegimeWarning()
     logger.addFilter(flt)
     try:

@@ -45,7 +45,6 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from arzsumo import __version__
 from arzsumo.bridge.compare import row_of
 from arzsumo.bridge.delay import compensated_delay
 from arzsumo.bridge.estimator import fill_speeds
@@ -68,9 +67,10 @@ from arzsumo.outputs.run_summary import (
     WindowCounts,
 )
 from arzsumo.outputs.waves import waves_summary
+from arzsumo.pde.metrics import performance
 from arzsumo.schema import CELLS, PERIODS, with_units
-from arzsumo.twin.metrics import performance
 from arzsumo.units import ms_to_kmh, veh_m_to_veh_km
+from arzsumo.version import __version__
 
 #: SUMO's tripinfo output of the run (every loaded vehicle), gzip-compressed
 TRIPINFO_GZ = "tripinfo.xml.gz"
@@ -399,13 +399,15 @@ def cells_table(res: CoSimResult) -> pa.Table:
 
 
 def write_results(res: CoSimResult, out: str | Path | OutputDir, scenario_text: str,
-                  plots: bool = True, overwrite: bool = False) -> tuple[Path, dict[str, Any]]:
+                  plots: bool = True, overwrite: bool = False,
+                  summ: RunSummary | None = None) -> tuple[Path, dict[str, Any]]:
     """Write everything into ``out`` atomically (a previous ``run`` result there is replaced
-    only with ``overwrite``, see :mod:`arzsumo.outdir`); return the path and summary."""
+    only with ``overwrite``, see :mod:`arzsumo.outdir`); return the path and summary
+    (``summ``: the run's summary when computed already)."""
     from arzsumo.outputs.figures import save_figures
     from arzsumo.plots.bridge import bridge_figures
 
-    summ = summary(res).to_dict()
+    summ = (summ if summ is not None else summary(res)).to_dict()
     with atomic_dir(out, "run", overwrite=overwrite) as tmp:
         pq.write_table(periods_table(res), tmp / "periods.parquet")
         pq.write_table(cells_table(res), tmp / "cells.parquet")

@@ -3,7 +3,7 @@
 ``--diagram`` ``diagram.png`` (stage 1's fit against SUMO's stationary states), and
 ``spectrum.png`` (where the runs' speed fluctuations lie in time scale).
 
-Their content is made by :mod:`arzsumo.studies.identify.report`; here the texts are
+Their content is made by :mod:`arzsumo.workflows.identify.report`; here the texts are
 written and the figures (:mod:`arzsumo.plots.identify`) drawn from arrays.
 """
 

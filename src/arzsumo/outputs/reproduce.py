@@ -2,7 +2,7 @@
 atomically (:func:`arzsumo.io.atomic_dir`).
 
 The content (report text, table rows, figure data) is built by
-:mod:`arzsumo.studies.paper.report`; this module only writes it, and draws the figures
+:mod:`arzsumo.workflows.paper.report`; this module only writes it, and draws the figures
 with :mod:`arzsumo.plots.reproduce`.
 """
 

@@ -21,6 +21,7 @@ section                   record                                     keys (units
 ``[actuation]``           ``actuation``: ActuationSettings (``run``) :mod:`.actuation`
 ``[alinea]``              ``alinea``: AlineaSettings (``run``)       :mod:`.alinea`
 ``[disturbance]``         ``disturbance``: Slowdown (``run``)        :mod:`.disturbance`
+``[network]``             ``network``: NetworkRequest (``run``)      :mod:`.network`
 ``[sweep]``               ``sweep``: DesignSweep (``reproduce``)     here
 ========================  =========================================  ====================
 
@@ -46,6 +47,7 @@ from arzsumo.io import read_toml
 from arzsumo.model.characteristic import linearize
 from arzsumo.model.equilibrium import Equilibrium
 from arzsumo.model.params import ModelParameters, get_preset
+from arzsumo.pde.initial import InitialCondition
 from arzsumo.scenario.actuation import (
     ACTUATION_KEYS,
     ActuationSettings,
@@ -70,6 +72,7 @@ from arzsumo.scenario.model import (
     equilibrium_section,
     model_section,
 )
+from arzsumo.scenario.network import NETWORK_KEYS, network_section
 from arzsumo.scenario.run import (
     RUN_KEYS,
     RUN_RENAMED,
@@ -89,8 +92,8 @@ from arzsumo.scenario.twin import (
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.disturbance import Slowdown
 from arzsumo.sumo.sensing import SensorLayout
+from arzsumo.sumo.user_network import NetworkRequest
 from arzsumo.tables import Key, check_keys, check_renamed, checked, not_allowed, where
-from arzsumo.twin.initial import InitialCondition
 
 #: the ETC design parameters that a ``[sweep]`` table may vary (one number each)
 SWEEPABLE = tuple(sorted(set(DESIGN_KEYS) - {"A", "varsigma", "noise_sd_kmh",
@@ -108,7 +111,8 @@ KEYS: dict[str, dict[str, Key]] = {
     "model": MODEL_KEYS, "equilibrium": EQUILIBRIUM_KEYS, "design": DESIGN_KEYS,
     "initial": INITIAL_KEYS, "twin": TWIN_KEYS, "sumo": SUMO_KEYS, "run": RUN_KEYS,
     "sensing": SENSING_KEYS, "estimation": ESTIMATION_KEYS, "actuation": ACTUATION_KEYS,
-    "alinea": ALINEA_KEYS, "disturbance": DISTURBANCE_KEYS, "sweep": SWEEP_KEYS,
+    "alinea": ALINEA_KEYS, "disturbance": DISTURBANCE_KEYS, "network": NETWORK_KEYS,
+    "sweep": SWEEP_KEYS,
 }
 #: table -> {old key: new key}: keys renamed since earlier versions (a one-line hint)
 RENAMED: dict[str, dict[str, str]] = {"run": RUN_RENAMED}
@@ -149,6 +153,9 @@ class Scenario:
     actuation: ActuationSettings = field(default_factory=ActuationSettings)
     alinea: AlineaSettings = field(default_factory=AlineaSettings)
     disturbance: Slowdown = field(default_factory=Slowdown)
+    #: the ``[network]`` table (None: the shipped network); checked against the network
+    #: by :func:`arzsumo.bridge.session.prepare_run`
+    network: NetworkRequest | None = None
 
     def with_(self, changes: Mapping[str, Any]) -> Scenario:
         """A new scenario with keys changed, parsed and validated again.
@@ -214,9 +221,17 @@ def scenario_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scena
     run = run_section(t["run"], at["run"])
     check_constant_release(run, sumo.release_rate_min, sumo.release_rate_max, at["run"],
                            t["run"].get("constant_release_veh_h"))
-    sensing = sensing_section(t["sensing"], at["sensing"], params.length)
+    network = network_section(t["network"], at["network"], source)
+    # with [network] and no [model] length_m, L is the network's: loops are checked
+    # against it when the run is prepared
+    length = params.length
+    if network is not None and "length_m" not in t["model"]:
+        asked = t["sensing"].get("loop_positions_m")
+        length = max([length, *asked]) if isinstance(asked, list) and all(
+            isinstance(v, int | float) for v in asked) else length
+    sensing = sensing_section(t["sensing"], at["sensing"], length)
     estimation = estimation_section(t["estimation"], at["estimation"])
-    check_sensors(estimation, sensing, params.length, at["estimation"])
+    check_sensors(estimation, sensing, length, at["estimation"])
     actuation = actuation_section(t["actuation"], at["actuation"])
     if actuation.delay_compensation > 0:
         check_delay_horizon(actuation, linearize(eq).eigenvalues, params.length,
@@ -236,7 +251,7 @@ def scenario_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scena
                     design, initial, twin, sumo, run, sweep, source,
                     copy.deepcopy(dict(data)), sensing=sensing,
                     estimation=estimation, actuation=actuation, alinea=alinea,
-                    disturbance=disturbance)
+                    disturbance=disturbance, network=network)
 
 
 def load_scenario(path: str | Path) -> Scenario:

@@ -59,6 +59,10 @@ SECTIONS: dict[str, tuple[str, Callable[[str], Any] | None]] = {
     "disturbance": ("a reproducible perturbation of `arzsumo run` after the start of control "
                     "(the disturbance experiment); default: none. Runs with and without it "
                     "share their warm-up", lambda f: getattr(Slowdown(), f)),
+    "network": ("`arzsumo run` on a SUMO network the user brings (docs/networks.md); "
+                "default: none, the shipped network. Checked with sumolib before SUMO starts",
+                lambda f: {"route_files": (), "av_types": (), "start_offset": 0.0,
+                           "end_offset": 0.0, "sublane": True}.get(f)),
     "sweep": ("`arzsumo reproduce` only: one ETC run per value of a [design] parameter", None),
 }
 

@@ -47,7 +47,7 @@ REFERENCES = ("equilibrium", "warmup")
 #: default EnKF model-error sd per forecast (rho_h veh/m, v_h m/s, rho_a veh/m, v_a m/s):
 #: 2 veh/km, 1 km/h, 1 veh/km, 1 km/h, chosen offline on SUMO records of the default
 #: scenario (seeds 1-2, loops every 250 m + AV probes; ``arzsumo study enkf-noise``,
-#: docs/readings/enkf_model_noise.md): RMSE / spread fell from 5.1, 7.5, 7.9, 8.1 to 3.0, 3.4,
+#: research/readings/enkf_model_noise.md): RMSE / spread fell from 5.1, 7.5, 7.9, 8.1 to 3.0, 3.4,
 #: 4.2, 1.8 at RMSE +12 %, -1 %, +8 %, -48 %; larger noise or inflation raised the spread and the
 #: error together (density RMSE x 1.5-3 for RMSE / spread 2-3).
 MODEL_SD = (2e-3, float(kmh_to_ms(1.0)), 1e-3, float(kmh_to_ms(1.0)))

@@ -38,12 +38,12 @@ from typing import Any
 from arzsumo.control.etc import PAPER_DESIGN, EtcDesign
 from arzsumo.control.registry import controller_names
 from arzsumo.errors import ArzsumoError, ScenarioError, require
+from arzsumo.pde.flux import FLUXES, LIMITERS
+from arzsumo.pde.initial import KINDS, InitialCondition
+from arzsumo.pde.scheme import SCHEMES
+from arzsumo.pde.solver import SolverOptions
 from arzsumo.scenario.run import KERNEL_CELLS
 from arzsumo.tables import Key, checked, in_user_terms, not_allowed, read_keys, written
-from arzsumo.twin.flux import FLUXES, LIMITERS
-from arzsumo.twin.initial import KINDS, InitialCondition
-from arzsumo.twin.scheme import SCHEMES
-from arzsumo.twin.solver import SolverOptions
 from arzsumo.units import VEH_H_PER_VEH_S
 
 #: default initial condition of scenario files: a moderate stop-and-go wave

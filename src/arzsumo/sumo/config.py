@@ -7,11 +7,12 @@ keys and their conversions are listed once, in :mod:`arzsumo.scenario.sumo`.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
 from arzsumo.errors import ScenarioError, require
 from arzsumo.sumo.car_following import ATTRIBUTES, check_values
+from arzsumo.sumo.layout import RoadLayout
 from arzsumo.sumo.network import NetworkSpec
 
 HV_MODELS = ("Krauss", "IDM", "EIDM")
@@ -155,6 +156,9 @@ class SumoConfig:
     fcd : bool
         Have SUMO write its floating-car data (every vehicle every step: position, lateral
         position, speed, lane, type) into ``fcd.xml.gz`` of ``arzsumo run``'s directory.
+    layout : RoadLayout, optional
+        The user's network of a ``[network]`` table, checked by
+        :func:`arzsumo.sumo.user_network.read_layout`; None (default): the shipped one.
     """
 
     step_length: float = 0.1
@@ -222,6 +226,7 @@ class SumoConfig:
     fill_demand_a: float = 0.0
     eager_insert: bool = True
     fcd: bool = False
+    layout: RoadLayout | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
         def pos(name: str) -> None:
@@ -258,10 +263,7 @@ class SumoConfig:
                 ScenarioError)
         require(self.step_length <= 1.0, "step_length", self.step_length, "at most 1 s",
                 ScenarioError)
-        subl = LANE_WIDTH / self.lateral_resolution
-        require(abs(subl - round(subl)) < 1e-6, "lateral_resolution", self.lateral_resolution,
-                f"a width dividing the {LANE_WIDTH} m lane, e.g. 0.5 or 0.25",
-                ScenarioError)
+        self._check_resolution()
         # a shorter run holds no complete control period: nothing measured, NaN summaries
         require(self.horizon >= self.control_period, "horizon", self.horizon,
                 f"at least one control period (control_period = {self.control_period} s)",
@@ -283,6 +285,17 @@ class SumoConfig:
         require(isinstance(self.eager_insert, bool), "eager_insert", self.eager_insert,
                 "true or false", ScenarioError)
         self._check_behaviour()
+
+    def _check_resolution(self) -> None:
+        """The sublane width divides the lane (the section's lanes on a user's network
+        that runs the sublane model)."""
+        widths = (LANE_WIDTH,) if self.layout is None else \
+            self.layout.lane_widths if self.layout.sublane else ()
+        for width in sorted(set(widths)):
+            subl = width / self.lateral_resolution
+            require(abs(subl - round(subl)) < 1e-6, "lateral_resolution",
+                    self.lateral_resolution,
+                    f"a width dividing the {width:g} m lane, e.g. 0.5 or 0.25", ScenarioError)
 
     def _check_behaviour(self) -> None:
         """The car-following models, the lateral behaviour's choices, the HVs' action step."""
@@ -309,7 +322,8 @@ class SumoConfig:
                 "an integer >= 0 (0 = no queue override; -1: what the ramp holds)",
                 ScenarioError)
         if self.ramp_storage == -1:
-            object.__setattr__(self, "ramp_storage", ramp_capacity())
+            ramp = None if self.layout is None else self.layout.ramp_length
+            object.__setattr__(self, "ramp_storage", ramp_capacity(ramp))
 
     def _check_meter(self) -> None:
         """The meter's mode and timings fit together (clearance inside the cycle, release

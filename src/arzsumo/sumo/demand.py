@@ -45,6 +45,8 @@ class Flow:
     lat: str = "center"
     #: departSpeed; None: "desired" on the mainline (free road at x = 0), "max" on the ramp
     depart_speed: str | None = None
+    #: departLane: the one lane of the shipped network, "free" on a user's network
+    depart_lane: str = "0"
 
     @property
     def period(self) -> float:
@@ -63,7 +65,8 @@ class Flow:
         speed = self.depart_speed or ("desired" if self.route == ROUTE_MAIN else "max")
         attrs = {"id": self.id, "type": self.type, "route": self.route,
                  "begin": f"{self.begin:.6g}", "end": f"{self.end:.6g}",
-                 "period": f"{self.period:.9g}", "departLane": "0", "departPos": "base",
+                 "period": f"{self.period:.9g}", "departLane": self.depart_lane,
+                 "departPos": "base",
                  "departPosLat": lat, "departSpeed": speed}
         return "<flow " + " ".join(f"{k}={quoteattr(v)}" for k, v in attrs.items()) + "/>"
 
@@ -162,13 +165,41 @@ def check_columns(road_width: float, vehicle_width: float, resolution: float,
         used.append((lo, hi))
 
 
+def _routes_file(lines: list[str]) -> str:
+    body = "\n".join(f"    {ln}" for ln in lines)
+    return f'<?xml version="1.0" encoding="UTF-8"?>\n<routes>\n{body}\n</routes>\n'
+
+
+def layout_route_text(params: ModelParameters, cfg: SumoConfig) -> str:
+    """The route file on a user's network (``cfg.layout``): nothing when the user's
+    route files carry the demand; else the run's vTypes, the mainline route from the first
+    section edge and the ramp route, and the ``[sumo]`` demand as flows on them, each
+    vehicle entering the lane SUMO finds freest (``departLane="free"``; mainline vehicles
+    laterally at the lane's centre unless ``depart_pos_lat`` names a SUMO value)."""
+    lay = cfg.layout
+    if lay is None or lay.route_files:
+        return _routes_file([])
+    hv, av = vehicle_types(params, cfg)
+    lines = [hv.to_xml(), av.to_xml(),
+             f'<route id="{ROUTE_MAIN}" edges={quoteattr(" ".join(lay.main_route))}/>',
+             f'<route id="{ROUTE_RAMP}" edges={quoteattr(" ".join(lay.ramp_route))}/>']
+    lat = "center" if cfg.depart_pos_lat == "columns" else cfg.depart_pos_lat
+    flows = [replace(f, depart_lane="free")
+             for f in demand_flows(replace(cfg, depart_pos_lat=lat))]
+    lines += [f.to_xml() for f in sorted(flows, key=lambda f: f.begin)]
+    return _routes_file(lines)
+
+
 def route_file_text(params: ModelParameters, cfg: SumoConfig,
                     initial: Sequence[InitialVehicle] = ()) -> str:
     """The route file: vTypes, the routes, initial vehicles, then the flows.
 
     Mainline flows start on ``approach`` when ``cfg.approach_length > 0`` (the network
-    must have that edge), else on ``main`` at x = 0.
+    must have that edge), else on ``main`` at x = 0. On a user's network
+    (``cfg.layout``): :func:`layout_route_text`.
     """
+    if cfg.layout is not None:
+        return layout_route_text(params, cfg)
     if cfg.depart_pos_lat == "columns":   # otherwise SUMO places every vehicle itself
         check_columns(params.road_width, params.vehicle_width, cfg.lateral_resolution,
                       insertion_columns(params.road_width, params.vehicle_width, 3))
@@ -192,8 +223,7 @@ def route_file_text(params: ModelParameters, cfg: SumoConfig,
                  for f in flows]
     # SUMO drops departures listed out of time order: sort the flows by their begin
     lines += [f.to_xml() for f in sorted(flows, key=lambda f: f.begin)]
-    body = "\n".join(f"    {ln}" for ln in lines)
-    return f'<?xml version="1.0" encoding="UTF-8"?>\n<routes>\n{body}\n</routes>\n'
+    return _routes_file(lines)
 
 
 def write_route_file(path: Path, params: ModelParameters, cfg: SumoConfig,
@@ -219,7 +249,8 @@ def sumocfg_text(net_file: str, route_file: str, cfg: SumoConfig,
         "input": inputs,
         "time": {"begin": "0", "end": f"{cfg.horizon:.6g}",
                  "step-length": f"{cfg.step_length:.6g}"},
-        "processing": {"lateral-resolution": f"{cfg.lateral_resolution:.6g}",
+        "processing": {**({"lateral-resolution": f"{cfg.lateral_resolution:.6g}"}
+                          if cfg.layout is None or cfg.layout.sublane else {}),
                        "time-to-teleport": f"{cfg.time_to_teleport:.6g}",
                        "eager-insert": str(cfg.eager_insert).lower(),
                        "collision.action": "warn",

@@ -48,6 +48,7 @@ import numpy as np
 from arzsumo.errors import ScenarioError, require
 from arzsumo.estimate.observations import LoopNoise, LoopObservation
 from arzsumo.sumo.detectors import write_additional
+from arzsumo.sumo.layout import RoadLayout
 from arzsumo.sumo.network import DOWN, MAIN
 from arzsumo.sumo.vtypes import AV_TYPE
 
@@ -93,11 +94,27 @@ def placed_positions(x: Sequence[float], length: float) -> np.ndarray:
     return placed
 
 
-def write_loops(path: Path, x: Sequence[float], length: float) -> Path:
-    """Write an additional file with one E1 station per position of ``main_0``."""
+def lane_loop_ids(station: str, lanes: int) -> list[str]:
+    """Ids of a station's E1 loops on a user's section, one per lane (lane 0 first)."""
+    return [f"{station}_{k}" for k in range(lanes)]
+
+
+def write_loops(path: Path, x: Sequence[float], length: float,
+                layout: RoadLayout | None = None) -> Path:
+    """Write an additional file with one E1 station per position of ``main_0``; on a
+    user's section (``layout``) a station is one E1 per lane of the edge at x."""
     placed = placed_positions(x, length)
-    elements = [{"id": det, "lane": f"{MAIN}_0", "pos": f"{pos:.3f}", "period": "3600",
-                 "file": "NUL"} for det, pos in zip(loop_ids(placed.size), placed, strict=True)]
+    if layout is None:
+        elements = [{"id": det, "lane": f"{MAIN}_0", "pos": f"{pos:.3f}", "period": "3600",
+                     "file": "NUL"}
+                    for det, pos in zip(loop_ids(placed.size), placed, strict=True)]
+        return write_additional(path, "inductionLoop", elements)
+    elements = []
+    for station, xj in zip(loop_ids(placed.size), placed, strict=True):
+        edge, pos = layout.locate(float(xj))
+        elements += [{"id": det, "lane": f"{edge}_{k}", "pos": f"{pos:.3f}",
+                      "period": "3600", "file": "NUL"}
+                     for k, det in enumerate(lane_loop_ids(station, layout.lanes))]
     return write_additional(path, "inductionLoop", elements)
 
 
@@ -149,13 +166,18 @@ class LoopSensor:
 
     def __init__(self, lib: ModuleType, x: Sequence[float], length: float, dt: float,
                  steps_per_period: int, noise: LoopNoise | None = None,
-                 speed: str = "time_mean") -> None:
+                 speed: str = "time_mean", layout: RoadLayout | None = None) -> None:
         require(steps_per_period >= 1, "steps_per_period", steps_per_period, "at least 1")
         require(speed in LOOP_SPEEDS, "loop_speed", speed, f"one of {', '.join(LOOP_SPEEDS)}")
         self.lib, self.dt, self.steps_per_period = lib, dt, steps_per_period
         self.speed = speed
         self.x = placed_positions(x, length)
         self.ids = loop_ids(self.x.size)
+        #: the E1 loops of each station (one; one per lane on a user's section), and the
+        #: vTypes counted as AVs
+        self.lanes = [[i] for i in self.ids] if layout is None else \
+            [lane_loop_ids(i, layout.lanes) for i in self.ids]
+        self.av_types = frozenset({AV_TYPE}) if layout is None else layout.av_types
         self.noise = noise or LoopNoise()
         self._on: list[set[str]] = [set() for _ in self.ids]
         self.records: list[LoopObservation] = []
@@ -173,9 +195,8 @@ class LoopSensor:
         """Add station ``j``'s vehicles of the step ending at ``t`` (s)."""
         on = set()
         t0 = t - self.dt
-        for vid, length, t_in, t_out, vtype in self.lib.inductionloop.getVehicleData(
-                self.ids[j]):
-            c = 1 if vtype == AV_TYPE else 0
+        for vid, length, t_in, t_out, vtype in self._vehicle_data(j):
+            c = 1 if vtype in self.av_types else 0
             on.add(vid)
             if vid not in self._on[j]:
                 v = self.lib.vehicle.getSpeed(vid)
@@ -185,6 +206,14 @@ class LoopSensor:
             end = t if t_out < 0 else min(t_out, t)
             self.dwell[c, j] += max(end - max(t_in, t0), 0.0) / length
         self._on[j] = on
+
+    def _vehicle_data(self, j: int) -> list[tuple]:
+        """The vehicles on station ``j``'s loops in the step (every lane's)."""
+        data = self.lib.inductionloop.getVehicleData
+        ids = self.lanes[j]
+        if len(ids) == 1:
+            return list(data(ids[0]))
+        return [row for i in ids for row in data(i)]
 
     def observe(self, t: float) -> LoopObservation | None:
         """Read the step that ended at ``t`` (s); the period's record when it is complete."""
@@ -209,14 +238,30 @@ DOWNSTREAM_LOOP = "e1_down"
 DOWNSTREAM_DISTANCE = 100.0
 
 
-def write_downstream_loop(path: Path, distance: float = DOWNSTREAM_DISTANCE) -> Path:
+def downstream_ids(layout: RoadLayout | None) -> list[str]:
+    """Ids of the downstream loop: one on ``down``, one per lane on a user's network."""
+    if layout is None:
+        return [DOWNSTREAM_LOOP]
+    return lane_loop_ids(DOWNSTREAM_LOOP, layout.outlet_lanes)
+
+
+def write_downstream_loop(path: Path, distance: float = DOWNSTREAM_DISTANCE,
+                          layout: RoadLayout | None = None) -> Path:
     """Write an additional file with one E1 loop on ``down_0`` at ``distance`` m past the
-    merge nose (the end of ``merge`` is the start of ``down``)."""
+    merge nose (the end of ``merge`` is the start of ``down``). On a user's network
+    (``layout``): one E1 per lane on the first mainline edge past the ramp's junction,
+    ``distance`` m along it (at most its length less 0.1 m)."""
     require(0 < distance < 500, "loop_distance", distance,
             "a distance in (0, 500) m on the 500 m `down` edge", ScenarioError)
+    if layout is None:
+        return write_additional(path, "inductionLoop", [
+            {"id": DOWNSTREAM_LOOP, "lane": f"{DOWN}_0", "pos": f"{distance:.3f}",
+             "period": "3600", "file": "NUL"}])
+    pos = min(distance, layout.outlet_length - BOUNDARY_GAP)
     return write_additional(path, "inductionLoop", [
-        {"id": DOWNSTREAM_LOOP, "lane": f"{DOWN}_0", "pos": f"{distance:.3f}",
-         "period": "3600", "file": "NUL"}])
+        {"id": det, "lane": f"{layout.outlet_edge}_{k}", "pos": f"{pos:.3f}",
+         "period": "3600", "file": "NUL"}
+        for k, det in enumerate(downstream_ids(layout))])
 
 
 class DownstreamLoop:
@@ -230,9 +275,12 @@ class DownstreamLoop:
     front reached the loop in the period).
     """
 
-    def __init__(self, lib: ModuleType, dt: float, steps_per_period: int) -> None:
+    def __init__(self, lib: ModuleType, dt: float, steps_per_period: int,
+                 ids: Sequence[str] = (DOWNSTREAM_LOOP,)) -> None:
         require(steps_per_period >= 1, "steps_per_period", steps_per_period, "at least 1")
         self.lib, self.dt, self.steps_per_period = lib, dt, steps_per_period
+        #: the loop's E1s (one per lane; the occupancy is their mean)
+        self.ids = tuple(ids)
         self._on: set[str] = set()
         self._reset()
 
@@ -243,8 +291,10 @@ class DownstreamLoop:
         """Read the step that ended at ``t`` (s); ``(occupancy, flow)`` (fraction, veh/s)
         of the period when it is complete, else None."""
         on, t0 = set(), t - self.dt
-        for vid, _length, t_in, t_out, _vtype in self.lib.inductionloop.getVehicleData(
-                DOWNSTREAM_LOOP):
+        data = self.lib.inductionloop.getVehicleData
+        rows = data(self.ids[0]) if len(self.ids) == 1 else \
+            [row for i in self.ids for row in data(i)]
+        for vid, _length, t_in, t_out, _vtype in rows:
             on.add(vid)
             self.entered += vid not in self._on
             end = t if t_out < 0 else min(t_out, t)
@@ -254,6 +304,7 @@ class DownstreamLoop:
         if self.steps < self.steps_per_period:
             return None
         span = self.steps * self.dt
-        out = (self.occupied / span, self.entered / span)
+        occupied = self.occupied if len(self.ids) == 1 else self.occupied / len(self.ids)
+        out = (occupied / span, self.entered / span)
         self._reset()
         return out

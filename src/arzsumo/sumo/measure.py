@@ -25,6 +25,7 @@ from types import ModuleType
 import numpy as np
 
 from arzsumo.errors import require
+from arzsumo.sumo.layout import RoadLayout, VehicleClasses
 from arzsumo.sumo.network import MAIN
 
 
@@ -140,25 +141,53 @@ class MainlineSensor:
     """Collects ``main`` every step from an open libsumo run and yields windows.
 
     Call :meth:`collect` after every SUMO step; when :attr:`steps_per_window` steps have
-    been collected it returns the window's :class:`CellData` (otherwise None).
+    been collected it returns the window's :class:`CellData` (otherwise None). With a
+    ``layout`` (a user's network) the section is its edges from x = 0 to x = L, every
+    lane: Edie's sums run over all of them, so the densities are per road.
     """
 
     def __init__(self, lib: ModuleType, length: float, cell_length: float, dt: float,
-                 steps_per_window: int) -> None:
+                 steps_per_window: int, layout: RoadLayout | None = None,
+                 classes: VehicleClasses | None = None) -> None:
         require(steps_per_window >= 1, "steps_per_window", steps_per_window, "at least 1")
         self.lib, self.grid = lib, EdieGrid(length, cell_length, dt)
         self.steps_per_window = steps_per_window
+        self.layout = layout
+        self.classes = classes or VehicleClasses(lib, layout)
         self._prev: set[str] = set()
         self.log = MeasurementLog()
 
     def sample(self) -> tuple[tuple[str, ...], np.ndarray, np.ndarray, np.ndarray]:
         """(ids, positions m, speeds m/s, AV mask) of the vehicles on ``main`` now."""
+        if self.layout is not None:
+            return self._sample_section(self.layout)
         v = self.lib.vehicle
         ids = self.lib.edge.getLastStepVehicleIDs(MAIN)
         n = len(ids)
         pos = np.fromiter(map(v.getLanePosition, ids), float, n)
         speed = np.fromiter(map(v.getSpeed, ids), float, n)
         return ids, pos, speed, is_av(ids)
+
+    def _sample_section(self, layout: RoadLayout
+                        ) -> tuple[tuple[str, ...], np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`sample` on a user's section: x = the edge's start + the lane position,
+        vehicles in [0, L) only (internal edges between section edges count at the next
+        edge's start)."""
+        v, edge = self.lib.vehicle, self.lib.edge
+        ids: list[str] = []
+        xs: list[float] = []
+        for e, x0 in layout.section_places():
+            on = edge.getLastStepVehicleIDs(e)
+            if not on:
+                continue
+            internal = e.startswith(":")
+            ids += on
+            xs += [x0] * len(on) if internal else [x0 + v.getLanePosition(i) for i in on]
+        pos = np.asarray(xs, float)
+        keep = (pos >= 0.0) & (pos < layout.length)
+        ids_in = tuple(i for i, k in zip(ids, keep, strict=True) if k)
+        speed = np.fromiter(map(v.getSpeed, ids_in), float, len(ids_in))
+        return ids_in, pos[keep], speed, self.classes.av_mask(ids_in)
 
     def collect(self, t: float) -> CellData | None:
         """Sample the current step (time ``t``, s); return a finished window or None."""
@@ -170,12 +199,13 @@ class MainlineSensor:
         entered = cur - self._prev
         left = self._prev - cur
         entered = {i for i in entered if "_init" not in i}   # placed at t = 0: not inflow
+        is_av_id = self.classes.av
         if entered:
-            na = sum(1 for i in entered if i.startswith("av"))
+            na = sum(1 for i in entered if is_av_id(i))
             self.grid.flows[0] += len(entered) - na
             self.grid.flows[1] += na
         if left:
-            na = sum(1 for i in left if i.startswith("av"))
+            na = sum(1 for i in left if is_av_id(i))
             self.grid.flows[2] += len(left) - na
             self.grid.flows[3] += na
         self._prev = cur

@@ -93,6 +93,8 @@ class MeterLight:
     mode = ""
 
     def __init__(self, lib: ModuleType, cfg: SumoConfig, tl_id: str = METER_TL) -> None:
+        if cfg.layout is not None and tl_id == METER_TL:   # a user's network: its light
+            tl_id = cfg.layout.meter_tl
         self.lib, self.cfg, self.tl_id = lib, cfg, tl_id
         self.dt = cfg.step_length
         self.clearance_steps = round(cfg.meter_clearance / self.dt)
@@ -142,6 +144,8 @@ class MeterLight:
                 f"a value in [{lo:.6g}, {hi:.6g}] (saturate in the actuator)", ArzsumoError)
 
     def _set(self, state: str) -> None:
+        if self.cfg.layout is not None:   # the ramp's links of the user's light
+            state = self.cfg.layout.signal(state)
         self.lib.trafficlight.setRedYellowGreenState(self.tl_id, state)
 
     def _show(self, wanted: str) -> None:

@@ -22,6 +22,7 @@ import tempfile
 import weakref
 from collections.abc import Sequence
 from pathlib import Path
+from xml.sax.saxutils import quoteattr
 
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.demand import sumocfg_text
@@ -39,11 +40,15 @@ METER_PROGRAM = "nominal"
 def meter_program_text(cfg: SumoConfig) -> str:
     """An additional file with the nominal plan of the meter as a static ``tlLogic``
     (durations in s; :func:`~arzsumo.sumo.meter_release.nominal_phases`)."""
+    lay = cfg.layout
+    signal = (lambda state: state * METER_LINKS) if lay is None else lay.signal
+    tl_id = METER_TL if lay is None else lay.meter_tl
     phases = [f'        <phase duration="{n * cfg.step_length:.6g}" '
-              f'state="{state * METER_LINKS}"/>' for state, n in nominal_phases(cfg)]
+              f'state={quoteattr(signal(state))}/>' for state, n in nominal_phases(cfg)]
     return "\n".join([
         '<?xml version="1.0" encoding="UTF-8"?>', "<additional>",
-        f'    <tlLogic id="{METER_TL}" type="static" programID="{METER_PROGRAM}" offset="0">',
+        f'    <tlLogic id={quoteattr(tl_id)} type="static" programID="{METER_PROGRAM}" '
+        'offset="0">',
         *phases, "    </tlLogic>", "</additional>"]) + "\n"
 
 
@@ -65,13 +70,15 @@ class RunFiles:
         sub = self.root / SUMO_DIR
         sub.mkdir(exist_ok=True)
         names = []
-        for src in (net, route, *additional):
+        routes = cfg.layout.route_files if cfg.layout is not None else ()
+        for src in (net, route, *additional, *routes):
             shutil.copyfile(src, sub / Path(src).name)
             names.append(f"{SUMO_DIR}/{Path(src).name}")
         (sub / METER_FILE).write_text(meter_program_text(cfg), encoding="utf-8")
         config = self.root / CONFIG_FILE
-        config.write_text(sumocfg_text(names[0], names[1], cfg,
-                                       [*names[2:], f"{SUMO_DIR}/{METER_FILE}"]),
+        n = 2 + len(additional)
+        config.write_text(sumocfg_text(names[0], ",".join([names[1], *names[n:]]), cfg,
+                                       [*names[2:n], f"{SUMO_DIR}/{METER_FILE}"]),
                           encoding="utf-8")
         return config
 

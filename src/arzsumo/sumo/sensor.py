@@ -44,7 +44,8 @@ from arzsumo.estimate.observations import (
 )
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.lateral import LateralSampler
-from arzsumo.sumo.loops import DownstreamLoop, LoopSensor
+from arzsumo.sumo.layout import VehicleClasses
+from arzsumo.sumo.loops import DownstreamLoop, LoopSensor, downstream_ids
 from arzsumo.sumo.measure import CellData, MainlineSensor
 from arzsumo.sumo.probes import AvProbes
 from arzsumo.sumo.sensing import SensorLayout
@@ -149,18 +150,21 @@ class SumoSensor:
                  loop_noise: LoopNoise | None = None,
                  probe_noise: ProbeNoise | None = None, measure: bool = True) -> None:
         self.lib, self.measure = lib, measure
-        self.stop_line = StopLine(lib)
+        road = cfg.layout
+        self.classes = VehicleClasses(lib, road)
+        self.stop_line = StopLine(lib) if road is None else StopLine(lib, road.ramp_edge)
         self._end: tuple[float, object, EmissionsLedger] | None = None
         self.mainline = MainlineSensor(lib, length, cfg.cell_length, cfg.step_length,
-                                       cfg.steps_per_period)
+                                       cfg.steps_per_period, road, self.classes)
         layout = layout or SensorLayout()
         self.loops = LoopSensor(lib, layout.loop_x(length), length, cfg.step_length,
-                                cfg.steps_per_period, loop_noise, layout.loop_speed) \
-            if layout.loops else None
+                                cfg.steps_per_period, loop_noise, layout.loop_speed,
+                                road) if layout.loops else None
         self.probes = AvProbes(layout.av_probe_share, layout.av_probe_seed, probe_noise) \
             if layout.av_probes else None
         self.queue = 0
-        self.downstream = DownstreamLoop(lib, cfg.step_length, cfg.steps_per_period)
+        self.downstream = DownstreamLoop(lib, cfg.step_length, cfg.steps_per_period,
+                                         downstream_ids(road))
         self.ledger = EmissionsLedger(lib, cfg.step_length) if window else None
         self.window_open = False
         self.speeds = SpeedMoments()
@@ -193,7 +197,8 @@ class SumoSensor:
         back now, :attr:`arzsumo.sumo.simulation.SumoSimulation.pending`): the meter's
         reading, and the period's measurement when the period is complete (else None).
         :attr:`queue` is the ramp queue now."""
-        self.queue = ramp_queue(self.lib, pending)
+        self.queue = ramp_queue(self.lib, pending) if self.classes.layout is None else \
+            ramp_queue(self.lib, pending, self.classes.layout.ramp_edge, self.classes.ramp)
         reading = MeterReading(self.queue, self.stop_line.read())
         if self._end is not None:
             self._end[2].add()

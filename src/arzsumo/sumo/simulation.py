@@ -27,6 +27,7 @@ from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.demand import InitialVehicle, demand_flows, write_route_file
 from arzsumo.sumo.frontend import Frontend
+from arzsumo.sumo.layout import VehicleClasses
 from arzsumo.sumo.loops import DOWNSTREAM_DISTANCE, write_downstream_loop
 from arzsumo.sumo.network import NetworkSpec, approach_length_of, build_network
 from arzsumo.sumo.paths import (
@@ -139,6 +140,8 @@ class SumoSimulation:
         self._cleanup = tuple(cleanup)
         self._flows = demand_flows(cfg)
         self._lib: ModuleType | None = None
+        #: which vehicles are AVs and ramp vehicles (by id on the shipped network)
+        self.classes = VehicleClasses(None, cfg.layout)
         self.started = self.closed = False
         self.loaded = self.loaded_ramp = self.inserted = self.inserted_ramp = self.arrived = 0
         self.collisions = self.teleports = self.emergency_stops = 0
@@ -160,11 +163,13 @@ class SumoSimulation:
     def command(self) -> list[str]:
         """The SUMO command line (the one place it is built)."""
         c = self.cfg
+        routes = [self.route_file, *(c.layout.route_files if c.layout else ())]
+        lateral = ["--lateral-resolution", f"{c.lateral_resolution:.6g}"] \
+            if c.layout is None or c.layout.sublane else []
         return [self.frontend.binary(), "--net-file", str(self.net_file),
-                "--route-files", str(self.route_file),
+                "--route-files", ",".join(map(str, routes)),
                 "--step-length", f"{c.step_length:.6g}", "--seed", str(c.seed),
-                "--lateral-resolution", f"{c.lateral_resolution:.6g}",
-                "--time-to-teleport", f"{c.time_to_teleport:.6g}",
+                *lateral, "--time-to-teleport", f"{c.time_to_teleport:.6g}",
                 "--eager-insert", str(c.eager_insert).lower(), "--collision.action", "warn",
                 "--collision.check-junctions", "true",
                 "--statistic-output", str(self.stats_file),
@@ -190,6 +195,7 @@ class SumoSimulation:
                 raise SumoError(f"SUMO did not start: {_one_line(exc).rstrip('.')}"
                                 f"{self.frontend.failed_hint()}") from None
             self._lib, self.started, _ACTIVE = lib, True, self
+            self.classes = VehicleClasses(lib, self.cfg.layout)
             self.time = float(lib.simulation.getTime())
         except BaseException:   # Ctrl-C or a dying parent too
             if self._lib is not None:
@@ -220,11 +226,11 @@ class SumoSimulation:
         loaded = sim.getLoadedIDList()
         self.loaded += len(loaded)
         if loaded:
-            self.loaded_ramp += sum(1 for v in loaded if v.startswith("ramp"))
+            self.loaded_ramp += sum(1 for v in loaded if self.classes.ramp(v))
         departed = sim.getDepartedIDList()
         self.inserted += len(departed)
         if departed:
-            self.inserted_ramp += sum(1 for v in departed if v.startswith("ramp"))
+            self.inserted_ramp += sum(1 for v in departed if self.classes.ramp(v))
         self.arrived += sim.getArrivedNumber()
         #: vehicles due but not yet inserted after this step (ids), read once per step
         self.pending = sim.getPendingVehicles()
@@ -257,7 +263,7 @@ class SumoSimulation:
         """Accounting at the current time (run must be open)."""
         sim, veh = self.lib.simulation, self.lib.vehicle
         waits = {v: float(veh.getWaitingTime(v)) for v in veh.getIDList()
-                 if not v.startswith("ramp")}   # the meter's queue stands by design
+                 if not self.classes.ramp(v)}   # the meter's queue stands by design
         still = max(waits, key=waits.__getitem__, default="")
         return RunReport(self.time, self.requested(), self.loaded, self.inserted,
                          len(sim.getPendingVehicles()), self.arrived,
@@ -352,6 +358,8 @@ def network_file(cfg: SumoConfig, net_dir: Path | None, workdir: Path) -> Path:
     (:func:`network_spec`) is built with netconvert into ``workdir`` (about 0.5 s; it
     goes with the run's temporary files).
     """
+    if cfg.layout is not None:       # a [network] table: the user's network, checked
+        return cfg.layout.net_file
     spec = network_spec(cfg)
     if spec != NetworkSpec() and net_dir is None and not os.environ.get(NETS_ENV):
         return build_network(workdir / "net", spec)
@@ -397,11 +405,13 @@ def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
     try:
         net = network_file(cfg, net_dir, workdir)
         route = write_route_file(workdir / "run.rou.xml", params, cfg, initial)
-        adds = [write_downstream_loop(workdir / "e1_down.add.xml", downstream_loop)]
+        adds = [write_downstream_loop(workdir / "e1_down.add.xml", downstream_loop,
+                                      cfg.layout)]
         if len(loops):
             from arzsumo.sumo.loops import write_loops
 
-            adds.append(write_loops(workdir / "e1.add.xml", loops, params.length))
+            adds.append(write_loops(workdir / "e1.add.xml", loops, params.length,
+                                    cfg.layout))
         extra_args = ("--additional-files", ",".join(map(str, adds)), *extra_args)
         if keep is not None:
             keep.keep_config(net, route, adds, cfg)

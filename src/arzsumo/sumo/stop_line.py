@@ -11,7 +11,7 @@ emergency braking episodes of the :data:`HEAD_VEHICLES` vehicles nearest the lin
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from types import ModuleType
 from typing import NamedTuple
 
@@ -32,13 +32,18 @@ class MeterReading(NamedTuple):
     released: int
 
 
-def ramp_queue(lib: ModuleType, pending: Sequence[str] | None = None) -> int:
-    """Halted vehicles on ``ramp_up`` plus ramp vehicles still waiting to be inserted
-    (``pending``: the ids SUMO holds back this step, read here when not given)."""
+def ramp_queue(lib: ModuleType, pending: Sequence[str] | None = None, edge: str = RAMP_UP,
+               is_ramp: Callable[[str], bool] | None = None) -> int:
+    """Halted vehicles on ``edge`` (``ramp_up``) plus ramp vehicles still waiting to be
+    inserted (``pending``: the ids SUMO holds back this step, read here when not given;
+    ``is_ramp``: which are ramp vehicles, by default ids starting with ``ramp``)."""
     if pending is None:
         pending = lib.simulation.getPendingVehicles()
-    waiting = sum(1 for v in pending if v.startswith("ramp"))
-    return int(lib.edge.getLastStepHaltingNumber(RAMP_UP)) + waiting
+    if is_ramp is None:
+        waiting = sum(1 for v in pending if v.startswith("ramp"))
+    else:
+        waiting = sum(1 for v in pending if is_ramp(v))
+    return int(lib.edge.getLastStepHaltingNumber(edge)) + waiting
 
 
 class StopLine:

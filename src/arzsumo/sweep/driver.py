@@ -36,7 +36,6 @@ from typing import Any
 
 import pandas as pd
 
-from arzsumo import __version__
 from arzsumo.interrupts import guarded, worker_pool
 from arzsumo.io import atomic_file
 from arzsumo.outdir import atomic_dir, resumable_dir
@@ -53,6 +52,7 @@ from arzsumo.sweep.table import (
     sweep_table,
 )
 from arzsumo.sweep.worker import FINISHED, RunOutcome, RunTask, crashed, execute
+from arzsumo.version import __version__
 
 log = logging.getLogger(__name__)
 
@@ -272,7 +272,7 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
         Address of a Dask scheduler (``tcp://host:8786``) to run on instead.
     paper : mapping, optional
         Reference points drawn on ``study.png``: metric -> {axis value: value} (the CLI
-        passes :func:`arzsumo.studies.paper.values.paper_points` of ``spec.paper``).
+        passes :func:`arzsumo.workflows.paper.values.paper_points` of ``spec.paper``).
     kind : str
         The kind of result ``out`` holds (its marker): ``sweep``, or ``evaluation`` for
         ``arzsumo evaluate``; a directory of another kind is refused.

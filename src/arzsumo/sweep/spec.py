@@ -6,6 +6,7 @@ Example (``scenarios/sweeps/penetration_twin.toml``)::
     base = "../paper/penetration_44_etc.toml"   # relative to the sweep file
     engine = "twin"                              # or "sumo"
     seeds = [1, 2, 3]                            # the engine's seed: [twin] or [sumo] seed
+                                                 # (a count N: seeds 1..N)
     paper = "diffpene"                           # paper values drawn on the plots
 
     [set]                                        # changed in every run
@@ -340,10 +341,12 @@ def sweep_from_dict(data: Mapping[str, Any], source: str = "<dict>",
     axes = [replace(a, sets=tuple(_anchor(s, root) for s in a.sets)) for a in axes]
     if "seeds" in data:
         seeds = data["seeds"]
+        if isinstance(seeds, int) and not isinstance(seeds, bool) and seeds >= 1:
+            seeds = list(range(1, seeds + 1))      # a count, as `arzsumo evaluate --seeds`
         if not isinstance(seeds, list) or not seeds or any(
                 isinstance(s, bool) or not isinstance(s, int) or s < 0 for s in seeds):
-            raise SweepError(f"{source}: seeds = {written(seeds)} is not allowed: a non-empty list "
-                             "of integers >= 0")
+            raise SweepError(f"{source}: seeds = {written(seeds)} is not allowed: a count N "
+                             ">= 1 (seeds 1..N) or a non-empty list of integers >= 0")
         axes.append(_axis({"field": SEED_FIELD[engine], "name": "seed", "values": seeds},
                           len(axes) + 1, source, allowed))
     names = [a.name for a in axes]

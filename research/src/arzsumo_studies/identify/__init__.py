@@ -1,0 +1,1 @@
+"""Identification studies beside ``arzsumo identify``: the replay inlet study."""

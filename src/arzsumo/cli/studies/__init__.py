@@ -1,4 +1,0 @@
-"""The command-line side of the studies that are library code: per study its options on
-the command line (argparse) mapped onto the study's frozen ``Options``, its ``run`` called
-with them, its result printed. The study itself (``arzsumo.studies.NAME``) holds no
-argparse."""

@@ -1,0 +1,118 @@
+"""One SUMO run held open across an environment's steps, closed on every way out.
+
+:class:`SumoEpisode` runs the stages of ``arzsumo run``
+(:func:`arzsumo.bridge.cosim.run_cosimulation`) with the control window opened to an
+outside driver: :func:`~arzsumo.bridge.cosim.open_run` (entered on an
+:class:`contextlib.ExitStack` the episode owns), :func:`~arzsumo.bridge.cosim.warm_start`,
+:func:`~arzsumo.bridge.cosim.open_window` with a :class:`~arzsumo.gym.stand_in.StandIn`
+in the law's place, then one :meth:`~arzsumo.bridge.loop.ClosedLoop.advance` per step and
+:func:`~arzsumo.bridge.cosim.close_window` at the horizon. The numbers are those of
+``arzsumo run``: the same calls in the same order.
+
+Closing: :meth:`SumoEpisode.close` (safe to call twice) leaves the run's context, which
+closes SUMO (libsumo in this process, or the TraCI child) and removes the run's scratch
+files; an error inside an episode closes it as ``arzsumo run`` does on an error; a
+:func:`weakref.finalize` closes an episode nobody closed when it is collected.
+"""
+
+from __future__ import annotations
+
+import weakref
+from contextlib import ExitStack
+from typing import TYPE_CHECKING
+
+from arzsumo.bridge.actuator import Actuation
+from arzsumo.bridge.cosim import Controlled, close_window, open_run, open_window, warm_start
+from arzsumo.bridge.prepared import PreparedRun
+from arzsumo.bridge.result import CoSimResult
+from arzsumo.control.base import MacroState
+from arzsumo.errors import EnvError
+from arzsumo.gym.stand_in import StandIn
+from arzsumo.sumo.meter import MeterState
+
+if TYPE_CHECKING:
+    from arzsumo.bridge.cosim import OpenRun
+
+
+def _leave(stack: ExitStack, opened: list[OpenRun]) -> None:
+    """Leave the run's context and remove its kept files (a finalizer: no ``self``)."""
+    try:
+        stack.close()
+    finally:
+        for o in opened:
+            o.files.remove()
+
+
+class SumoEpisode:
+    """SUMO warmed up and the control window open at its first check.
+
+    Parameters
+    ----------
+    run : PreparedRun
+        What :func:`arzsumo.bridge.session.prepare_run` made of the scenario.
+    frontend : str
+        "libsumo" or "traci".
+    law : bool
+        Whether the stand-in may be advised by the run's law (a policy stands in for it).
+    """
+
+    def __init__(self, run: PreparedRun, frontend: str, law: bool) -> None:
+        self.run = run
+        self._stack = ExitStack()
+        self._opened: list[OpenRun] = []
+        self._finalizer = weakref.finalize(self, _leave, self._stack, self._opened)
+        try:
+            opened = self._stack.enter_context(open_run(run, frontend=frontend))
+            self._opened.append(opened)
+            warmed = warm_start(opened.sim, run, opened.bar)
+            self.c: Controlled = open_window(
+                warmed, run, opened.bar, in_loop=lambda ctrl: StandIn(ctrl if law else None))
+            self.c.loop.begin(warmed.warm[-1])
+            self.state: MacroState = self.c.loop.estimate(self.c.loop.m, 0.0)
+        except BaseException as exc:
+            self.abort(exc)
+            raise
+
+    @property
+    def stand_in(self) -> StandIn:
+        """The loop's controller."""
+        ctrl = self.c.loop.controller
+        if not isinstance(ctrl, StandIn):
+            raise EnvError(f"the loop's controller is {ctrl.name!r}, not the environment's "
+                           "stand-in")
+        return ctrl
+
+    def step(self, u: float, mirror: bool) -> tuple[Actuation, MeterState]:
+        """Check the stand-in holding ``u`` (veh/s; ``mirror``: the law's own command),
+        actuate, run one control period and estimate at its end (:attr:`state`)."""
+        loop = self.c.loop
+        self.stand_in.take(u, mirror)
+        act, meter = loop.advance(loop.decide(self.state, loop.told))
+        self.state = loop.estimate(loop.m, loop.t)
+        return act, meter
+
+    def last_check(self, u: float, mirror: bool) -> None:
+        """The check at the horizon, which no period follows (as ``arzsumo run``)."""
+        self.stand_in.take(u, mirror)
+        self.c.loop.decide(self.state, self.c.loop.told)
+
+    def finish(self) -> CoSimResult:
+        """The drain, SUMO closed, the network measures: the run's result; then closed."""
+        try:
+            return close_window(self._opened[0], self.c, self.run)
+        except BaseException as exc:
+            self.abort(exc)
+            raise
+        finally:
+            self.close()
+
+    def abort(self, exc: BaseException) -> None:
+        """Leave the run's context on the error ``exc`` (as ``arzsumo run`` does)."""
+        try:
+            self._stack.__exit__(type(exc), exc, exc.__traceback__)
+        finally:
+            self._finalizer()
+
+    def close(self) -> None:
+        """Close SUMO and remove the run's files (safe to call twice)."""
+        self._finalizer()

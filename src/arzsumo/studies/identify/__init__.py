@@ -1,3 +1,0 @@
-"""The model identified from open-loop SUMO runs (``arzsumo identify``: runs, run cache,
-stage 1's diagram, scores, report) and the replay inlet study.
-"""
