@@ -79,7 +79,8 @@ def test_sumo_key_and_its_errors_name_the_key_in_metres():
 
 @pytest.mark.sumo
 def test_vehicles_depart_on_the_approach_and_main_is_measured_from_x0():
-    cfg = FAST.with_(approach_length=300.0, horizon=40.0, ramp_demand=0.0)
+    cfg = FAST.with_(approach_length=300.0, horizon=40.0, ramp_demand=0.0,
+                     collision_check=True)
     first_on_main, roads = None, set()
     with open_simulation(PARAMS, cfg) as sim:
         sensor = MainlineSensor(sim.lib, PARAMS.length, cfg.cell_length, cfg.step_length,

@@ -21,7 +21,7 @@ FAST = SumoConfig(horizon=40.0, step_length=0.2, control_period=1.0)
 
 
 def test_vehicles_are_conserved():
-    cfg = FAST.with_(horizon=100.0, ramp_demand=1500 / 3600)
+    cfg = FAST.with_(horizon=100.0, ramp_demand=1500 / 3600, collision_check=True)
     checked = 0
     with open_simulation(PARAMS, cfg) as sim:
         plant = SumoPlant(sim, PARAMS.length, cfg, measure=False)
@@ -46,7 +46,7 @@ def test_vehicles_are_conserved():
 def test_no_emergency_braking_without_merging_traffic():
     """Emergency braking is read from SUMO's statistics (-1 when it is not there). SUMO
     reports a few at the merge when the ramp has traffic; with none, nobody brakes hard."""
-    cfg = FAST.with_(horizon=100.0, ramp_demand=0.0)
+    cfg = FAST.with_(horizon=100.0, ramp_demand=0.0, collision_check=True)
     r = run_fixed_meter(PARAMS, cfg, measure=False).report
     assert r.requested > 150 and r.requested_ramp == 0
     assert r.requested == r.inserted + r.waiting and r.inserted == r.arrived + r.on_network
@@ -219,7 +219,7 @@ def test_a_mainline_vehicle_held_still_is_the_longest_standstill_and_told(caplog
     from arzsumo.sumo import simulation
 
     monkeypatch.setattr(simulation, "DEADLOCK_S", 30.0)
-    cfg = FAST.with_(horizon=100.0, ramp_demand=0.0)
+    cfg = FAST.with_(horizon=100.0, ramp_demand=0.0, collision_check=True)
     with caplog.at_level("WARNING", logger="arzsumo.sumo.simulation"), \
             open_simulation(PARAMS, cfg) as sim:
         sim.run_until(20.0)
@@ -246,3 +246,23 @@ def test_a_flowing_run_stands_nobody_still_for_long():
         sim.run_until(60.0)
         rep = sim.take_report()
     assert rep.on_network > 20 and rep.standstill_main_s < 5.0
+
+
+def test_the_collision_check_changes_no_vehicle_and_is_off_by_default():
+    """SUMO's collision check with ``warn`` changes no vehicle: the same trajectories to
+    the last bit without it (a third of the sublane step saved); its count is None then."""
+    cfg = FAST.with_(horizon=60.0, ramp_demand=1200 / 3600)
+    assert not cfg.collision_check and cfg.collision_options == {"collision.action": "none"}
+    runs = {}
+    for check in (False, True):
+        c = cfg.with_(collision_check=check)
+        with open_simulation(PARAMS, c) as sim:
+            plant, seen = SumoPlant(sim, PARAMS.length, c, measure=False), []
+            while sim.time < c.horizon:
+                plant.step()
+                lib = sim.lib.vehicle
+                seen.append(sorted((v, lib.getPosition(v), lib.getSpeed(v),
+                                    lib.getLateralLanePosition(v)) for v in lib.getIDList()))
+        runs[check] = (seen, sim.report)
+    assert runs[False][0] == runs[True][0] and len(runs[True][0][-1]) > 20
+    assert runs[False][1].collisions is None and runs[True][1].collisions == 0

@@ -189,6 +189,10 @@ SUMO_KEYS: dict[str, Key] = {
     "eager_insert": Key("eager_insert", "bool",
                         doc="try every vehicle waiting for insertion every step (SUMO "
                             "--eager-insert), not only the first of each edge"),
+    "collision_check": Key("collision_check", "bool",
+                           doc="SUMO's collision detection (--collision.action warn, at "
+                               "junctions too), to count collisions; off: it changes no "
+                               "vehicle and costs a third of the sublane step"),
     "fcd": Key("fcd", "bool", doc="write SUMO's trajectories of every vehicle every step "
                                   "(fcd.xml.gz in the run directory; `arzsumo run --fcd`)"),
 }

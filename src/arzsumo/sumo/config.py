@@ -153,6 +153,12 @@ class SumoConfig:
         SUMO's ``--eager-insert``: every vehicle waiting for insertion (the virtual queues
         of the mainline and the ramp) is tried every step, not only each edge's first
         (default True).
+    collision_check : bool
+        SUMO's collision detection (``--collision.action warn``, junctions included), to
+        count collisions (``summary.json["collisions"]``). Off by default
+        (``--collision.action none``): with ``warn`` a detected collision changes no
+        vehicle, so every trajectory is the same to the last bit, and the pairwise check
+        costs about a third of the sublane step on this road (docs/sumo.md).
     fcd : bool
         Have SUMO write its floating-car data (every vehicle every step: position, lateral
         position, speed, lane, type) into ``fcd.xml.gz`` of ``arzsumo run``'s directory.
@@ -225,6 +231,7 @@ class SumoConfig:
     fill_demand_h: float = 0.0
     fill_demand_a: float = 0.0
     eager_insert: bool = True
+    collision_check: bool = False
     fcd: bool = False
     layout: RoadLayout | None = field(default=None, repr=False)
 
@@ -284,6 +291,8 @@ class SumoConfig:
         require(isinstance(self.fcd, bool), "fcd", self.fcd, "true or false", ScenarioError)
         require(isinstance(self.eager_insert, bool), "eager_insert", self.eager_insert,
                 "true or false", ScenarioError)
+        require(isinstance(self.collision_check, bool), "collision_check",
+                self.collision_check, "true or false", ScenarioError)
         self._check_behaviour()
 
     def _check_resolution(self) -> None:
@@ -296,6 +305,13 @@ class SumoConfig:
             require(abs(subl - round(subl)) < 1e-6, "lateral_resolution",
                     self.lateral_resolution,
                     f"a width dividing the {width:g} m lane, e.g. 0.5 or 0.25", ScenarioError)
+
+    @property
+    def collision_options(self) -> dict[str, str]:
+        """SUMO's collision options of :attr:`collision_check` (option -> value)."""
+        if self.collision_check:
+            return {"collision.action": "warn", "collision.check-junctions": "true"}
+        return {"collision.action": "none"}
 
     def _check_behaviour(self) -> None:
         """The car-following models, the lateral behaviour's choices, the HVs' action step."""

@@ -253,8 +253,7 @@ def sumocfg_text(net_file: str, route_file: str, cfg: SumoConfig,
                           if cfg.layout is None or cfg.layout.sublane else {}),
                        "time-to-teleport": f"{cfg.time_to_teleport:.6g}",
                        "eager-insert": str(cfg.eager_insert).lower(),
-                       "collision.action": "warn",
-                       "collision.check-junctions": "true"},
+                       **cfg.collision_options},
         "random_number": {"seed": str(cfg.seed)},
     }
     lines = ['<?xml version="1.0" encoding="UTF-8"?>', "<configuration>"]

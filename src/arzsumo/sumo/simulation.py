@@ -69,7 +69,7 @@ class RunReport:
     waiting: int
     arrived: int
     on_network: int
-    collisions: int
+    collisions: int | None     # None: SUMO's collision check was off ([sumo] collision_check)
     teleports: int
     emergency_stops: int
     emergency_braking: int = -1
@@ -170,8 +170,8 @@ class SumoSimulation:
                 "--route-files", ",".join(map(str, routes)),
                 "--step-length", f"{c.step_length:.6g}", "--seed", str(c.seed),
                 *lateral, "--time-to-teleport", f"{c.time_to_teleport:.6g}",
-                "--eager-insert", str(c.eager_insert).lower(), "--collision.action", "warn",
-                "--collision.check-junctions", "true",
+                "--eager-insert", str(c.eager_insert).lower(),
+                *(a for k, v in c.collision_options.items() for a in (f"--{k}", v)),
                 "--statistic-output", str(self.stats_file),
                 "--no-step-log", "true", "--no-warnings", "true",
                 "--duration-log.disable", "true", *self.frontend.extra_args(),
@@ -267,7 +267,9 @@ class SumoSimulation:
         still = max(waits, key=waits.__getitem__, default="")
         return RunReport(self.time, self.requested(), self.loaded, self.inserted,
                          len(sim.getPendingVehicles()), self.arrived,
-                         int(veh.getIDCount()), self.collisions, self.teleports,
+                         int(veh.getIDCount()),
+                         self.collisions if self.cfg.collision_check else None,
+                         self.teleports,
                          self.emergency_stops, self.emergency_braking,
                          self.requested(ramp_only=True), self.inserted_ramp,
                          waits.get(still, 0.0), still)
