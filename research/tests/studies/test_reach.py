@@ -8,9 +8,8 @@ import json
 import numpy as np
 import pandas as pd
 import pytest
-
 from arzsumo_studies.common import StudyError
-from arzsumo_studies.control.reach import read_run, reach, reach_table
+from arzsumo_studies.control.reach import reach, reach_table, read_run
 
 L, C, V_STAR = 1000.0, -8.0, 4.5                 # m, m/s (lambda_4), m/s
 X = np.arange(25.0, 1000.0, 50.0)
