@@ -7,7 +7,7 @@ The public API (``docs/api.md``)::
     sc = arzsumo.load_scenario("default")              # a shipped name or a TOML file
     res = arzsumo.run(sc, controller="etc", seed=1)    # SUMO's closed loop -> RunResult
     res.save("results/etc-seed1")                      # what `arzsumo run --out` writes
-    twin = arzsumo.pde(sc, controller="etc")          # the PDE twin -> TwinResult
+    twin = arzsumo.twin(sc, controller="etc")          # the PDE twin -> TwinResult
     ev = arzsumo.evaluate(sc, controllers=["open", "etc"], seeds=10)   # paired, 10 seeds
 
 Your own law subclasses :class:`arzsumo.Controller` (one method, ``decide(state) -> U``)
@@ -53,4 +53,4 @@ def __getattr__(name: str) -> Any:
 
 
 def __dir__() -> list[str]:
-    return sorted({*globals(), *_API})
+    return sorted({*__all__, *(n for n in globals() if n.startswith("__"))})

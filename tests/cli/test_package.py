@@ -41,7 +41,7 @@ def test_without_the_research_package_the_tool_lists_its_own_commands(capsys, mo
     text = capsys.readouterr().out
     block = text.split("  COMMAND\n", 1)[1].split("\noptions:")[0]
     assert re.findall(r"^    (\S+)", block, flags=re.MULTILINE) == TOOL
-    assert text.rstrip().endswith("arzsumo twin default --controller backstepping --out "
+    assert text.rstrip().endswith("arzsumo twin paper/base_etc --controller backstepping --out "
                                   "results/twin-bs")
     assert main(["study", "control"]) == 2           # refused by the parser: unknown command
 

@@ -31,9 +31,12 @@ def _write_run(path, seed, noise_sd, t_end=3600, empty=()):
         v[:, j] = np.nan
     n = v.shape[0]
     path.mkdir()
-    cells = pd.DataFrame({"source": "micro", "t_s": np.repeat(np.arange(n, dtype=float) + 1,
-                                                              X.size),
-                          "x_m": np.tile(X, n), "rho_h": 0.1, "v_h": v.ravel(),
+    # as a run writes them: the cells at the start of control (t = 0), then at the end of
+    # each period; the periods at their check times 0 .. n - 1
+    v = np.vstack([np.full((1, X.size), 99.0), v])
+    cells = pd.DataFrame({"source": "micro",
+                          "t_s": np.repeat(np.arange(n + 1, dtype=float), X.size),
+                          "x_m": np.tile(X, n + 1), "rho_h": 0.1, "v_h": v.ravel(),
                           "rho_a": 0.02, "v_a": v.ravel()})
     cells.to_parquet(path / "cells.parquet")
     periods = pd.DataFrame({"t_s": np.arange(n, dtype=float),

@@ -1,4 +1,4 @@
-"""The public API, re-exported by :mod:`arzsumo` (``arzsumo.run``, ``arzsumo.pde``, ...).
+"""The public API, re-exported by :mod:`arzsumo` (``arzsumo.run``, ``arzsumo.twin``, ...).
 
 Each module keeps its ``__all__``; this package gathers them. The CLI calls these
 functions: every check a command makes is made here, so a Python caller gets it too.

@@ -7,7 +7,7 @@ outlet flow from q* in veh/s (the paper's boundary input, section 2). It reaches
 entry point by name once registered:
 
 * in this process: :func:`register_controller`, or pass the class itself as
-  ``controller=`` to :func:`arzsumo.run`, :func:`arzsumo.pde`;
+  ``controller=`` to :func:`arzsumo.run`, :func:`arzsumo.twin`;
 * in every process of a sweep or an evaluation (process pools and Dask workers import the
   package afresh), and in the CLI's ``--controller NAME``: an entry point of the group
   ``arzsumo.controllers`` in the user's own package (``docs/api.md``).
@@ -19,6 +19,7 @@ from collections.abc import Callable
 
 from arzsumo.control.base import Controller
 from arzsumo.control.registry import (
+    BUILTIN,
     REGISTRY,
     ControllerInputs,
     ControllerSpec,
@@ -96,6 +97,9 @@ def controller_name(controller: ControllerLike | None, engine: str) -> str | Non
         return None
     if isinstance(controller, type) and issubclass(controller, Controller):
         name = controller.name
+        if name == Controller.name:
+            raise ScenarioError(f"controller = {controller.__name__} is not allowed: give "
+                                "the class a name of its own (its `name` attribute)")
         if name in BUILTIN:
             raise ScenarioError(f"controller = {controller.__name__} is not allowed: its "
                                 f"name {name!r} is a built-in controller's; give the class "
@@ -111,9 +115,7 @@ def controller_name(controller: ControllerLike | None, engine: str) -> str | Non
     return controller
 
 
-#: the names the package registers itself (never replaced by a user's class; read before
-#: any entry point is loaded)
-BUILTIN = frozenset(REGISTRY)
+
 
 __all__ = ["BUILTIN", "Controller", "ControllerInputs", "ControllerLike", "controller_name",
            "controller_names", "register_controller"]

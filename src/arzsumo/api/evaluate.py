@@ -4,7 +4,10 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
+from numbers import Integral
 from pathlib import Path
+
+import numpy as np
 
 from arzsumo.api.controllers import BUILTIN, ControllerLike, controller_name
 from arzsumo.api.scenarios import load_scenario, scenario_file
@@ -25,12 +28,14 @@ def default_controllers() -> tuple[str, ...]:
 
 def seed_list(seeds: int | Sequence[int], start: int = 1) -> list[int]:
     """The seeds: a count N (``start``, ..., ``start`` + N - 1) or the seeds themselves."""
-    if isinstance(seeds, bool):
+    if isinstance(seeds, bool | np.bool_):
         raise ScenarioError(f"seeds = {seeds!r} is not allowed: a count >= 1 or a list of "
                             "seeds")
-    values = list(range(start, start + seeds)) if isinstance(seeds, int) else list(seeds)
-    bad = [s for s in values if isinstance(s, bool) or not isinstance(s, int)
+    values = list(range(start, start + int(seeds))) if isinstance(seeds, Integral) \
+        else list(seeds)
+    bad = [s for s in values if isinstance(s, bool | np.bool_) or not isinstance(s, Integral)
            or not 0 <= s < SEED_LIMIT]
+    values = [int(s) for s in values]
     if not values or bad or len(set(values)) != len(values):
         raise ScenarioError(f"seeds = {seeds!r} is not allowed: a count >= 1 or distinct "
                             f"integers in [0, {SEED_LIMIT})")
@@ -98,6 +103,8 @@ def evaluate(scenario: str | Path | Scenario | None = None, *,
     ...                       out="results/evaluate-etc")        # doctest: +SKIP
     """
     path = _file_of(scenario)
+    if isinstance(controllers, str):                  # "open,etc", as the CLI writes it
+        controllers = [c.strip() for c in controllers.split(",") if c.strip()]
     # a class is registered here; names are checked with the list (one line naming it)
     names = [c if isinstance(c, str) else controller_name(c, "sumo") for c in (
         default_controllers() if controllers is None else controllers)]

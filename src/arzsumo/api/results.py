@@ -1,4 +1,4 @@
-"""Typed, frozen results of :func:`arzsumo.run` (SUMO) and :func:`arzsumo.pde` (the PDE
+"""Typed, frozen results of :func:`arzsumo.run` (SUMO) and :func:`arzsumo.twin` (the PDE
 twin): the summary as a dataclass, the per-period and per-cell frames as pandas
 DataFrames (SI units; each column's unit in ``docs/outputs.md``), the resolved scenario
 and the package version; ``save(directory)`` writes exactly what ``--out`` writes, under
@@ -25,7 +25,7 @@ from arzsumo.scenario import Scenario
 from arzsumo.version import __version__
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class RunResult:
     """One closed loop in SUMO, with the PDE twins alongside.
 
@@ -117,7 +117,7 @@ class TwinSummary:
         return dict(self.data)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class TwinResult:
     """One run of the nonlinear PDE twin.
 

@@ -71,7 +71,8 @@ def with_network(sc: Scenario) -> Scenario:
     if changes:
         sc = sc.with_(changes)
     sumo = sc.tables.get("sumo", {})
-    storage = sc.sumo.ramp_storage if "ramp_storage_veh" in sumo else -1
+    # -1 (written or not): what the user's ramp edge holds, not the shipped ramp's
+    storage = -1 if sumo.get("ramp_storage_veh", -1) == -1 else sc.sumo.ramp_storage
     try:
         cfg = sc.sumo.with_(layout=layout, ramp_storage=storage)
     except ArzsumoError as exc:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from numbers import Integral
 
 import numpy as np
 
@@ -51,9 +52,10 @@ class SumoSession:
 
 
 def _seed(seed: int) -> int:
-    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**31:
+    if isinstance(seed, bool | np.bool_) or not isinstance(seed, Integral) \
+            or not 0 <= seed < 2**31:
         raise ScenarioError(f"--seed = {seed} is not allowed: an integer in [0, 2^31)")
-    return seed
+    return int(seed)
 
 
 def _horizon(horizon: float, cfg: SumoConfig) -> float:

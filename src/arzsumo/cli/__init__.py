@@ -63,10 +63,11 @@ def plugin_registers() -> list[Callable[[argparse._SubParsersAction], None]]:
 
     registers = []
     for ep in sorted(entry_points(group=COMMAND_PLUGINS), key=lambda ep: ep.name):
-        try:
+        try:   # a broken package must not take the tool's own commands down with it
             registers.append(ep.load())
-        except ImportError as exc:
-            log.debug("command %s (%s) not loaded: %s", ep.name, ep.value, exc)
+        except Exception as exc:
+            print(f"arzsumo: warning: command {ep.name} ({ep.value}) not loaded: {exc}",
+                  file=sys.stderr)
     return registers
 
 
@@ -88,7 +89,7 @@ exit codes:
 'arzsumo list' shows the shipped scenario and sweep files; 'arzsumo CMD --help' each
 command's options. For example:
   arzsumo run --controller etc --seed 1 --out results/etc-seed1
-  arzsumo twin default --controller backstepping --out results/twin-bs"""
+  arzsumo twin paper/base_etc --controller backstepping --out results/twin-bs"""
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -15,6 +15,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from arzsumo.errors import ArzsumoError
+
+
+class ControllerError(ArzsumoError, ValueError):
+    """A controller that returned what no actuator can apply."""
+
 
 @dataclass(frozen=True)
 class MacroState:
@@ -128,6 +134,9 @@ class Controller(ABC):
         """Evaluate the controller at a check instant and return U (veh/s) to hold."""
         log, checks = self.log, len(self.log.t)
         u = float(self.decide(state))
+        if not math.isfinite(u):
+            raise ControllerError(f"controller {self.name!r} returned U = {u!r} at t = "
+                                  f"{state.t:g} s; allowed: a finite U, veh/s")
         if len(log.t) == checks:       # decide kept no record: U applied as decided
             log.record(state.t, u, u, not checks or u != log.u_applied[-1])
         return u

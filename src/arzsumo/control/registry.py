@@ -163,10 +163,14 @@ def load_plugins() -> None:
     for ep in entry_points(group=PLUGIN_GROUP):
         if ep.name in REGISTRY:
             continue
-        try:
+        try:   # one broken package must not take the others, or the tool, down with it
             spec = _plugin_spec(ep.name, ep.load())
-        except ImportError as exc:    # metadata of an uninstalled package: skip it
+        except Exception as exc:
             log.warning("controller %s (%s) not loaded: %s", ep.name, ep.value, exc)
+            continue
+        if spec.name in REGISTRY:
+            log.warning("controller %s (%s) not loaded: the name %r is taken", ep.name,
+                        ep.value, spec.name)
             continue
         REGISTRY[spec.name] = spec
 
@@ -197,6 +201,9 @@ for _spec in (
                                "of control"),
 ):
     register_controller(_spec)
+
+#: the names the package registers itself (a user's class never replaces one)
+BUILTIN = frozenset(REGISTRY)
 
 
 def controller_names(engine: str | None = None) -> tuple[str, ...]:

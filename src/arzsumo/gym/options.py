@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from arzsumo.bridge.road import with_network
 from arzsumo.errors import ArzsumoError, EnvError
 from arzsumo.scenario import Scenario
 
@@ -105,7 +106,7 @@ class EnvOptions:
         from arzsumo.gym.rewards import reward_of
 
         reward_of(reward)      # refused here, before the scenario is read
-        sc = scenario_of(scenario)
+        sc = with_network(scenario_of(scenario))   # L, lanes and cells of a [network]
         period = sc.sumo.control_period
         opts = cls(sc, check_seed(seed), reward,
                    check_choice(observation, "observation", OBSERVATIONS),

@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from arzsumo.errors import EnvError
-from arzsumo.units import ms_to_kmh
+from arzsumo.units import ms_to_kmh, s_to_h
 
 #: the time constants of the band-power proxy's exponential means, s (the band's ends)
 BAND_S = (60.0, 600.0)
@@ -94,7 +94,7 @@ def vehicle_hours(r: StepRecord) -> float:
 
 def ramp_queue(r: StepRecord) -> float:
     """Minus the ramp queue's vehicle-hours of the period."""
-    return -r.queue * r.period / 3600.0
+    return -float(s_to_h(r.queue * r.period))
 
 
 def plan_changes(r: StepRecord) -> float:

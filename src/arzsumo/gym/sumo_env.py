@@ -36,6 +36,7 @@ from arzsumo.gym.base import RampMeterEnv
 from arzsumo.gym.options import FRONTENDS, EnvOptions, check_choice, refuse
 from arzsumo.gym.rewards import StepRecord
 from arzsumo.gym.sumo_episode import SumoEpisode
+from arzsumo.units import s_to_h
 
 #: the registry's controller an agent's run is prepared as (module docstring)
 AGENT_RUN = "constant"
@@ -143,7 +144,7 @@ class SumoRampMeterEnv(RampMeterEnv):
         loop = ep.c.loop
         c = loop.m.cells
         dx = self.scenario.params.length / c.x.size
-        veh_h = float(np.nansum(c.rho_h + c.rho_a) * dx * c.window / 3600.0)
+        veh_h = float(s_to_h(np.nansum(c.rho_h + c.rho_a) * dx * c.window))
         rec = StepRecord(loop.t, self.period, c.x, micro_fields(c), veh_h, u,
                          act.u_applied, meter.plan_changes - self._plan_changes,
                          float(meter.queue), act.saturated, act.rate_limited)

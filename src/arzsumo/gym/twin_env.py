@@ -37,6 +37,7 @@ from arzsumo.pde.initial import InitialCondition, initial_fields
 from arzsumo.pde.metrics import performance
 from arzsumo.pde.solver import SolverOptions, TwinStepper, TwinStoppedError
 from arzsumo.pde.state import cell_centres
+from arzsumo.units import s_to_h
 
 #: the random wave's highest mode (periods over the road) and its least amplitude
 RANDOM_MODES, RANDOM_AMPLITUDE = 3, 0.05
@@ -138,7 +139,7 @@ class TwinRampMeterEnv(RampMeterEnv):
         except TwinStoppedError as exc:
             terminated, self.status = True, str(exc)
         fields = st.primitive()
-        veh_h = 0.5 * (n0 + st.total_vehicles()) * (st.t - (t_end - self.period)) / 3600.0
+        veh_h = float(s_to_h(0.5 * (n0 + st.total_vehicles()) * (st.t - (t_end - self.period))))
         rec = StepRecord(st.t, self.period, self.x, fields, veh_h, u, lim.u_applied,
                          changed, 0.0, lim.saturated, lim.rate_limited)
         self._keep(st.t, fields, lim.u_applied)

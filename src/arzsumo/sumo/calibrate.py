@@ -82,7 +82,7 @@ class RunData:
     outflow: float
     inflow: float
     delivered: float
-    collisions: int
+    collisions: int | None      # None: the collision check was off
     meter: dict[str, float]
 
 

@@ -75,8 +75,11 @@ def read_run(path: Path, block_s: float = 5.0) -> RunSeries:
     cells = pd.read_parquet(path / "cells.parquet", filters=[("source", "==", "micro")])
     per = pd.read_parquet(path / "periods.parquet")
     summ = json.loads((path / "summary.json").read_text(encoding="utf-8"))
-    field = cells.pivot(index="t_s", columns="x_m", values="v_h")
     period = float(np.median(np.diff(per["t_s"]))) if len(per) > 1 else 1.0
+    # the cells at t_s are the end of the period checked at t_s - period: the row of t_s = 0
+    # (the measurement control starts from) has no period of its own
+    field = cells.pivot(index="t_s", columns="x_m", values="v_h")
+    field = field.loc[np.isin(field.index, per["t_s"].to_numpy() + period)]
     blocks = max(1, round(block_s / period))
     n = len(field) // blocks
     with warnings.catch_warnings():    # a block of a cell that stayed empty: NaN, filled
