@@ -62,7 +62,8 @@ def test_save_refuses_a_directory_it_did_not_write(result, tmp_path):
     mine = tmp_path / "mine"
     mine.mkdir()
     (mine / "notes.txt").write_text("keep me")
-    with pytest.raises(arzsumo.ArzsumoError, match="is not allowed"):
+    with pytest.raises(arzsumo.ArzsumoError, match="is a non-empty directory that is not an "
+                                                   "arzsumo result"):
         result.save(mine)
     assert (mine / "notes.txt").read_text() == "keep me"
     assert sorted(p.name for p in mine.iterdir()) == ["notes.txt"]
