@@ -42,6 +42,16 @@ def seed_list(seeds: int | Sequence[int], start: int = 1) -> list[int]:
     return values
 
 
+def _names(controllers: str | Sequence[ControllerLike] | None) -> list[str]:
+    """The controllers' names: a class is registered here; names are checked with the
+    list (one line naming it); ``"open,etc"`` as the CLI writes it."""
+    if controllers is None:
+        return list(default_controllers())
+    if isinstance(controllers, str):
+        controllers = [c.strip() for c in controllers.split(",") if c.strip()]
+    return [c if isinstance(c, str) else controller_name(c, "sumo") for c in controllers]
+
+
 def _file_of(scenario: str | Path | Scenario | None) -> Path:
     if isinstance(scenario, Scenario):
         path = Path(scenario.source)
@@ -103,11 +113,7 @@ def evaluate(scenario: str | Path | Scenario | None = None, *,
     ...                       out="results/evaluate-etc")        # doctest: +SKIP
     """
     path = _file_of(scenario)
-    if isinstance(controllers, str):                  # "open,etc", as the CLI writes it
-        controllers = [c.strip() for c in controllers.split(",") if c.strip()]
-    # a class is registered here; names are checked with the list (one line naming it)
-    names = [c if isinstance(c, str) else controller_name(c, "sumo") for c in (
-        default_controllers() if controllers is None else controllers)]
+    names = _names(controllers)
     check_warmup(load_scenario(path), warmup_s, horizon_s, allow_short_warmup)
     target = Path(out) if out is not None else Path("results") / "evaluate" / path.stem
     return run_evaluation(path, names, seed_list(seeds), out=target, horizon=horizon_s,

@@ -33,6 +33,7 @@ from arzsumo.errors import ModelError, require
 from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.config import LANE_WIDTH, SumoConfig
 from arzsumo.sumo.vtypes import vehicle_types
+from arzsumo.units import veh_m_to_veh_km
 from arzsumo_studies.measures.string_stability import (
     IdmParameters,
     Partials,
@@ -93,7 +94,7 @@ def predict(params: ModelParameters, cfg: SumoConfig, rho_h: float, rho_a: float
     gap = files / rho - mean_length
     n_h, n_a = rho_h * params.length, rho_a * params.length
     if gap <= 0:
-        why = f"no net gap at {rho * 1000:.0f} veh/km in {files} files"
+        why = f"no net gap at {veh_m_to_veh_km(rho):.0f} veh/km in {files} files"
         return {"hv": _prediction(cfg.hv_model, None, n_h, why),
                 "av": _prediction(cfg.av_model, None, n_a, why)}
     if cfg.hv_model == "Krauss":
