@@ -36,6 +36,7 @@ _API = {
     "controller_names": "arzsumo.api.controllers",
     "register_controller": "arzsumo.api.controllers",
     "evaluate": "arzsumo.api.evaluate", "load_scenario": "arzsumo.api.scenarios",
+    "network_figure": "arzsumo.api.network", "road_geometry": "arzsumo.api.network",
     "prepare": "arzsumo.api.runs", "run": "arzsumo.api.runs", "twin": "arzsumo.api.runs",
 }
 

@@ -80,7 +80,7 @@ def test_every_command_has_help_and_description():
     commands = _subparsers(build_parser())
     assert {"model", "kernels", "verify", "design-check", "twin", "reproduce", "build-net",
             "calibrate", "run", "compare", "alinea-target", "sweep", "evaluate", "premise",
-            "identify", "list", "study"} == set(commands)
+            "identify", "list", "study", "network"} == set(commands)
     for name, p in commands.items():
         assert p.description and len(p.description) > 30, name
 

@@ -15,7 +15,7 @@ PACKAGE = Path(__file__).resolve().parents[2] / "src" / "arzsumo"
 #: the tool's commands of ``arzsumo --help``, in order: a run first
 TOOL = ["run", "compare", "evaluate", "sweep", "twin", "reproduce", "model", "kernels",
         "verify", "design-check", "identify", "build-net", "calibrate", "alinea-target",
-        "list"]
+        "network", "list"]
 #: then the commands of the installed research package (entry points ``arzsumo.commands``)
 COMMANDS = [*TOOL, "premise", "study"]
 

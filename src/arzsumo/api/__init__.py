@@ -6,6 +6,7 @@ functions: every check a command makes is made here, so a Python caller gets it 
 
 from arzsumo.api.controllers import controller_names, register_controller
 from arzsumo.api.evaluate import evaluate
+from arzsumo.api.network import network_figure, road_geometry
 from arzsumo.api.results import RunResult, TwinResult, TwinSummary
 from arzsumo.api.runs import prepare, run, twin
 from arzsumo.api.scenarios import load_scenario
@@ -19,4 +20,5 @@ from arzsumo.sweep.evaluate import EvaluationResult
 __all__ = ["Applied", "ArzsumoError", "Command", "Controller", "ControllerInputs",
            "EvaluationResult", "MacroState", "RunResult", "RunSummary", "Scenario",
            "ScenarioError", "TwinResult", "TwinSummary", "controller_names", "evaluate",
-           "load_scenario", "prepare", "register_controller", "run", "twin"]
+           "load_scenario", "network_figure", "prepare", "register_controller",
+           "road_geometry", "run", "twin"]

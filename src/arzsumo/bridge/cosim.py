@@ -335,7 +335,7 @@ def close_window(opened: OpenRun, c: Controlled, run: PreparedRun) -> CoSimResul
     outlet = round(sum((r.outflow_h + r.outflow_a) * cfg.control_period for r in records))
     network, trips = measure_network(opened.out_dir, c.start, t_end, outlet,
                                      drained.end if drained else None, sim.time,
-                                     **outlet_edge(cfg))
+                                     **outlet_edge(cfg, sim))
     if drained is not None:
         network = whole_demand(network, trips, plant, drained)
     if cfg.fcd:   # moved, not read: an FCD file is large
@@ -344,10 +344,13 @@ def close_window(opened: OpenRun, c: Controlled, run: PreparedRun) -> CoSimResul
                    opened.files, timings, time.perf_counter() - opened.wall0)
 
 
-def outlet_edge(cfg: SumoConfig) -> dict[str, str]:
-    """``{"outlet_edge": the last section edge}`` on a user's network; {} on the shipped
-    one (``main``)."""
-    return {} if cfg.layout is None else {"outlet_edge": cfg.layout.section_edges[-1]}
+def outlet_edge(cfg: SumoConfig, sim: SumoSimulation | None = None) -> dict[str, Any]:
+    """``{"outlet_edge": the last section edge, "ramp": ramp vehicles by route, as ``sim``
+    recorded them}`` on a user's network; {} on the shipped one (``main``, ids ``ramp...``)."""
+    if cfg.layout is None:
+        return {}
+    return {"outlet_edge": cfg.layout.section_edges[-1],
+            **({"ramp": sim.classes.recorded} if sim is not None else {})}
 
 
 def _result(c: Controlled, scenario: Scenario, cfg: SumoConfig, meter: dict[str, Any],

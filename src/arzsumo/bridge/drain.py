@@ -77,10 +77,10 @@ def whole_demand(network: NetworkMeasures, trips: pd.DataFrame, plant: SumoPlant
     """``network`` with its ``whole_demand`` block (:mod:`arzsumo.sumo.whole_demand`):
     the whole run after the drain, the per-step integral of vehicles in the system and
     the ramp vehicles' waits at the meter."""
-    spec = NetworkSpec()
-    sim = plant.sim
-    waits = ramp_waits(trips, plant.sensor.stop_line.crossings, sim.cfg.step_length,
-                       spec.ramp_length / spec.ramp_speed)
+    spec, sim = NetworkSpec(), plant.sim
+    road = sim.cfg.layout
+    free = spec.ramp_length / spec.ramp_speed if road is None else road.ramp_free_time
+    waits = ramp_waits(trips, plant.sensor.stop_line.crossings, sim.cfg.step_length, free)
     block = whole_demand_summary(network.whole_run, waits, sim.in_system_s,
                                  drained.duration_s, drained.max_s, drained.gridlock)
     return replace(network, whole_demand=block)

@@ -27,6 +27,7 @@ from arzsumo.cli import (
     identify,
     listing,
     model,
+    network,
     reproduce,
     run,
     sumo,
@@ -47,7 +48,7 @@ Command = Callable[[argparse.Namespace], int]
 REGISTER: tuple[Callable[[argparse._SubParsersAction], None], ...] = (
     run.register, compare.register, evaluate.register, sweep.register, twin.register,
     reproduce.register, model.register, control.register, identify.register,
-    sumo.register, sumo.register_alinea_target, listing.register)
+    sumo.register, sumo.register_alinea_target, network.register, listing.register)
 
 #: entry-point group of packages that add commands of their own (a ``register(sub)``
 #: function each, as the modules of :data:`REGISTER`); listed after the tool's commands

@@ -76,6 +76,9 @@ class RoadLayout:
         vType IDs counted as AVs.
     sublane : bool
         Run SUMO's sublane model (``--lateral-resolution``); False: lane changes only.
+    ramp_free_time : float
+        Free-flow travel time over ``ramp_edge`` (its length over its speed limit), s:
+        what a ramp vehicle's wait at the meter is net of.
     """
 
     net_file: Path
@@ -98,6 +101,7 @@ class RoadLayout:
     outlet_lanes: int
     av_types: frozenset[str]
     sublane: bool = True
+    ramp_free_time: float = 0.0
 
     def __post_init__(self) -> None:
         n = len(self.main_route)
@@ -186,6 +190,16 @@ class VehicleClasses:
         if hit is None:
             hit = self._ramp[vid] = self.layout.ramp_edge in self.lib.vehicle.getRoute(vid)
         return hit
+
+    def recorded(self, vid: str) -> bool:
+        """Whether ``vid`` entered from the ramp, from what :meth:`ramp` learnt while SUMO
+        ran (no SUMO call: usable once it has closed). The run asks :meth:`ramp` of every
+        vehicle SUMO loads (:meth:`arzsumo.sumo.simulation.SumoSimulation.step`), so every
+        vehicle of its tripinfo is known; one never asked is a mainline vehicle. Without a
+        layout: the id (``ramp...``)."""
+        if self.layout is None or self.lib is None:
+            return vid.startswith("ramp")
+        return self._ramp.get(vid, False)
 
     def av_mask(self, ids: Sequence[str]) -> np.ndarray:
         """Boolean array: which of ``ids`` are AVs."""

@@ -28,13 +28,17 @@ Outputs (files in ``out``; SUMO 1.28 checked):
 
 Rule: a vehicle's time in the system is ``duration + departDelay``, i.e. from its wanted
 departure to its arrival or to the end of the run (SUMO's ``timeLoss`` excludes the depart
-delay, so ``time_loss_s`` adds it). Origin: ids starting with ``ramp`` are ramp vehicles
-(the flow ids of :mod:`arzsumo.sumo.demand`), all others are mainline vehicles.
+delay, so ``time_loss_s`` adds it). Origin: on the shipped network ids starting with
+``ramp`` are ramp vehicles (the flow ids of :mod:`arzsumo.sumo.demand`), all others are
+mainline vehicles; on a user's network (``[network]``) the run passes ``ramp``, which
+tells them by route (:meth:`arzsumo.sumo.layout.VehicleClasses.recorded`: a vehicle
+whose route holds the ramp edge), whatever the ids of the user's route files.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -98,13 +102,20 @@ def _need(path: Path) -> Path:
     return path
 
 
-def origin_of(vehicle_id: str) -> str:
-    """``"ramp"`` for ids of the ramp flows, ``"mainline"`` otherwise."""
-    return "ramp" if vehicle_id.startswith("ramp") else "mainline"
+#: which vehicle ids came from the ramp (None: the shipped flows' ids, ``ramp...``)
+RampTest = Callable[[str], bool] | None
 
 
-def _record(trip: Any) -> dict[str, Any]:
-    row: dict[str, Any] = {"id": trip.id, "vtype": trip.vType, "origin": origin_of(trip.id)}
+def origin_of(vehicle_id: str, ramp: RampTest = None) -> str:
+    """``"ramp"`` for a ramp vehicle, ``"mainline"`` otherwise: by ``ramp(vehicle_id)``,
+    else by the id (``ramp...``: the ramp flows of :mod:`arzsumo.sumo.demand`)."""
+    is_ramp = vehicle_id.startswith("ramp") if ramp is None else ramp(vehicle_id)
+    return "ramp" if is_ramp else "mainline"
+
+
+def _record(trip: Any, ramp: RampTest = None) -> dict[str, Any]:
+    row: dict[str, Any] = {"id": trip.id, "vtype": trip.vType,
+                           "origin": origin_of(trip.id, ramp)}
     row.update({col: float(getattr(trip, attr)) for attr, col in _TRIP_COLUMNS.items()})
     em = trip.emissions[0] if trip.hasChild("emissions") else None
     row["fuel_g"] = float(em.fuel_abs) / MG_PER_G if em is not None else math.nan
@@ -112,8 +123,9 @@ def _record(trip: Any) -> dict[str, Any]:
     return row
 
 
-def read_trips(path: Path) -> pd.DataFrame:
-    """One row per vehicle of a tripinfo file written with :func:`network_options`.
+def read_trips(path: Path, ramp: RampTest = None) -> pd.DataFrame:
+    """One row per vehicle of a tripinfo file written with :func:`network_options`;
+    ``ramp`` tells ramp vehicles by id (default: ids ``ramp...``, the shipped flows).
 
     Returns
     -------
@@ -135,7 +147,7 @@ def read_trips(path: Path) -> pd.DataFrame:
     """
     import sumolib
 
-    rows = [_record(t) for t in sumolib.xml.parse(str(_need(path)), "tripinfo")]
+    rows = [_record(t, ramp) for t in sumolib.xml.parse(str(_need(path)), "tripinfo")]
     df = pd.DataFrame(rows, columns=["id", "vtype", "origin", *_TRIP_COLUMNS.values(),
                                      "fuel_g", "co2_g"])
     df.insert(3, "state", "en_route")
@@ -233,7 +245,7 @@ def aggregate(df: pd.DataFrame, begin: float, end: float, outlet_left: int) -> d
 
 
 def network_summary(out_dir: Path, end_time: float | None = None,
-                    outlet_edge: str = MAIN) -> dict[str, Any]:
+                    outlet_edge: str = MAIN, ramp: RampTest = None) -> dict[str, Any]:
     """Network-wide measures of the run whose outputs are in ``out_dir`` (see module doc).
 
     Parameters
@@ -244,6 +256,8 @@ def network_summary(out_dir: Path, end_time: float | None = None,
         End of the run, s; checked against the outputs when given.
     outlet_edge : str
         Edge whose downstream end is the section outlet (``main``: x = L).
+    ramp : callable, optional
+        Which vehicle ids are ramp vehicles (:func:`read_trips`).
 
     Returns
     -------
@@ -252,7 +266,7 @@ def network_summary(out_dir: Path, end_time: float | None = None,
         tripinfo records do not cover every vehicle SUMO loaded.
     """
     out_dir = Path(out_dir)
-    df = read_trips(out_dir / TRIPINFO_FILE)
+    df = read_trips(out_dir / TRIPINFO_FILE, ramp)
     stats = read_statistics(out_dir / STATISTICS_FILE)
     _check(df, stats, end_time)
     left, _, _ = edge_left(out_dir / EDGEDATA_FILE, outlet_edge)

@@ -289,4 +289,5 @@ def read_layout(req: NetworkRequest, at: str) -> RoadLayout:
         outlet_edge=outlet.getID(), outlet_length=float(outlet.getLength()),
         outlet_lanes=outlet.getLaneNumber(),
         av_types=frozenset(req.av_types) if req.route_files else frozenset({AV_TYPE}),
-        sublane=req.sublane)
+        sublane=req.sublane,
+        ramp_free_time=float(ramp_edge.getLength()) / max(float(ramp_edge.getSpeed()), 0.1))

@@ -35,6 +35,7 @@ from arzsumo.sumo.network import MAIN
 from arzsumo.sumo.network_measures import (
     ORIGINS,
     TRIPINFO_FILE,
+    RampTest,
     aggregate,
     network_summary,
     read_trips,
@@ -254,22 +255,24 @@ class NetworkMeasures:
 
 def measure_network(out_dir: Path, start: WindowStart, end: float,
                     outlet_left_window: int, finish: WindowEnd | None = None,
-                    run_end: float | None = None, outlet_edge: str = MAIN
-                    ) -> tuple[NetworkMeasures, pd.DataFrame]:
+                    run_end: float | None = None, outlet_edge: str = MAIN,
+                    ramp: RampTest = None) -> tuple[NetworkMeasures, pd.DataFrame]:
     """Read the outputs of a run started with
     :func:`~arzsumo.sumo.network_measures.network_options` into ``out_dir``, whose control
     window ended at ``end`` (s) and the run at ``run_end`` (s; ``end`` without a drain,
     then ``finish`` holds the values at ``end``); ``outlet_left_window``: vehicles that
     crossed x = L in the control window. Returns the measures and the per-vehicle rows
     of the whole run (:func:`~arzsumo.sumo.network_measures.read_trips`).
-    ``outlet_edge``: the edge whose end is x = L (``main``; a user's last section edge).
+    ``outlet_edge``: the edge whose end is x = L (``main``; a user's last section edge);
+    ``ramp``: which vehicle ids are ramp vehicles (default: ids ``ramp...``; a user's
+    network: by route, :meth:`~arzsumo.sumo.layout.VehicleClasses.recorded`).
     """
     out_dir = Path(out_dir)
     last = end if run_end is None else run_end
     whole = {"window": "whole run: each vehicle's time inside [begin_s, end_s] (from t = 0 "
                        "of SUMO, warm-up and any drain included)",
-             **network_summary(out_dir, end_time=last, outlet_edge=outlet_edge)}
-    trips = read_trips(out_dir / TRIPINFO_FILE)
+             **network_summary(out_dir, end_time=last, outlet_edge=outlet_edge, ramp=ramp)}
+    trips = read_trips(out_dir / TRIPINFO_FILE, ramp)
     window = window_summary(trips, start, end, outlet_left_window, finish, run_end)
     blob = gzip.compress((out_dir / TRIPINFO_FILE).read_bytes(), compresslevel=6, mtime=0)
     return NetworkMeasures(window, whole, blob), trips

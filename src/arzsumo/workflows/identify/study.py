@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from arzsumo.bridge.replay_data import replay_data_of, replay_options_of
+from arzsumo.bridge.road import with_network
 from arzsumo.bridge.session import run_in_sumo
 from arzsumo.errors import ArzsumoError, ScenarioError
 from arzsumo.identify import (
@@ -231,7 +232,8 @@ def make_setup(sc: Scenario, train: Sequence[int], held_out: Sequence[int], *,
         changes["sumo.horizon_s"] = horizon
     if warmup is not None:
         changes["run.warmup_s"] = warmup
-    base, sc = sc, sc.with_(changes)
+    # a [network] table: checked with sumolib, L and W of the fit read from the network
+    base, sc = sc, with_network(sc.with_(changes))
     names = STAGE_TWO if diagram is not None else parse_which(which, sc.params)
     for name in names:
         low, high = DEFAULT_BOUNDS[name]
