@@ -152,10 +152,23 @@ def test_bad_seeds_are_refused(seeds):
 
 
 def test_a_warmup_inside_the_fill_is_refused_by_the_api_as_by_the_cli():
-    with pytest.raises(arzsumo.ScenarioError, match="--warmup = 60 is not allowed: the "
-                                                    "control window"):
+    with pytest.raises(arzsumo.ScenarioError, match="warmup_s = 60 is not allowed: the "
+                                                    "control window") as exc:
         arzsumo.prepare("default", warmup_s=60)
+    assert str(exc.value).endswith("or allow_short_warmup=True")
     assert arzsumo.prepare("default", warmup_s=60, allow_short_warmup=True)
+    assert main(["run", "--warmup", "60", "--dry-run"]) == 2     # the CLI names its options
+
+
+@pytest.mark.parametrize(("kwargs", "message"), [
+    ({"seed": -1}, r"seed = -1 is not allowed: an integer in \[0, 2\^31\)"),
+    ({"horizon_s": 0.05}, "horizon_s = 0.05 is not allowed: a control horizon"),
+    ({"controller": "pid"}, "controller = 'pid' is not allowed: one of open"),
+])
+def test_the_api_names_its_own_arguments(kwargs, message):
+    with pytest.raises(arzsumo.ScenarioError, match=message) as exc:
+        arzsumo.prepare("default", **kwargs)
+    assert "--" not in str(exc.value)
 
 
 def test_an_entry_point_controller_reaches_a_fresh_process_and_the_cli(tmp_path):

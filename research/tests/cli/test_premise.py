@@ -107,7 +107,8 @@ def test_a_short_run_writes_every_gate_and_a_restart_reuses_its_runs(tmp_path):
     # every lateral sample is a vehicle on main at a period's end; 120 snapshots
     assert runs["lateral_samples"] == runs["main_vehicles_total"] > 120 * 50
     assert runs["lateral_samples"] == sum(runs["class_samples"].values())
-    assert runs["pulse_plan"] == 0.0 and runs["collisions"] == 0
+    # collisions are not counted unless [sumo] collision_check (it changes no vehicle)
+    assert runs["pulse_plan"] == 0.0 and runs["collisions"] is None
     table = pd.read_csv(out / "premise.csv")
     assert table["gate"].tolist() == list(gates)
     row = table.set_index("gate").loc["waves[hv]"]

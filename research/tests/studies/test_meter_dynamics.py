@@ -107,7 +107,7 @@ def test_one_short_run_in_sumo_records_the_running_plan_every_second():
     # asked half a cycle early, each plan runs from the next cycle start
     assert [(g0, g1) for _, g0, g1 in changes] == [(0.5, 0.8), (0.8, 0.5)]
     assert 36.0 <= changes[0][0] <= 42.0 and 54.0 <= changes[1][0] <= 60.0
-    assert got["info"]["collisions"] == 0
+    assert got["info"]["collisions"] is None        # not counted: collision_check is off
 
 
 @pytest.mark.parametrize("greens", ["0.2,1.5", "-0.1", "0.5,nan"])

@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from numbers import Integral
 from pathlib import Path
 
@@ -12,7 +12,7 @@ import numpy as np
 from arzsumo.api.controllers import BUILTIN, ControllerLike, controller_name
 from arzsumo.api.scenarios import load_scenario, scenario_file
 from arzsumo.argtypes import SEED_LIMIT
-from arzsumo.bridge.session import check_warmup
+from arzsumo.bridge.session import API_NAMES, check_warmup
 from arzsumo.control.registry import controller_names
 from arzsumo.errors import ScenarioError
 from arzsumo.scenario import Scenario
@@ -71,7 +71,8 @@ def evaluate(scenario: str | Path | Scenario | None = None, *,
              scheduler: str | None = None, share_warmup: bool = True,
              overwrite: bool = False, progress: bool = False, plots: bool = True,
              baseline_from: str | Path | None = None,
-             runs_from: Sequence[str | Path] = (), command: str = "") -> EvaluationResult:
+             runs_from: Sequence[str | Path] = (), command: str = "",
+             option_names: Mapping[str, str] = API_NAMES) -> EvaluationResult:
     """Run every controller on the same SUMO seeds and compare each with the open loop,
     seed by seed (a paired comparison, every vehicle of the demand charged).
 
@@ -114,7 +115,7 @@ def evaluate(scenario: str | Path | Scenario | None = None, *,
     """
     path = _file_of(scenario)
     names = _names(controllers)
-    check_warmup(load_scenario(path), warmup_s, horizon_s, allow_short_warmup)
+    check_warmup(load_scenario(path), warmup_s, horizon_s, allow_short_warmup, option_names)
     target = Path(out) if out is not None else Path("results") / "evaluate" / path.stem
     return run_evaluation(path, names, seed_list(seeds), out=target, horizon=horizon_s,
                           warmup=warmup_s, workers=workers, scheduler=scheduler,

@@ -4,13 +4,14 @@ call these; every check they make is made here."""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 
 from arzsumo.api.controllers import ControllerLike, controller_name
 from arzsumo.api.results import RunResult, TwinResult
 from arzsumo.api.scenarios import load_scenario
 from arzsumo.bridge.prepared import PreparedRun
-from arzsumo.bridge.session import SumoSession, prepare_run, run_prepared
+from arzsumo.bridge.session import API_NAMES, SumoSession, prepare_run, run_prepared
 from arzsumo.control.registry import controller_names
 from arzsumo.engines.twin import run_twin
 from arzsumo.io import dump_toml
@@ -22,11 +23,13 @@ from arzsumo.sumo.frontend import Frontend
 def prepare(scenario: str | Path | Scenario | None = None, *,
             controller: ControllerLike | None = None, seed: int | None = None,
             horizon_s: float | None = None, warmup_s: float | None = None,
-            fcd: bool | None = None, allow_short_warmup: bool = False) -> PreparedRun:
+            fcd: bool | None = None, allow_short_warmup: bool = False,
+            names: Mapping[str, str] = API_NAMES) -> PreparedRun:
     """Check a SUMO run as :func:`run` would, without starting SUMO (the dry run).
 
-    Parameters are those of :func:`run`. Returns the checked run; its ``describe()`` is
-    what ``arzsumo run --dry-run`` prints.
+    Parameters are those of :func:`run` (``names``: how a refusal names them, the Python
+    arguments by default; the CLI passes its options). Returns the checked run; its
+    ``describe()`` is what ``arzsumo run --dry-run`` prints.
 
     Examples
     --------
@@ -39,7 +42,7 @@ def prepare(scenario: str | Path | Scenario | None = None, *,
     sc = load_scenario(scenario)
     return prepare_run(sc, controller=controller_name(controller, "sumo"), seed=seed,
                        horizon=horizon_s, warmup=warmup_s, fcd=fcd,
-                       allow_short_warmup=allow_short_warmup)
+                       allow_short_warmup=allow_short_warmup, names=names)
 
 
 def run(scenario: str | Path | Scenario | None = None, *,

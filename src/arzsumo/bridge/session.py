@@ -9,8 +9,10 @@ and runs :func:`arzsumo.bridge.cosim.run_cosimulation`. It writes nothing.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from numbers import Integral
+from types import MappingProxyType
 
 import numpy as np
 
@@ -51,17 +53,27 @@ class SumoSession:
             f"\n# sumo = {self.sumo!r}\n"
 
 
-def _seed(seed: int) -> int:
+#: how errors name the caller's overrides: the CLI's options (the default) ...
+CLI_NAMES = MappingProxyType({"controller": "--controller", "seed": "--seed",
+                              "horizon": "--horizon", "warmup": "--warmup", "fcd": "--fcd",
+                              "allow": "--allow-short-warmup"})
+#: ... or the Python API's arguments (:func:`arzsumo.run`)
+API_NAMES = MappingProxyType({"controller": "controller", "seed": "seed",
+                              "horizon": "horizon_s", "warmup": "warmup_s", "fcd": "fcd",
+                              "allow": "allow_short_warmup=True"})
+
+
+def _seed(seed: int, name: str = "--seed") -> int:
     if isinstance(seed, bool | np.bool_) or not isinstance(seed, Integral) \
             or not 0 <= seed < 2**31:
-        raise ScenarioError(f"--seed = {seed} is not allowed: an integer in [0, 2^31)")
+        raise ScenarioError(f"{name} = {seed} is not allowed: an integer in [0, 2^31)")
     return int(seed)
 
 
-def _horizon(horizon: float, cfg: SumoConfig) -> float:
+def _horizon(horizon: float, cfg: SumoConfig, name: str = "--horizon") -> float:
     # at least one control period: a shorter run measures nothing (NaN summaries)
     if not (math.isfinite(horizon) and horizon >= cfg.control_period):
-        raise ScenarioError(f"--horizon = {horizon:g} is not allowed: a control horizon of at "
+        raise ScenarioError(f"{name} = {horizon:g} is not allowed: a control horizon of at "
                             "least one control period ([sumo] control_period_s = "
                             f"{cfg.control_period:g} s)")
     return float(horizon)
@@ -98,18 +110,19 @@ def _check_model(sc: Scenario, cfg: SumoConfig) -> None:
                             "allowed: parameters that keep them finite")
 
 
-def _check_regime(sc: Scenario, settings: RunSettings, from_cli: bool) -> None:
-    """:func:`check_before_start`, its refusal naming where the controller was chosen."""
-    at = (f"--controller = {settings.controller}" if from_cli else
+def _check_regime(sc: Scenario, settings: RunSettings, option: str | None) -> None:
+    """:func:`check_before_start`, its refusal naming where the controller was chosen
+    (``option``: the caller's name for it; None: the scenario file)."""
+    at = (f"{option} = {settings.controller}" if option else
           f"{sc.source}: [run] controller = {written(settings.controller)}")
     check_before_start(settings, sc.equilibrium, at, f"the [equilibrium] of {sc.source}")
 
 
-def _check_estimation(sc: Scenario, settings: RunSettings, from_cli: bool) -> None:
+def _check_estimation(sc: Scenario, settings: RunSettings, option: str | None) -> None:
     """observer-etc with an estimator acts on the boundary stations: it needs loops."""
     method = sc.estimation.method
     if settings.controller == "observer-etc" and method != "none" and not sc.sensing.loops:
-        at = (f"--controller = {settings.controller}" if from_cli else
+        at = (f"{option} = {settings.controller}" if option else
               f"{sc.source}: [run] controller = {written(settings.controller)}")
         raise ScenarioError(f"{at} is not allowed with [estimation] method = "
                             f"{written(method)} and no loops: it acts on the estimate from "
@@ -117,7 +130,7 @@ def _check_estimation(sc: Scenario, settings: RunSettings, from_cli: bool) -> No
 
 
 def check_warmup(sc: Scenario, warmup: float | None, horizon: float | None,
-                 allow_short: bool) -> None:
+                 allow_short: bool, names: Mapping[str, str] = CLI_NAMES) -> None:
     """Refuse control that starts inside the scenario's fill phase.
 
     A scenario with ``[sumo] fill_s`` > 0 sends a fill demand from t = 0 until the queue
@@ -132,17 +145,18 @@ def check_warmup(sc: Scenario, warmup: float | None, horizon: float | None,
     if allow_short or fill <= 0 or warm >= fill:
         return
     window = sc.sumo.horizon if horizon is None else float(horizon)
-    given = (f"--warmup = {warm:g}" if warmup is not None else
+    given = (f"{names['warmup']} = {warm:g}" if warmup is not None else
              f"{sc.source}: [run] warmup_s = {sc.written('run', 'warmup_s', warm)}")
     raise ScenarioError(f"{given} is not allowed: the control window ({warm:g}-"
                         f"{warm + window:g} s) starts inside the fill phase of {sc.name} "
                         f"([sumo] fill_s = {fill:g} s), so its measures describe the fill; "
-                        f"allowed: a warm-up >= {fill:g} s, or --allow-short-warmup")
+                        f"allowed: a warm-up >= {fill:g} s, or {names['allow']}")
 
 
 def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None = None,
                 horizon: float | None = None, warmup: float | None = None,
-                fcd: bool | None = None, allow_short_warmup: bool = True) -> PreparedRun:
+                fcd: bool | None = None, allow_short_warmup: bool = True,
+                names: Mapping[str, str] = CLI_NAMES) -> PreparedRun:
     """Everything ``arzsumo run`` checks before SUMO starts, without starting it.
 
     Applies the caller's overrides to the ``run`` and ``sumo`` sections of ``sc``
@@ -157,26 +171,29 @@ def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None
     API and the CLI ask for it; the engine's own callers, sweeps and studies, decide
     their warm-ups themselves), and draws
     the placement profile of ``start = "placement"``. Raises an
-    :class:`arzsumo.errors.ArzsumoError` naming the key or option.
+    :class:`arzsumo.errors.ArzsumoError` naming the key, or the override as ``names`` call
+    it (:data:`CLI_NAMES` or :data:`API_NAMES`).
     """
     base = sc
     if controller is not None:
-        sc = _override(sc, "run.controller", controller, "--controller")
+        sc = _override(sc, "run.controller", controller, names["controller"])
     if seed is not None:
-        sc = _override(sc, "sumo.seed", _seed(seed), "--seed")
+        sc = _override(sc, "sumo.seed", _seed(seed, names["seed"]), names["seed"])
     if horizon is not None:
-        sc = _override(sc, "sumo.horizon_s", _horizon(horizon, sc.sumo), "--horizon")
+        sc = _override(sc, "sumo.horizon_s", _horizon(horizon, sc.sumo, names["horizon"]),
+                       names["horizon"])
     if warmup is not None:
-        sc = _override(sc, "run.warmup_s", warmup, "--warmup")
+        sc = _override(sc, "run.warmup_s", warmup, names["warmup"])
     if fcd is not None:
-        sc = _override(sc, "sumo.fcd", fcd, "--fcd")
+        sc = _override(sc, "sumo.fcd", fcd, names["fcd"])
     sc = with_network(sc)     # a [network] table checked with sumolib, L and W from it
     settings, cfg = sc.run, sc.sumo
     ic = seeded(sc.initial, cfg.seed)  # one seed draws all randomness
     _check_model(sc, cfg)
+    chosen = names["controller"] if controller is not None else None
     if settings.equilibrium == "scenario":
-        _check_regime(sc, settings, controller is not None)
-    _check_estimation(sc, settings, controller is not None)
+        _check_regime(sc, settings, chosen)
+    _check_estimation(sc, settings, chosen)
     check_delay(sc, acting_controller(sc.estimation.method, settings.controller))
     initial = None
     if settings.start == "placement":
@@ -184,7 +201,7 @@ def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None
         xc = (np.arange(n) + 0.5) * cfg.cell_length
         initial = initial_fields(ic, sc.equilibrium, xc)
     curve = meter_curve_of(cfg, sc.source)   # a bad curve file stops the run before SUMO
-    check_warmup(base, warmup, horizon, allow_short_warmup)
+    check_warmup(base, warmup, horizon, allow_short_warmup, names)
     return PreparedRun(sc, initial, curve)
 
 

@@ -37,6 +37,7 @@ HEADLINES = ("network_whole_demand.time_spent_s.total", "network_whole_demand.ra
 def cmd_evaluate(args: argparse.Namespace) -> int:
     from arzsumo.api.evaluate import evaluate, seed_list
     from arzsumo.api.scenarios import scenario_file
+    from arzsumo.bridge.session import CLI_NAMES
     from arzsumo.sweep.evaluate import BASELINE
 
     scenario = scenario_file(args.scenario)
@@ -50,7 +51,8 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
                    scheduler=args.scheduler, share_warmup=not args.no_shared_warmup,
                    overwrite=args.overwrite, progress=not args.quiet,
                    plots=not args.no_plots, baseline_from=args.baseline_from,
-                   runs_from=args.runs_from or (), command=command)
+                   runs_from=args.runs_from or (), command=command,
+                   option_names=CLI_NAMES)
     rep, bad = res.sweep, None
     if rep is None:
         print(f"evaluate {scenario.name}: every run taken from --runs-from, none executed")

@@ -31,7 +31,7 @@ from arzsumo.control.registry import controller_names
 def cmd_run(args: argparse.Namespace) -> int:
     from arzsumo.api.runs import prepare, run_checked
     from arzsumo.bridge.run_progress import WRITING, run_progress
-    from arzsumo.bridge.session import default_run_name
+    from arzsumo.bridge.session import CLI_NAMES, default_run_name
     from arzsumo.outdir import OutputDir, check_target
     from arzsumo.sumo.frontend import Frontend
 
@@ -40,7 +40,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     fcd = True if args.fcd else None   # without --fcd the scenario's [sumo] fcd holds
     prepared = prepare(sc, controller=args.controller, seed=args.seed,
                        horizon_s=args.horizon, warmup_s=args.warmup, fcd=fcd,
-                       allow_short_warmup=args.allow_short_warmup)
+                       allow_short_warmup=args.allow_short_warmup, names=CLI_NAMES)
     frontend = "gui" if args.gui else "libsumo"
     Frontend(frontend).check()   # no display or no sumo-gui: one line, before any output
     out = Path(args.out) if args.out else Path("results") / default_run_name(
