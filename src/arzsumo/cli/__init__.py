@@ -66,6 +66,8 @@ def plugin_registers() -> list[Callable[[argparse._SubParsersAction], None]]:
     for ep in sorted(entry_points(group=COMMAND_PLUGINS), key=lambda ep: ep.name):
         try:   # a broken package must not take the tool's own commands down with it
             registers.append(ep.load())
+        except ImportError as exc:   # metadata an uninstalled package left behind
+            log.debug("command %s (%s) not loaded: %s", ep.name, ep.value, exc)
         except Exception as exc:
             print(f"arzsumo: warning: command {ep.name} ({ep.value}) not loaded: {exc}",
                   file=sys.stderr)

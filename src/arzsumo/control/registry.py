@@ -165,6 +165,9 @@ def load_plugins() -> None:
             continue
         try:   # one broken package must not take the others, or the tool, down with it
             spec = _plugin_spec(ep.name, ep.load())
+        except ImportError as exc:   # metadata an uninstalled package left behind
+            log.debug("controller %s (%s) not loaded: %s", ep.name, ep.value, exc)
+            continue
         except Exception as exc:
             log.warning("controller %s (%s) not loaded: %s", ep.name, ep.value, exc)
             continue
