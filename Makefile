@@ -32,18 +32,17 @@ STUDIES := results/studies
 results: $(STAMP)
 	@echo "make results: the control and penetration studies, reported from the runs in"
 	@echo "$(RECORDS)/ (made earlier; nothing runs now); the headline rows:"
-	@mkdir -p $(STUDIES)
-	@$(BIN)/arzsumo study control --report --scenario scenarios/default_power_law.toml \
-		--seeds 1-20 --records $(RECORDS) --quiet \
-		--out $(STUDIES)/control > $(STUDIES)/control.md
-	@$(BIN)/arzsumo study penetration --report --records $(RECORDS) --quiet \
-		--out $(STUDIES)/penetration > $(STUDIES)/penetration.md
-	@head -n 1 $(STUDIES)/control.md
-	@grep -E '^\| (measure|---|whole-demand time spent, total) ' $(STUDIES)/control.md
-	@awk '/section-5 claims/ {f = 1} f {print} f && /^$$/ && n++ {exit}' $(STUDIES)/control.md
-	@echo "make results: every table in $(STUDIES)/control.md and $(STUDIES)/penetration.md,"
-	@echo "figures in $(STUDIES)/control/ and $(STUDIES)/penetration/ (what they say:"
-	@echo "research/readings/current_result.md)"
+	@t=$$(mktemp) && $(BIN)/arzsumo study control --report \
+		--scenario scenarios/default_power_law.toml --seeds 1-20 --records $(RECORDS) \
+		--quiet --out $(STUDIES)/control > $$t && mv $$t $(STUDIES)/control/tables.md
+	@t=$$(mktemp) && $(BIN)/arzsumo study penetration --report --records $(RECORDS) \
+		--quiet --out $(STUDIES)/penetration > $$t && mv $$t $(STUDIES)/penetration/tables.md
+	@head -n 1 $(STUDIES)/control/tables.md
+	@grep -E '^\| (measure|---|whole-demand time spent, total) ' $(STUDIES)/control/tables.md
+	@awk '/section-5 claims/ {f = 1} f {print} f && /^$$/ && n++ {exit}' \
+		$(STUDIES)/control/tables.md
+	@echo "make results: every table (tables.md) and figure in $(STUDIES)/control/ and $(STUDIES)/penetration/"
+	@echo "(what they say: research/readings/current_result.md)"
 
 test: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks research
