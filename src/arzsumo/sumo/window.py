@@ -263,7 +263,8 @@ def measure_network(out_dir: Path, start: WindowStart, end: float,
     then ``finish`` holds the values at ``end``); ``outlet_left_window``: vehicles that
     crossed x = L in the control window. Returns the measures and the per-vehicle rows
     of the whole run (:func:`~arzsumo.sumo.network_measures.read_trips`).
-    ``outlet_edge``: the edge whose end is x = L (``main``; a user's last section edge);
+    ``outlet_edge``: the section's last edge, which holds x = L (``main``; a user's last
+    section edge, with x = L inside it under ``end_offset_m``);
     ``ramp``: which vehicle ids are ramp vehicles (default: ids ``ramp...``; a user's
     network: by route, :meth:`~arzsumo.sumo.layout.VehicleClasses.recorded`).
     """
