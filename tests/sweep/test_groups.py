@@ -141,8 +141,9 @@ def test_a_group_with_a_killed_branch_completes_and_equals_plain_runs(tmp_path):
         assert _numbers(got.summary) == _numbers(plain.summary)
         # as frames: NaN where the other has NaN is equal (the trigger's columns of a
         # law without a trigger)
-        assert _table(got.tables["periods.parquet"]).to_pandas().equals(
-            _table(plain.tables["periods.parquet"]).to_pandas())
+        for name in ("periods.parquet", "cells.parquet"):
+            assert _table(got.tables[name]).to_pandas().equals(
+                _table(plain.tables[name]).to_pandas()), name
 
 
 @pytest.mark.sumo

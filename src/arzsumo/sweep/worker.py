@@ -114,11 +114,14 @@ def _run_sumo(task: RunTask) -> tuple[str, dict[str, Any], dict[str, bytes]]:
 def sumo_outcome(session: Any) -> tuple[str, dict[str, Any], dict[str, bytes]]:
     """Status, summary and tables of a finished SUMO session (a plain run's or a branch's
     of :mod:`arzsumo.sweep.groups`)."""
-    from arzsumo.outputs.bridge import periods_table, summary
+    from arzsumo.outputs.bridge import cells_table, periods_table, summary
 
     summ = json_safe(summary(session.result).to_dict())
     summ["settings_resolved"] = session.resolved_comment()
-    return "ok", summ, {"periods.parquet": _parquet(periods_table(session.result))}
+    # the cells (about 0.1 MB a run) let a reading of the field, such as what a boundary
+    # can reach, be made from a sweep's runs without running them again
+    return "ok", summ, {"periods.parquet": _parquet(periods_table(session.result)),
+                        "cells.parquet": _parquet(cells_table(session.result))}
 
 
 ENGINES = {"twin": _run_twin, "sumo": _run_sumo}
