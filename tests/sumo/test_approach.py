@@ -14,12 +14,15 @@ from arzsumo.sumo.network import (
     APPROACH,
     MAIN,
     NetworkSpec,
+    approach_edges,
     approach_length_of,
+    approach_of,
     build_network,
     edge_lengths,
     network_sources,
 )
 from arzsumo.sumo.paths import NET_FILE, SumoError, default_nets_dir
+from arzsumo.sumo.period_reads import approach_queue
 from arzsumo.sumo.simulation import open_simulation
 
 PARAMS = get_preset("paper_base").params
@@ -38,6 +41,27 @@ def test_approach_edge_has_the_stated_length_and_leads_into_main(tmp_path):
     assert [e.getID() for e in approach.getOutgoing()] == [MAIN]
     assert approach.getLane(0).getWidth() == pytest.approx(6.5)
     assert approach.getSpeed() == pytest.approx(net.getEdge(MAIN).getSpeed())
+
+
+def test_the_approach_cut_into_pieces_is_a_chain_of_equal_edges_of_the_same_length(tmp_path):
+    import sumolib
+
+    net_file = build_network(tmp_path, NetworkSpec(approach_length=2500.0,
+                                                   approach_piece=250.0))
+    pieces = approach_of(net_file)
+    assert pieces == tuple(f"approach{k}" for k in range(10))
+    assert approach_length_of(net_file) == pytest.approx(2500.0)
+    lengths = edge_lengths(net_file)
+    assert {round(lengths[e], 6) for e in pieces} == {250.0}
+    net = sumolib.net.readNet(str(net_file))
+    chain = [e.getID() for e in net.getEdge(pieces[0]).getToNode().getOutgoing()]
+    assert chain == [pieces[1]]
+    assert [e.getID() for e in net.getEdge(pieces[-1]).getOutgoing()] == [MAIN]
+    assert all(net.getEdge(e).getSpeed() == net.getEdge(MAIN).getSpeed() for e in pieces)
+    # a last piece within a millimetre of P makes none more; a remainder makes one
+    assert len(approach_edges(1000.0004, 250.0)) == 4
+    assert len(approach_edges(1001.0, 250.0)) == 5
+    assert approach_edges(2500.0, 0.0) == (APPROACH,) and approach_edges(0.0, 250.0) == ()
 
 
 def test_zero_approach_is_the_shipped_network():
@@ -78,9 +102,12 @@ def test_sumo_key_and_its_errors_name_the_key_in_metres():
 
 
 @pytest.mark.sumo
-def test_vehicles_depart_on_the_approach_and_main_is_measured_from_x0():
+@pytest.mark.parametrize("piece", [0.0, 100.0])
+def test_vehicles_depart_on_the_approach_and_main_is_measured_from_x0(piece):
+    """One edge or three of 100 m: the same road, the same conservation."""
     cfg = FAST.with_(approach_length=300.0, horizon=40.0, ramp_demand=0.0,
-                     collision_check=True)
+                     collision_check=True, approach_piece=piece)
+    edges = approach_edges(300.0, piece)
     first_on_main, roads = None, set()
     with open_simulation(PARAMS, cfg) as sim:
         sensor = MainlineSensor(sim.lib, PARAMS.length, cfg.cell_length, cfg.step_length,
@@ -95,9 +122,11 @@ def test_vehicles_depart_on_the_approach_and_main_is_measured_from_x0():
                 if first_on_main is None and data.rho_h.sum() + data.rho_a.sum() > 0:
                     first_on_main = t
                     first = data
-        on_approach = sim.lib.edge.getLastStepVehicleNumber(APPROACH)
+        on_approach = sum(sim.lib.edge.getLastStepVehicleNumber(e) for e in edges)
+        count, queue = approach_queue(sim.lib, 300.0, 30.0, edges)
     rep = sim.report
-    assert roads == {APPROACH}
+    assert roads == {edges[0]} and len(edges) == (3 if piece else 1)
+    assert count == on_approach and 0.0 <= queue <= 300.0
     # 300 m at the desired speed (<= 80 km/h) takes more than 13 s
     assert first_on_main is not None and 13.0 <= first_on_main <= 20.0
     # the first vehicles on main sit in the first cells (x = 0 is the approach's end)
@@ -109,10 +138,10 @@ def test_vehicles_depart_on_the_approach_and_main_is_measured_from_x0():
 
 @pytest.mark.sumo
 def test_a_network_that_does_not_match_the_approach_length_is_refused(tmp_path):
-    with pytest.raises(SumoError, match=r"approach_length = 300 m does not match the network"):
+    with pytest.raises(SumoError, match=r"approach_length = 300 m \(1 edge\) does not match the network"):
         open_simulation(PARAMS, FAST.with_(approach_length=300.0), net_dir=default_nets_dir())
     build_network(tmp_path, NetworkSpec(approach_length=200.0))
-    with pytest.raises(SumoError, match=r"approach edge is 200 m long"):
+    with pytest.raises(SumoError, match=r"whose approach is 200 m long \(1 edge\)"):
         open_simulation(PARAMS, FAST, net_dir=tmp_path)
     with open_simulation(PARAMS, FAST.with_(approach_length=200.0, horizon=2.0),
                          net_dir=tmp_path) as sim:

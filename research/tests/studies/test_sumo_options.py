@@ -18,13 +18,19 @@ TTS = "network_whole_demand.time_spent_s.total"
 def test_the_design_changes_one_option_at_a_time_on_the_same_seeds():
     spec = options_spec([1, 2, 3])
     runs = spec.runs()
-    assert len(runs) == 7 * 3
+    assert len(runs) == 8 * 3
     base = [r for r in runs if r.run_id.startswith("lateral_resolution_m=0.5,")]
     assert [r.scenario["sumo"]["seed"] for r in base] == [1, 2, 3]
     eager = next(r for r in runs if r.run_id == "eager_insert=false,seed=2")
     assert eager.scenario["sumo"]["eager_insert"] is False
     assert eager.scenario["sumo"]["lateral_resolution_m"] == 0.5      # the rest shipped
     assert all(r.scenario["run"]["controller"] == "open" for r in runs)
+
+
+def test_the_approach_in_pieces_is_a_variant_of_its_own_against_one_edge():
+    runs = options_spec([1], vary=("approach_piece_m",)).runs()
+    assert [r.scenario["sumo"]["approach_piece_m"] for r in runs] == [0.0, 250.0]
+    assert runs[1].scenario["sumo"]["approach_length_m"] == 2500
 
 
 def test_vary_runs_the_shipped_approach_once_then_each_shorter_one():
@@ -44,6 +50,8 @@ def _table(shift: float, noise: float, n: int = 10) -> pd.DataFrame:
         for res, extra, wall in ((0.5, 0.0, 100.0), (1.3, shift, 80.0)):
             rows.append({OPTION: "lateral_resolution_m", "lateral_resolution_m": res,
                          "seed": seed, "status": "ok", "execution.wall_s": wall,
+                         "execution.cpu_s": wall / 2, "teleports": 0,
+                         "network_whole_demand.vehicles.loaded.total": 1000,
                          TTS: level + extra + noise * rng.standard_normal()})
     return pd.DataFrame(rows)
 
@@ -58,7 +66,26 @@ def test_a_shift_beyond_seed_noise_moves_and_one_within_does_not():
     still = compare(_table(shift=0.0, noise=360.0))
     assert not still[still["variant"] == "lateral_resolution_m=1.3"].iloc[0]["moves"]
     text = markdown(moved)
-    assert "| lateral_resolution_m=1.3 | 10 | 80 | 0.80 |" in text and "**moves**" in text
+    assert "| lateral_resolution_m=1.3 | 10 | 80 | 0.80 | 0.80 |" in text and "**moves**" in text
+
+
+def test_a_lever_keeps_the_signature_only_when_every_interval_lies_inside_its_margin():
+    """Time per vehicle: 400 s a vehicle, margin 10 % = 40 s. A shift of 0 with a little
+    noise lies inside; a shift of 0 with noise so large that the interval reaches past 40 s
+    is outside although it contains 0; a teleport count of 0 on both is an exact 0."""
+    def row(table, measure):
+        t = compare(table)
+        return t[(t["variant"] == "lateral_resolution_m=1.3")
+                 & (t["measure"] == measure)].iloc[0]
+
+    per_vehicle = "whole-demand time per vehicle"
+    quiet = row(_table(shift=0.0, noise=2_000.0), per_vehicle)
+    assert quiet["margin"] == pytest.approx(40.0, rel=0.05) and quiet["inside"]
+    noisy = row(_table(shift=0.0, noise=60_000.0), per_vehicle)
+    assert noisy["diff_low"] < 0 < noisy["diff_high"] and not noisy["inside"]
+    teleports = row(_table(shift=0.0, noise=2_000.0), "teleports")
+    assert (teleports["diff_low"], teleports["diff_high"], teleports["inside"]) == (0, 0, True)
+    assert "inside +-" in markdown(compare(_table(shift=0.0, noise=2_000.0)))
 
 
 def test_eager_insertion_is_a_scenario_key_that_reaches_sumo():
@@ -82,7 +109,7 @@ def test_the_study_runs_from_python_with_its_options(monkeypatch, tmp_path):
     from arzsumo_studies.sumo_map import sumo_options
 
     opts = sumo_options.SumoOptionsOptions(seeds=(1, 2), out=tmp_path / "out")
-    assert len(sumo_options.design(opts)) == 7 * 2
+    assert len(sumo_options.design(opts)) == 8 * 2
     asked = {}
 
     def fake_sweep(spec, out, **kwargs):
@@ -92,7 +119,7 @@ def test_the_study_runs_from_python_with_its_options(monkeypatch, tmp_path):
 
     monkeypatch.setattr("arzsumo.sweep.driver.run_sweep", fake_sweep)
     result = sumo_options.run_sumo_options(opts, progress=False)
-    assert (result.code, result.statuses["failed"], asked["runs"]) == (4, 1, 14)
+    assert (result.code, result.statuses["failed"], asked["runs"]) == (4, 1, 16)
     row = result.table[result.table["variant"] == "lateral_resolution_m=1.3"].iloc[0]
     assert row["diff_mean"] == pytest.approx(1.0, abs=0.15)
     assert result.files == (tmp_path / "out" / "sumo_options.csv",)

@@ -28,7 +28,7 @@ TOLERANCE_M = 1e-3
 def _refuse_shipped_only(sc: Scenario) -> None:
     """Keys that act on the shipped network's own edges (``approach``, ``down``)."""
     sumo = sc.tables.get("sumo", {})
-    for key in ("approach_length_m", "down_speed_kmh", "down_length_m"):
+    for key in ("approach_length_m", "approach_piece_m", "down_speed_kmh", "down_length_m"):
         if key in sumo:
             raise not_allowed(where(sc.source, "sumo"), key, sumo[key],
                               "no such key with [network]: it changes the shipped "

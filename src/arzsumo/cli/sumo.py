@@ -42,11 +42,13 @@ def cmd_build_net(args: argparse.Namespace) -> int:
     from arzsumo.sumo.paths import CONFIG_FILE, NET_FILE, ROUTE_FILE, build_nets_dir
 
     out = build_nets_dir(args.out)
-    spec = NetworkSpec(approach_length=args.approach_length)
+    spec = NetworkSpec(approach_length=args.approach_length,
+                       approach_piece=args.approach_piece)
     net, changed = rebuild_network(out, spec, write=not args.keep_sources)
     write_gui_files(out, get_preset("paper_base").params,
-                    SumoConfig(approach_length=args.approach_length), NET_FILE, ROUTE_FILE,
-                    CONFIG_FILE)
+                    SumoConfig(approach_length=args.approach_length,
+                               approach_piece=args.approach_piece),
+                    NET_FILE, ROUTE_FILE, CONFIG_FILE)
     lengths = edge_lengths(net)
     print(f"network: {net} ({'written' if changed else 'unchanged'})")
     print("edges (m): " + ", ".join(f"{k} {v:.2f}" for k, v in sorted(lengths.items())))
@@ -113,6 +115,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    default=0.0, metavar="M",
                    help="length of the approach edge before x = 0 where mainline vehicles "
                         "are inserted (default 0: none, the shipped network)")
+    p.add_argument("--approach-piece-m", dest="approach_piece", type=non_negative_float,
+                   default=0.0, metavar="M",
+                   help="cut the approach into edges of at most M m (default 0: one edge)")
     p.set_defaults(func=cmd_build_net)
 
     p = sub.add_parser("calibrate", help="fit the AO fundamental diagram and the meter curve "

@@ -174,6 +174,10 @@ SUMO_KEYS: dict[str, Key] = {
                              doc="approach (buffer) edge before x = 0 where mainline vehicles "
                                  "are inserted and may queue; 0 inserts them at x = 0 on the "
                                  "shipped network"),
+    "approach_piece_m": Key("approach_piece", unit="m",
+                            doc="longest edge the approach is cut into (the same road; "
+                                "SUMO's sublane step costs less on short edges); 0: one "
+                                "edge"),
     "hv_max_speed_kmh": Key("hv_max_speed", factor=KMH_PER_MS, unit="km/h",
                             doc="HV maxSpeed in SUMO; 0: the model's V_h"),
     "av_max_speed_kmh": Key("av_max_speed", factor=KMH_PER_MS, unit="km/h",

@@ -138,6 +138,9 @@ class SumoConfig:
     approach_length : float
         Length of the ``approach`` edge before x = 0 where mainline vehicles are inserted
         and may queue, m; 0 (default) inserts them at x = 0 on the shipped network.
+    approach_piece : float
+        Longest edge the approach is cut into, m; 0 (default) keeps it one edge. The same
+        road in shorter edges: SUMO's sublane step costs less (docs/sumo.md).
     hv_max_speed, av_max_speed : float
         The vehicle types' maxSpeed, m/s; 0 (default) takes the model's free-flow speed
         V_i. A scenario whose model is identified from SUMO states the speeds its SUMO
@@ -225,6 +228,7 @@ class SumoConfig:
     down_length: float = 500.0
     meter_curve: str = ""
     approach_length: float = 0.0
+    approach_piece: float = 0.0
     hv_max_speed: float = 0.0
     av_max_speed: float = 0.0
     fill_duration: float = 0.0
@@ -252,8 +256,9 @@ class SumoConfig:
                      "down_speed", "down_length"):
             pos(name)
         for name in ("demand_h", "demand_a", "ramp_demand", "min_green", "min_red",
-                     "approach_length", "meter_clearance", "fill_duration", "drain_max",
-                     "fill_demand_h", "fill_demand_a", "hv_max_speed", "av_max_speed",
+                     "approach_length", "approach_piece", "meter_clearance",
+                     "fill_duration", "drain_max", "fill_demand_h", "fill_demand_a",
+                     "hv_max_speed", "av_max_speed",
                      "lc_sublane", "lc_speed_gain", "hv_action_step"):
             v = getattr(self, name)
             require(isinstance(v, int | float) and math.isfinite(v) and v >= 0, name, v,

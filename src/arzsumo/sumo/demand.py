@@ -26,7 +26,7 @@ from arzsumo.errors import ScenarioError
 from arzsumo.io import atomic_file
 from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.network import APPROACH, DOWN, MAIN, MERGE, RAMP_DN, RAMP_UP
+from arzsumo.sumo.network import DOWN, MAIN, MERGE, RAMP_DN, RAMP_UP, approach_edges
 from arzsumo.sumo.vtypes import AV_TYPE, HV_TYPE, vehicle_types
 
 ROUTE_MAIN, ROUTE_RAMP, ROUTE_SECTION = "r_main", "r_ramp", "r_section"
@@ -207,7 +207,8 @@ def route_file_text(params: ModelParameters, cfg: SumoConfig,
     section = f"{MAIN} {MERGE} {DOWN}"
     lines = [hv.to_xml(), av.to_xml()]
     if cfg.approach_length > 0:
-        lines += [f'<route id="{ROUTE_MAIN}" edges="{APPROACH} {section}"/>',
+        approach = " ".join(approach_edges(cfg.approach_length, cfg.approach_piece))
+        lines += [f'<route id="{ROUTE_MAIN}" edges="{approach} {section}"/>',
                   f'<route id="{ROUTE_SECTION}" edges="{section}"/>']
     else:
         lines.append(f'<route id="{ROUTE_MAIN}" edges="{section}"/>')

@@ -15,12 +15,18 @@ mainline capacity and the meter sets the mainline outflow q(L, t). The traffic l
 With ``approach_length`` La > 0 an ``approach`` edge Q(-La) -> A(0) (same lane, speed
 and priority as ``main``) comes first: mainline vehicles are inserted there and may queue,
 so a queue from the merge that reaches x = 0 no longer blocks insertion and the inflow at
-x = 0 is set by traffic. With La = 0 (default) the network is the shipped one.
+x = 0 is set by traffic. With La = 0 (default) the network is the shipped one. With
+``approach_piece`` P > 0 the approach is cut into ceil(La / P) equal edges in a row
+(``approach0``, ``approach1``, ... in driving order, priority junctions between them): the
+same road, but SUMO's sublane step, whose follower search and collision check walk every
+pair of vehicles on a lane, sees a tenth of the approach's queue per lane (docs/sumo.md,
+"What SUMO's step costs").
 """
 
 from __future__ import annotations
 
 import logging
+import math
 import re
 import shutil
 import subprocess
@@ -64,6 +70,8 @@ class NetworkSpec:
         ramp speed limit (m/s).
     approach_length : float
         Length of the ``approach`` edge before x = 0, m (0: no approach edge).
+    approach_piece : float
+        Longest edge the approach is cut into, m (0: one edge; :func:`approach_edges`).
     """
 
     length: float = 1000.0
@@ -77,13 +85,14 @@ class NetworkSpec:
     ramp_dn_length: float = 120.0
     ramp_speed: float = 50.0 / 3.6
     approach_length: float = 0.0
+    approach_piece: float = 0.0
 
     def __post_init__(self) -> None:
         for f in fields(self):
             value = getattr(self, f.name)
-            if f.name == "approach_length":
+            if f.name in ("approach_length", "approach_piece"):
                 require(isinstance(value, int | float) and 0 <= value < 1e6, f.name, value,
-                        "a length in [0, 1e6) m (0: no approach edge)")
+                        "a length in [0, 1e6) m (0: no approach edge / one edge)")
                 continue
             require(isinstance(value, int | float) and value > 0, f.name, value,
                     "a number greater than 0")
@@ -149,12 +158,31 @@ def network_sources(spec: NetworkSpec) -> dict[str, str]:
     }
 
 
+def approach_edges(approach_length: float, approach_piece: float = 0.0) -> tuple[str, ...]:
+    """The approach's edge IDs in driving order: none without an approach, ``approach``
+    uncut, else ``approach0`` ... ``approach{n-1}``, n = ceil(La / P) (a last piece
+    within a millimetre of P does not make another)."""
+    if approach_length <= 0:
+        return ()
+    n = max(1, math.ceil((approach_length - 1e-3) / approach_piece)) if approach_piece else 1
+    return (APPROACH,) if n == 1 else tuple(f"{APPROACH}{k}" for k in range(n))
+
+
 def _add_approach(spec: NetworkSpec, nodes: list[str], edges: list[str],
                   cons: list[str]) -> None:
-    """Append node Q, edge ``approach`` (Q -> A, explicit length) and its connection."""
-    nodes.append(f'<node {_attrs(id="Q", x=-spec.approach_length, y=0.0)}/>')
-    edges.insert(0, f'<edge {_attrs(id=APPROACH, **{"from": "Q"}, to="A", numLanes=1, speed=spec.main_speed, priority=3, length=spec.approach_length, width=spec.lane_width)}/>')  # noqa: E501
-    cons.insert(0, f'<connection {_attrs(**{"from": APPROACH}, to=MAIN, fromLane=0, toLane=0)}/>')
+    """Prepend the approach's nodes (Q at -La, then the cuts), its equal edges (explicit
+    lengths) and their connections, the last into ``main``."""
+    ids = approach_edges(spec.approach_length, spec.approach_piece)
+    piece = spec.approach_length / len(ids)
+    ends = ["Q"] + [f"Q{k}" for k in range(1, len(ids))] + ["A"]
+    for k, node in enumerate(ends[:-1]):
+        kind = {} if k == 0 else {"type": "priority"}
+        nodes.append(f'<node {_attrs(id=node, x=-spec.approach_length + k * piece, y=0.0, **kind)}/>')  # noqa: E501
+    new_edges = [f'<edge {_attrs(id=e, **{"from": ends[k]}, to=ends[k + 1], numLanes=1, speed=spec.main_speed, priority=3, length=piece, width=spec.lane_width)}/>'  # noqa: E501
+                 for k, e in enumerate(ids)]
+    edges[:0] = new_edges
+    cons[:0] = [f'<connection {_attrs(**{"from": e}, to=nxt, fromLane=0, toLane=0)}/>'
+                for e, nxt in zip(ids, (*ids[1:], MAIN), strict=True)]
 
 
 def write_if_changed(path: Path, data: bytes) -> bool:
@@ -253,8 +281,8 @@ def rebuild_network(out_dir: Path, spec: NetworkSpec | None = None, *,
                         "a writable directory") from None
     lengths = edge_lengths(net)
     wanted = {MAIN: spec.length}
-    if spec.approach_length > 0:
-        wanted[APPROACH] = spec.approach_length
+    ids = approach_edges(spec.approach_length, spec.approach_piece)
+    wanted |= {e: spec.approach_length / len(ids) for e in ids}
     for edge, length in wanted.items():
         if abs(lengths.get(edge, -1.0) - length) > 1e-6:
             raise SumoError(f"{edge} edge length = {lengths.get(edge)} m differs from the "
@@ -262,6 +290,21 @@ def rebuild_network(out_dir: Path, spec: NetworkSpec | None = None, *,
     return net, changed
 
 
+def approach_of(net_file: Path) -> tuple[str, ...]:
+    """The approach's edge IDs of a built network in driving order (:func:`approach_edges`);
+    none without an approach."""
+    return _approach_ids(edge_lengths(net_file))
+
+
+def _approach_ids(lengths: dict[str, float]) -> tuple[str, ...]:
+    if APPROACH in lengths:
+        return (APPROACH,)
+    pieces = sorted((int(m.group(1)), e) for e in lengths
+                    if (m := re.fullmatch(rf"{APPROACH}(\d+)", e)))
+    return tuple(e for _, e in pieces)
+
+
 def approach_length_of(net_file: Path) -> float:
-    """Length (m) of the ``approach`` edge of a built network; 0 without one."""
-    return edge_lengths(net_file).get(APPROACH, 0.0)
+    """Length (m) of the approach of a built network, all its pieces; 0 without one."""
+    lengths = edge_lengths(net_file)
+    return sum(lengths[e] for e in _approach_ids(lengths))

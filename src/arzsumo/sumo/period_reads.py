@@ -95,13 +95,19 @@ class OpenLoopEnd:
     ramp_queue: int
 
 
-def approach_queue(lib: ModuleType, length: float, queued_below: float) -> tuple[int, float]:
-    """Vehicles on ``approach`` (of ``length`` m) and its queue length: m from x = 0 to the
-    farthest upstream vehicle slower than ``queued_below`` (m/s)."""
-    ids = lib.edge.getLastStepVehicleIDs(APPROACH)
-    slow = [lib.vehicle.getLanePosition(v) for v in ids
-            if lib.vehicle.getSpeed(v) < queued_below]
-    return len(ids), (length - min(slow)) if slow else 0.0
+def approach_queue(lib: ModuleType, length: float, queued_below: float,
+                   edges: tuple[str, ...] = (APPROACH,)) -> tuple[int, float]:
+    """Vehicles on the approach (``edges`` in driving order, of ``length`` m in all, equal
+    pieces) and its queue length: m from x = 0 to the farthest upstream vehicle slower
+    than ``queued_below`` (m/s)."""
+    piece = length / len(edges)
+    count, slow = 0, []
+    for k, edge in enumerate(edges):
+        ids = lib.edge.getLastStepVehicleIDs(edge)
+        count += len(ids)
+        slow += [k * piece + lib.vehicle.getLanePosition(v) for v in ids
+                 if lib.vehicle.getSpeed(v) < queued_below]
+    return count, (length - min(slow)) if slow else 0.0
 
 
 class PeriodReader:
@@ -153,9 +159,10 @@ class PeriodReader:
         passed, self._passed = self._passed, 0
         return vehicles, passed, self._loop
 
-    def end(self, periods: int, approach_length: float, ramp_queue: int) -> OpenLoopEnd:
-        """The run's end (:class:`OpenLoopEnd`)."""
+    def end(self, periods: int, approach_length: float, ramp_queue: int,
+            approach: tuple[str, ...] = (APPROACH,)) -> OpenLoopEnd:
+        """The run's end (:class:`OpenLoopEnd`); ``approach``: its edges in driving order."""
         q = self.reads.queued_below
         return OpenLoopEnd(periods, self.lateral.record() if self.lateral else None,
-                           approach_queue(self.lib, approach_length, q)
+                           approach_queue(self.lib, approach_length, q, approach)
                            if q is not None else None, ramp_queue)

@@ -29,6 +29,7 @@ from arzsumo.sumo.disturbance import DisturbanceSchedule, Slowdown
 from arzsumo.sumo.green_share import DEFAULT_CURVE, GreenShareCurve
 from arzsumo.sumo.meter import MeterLight, MeterState, RampMeter
 from arzsumo.sumo.meter_release import make_meter
+from arzsumo.sumo.network import APPROACH, approach_edges
 from arzsumo.sumo.period_reads import OpenLoopEnd, OpenLoopPeriod, OpenLoopReads, PeriodReader
 from arzsumo.sumo.sensing import SensorLayout
 from arzsumo.sumo.sensor import PeriodMeasurement, SumoSensor
@@ -159,7 +160,8 @@ class SumoPlant:
                 on_period(OpenLoopPeriod(k, t, got, self.meter.state(), self.meter.releases,
                                          plan, vehicles, passed, loop))
             k += 1
-        return reader.end(k, self.cfg.approach_length, self.sensor.queue)
+        approach = approach_edges(self.cfg.approach_length, self.cfg.approach_piece)
+        return reader.end(k, self.cfg.approach_length, self.sensor.queue, approach or (APPROACH,))
 
     def _set_due(self, schedule: Sequence[tuple[float, float]], due: int,
                  plan: float | None, green_shares: bool) -> tuple[int, float | None]:

@@ -29,7 +29,13 @@ from arzsumo.sumo.demand import InitialVehicle, demand_flows, write_route_file
 from arzsumo.sumo.frontend import Frontend
 from arzsumo.sumo.layout import VehicleClasses
 from arzsumo.sumo.loops import DOWNSTREAM_DISTANCE, write_downstream_loop
-from arzsumo.sumo.network import NetworkSpec, approach_length_of, build_network
+from arzsumo.sumo.network import (
+    NetworkSpec,
+    approach_edges,
+    approach_length_of,
+    approach_of,
+    build_network,
+)
 from arzsumo.sumo.paths import (
     NET_FILE,
     NETS_ENV,
@@ -347,7 +353,8 @@ class SumoSimulation:
 def network_spec(cfg: SumoConfig) -> NetworkSpec:
     """The network geometry of a run with ``cfg``: the shipped one with the run's
     approach and downstream edge ``down``."""
-    return NetworkSpec(approach_length=cfg.approach_length, down_speed=cfg.down_speed,
+    return NetworkSpec(approach_length=cfg.approach_length,
+                       approach_piece=cfg.approach_piece, down_speed=cfg.down_speed,
                        down_length=cfg.down_length)
 
 
@@ -372,13 +379,19 @@ def network_file(cfg: SumoConfig, net_dir: Path | None, workdir: Path) -> Path:
                         f"network directory (the run builds it), or the shipped "
                         f"{ms_to_kmh(shipped.down_speed):g} km/h and {shipped.down_length:g} m")
     net = nets_dir(net_dir) / NET_FILE
-    have = approach_length_of(net)
-    if abs(have - cfg.approach_length) > 1e-6:
-        raise SumoError(f"approach_length = {cfg.approach_length:g} m does not match the "
-                        f"network {str(net)!r}, whose approach edge is {have:g} m long; "
-                        "allowed: the same length (`arzsumo build-net --approach-length-m "
-                        "LEN --out DIR`), or no network directory so that the run builds it")
+    have, pieces = approach_length_of(net), approach_of(net)
+    wanted = approach_edges(cfg.approach_length, cfg.approach_piece)
+    if abs(have - cfg.approach_length) > 1e-6 or len(pieces) != len(wanted):
+        raise SumoError(f"approach_length = {cfg.approach_length:g} m ({_edges(wanted)}) "
+                        f"does not match the network {str(net)!r}, whose approach is "
+                        f"{have:g} m long ({_edges(pieces)}); allowed: the same (`arzsumo "
+                        "build-net --approach-length-m LEN --approach-piece-m P --out "
+                        "DIR`), or no network directory so that the run builds it")
     return net
+
+
+def _edges(ids: Sequence[str]) -> str:
+    return f"{len(ids)} edge" + ("" if len(ids) == 1 else "s")
 
 
 def open_simulation(params: ModelParameters, cfg: SumoConfig, *,

@@ -11,21 +11,28 @@ Each variant is the default scenario with one ``[sumo]`` key changed (:data:`VAR
   insertion backlog, where it costs nothing per step and its depart delay is charged
   to the whole demand all the same);
 * SUMO's eager insertion (every waiting vehicle of the virtual queues tried every step
-  as shipped; off: only each edge's first).
+  as shipped; off: only each edge's first);
+* the approach cut into edges of 250 m (one 2500 m edge as shipped): the same road, where
+  SUMO's sublane step, quadratic in the vehicles of a lane, costs less.
 
 Every run is an ``arzsumo run`` of the open loop through the sweep engine (its drain
 included unless ``--no-drain``), on the same seeds for every variant; ``--vary`` picks
 the options (all by default), and the shipped scenario runs once per seed as the
 baseline. For each variant against the shipped one, seed by seed, ``sumo_options.csv``
-gives the wall time per run and its ratio, and the paired difference of each measure
-(:data:`MEASURES`) with its 95 % t interval and whether it moves beyond seed noise (the
-interval excludes zero). A default may change only where nothing moves.
+gives the wall and CPU time per run and their ratios, and the paired difference of each
+measure (:data:`MEASURES`) with its 95 % t interval and whether it moves beyond seed noise
+(the interval excludes zero). The stream's signature (coupling, wave speed and growth, band
+powers, the section's density and speed, the whole-demand time per vehicle, teleports and
+deadlocks) has margins stated before any run (:data:`MARGINS`): a lever leaves the stream
+where it was only when the interval of every signature measure lies inside its margin;
+an interval that merely contains zero is not enough. A default may change only then.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -55,6 +62,7 @@ VARIANTS: dict[str, list[Any]] = {
     "sumo.hv_action_step_s": [0.5],
     "sumo.approach_length_m": [1500.0, 1000.0],
     "sumo.eager_insert": [False],
+    "sumo.approach_piece_m": [250.0],
 }
 #: summary column -> (label, unit factor from SI, unit)
 MEASURES: dict[str, tuple[str, float, str]] = {
@@ -74,8 +82,60 @@ MEASURES: dict[str, tuple[str, float, str]] = {
     "section.inlet.v_h_kmh": ("inlet HV speed", 1.0, "km/h"),
     "rmse_blocks.replay.rho_h.relative": ("HV replay error", 100.0, "%"),
     "rmse_blocks.replay.rho_a.relative": ("AV replay error", 100.0, "%"),
+    "whole_demand_time_per_vehicle_s": ("whole-demand time per vehicle", 1.0, "s"),
+    "section.waves.a.band_power_kmh2": ("AV band power", 1.0, "(km/h)^2"),
+    "section.waves.h.growth_per_km": ("HV wave growth", 1.0, "1/km"),
+    "section_trend.mean_veh": ("section's mean vehicles", 1.0, "veh"),
+    "hv_file_gap_kmh": ("HV files' speed gap", 1.0, "km/h"),
+    "teleports": ("teleports", 1.0, "veh"),
+    "deadlocked": ("deadlocks", 1.0, "runs"),
 }
-WALL = "execution.wall_s"
+#: the signature's margins, stated before the runs: a measure stays where it was when its
+#: paired 95 % interval lies inside +-margin ("rel": that share of the shipped mean; "abs":
+#: in the measure's unit). 10 % where the issue of a lever is the level of a quantity; 2
+#: km/h on the wave speed; growth rates and the files' gap near 0 take absolute margins
+#: (0.2 per km: a fifth of the IDM stream's 0.8; 2 km/h between files); none of a
+#: deadlock or a teleport may appear.
+MARGINS: dict[str, tuple[str, float]] = {
+    "whole_demand_time_per_vehicle_s": ("rel", 0.10),
+    "section.speed_mean_kmh.h": ("rel", 0.10),
+    "section.speed_mean_kmh.a": ("rel", 0.10),
+    "section_trend.mean_veh": ("rel", 0.10),
+    "section.waves.h.band_power_kmh2": ("rel", 0.10),
+    "section.waves.a.band_power_kmh2": ("rel", 0.10),
+    "section.speed_wave.h.speed_kmh": ("abs", 2.0),
+    "section.waves.h.growth_per_km": ("abs", 0.2),
+    "hv_file_gap_kmh": ("abs", 2.0),
+    "teleports": ("abs", 0.0),
+    "deadlocked": ("abs", 0.0),
+}
+WALL, CPU = "execution.wall_s", "execution.cpu_s"
+
+
+def with_signature(df: pd.DataFrame) -> pd.DataFrame:
+    """``df`` (a sweep's table) with the signature's derived columns: the whole-demand time
+    per vehicle of the demand (s), the spread of the HV files' mean speeds (km/h; 0 with one
+    file: the coupling) and whether the run deadlocked (0/1)."""
+    out = df.copy()
+    tts, n = ("network_whole_demand.time_spent_s.total",
+              "network_whole_demand.vehicles.loaded.total")
+    if tts in out and n in out:
+        out["whole_demand_time_per_vehicle_s"] = out[tts] / out[n]
+    files = [c for c in out if c.startswith("section.waves.h.files.")
+             and c.endswith(".speed_mean_kmh")]
+    if files:
+        speeds = out[files].to_numpy(float)
+        gap = np.nanmax(speeds, axis=1) - np.nanmin(speeds, axis=1)
+        out["hv_file_gap_kmh"] = np.where(np.isfinite(gap), gap, 0.0)
+    grid = "network_whole_demand.drain.gridlock"
+    if grid in out:
+        out["deadlocked"] = out[grid].fillna(False).astype(float)
+    return out
+
+
+def inside_margin(low: float, high: float, margin: float) -> bool:
+    """Whether the interval [low, high] lies inside [-margin, +margin]."""
+    return -margin <= low and high <= margin
 
 
 def shipped_values(scenario: str = "default.toml") -> dict[str, Any]:
@@ -123,7 +183,7 @@ def compare(df: pd.DataFrame, drained: bool = True, base_name: str | None = None
     ``base_name`` (a :func:`variant_name`; None: the variant of the sweep's first run, the
     shipped value of its first axis) over the seeds both finished (module docstring);
     whole-demand measures only when the runs were ``drained``."""
-    ok = df[df["status"] == "ok"].copy()
+    ok = with_signature(df[df["status"] == "ok"])
     ok["variant"] = ok.apply(variant_of, axis=1)
     base_name = base_name or variant_of(df.iloc[0])
     base = ok[ok["variant"] == base_name].set_index("seed")
@@ -131,31 +191,66 @@ def compare(df: pd.DataFrame, drained: bool = True, base_name: str | None = None
     for variant, runs in ok.groupby("variant", sort=False):
         runs = runs.set_index("seed")
         seeds = sorted(set(runs.index) & set(base.index))
-        wall = runs.loc[seeds, WALL].to_numpy(float)
-        ratio = wall / base.loc[seeds, WALL].to_numpy(float)
+        cost = _cost(runs.loc[seeds], base.loc[seeds])
         for col, (label, factor, unit) in MEASURES.items():
             if col not in runs or (not drained and col.startswith("network_whole_demand")):
                 continue
             a = runs.loc[seeds, col].to_numpy(float) * factor
             b = base.loc[seeds, col].to_numpy(float) * factor
             same = variant == base_name
-            pc = None if same or len(seeds) < 2 else paired_difference(a, b, n_resamples=999)
+            pc = None if same or len(seeds) < 2 else _paired(a, b)
+            low, high = (pc.t.low, pc.t.high) if pc else (0.0, 0.0)
+            margin = _margin(col, float(np.nanmean(b)))
             rows.append({
-                "variant": variant, "seeds": len(seeds), "wall_s_per_run": wall.mean(),
-                "wall_ratio": float(np.mean(ratio)), "measure": label, "unit": unit,
-                "base_mean": float(np.nanmean(b)), "variant_mean": float(np.nanmean(a)),
-                "diff_mean": pc.mean_diff if pc else 0.0,
-                "diff_low": pc.t.low if pc else 0.0, "diff_high": pc.t.high if pc else 0.0,
-                "moves": bool(pc and not pc.t.covers(0.0))})
+                "variant": variant, "seeds": len(seeds), **cost, "measure": label,
+                "unit": unit, "base_mean": float(np.nanmean(b)),
+                "variant_mean": float(np.nanmean(a)),
+                "diff_mean": pc.mean_diff if pc else 0.0, "diff_low": low, "diff_high": high,
+                "moves": bool(pc and not pc.t.covers(0.0)), "margin": margin,
+                "inside": (None if np.isnan(margin) or same
+                           else inside_margin(low, high, margin))})
     return pd.DataFrame(rows)
+
+
+def _paired(a: np.ndarray, b: np.ndarray):
+    """The paired difference a - b, or, when it is 0 on every seed (a count that never
+    happens), an exact zero interval (a t interval of no spread is undefined)."""
+    d = a - b
+    if np.all(d[np.isfinite(d)] == 0.0):
+        zero = SimpleNamespace(low=0.0, high=0.0, covers=lambda v: v == 0.0)
+        return SimpleNamespace(mean_diff=0.0, t=zero)
+    return paired_difference(a, b, n_resamples=999)
+
+
+def _margin(col: str, base_mean: float) -> float:
+    """The margin of :data:`MARGINS` for ``col`` in its unit (NaN: not a signature
+    measure)."""
+    if col not in MARGINS:
+        return float("nan")
+    kind, value = MARGINS[col]
+    return value * abs(base_mean) if kind == "rel" else value
+
+
+def _cost(runs: pd.DataFrame, base: pd.DataFrame) -> dict[str, float]:
+    """Wall and CPU time per run (s) and their mean ratios to the baseline's, seed by
+    seed (CPU NaN for runs that did not record it)."""
+    out = {}
+    for name, col in (("wall", WALL), ("cpu", CPU)):
+        if col not in runs or col not in base:
+            out |= {f"{name}_s_per_run": float("nan"), f"{name}_ratio": float("nan")}
+            continue
+        mine, theirs = runs[col].to_numpy(float), base[col].to_numpy(float)
+        out |= {f"{name}_s_per_run": float(np.mean(mine)),
+                f"{name}_ratio": float(np.mean(mine / theirs))}
+    return out
 
 
 def markdown(table: pd.DataFrame) -> str:
     """The comparison as a Markdown table, one line per variant."""
-    lines = ["| variant | seeds | wall s / run | wall ratio | "
+    lines = ["| variant | seeds | wall s / run | wall ratio | CPU ratio | "
              + " | ".join(f"{m} ({u})" for m, u in dict.fromkeys(
                  zip(table["measure"], table["unit"], strict=True)))
-             + " |", "|---|---:|---:|---:|" + "---|" * table["measure"].nunique()]
+             + " |", "|---|---:|---:|---:|---:|" + "---|" * table["measure"].nunique()]
     for variant, rows in table.groupby("variant", sort=False):
         cells = []
         for r in rows.itertuples():
@@ -163,11 +258,14 @@ def markdown(table: pd.DataFrame) -> str:
                 cells.append(f"{r.base_mean:.3g}")
             else:
                 star = " **moves**" if r.moves else ""
+                if r.inside is not None and not pd.isna(r.inside):
+                    star += (f" inside +-{r.margin:.3g}" if r.inside
+                             else f" **outside +-{r.margin:.3g}**")
                 cells.append(f"{r.diff_mean:+.3g} [{r.diff_low:+.3g}, {r.diff_high:+.3g}]"
                              f"{star}")
         r0 = rows.iloc[0]
         lines.append(f"| {variant} | {r0.seeds} | {r0.wall_s_per_run:.0f} | "
-                     f"{r0.wall_ratio:.2f} | " + " | ".join(cells) + " |")
+                     f"{r0.wall_ratio:.2f} | {r0.cpu_ratio:.2f} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 
