@@ -1,4 +1,4 @@
-"""A ``[network]`` scenario on networks the package does not ship (issue 58).
+"""A ``[network]`` scenario on networks the package does not ship.
 
 Checks before SUMO starts (sumolib only), then short SUMO runs on both test networks of
 :mod:`tests.sumo.user_nets`: vehicles conserved between the section's loops, the sensor
@@ -196,14 +196,13 @@ def test_trip_measures_tell_ramp_vehicles_by_route(net_a):
 def test_identify_fits_on_the_networks_road(net_a):
     """``arzsumo identify`` replays on L and W read from the network, and the scenario it
     writes elsewhere points at the network by absolute paths."""
-    from arzsumo.workflows.identify.report import _network_paths
     from arzsumo.workflows.identify.study import make_setup
 
     sc = load_scenario(net_a)
     setup = make_setup(sc, [1], [2], horizon=60, warmup=60)
     assert setup.scenario.params.length == pytest.approx(1500.0)
     assert setup.scenario.params.road_width == pytest.approx(7.0)
-    table = _network_paths(sc.network, dict(sc.tables["network"]))
+    table = sc.network.absolute_table(dict(sc.tables["network"]))
     assert table["net_file"] == str(net_a.parent / "two_lane.net.xml")
     assert table["route_files"] == [str(net_a.parent / "demand.rou.xml")]
     assert table["section_edges"] == ["s1", "s2", "s3"]

@@ -1,4 +1,4 @@
-"""Two networks the package does not ship, built by netconvert from plain XML (issue 58).
+"""Two networks the package does not ship, built by netconvert from plain XML.
 
 (a) ``two_lane``: two 3.5 m lanes, a 1.5 km section over the edges ``s1``, ``s2``,
 ``s3``; the ramp ``onramp`` held by the light ``rm1`` joins the acceleration lane of

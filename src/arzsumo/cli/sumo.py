@@ -57,11 +57,12 @@ def cmd_build_net(args: argparse.Namespace) -> int:
 
 
 def cmd_calibrate(args: argparse.Namespace) -> int:
+    from arzsumo.bridge.road import with_network
     from arzsumo.outdir import OutputDir
     from arzsumo.outputs.calibration import write_calibration
     from arzsumo.sumo.calibrate import CalibrationPlan, calibrate
 
-    sc = scenario_of(args)
+    sc = with_network(scenario_of(args))   # a [network]: checked, its L, W and layout
     cfg = sc.sumo
     changes = {"seed": args.seed, "step_length": args.step_length}
     cfg = cfg.with_(**{k: v for k, v in changes.items() if v is not None})
@@ -75,7 +76,9 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
                                   "warmup": min(plan.warmup, args.horizon / 3)})
     with OutputDir(args.out, "calibration", overwrite=args.overwrite) as target:
         cal = calibrate(sc.params, cfg, plan, jobs=args.jobs)
-        write_calibration(target, cal, cfg)
+        network = (sc.network.absolute_table(sc.tables["network"])
+                   if sc.network is not None else None)
+        write_calibration(target, cal, cfg, network=network)
     out = args.out
     for cls, name in (("h", "HV"), ("a", "AV")):
         f = cal.fits[cls]

@@ -7,7 +7,9 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -15,17 +17,21 @@ from arzsumo.outdir import OutputDir, atomic_dir, target_of
 from arzsumo.outputs.figures import save_png
 from arzsumo.plots.calibration import calibration_figure
 from arzsumo.sumo.calibrate import Calibration
-from arzsumo.sumo.calibration_io import calibration_json, curve_text, scenario_text
+from arzsumo.sumo.calibration_io import CURVE_FILE, calibration_json, curve_text, scenario_text
 from arzsumo.sumo.config import SumoConfig
 
 
 def write_calibration(out: str | Path | OutputDir, cal: Calibration, cfg: SumoConfig,
-                      overwrite: bool = False) -> Path:
+                      overwrite: bool = False,
+                      network: Mapping[str, Any] | None = None) -> Path:
     """Write all calibration outputs into directory ``out`` atomically (a previous
-    ``calibration`` result is replaced only with ``overwrite``, see :mod:`arzsumo.outdir`)."""
+    ``calibration`` result is replaced only with ``overwrite``, see :mod:`arzsumo.outdir`);
+    ``network``: the scenario's ``[network]`` table with absolute paths, for the calibrated
+    scenario."""
     with atomic_dir(out, "calibration", overwrite=overwrite) as tmp:
-        (tmp / "calibrated_model.toml").write_text(scenario_text(cal, cfg), encoding="utf-8")
-        (tmp / "meter_curve.toml").write_text(curve_text(cal.curve, cfg), encoding="utf-8")
+        (tmp / "calibrated_model.toml").write_text(scenario_text(cal, cfg, network),
+                                                   encoding="utf-8")
+        (tmp / CURVE_FILE).write_text(curve_text(cal.curve, cfg), encoding="utf-8")
         (tmp / "calibration.json").write_text(json.dumps(calibration_json(cal, cfg), indent=2),
                                               encoding="utf-8")
         np.savez_compressed(tmp / "calibration_points.npz",

@@ -174,6 +174,9 @@ SUMO_KEYS: dict[str, Key] = {
                              doc="approach (buffer) edge before x = 0 where mainline vehicles "
                                  "are inserted and may queue; 0 inserts them at x = 0 on the "
                                  "shipped network"),
+    "demand_scale": Key("demand_scale",
+                        doc="SUMO --scale: the demand, route files included, loaded this "
+                            "many times on average (1: as written)"),
     "approach_piece_m": Key("approach_piece", unit="m",
                             doc="longest edge the approach is cut into (the same road; "
                                 "SUMO's sublane step costs less on short edges); 0: one "

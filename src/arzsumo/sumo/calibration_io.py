@@ -4,7 +4,8 @@
 writes, atomically as one directory:
 
 * ``calibrated_model.toml``: a scenario file (``arzsumo model --scenario ...``) whose
-  ``[model]`` holds the fitted FD and whose ``[equilibrium]`` is the state SUMO held;
+  ``[model]`` holds the fitted FD and whose ``[equilibrium]`` is the state SUMO held, with
+  the meter curve beside it and, on a user's network, its ``[network]`` table;
 * ``meter_curve.toml``: the outflow against green share curve the actuator inverts
   (:func:`load_green_share_curve`);
 * ``calibration.json``: every number (SI), ``calibration_points.npz``: the fitted points;
@@ -14,21 +15,29 @@ writes, atomically as one directory:
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from arzsumo.errors import ArzsumoError
-from arzsumo.io import read_toml, toml_value
+from arzsumo.io import dump_toml, read_toml, toml_value
 from arzsumo.sumo.calibrate import Calibration
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.green_share import GreenShareCurve
 from arzsumo.units import ms_to_kmh, veh_h_to_veh_s, veh_m_to_veh_km, veh_s_to_veh_h
 
+#: the meter curve's file beside the calibrated scenario
+CURVE_FILE = "meter_curve.toml"
 
-def scenario_text(cal: Calibration, cfg: SumoConfig) -> str:
-    """The calibrated model as a scenario file (human units in key names)."""
+
+def scenario_text(cal: Calibration, cfg: SumoConfig,
+                  network: Mapping[str, Any] | None = None) -> str:
+    """The calibrated model as a scenario file (human units in key names), the meter curve
+    written beside it (``meter_curve.toml``) as its ``[sumo] meter_curve``; on a user's
+    network, its ``network`` table (files as absolute paths), and the demand keys only
+    where the run made the demand (no route files)."""
     p, eq = cal.calibrated, cal.equilibrium
     fh, fa = cal.fits["h"], cal.fits["a"]
     lines = [
@@ -56,12 +65,15 @@ def scenario_text(cal: Calibration, cfg: SumoConfig) -> str:
                   f"rho_h_veh_km = {veh_m_to_veh_km(eq['rho_h']):.4f}",
                   f"rho_a_veh_km = {veh_m_to_veh_km(eq['rho_a']):.4f}"]
     lines += ["", "[sumo]", f"step_length_s = {cfg.step_length:.6g}",
-              f"lateral_resolution_m = {cfg.lateral_resolution:.6g}", f"seed = {cfg.seed}",
-              f"demand_h_veh_h = {veh_s_to_veh_h(cfg.demand_h):.6g}",
-              f"demand_a_veh_h = {veh_s_to_veh_h(cfg.demand_a):.6g}",
-              f"ramp_demand_veh_h = {veh_s_to_veh_h(cfg.ramp_demand):.6g}",
-              f"meter_cycle_s = {cfg.meter_cycle:.6g}",
-              f"green_share = {cfg.green_share:.6g}"]
+              f"lateral_resolution_m = {cfg.lateral_resolution:.6g}", f"seed = {cfg.seed}"]
+    if cfg.layout is None or not cfg.layout.route_files:
+        lines += [f"demand_h_veh_h = {veh_s_to_veh_h(cfg.demand_h):.6g}",
+                  f"demand_a_veh_h = {veh_s_to_veh_h(cfg.demand_a):.6g}",
+                  f"ramp_demand_veh_h = {veh_s_to_veh_h(cfg.ramp_demand):.6g}"]
+    lines += [f"meter_cycle_s = {cfg.meter_cycle:.6g}", f"green_share = {cfg.green_share:.6g}",
+              f'meter_curve = "{CURVE_FILE}"']
+    if network is not None:
+        lines += ["", dump_toml({"network": dict(network)}).strip()]
     return "\n".join(lines) + "\n"
 
 
@@ -113,5 +125,6 @@ def calibration_json(cal: Calibration, cfg: SumoConfig) -> dict[str, Any]:
                               "outflow": list(cal.curve.outflow)},
         "equilibrium": cal.equilibrium,
         "runs": cal.runs,
-        "config": cfg.__dict__,
+        "config": {k: v for k, v in cfg.__dict__.items() if k != "layout"}
+        | ({"net_file": str(cfg.layout.net_file)} if cfg.layout is not None else {}),
     })

@@ -138,6 +138,9 @@ class SumoConfig:
     approach_length : float
         Length of the ``approach`` edge before x = 0 where mainline vehicles are inserted
         and may queue, m; 0 (default) inserts them at x = 0 on the shipped network.
+    demand_scale : float
+        SUMO's ``--scale``: every vehicle of the demand, the route files' included, is
+        loaded this many times on average (1: as written; 0.5: every other one).
     approach_piece : float
         Longest edge the approach is cut into, m; 0 (default) keeps it one edge. The same
         road in shorter edges: SUMO's sublane step costs less (docs/sumo.md).
@@ -229,6 +232,7 @@ class SumoConfig:
     meter_curve: str = ""
     approach_length: float = 0.0
     approach_piece: float = 0.0
+    demand_scale: float = 1.0
     hv_max_speed: float = 0.0
     av_max_speed: float = 0.0
     fill_duration: float = 0.0
@@ -253,7 +257,7 @@ class SumoConfig:
         for name in ("step_length", "lateral_resolution", "horizon", "cell_length",
                      "control_period", "meter_cycle", "min_gap_lat", "max_green",
                      "release_rate", "release_rate_min", "release_rate_max", "hv_tau",
-                     "down_speed", "down_length"):
+                     "down_speed", "down_length", "demand_scale"):
             pos(name)
         for name in ("demand_h", "demand_a", "ramp_demand", "min_green", "min_red",
                      "approach_length", "approach_piece", "meter_clearance",

@@ -68,7 +68,8 @@ def run_fixed_meter(params: ModelParameters, cfg: SumoConfig, green_share: float
         plant = SumoPlant(sim, params.length, cfg, curve, measure=measure)
         plant.run_open_loop(on_period=keep, until=cfg.horizon)
         # ramp vehicles past the meter: inserted minus those still upstream of it
-        ramp_passed = sim.inserted_ramp - int(sim.lib.edge.getLastStepVehicleNumber(RAMP_UP))
+        ramp = cfg.layout.ramp_edge if cfg.layout is not None else RAMP_UP
+        ramp_passed = sim.inserted_ramp - int(sim.lib.edge.getLastStepVehicleNumber(ramp))
     if sim.report is None:  # pragma: no cover - close() failed to read SUMO's counts
         raise SumoError("SUMO closed without a final report")
     log.info("%s", sim.report.summary())

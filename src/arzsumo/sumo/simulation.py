@@ -177,6 +177,7 @@ class SumoSimulation:
                 "--step-length", f"{c.step_length:.6g}", "--seed", str(c.seed),
                 *lateral, "--time-to-teleport", f"{c.time_to_teleport:.6g}",
                 "--eager-insert", str(c.eager_insert).lower(),
+                *(("--scale", f"{c.demand_scale:.6g}") if c.demand_scale != 1.0 else ()),
                 *(a for k, v in c.collision_options.items() for a in (f"--{k}", v)),
                 "--statistic-output", str(self.stats_file),
                 "--no-step-log", "true", "--no-warnings", "true",

@@ -21,6 +21,7 @@ from __future__ import annotations
 import difflib
 import itertools
 import xml.etree.ElementTree as ET
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -73,6 +74,15 @@ class NetworkRequest:
     end_offset: float = 0.0
     sublane: bool = True
     base: str = "."
+
+    def absolute_table(self, table: Mapping[str, Any]) -> dict[str, Any]:
+        """``table`` (this ``[network]`` as written) with its files as absolute paths: a
+        scenario written elsewhere (``arzsumo identify``, ``arzsumo calibrate``) still
+        finds the network."""
+        out = {**table, "net_file": str(self.path(self.net_file).resolve())}
+        if self.route_files:
+            out["route_files"] = [str(self.path(r).resolve()) for r in self.route_files]
+        return out
 
     def __post_init__(self) -> None:
         for name in ("start_offset", "end_offset"):

@@ -44,7 +44,6 @@ from arzsumo.outdir import OutputDir
 from arzsumo.outputs.identify import DiagramPanel, FieldsPanel, ScatterPanel, SpectrumPanel
 from arzsumo.scenario.model import MODEL_KEYS
 from arzsumo.schema import IDENTIFY_SUMMARY, key_units
-from arzsumo.sumo.user_network import NetworkRequest
 from arzsumo.sumo.vtypes import vehicle_types
 from arzsumo.units import ms_to_kmh, veh_m_to_veh_km
 from arzsumo.version import __version__
@@ -102,14 +101,6 @@ def _diagram_table(diagram: DiagramFit, table: dict[str, Any]) -> dict[str, str]
     return notes
 
 
-def _network_paths(req: NetworkRequest, table: dict[str, Any]) -> dict[str, Any]:
-    """A ``[network]`` table with its files as absolute paths."""
-    out = {**table, "net_file": str(req.path(req.net_file).resolve())}
-    if req.route_files:
-        out["route_files"] = [str(req.path(r).resolve()) for r in req.route_files]
-    return out
-
-
 def identified_toml(study: IdentifyStudy) -> str:
     """The text of ``identified.toml`` (module docstring)."""
     base, setup = study.setup.base, study.setup
@@ -142,7 +133,7 @@ def identified_toml(study: IdentifyStudy) -> str:
     if base.sumo.meter_curve:
         data["sumo"] = {**data.get("sumo", {}), "meter_curve": str(base.sumo.meter_curve)}
     if base.network is not None:       # the file is written elsewhere: absolute paths
-        data["network"] = _network_paths(base.network, data["network"])
+        data["network"] = base.network.absolute_table(data["network"])
     # SUMO's vehicles keep the speeds the runs had: the identified V_i describe SUMO
     vtypes = vehicle_types(study.setup.scenario.params, study.setup.scenario.sumo)
     data["sumo"] = {**data.get("sumo", {}),
