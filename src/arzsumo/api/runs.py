@@ -11,6 +11,7 @@ from arzsumo.api.controllers import ControllerLike, controller_name
 from arzsumo.api.results import RunResult, TwinResult
 from arzsumo.api.scenarios import load_scenario
 from arzsumo.bridge.prepared import PreparedRun
+from arzsumo.bridge.road import with_network
 from arzsumo.bridge.session import API_NAMES, SumoSession, prepare_run, run_prepared
 from arzsumo.control.registry import controller_names
 from arzsumo.engines.twin import run_twin
@@ -172,7 +173,8 @@ def twin(scenario: str | Path | Scenario | None = None, *,
     >>> res.summary.controller, res.summary.triggers < 450
     ('etc', True)
     """
-    sc, _ = twin_controller(load_scenario(scenario), controller)
+    # a [network]: the twin runs on the section's length and width read from it
+    sc, _ = twin_controller(with_network(load_scenario(scenario)), controller)
     return TwinResult.of(run_twin(sc, baseline=baseline))
 
 

@@ -17,9 +17,12 @@ def load_named(text: str | None, default: Path | None = None) -> tuple[Path, Sce
 
 
 def scenario_of(args: argparse.Namespace) -> Scenario:
-    """The scenario of ``--scenario FILE|NAME``, else of the ``--preset``."""
+    """The scenario of ``--scenario FILE|NAME``, else of the ``--preset``; one with a
+    ``[network]`` takes the section's length and width from that network (checked)."""
     if getattr(args, "scenario", None):
-        return load_named(args.scenario)[1]
+        from arzsumo.bridge.road import with_network
+
+        return with_network(load_named(args.scenario)[1])
     return scenario_from_preset(args.preset)
 
 

@@ -57,12 +57,11 @@ def cmd_build_net(args: argparse.Namespace) -> int:
 
 
 def cmd_calibrate(args: argparse.Namespace) -> int:
-    from arzsumo.bridge.road import with_network
     from arzsumo.outdir import OutputDir
     from arzsumo.outputs.calibration import write_calibration
     from arzsumo.sumo.calibrate import CalibrationPlan, calibrate
 
-    sc = with_network(scenario_of(args))   # a [network]: checked, its L, W and layout
+    sc = scenario_of(args)        # a [network]: checked, its L, W and layout
     cfg = sc.sumo
     changes = {"seed": args.seed, "step_length": args.step_length}
     cfg = cfg.with_(**{k: v for k, v in changes.items() if v is not None})
