@@ -35,7 +35,7 @@ _API = {
     "TwinSummary": "arzsumo.api.results",
     "controller_names": "arzsumo.api.controllers",
     "register_controller": "arzsumo.api.controllers",
-    "evaluate": "arzsumo.api.evaluate", "load_scenario": "arzsumo.api.scenarios",
+    "evaluate": "arzsumo.api.evaluation", "load_scenario": "arzsumo.api.scenarios",
     "network_figure": "arzsumo.api.network", "road_geometry": "arzsumo.api.network",
     "prepare": "arzsumo.api.runs", "run": "arzsumo.api.runs", "twin": "arzsumo.api.runs",
 }

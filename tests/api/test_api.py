@@ -11,7 +11,7 @@ import textwrap
 import pytest
 
 import arzsumo
-from arzsumo.api.evaluate import seed_list
+from arzsumo.api.evaluation import seed_list
 from arzsumo.cli import main
 from arzsumo.control.registry import unregister_controller
 

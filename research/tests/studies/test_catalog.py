@@ -18,7 +18,7 @@ from .conftest import parse
 NAMES = ["ablation", "ablation-mechanism", "held-ramp", "meter-dynamics", "approach", "fill",
          "wave-speed", "inlet", "estimation-layouts", "loop-speed", "enkf-noise",
          "u-estimate", "premise-map", "sumo-options", "control", "control-ablation",
-         "etc-noise", "meter-delay", "penetration", "share-models", "space-time"]
+         "etc-noise", "meter-delay", "penetration", "share-models", "space-time", "reach"]
 
 
 def test_the_catalog_lists_the_studies_by_their_names():
@@ -46,7 +46,8 @@ def test_each_study_writes_under_results_studies_name_and_publishes_on_request(n
 
 @pytest.mark.parametrize("name", [n for n in NAMES if n not in
                                   ("ablation-mechanism", "inlet", "enkf-noise",
-                                   "meter-delay", "share-models", "space-time")])
+                                   "meter-delay", "share-models", "space-time",
+                                   "reach")])
 def test_studies_that_run_simulations_take_seeds_workers_and_list(name):
     args = parse(name, "--seeds", "3-5", "--workers", "2", "--quiet", "--list")
     assert (args.seeds, args.workers, args.quiet, args.list) == ([3, 4, 5], 2, True, True)
@@ -96,4 +97,4 @@ def test_each_study_names_a_results_page_of_the_docs_layout():
                      "control-ablation": "control_default", "etc-noise": "control_default",
                      "meter-delay": "control_default",
                      "penetration": "control_default", "share-models": "share_models",
-                     "space-time": "control_default"}
+                     "space-time": "control_default", "reach": "reach"}

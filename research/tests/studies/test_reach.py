@@ -90,3 +90,85 @@ def test_a_cell_empty_in_a_run_is_left_out_and_a_run_without_two_cells_refused(t
     assert res.x.size == X.size - 1 and 175.0 not in res.x
     with pytest.raises(StudyError, match="runs = 0 is not allowed"):
         reach([])
+
+
+# ``arzsumo study reach``: the same synthetic runs through the study and its command line
+
+@pytest.fixture(scope="module")
+def synthetic(tmp_path_factory):
+    """Three noiseless synthetic runs (``run0`` .. ``run2``) in one directory."""
+    root = tmp_path_factory.mktemp("reach_runs")
+    for s in range(3):
+        _write_run(root / f"run{s}", s, noise_sd=0.0)
+    return root
+
+
+def test_run_dirs_sort_by_seed_keep_the_first_and_refuse_what_is_not_a_run(tmp_path):
+    from arzsumo_studies.control.reach import RUN_FILES, run_dirs
+
+    for seed in (10, 2, 1):
+        d = tmp_path / f"controller=open,seed={seed}"
+        d.mkdir()
+        for f in RUN_FILES:
+            (d / f).touch()
+    pattern = f"{tmp_path}/controller=open,seed=*"
+    assert [d.name for d in run_dirs("open", pattern)] == [
+        "controller=open,seed=1", "controller=open,seed=2", "controller=open,seed=10"]
+    assert [d.name for d in run_dirs("open", pattern, 2)] == [
+        "controller=open,seed=1", "controller=open,seed=2"]
+    (tmp_path / "controller=open,seed=2" / "summary.json").unlink()
+    with pytest.raises(StudyError, match=r"--runs = .*seed=2 has no summary.json"):
+        run_dirs("open", pattern)
+    with pytest.raises(StudyError, match=r"--runs = 'none=.*/nothing\*'.*matches none"):
+        run_dirs("none", f"{tmp_path}/nothing*")
+
+
+def test_the_study_writes_the_table_its_page_and_the_figure(synthetic, tmp_path):
+    from arzsumo_studies.control.reach import ReachOptions, run_reach
+
+    opts = ReachOptions(runs=(("syn", f"{synthetic}/run*"),), out=tmp_path / "out")
+    res = run_reach(opts)
+    assert [p.name for p in res.files] == ["reach.csv", "reach.md", "reach.png"]
+    assert [d.name for d in res.dirs["syn"]] == ["run0", "run1", "run2"]
+    assert list(res.table.columns[:7]) == ["condition", "boundary", "band", "share",
+                                           "floor", "beyond_floor", "runs"]
+    assert res.text.startswith(f"`{opts.command()}`")
+    assert "| syn | qL | 3 | 1.00 [0.0" in res.text
+    no_plots = run_reach(ReachOptions(runs=opts.runs, out=opts.out, plots=False))
+    assert not (opts.out / "reach.png").exists() and len(no_plots.files) == 2
+
+
+def test_the_command_writes_the_shares_the_library_reads(synthetic, tmp_path, capsys):
+    from arzsumo.cli import main
+
+    out = tmp_path / "out"
+    assert main(["study", "reach", "--runs", f"syn={synthetic}/run*", "--out",
+                 str(out)]) == 0
+    table = pd.read_csv(out / "reach.csv")
+    row = table.set_index(["boundary", "band"])
+    assert set(table["condition"]) == {"syn"} and set(table["runs"]) == {3}
+    for band in ("short_waves", "stop_and_go"):
+        assert row.loc[("qL", band), "share"] == pytest.approx(1.0, abs=0.03)
+        for b in ("q0", "U"):
+            r = row.loc[(b, band)]
+            assert r["share"] < 3 * r["floor"] + 0.02, (b, band)
+    png = (out / "reach.png").read_bytes()
+    assert png.startswith(b"\x89PNG\r\n\x1a\n") and len(png) > 1000
+    text = (out / "reach.md").read_text(encoding="utf-8")
+    assert text.startswith("`arzsumo study reach --runs") and "| syn | q0 | 3 |" in text
+    assert text.strip() in capsys.readouterr().out
+
+
+def test_a_glob_matching_nothing_is_refused_in_one_line(tmp_path, capsys):
+    from arzsumo.cli import main
+
+    out = tmp_path / "out"
+    pattern = f"{tmp_path}/nothing=*"
+    assert main(["study", "reach", "--runs", f"none={pattern}", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("arzsumo: error: --runs = ")
+    assert pattern in err and not out.exists()
+    assert main(["study", "reach", "--out", str(out)]) == 2
+    assert "--runs" in capsys.readouterr().err
+    assert main(["study", "reach", "--runs", "no-glob", "--out", str(out)]) == 2
+    assert "--runs = no-glob is not allowed: NAME=GLOB" in capsys.readouterr().err

@@ -3,7 +3,7 @@ in SUMO, compared with the open loop seed by seed.
 
 Checks the scenario for every controller (as ``arzsumo run`` would, the warm-up against
 the scenario's fill phase included) before any run, then calls :func:`arzsumo.evaluate`
-(:func:`arzsumo.api.evaluate.evaluate`) and prints the headline differences and where the
+(:func:`arzsumo.api.evaluation.evaluate`) and prints the headline differences and where the
 report is.
 Exit codes: 0 every run finished, 4 some runs were invalid, failed or crashed (the
 report uses the seeds that finished for both members of a pair), 2 a user error.
@@ -15,7 +15,6 @@ import argparse
 import shlex
 import sys
 
-from arzsumo.api.evaluate import default_controllers
 from arzsumo.cli.args import positive_float, positive_int, seed_int
 from arzsumo.cli.options import (
     add_no_plots,
@@ -26,6 +25,7 @@ from arzsumo.cli.options import (
     add_scenario,
     add_warmup,
 )
+from arzsumo.control.registry import default_controllers
 from arzsumo.errors import EXIT_SOME_FAILED
 
 #: the measures printed, in the report's order: whole-demand time spent, the ramp's
@@ -35,7 +35,7 @@ HEADLINES = ("network_whole_demand.time_spent_s.total", "network_whole_demand.ra
 
 
 def cmd_evaluate(args: argparse.Namespace) -> int:
-    from arzsumo.api.evaluate import evaluate, seed_list
+    from arzsumo.api.evaluation import evaluate, seed_list
     from arzsumo.api.scenarios import scenario_file
     from arzsumo.bridge.session import CLI_NAMES
     from arzsumo.sweep.evaluate import BASELINE

@@ -215,6 +215,13 @@ def controller_names(engine: str | None = None) -> tuple[str, ...]:
     return tuple(n for n, s in REGISTRY.items() if engine is None or getattr(s, engine))
 
 
+def default_controllers() -> tuple[str, ...]:
+    """What ``arzsumo.evaluate`` compares by default: the package's own laws that run in
+    SUMO, the paper's and the baselines a traffic engineer would field (all but
+    ``constant``, which needs a release rate of its own)."""
+    return tuple(n for n in controller_names("sumo") if n in BUILTIN and n != "constant")
+
+
 def pde_controller_names() -> tuple[str, ...]:
     """Names of the PDE controllers (kernels needed)."""
     return tuple(n for n, s in REGISTRY.items() if s.pde)

@@ -79,10 +79,12 @@ def scenario_text(cal: Calibration, cfg: SumoConfig,
 
 def curve_text(curve: GreenShareCurve, cfg: SumoConfig) -> str:
     """The outflow curve as TOML."""
+    demand = (f"the route files' demand ({', '.join(p.name for p in cfg.layout.route_files)})"
+              if cfg.layout is not None and cfg.layout.route_files else
+              f"medium demand, ramp demand {veh_s_to_veh_h(cfg.ramp_demand):.0f} veh/h")
     return "\n".join([
-        "# Mainline outflow q(L) against the ramp meter's green share, medium demand,",
-        f"# ramp demand {veh_s_to_veh_h(cfg.ramp_demand):.0f} veh/h, cycle "
-        f"{cfg.meter_cycle:g} s. Written by `arzsumo calibrate`.",
+        "# Mainline outflow q(L) against the ramp meter's green share,",
+        f"# {demand}, cycle {cfg.meter_cycle:g} s. Written by `arzsumo calibrate`.",
         f"green_share = {toml_value([round(g, 6) for g in curve.green_share])}",
         "outflow_veh_h = "
         f"{toml_value([round(float(veh_s_to_veh_h(q)), 2) for q in curve.outflow])}",

@@ -9,7 +9,8 @@ ablation, ablation-mechanism, held-ramp and wave-speed, ``meter_dynamics``, ``su
 for approach, ``sumo_fill`` for fill, ``identified_model`` for inlet,
 ``estimation_layouts`` for estimation-layouts and loop-speed, ``enkf_noise``,
 ``u_on_estimate``, ``premise_map``, ``sumo_options``, ``control_default`` for control,
-control-ablation, etc-noise, meter-delay and penetration;
+control-ablation, etc-noise, meter-delay, penetration and space-time, ``share_models``,
+``reach``;
 :mod:`arzsumo_studies.common`). ``run`` returns the exit code (0 done; 4 some runs were
 invalid, failed or crashed) and raises
 :class:`~arzsumo.errors.ArzsumoError` for bad input. A study's module is imported only
@@ -105,6 +106,8 @@ _MODULES = {
                                      "the model identified there, the ETC designed"),
     "space-time": ("space_time", "SUMO's speeds and densities under a few controllers of "
                                  "one seed, side by side"),
+    "reach": ("reach", "the share of the section's speed variance coherent with q(0), "
+                       "q(L) and U, per band"),
 }
 
 #: study name -> its library module under arzsumo_studies (a package per family of
@@ -120,7 +123,7 @@ STUDY_MODULES = {
     "control": "control.study", "control-ablation": "control.ablation",
     "etc-noise": "control.etc_noise", "meter-delay": "control.meter_delay",
     "penetration": "control.penetration", "share-models": "share_models",
-    "space-time": "control.space_time",
+    "space-time": "control.space_time", "reach": "control.reach",
 }
 
 #: the studies that are library code (frozen Options, ``run(options) -> Result``): their

@@ -16,7 +16,6 @@ import argparse
 import json
 from pathlib import Path
 
-from arzsumo.bridge.session import check_warmup
 from arzsumo.cli.args import SEED_LIMIT, positive_float, positive_int, seed_int
 from arzsumo.cli.options import (
     add_json,
@@ -52,6 +51,8 @@ def cmd_premise(args: argparse.Namespace) -> int:
     )
 
     path, sc = load_named(args.scenario)
+    from arzsumo.bridge.session import check_warmup  # SUMO's side: not at --help
+
     check_warmup(sc, args.warmup, args.window, args.allow_short_warmup)
     if args.seed_start + args.seeds > SEED_LIMIT:
         raise ScenarioError(f"--seed-start = {args.seed_start} is not allowed with --seeds = "

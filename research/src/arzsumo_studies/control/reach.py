@@ -17,11 +17,21 @@ are averaged over every segment of every run.
   HV speed (q(0)).
 
 SI inside: s, m, m/s, veh/s; the shares are dimensionless.
+
+``arzsumo study reach`` (:func:`run_reach`) runs it once on conditions given as globs of
+run directories and writes ``reach.csv`` (:func:`reach_table`'s rows), ``reach.md`` (the
+command, then share [floor] per condition, boundary and band) and ``reach.png`` (the
+coherence against x and period, a row of panels per condition) under ``--out``.
 """
 
 from __future__ import annotations
 
+import glob
 import json
+import math
+import os
+import re
+import shlex
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -32,11 +42,26 @@ import pandas as pd
 
 from arzsumo.errors import require
 from arzsumo.evaluation.authority import window_means
-from arzsumo_studies.common import StudyError
+from arzsumo.outdir import resumable_dir
+from arzsumo.outputs.pages import (
+    markdown_table,
+    publish,
+    remove_stale_figures,
+    write_csv,
+    write_text,
+)
+from arzsumo_studies.common import RESULTS_DIR, StudyError
 from arzsumo_studies.measures.coherence import BoundaryShares, boundary_shares, travel_lags
 
+NAME = "reach"
+#: the results page (``research/results/PAGE.md``) this study keeps a block of
+PAGE = "reach"
 #: the boundary series, in the table's order
 BOUNDARIES = ("q0", "qL", "U")
+#: the files of a run directory that :func:`read_run` reads
+RUN_FILES = ("cells.parquet", "periods.parquet", "summary.json")
+#: the table's leading columns (the rest of :meth:`CoherentShare.table`'s follow)
+LEADING = ("condition", "boundary", "band", "share", "floor", "beyond_floor", "runs")
 
 
 @dataclass(frozen=True)
@@ -110,13 +135,179 @@ def reach(runs: Sequence[RunSeries]) -> BoundaryShares:
                            first.dt, x, lags=lags)
 
 
+def shares_table(shares: Mapping[str, BoundaryShares]) -> pd.DataFrame:
+    """One row per condition (the keys of ``shares``), boundary and band: the columns of
+    :meth:`BoundaryShares.table` with ``condition`` first, then :data:`LEADING`'s order
+    (shares and floors dimensionless, periods s)."""
+    table = pd.concat([s.table().assign(condition=name) for name, s in shares.items()],
+                      ignore_index=True)
+    rest = [c for c in table.columns if c not in LEADING]
+    return table[[*LEADING, *rest]]
+
+
 def reach_table(conditions: Mapping[str, Sequence[Path]], block_s: float = 5.0
                 ) -> pd.DataFrame:
     """One row per condition, boundary and band: the section's coherent share, its floor
     and the share beyond the floor, with the runs pooled (the directories of each
-    condition)."""
-    parts = []
-    for name, dirs in conditions.items():
-        table = reach([read_run(Path(d), block_s) for d in dirs]).table()
-        parts.append(table.assign(condition=name, runs=len(dirs)))
-    return pd.concat(parts, ignore_index=True)
+    condition; ``block_s``: the blocks averaged over, s)."""
+    return shares_table({name: reach([read_run(Path(d), block_s) for d in dirs])
+                         for name, dirs in conditions.items()})
+
+
+def _seed_order(path: Path) -> tuple[float, str]:
+    """Sort key of a run directory: its seed ``seed=K`` when its name has one, then its
+    path (a directory without a seed after those with one)."""
+    found = re.search(r"(?:^|[^A-Za-z0-9_])seed=(\d+)", path.name)
+    return (int(found.group(1)) if found else math.inf, str(path))
+
+
+def run_dirs(name: str, pattern: str, max_runs: int | None = None) -> tuple[Path, ...]:
+    """The run directories of condition ``name``: those the glob ``pattern`` matches,
+    sorted by seed (:func:`_seed_order`), the first ``max_runs`` of them (None: all).
+
+    Raises
+    ------
+    StudyError
+        The glob matches no directory, or one of them lacks a file of :data:`RUN_FILES`.
+    """
+    spec = f"{name}={pattern}"
+    dirs = sorted((Path(p) for p in glob.glob(os.path.expanduser(pattern))
+                   if Path(p).is_dir()), key=_seed_order)
+    require(len(dirs) > 0, "--runs", spec,
+            "a glob of run directories (as `arzsumo run --out` writes them); it matches "
+            "none", StudyError)
+    dirs = dirs[:max_runs] if max_runs is not None else dirs
+    for d in dirs:
+        missing = [f for f in RUN_FILES if not (d / f).is_file()]
+        require(not missing, "--runs", spec,
+                f"run directories holding {', '.join(RUN_FILES)}; {d} has no "
+                f"{', '.join(missing)}", StudyError)
+    return tuple(dirs)
+
+
+@dataclass(frozen=True)
+class ReachOptions:
+    """What ``arzsumo study reach`` reads and where it writes.
+
+    Parameters
+    ----------
+    runs : tuple of (str, str)
+        The conditions: (name, glob of its run directories), in the table's order.
+    block_s : float
+        The blocks the fields and series are averaged over, s.
+    max_runs : int, optional
+        The first this many directories of each condition, by seed (None: all).
+    out : Path
+        The study's directory.
+    docs : Path, optional
+        Also regenerate the study's block of ``docs/PAGE.md`` (None: no page).
+    plots : bool
+        Draw ``reach.png``.
+    """
+
+    runs: tuple[tuple[str, str], ...]
+    block_s: float = 5.0
+    max_runs: int | None = None
+    out: Path = RESULTS_DIR / NAME
+    docs: Path | None = None
+    plots: bool = True
+
+    def __post_init__(self) -> None:
+        names = [n for n, _ in self.runs]
+        require(len(names) > 0, "--runs", None, "at least one condition NAME=GLOB",
+                StudyError)
+        require(len(set(names)) == len(names) and all(n and g for n, g in self.runs),
+                "--runs", [f"{n}={g}" for n, g in self.runs],
+                "conditions NAME=GLOB of distinct, non-empty names and globs", StudyError)
+        require(math.isfinite(self.block_s) and self.block_s > 0, "block_s", self.block_s,
+                "a block > 0 s", StudyError)
+        require(self.max_runs is None or self.max_runs >= 1, "max_runs", self.max_runs,
+                "at least 1 run per condition", StudyError)
+
+    def command(self) -> str:
+        """The command line that runs the study with these options."""
+        words = ["arzsumo", "study", NAME]
+        for name, pattern in self.runs:
+            words += ["--runs", f"{name}={pattern}"]
+        words += ["--block-s", f"{self.block_s:g}"]
+        if self.max_runs is not None:
+            words += ["--max-runs", str(self.max_runs)]
+        words += ["--out", str(self.out)]
+        if not self.plots:
+            words.append("--no-plots")
+        return shlex.join(words)
+
+
+@dataclass(frozen=True)
+class ReachResult:
+    """The study's outcome: each condition's ``dirs`` (the runs pooled) and ``shares``,
+    the ``table`` (:func:`shares_table`), the markdown ``text`` and the ``files``
+    written."""
+
+    dirs: Mapping[str, tuple[Path, ...]]
+    shares: Mapping[str, BoundaryShares]
+    table: pd.DataFrame
+    text: str
+    files: tuple[Path, ...]
+
+
+def _cell(row: pd.Series) -> str:
+    """``share [floor]`` of one row, two decimals; ``-`` for a band not resolved."""
+    if not (np.isfinite(row["share"]) and np.isfinite(row["floor"])):
+        return "-"
+    return f"{row['share']:.2f} [{row['floor']:.2f}]"
+
+
+def reach_markdown(table: pd.DataFrame, command: str) -> str:
+    """The command (at the top), then a markdown table of ``table`` (:func:`shares_table`):
+    one row per condition and boundary, a column ``share [floor]`` per band (its periods
+    in s); shares and floors dimensionless."""
+    bands = table.drop_duplicates("band")
+    heads = {b: f"{b} {lo:g}-{hi:g} s" for b, lo, hi in
+             zip(bands["band"], bands["period_short_s"], bands["period_long_s"], strict=True)}
+    rows = []
+    for (condition, boundary), g in table.groupby(["condition", "boundary"], sort=False):
+        by_band = g.set_index("band")
+        rows.append({"condition": condition, "boundary": boundary,
+                     "runs": int(g["runs"].iloc[0]),
+                     **{head: _cell(by_band.loc[b]) for b, head in heads.items()}})
+    return (f"`{command}`\n\nThe share of the section's HV speed variance coherent with "
+            "each boundary series (q0: the inlet's flow, qL: the outlet's flow, U: the "
+            "law's input), per band of periods, the runs of a condition pooled: share "
+            "[bias floor 1/n_eff]; a share at or below its floor is no evidence of "
+            "coherence.\n\n" + markdown_table(pd.DataFrame(rows)))
+
+
+def run_reach(opts: ReachOptions) -> ReachResult:
+    """Read each condition's runs, pool them, write the table, its page and the figure.
+
+    ``opts``: the study's :class:`ReachOptions`. Every glob is expanded and checked
+    before anything is read or written.
+
+    Returns
+    -------
+    ReachResult
+        The shares and the files written (``reach.csv``, ``reach.md`` and, with
+        ``opts.plots``, ``reach.png`` in ``opts.out``; without, an earlier
+        ``reach.png`` is removed).
+    """
+    from arzsumo_studies.outputs.study_figures import write_reach_figure
+
+    dirs = {name: run_dirs(name, pattern, opts.max_runs) for name, pattern in opts.runs}
+    shares = {name: reach([read_run(d, opts.block_s) for d in ds])
+              for name, ds in dirs.items()}
+    table = shares_table(shares)
+    text = reach_markdown(table, opts.command())
+    with resumable_dir(opts.out, f"study-{NAME}") as out:
+        files = [write_csv(table, out / "reach.csv"), write_text(text, out / "reach.md")]
+        figure = out / "reach.png"
+        if opts.plots:
+            files.append(write_reach_figure({n: s.results for n, s in shares.items()},
+                                            figure))
+        else:
+            remove_stale_figures(figure)
+        if opts.docs is not None:
+            shown = f"\n\n![coherence against x and period]({PAGE}/{figure.name})"
+            publish(opts.docs, PAGE, NAME, "What a boundary can reach",
+                    text + (shown if opts.plots else ""), files[:1] + files[2:])
+    return ReachResult(dirs, shares, table, text, tuple(files))

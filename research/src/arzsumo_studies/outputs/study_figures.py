@@ -49,3 +49,11 @@ def write_u_series(series: Sequence[tuple[str, np.ndarray, np.ndarray]], title: 
     from arzsumo_studies.plots.u_estimate import u_series_figure
 
     return save_png(u_series_figure(series, title), path, dpi=90)
+
+
+def write_reach_figure(conditions: Mapping[str, Mapping[str, object]], path: Path) -> Path:
+    """The reach figure (:func:`arzsumo_studies.plots.coherence.reach_figure`: condition ->
+    boundary -> coherent share) as PNG at ``path``."""
+    from arzsumo_studies.plots.coherence import reach_figure
+
+    return save_png(reach_figure(conditions), path, dpi=120)

@@ -9,21 +9,14 @@ from pathlib import Path
 
 import numpy as np
 
-from arzsumo.api.controllers import BUILTIN, ControllerLike, controller_name
+from arzsumo.api.controllers import ControllerLike, controller_name
 from arzsumo.api.scenarios import load_scenario, scenario_file
 from arzsumo.argtypes import SEED_LIMIT
 from arzsumo.bridge.session import API_NAMES, check_warmup
-from arzsumo.control.registry import controller_names
+from arzsumo.control.registry import default_controllers
 from arzsumo.errors import ScenarioError
 from arzsumo.scenario import Scenario
 from arzsumo.sweep.evaluate import EvaluationResult, run_evaluation
-
-
-def default_controllers() -> tuple[str, ...]:
-    """What :func:`evaluate` compares by default: the package's own laws that run in SUMO,
-    the paper's and the baselines a traffic engineer would field (all but ``constant``,
-    which needs a release rate of its own)."""
-    return tuple(n for n in controller_names("sumo") if n in BUILTIN and n != "constant")
 
 
 def seed_list(seeds: int | Sequence[int], start: int = 1) -> list[int]:
