@@ -5,7 +5,14 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 import pytest
-from arzsumo_studies.sumo_map.sumo_options import MEASURES, OPTION, compare, markdown, options_spec
+from arzsumo_studies.sumo_map.sumo_options import (
+    MEASURES,
+    OPTION,
+    compare,
+    markdown,
+    options_spec,
+    signature_markdown,
+)
 
 from arzsumo.errors import ScenarioError
 from arzsumo.resources import shipped_scenarios_dir
@@ -86,6 +93,10 @@ def test_a_lever_keeps_the_signature_only_when_every_interval_lies_inside_its_ma
     teleports = row(_table(shift=0.0, noise=2_000.0), "teleports")
     assert (teleports["diff_low"], teleports["diff_high"], teleports["inside"]) == (0, 0, True)
     assert "inside +-" in markdown(compare(_table(shift=0.0, noise=2_000.0)))
+    kept = signature_markdown(compare(_table(shift=0.0, noise=2_000.0)))
+    assert "the signature is kept: every interval inside its margin" in kept
+    moved = signature_markdown(compare(_table(shift=0.0, noise=60_000.0)))
+    assert "moved: whole-demand time per vehicle outside" in moved and "| **no** |" in moved
 
 
 def test_eager_insertion_is_a_scenario_key_that_reaches_sumo():

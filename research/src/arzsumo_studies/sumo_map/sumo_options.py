@@ -269,6 +269,28 @@ def markdown(table: pd.DataFrame) -> str:
     return "\n".join(lines)
 
 
+def signature_markdown(table: pd.DataFrame) -> str:
+    """Per variant, its signature (the measures with a margin, :data:`MARGINS`) as rows:
+    the shipped mean, the paired difference and whether it lies inside the margin; the
+    heading says whether the stream kept its signature (every interval inside)."""
+    blocks = []
+    sig = table[table["margin"].notna() & table["inside"].notna()]
+    for variant, rows in sig.groupby("variant", sort=False):
+        moved = [r.measure for r in rows.itertuples() if not r.inside]
+        r0 = rows.iloc[0]
+        verdict = ("kept: every interval inside its margin" if not moved
+                   else "moved: " + ", ".join(moved) + " outside")
+        lines = [f"**{variant}** ({r0.seeds} paired seeds, CPU ratio {r0.cpu_ratio:.2f}, "
+                 f"wall ratio {r0.wall_ratio:.2f}): the signature is {verdict}.", "",
+                 "| measure | unit | shipped mean | variant minus shipped [95 % t] | margin "
+                 "| inside |", "|---|---|---:|---|---:|---|"]
+        lines += [f"| {r.measure} | {r.unit} | {r.base_mean:.4g} | {r.diff_mean:+.3g} "
+                  f"[{r.diff_low:+.3g}, {r.diff_high:+.3g}] | +-{r.margin:.3g} | "
+                  f"{'yes' if r.inside else '**no**'} |" for r in rows.itertuples()]
+        blocks.append("\n".join(lines))
+    return "\n\n".join(blocks)
+
+
 @dataclass(frozen=True)
 class SumoOptionsOptions(checks.Shared):
     """What the study runs and where it writes.
@@ -346,7 +368,7 @@ def run_sumo_options(opts: SumoOptionsOptions, *, progress: bool = True
         table = compare(rep.table, drained=opts.drain, base_name=variant_name(
             first.columns[OPTION], first.columns[first.columns[OPTION]]))
         files = [write_csv(table, Path(out) / f"{PAGE}.csv")]
-        text = markdown(table)
+        text = markdown(table) + "\n\n" + signature_markdown(table)
         if opts.docs is not None:
             body = ("The open loop of the default scenario, one SUMO option changed at a "
                     f"time, paired by seed (`arzsumo study {NAME}`). Each cell: the "
