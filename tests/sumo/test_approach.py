@@ -138,7 +138,8 @@ def test_vehicles_depart_on_the_approach_and_main_is_measured_from_x0(piece):
 
 @pytest.mark.sumo
 def test_a_network_that_does_not_match_the_approach_length_is_refused(tmp_path):
-    with pytest.raises(SumoError, match=r"approach_length = 300 m \(1 edge\) does not match the network"):
+    with pytest.raises(SumoError,
+                       match=r"approach_length = 300 m \(1 edge\) does not match the network"):
         open_simulation(PARAMS, FAST.with_(approach_length=300.0), net_dir=default_nets_dir())
     build_network(tmp_path, NetworkSpec(approach_length=200.0))
     with pytest.raises(SumoError, match=r"whose approach is 200 m long \(1 edge\)"):

@@ -9,7 +9,7 @@ from arzsumo.scenario import scenario_from_dict
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.demand import demand_flows
 from arzsumo.sumo.network import NetworkSpec, network_sources
-from arzsumo.sumo.simulation import network_spec
+from arzsumo.sumo.run_network import network_spec
 from arzsumo.sumo.vtypes import vehicle_types
 
 PARAMS = get_preset("paper_base").params

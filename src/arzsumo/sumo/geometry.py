@@ -26,7 +26,7 @@ from arzsumo.errors import ScenarioError, require
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.layout import RoadLayout
 from arzsumo.sumo.loops import BOUNDARY_GAP, placed_positions
-from arzsumo.sumo.simulation import network_file
+from arzsumo.sumo.run_network import network_file
 from arzsumo.sumo.user_network import NetworkRequest, read_layout
 
 #: roles of the lane shapes, in drawing order
