@@ -8,8 +8,11 @@
    beside SUMO's (the sim-to-real gap), and in SUMO the whole demand's time spent (every
    vehicle of the demand, the drain included) minus the open loop's, with 95 % intervals.
 
-Needs ``pip install -e '.[learn]'``. The full run (30 CPU minutes of training, 10 seeds
-of 4 policies in SUMO at the scenario's warm-up and horizon) takes hours on 2 cores::
+Needs ``pip install -e '.[learn]'``. Resumable: the learned policy is saved beside the
+table (``--model``) and every finished episode is appended to ``--episodes``; a later call
+with the same files trains nothing and runs only the missing episodes. The full run (30
+CPU minutes of training, 10 seeds of 4 policies in SUMO at the scenario's warm-up and
+horizon) takes hours on 2 cores::
 
     .venv/bin/python examples/learn_twin_test_sumo.py --budget-min 30 --seeds 10
 
@@ -22,8 +25,10 @@ A smoke test in a few minutes::
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import time
+from concurrent.futures import as_completed
 from pathlib import Path
 
 import gymnasium as gym
@@ -113,33 +118,41 @@ def _pair(name: str, model, seed: int, args: argparse.Namespace) -> tuple[dict, 
     return twin, sumo, time.perf_counter() - t0
 
 
-def evaluate(model, args: argparse.Namespace) -> dict[str, dict[str, list[float]]]:
+def _done(path: Path) -> dict[tuple[str, int], dict]:
+    """The episodes already finished (policy, seed) -> their scores, from ``path``."""
+    if not path.is_file():
+        return {}
+    rows = [json.loads(line) for line in path.read_text(encoding="utf-8").splitlines() if line]
+    return {(r["policy"], r["seed"]): r for r in rows}
+
+
+def evaluate(model_file: Path, args: argparse.Namespace) -> dict[str, dict[str, list[float]]]:
     """Per policy, per seed: the twin's and SUMO's section veh h, SUMO's whole demand.
     ``--workers`` processes at a time (libsumo holds one simulation per process); the
-    learned policy reaches them as a saved file."""
+    learned policy reaches them as its saved file. Each finished pair of episodes is
+    appended to ``--episodes`` at once, and a later call runs only what is missing there:
+    a run stopped half-way loses at most the episodes under way."""
     from concurrent.futures import ProcessPoolExecutor
     from multiprocessing import get_context
-    from tempfile import TemporaryDirectory
 
-    seeds = range(1, args.seeds + 1)
-    names = (*LAWS, "ppo")
-    out = {n: {"twin": [], "sumo": [], "whole": [], "plans": []} for n in names}
-    with TemporaryDirectory() as tmp, ProcessPoolExecutor(
-            args.workers, mp_context=get_context("spawn")) as pool:
-        saved = Path(tmp) / "ppo.zip"
-        model.save(saved)
-        jobs = {(n, s): pool.submit(_pair, n, saved if n == "ppo" else None, s, args)
-                for n in names for s in seeds}
-        for (name, seed), job in jobs.items():
-            twin, sumo, wall = job.result()
-            rows = out[name]
-            rows["twin"].append(twin["section_veh_h"])
-            rows["sumo"].append(sumo["section_veh_h"])
-            rows["whole"].append(whole_demand_h(sumo["summary"]))
-            rows["plans"].append(sumo["plan_changes"])
-            print(f"{name} seed {seed}: twin {rows['twin'][-1]:.3f}, SUMO "
-                  f"{rows['sumo'][-1]:.3f} veh h ({wall:.0f} s)", flush=True)
-    return out
+    names, seeds = (*LAWS, "ppo"), range(1, args.seeds + 1)
+    done = _done(args.episodes)
+    todo = [(n, s) for n in names for s in seeds if (n, s) not in done]
+    with ProcessPoolExecutor(args.workers, mp_context=get_context("spawn")) as pool:
+        jobs = {pool.submit(_pair, n, model_file if n == "ppo" else None, s, args): (n, s)
+                for n, s in todo}
+        for job in as_completed(jobs):
+            (name, seed), (twin, sumo, wall) = jobs[job], job.result()
+            row = {"policy": name, "seed": seed, "twin": twin["section_veh_h"],
+                   "sumo": sumo["section_veh_h"], "whole": whole_demand_h(sumo["summary"]),
+                   "plans": sumo["plan_changes"], "wall_s": wall}
+            with args.episodes.open("a", encoding="utf-8") as f:
+                f.write(json.dumps(row) + "\n")
+            done[name, seed] = row
+            print(f"{name} seed {seed}: twin {row['twin']:.3f}, SUMO {row['sumo']:.3f} veh h "
+                  f"({wall:.0f} s)", flush=True)
+    return {n: {k: [done[n, s][k] for s in seeds] for k in ("twin", "sumo", "whole", "plans")}
+            for n in names}
 
 
 def _ci(values, baseline) -> str:
@@ -188,10 +201,25 @@ def main() -> None:
     ap.add_argument("--workers", type=int, default=2,
                     help="evaluation processes at a time (default 2)")
     ap.add_argument("--out", type=Path, default=Path("docs/gym_learned.md"))
+    ap.add_argument("--model", type=Path, default=None,
+                    help="the learned policy's file: trained and saved there when missing, "
+                         "read when present (default: OUT with .ppo.zip)")
+    ap.add_argument("--episodes", type=Path, default=None,
+                    help="the finished episodes, one JSON line each: a later call runs only "
+                         "the missing ones (default: OUT with .episodes.jsonl)")
     args = ap.parse_args()
+    args.model = args.model or args.out.with_suffix(".ppo.zip")
+    args.episodes = args.episodes or args.out.with_suffix(".episodes.jsonl")
     t0 = time.perf_counter()
-    model = train(args)
-    res = evaluate(model, args)
+    if args.model.is_file():
+        from stable_baselines3 import PPO
+
+        model = PPO.load(args.model, device="cpu")
+        print(f"learned policy read from {args.model} ({model.num_timesteps} twin steps)")
+    else:
+        model = train(args)
+        model.save(args.model)
+    res = evaluate(args.model, args)
     args.out.write_text(table(res, args, model.num_timesteps), encoding="utf-8")
     print(f"wrote {args.out} in {time.perf_counter() - t0:.0f} s")
 
