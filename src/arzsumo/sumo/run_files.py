@@ -52,6 +52,16 @@ def meter_program_text(cfg: SumoConfig) -> str:
         *phases, "    </tlLogic>", "</additional>"]) + "\n"
 
 
+def _unique(name: str, taken: set[str]) -> str:
+    """``name``, or ``2_name``, ``3_name``, ... when it is taken: two of a user's route
+    files may share a name in different directories, or take the run's own."""
+    k, out = 1, name
+    while out in taken:
+        k += 1
+        out = f"{k}_{name}"
+    return out
+
+
 class RunFiles:
     """A directory laid out as the results directory will be, gathered during a run.
 
@@ -69,11 +79,12 @@ class RunFiles:
         meter's nominal program and write ``run.sumocfg``; return its path."""
         sub = self.root / SUMO_DIR
         sub.mkdir(exist_ok=True)
-        names = []
+        names: list[str] = []
         routes = cfg.layout.route_files if cfg.layout is not None else ()
         for src in (net, route, *additional, *routes):
-            shutil.copyfile(src, sub / Path(src).name)
-            names.append(f"{SUMO_DIR}/{Path(src).name}")
+            name = _unique(Path(src).name, {Path(n).name for n in names} | {METER_FILE})
+            shutil.copyfile(src, sub / name)
+            names.append(f"{SUMO_DIR}/{name}")
         (sub / METER_FILE).write_text(meter_program_text(cfg), encoding="utf-8")
         config = self.root / CONFIG_FILE
         n = 2 + len(additional)
