@@ -110,48 +110,86 @@ def whole_demand_h(summary: dict) -> float:
     return whole["time_spent_s"]["total"] / 3600.0 if whole.get("complete") else math.nan
 
 
-def _pair(name: str, model, seed: int, args: argparse.Namespace) -> tuple[dict, dict, float]:
-    """Policy ``name`` on the twin and in SUMO on ``seed``: both final infos, wall s."""
+def _scores(summary: dict) -> dict:
+    """What the table reads of a SUMO run's summary: the section's veh h over the window
+    (TTT), every vehicle's time spent (veh h, NaN if the drain did not end) and the
+    meter's plan changes."""
+    return {"sumo": summary["TTT"]["total"] / 3600.0, "whole": whole_demand_h(summary),
+            "plans": summary["plan_changes"]}
+
+
+def _sumo_ppo(model_file: Path, seed: int, args: argparse.Namespace) -> tuple[dict, float]:
+    """The learned policy's SUMO episode on ``seed``: its scores and wall s."""
     t0 = time.perf_counter()
-    twin = run_policy("twin", name, model, seed, args)
-    sumo = run_policy("sumo", name, model, seed, args)
-    return twin, sumo, time.perf_counter() - t0
+    info = run_policy("sumo", "ppo", model_file, seed, args)
+    return _scores(info["summary"]), time.perf_counter() - t0
 
 
-def _done(path: Path) -> dict[tuple[str, int], dict]:
-    """The episodes already finished (policy, seed) -> their scores, from ``path``."""
+def _done(path: Path) -> dict[tuple[str, str, int], dict]:
+    """The episodes already finished (engine, policy, seed) -> scores, from ``path``."""
     if not path.is_file():
         return {}
     rows = [json.loads(line) for line in path.read_text(encoding="utf-8").splitlines() if line]
-    return {(r["policy"], r["seed"]): r for r in rows}
+    return {(r["engine"], r["policy"], r["seed"]): r for r in rows}
+
+
+def _keep(path: Path, done: dict, row: dict) -> None:
+    with path.open("a", encoding="utf-8") as f:
+        f.write(json.dumps(row) + "\n")
+    done[row["engine"], row["policy"], row["seed"]] = row
+    print(f"{row['engine']} {row['policy']} seed {row['seed']}: section "
+          f"{row['section_veh_h']:.3f} veh h", flush=True)
+
+
+def laws_in_sumo(args: argparse.Namespace) -> dict[tuple[str, int], dict]:
+    """The laws' SUMO runs through ``arzsumo.evaluate`` (a law's SumoRampMeter-v0 episode
+    is its ``arzsumo run``, a test of the package holds this): its seeds in parallel, one
+    warm-up per seed shared by the laws, resumable in ``OUT.laws/``."""
+    res = arzsumo.evaluate(args.scenario, controllers=list(LAWS), seeds=args.seeds,
+                           out=args.out.with_suffix(".laws"), horizon_s=args.horizon_s,
+                           warmup_s=args.warmup_s, workers=args.workers, plots=False,
+                           allow_short_warmup=args.warmup_s is not None)
+    return {(str(r["controller"]), int(r["seed"])): _scores(_nested(r))
+            for _, r in res.runs.iterrows()}
+
+
+def _nested(row) -> dict:
+    """The entries :func:`_scores` reads, from a flat row of ``arzsumo.evaluate``'s runs."""
+    whole = {"complete": bool(row.get("network_whole_demand.complete", False)),
+             "time_spent_s": {"total": row.get("network_whole_demand.time_spent_s.total")}}
+    return {"TTT": {"total": row["TTT.total"]}, "plan_changes": row["plan_changes"],
+            "network_whole_demand": whole}
 
 
 def evaluate(model_file: Path, args: argparse.Namespace) -> dict[str, dict[str, list[float]]]:
-    """Per policy, per seed: the twin's and SUMO's section veh h, SUMO's whole demand.
-    ``--workers`` processes at a time (libsumo holds one simulation per process); the
-    learned policy reaches them as its saved file. Each finished pair of episodes is
-    appended to ``--episodes`` at once, and a later call runs only what is missing there:
-    a run stopped half-way loses at most the episodes under way."""
+    """Per policy, per seed: the twin's and SUMO's section veh h, SUMO's whole demand and
+    plan changes. The twin's episodes run here, one after another (seconds each); the
+    learned policy's SUMO episodes in ``--workers`` processes (libsumo holds one simulation
+    per process), each appended to ``--episodes`` as it ends, so a later call runs only
+    what is missing; the laws' SUMO runs through :func:`laws_in_sumo`."""
     from concurrent.futures import ProcessPoolExecutor
     from multiprocessing import get_context
 
     names, seeds = (*LAWS, "ppo"), range(1, args.seeds + 1)
     done = _done(args.episodes)
-    todo = [(n, s) for n in names for s in seeds if (n, s) not in done]
+    for name, seed in ((n, s) for n in names for s in seeds):
+        if ("twin", name, seed) not in done:
+            info = run_policy("twin", name, model_file if name == "ppo" else None, seed, args)
+            _keep(args.episodes, done, {"engine": "twin", "policy": name, "seed": seed,
+                                        "section_veh_h": info["section_veh_h"]})
+    todo = [s for s in seeds if ("sumo", "ppo", s) not in done]
     with ProcessPoolExecutor(args.workers, mp_context=get_context("spawn")) as pool:
-        jobs = {pool.submit(_pair, n, model_file if n == "ppo" else None, s, args): (n, s)
-                for n, s in todo}
+        jobs = {pool.submit(_sumo_ppo, model_file, s, args): s for s in todo}
         for job in as_completed(jobs):
-            (name, seed), (twin, sumo, wall) = jobs[job], job.result()
-            row = {"policy": name, "seed": seed, "twin": twin["section_veh_h"],
-                   "sumo": sumo["section_veh_h"], "whole": whole_demand_h(sumo["summary"]),
-                   "plans": sumo["plan_changes"], "wall_s": wall}
-            with args.episodes.open("a", encoding="utf-8") as f:
-                f.write(json.dumps(row) + "\n")
-            done[name, seed] = row
-            print(f"{name} seed {seed}: twin {row['twin']:.3f}, SUMO {row['sumo']:.3f} veh h "
-                  f"({wall:.0f} s)", flush=True)
-    return {n: {k: [done[n, s][k] for s in seeds] for k in ("twin", "sumo", "whole", "plans")}
+            scores, wall = job.result()
+            _keep(args.episodes, done, {"engine": "sumo", "policy": "ppo", "seed": jobs[job],
+                                        "section_veh_h": scores["sumo"], **scores,
+                                        "wall_s": wall})
+    laws = laws_in_sumo(args)
+    sumo = {n: [laws[n, s] if n != "ppo" else done["sumo", "ppo", s] for s in seeds]
+            for n in names}
+    return {n: {"twin": [done["twin", n, s]["section_veh_h"] for s in seeds],
+                **{k: [r[k] for r in sumo[n]] for k in ("sumo", "whole", "plans")}}
             for n in names}
 
 
@@ -173,7 +211,10 @@ def table(res: dict, args: argparse.Namespace, trained: int) -> str:
             f"`{REWARD}`. Section veh h: vehicle-hours on x in [0, L] over the control "
             "window (twin beside SUMO: the sim-to-real gap); whole demand: every "
             "vehicle's time spent in SUMO, drain included, minus the open loop's "
-            "(mean, 95 % t interval).\n\nRegenerate: `.venv/bin/python "
+            "(mean, 95 % t interval). The learned policy runs in `SumoRampMeter-v0`; the "
+            "laws' SUMO runs are `arzsumo.evaluate`'s (a law's episode in the environment "
+            "is its `arzsumo run`: a test of the package holds this for the ETC), sharing "
+            "each seed's warm-up.\n\nRegenerate: `.venv/bin/python "
             "examples/learn_twin_test_sumo.py` with the options of this run.\n\n")
     rows = ["| policy | twin section veh h | SUMO section veh h | gap (SUMO - twin) | "
             "SUMO whole demand veh h | minus open | plan changes |",
