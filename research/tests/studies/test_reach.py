@@ -110,7 +110,7 @@ def test_run_dirs_sort_by_seed_keep_the_first_and_refuse_what_is_not_a_run(tmp_p
         d = tmp_path / f"controller=open,seed={seed}"
         d.mkdir()
         for f in RUN_FILES:
-            (d / f).touch()
+            (d / f).write_text("{}")
     pattern = f"{tmp_path}/controller=open,seed=*"
     assert [d.name for d in run_dirs("open", pattern)] == [
         "controller=open,seed=1", "controller=open,seed=2", "controller=open,seed=10"]
@@ -121,6 +121,23 @@ def test_run_dirs_sort_by_seed_keep_the_first_and_refuse_what_is_not_a_run(tmp_p
         run_dirs("open", pattern)
     with pytest.raises(StudyError, match=r"--runs = 'none=.*/nothing\*'.*matches none"):
         run_dirs("none", f"{tmp_path}/nothing*")
+
+
+def test_a_run_deadlocked_before_control_is_left_out_with_a_warning(tmp_path):
+    """Standing since before the window (842 s >= 450 s window + 300 s drain - 1): out; a
+    gridlock that came later (standstill 200 s) stays in."""
+    from arzsumo_studies.control.reach import run_dirs
+
+    for seed, standstill in ((1, 842.3), (2, 200.0), (3, None)):
+        d = _write_run(tmp_path / f"controller=open,seed={seed}", seed, 0.1)
+        summary = json.loads((d / "summary.json").read_text())
+        summary |= {"horizon": 450.0, "longest_standstill_main": standstill,
+                    "network_whole_demand": {"drain": {"gridlock": standstill is not None,
+                                                       "duration_s": 300.0}}}
+        (d / "summary.json").write_text(json.dumps(summary))
+    with pytest.warns(UserWarning, match=r"open: 1 run\(s\) left out.*seed=1"):
+        kept = run_dirs("open", f"{tmp_path}/controller=open,seed=*")
+    assert [d.name for d in kept] == ["controller=open,seed=2", "controller=open,seed=3"]
 
 
 def test_the_study_writes_the_table_its_page_and_the_figure(synthetic, tmp_path):

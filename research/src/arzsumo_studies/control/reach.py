@@ -169,6 +169,8 @@ def run_dirs(name: str, pattern: str, max_runs: int | None = None) -> tuple[Path
     ------
     StudyError
         The glob matches no directory, or one of them lacks a file of :data:`RUN_FILES`.
+    Runs deadlocked before control (:func:`deadlocked_before_control`) are left out with
+    a warning.
     """
     spec = f"{name}={pattern}"
     dirs = sorted((Path(p) for p in glob.glob(os.path.expanduser(pattern))
@@ -176,13 +178,32 @@ def run_dirs(name: str, pattern: str, max_runs: int | None = None) -> tuple[Path
     require(len(dirs) > 0, "--runs", spec,
             "a glob of run directories (as `arzsumo run --out` writes them); it matches "
             "none", StudyError)
-    dirs = dirs[:max_runs] if max_runs is not None else dirs
     for d in dirs:
         missing = [f for f in RUN_FILES if not (d / f).is_file()]
         require(not missing, "--runs", spec,
                 f"run directories holding {', '.join(RUN_FILES)}; {d} has no "
                 f"{', '.join(missing)}", StudyError)
-    return tuple(dirs)
+    stuck = [d for d in dirs if deadlocked_before_control(d)]
+    if stuck:
+        warnings.warn(f"{name}: {len(stuck)} run(s) left out, SUMO deadlocked before "
+                      f"control: {', '.join(d.name for d in stuck)}", stacklevel=2)
+    dirs = [d for d in dirs if d not in stuck]
+    require(len(dirs) > 0, "--runs", spec, "a glob of run directories with at least one run "
+            "that did not deadlock before control", StudyError)
+    return tuple(dirs[:max_runs] if max_runs is not None else dirs)
+
+
+def deadlocked_before_control(run: Path) -> bool:
+    """Whether SUMO deadlocked in the run before its control window opened (its drain
+    ended in a gridlock with a mainline vehicle standing since before the window): its
+    field is a standstill's, not the stream's (as the studies' tables leave such seeds
+    out, :func:`arzsumo.evaluation.report.deadlocked_seeds`)."""
+    summary = json.loads((run / "summary.json").read_text(encoding="utf-8"))
+    drain = (summary.get("network_whole_demand") or {}).get("drain") or {}
+    standstill = summary.get("longest_standstill_main")
+    if not drain.get("gridlock") or standstill is None:
+        return False
+    return float(standstill) >= float(summary["horizon"]) + float(drain["duration_s"]) - 1.0
 
 
 @dataclass(frozen=True)
