@@ -147,6 +147,8 @@ SWEEP_FIXED: dict[str, Column] = {
     "execution.started": Column("s", "start, seconds since 1970-01-01 UTC"),
     "execution.wall_s": Column("s", "wall time of the execution (a run that shared its "
                                     "warm-up: the warm-up's plus its own)"),
+    "execution.cpu_s": Column("s", "CPU time of the worker process over the run, libsumo's "
+                                   "SUMO included (empty for a branch of a shared warm-up)"),
     "execution.shared_warmup": Column("count", "runs that continued the same simulated "
                                                "warm-up (empty: the run had its own)"),
     "execution.rerun_alone": Column(TEXT, "why the run's branch of a shared warm-up failed "
