@@ -27,6 +27,8 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import shlex
+import sys
 import time
 from concurrent.futures import as_completed
 from pathlib import Path
@@ -200,6 +202,20 @@ def _ci(values, baseline) -> str:
     return f"{d.mean_diff:+.3f} [{d.t.low:+.3f}, {d.t.high:+.3f}]"
 
 
+def _options() -> str:
+    """This run's options, but where it wrote (``--out``, ``--model``, ``--episodes``)."""
+    args, keep = sys.argv[1:], []
+    skip = False
+    for a in args:
+        if skip:
+            skip = False
+        elif a in ("--out", "--model", "--episodes"):
+            skip = True
+        elif not a.startswith(("--out=", "--model=", "--episodes=")):
+            keep.append(shlex.quote(a))
+    return " ".join(keep)
+
+
 def table(res: dict, args: argparse.Namespace, trained: int) -> str:
     """The markdown report."""
     horizon = f"{args.horizon_s:g} s" if args.horizon_s else "the scenario's"
@@ -214,8 +230,8 @@ def table(res: dict, args: argparse.Namespace, trained: int) -> str:
             "(mean, 95 % t interval). The learned policy runs in `SumoRampMeter-v0`; the "
             "laws' SUMO runs are `arzsumo.evaluate`'s (a law's episode in the environment "
             "is its `arzsumo run`: a test of the package holds this for the ETC), sharing "
-            "each seed's warm-up.\n\nRegenerate: `.venv/bin/python "
-            "examples/learn_twin_test_sumo.py` with the options of this run.\n\n")
+            "each seed's warm-up.\n\nRegenerate (resumable; add `--out FILE`): "
+            f"`.venv/bin/python examples/learn_twin_test_sumo.py {_options()}`.\n\n")
     rows = ["| policy | twin section veh h | SUMO section veh h | gap (SUMO - twin) | "
             "SUMO whole demand veh h | minus open | plan changes |",
             "|---|---|---|---|---|---|---|"]
