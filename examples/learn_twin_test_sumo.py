@@ -76,13 +76,14 @@ def train(args: argparse.Namespace):
 
 
 def episode(env: gym.Env, seed: int, act) -> dict:
-    """Run the episode of ``seed`` with ``act(obs)``; its last info."""
+    """Run the episode of ``seed`` with ``act(obs)``; its last info, with the episode's
+    ``return`` (the rewards summed) and whether it ``ended_early``."""
     obs, info = env.reset(seed=seed)
-    done = False
+    done, total = False, 0.0
     while not done:
-        obs, _, terminated, truncated, info = env.step(act(obs))
-        done = terminated or truncated
-    return info
+        obs, reward, terminated, truncated, info = env.step(act(obs))
+        done, total = terminated or truncated, total + float(reward)
+    return {**info, "return": total, "ended_early": bool(terminated)}
 
 
 def run_policy(engine: str, name: str, model, seed: int, args: argparse.Namespace) -> dict:
@@ -178,7 +179,9 @@ def evaluate(model_file: Path, args: argparse.Namespace) -> dict[str, dict[str, 
         if ("twin", name, seed) not in done:
             info = run_policy("twin", name, model_file if name == "ppo" else None, seed, args)
             _keep(args.episodes, done, {"engine": "twin", "policy": name, "seed": seed,
-                                        "section_veh_h": info["section_veh_h"]})
+                                        "section_veh_h": info["section_veh_h"],
+                                        "charged_veh_h": -info["return"],
+                                        "ended_early": info["ended_early"]})
     todo = [s for s in seeds if ("sumo", "ppo", s) not in done]
     with ProcessPoolExecutor(args.workers, mp_context=get_context("spawn")) as pool:
         jobs = {pool.submit(_sumo_ppo, model_file, s, args): s for s in todo}
@@ -190,7 +193,8 @@ def evaluate(model_file: Path, args: argparse.Namespace) -> dict[str, dict[str, 
     laws = laws_in_sumo(args)
     sumo = {n: [laws[n, s] if n != "ppo" else done["sumo", "ppo", s] for s in seeds]
             for n in names}
-    return {n: {"twin": [done["twin", n, s]["section_veh_h"] for s in seeds],
+    return {n: {"twin": [done["twin", n, s]["charged_veh_h"] for s in seeds],
+                "early": [done["twin", n, s]["ended_early"] for s in seeds],
                 **{k: [r[k] for r in sumo[n]] for k in ("sumo", "whole", "plans")}}
             for n in names}
 
@@ -225,19 +229,22 @@ def table(res: dict, args: argparse.Namespace, trained: int) -> str:
             "PPO trained "
             f"{trained} twin steps ({args.budget_min:g} CPU min budget), reward "
             f"`{REWARD}`. Section veh h: vehicle-hours on x in [0, L] over the control "
-            "window (twin beside SUMO: the sim-to-real gap); whole demand: every "
+            "window (twin beside SUMO: the sim-to-real gap); on the twin, an episode "
+            "that left the model's domain (early) is charged the rest of the window as "
+            "the section standing jammed, as its reward is; whole demand: every "
             "vehicle's time spent in SUMO, drain included, minus the open loop's "
             "(mean, 95 % t interval). The learned policy runs in `SumoRampMeter-v0`; the "
             "laws' SUMO runs are `arzsumo.evaluate`'s (a law's episode in the environment "
             "is its `arzsumo run`: a test of the package holds this for the ETC), sharing "
             "each seed's warm-up.\n\nRegenerate (resumable; add `--out FILE`): "
             f"`.venv/bin/python examples/learn_twin_test_sumo.py {_options()}`.\n\n")
-    rows = ["| policy | twin section veh h | SUMO section veh h | gap (SUMO - twin) | "
+    rows = ["| policy | twin section veh h (early) | SUMO section veh h | gap (SUMO - twin) | "
             "SUMO whole demand veh h | minus open | plan changes |",
             "|---|---|---|---|---|---|---|"]
     for name, r in res.items():
         gap = np.mean(np.subtract(r["sumo"], r["twin"]))
-        rows.append(f"| {name} | {np.mean(r['twin']):.3f} | {np.mean(r['sumo']):.3f} | "
+        rows.append(f"| {name} | {np.mean(r['twin']):.3f} ({sum(r['early'])}) | "
+                    f"{np.mean(r['sumo']):.3f} | "
                     f"{gap:+.3f} | {np.nanmean(r['whole']):.2f} | "
                     f"{_ci(r['whole'], res['open']['whole'])} | "
                     f"{np.mean(r['plans']):.1f} |")

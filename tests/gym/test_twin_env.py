@@ -134,3 +134,32 @@ def test_stepping_outside_an_episode_and_unknown_policies_are_refused():
     pi = policy("etc", env)
     with pytest.raises(EnvError, match="cannot act now"):
         pi(None)
+
+
+def test_ending_an_episode_early_never_pays():
+    """Releasing all the meter can (U at its top, what a learner paid in minus
+    vehicle-hours first found) empties the IDM stream's section until the inlet's density
+    turns negative and the twin stops at about 125 s. That step is charged the rest of the
+    horizon as the section standing jammed, so its return is below the open loop's, which
+    runs to the horizon."""
+    def episode_return(pick):
+        env = gym.make(arzsumo.gym.TWIN_ID, scenario="stop_and_go_idm", initial="random",
+                       reward="vehicle-hours")
+        env.reset(seed=1)
+        total, done, info = 0.0, False, {}
+        while not done:
+            _, r, terminated, truncated, info = env.step(pick(env))
+            total, done = total + r, terminated or truncated
+        env.close()
+        return total, terminated, info
+
+    drained, ended, info = episode_return(lambda env: env.action_space.high)
+    held, ended_held, _ = episode_return(lambda env: np.zeros(1, np.float32))   # U = 0
+    assert ended and not ended_held
+    assert info["t"] < 200.0 and drained < held
+    env = gym.make(arzsumo.gym.TWIN_ID, scenario="stop_and_go_idm")
+    sc, rest = env.unwrapped.scenario, env.unwrapped.options.horizon - info["t"]
+    eq = sc.equilibrium
+    jam = (eq.rho_h + eq.rho_a) * sc.params.ao_max_h / eq.ao * sc.params.length
+    assert info["termination_reward"] == pytest.approx(-jam * rest / 3600.0, rel=1e-9)
+    env.close()

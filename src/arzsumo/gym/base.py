@@ -123,6 +123,10 @@ class RampMeterEnv(gymnasium.Env):
         try:     # an error anywhere in the step (the engine, the reward) ends the episode
             rec, obs, terminated, truncated, info = self._advance(u)
             reward = float(self.reward_fn(rec))
+            rest = self._rest_of_horizon(rec) if terminated else None
+            if rest is not None:     # ending early must never pay (see _rest_of_horizon)
+                info["termination_reward"] = float(self.reward_fn(rest))
+                reward += info["termination_reward"]
         except BaseException:
             self._running = False
             self._close()
@@ -210,6 +214,11 @@ class RampMeterEnv(gymnasium.Env):
 
     def _close(self) -> None:
         raise NotImplementedError
+
+    def _rest_of_horizon(self, rec: StepRecord) -> StepRecord | None:
+        """The period an episode that ended before its horizon is charged for the rest of
+        it (None: nothing to charge)."""
+        return None
 
     def _law_state(self) -> MacroState:
         raise NotImplementedError

@@ -14,7 +14,9 @@ by ``[actuation]``: the range and the rate) for one control period. The twin has
 ramp: the queue is 0 and a *plan change* is a change of the U applied.
 
 The episode ends at the horizon (``truncated``), or ``terminated`` when the state would
-leave the model's physical domain (``info["status"]`` says where). ``info["summary"]``
+leave the model's physical domain (``info["status"]`` says where); then the last step's
+reward also charges the rest of the horizon as the section standing jammed
+(``info["termination_reward"]``), so that ending an episode early never pays. ``info["summary"]``
 at the end: the section's indices (``TTT``, ``total_delay``, ``J_fuel``, ``J_discom``,
 computed as ``arzsumo run`` computes SUMO's, on the observation's cells), vehicle-hours,
 plan changes, and whether the run completed.
@@ -153,6 +155,23 @@ class TwinRampMeterEnv(RampMeterEnv):
             info["status"] = self.status
             info["summary"] = self.summary()
         return rec, self._observe(fields), terminated, truncated, info
+
+    def _rest_of_horizon(self, rec: StepRecord) -> StepRecord | None:
+        """An episode that leaves the model's domain is charged the rest of its horizon as
+        one period of the section standing jammed: the classes in the equilibrium's
+        proportion at the HVs' AO_max, speeds 0. Without it an agent paid in minus
+        vehicle-hours learns to empty the section until the twin leaves its domain (the
+        inlet's density turns negative) and so stops paying: ending early never pays."""
+        rest = self.options.horizon - rec.t
+        if rest <= 0.0:
+            return None
+        p, eq = self.scenario.params, self.eq
+        scale = p.ao_max_h / eq.ao
+        rho = np.array([eq.rho_h * scale, 0.0, eq.rho_a * scale, 0.0])
+        fields = np.repeat(rho[:, None], self.x.size, axis=1)
+        jam_veh_h = float(s_to_h((rho[0] + rho[2]) * p.length * rest))
+        return StepRecord(self.options.horizon, rest, self.x, fields, jam_veh_h,
+                          rec.u_action, rec.u_applied, 0, 0.0, False, False)
 
     def _keep(self, t: float, fields: np.ndarray, u: float) -> None:
         state, _ = self.observer.sample(self.x, fields)
