@@ -9,6 +9,7 @@ The public API (``docs/api.md``)::
     res.save("results/etc-seed1")                      # what `arzsumo run --out` writes
     twin = arzsumo.twin(sc, controller="etc")          # the PDE twin -> TwinResult
     ev = arzsumo.evaluate(sc, controllers=["open", "etc"], seeds=10)   # paired, 10 seeds
+    cal = arzsumo.calibrate(sc, out="runs/cal")        # the diagram and the meter curve
 
 Your own law subclasses :class:`arzsumo.Controller` (one method, ``decide(state) -> U``)
 and is passed as ``controller=`` or registered with :func:`arzsumo.register_controller`.
@@ -35,6 +36,7 @@ _API = {
     "TwinSummary": "arzsumo.api.results",
     "controller_names": "arzsumo.api.controllers",
     "register_controller": "arzsumo.api.controllers",
+    "calibrate": "arzsumo.api.calibration",
     "evaluate": "arzsumo.api.evaluation", "load_scenario": "arzsumo.api.scenarios",
     "network_figure": "arzsumo.api.network", "road_geometry": "arzsumo.api.network",
     "prepare": "arzsumo.api.runs", "run": "arzsumo.api.runs", "twin": "arzsumo.api.runs",

@@ -15,7 +15,8 @@ from arzsumo.api.evaluation import seed_list
 from arzsumo.cli import main
 from arzsumo.control.registry import unregister_controller
 
-NAMES = {"load_scenario", "run", "twin", "evaluate", "Controller", "register_controller",
+NAMES = {"load_scenario", "run", "twin", "evaluate", "calibrate", "Controller",
+         "register_controller",
          "RunResult", "TwinResult", "prepare", "MacroState"}
 
 

@@ -57,27 +57,12 @@ def cmd_build_net(args: argparse.Namespace) -> int:
 
 
 def cmd_calibrate(args: argparse.Namespace) -> int:
-    from arzsumo.outdir import OutputDir
-    from arzsumo.outputs.calibration import write_calibration
-    from arzsumo.sumo.calibrate import CalibrationPlan, calibrate
+    from arzsumo.api.calibration import calibrate
 
-    sc = scenario_of(args)        # a [network]: checked, its L, W and layout
-    cfg = sc.sumo
-    changes = {"seed": args.seed, "step_length": args.step_length}
-    cfg = cfg.with_(**{k: v for k, v in changes.items() if v is not None})
-    plan = CalibrationPlan()
-    if args.quick:
-        plan = CalibrationPlan(horizon=90.0, warmup=30.0, window=10.0,
-                               curve_shares=(0.0, 1.0), fd_levels=("light",),
-                               fd_shares=(1.0,), min_samples=5.0)
-    if args.horizon is not None:
-        plan = CalibrationPlan(**{**plan.__dict__, "horizon": args.horizon,
-                                  "warmup": min(plan.warmup, args.horizon / 3)})
-    with OutputDir(args.out, "calibration", overwrite=args.overwrite) as target:
-        cal = calibrate(sc.params, cfg, plan, jobs=args.jobs)
-        network = (sc.network.absolute_table(sc.tables["network"])
-                   if sc.network is not None else None)
-        write_calibration(target, cal, cfg, network=network)
+    scenario = args.scenario or scenario_of(args)   # --preset: its scenario
+    cal = calibrate(scenario, out=args.out, quick=args.quick, horizon_s=args.horizon,
+                    seed=args.seed, step_length_s=args.step_length, jobs=args.jobs,
+                    overwrite=args.overwrite)
     out = args.out
     for cls, name in (("h", "HV"), ("a", "AV")):
         f = cal.fits[cls]
