@@ -63,6 +63,7 @@ VARIANTS: dict[str, list[Any]] = {
     "sumo.approach_length_m": [1500.0, 1000.0],
     "sumo.eager_insert": [False],
     "sumo.approach_piece_m": [250.0],
+    "sumo.step_length_s": [0.2],
 }
 #: summary column -> (label, unit factor from SI, unit)
 MEASURES: dict[str, tuple[str, float, str]] = {
