@@ -231,21 +231,25 @@ def table(res: dict, args: argparse.Namespace, trained: int) -> str:
             f"`{REWARD}`. Section veh h: vehicle-hours on x in [0, L] over the control "
             "window (twin beside SUMO: the sim-to-real gap); on the twin, an episode "
             "that left the model's domain (early) is charged the rest of the window as "
-            "the section standing jammed, as its reward is; whole demand: every "
-            "vehicle's time spent in SUMO, drain included, minus the open loop's "
-            "(mean, 95 % t interval). The learned policy runs in `SumoRampMeter-v0`; the "
-            "laws' SUMO runs are `arzsumo.evaluate`'s (a law's episode in the environment "
-            "is its `arzsumo run`: a test of the package holds this for the ETC), sharing "
-            "each seed's warm-up.\n\nRegenerate (resumable; add `--out FILE`): "
+            "the section standing jammed, as its reward is. Minus open: the paired "
+            "difference on the same seeds (mean, 95 % t interval). Whole demand: every "
+            "vehicle's time spent in SUMO, drain included, over the seeds whose drain "
+            "emptied the network (a seed SUMO deadlocked has none). The learned policy "
+            "runs in `SumoRampMeter-v0`; the laws' SUMO runs are `arzsumo.evaluate`'s "
+            "(a law's episode in the environment is its `arzsumo run`: a test of the "
+            "package holds this for the ETC), sharing each seed's warm-up.\n\n"
+            "Regenerate (resumable; add `--out FILE`): "
             f"`.venv/bin/python examples/learn_twin_test_sumo.py {_options()}`.\n\n")
-    rows = ["| policy | twin section veh h (early) | SUMO section veh h | gap (SUMO - twin) | "
-            "SUMO whole demand veh h | minus open | plan changes |",
-            "|---|---|---|---|---|---|---|"]
+    rows = ["| policy | twin section veh h (early) | SUMO section veh h | minus open | "
+            "gap (SUMO - twin) | SUMO whole demand veh h (seeds drained) | minus open | "
+            "plan changes |",
+            "|---|---|---|---|---|---|---|---|"]
     for name, r in res.items():
         gap = np.mean(np.subtract(r["sumo"], r["twin"]))
+        drained = int(np.isfinite(np.asarray(r["whole"], dtype=float)).sum())
         rows.append(f"| {name} | {np.mean(r['twin']):.3f} ({sum(r['early'])}) | "
-                    f"{np.mean(r['sumo']):.3f} | "
-                    f"{gap:+.3f} | {np.nanmean(r['whole']):.2f} | "
+                    f"{np.mean(r['sumo']):.3f} | {_ci(r['sumo'], res['open']['sumo'])} | "
+                    f"{gap:+.3f} | {np.nanmean(r['whole']):.2f} ({drained}) | "
                     f"{_ci(r['whole'], res['open']['whole'])} | "
                     f"{np.mean(r['plans']):.1f} |")
     return head + "\n".join(rows) + "\n"
