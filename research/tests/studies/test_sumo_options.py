@@ -5,9 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 import pytest
+from arzsumo_studies.common import StudyError
 from arzsumo_studies.sumo_map.sumo_options import (
     MEASURES,
     OPTION,
+    SumoOptionsOptions,
     compare,
     markdown,
     options_spec,
@@ -25,7 +27,7 @@ TTS = "network_whole_demand.time_spent_s.total"
 def test_the_design_changes_one_option_at_a_time_on_the_same_seeds():
     spec = options_spec([1, 2, 3])
     runs = spec.runs()
-    assert len(runs) == 8 * 3
+    assert len(runs) == 10 * 3
     base = [r for r in runs if r.run_id.startswith("lateral_resolution_m=0.5,")]
     assert [r.scenario["sumo"]["seed"] for r in base] == [1, 2, 3]
     eager = next(r for r in runs if r.run_id == "eager_insert=false,seed=2")
@@ -38,6 +40,19 @@ def test_the_approach_in_pieces_is_a_variant_of_its_own_against_one_edge():
     runs = options_spec([1], vary=("approach_piece_m",)).runs()
     assert [r.scenario["sumo"]["approach_piece_m"] for r in runs] == [0.0, 250.0]
     assert runs[1].scenario["sumo"]["approach_length_m"] == 2500
+
+
+def test_one_value_of_a_key_is_a_variant_of_its_own_after_the_baseline_asked_first():
+    """``KEY=VALUE`` picks that value alone; the first entry leads with the shipped value,
+    so a later study reuses the runs of an earlier one with the same first entry."""
+    runs = options_spec([1], vary=("approach_piece_m", "lateral_resolution_m=3.25")).runs()
+    assert [r.run_id for r in runs] == ["approach_piece_m=0,seed=1",
+                                        "approach_piece_m=250,seed=1",
+                                        "lateral_resolution_m=3.25,seed=1"]
+    assert runs[2].scenario["sumo"]["lateral_resolution_m"] == 3.25
+    assert "approach_piece_m" not in runs[2].scenario["sumo"]          # the rest shipped
+    with pytest.raises(StudyError, match=r"lateral_resolution_m=3\.3 is not allowed"):
+        SumoOptionsOptions(vary=("lateral_resolution_m=3.3",))
 
 
 def test_vary_runs_the_shipped_approach_once_then_each_shorter_one():
@@ -120,7 +135,7 @@ def test_the_study_runs_from_python_with_its_options(monkeypatch, tmp_path):
     from arzsumo_studies.sumo_map import sumo_options
 
     opts = sumo_options.SumoOptionsOptions(seeds=(1, 2), out=tmp_path / "out")
-    assert len(sumo_options.design(opts)) == 8 * 2
+    assert len(sumo_options.design(opts)) == 10 * 2
     asked = {}
 
     def fake_sweep(spec, out, **kwargs):
@@ -130,7 +145,7 @@ def test_the_study_runs_from_python_with_its_options(monkeypatch, tmp_path):
 
     monkeypatch.setattr("arzsumo.sweep.driver.run_sweep", fake_sweep)
     result = sumo_options.run_sumo_options(opts, progress=False)
-    assert (result.code, result.statuses["failed"], asked["runs"]) == (4, 1, 16)
+    assert (result.code, result.statuses["failed"], asked["runs"]) == (4, 1, 10 * 2)
     row = result.table[result.table["variant"] == "lateral_resolution_m=1.3"].iloc[0]
     assert row["diff_mean"] == pytest.approx(1.0, abs=0.15)
     assert result.files == (tmp_path / "out" / "sumo_options.csv",)

@@ -90,8 +90,8 @@ _MODULES = {
                                  "EnKF estimates, same seed"),
     "premise-map": ("premise_map", "where the paper's premise holds in SUMO: premise gates "
                                    "over the free SUMO parameters"),
-    "sumo-options": ("sumo_options", "what SUMO's options (sublanes, action step, step length, "
-                                     "approach, insertion) cost and change, by seed"),
+    "sumo-options": ("sumo_options", "what SUMO's options (sublanes, steps, approach, "
+                                     "insertion) cost and change, by seed"),
     "control": ("control", "the controllers on the default: regulation and disturbance "
                            "rejection, paired by seed"),
     "control-ablation": ("control_ablation", "the control study's configuration, one piece "

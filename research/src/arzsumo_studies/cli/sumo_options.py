@@ -14,6 +14,7 @@ from arzsumo_studies.sumo_map.sumo_options import (
     SumoOptionsOptions,
     design,
     run_sumo_options,
+    variant_name,
 )
 
 
@@ -26,14 +27,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--vary", default="", metavar="KEYS",
                         help="comma-separated [sumo] keys varied, of "
                              + ", ".join(f.split(".", 1)[1] for f in VARIANTS)
-                             + " (default: all)")
+                             + ", or one value of a key as KEY=VALUE, e.g. "
+                             "lateral_resolution_m=1.3 (default: all)")
     add_output(parser, NAME, PAGE, plots=False)
 
 
 def _varied(text: str) -> tuple[str, ...]:
-    """The ``--vary`` keys (none given: every option)."""
+    """The ``--vary`` keys or ``KEY=VALUE`` variants (none given: every option)."""
     keys = [f.split(".", 1)[1] for f in VARIANTS]
-    return tuple(names_among(text, keys, "--vary")) if text.strip() else ()
+    named = [variant_name(f.split(".", 1)[1], v) for f, vs in VARIANTS.items() for v in vs]
+    return tuple(names_among(text, keys + named, "--vary")) if text.strip() else ()
 
 
 def options(args: argparse.Namespace) -> SumoOptionsOptions:

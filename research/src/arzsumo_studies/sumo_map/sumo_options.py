@@ -58,7 +58,7 @@ PAGE = "sumo_options"
 OPTION = "option"
 #: the variants of each option (field -> values; the shipped value is the baseline)
 VARIANTS: dict[str, list[Any]] = {
-    "sumo.lateral_resolution_m": [0.65, 1.3],
+    "sumo.lateral_resolution_m": [0.65, 1.3, 3.25],
     "sumo.hv_action_step_s": [0.5],
     "sumo.approach_length_m": [1500.0, 1000.0],
     "sumo.eager_insert": [False],
@@ -156,15 +156,32 @@ def options_spec(seeds: list[int], scenario: str = "default.toml", drain: bool =
     every option of :data:`VARIANTS`), varied one at a time, the first axis led by its
     shipped value (the baseline); without ``drain`` the runs end with the control window
     (the whole-demand measures then stop there too, and are left out)."""
-    fields = [f for f in VARIANTS if not vary or f.split(".", 1)[1] in vary]
+    chosen = variants_of(vary)
     shipped = shipped_values(scenario)
-    axes = [{"field": f, "values": ([shipped[f]] if i == 0 else []) + VARIANTS[f],
-             "group": OPTION} for i, f in enumerate(fields)]
+    axes = [{"field": f, "values": ([shipped[f]] if i == 0 else []) + values,
+             "group": OPTION} for i, (f, values) in enumerate(chosen.items())]
     fixed: dict[str, Any] = {"run.controller": "open"}
     if not drain:
         fixed["sumo.drain_max_s"] = 0.0
     return study_spec(NAME, shipped_scenario(scenario), seeds=list(seeds), set=fixed,
                       axis=axes)
+
+
+def variants_of(vary: tuple[str, ...]) -> dict[str, list[Any]]:
+    """The variants ``vary`` picks (field -> values), in ``vary``'s order: an entry ``KEY``
+    takes every value of that ``[sumo]`` key in :data:`VARIANTS`, ``KEY=VALUE`` the one
+    value so named (as the tables name it); empty: every variant. Unknown entries are left
+    out (the options check them)."""
+    if not vary:
+        return {f: list(v) for f, v in VARIANTS.items()}
+    picked: dict[str, list[Any]] = {}
+    for entry in vary:
+        key = entry.split("=", 1)[0]
+        field = f"sumo.{key}"
+        named = [v for v in VARIANTS.get(field, [])
+                 if entry == key or variant_name(key, v) == entry]
+        picked.setdefault(field, []).extend(v for v in named if v not in picked[field])
+    return {f: v for f, v in picked.items() if v}
 
 
 def variant_name(key: str, value: Any) -> str:
@@ -304,7 +321,8 @@ class SumoOptionsOptions(checks.Shared):
         Run each run's drain after the control window (False: end with the window;
         faster, no whole-demand measures).
     vary : tuple of str
-        The ``[sumo]`` keys varied (keys of :data:`VARIANTS`; empty: all).
+        The ``[sumo]`` keys varied (keys of :data:`VARIANTS`; empty: all), or one value
+        of a key as ``KEY=VALUE`` (:func:`variants_of`).
 
     ``out``, ``docs``, ``workers``, ``scheduler``: as every study's
     (:data:`~arzsumo_studies.common.SHARED_FIELDS`).
@@ -319,10 +337,12 @@ class SumoOptionsOptions(checks.Shared):
         super().__post_init__()
         checks.seeds(self.seeds)
         known = [f.split(".", 1)[1] for f in VARIANTS]
-        bad = [k for k in self.vary if k not in known]
+        named = [variant_name(f.split(".", 1)[1], v) for f, vs in VARIANTS.items() for v in vs]
+        bad = [k for k in self.vary if k not in known and k not in named]
         if bad or len(set(self.vary)) != len(self.vary):
             raise StudyError(f"--vary = {','.join(self.vary)} is not allowed: "
-                             f"distinct options of {', '.join(known)}")
+                             f"distinct options of {', '.join(known)}, or one value "
+                             f"of one, of {', '.join(named)}")
 
     def spec(self) -> SweepSpec:
         """The study's sweep (:func:`options_spec`)."""
