@@ -12,9 +12,10 @@ from arzsumo.evaluation.report import (
     Measure,
     evaluate,
     markdown,
+    paired_cell,
     paired_differences,
 )
-from arzsumo.evaluation.stats import StatisticsError
+from arzsumo.evaluation.stats import StatisticsError, paired_difference
 
 DELAY = Measure("network.time_loss_s.total", "time loss", "veh h", 1 / 3600)
 FLOW = Measure("network.throughput_veh_h.section_outlet", "outlet", "veh/h",
@@ -134,3 +135,16 @@ def test_a_seed_deadlocked_before_control_under_every_controller_is_the_only_one
     # a seed whose baseline has not finished yet is not named on the ETC's word alone
     assert deadlocked_seeds(runs[runs["controller"] == "etc"], ["open", "etc"]) == []
     assert deadlocked_seeds(runs.drop(columns=[grid]), ["open", "etc"]) == []
+
+
+def test_a_paired_cell_gives_the_bootstrap_interval_of_the_same_differences():
+    """The cell's {bootstrap} bounds are those of ``paired_difference`` on the same pairs,
+    and they bracket the mean; without ``bootstrap`` the cell has none."""
+    base = np.arange(12.0)
+    treat = base + np.array([1.0, 3.0, -1.0, 2.0, 0.5, 4.0, 1.5, -0.5, 2.5, 1.0, 3.5, 0.0])
+    d = paired_difference(treat, base)
+    cell = paired_cell(treat, base, bootstrap=True)
+    low, high = (float(x) for x in cell.split("{")[1].split("}")[0].split(","))
+    assert (low, high) == pytest.approx((d.bootstrap.low, d.bootstrap.high), rel=5e-3)
+    assert low < d.mean_diff < high
+    assert cell.endswith(f"{d.wins}/{d.losses}") and "{" not in paired_cell(treat, base)

@@ -70,18 +70,18 @@ def test_the_table_pairs_each_step_with_the_full_configuration():
     text = control_ablation.table({"raw-cells": step}, full, [1, 2, 3])
     bs = next(x for x in text.splitlines() if x.startswith("| raw-cells | backstepping"))
     etc = next(x for x in text.splitlines() if x.startswith("| raw-cells | etc"))
-    assert "| +2 [+2, +2] 0/3 |" in bs              # 2 veh h worse on every seed
-    assert "| -0.5 [-0.5, -0.5] 3/0 |" in etc
-    assert "| +0 [+0, +0] 0/0 |" in bs               # the same plan changes: ties
+    assert "| +2 [+2, +2] {+2, +2} 0/3 |" in bs              # 2 veh h worse on every seed
+    assert "| -0.5 [-0.5, -0.5] {-0.5, -0.5} 3/0 |" in etc
+    assert "| +0 [+0, +0] {+0, +0} 0/0 |" in bs               # the same plan changes: ties
     assert not any(x.startswith("| full |") for x in text.splitlines())   # no open loop
     # with the (borrowed) open loop among the step's runs: each step and the full
     # configuration are also given against it
     with_open = pd.concat([step, runs({"open": 103.0})], ignore_index=True)
     text = control_ablation.table({"raw-cells": with_open}, full, [1, 2, 3])
     rows = {tuple(c.strip() for c in x.split("|")[1:4]): x for x in text.splitlines()}
-    assert "| -1 [-1, -1] 3/0 |" in rows[("raw-cells", "backstepping", "open")]
-    assert "| -3 [-3, -3] 3/0 |" in rows[("full", "backstepping", "open")]
-    assert "| +2 [+2, +2] 0/3 |" in rows[("raw-cells", "backstepping", "full")]
+    assert "| -1 [-1, -1] {-1, -1} 3/0 |" in rows[("raw-cells", "backstepping", "open")]
+    assert "| -3 [-3, -3] {-3, -3} 3/0 |" in rows[("full", "backstepping", "open")]
+    assert "| +2 [+2, +2] {+2, +2} 0/3 |" in rows[("raw-cells", "backstepping", "full")]
     # a step run on one law only (--laws etc) shows no rows of the other
     etc_only = runs({"etc": 100.5})
     text = control_ablation.table({"raw-cells": etc_only}, full, [1, 2, 3])
@@ -90,7 +90,7 @@ def test_the_table_pairs_each_step_with_the_full_configuration():
     # without a full configuration: each step against the open loop only
     text = control_ablation.table({"raw-cells": with_open}, None, [1, 2, 3])
     rows = {tuple(c.strip() for c in x.split("|")[1:4]): x for x in text.splitlines()}
-    assert "| -1 [-1, -1] 3/0 |" in rows[("raw-cells", "backstepping", "open")]
+    assert "| -1 [-1, -1] {-1, -1} 3/0 |" in rows[("raw-cells", "backstepping", "open")]
     assert not any(k[0] == "full" or k[2] == "full" for k in rows)
 
 

@@ -156,16 +156,18 @@ def seed_values(runs: pd.DataFrame, measure: Measure, controller: str,
 
 
 def paired_cell(treatment: np.ndarray, baseline: np.ndarray, *, lower_is_better: bool = True,
-                bracket_counts: bool = False) -> str:
+                bracket_counts: bool = False, bootstrap: bool = False) -> str:
     """Treatment minus baseline, paired by seed, as a table cell: the mean difference
-    [95 % t interval] (unit of the data), then the seeds won / lost by the treatment
-    (``(wins/losses)`` with ``bracket_counts``); empty where the pairs are too few."""
+    [95 % t interval] (unit of the data), with ``bootstrap`` its {95 % bootstrap
+    interval}, then the seeds won / lost by the treatment (``(wins/losses)`` with
+    ``bracket_counts``); empty where the pairs are too few."""
     try:
         d = paired_difference(treatment, baseline, lower_is_better=lower_is_better)
     except StatisticsError:
         return ""
     counts = f"{d.wins}/{d.losses}"
-    return (f"{d.mean_diff:+.3g} [{d.t.low:+.3g}, {d.t.high:+.3g}] "
+    boot = f"{{{d.bootstrap.low:+.3g}, {d.bootstrap.high:+.3g}}} " if bootstrap else ""
+    return (f"{d.mean_diff:+.3g} [{d.t.low:+.3g}, {d.t.high:+.3g}] {boot}"
             + (f"({counts})" if bracket_counts else counts))
 
 

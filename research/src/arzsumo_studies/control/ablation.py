@@ -117,7 +117,8 @@ KEYS = ("network_whole_demand.time_spent_s.total", "network_whole_demand.ramp_wa
         "section.deviation.deviation_excess_s", "section.deviation.decay_time_s",
         "section.waves.h.band_power_kmh2", "section.waves.a.band_power_kmh2",
         "section.speed_oscillation_kmh.h", "section.speed_oscillation_kmh.a",
-        "section.waves.h.growth_per_km", "plan_changes", "triggers")
+        "section.waves.h.short_power_kmh2", "section.waves.h.growth_per_km",
+        "plan_changes", "triggers")
 
 
 def step_name(step: str, experiment: str = "regulation") -> str:
@@ -142,9 +143,11 @@ def measures() -> list[Measure]:
 def _cells(a_runs: pd.DataFrame, a: str, b_runs: pd.DataFrame, b: str,
            seeds: list[int]) -> list[str]:
     """Per measure, ``a`` of ``a_runs`` minus ``b`` of ``b_runs``, paired by seed:
-    mean [95 % t] wins/losses of ``a`` (empty where there are too few pairs)."""
+    mean [95 % t] {95 % bootstrap} wins/losses of ``a`` (empty where there are too few
+    pairs)."""
     return [paired_cell(seed_values(a_runs, m, a, seeds), seed_values(b_runs, m, b, seeds),
-                        lower_is_better=m.lower_is_better) for m in measures()]
+                        lower_is_better=m.lower_is_better, bootstrap=True)
+            for m in measures()]
 
 
 def _ran(runs: pd.DataFrame, laws: Sequence[str]) -> list[str]:
