@@ -14,7 +14,7 @@ from arzsumo_studies.sumo_map.sumo_options import (
     SumoOptionsOptions,
     design,
     run_sumo_options,
-    variant_name,
+    variant_names,
 )
 
 
@@ -35,8 +35,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def _varied(text: str) -> tuple[str, ...]:
     """The ``--vary`` keys or ``KEY=VALUE`` variants (none given: every option)."""
     keys = [f.split(".", 1)[1] for f in VARIANTS]
-    named = [variant_name(f.split(".", 1)[1], v) for f, vs in VARIANTS.items() for v in vs]
-    return tuple(names_among(text, keys + named, "--vary")) if text.strip() else ()
+    return tuple(names_among(text, keys + variant_names(), "--vary")) if text.strip() else ()
 
 
 def options(args: argparse.Namespace) -> SumoOptionsOptions:

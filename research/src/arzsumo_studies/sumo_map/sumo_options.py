@@ -184,6 +184,11 @@ def variants_of(vary: tuple[str, ...]) -> dict[str, list[Any]]:
     return {f: v for f, v in picked.items() if v}
 
 
+def variant_names() -> list[str]:
+    """Every variant of :data:`VARIANTS` by its name, ``KEY=VALUE``."""
+    return [variant_name(f.split(".", 1)[1], v) for f, vs in VARIANTS.items() for v in vs]
+
+
 def variant_name(key: str, value: Any) -> str:
     """``key=value`` as the study's tables name a variant."""
     text = str(value).lower() if isinstance(value, bool | np.bool_) else f"{value:g}"
@@ -337,7 +342,7 @@ class SumoOptionsOptions(checks.Shared):
         super().__post_init__()
         checks.seeds(self.seeds)
         known = [f.split(".", 1)[1] for f in VARIANTS]
-        named = [variant_name(f.split(".", 1)[1], v) for f, vs in VARIANTS.items() for v in vs]
+        named = variant_names()
         bad = [k for k in self.vary if k not in known and k not in named]
         if bad or len(set(self.vary)) != len(self.vary):
             raise StudyError(f"--vary = {','.join(self.vary)} is not allowed: "
