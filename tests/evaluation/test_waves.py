@@ -5,17 +5,28 @@ import pytest
 
 from arzsumo.evaluation.fields import block_means, oscillation
 from arzsumo.evaluation.waves import (
-    band_power,
+    STOP_AND_GO_S,
     block_centres,
     file_boundaries,
     growth_upstream,
     lateral_files,
-    peak_period,
+    place_spectra,
     snapshot_blocks,
     speed_spread,
     temporal_sd,
     wave_measures,
 )
+
+
+def band_power(blocks: np.ndarray, dt: float,
+               band: tuple[float, float] = STOP_AND_GO_S) -> dict[str, float]:
+    """The places' mean spectral power of ``blocks`` (T, N) in ``band`` (periods, s)."""
+    return place_spectra(blocks, dt).band(band)
+
+
+def peak_period(blocks: np.ndarray, dt: float) -> float:
+    """The period (s) of the places' mean periodogram's peak."""
+    return place_spectra(blocks, dt).peak_period()
 
 L, DX, DT = 1000.0, 50.0, 1.0          # section, control cells (m), control period (s)
 X = (np.arange(20) + 0.5) * DX

@@ -1,19 +1,10 @@
 """How much of the law's boundary input reached the boundary: the actuator's authority.
 
-The paper's input U is the section outflow's deviation from q* (clpsys4). What the laws
-ask and what the actuator realises are read from a run's periods, on means over windows
-of ``window`` seconds (the meter releases one vehicle per green, so a one-period outflow
-is 0 or a few vehicles):
-
-* the sd of the U applied and of the outflow q(L) over those windows (veh/s);
-* the *realised gain*: the least-squares slope of the outflow's window means on the U
-  applied's, with its standard error. On a unit actuator with no dead time it is 1; a
-  meter whose release moves the outflow less, or a dead time longer than the window,
-  gives less. In closed loop U answers the state, and the state the outflow, so the
-  slope mixes the actuator's response with the law's: a diagnostic of authority, not an
-  identification of the actuator (the premise's staircase is that).
-
-Pure: no SUMO, no files. SI: s, veh/s.
+The U applied (clpsys4) and the outflow q(L) of a run's periods, on means over windows
+(a meter's one-period outflow is 0 or a few vehicles): their sd and the *realised gain*,
+the slope of the one on the other, 1 on a unit actuator without dead time; in closed loop
+a diagnostic, not an identification (docs/outputs.md, ``actuation.authority``; docs/sumo.md,
+"Actuation limits"). Pure. SI: s, veh/s.
 """
 
 from __future__ import annotations

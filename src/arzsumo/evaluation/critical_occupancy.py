@@ -1,27 +1,14 @@
 """The critical occupancy of a loop's flow-occupancy curve, and ALINEA's target from it.
 
-ALINEA regulates the occupancy of its loop to a target just below the *critical
-occupancy* o_c, where the loop's flow-occupancy curve peaks: below o_c flow rises with
-occupancy (free flow), above it flow falls (congestion) or stays at capacity (a loop
-downstream of a bottleneck it does not block). Papageorgiou et al. (1991) and practice
-take o_target a little below o_c; :data:`TARGET_SHARE` = 0.9 by default.
-
-Steps (all pure; SI: occupancy a fraction, flow veh/s, time s):
-
-1. :func:`period_means` averages the loop's samples (one per control period of the
-   closed loop, 1 s) over ALINEA's period, the resolution the controller sees.
-2. :func:`fit_triangle` fits the triangular (two-branch, continuous) curve
-   q = q_c + s_f min(o - o_c, 0) + s_c max(o - o_c, 0) by least squares over a grid of
-   breakpoints o_c (linear in q_c, s_f, s_c for each), the shape of the Daganzo-Newell
-   fundamental diagram; the best o_c is the critical occupancy and q_c the capacity.
-3. :func:`binned_curve` gives the mean flow per occupancy bin (the curve to plot and the
-   occupancy of the highest bin, a model-free cross-check).
-
-:func:`critical_occupancy` chains them. When the congested branch still rises (s_c >
-half the free slope: the loop never saw flow saturate, as downstream of an active
-bottleneck that never spills past the loop), the curve has no peak in the data: o_c is
-then reported as the lower bound the data give, the 98th percentile of the occupancies
-(flow still rose there), and ``saturated`` is False.
+ALINEA (Papageorgiou et al. 1991) regulates its loop's occupancy to a target just below
+the *critical occupancy* o_c, where the curve peaks (:data:`TARGET_SHARE` of it). On
+period means (:func:`period_means`, ALINEA's resolution) :func:`fit_triangle` fits the
+triangular curve q = q_c + s_f min(o - o_c, 0) + s_c max(o - o_c, 0), the shape of the
+Daganzo-Newell diagram, by least squares over a grid of breakpoints o_c; :func:`binned_curve`
+is the model-free cross-check. When the congested branch still rises (s_c > s_f / 2: the
+loop never saw flow saturate), o_c is only a lower bound, the 98th percentile of the
+occupancies, and ``saturated`` is False (docs/sumo.md, "The target").
+Pure; SI: occupancy a fraction, flow veh/s, time s.
 """
 
 from __future__ import annotations
@@ -61,9 +48,8 @@ def binned_curve(occupancy: np.ndarray, flow: np.ndarray, width: float = BIN_WID
     bins holding at least one sample."""
     occ, q = np.asarray(occupancy, float), np.asarray(flow, float)
     idx = np.floor(occ / width).astype(int)
-    bins = np.unique(idx)
+    bins, count = np.unique(idx, return_counts=True)
     mean = np.array([q[idx == b].mean() for b in bins])
-    count = np.array([int(np.sum(idx == b)) for b in bins])
     return (bins + 0.5) * width, mean, count
 
 

@@ -1,23 +1,16 @@
 """How far a run's section is from the stationary state, and how fast a disturbance decays.
 
-The paper judges its laws by the decay of the state's deviation from the equilibrium in
-L2 (section 5, ``\\label{sec:simulation}``). In SUMO the equilibrium the stream holds is
-measured, not assumed: the *stationary state* S (4, cells) is the time-mean of SUMO's
-Edie cells over the warm-up's last minutes (the state the nominal plan holds, the same
-for every controller of a seed, and the reference the PDE laws act about). For the
-control window, the relative deviation norm per control period is
+The paper judges its laws by the decay of the state's L2 deviation from the equilibrium
+(section 5, ``\\label{sec:simulation}``). In SUMO the reference is measured: the
+*stationary state* S (4, cells), the time-mean of the Edie cells over the warm-up's last
+minutes (the same for every controller of a seed). The relative deviation norm per period is
 
     e(t) = sqrt( mean over variables k and cells x of ((f_k(t, x) - S_k(x)) / s_k)^2 ),
 
-with s_k the cell-mean of |S_k| (so densities and speeds weigh alike; NaN cells, where no
-vehicle of a class passed, are left out). Its 30 s moving mean ē(t) is compared with the
-*stationary band* theta: the 95th percentile of ē over the same warm-up minutes, what the
-stream's own fluctuations reach under the nominal plan. Then
-
-- ``decay_time_s``: the last time ē is above theta (0 when it never is); a run that ends
-  above theta has ``decayed = False`` and the window's length as its decay time;
-- ``deviation_integral_s``: the integral of e over the window (s), the paper's index;
-- ``deviation_excess_s``: the integral of max(ē - theta, 0) (s), the part above the band.
+with s_k the cell-mean of |S_k| (densities and speeds weigh alike; NaN cells left out).
+Its 30 s moving mean ē(t) is compared with the *stationary band* theta, the 95th
+percentile of ē over the same warm-up minutes; the measures (``decay_time_s``: the last
+time ē > theta, ...) are in docs/outputs.md, ``section.deviation``.
 
 Pure numpy: fields in SI (veh/m, m/s), times in s.
 """
@@ -35,21 +28,22 @@ SMOOTH_S = 30.0
 BAND_PERCENTILE = 95.0
 
 
+def _finite_mean(a: np.ndarray, axis: int) -> np.ndarray:
+    """Mean of ``a``'s finite values along ``axis``; NaN where there is none."""
+    count = np.isfinite(a).sum(axis=axis)
+    return np.where(count > 0, np.nansum(a, axis=axis) / np.maximum(count, 1), np.nan)
+
+
 def stationary_state(fields: np.ndarray) -> np.ndarray:
     """The time-mean (4, cells) of ``fields`` (periods, 4, cells), NaN ignored."""
-    f = np.asarray(fields, float)
-    count = np.sum(np.isfinite(f), axis=0)
-    total = np.nansum(f, axis=0)
-    return np.where(count > 0, total / np.maximum(count, 1), np.nan)
+    return _finite_mean(np.asarray(fields, float), 0)
 
 
 def deviation_norm(fields: np.ndarray, stationary: np.ndarray) -> np.ndarray:
     """e(t) (periods,) of ``fields`` (periods, 4, cells) from ``stationary`` (4, cells):
     the relative RMS deviation of the module docstring (1)."""
     f, s = np.asarray(fields, float), np.asarray(stationary, float)
-    a = np.abs(s)
-    count = np.isfinite(a).sum(axis=1)
-    scale = np.where(count > 0, np.nansum(a, axis=1) / np.maximum(count, 1), np.nan)  # (4,)
+    scale = _finite_mean(np.abs(s), 1)  # (4,)
     scale = np.where(scale > 0, scale, np.nan)   # a field with no stationary level is left out
     d = (f - s[None]) / scale[None, :, None]
     ok = np.isfinite(d)

@@ -1,16 +1,11 @@
-"""Space-time fields compared at a chosen resolution: block means and their RMSE.
+"""Space-time fields compared at a chosen resolution: block means, RMSE, oscillation, travel.
 
-A 50 m x 1 s Edie cell holds two to five vehicles of a class, so its density and speed
-carry counting noise that no macroscopic model can or should explain; a macroscopic model
-describes means over a few hundred metres and tens of seconds (detector data for
-calibration are commonly aggregated to 30 s to 1 min). :func:`block_means` averages a
-(periods, variables, cells) field over blocks of ``periods`` x ``cells`` (NaN skipped),
-and :func:`field_rmse` compares two fields at that resolution.
-
-:func:`oscillation` measures what the paper's controllers act on, the oscillation of a
-field about its own mean at each place: a pooled sd over space and time also counts the
-mean profile along the section (slow at the merge, free upstream), which moves with the
-operating point, not with the waves.
+A 50 m x 1 s Edie cell holds two to five vehicles of a class, so its values carry counting
+noise no macroscopic model should explain: :func:`block_means` averages a field over
+blocks (e.g. 100 m x 10 s) before :func:`field_rmse` compares two fields and
+:func:`oscillation` measures one about each place's own mean (a pooled sd would also count
+the mean profile along the section). docs/outputs.md: ``rmse_blocks``,
+``section.speed_oscillation_kmh``, ``section.speed_wave``.
 """
 
 from __future__ import annotations
@@ -65,35 +60,28 @@ def field_rmse(observed: np.ndarray, predicted: np.ndarray, periods: int = 1,
 
 
 def oscillation(field: np.ndarray, periods: int = 1, cells: int = 1) -> np.ndarray:
-    """Root mean square over places of each place's temporal sd, per variable.
+    """Root mean square over places of each place's temporal sd, per variable (V,).
 
-    ``field`` (T, V, N) is block-averaged first (:func:`block_means`); at each block column
-    the sample sd over time (ddof 1, NaN skipped, at least two blocks) measures the
-    oscillation about that place's own mean; the columns are then pooled as an RMS. A
-    field steady in time has 0 whatever its profile; ``a(x) + A sin(wt)`` has A / sqrt(2).
-    A slow drift within the window (a transient after control starts) counts too.
-
-    Parameters
-    ----------
-    field : ndarray (T, V, N)
-        Periods x variables x places, any unit; NaN where not observed.
-    periods, cells : int
-        Block size in periods and in places (>= 1).
-
-    Returns
-    -------
-    ndarray (V,)
-        In the field's unit; NaN for a variable with no column of two finite blocks.
+    ``field`` (T, V, N; any unit, NaN where not observed) is block-averaged first over
+    ``periods`` x ``cells`` (:func:`block_means`); each block column's sample sd over time
+    (ddof 1, NaN skipped) is pooled as an RMS. A field steady in time has 0 whatever its
+    profile, ``a(x) + A sin(wt)`` has A / sqrt(2); a slow drift counts too. NaN for a
+    variable with no column of two finite blocks.
     """
-    blocks = block_means(field, periods, cells)
+    var = temporal_var(block_means(field, periods, cells))
+    used = np.isfinite(var).sum(axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(used > 0, np.sqrt(np.nansum(var, axis=1) / used), np.nan)
+
+
+def temporal_var(blocks: np.ndarray) -> np.ndarray:
+    """Sample variance over time (axis 0; ddof 1, NaN skipped) of each column of
+    ``blocks``; NaN where fewer than two values are finite."""
     n = np.isfinite(blocks).sum(axis=0)
     with np.errstate(invalid="ignore", divide="ignore"):
         mean = np.nansum(blocks, axis=0) / n
         var = np.nansum((blocks - mean) ** 2, axis=0) / (n - 1)
-    var = np.where(n >= 2, var, np.nan)
-    used = np.isfinite(var).sum(axis=1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(used > 0, np.sqrt(np.nansum(var, axis=1) / used), np.nan)
+    return np.where(n >= 2, var, np.nan)
 
 
 def _fill_in_time(field: np.ndarray) -> np.ndarray:
@@ -124,31 +112,15 @@ def wave_travel(field: np.ndarray, dt: float, dx: float, gap: int,
                 max_lag_s: float) -> dict[str, float]:
     """Which way, and how fast, the fluctuations of a (T, N) field travel.
 
-    For every pair of places ``gap`` cells apart the fluctuations (each place's series,
-    NaN filled in time) are cross-correlated at lags k = -K..K; the correlations are
-    averaged over the pairs and the lag of the peak (> 0: the downstream place follows)
-    is the travel time of ``gap dx``. A peak at the edge of the search (|k| = K: slower
-    than ``gap dx / max_lag_s``) or within two samples of 0 (faster than the grid
-    resolves) gives no speed. A field f(x - c t) gives c when |c| lies between those.
+    ``field``: periods (``dt`` s) x places (``dx`` m apart), e.g. a class speed in m/s,
+    NaN where not observed. For every pair of places ``gap`` (>= 1) cells apart the
+    series (NaN filled in time) are cross-correlated at lags k = -K..K (K: ``max_lag_s``,
+    held to half the series); the lag of the peak of the pair-averaged correlation (> 0:
+    the downstream place follows) is the travel time of ``gap dx``. A peak at |k| = K or
+    within two samples of 0 gives no speed; f(x - c t) gives c between those.
 
-    Parameters
-    ----------
-    field : ndarray (T, N)
-        Periods x places (e.g. a class speed, m/s); NaN where not observed.
-    dt : float
-        Period, s.
-    dx : float
-        Distance between neighbouring places, m.
-    gap : int
-        Places between the two of a pair (>= 1).
-    max_lag_s : float
-        Largest lag searched, s (held to half the series).
-
-    Returns
-    -------
-    dict
-        ``lag_s`` (s), ``speed`` (m/s; > 0 downstream; NaN when unresolved), ``peak_corr``
-        (pair-averaged correlation at the peak) and ``pairs`` (pairs used).
+    Returns ``lag_s`` (s), ``speed`` (m/s; > 0 downstream; NaN when unresolved),
+    ``peak_corr`` (at the peak) and ``pairs`` (pairs used).
     """
     f = _fill_in_time(field)
     seen = np.isfinite(f).all(axis=0)

@@ -1,25 +1,13 @@
 """Wave measures of a speed field: oscillation, stop-and-go band power, growth upstream.
 
-The section's per-vehicle speed sd pools every sample, so in SUMO's sublane model it
-mostly measures the speed gap between *lateral files* (vehicles riding side by side in
-the wide lane), not waves. The measures here look at what waves are: the fluctuation in
-time of block-mean speeds at each place (blocks of e.g. 100 m x 10 s,
-:func:`arzsumo.evaluation.fields.block_means`):
-
-* :func:`temporal_sd`: each place's sd over time; its RMS over places is
-  :func:`arzsumo.evaluation.fields.oscillation`;
-* :func:`band_power`: the share of that variance in the stop-and-go band (periods of 1 to
-  10 min, :data:`STOP_AND_GO_S`), from a Hann-windowed periodogram of each place's
-  linearly detrended series;
-* :func:`peak_period`: the period of the places' mean periodogram's peak, and the power
-  in the short waves' band (20 s to 1 min, :data:`SHORT_WAVES_S`);
-* :func:`growth_upstream`: the log-linear slope of the amplitude (the temporal sd) against
-  the distance upstream from x = L; > 0 when waves grow as they travel upstream;
-* :func:`file_boundaries` and :func:`snapshot_blocks`: the lateral files of a class, found
-  from a histogram of lateral offsets with empty gaps between files, and the block
-  speeds of the vehicles of one file, so that every measure can be taken per file.
-
-Pure numpy/scipy, SI units (m, s, m/s); :func:`wave_measures` bundles them.
+The per-vehicle speed sd mostly measures the speed gap between *lateral files* (vehicles
+side by side in SUMO's wide lane), not waves; these measures take the fluctuation in time
+of block-mean speeds at each place (:func:`arzsumo.evaluation.fields.block_means`): each
+place's sd over time, the power of its periodogram in the stop-and-go band
+(:data:`STOP_AND_GO_S`) and the short waves' band, the peak period, the growth of the
+amplitude upstream, and the lateral files of a class so that each is taken per file.
+docs/outputs.md, ``section.waves``. Pure numpy/scipy, SI (m, s, m/s);
+:func:`wave_measures` bundles them.
 """
 
 from __future__ import annotations
@@ -29,6 +17,8 @@ from itertools import pairwise
 
 import numpy as np
 from scipy.signal import periodogram
+
+from arzsumo.evaluation.fields import temporal_var
 
 #: the stop-and-go band: periods from 1 to 10 min, s
 STOP_AND_GO_S = (60.0, 600.0)
@@ -40,24 +30,9 @@ MIN_BLOCKS, MIN_PLACES = 8, 3
 
 
 def temporal_sd(blocks: np.ndarray) -> np.ndarray:
-    """Each place's sample sd over time (ddof 1, NaN skipped).
-
-    Parameters
-    ----------
-    blocks : ndarray (T, N)
-        Block-mean speeds, m/s; NaN where a block holds no vehicle.
-
-    Returns
-    -------
-    ndarray (N,)
-        m/s; NaN at a place with fewer than two finite blocks.
-    """
-    b = np.asarray(blocks, float)
-    n = np.isfinite(b).sum(axis=0)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        mean = np.nansum(b, axis=0) / n
-        var = np.nansum((b - mean) ** 2, axis=0) / (n - 1)
-    return np.where(n >= 2, np.sqrt(np.maximum(var, 0.0)), np.nan)
+    """Each place's sample sd over time (N,) of ``blocks`` (T, N; m/s, NaN where a block
+    holds no vehicle): ddof 1, NaN skipped; NaN at a place with fewer than two blocks."""
+    return np.sqrt(np.maximum(temporal_var(np.asarray(blocks, float)), 0.0))
 
 
 def rms(values: np.ndarray) -> float:
@@ -81,14 +56,16 @@ def _filled(series: np.ndarray, min_coverage: float) -> np.ndarray | None:
 @dataclass(frozen=True)
 class PlaceSpectra:
     """The one-sided periodogram densities ``psd`` (P, F; (m/s)^2 s) of each place's
-    series used, at frequencies ``f`` (F,; Hz): what :func:`band_power`,
-    :func:`mean_periodogram` and :func:`peak_period` read. P may be 0."""
+    series used, at frequencies ``f`` (F,; Hz). P may be 0."""
 
     f: np.ndarray
     psd: np.ndarray
 
     def band(self, band: tuple[float, float]) -> dict[str, float]:
-        """:func:`band_power`'s result for ``band`` (shortest, longest period, s)."""
+        """Power in ``band`` (shortest, longest period, s): ``band_power`` and
+        ``total_variance`` (over all frequencies above 0), means over the places, (m/s)^2;
+        ``band_share``, their ratio; ``places`` used; NaN without any. A sine of amplitude
+        A and a period inside the band gives A^2 / 2 and a share near 1."""
         if not self.psd.shape[0]:
             return {"band_power": np.nan, "total_variance": np.nan, "band_share": np.nan,
                     "places": 0}
@@ -101,13 +78,14 @@ class PlaceSpectra:
                 "places": int(self.psd.shape[0])}
 
     def mean(self) -> tuple[np.ndarray, np.ndarray]:
-        """:func:`mean_periodogram`'s result."""
+        """Periods (s, longest first; frequency 0 left out) and the places' mean density."""
         if not self.psd.shape[0] or self.f.size < 2:
             return np.zeros(0), np.zeros(0)
         return 1.0 / self.f[1:], self.psd[:, 1:].mean(axis=0)
 
     def peak_period(self) -> float:
-        """:func:`peak_period`'s result."""
+        """The period (s) where :meth:`mean` is largest: the waves' dominant period; NaN
+        without a place, a resolved frequency or any power (a field standing still)."""
         periods, mean = self.mean()
         if not np.any(mean > 0):
             return float("nan")
@@ -129,72 +107,21 @@ def place_spectra(blocks: np.ndarray, dt: float, min_coverage: float = 0.75
     return PlaceSpectra(f, np.array(psds).reshape(len(psds), f.size))
 
 
-def band_power(blocks: np.ndarray, dt: float, band: tuple[float, float] = STOP_AND_GO_S,
-               min_coverage: float = 0.75) -> dict[str, float]:
-    """Spectral power of each place's block series in a band of periods, averaged over places.
-
-    Each place's series (NaN filled linearly in time; a place with less than
-    ``min_coverage`` finite blocks is skipped) is detrended linearly and Hann-windowed;
-    its one-sided periodogram density integrated over the band's frequencies is the band
-    power, over all frequencies above 0 the total variance. A sine of amplitude A and a
-    period inside the band gives A^2 / 2 in the band and a share near 1. Periods longer
-    than the series are not resolved (their power shows up at its lowest frequencies).
-
-    Parameters
-    ----------
-    blocks : ndarray (T, N)
-        Block-mean speeds, m/s.
-    dt : float
-        Block duration, s.
-    band : (float, float)
-        Shortest and longest period of the band, s.
-    min_coverage : float
-        Least share of finite blocks of a place used.
-
-    Returns
-    -------
-    dict
-        ``band_power`` and ``total_variance`` (means over the places used, (m/s)^2),
-        ``band_share`` (their ratio, 1) and ``places`` (places used); NaN without any.
-    """
-    return place_spectra(blocks, dt, min_coverage).band(band)
-
-
 def mean_periodogram(blocks: np.ndarray, dt: float, min_coverage: float = 0.75
                      ) -> tuple[np.ndarray, np.ndarray]:
     """Periods (s, longest first; frequency 0 left out) and the places' mean one-sided
-    periodogram density ((m/s)^2 s) of ``blocks`` (T, N; as :func:`band_power`); both
+    periodogram density ((m/s)^2 s) of ``blocks`` (T, N; as :func:`place_spectra`); both
     empty without a place used."""
     return place_spectra(blocks, dt, min_coverage).mean()
 
 
-def peak_period(blocks: np.ndarray, dt: float, min_coverage: float = 0.75) -> float:
-    """The period (s) at which the places' mean periodogram of ``blocks`` (T, N; as
-    :func:`band_power`) is largest, frequency 0 excluded: the waves' dominant period.
-    NaN without a place, a resolved frequency or any power (a field standing still)."""
-    return place_spectra(blocks, dt, min_coverage).peak_period()
-
-
 def growth_upstream(x: np.ndarray, amplitude: np.ndarray, length: float) -> float:
-    """Log-linear slope of ``amplitude`` against the distance upstream from x = ``length``.
+    """Log-linear slope g (1/m) of ``amplitude`` against the distance upstream from x = ``length``.
 
-    Fits ``log a = c + g (L - x)`` by least squares over the places with a finite,
-    positive amplitude; ``a0 exp(g d)`` gives g. g > 0: waves grow as they travel
-    upstream (away from the meter); g < 0: they decay.
-
-    Parameters
-    ----------
-    x : ndarray (N,)
-        Places, m from the inlet.
-    amplitude : ndarray (N,)
-        Amplitude at each place (e.g. :func:`temporal_sd`), any unit.
-    length : float
-        Position of the meter, x = L, m.
-
-    Returns
-    -------
-    float
-        g, 1/m; NaN with fewer than MIN_PLACES places.
+    Fits ``log a = c + g (L - x)`` by least squares over the places ``x`` (m from the
+    inlet) with a finite, positive amplitude (any unit, e.g. :func:`temporal_sd`). g > 0:
+    waves grow as they travel upstream (away from the meter at L); NaN with fewer than
+    MIN_PLACES places.
     """
     a = np.asarray(amplitude, float)
     ok = np.isfinite(a) & (a > 0)
@@ -206,13 +133,13 @@ def growth_upstream(x: np.ndarray, amplitude: np.ndarray, length: float) -> floa
 
 @dataclass(frozen=True)
 class WaveMeasures:
-    """Measures 1-3 of one block field (SI).
+    """The wave measures of one block field (SI).
 
     ``oscillation`` m/s (RMS over places of ``sd``); ``band_power``, ``total_variance``
     (m/s)^2, ``band_share`` 1, ``places`` used by the spectrum; ``x`` block centres, m,
     and ``sd`` the amplitude there, m/s; ``growth`` 1/m (:func:`growth_upstream`);
     ``short_power`` (m/s)^2 and ``short_share`` 1, the same as the band's in
-    :data:`SHORT_WAVES_S`; ``peak_period`` s (:func:`peak_period`).
+    :data:`SHORT_WAVES_S`; ``peak_period`` s (:meth:`PlaceSpectra.peak_period`).
     """
 
     oscillation: float
@@ -230,8 +157,8 @@ class WaveMeasures:
 
 def wave_measures(blocks: np.ndarray, dt: float, x: np.ndarray, length: float,
                   band: tuple[float, float] = STOP_AND_GO_S) -> WaveMeasures:
-    """:func:`temporal_sd`, :func:`band_power` (in ``band`` and in
-    :data:`SHORT_WAVES_S`), :func:`peak_period` and :func:`growth_upstream` of ``blocks``
+    """:func:`temporal_sd`, the power (:meth:`PlaceSpectra.band`, in ``band`` and in
+    :data:`SHORT_WAVES_S`), the peak period and :func:`growth_upstream` of ``blocks``
     (T, N; m/s) with block duration ``dt`` (s), block centres ``x`` (m) and the meter at
     ``length`` (m)."""
     sd = temporal_sd(blocks)
@@ -251,27 +178,12 @@ def block_centres(places: int, block_m: float) -> np.ndarray:
 def snapshot_blocks(period: np.ndarray, pos: np.ndarray, speed: np.ndarray,
                     n_periods: int, periods_per_block: int, block_m: float,
                     length: float) -> np.ndarray:
-    """Mean speed of vehicle samples per block of ``periods_per_block`` x ``block_m``.
+    """Mean speed (m/s) of vehicle samples per block of ``periods_per_block`` x ``block_m``.
 
-    Parameters
-    ----------
-    period : ndarray of int (S,)
-        Period index of each sample, 0 .. n_periods - 1.
-    pos, speed : ndarray (S,)
-        Position (m from the inlet) and speed (m/s) of each sample.
-    n_periods : int
-        Periods observed; an incomplete trailing block of periods or metres is dropped.
-    periods_per_block : int
-        Periods per block (>= 1).
-    block_m : float
-        Block length, m.
-    length : float
-        Section length, m.
-
-    Returns
-    -------
-    ndarray (n_periods // periods_per_block, floor(length / block_m))
-        m/s; NaN in a block with no sample.
+    Samples: ``period`` index (0 .. n_periods - 1), ``pos`` (m from the inlet) and
+    ``speed`` (m/s), each (S,). Returns (n_periods // periods_per_block,
+    floor(length / block_m)), an incomplete trailing block of periods or metres dropped;
+    NaN in a block with no sample.
     """
     bt, bx = n_periods // periods_per_block, int(length // block_m + 1e-9)
     it = np.asarray(period, np.intp) // periods_per_block
@@ -302,17 +214,9 @@ def file_boundaries(lat: np.ndarray, bin_m: float = 0.1, min_gap_m: float = 0.3,
     ``empty_share`` of the samples counts as empty (vehicles moving between files cross
     the gaps); runs of occupied bins apart by at least ``min_gap_m`` of empty bins are
     files, those holding less than ``min_share`` of the samples dropped. A boundary lies
-    midway across each gap between neighbouring files.
-
-    Parameters
-    ----------
-    lat : ndarray (S,)
-        Lateral offset of each sample from the lane centre, m (NaN skipped).
-
-    Returns
-    -------
-    ndarray (files - 1,)
-        Increasing boundaries, m; assign samples with ``numpy.searchsorted``.
+    midway across each gap between neighbouring files. ``lat``: each sample's offset
+    from the lane centre, m (NaN skipped). Returns the increasing boundaries (files - 1,),
+    m; assign samples with ``numpy.searchsorted``.
     """
     v = np.asarray(lat, float)
     v = v[np.isfinite(v)]
@@ -350,21 +254,11 @@ class LateralFile:
 
 def lateral_files(lat: np.ndarray, speed: np.ndarray,
                   **histogram: float) -> tuple[np.ndarray, list[LateralFile]]:
-    """The files of one class's samples and which file each sample rides in.
+    """The files of one class's samples (``lat`` m, ``speed`` m/s, each (S,); ``histogram``:
+    options of :func:`file_boundaries`) and which file each sample rides in.
 
-    Parameters
-    ----------
-    lat, speed : ndarray (S,)
-        Lateral offset (m) and speed (m/s) of each sample.
-    **histogram
-        Options of :func:`file_boundaries`.
-
-    Returns
-    -------
-    labels : ndarray of int (S,)
-        File of each sample, 0 for the lowest lateral offset (SUMO: the rightmost).
-    files : list of LateralFile
-        In that order; the shares sum to 1 (every sample is in a file).
+    Returns ``labels`` (S,), the file of each sample, 0 for the lowest lateral offset (SUMO:
+    the rightmost), and the :class:`LateralFile` list in that order (shares sum to 1).
     """
     lat, speed = np.asarray(lat, float), np.asarray(speed, float)
     labels = np.searchsorted(file_boundaries(lat, **histogram), lat)
