@@ -1,14 +1,10 @@
 """The evaluation of controllers over seeds: per measure, mean with its CI per controller
 and the paired difference against a baseline (the open loop) over the same seeds.
 
-Pure: takes a table with one row per run (columns ``controller``, ``seed`` and the
-measures as dotted summary keys in SI, as the sweep table has them) and returns tables
-and text; writes nothing (:mod:`arzsumo.outputs.evaluation` writes them).
-
-Values in the results are in the human units of :data:`MEASURES` (veh h, veh/h, kg, km/h,
-counts). Intervals: 95 % Student t for means and paired differences; the bootstrap (BCa,
-seeded) interval of the paired difference is given too (:mod:`~arzsumo.evaluation.stats`).
-Seeds where either run lacks a value are dropped pair-wise.
+Pure: reads a table with one row per run (``controller``, ``seed`` and the measures as
+dotted summary keys in SI, as the sweep table has them); values come out in the human
+units of :data:`MEASURES`. The table and its intervals: docs/outputs.md, "``arzsumo
+evaluate``"; :mod:`arzsumo.outputs.evaluation` writes them.
 """
 
 from __future__ import annotations
@@ -41,12 +37,13 @@ class Measure:
     aliases: tuple[str, ...] = ()
 
 
-def _split(key: str, label: str, unit: str, scale: float) -> tuple[Measure, ...]:
-    return tuple(Measure(f"{key}.{part}", f"{label}, {part}", unit, scale)
-                 for part in ("mainline", "ramp", "total"))
+def _split(key: str, label: str, unit: str, scale: float,
+           parts: tuple[str, ...] = ("mainline", "ramp", "total")) -> tuple[Measure, ...]:
+    return tuple(Measure(f"{key}.{part}", f"{label}, {part}", unit, scale) for part in parts)
 
 
 _CLASSES = (("h", "HV"), ("a", "AV"))
+_VEH_H = 1 / S_PER_H
 
 _WHOLE = "network_whole_demand"
 _WAIT = f"{_WHOLE}.ramp_wait_s"
@@ -55,14 +52,9 @@ _WAIT = f"{_WHOLE}.ramp_wait_s"
 #: arrival: what a controller leaves behind is charged), then the waves, then the meter's
 #: counts, then the control window's own measures
 MEASURES: tuple[Measure, ...] = (
-    Measure(f"{_WHOLE}.time_spent_s.total", "whole-demand time spent, total", "veh h",
-            1 / S_PER_H),
-    Measure(f"{_WHOLE}.time_spent_s.mainline", "whole-demand time spent, mainline", "veh h",
-            1 / S_PER_H),
-    Measure(f"{_WHOLE}.time_spent_s.ramp", "whole-demand time spent, ramp", "veh h",
-            1 / S_PER_H),
-    Measure(f"{_WHOLE}.time_loss_s.total", "whole-demand time loss, total", "veh h",
-            1 / S_PER_H),
+    *_split(f"{_WHOLE}.time_spent_s", "whole-demand time spent", "veh h", _VEH_H,
+            ("total", "mainline", "ramp")),
+    Measure(f"{_WHOLE}.time_loss_s.total", "whole-demand time loss, total", "veh h", _VEH_H),
     Measure(f"{_WHOLE}.fuel_g.total", "whole-demand fuel", "kg", 1e-3),
     Measure(f"{_WAIT}.p95", "ramp wait at the meter, 95th percentile", "s"),
     Measure(f"{_WAIT}.max", "ramp wait at the meter, maximum", "s"),
@@ -82,9 +74,9 @@ MEASURES: tuple[Measure, ...] = (
     Measure("light_changes", "ramp-light changes", "count"),
     Measure("triggers", "controller updates (triggers)", "count"),
     Measure("meter.override_s", "queue override on (window)", "s"),
-    *_split("network.time_spent_s", "window time spent", "veh h", 1 / S_PER_H),
-    *_split("network.time_loss_s", "window time loss", "veh h", 1 / S_PER_H),
-    *_split("network.depart_delay_s", "window depart delay", "veh h", 1 / S_PER_H),
+    *_split("network.time_spent_s", "window time spent", "veh h", _VEH_H),
+    *_split("network.time_loss_s", "window time loss", "veh h", _VEH_H),
+    *_split("network.depart_delay_s", "window depart delay", "veh h", _VEH_H),
     Measure("network.throughput_veh_h.section_outlet", "throughput, section outlet", "veh/h",
             1.0, lower_is_better=False),
     Measure("network.throughput_veh_h.network_exit", "throughput, network exit", "veh/h",
@@ -94,8 +86,8 @@ MEASURES: tuple[Measure, ...] = (
     *(Measure(f"section.speed_spread_kmh.{c}",
               f"section speed spread across vehicles, {name}", "km/h",
               aliases=(f"section.speed_sd_kmh.{c}",)) for c, name in _CLASSES),
-    Measure("section.TTT.total", "section TTT", "veh h", 1 / S_PER_H),
-    Measure("section.total_delay.total", "section delay", "veh h", 1 / S_PER_H),
+    Measure("section.TTT.total", "section TTT", "veh h", _VEH_H),
+    Measure("section.total_delay.total", "section delay", "veh h", _VEH_H),
 )
 
 #: columns of the long table, in order (``evaluation.csv``)
@@ -141,11 +133,8 @@ def deadlocked_seeds(runs: pd.DataFrame, controllers: Sequence[str]) -> list[int
     num = {k: pd.to_numeric(runs[k], errors="coerce") for k in keys[1:]}
     before = num["longest_standstill_main"] >= num["horizon"] + num[keys[1]] - 1.0
     stuck = (runs[keys[0]].astype(str).str.lower() == "true") & before
-    out = []
-    for seed, rows in runs.assign(_stuck=stuck).groupby("seed"):
-        if set(controllers) <= set(rows["controller"]) and bool(rows["_stuck"].all()):
-            out.append(int(seed))
-    return sorted(out)
+    return sorted(int(seed) for seed, rows in runs.assign(_stuck=stuck).groupby("seed")
+                  if set(controllers) <= set(rows["controller"]) and bool(rows["_stuck"].all()))
 
 
 def seed_values(runs: pd.DataFrame, measure: Measure, controller: str,
@@ -197,15 +186,9 @@ def evaluate(runs: pd.DataFrame, controllers: Sequence[str], baseline: str = "op
              measures: Sequence[Measure] = MEASURES) -> pd.DataFrame:
     """The long table (:data:`COLUMNS`): one row per measure and controller.
 
-    Parameters
-    ----------
-    runs : pandas.DataFrame
-        One row per finished run: ``controller``, ``seed`` and the measures' keys (SI).
-    controllers : sequence of str
-        Controllers in report order; must contain ``baseline``.
-    baseline : str
-        The controller every other is compared with, seed by seed (its own row has a
-        difference of 0 with a zero-width interval).
+    ``runs``: one row per finished run (``controller``, ``seed`` and the measures' keys,
+    SI); ``controllers`` in report order, ``baseline`` among them: every other is compared
+    with it seed by seed (its own row has a difference of 0, zero-width interval).
     """
     if baseline not in controllers:
         raise StatisticsError(f"baseline = {baseline!r} is not among the controllers "
@@ -223,12 +206,8 @@ def paired_differences(runs: pd.DataFrame, measure: Measure, controllers: Sequen
     """Per controller (baseline excluded), the per-seed differences against the baseline
     in the measure's human unit, seeds where either value is missing left out."""
     wide = per_seed(runs, measure, controllers)
-    out = {}
-    for c in controllers:
-        if c != baseline:
-            d = (wide[c] - wide[baseline]).to_numpy(float)
-            out[c] = d[np.isfinite(d)]
-    return out
+    diffs = {c: (wide[c] - wide[baseline]).to_numpy(float) for c in controllers if c != baseline}
+    return {c: d[np.isfinite(d)] for c, d in diffs.items()}
 
 
 def _fmt(value: float, digits: int = 3) -> str:

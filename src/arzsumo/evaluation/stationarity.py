@@ -1,15 +1,9 @@
 """Is a run stationary? The trend of the section's vehicle count over a window.
 
-The count N(t) of vehicles in the section (veh) is averaged over blocks of ``block_s``
-seconds (30 s by default: longer than most of the autocorrelation of SUMO's waves, short
-enough to leave 15 blocks in a 450 s horizon). On the block means:
-
-* the OLS slope (veh/min) with its 95 % t-interval,
-* Kendall's tau test of the block means against time (no assumption of linearity or
-  normality; p-value two-sided),
-* the drift: the OLS slope times the window over the mean count.
-
-A window is called stationary when Kendall's p > 0.05 and |drift| < 10 %.
+On block means of the section's vehicle count (30 s by default: longer than most of the
+autocorrelation of SUMO's waves, short enough to leave 15 blocks in a 450 s horizon): the
+OLS slope with its 95 % t-interval, Kendall's tau test against time (no assumption of
+linearity or normality) and the drift; docs/outputs.md, ``section_trend``.
 """
 
 from __future__ import annotations

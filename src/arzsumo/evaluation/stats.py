@@ -1,14 +1,8 @@
 """Statistics over seeds: means with confidence intervals, paired differences, wins.
 
-Pure numpy/scipy: no SUMO, no files. Controllers are compared on the *same* seeds, so
-the comparison is the paired difference ``d_i = treatment_i - baseline_i`` (seed i), whose
-mean is estimated with two 95 % confidence intervals:
-
-* Student t: ``mean(d) +- t(0.975, n - 1) sd(d) / sqrt(n)``;
-* bootstrap: scipy's BCa (or percentile) bootstrap of ``mean(d)``, seeded, so the same
-  data give the same interval.
-
-Conventions, decided once for every function here:
+Pure numpy/scipy. Controllers are compared on the *same* seeds: the paired difference
+``d_i = treatment_i - baseline_i`` (seed i), whose mean gets a Student-t and a seeded
+(reproducible) BCa or percentile bootstrap 95 % interval. Conventions of every function:
 
 * **NaN** values are *dropped*, pair-wise for paired data (a seed whose run failed or
   whose measure is undefined leaves both members out), and the number dropped is kept
@@ -132,6 +126,14 @@ def _is_constant(a: np.ndarray) -> bool:
     return float(np.ptp(a)) <= CONSTANT_RTOL * scale
 
 
+def _kept(x: ArrayLike) -> tuple[np.ndarray, int]:
+    """The values of ``x`` that are not NaN, and how many were; nothing left refused."""
+    a, nan = _clean(x, "x")
+    if nan.all():
+        raise StatisticsError(f"x = {a.tolist()} is not allowed: at least one value not NaN")
+    return a[~nan], int(nan.sum())
+
+
 def _t_interval(a: np.ndarray, level: float) -> tuple[float, float, float]:
     """Mean and Student-t interval of ``a`` (NaN bounds for one value)."""
     mean = float(np.mean(a))
@@ -158,12 +160,9 @@ def mean_ci(x: ArrayLike, level: float = 0.95) -> MeanCI:
     MeanCI
         NaN bounds when one value is left; zero width for constant data.
     """
-    a, nan = _clean(x, "x")
-    kept = a[~nan]
-    if kept.size == 0:
-        raise StatisticsError(f"x = {a.tolist()} is not allowed: at least one value not NaN")
+    kept, dropped = _kept(x)
     mean, low, high = _t_interval(kept, level)
-    return MeanCI(mean, low, high, int(kept.size), int(nan.sum()), level, "t")
+    return MeanCI(mean, low, high, int(kept.size), dropped, level, "t")
 
 
 def bootstrap_mean_ci(x: ArrayLike, level: float = 0.95, *, method: str = "BCa",
@@ -176,10 +175,7 @@ def bootstrap_mean_ci(x: ArrayLike, level: float = 0.95, *, method: str = "BCa",
     """
     if method not in BOOTSTRAP_METHODS:
         raise StatisticsError(f"method = {method!r} is not allowed: one of {BOOTSTRAP_METHODS}")
-    a, nan = _clean(x, "x")
-    kept = a[~nan]
-    if kept.size == 0:
-        raise StatisticsError(f"x = {a.tolist()} is not allowed: at least one value not NaN")
+    kept, dropped = _kept(x)
     mean = float(np.mean(kept))
     if kept.size == 1:
         low = high = math.nan
@@ -190,7 +186,7 @@ def bootstrap_mean_ci(x: ArrayLike, level: float = 0.95, *, method: str = "BCa",
                             confidence_level=level, rng=np.random.default_rng(seed),
                             vectorized=True)
         low, high = float(res.confidence_interval.low), float(res.confidence_interval.high)
-    return MeanCI(mean, low, high, int(kept.size), int(nan.sum()), level, method)
+    return MeanCI(mean, low, high, int(kept.size), dropped, level, method)
 
 
 def wins_losses(diff: ArrayLike, *, lower_is_better: bool = True,

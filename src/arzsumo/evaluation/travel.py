@@ -1,13 +1,10 @@
 """How fast, and which way, a field's fluctuations travel.
 
-The paper's controllers act on a congested stream (section 2, "Free/congested traffic
-analysis"): the characteristic speed lambda_4 < 0, so what the meter does at x = L
-reaches the section by travelling upstream. In the stream itself this shows as speed
-fluctuations that travel upstream. :func:`wave_speed` measures their speed: for each of
-several distances d between places, the lag of the peak of the pair-averaged
-cross-correlation (:func:`arzsumo.evaluation.fields.wave_travel`; > 0 when the downstream
-place follows); a wave at one speed c gives lag = d / c, a line through the origin. The
-fit ``lag = a + d / c`` over the distances gives c and its r^2.
+On the paper's congested stream (section 2, "Free/congested traffic analysis":
+lambda_4 < 0) what the meter does at x = L travels upstream, and so do the speed
+fluctuations. :func:`wave_speed` takes, for several distances d between places, the lag of
+the peak cross-correlation (:func:`arzsumo.evaluation.fields.wave_travel`) and fits
+``lag = a + d / c``: a wave at one speed c gives a line through the origin.
 
 SI units: s, m, m/s.
 """
@@ -36,19 +33,11 @@ DISTANCES_M, MAX_LAG_S = (100.0, 200.0, 300.0, 400.0), 200.0
 class WaveSpeed:
     """The lag of the peak correlation against the distance between places.
 
-    Attributes
-    ----------
-    speed : float
-        c = 1 / slope of the fit lag = a + d / c, m/s (> 0 downstream, < 0 upstream; NaN
-        with fewer than three resolved distances or a zero slope).
-    r2 : float
-        Coefficient of determination of that fit (NaN when the lags do not vary).
-    intercept_s : float
-        a, s (0 for a pure travelling wave).
-    distances_m, lags_s, peak_corr : tuple of float
-        Per distance: d (m), lag of the peak (s), pair-averaged peak correlation.
-    used : tuple of bool
-        Distances in the fit: a peak inside the search and correlation >= ``min_corr``.
+    ``speed``: c of the fit lag = a + d / c, m/s (> 0 downstream; NaN with fewer than
+    three resolved distances or a zero slope); ``r2`` of that fit (NaN when the lags do
+    not vary); ``intercept_s``: a, s (0 for a pure travelling wave); per distance
+    ``distances_m`` d (m), ``lags_s`` (s), ``peak_corr`` and ``used``: in the fit (a peak
+    inside the search and correlation >= ``min_corr``).
     """
 
     speed: float
@@ -82,25 +71,10 @@ def wave_speed(field: np.ndarray, dt: float, dx: float,
                min_corr: float = 0.3) -> WaveSpeed:
     """Speed and direction of the fluctuations of a (T, N) field from lag against distance.
 
-    Parameters
-    ----------
-    field : ndarray (T, N)
-        Periods x places, e.g. a class's speed, m/s; NaN where not observed.
-    dt : float
-        Period, s.
-    dx : float
-        Distance between neighbouring places, m.
-    distances_m : sequence of float
-        Distances between the places of a pair, m; each is rounded to whole places
-        (at least one), repeats dropped.
-    max_lag_s : float
-        Largest lag searched, s (held to half the series, as in ``wave_travel``).
-    min_corr : float
-        Least peak correlation of a distance used in the fit.
-
-    Returns
-    -------
-    WaveSpeed
+    ``field``, ``dt``, ``dx``, ``max_lag_s`` as in
+    :func:`~arzsumo.evaluation.fields.wave_travel`; ``distances_m`` between the places of a
+    pair, m, each rounded to whole places (at least one), repeats dropped; ``min_corr``:
+    the least peak correlation of a distance used in the fit.
     """
     f = np.asarray(field, float)
     require(f.ndim == 2 and f.shape[0] >= 8 and f.shape[1] >= 2, "field", f.shape,
