@@ -1,36 +1,9 @@
 """Results of a co-simulation: tables, ``summary.json`` and plots, written atomically.
 
-Every file, column (with units, stored in the Parquet field metadata from
-:mod:`arzsumo.schema`) and summary key is described in ``docs/outputs.md``. Layout of
-``DIR``::
-
-    periods.parquet   per control period: t_s (check time), U applied and continuous (veh/s),
-                      event flag, green share commanded and running, light and plan changes,
-                      ramp queue and its maximum (veh), class in/outflows (veh/s),
-                      downstream occupancy; U of the law and applied, limit flags
-    cells.parquet     per period and cell: source (micro, replay, reference), t_s, x_m,
-                      rho_h, v_h, rho_a, v_a (SI; micro speeds NaN in empty cells)
-    summary.json      see :func:`summary`
-    summary.csv       the run's row of ``arzsumo compare``'s table: every column, in human
-                      units (``arzsumo run`` prints the key ones)
-    tripinfo.xml.gz   SUMO's tripinfo output (every loaded vehicle, with emissions),
-                      compressed; ``arzsumo.sumo.network_measures.read_trips`` reads it
-    fcd.xml.gz        with ``[sumo] fcd`` (``--fcd``): SUMO's FCD output, every vehicle
-                      every step (type, speed, pos, lane, posLat)
-    run.sumocfg, sumo/   the SUMO configuration the run ran (network, routes, loops) and
-                      the meter's nominal plan as a static program: ``sumo-gui -c``
-    scenario.toml     the resolved scenario (as loaded) and settings
-    fields_h.png, fields_a.png   micro | replay twin | reference twin, per class
-    control.png       U, green share, light, queue, release instants
-
-Counting windows: the meter's counts cover the *control window* only (from the start of
-control, after the warm-up, to the horizon). In ``periods.parquet``, ``light_changes`` and
-``plan_changes`` are cumulative counts since the start of control (0 before the first
-change) and ``max_queue`` is the maximum since the start of control, all read at the end
-of each period; ``queue`` is the queue at the end of the period. In ``summary.json`` the
-top-level ``plan_changes``, ``light_changes`` and ``max_ramp_queue`` are those of the
-control window; the warm-up's own counts (from t = 0 of SUMO to the start of control) are
-under ``warmup``, apart, and are not included in the top-level ones.
+Every file of ``DIR``, column (with units, in the Parquet field metadata from
+:mod:`arzsumo.schema`) and summary key, and the counting windows of the meter's counts
+(the control window; the warm-up's apart under ``warmup``), are described in
+docs/outputs.md, "``arzsumo run``".
 """
 
 from __future__ import annotations
@@ -137,12 +110,8 @@ def section_trend(res: CoSimResult) -> dict[str, Any] | None:
 
 def estimation_summary(res: CoSimResult) -> dict[str, Any] | None:
     """How well the state the controller acted on matched the full probe's cells
-    (:func:`arzsumo.bridge.sensor_record.estimation_scores`: ``method``, ``sensors``, RMSE
-    per variable absolute SI and relative to the equilibrium, the EnKF's mean ``spread``,
-    the RMSE of ``interpolation`` between the loop stations); ``reference`` and
-    ``reference_offset``: what a PDE controller's deviations were measured from and the
-    mean offset subtracted from its input (SI; None from the equilibrium). None without
-    an estimate."""
+    (:func:`arzsumo.bridge.sensor_record.estimation_scores`), and the reference of a PDE
+    controller's deviations (docs/outputs.md, ``estimation.*``); None without an estimate."""
     est = res.estimator
     if est is None or res.estimate is None or not res.estimate.size:
         return None
@@ -152,19 +121,10 @@ def estimation_summary(res: CoSimResult) -> dict[str, Any] | None:
 
 
 def actuation_summary(res: CoSimResult) -> dict[str, Any]:
-    """The ``[actuation]`` limits used (SI; null: off) and how often they acted: periods
-    and shares of the control window's periods saturated and rate limited;
-    ``delay_compensation``: the dead time theta (s) the acting law predicted over (0: off,
-    or a controller without a Riemann-state law, :mod:`arzsumo.bridge.delay`);
-    ``meter_gain`` and ``hold_plan_in_range`` as in ``[actuation]``;
-    ``trigger_output_noise`` (veh/s): the acting law's output noise on the warm-up's
-    estimate, and ``trigger_dead_band`` (veh/s, noise_k sqrt(2) times it) the dead band
-    it sized, both as the U the meter is asked for (the law's outflow units over
-    ``meter_gain``; null: not measured, :mod:`arzsumo.bridge.trigger_noise`);
-    ``actuator``: what the acting law's U drove (``meter`` or ``speed_limit``), and
-    ``authority``: the sd of the U applied and of the outflow q(L) over 60 s windows
-    (veh/s) and the realised gain, the slope of the one on the other
-    (:mod:`arzsumo.evaluation.authority`)."""
+    """``summary.json["actuation"]``: the ``[actuation]`` limits used (SI; null: off), how
+    often they acted, the delay compensation, the trigger's noise and dead band
+    (:mod:`arzsumo.bridge.trigger_noise`), the actuator and its authority
+    (:mod:`arzsumo.evaluation.authority`); docs/outputs.md, ``actuation.*``."""
     act, per = res.scenario.actuation, res.periods
     n = int(per["t"].size)
     sat, rate = int(np.sum(per["saturated"] > 0)), int(np.sum(per["rate_limited"] > 0))
@@ -217,10 +177,8 @@ def _blocks(res: CoSimResult) -> tuple[int, int]:
 
 
 def speed_oscillation(res: CoSimResult) -> dict[str, Any]:
-    """Per class, the RMS over places of the temporal sd of the micro speed (km/h) on
-    RMSE_BLOCK_M x RMSE_BLOCK_S blocks (:func:`arzsumo.evaluation.fields.oscillation`): the
-    waves, without the mean speed profile and the lateral files that the spread across
-    vehicles ``speed_spread_kmh`` also counts."""
+    """Per class, the micro speed's oscillation (km/h) on RMSE_BLOCK_M x RMSE_BLOCK_S
+    blocks (:func:`arzsumo.evaluation.fields.oscillation`): the waves alone."""
     periods, cells = _blocks(res)
     sd = oscillation(res.micro[:, [1, 3]], periods, cells)
     return {"speed_oscillation_kmh": {"h": float(ms_to_kmh(sd[0])),
@@ -236,10 +194,8 @@ WAVE_GAP_M, WAVE_MAX_LAG_S = 250.0, 150.0
 
 def speed_wave(res: CoSimResult) -> dict[str, Any]:
     """Per class, which way the micro speed fluctuations travel
-    (:func:`arzsumo.evaluation.fields.wave_travel` over places WAVE_GAP_M apart): lag of
-    the pair-averaged peak (s), speed (km/h; > 0 downstream, the way the meter cannot
-    reach; NaN when unresolved), peak correlation, pairs. The paper's actuator acts
-    through what travels upstream."""
+    (:func:`arzsumo.evaluation.fields.wave_travel` over places WAVE_GAP_M apart; speed in
+    km/h, > 0 downstream, the way the meter cannot reach)."""
     dx = float(res.x[1] - res.x[0]) if res.x.size > 1 else float(res.sumo.cell_length)
     gap = max(1, round(WAVE_GAP_M / dx))
     out: dict[str, Any] = {"gap_m": gap * dx, "max_lag_s": WAVE_MAX_LAG_S}
@@ -251,25 +207,18 @@ def speed_wave(res: CoSimResult) -> dict[str, Any]:
 
 
 def section_summary(res: CoSimResult, micro: dict[str, Any]) -> dict[str, Any]:
-    """The section's measures, labelled as such: per-vehicle speed moments per class (km/h;
-    ``speed_spread_kmh``, the spread across vehicles, also under its former name
-    ``speed_sd_kmh``), the speed oscillation (:func:`speed_oscillation`), the waves'
-    direction (:func:`speed_wave`), the wave measures per class and lateral file
-    (:func:`arzsumo.outputs.waves.waves_summary`), the deviation from the warm-up's
-    stationary state (:func:`deviation_summary`) and the micro indices ``micro``
-    (:func:`_indices`; also at the top level, kept for compatibility) and the inlet's
-    state (:func:`inlet_summary`)."""
+    """``summary.json["section"]``: the per-vehicle speed moments, the measures of the
+    functions below and the micro indices ``micro`` (:func:`_indices`; also at the top
+    level, kept for compatibility); docs/outputs.md, ``section.*``."""
     return {"window": SECTION_WINDOW, **res.section_speed, **speed_oscillation(res),
             "speed_wave": speed_wave(res), "waves": waves_summary(res, *_blocks(res)),
             "deviation": deviation_summary(res), "inlet": inlet_summary(res), **micro}
 
 
 def inlet_summary(res: CoSimResult) -> dict[str, float]:
-    """The state SUMO holds at the section's inlet: the window means of the first Edie
-    cell (x in [0, ``cell_length``]) per class, density in veh/km and speed in km/h
-    (NaN where the cell had no vehicle of the class in any period). What sits upstream
-    of x = 0 (the approach, SUMO's insertion backlog) reaches the section only through
-    this state."""
+    """The state SUMO holds at the section's inlet, the window means of the first Edie cell
+    per class (veh/km, km/h; NaN without a vehicle of the class): what sits upstream of
+    x = 0 reaches the section only through this state."""
     first = res.micro[:, :, 0]
     mean = {name: float(np.nanmean(first[:, k])) if np.isfinite(first[:, k]).any()
             else float("nan") for k, name in enumerate(VARIABLES)}
@@ -280,9 +229,8 @@ def inlet_summary(res: CoSimResult) -> dict[str, float]:
 
 
 def deviation_summary(res: CoSimResult) -> dict[str, Any] | None:
-    """The window's deviation from the warm-up's stationary state: decay time (s),
-    integrated norm and its part above the stationary band (s), the band (1), whether it
-    ended inside it (:mod:`arzsumo.evaluation.decay`); None without a reference."""
+    """The window's deviation from the warm-up's stationary state
+    (:mod:`arzsumo.evaluation.decay`); None without a reference."""
     if res.stationary is None or res.t.size < 2:
         return None
     e = deviation_norm(res.micro, res.stationary)
@@ -297,21 +245,14 @@ METER_KEYS = ("mode", "clearance_s", "release_rate", "releases", "greens",
 
 
 def meter_summary(res: CoSimResult) -> dict[str, Any]:
-    """The meter's realisation and its counts over the control window
-    (``summary.json["meter"]``): mode, clearance (s), last release rate (veh/s, null for
-    the fixed cycle), releases (vehicles crossing the stop line), green intervals begun
-    and the most releases in one, override steps, emergency stops and braking at the
-    meter; with the outlet's speed limit as the actuator, its changes over the window, its
-    last and its nominal limit (m/s; null on the meter)."""
+    """``summary.json["meter"]``: the meter's realisation and its counts over the control
+    window (docs/outputs.md, ``meter.*``)."""
     return {k: res.meter.get(k) for k in METER_KEYS}
 
 
 def finite_variance(values: np.ndarray) -> float:
-    """``numpy.nanvar`` of ``values`` (their unit squared, here m^2/s^2).
-
-    NaN, without numpy's "Degrees of freedom <= 0" warning, when every value is NaN: no
-    vehicle of the class was sampled in the window (a section still empty).
-    """
+    """``numpy.nanvar`` of ``values`` (m^2/s^2 here); NaN, without numpy's "Degrees of
+    freedom <= 0" warning, when every value is NaN (no vehicle of the class sampled)."""
     values = np.asarray(values, float)
     return float(np.nanvar(values)) if (~np.isnan(values)).any() else float("nan")
 

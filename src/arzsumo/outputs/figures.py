@@ -1,10 +1,8 @@
 """Figure files: every PNG of arzsumo is saved here, atomically, and its figure closed.
 
-The figures are drawn by :mod:`arzsumo.plots` (functions that return Figures and write
-nothing); :func:`save_png` saves one, :func:`save_figures` a dict of them by name. The
-single-figure writers of the CLI are here too: the regime map (``arzsumo model
---regime-map``) and the kernels (``arzsumo kernels --plot``). Importing this module selects
-matplotlib's Agg backend (through :mod:`arzsumo.plots`): nothing is ever displayed.
+:mod:`arzsumo.plots` draws the figures; here are also the CLI's single-figure writers (the
+regime map of ``arzsumo model --regime-map``, the kernels of ``arzsumo kernels --plot``).
+Importing this module selects matplotlib's Agg backend: nothing is ever displayed.
 """
 
 from __future__ import annotations
@@ -24,22 +22,8 @@ if TYPE_CHECKING:                  # annotations only: saving a figure needs nei
 
 
 def save_png(fig: Figure, path: str | Path, dpi: int = 110) -> Path:
-    """Save ``fig`` as PNG at ``path`` atomically and close it.
-
-    Parameters
-    ----------
-    fig : Figure
-        The figure; closed afterwards, also when saving fails.
-    path : str or Path
-        The file written (missing parent directories are made).
-    dpi : int, optional
-        Resolution in dots per inch.
-
-    Returns
-    -------
-    Path
-        ``path``.
-    """
+    """Save ``fig`` as PNG at ``path`` (parents made) atomically and close it, also when
+    saving fails; return ``path``."""
     try:
         with atomic_file(path) as tmp:
             fig.savefig(tmp, dpi=dpi, format="png")
@@ -50,23 +34,8 @@ def save_png(fig: Figure, path: str | Path, dpi: int = 110) -> Path:
 
 def save_figures(figs: Mapping[str, Figure], directory: str | Path,
                  dpi: int = 110) -> list[Path]:
-    """Save each figure of ``figs`` as ``<name>.png`` in ``directory`` and close them all.
-
-    Parameters
-    ----------
-    figs : mapping of str to Figure
-        Figures by name (the file name without ``.png``), saved in this order.
-    directory : str or Path
-        The directory (made if missing).
-    dpi : int, optional
-        Resolution in dots per inch, the same for every figure.
-
-    Returns
-    -------
-    list of Path
-        The files written, in the order of ``figs``. If one fails, the figures not yet
-        saved are closed too.
-    """
+    """Save each figure of ``figs`` as ``<name>.png`` in ``directory`` (made if missing),
+    in order, and close them all, those not yet saved too if one fails; return the files."""
     directory = Path(directory)
     pending = list(figs.items())
     written = []

@@ -1,10 +1,6 @@
-"""Write an identification (``arzsumo identify --out DIR``) atomically as one directory:
-``identified.toml``, ``identification.json``, ``fields.png`` and ``scatter.png``, and with
-``--diagram`` ``diagram.png`` (stage 1's fit against SUMO's stationary states), and
-``spectrum.png`` (where the runs' speed fluctuations lie in time scale).
-
-Their content is made by :mod:`arzsumo.workflows.identify.report`; here the texts are
-written and the figures (:mod:`arzsumo.plots.identify`) drawn from arrays.
+"""Write an identification (``arzsumo identify --out DIR``) atomically as one directory
+(docs/outputs.md, "``arzsumo identify``"). :mod:`arzsumo.workflows.identify.report` makes
+the content; here the texts are written and the figures drawn from arrays.
 """
 
 from __future__ import annotations

@@ -1,14 +1,9 @@
 """Writers of the studies (:mod:`arzsumo_studies`): tables, text, and the results page.
 
-A study writes its tables (CSV) and text (Markdown) under its ``--out`` directory with
-:func:`write_csv` and :func:`write_text`, its figures with
-:mod:`arzsumo_studies.outputs.study_figures`, and with ``--docs`` publishes them with
-:func:`publish`: the files are copied into ``DOCS/<page>/`` and the results page
-``DOCS/<page>.md`` gets the study's generated block, between :data:`BEGIN` and
-:data:`END` (named for the study, so several studies can keep a block in one page).
-Text outside the blocks (an introduction, the discussion of the results) is kept as it
-is, so a page can be edited by hand and regenerated; a page without the study's block
-gets it appended.
+With ``--docs`` a study :func:`publish`-es its files into ``DOCS/<page>/`` and its
+generated block, between :data:`BEGIN` and :data:`END` (named for the study), into the
+page ``DOCS/<page>.md``; text outside the blocks is kept, so a page can be edited by hand
+and regenerated.
 """
 
 from __future__ import annotations

@@ -1,9 +1,5 @@
 """Write a paper reproduction: ``report.md``, CSV tables, ``summaries.json`` and figures,
-atomically (:func:`arzsumo.io.atomic_dir`).
-
-The content (report text, table rows, figure data) is built by
-:mod:`arzsumo.workflows.paper.report`; this module only writes it, and draws the figures
-with :mod:`arzsumo.plots.reproduce`.
+atomically; :mod:`arzsumo.workflows.paper.report` builds the content.
 """
 
 from __future__ import annotations

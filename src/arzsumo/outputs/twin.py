@@ -1,13 +1,7 @@
-"""Write a twin run to a directory: Parquet fields, control history, summary, plots.
-
-Every file, column (units in the Parquet field metadata, from :mod:`arzsumo.schema`) and
-summary key is described in ``docs/outputs.md``.
-Layout of ``DIR`` (written atomically with :func:`arzsumo.io.atomic_dir`)::
-
-    fields.parquet    long table: t_s, x_m, rho_h, v_h, rho_a, v_a (SI: veh/m, m/s)
-    control.parquet   t_s, u_applied, u_requested, u_continuous, triggered (veh/s)
-    summary.json      :meth:`arzsumo.engines.twin.TwinRun.summary`
-    fields_h.png, fields_a.png, control.png
+"""Write a twin run to a directory atomically: Parquet fields, control history, summary
+(:meth:`arzsumo.engines.twin.TwinRun.summary`), plots. Every file, column (units in the
+Parquet field metadata, from :mod:`arzsumo.schema`) and summary key: docs/outputs.md,
+"``arzsumo twin``".
 """
 
 from __future__ import annotations

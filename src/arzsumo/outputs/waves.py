@@ -1,12 +1,8 @@
 """``summary.json["section"]["waves"]``: wave measures per class and per lateral file.
 
-Per class (HV ``h``, AV ``a``) the micro speed of the Edie cells on blocks of
-``periods`` x ``cells`` (:func:`arzsumo.evaluation.fields.block_means`), and per lateral
-file of that class the once-per-period snapshots of its vehicles
-(:class:`~arzsumo.sumo.lateral.LateralRecord`) averaged on the same blocks
-(:func:`~arzsumo.evaluation.waves.snapshot_blocks`), each measured by
-:func:`~arzsumo.evaluation.waves.wave_measures`: temporal sd of the block speeds, power in
-the stop-and-go band and growth of the amplitude upstream. Km/h here, SI inside.
+:func:`~arzsumo.evaluation.waves.wave_measures` of the Edie cells' micro speed per class,
+and per lateral file of the snapshots of its vehicles on the same blocks
+(docs/outputs.md, ``section.waves``). Km/h here, SI inside.
 """
 
 from __future__ import annotations
