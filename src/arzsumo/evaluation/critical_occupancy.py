@@ -18,6 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from arzsumo.evaluation.authority import window_means
+
 #: ALINEA's target as a share of the critical occupancy (just below it)
 TARGET_SHARE = 0.9
 #: width of the occupancy bins of the curve, fraction
@@ -34,10 +36,7 @@ def period_means(occupancy: np.ndarray, flow: np.ndarray, dt: float, period: flo
     n = round(period / dt)
     if n < 1 or abs(n * dt - period) > 1e-6:
         raise ValueError(f"period {period} s is not a whole multiple of {dt} s")
-    occ, q = np.asarray(occupancy, float), np.asarray(flow, float)
-    k = occ.size // n
-    o = occ[:k * n].reshape(k, n).mean(axis=1)
-    f = q[:k * n].reshape(k, n).mean(axis=1)
+    o, f = window_means(occupancy, dt, period), window_means(flow, dt, period)
     keep = np.isfinite(o) & np.isfinite(f)
     return o[keep], f[keep]
 

@@ -14,14 +14,8 @@ import numpy as np
 
 
 def block_means(field: np.ndarray, periods: int, cells: int) -> np.ndarray:
-    """Means of ``field`` (T, V, N) over blocks of ``periods`` x ``cells``, NaN skipped.
-
-    Incomplete trailing blocks are dropped; a block with no finite value is NaN.
-
-    Returns
-    -------
-    ndarray (T // periods, V, N // cells)
-    """
+    """Means (T // periods, V, N // cells) of ``field`` (T, V, N) over blocks of ``periods``
+    x ``cells``, NaN skipped; incomplete trailing blocks dropped, empty blocks NaN."""
     if periods < 1 or cells < 1:
         raise ValueError(f"block of {periods} periods x {cells} cells; expected >= 1 each")
     n_t, n_v, n_x = field.shape
@@ -37,18 +31,9 @@ def block_means(field: np.ndarray, periods: int, cells: int) -> np.ndarray:
 
 def field_rmse(observed: np.ndarray, predicted: np.ndarray, periods: int = 1,
                cells: int = 1) -> tuple[np.ndarray, np.ndarray]:
-    """RMSE per variable of two (T, V, N) fields at a block resolution.
-
-    Both fields are block-averaged over the same pairs: a value missing (NaN) in either
-    is removed from both first, so the blocks compare like with like.
-
-    Returns
-    -------
-    rmse : ndarray (V,)
-        In the fields' units; NaN for a variable with no finite block pair.
-    samples : ndarray (V,)
-        Block pairs compared per variable.
-    """
+    """RMSE per variable (V,; NaN without a finite block pair) of two (T, V, N) fields at
+    a block resolution, and the block pairs compared. A value missing (NaN) in either is
+    removed from both before the block means, so the blocks compare like with like."""
     both = np.isfinite(observed) & np.isfinite(predicted)
     a = block_means(np.where(both, observed, np.nan), periods, cells)
     b = block_means(np.where(both, predicted, np.nan), periods, cells)

@@ -118,13 +118,10 @@ def per_seed(runs: pd.DataFrame, measure: Measure, controllers: Sequence[str]) -
 def deadlocked_seeds(runs: pd.DataFrame, controllers: Sequence[str]) -> list[int]:
     """The seeds on which SUMO deadlocked before control began, under every controller.
 
-    A seed counts when every one of ``controllers`` (the baseline among them) has a run
-    on it, and each run's drain ended in a gridlock with a mainline vehicle standing
-    still since before the control window opened (its standstill at the end at least the
-    window plus the drain, s). A deadlock that one controller caused, or that came in the
-    window or the drain, leaves the seed in. A comparison leaves these seeds out: their
-    measures are a standstill's (band power 0, no whole-demand time), and their zero
-    differences would narrow every interval.
+    A seed counts when each of ``controllers`` has a run on it whose drain ended in a
+    gridlock with a mainline vehicle standing since before the window opened (its
+    standstill at the end at least the window plus the drain, s). A comparison leaves
+    these out: their zero differences would narrow every interval (docs/sumo.md).
     """
     keys = (f"{_WHOLE}.drain.gridlock", f"{_WHOLE}.drain.duration_s",
             "longest_standstill_main", "horizon")

@@ -38,16 +38,9 @@ class StatisticsError(ArzsumoError, ValueError):
 class MeanCI:
     """Mean of a sample with a two-sided confidence interval.
 
-    Attributes
-    ----------
-    mean, low, high : float
-        Estimate and interval bounds, in the unit of the data (NaN bounds when n = 1).
-    n, n_dropped : int
-        Values used, and NaN values left out.
-    level : float
-        Confidence level, e.g. 0.95.
-    method : str
-        ``"t"``, ``"BCa"`` or ``"percentile"``.
+    ``mean``, ``low``, ``high`` in the unit of the data (NaN bounds when n = 1); ``n``
+    values used and ``n_dropped`` NaN values left out; confidence ``level`` (e.g. 0.95);
+    ``method``: ``"t"``, ``"BCa"`` or ``"percentile"``.
     """
 
     mean: float
@@ -81,17 +74,10 @@ class MeanCI:
 
 @dataclass(frozen=True)
 class PairedComparison:
-    """Treatment minus baseline over the same seeds.
-
-    Attributes
-    ----------
-    t, bootstrap : MeanCI
-        Mean paired difference with its Student-t and bootstrap intervals.
-    wins, losses, ties : int
-        Seeds where the treatment is better, worse, or within ``tie_tol`` of the baseline
-        (better means lower when ``lower_is_better``).
-    lower_is_better : bool
-        Direction of the measure (True for delays, times, fuel).
+    """Treatment minus baseline over the same seeds: the mean paired difference with its
+    Student-t (``t``) and ``bootstrap`` intervals, and the seeds where the treatment is
+    better (``wins``), worse (``losses``) or within ``tie_tol`` of the baseline (``ties``);
+    better means lower when ``lower_is_better`` (delays, times, fuel).
     """
 
     t: MeanCI
@@ -146,20 +132,8 @@ def _t_interval(a: np.ndarray, level: float) -> tuple[float, float, float]:
 
 
 def mean_ci(x: ArrayLike, level: float = 0.95) -> MeanCI:
-    """Mean of ``x`` with its Student-t confidence interval.
-
-    Parameters
-    ----------
-    x : array_like, shape (n,)
-        One value per seed; NaN values are dropped and counted.
-    level : float
-        Confidence level.
-
-    Returns
-    -------
-    MeanCI
-        NaN bounds when one value is left; zero width for constant data.
-    """
+    """Mean of ``x`` (one value per seed; NaN dropped and counted) with its Student-t
+    confidence interval: NaN bounds when one value is left, zero width for constant data."""
     kept, dropped = _kept(x)
     mean, low, high = _t_interval(kept, level)
     return MeanCI(mean, low, high, int(kept.size), dropped, level, "t")
@@ -209,25 +183,10 @@ def paired_difference(treatment: ArrayLike, baseline: ArrayLike, *, level: float
                       seed: int = 0) -> PairedComparison:
     """Treatment minus baseline over the same seeds, with t and bootstrap intervals.
 
-    Parameters
-    ----------
-    treatment, baseline : array_like, shape (n,)
-        The measure per seed, both in the same seed order (and unit).
-    level : float
-        Confidence level of both intervals.
-    lower_is_better : bool
-        True when a smaller value is better (delays, times, fuel): a win is then
-        ``treatment < baseline - tie_tol``.
-    tie_tol : float
-        Differences with ``|d| <= tie_tol`` are ties (unit of the data).
-    method, n_resamples, seed : str, int, int
-        Bootstrap method ("BCa" or "percentile"), resamples, and the seed of its
-        generator.
-
-    Returns
-    -------
-    PairedComparison
-        Seeds where either value is NaN are dropped and counted in ``n_dropped``.
+    ``treatment`` and ``baseline``: the measure per seed, same seed order and unit; seeds
+    where either is NaN are dropped and counted in ``n_dropped``. With ``lower_is_better``
+    a win is ``treatment < baseline - tie_tol``; ``|d| <= tie_tol`` is a tie. ``method``
+    ("BCa" or "percentile"), ``n_resamples`` and ``seed`` are the bootstrap's.
     """
     t, t_nan = _clean(treatment, "treatment")
     b, b_nan = _clean(baseline, "baseline")

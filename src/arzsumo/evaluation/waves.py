@@ -36,8 +36,7 @@ def temporal_sd(blocks: np.ndarray) -> np.ndarray:
 
 
 def rms(values: np.ndarray) -> float:
-    """Root mean square of the finite values (NaN when none): e.g. the RMS over places of
-    :func:`temporal_sd`, :func:`arzsumo.evaluation.fields.oscillation` of one variable."""
+    """Root mean square of the finite values (NaN when none)."""
     v = np.asarray(values, float)
     v = v[np.isfinite(v)]
     return float(np.sqrt(np.mean(v * v))) if v.size else float("nan")

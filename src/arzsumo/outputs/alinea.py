@@ -1,8 +1,7 @@
 """Write ``arzsumo alinea-target --out DIR``: the loop's flow-occupancy curve and the target.
 
-Files: ``samples.csv`` (period means per seed: occupancy %, flow veh/h), ``curve.csv``
-(mean flow per occupancy bin), ``target.json`` (critical occupancy, target, fit, the
-runs) and ``curve.png``.
+``samples.csv`` (period means per seed), ``curve.csv`` (mean flow per occupancy bin),
+``target.json`` and ``curve.png``; occupancy in %, flow in veh/h.
 """
 
 from __future__ import annotations

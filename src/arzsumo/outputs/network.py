@@ -1,9 +1,5 @@
-"""The figure of a run's section and its detectors (``arzsumo network --figure``).
-
-:func:`network_figure` hands a :class:`~arzsumo.sumo.geometry.RoadGeometry` (read with
-sumolib on the SUMO side) to :func:`arzsumo.plots.network.network_figure`;
-:func:`write_network_figure` saves it as PNG.
-"""
+"""The figure of a run's section and its detectors (``arzsumo network --figure``), drawn
+from a :class:`~arzsumo.sumo.geometry.RoadGeometry` by :mod:`arzsumo.plots.network`."""
 
 from __future__ import annotations
 

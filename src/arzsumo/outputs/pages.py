@@ -36,13 +36,9 @@ def write_text(text: str, path: Path) -> Path:
 
 
 def remove_stale_figures(*paths: Path) -> list[Path]:
-    """Remove the figures ``paths`` (a study's own names in its output directory) that
-    this call did not redraw (``--no-plots``, or nothing to draw), so that none of an
-    earlier call is left beside tables it no longer matches; return those removed.
-
-    Only a regular file goes: a directory or a symbolic link of that name is not the
-    study's figure and is left alone.
-    """
+    """Remove the figures ``paths`` that this call did not redraw (``--no-plots``, or
+    nothing to draw), so that none of an earlier call is left beside tables it no longer
+    matches; return those removed. A directory or symbolic link of that name is left."""
     removed = []
     for path in map(Path, paths):
         if path.is_file() and not path.is_symlink():
@@ -77,13 +73,9 @@ def publish(docs: Path, page: str, name: str, title: str, body: str,
             files: Sequence[Published]) -> list[Path]:
     """Copy ``files`` into ``docs/page/`` (under their own names, or the names given with
     them) and write study ``name``'s block (``body``, whose links name the copies as
-    ``page/FILE``) into the page ``docs/page.md`` (``title``: the heading of a new page);
-    return the paths written.
-
-    Nothing of the user's is overwritten: ``docs`` must be a directory (made when
-    missing), and a page written by hand (one without this study's block) whose files
-    would be replaced is refused, in one line, before anything is written. A page that
-    holds the block, or a new page, is regenerated.
+    ``page/FILE``) into ``docs/page.md`` (``title``: a new page's heading); return the
+    paths written. A page written by hand (without this study's block) whose files would
+    be replaced is refused, in one line, before anything is written.
     """
     _check_publishable(Path(docs), page, name, files)
     written = []

@@ -1,8 +1,5 @@
-"""Write the figures of a sweep (``plots/study.png`` or ``plots/sensitivity.png``).
-
-The sweep engine (:mod:`arzsumo.sweep.driver`) passes its table of finished runs and a
-plain :class:`SweepLayout`; the figures are drawn by :mod:`arzsumo.plots.sweep`.
-"""
+"""Write the figures of a sweep (``plots/study.png`` or ``plots/sensitivity.png``) from
+the table of finished runs and the :class:`SweepLayout` of :mod:`arzsumo.sweep.driver`."""
 
 from __future__ import annotations
 

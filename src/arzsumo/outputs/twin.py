@@ -16,6 +16,7 @@ import pyarrow.parquet as pq
 
 from arzsumo.engines.twin import TwinRun
 from arzsumo.io import json_safe
+from arzsumo.model.params import VARIABLES
 from arzsumo.outdir import OutputDir, atomic_dir, target_of
 from arzsumo.schema import TWIN_CONTROL, TWIN_FIELDS, with_units
 
@@ -25,8 +26,7 @@ def fields_table(run: TwinRun) -> pa.Table:
     r = run.result
     n_t, _, n_x = r.fields.shape
     cols: dict[str, Any] = {"t_s": np.repeat(r.t, n_x), "x_m": np.tile(r.x, n_t)}
-    for k, name in enumerate(("rho_h", "v_h", "rho_a", "v_a")):
-        cols[name] = r.fields[:, k, :].ravel()
+    cols.update({name: r.fields[:, k, :].ravel() for k, name in enumerate(VARIABLES)})
     return with_units(pa.table(cols), TWIN_FIELDS, "fields")
 
 

@@ -1,9 +1,5 @@
 """Figures of a co-simulation: micro and twin space-time fields side by side, and the
-control and meter signals with release instants.
-
-``*_figure`` functions take arrays and return a Figure; :func:`bridge_figures` takes a
-:class:`arzsumo.bridge.result.CoSimResult` and returns the three figures of a run by name.
-Nothing is written here: :func:`arzsumo.outputs.figures.save_figures` saves them.
+control and meter signals with release instants (:func:`bridge_figures`, by name).
 """
 
 from __future__ import annotations
@@ -147,23 +143,11 @@ def signals_figure(t: np.ndarray, u: np.ndarray, u_cont: np.ndarray, events: np.
 
 
 def bridge_figures(res: Any, wave_kmh: dict[str, float] | None = None) -> dict[str, Figure]:
-    """The figures of a co-simulation run, by name: ``fields_h``, ``fields_a``, ``control``.
-
-    Parameters
-    ----------
-    res : CoSimResult
-        Read by attribute (:class:`arzsumo.bridge.result.CoSimResult`): fields in SI, the
-        equilibrium (veh/m, m/s), the per-period table and the meter's counts.
-    wave_kmh : dict of str to float, optional
-        Per class ("h", "a"), the measured travel speed of SUMO's speed fluctuations, km/h
-        (< 0 upstream; NaN when unresolved): drawn on the fields with the vehicles' mean
-        speed, so that waves and platoons are told apart.
-
-    Returns
-    -------
-    dict of str to Figure
-        Open figures; the caller saves and closes them.
-    """
+    """The open figures of a co-simulation run ``res`` (a
+    :class:`~arzsumo.bridge.result.CoSimResult`, read by attribute), by name: ``fields_h``,
+    ``fields_a``, ``control``. ``wave_kmh``: per class, the measured travel speed of
+    SUMO's speed fluctuations (km/h, < 0 upstream; NaN when unresolved), drawn on the
+    fields with the vehicles' mean speed so that waves and platoons are told apart."""
     eq = res.equilibrium
     title = f"{res.scenario.name}: {res.settings.controller}, seed {res.sumo.seed}"
     panels = {"SUMO (Edie)": res.micro, "twin replay": res.replay,

@@ -33,19 +33,9 @@ def _curve(p: ModelParameters, rho_h: np.ndarray, mix: float) -> tuple[np.ndarra
 def diagram_figure(blocks: Mapping[str, np.ndarray], models: Mapping[str, ModelParameters],
                    operating_point: tuple[float, float], waves: Mapping[str, float]
                    ) -> Figure:
-    """The figure (module docstring).
-
-    Parameters
-    ----------
-    blocks : mapping
-        ``rho_h``, ``rho_a`` (veh/m), ``v_h``, ``v_a`` (m/s) of SUMO's block states.
-    models : mapping label -> ModelParameters
-        The fitted models, each drawn as a curve.
-    operating_point : (rho_h, rho_a)
-        The measured mean densities, veh/m.
-    waves : mapping class -> c
-        The measured upstream wave speed per class ("h", "a"), m/s.
-    """
+    """The figure (module docstring) of SUMO's block states ``blocks`` (``rho_h``, ``rho_a``
+    veh/m, ``v_h``, ``v_a`` m/s), the fitted ``models`` by label, the measured mean
+    densities ``operating_point`` (veh/m) and upstream wave speed per class (m/s)."""
     fig, axes = plt.subplots(2, 2, figsize=(11, 8), layout="constrained")
     rho_op = np.array(operating_point)
     mix = rho_op[1] / rho_op[0]

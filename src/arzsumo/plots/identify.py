@@ -1,8 +1,5 @@
 """Figures of an identification (``arzsumo identify``): SUMO against the replay twin of the
-identified model in space and time, and predicted against observed per cell.
-
-Both take arrays in SI and return a Figure (densities drawn in veh/km, speeds in km/h).
-"""
+identified model in space and time, and predicted against observed per cell (SI arrays)."""
 
 from __future__ import annotations
 
@@ -22,18 +19,9 @@ PANELS = (("HV density", "veh/km", veh_m_to_veh_km), ("HV speed", "km/h", ms_to_
 def fields_figure(t: np.ndarray, x: np.ndarray, observed: np.ndarray, predicted: np.ndarray,
                   title: str = "", labels: tuple[str, str] = ("SUMO", "replay twin")
                   ) -> Figure:
-    """Heat maps of (rho_h, v_h, rho_a, v_a): ``observed`` on the top row, ``predicted``
-    below, one colour scale per variable.
-
-    Parameters
-    ----------
-    t : ndarray (T,)
-        Times, s.
-    x : ndarray (N,)
-        Cell centres, m.
-    observed, predicted : ndarray (T, 4, N)
-        Fields in SI; NaN (unobserved, or after the twin stopped) is drawn grey.
-    """
+    """Heat maps of (rho_h, v_h, rho_a, v_a) over times ``t`` (s) and cell centres ``x``
+    (m): ``observed`` (T, 4, N; SI) on the top row, ``predicted`` below, one colour scale
+    per variable; NaN (unobserved, or after the twin stopped) is drawn grey."""
     fig, axes = plt.subplots(2, 4, figsize=(16, 7.5), layout="constrained", sharex=True,
                              sharey=True)
     for j, (name, unit, conv) in enumerate(PANELS):
@@ -60,17 +48,9 @@ def fields_figure(t: np.ndarray, x: np.ndarray, observed: np.ndarray, predicted:
 def scatter_figure(observed: Sequence[np.ndarray], predicted: Sequence[np.ndarray],
                    rmse: Sequence[float], title: str = "", max_points: int = 20000,
                    seed: int = 0) -> Figure:
-    """Predicted against observed per cell and period, one panel per variable.
-
-    Parameters
-    ----------
-    observed, predicted : sequence of 4 ndarrays
-        Paired values of rho_h, v_h, rho_a, v_a (SI), where both exist.
-    rmse : sequence of 4 floats
-        Relative RMSE of each variable, written in its panel.
-    max_points : int
-        At most this many points per panel are drawn (a seeded random subset).
-    """
+    """Predicted against observed per cell and period (paired values of rho_h, v_h, rho_a,
+    v_a, SI), one panel per variable with its relative ``rmse``; at most ``max_points``
+    per panel are drawn (a seeded random subset)."""
     rng = np.random.default_rng(seed)
     fig, axes = plt.subplots(1, 4, figsize=(16, 4.4), layout="constrained")
     for j, (name, unit, conv) in enumerate(PANELS):

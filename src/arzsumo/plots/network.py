@@ -1,9 +1,5 @@
-"""The section and the detectors placed on it (``arzsumo network``, docs/networks.md).
-
-Two panels: the plan (the network's own x/y, m, to scale) with the section's lanes, the
-mainline past it, the ramp, the meter's light, the loops and the cells' boundaries; and
-the section unrolled along x (m from the section's start; across the road not to scale)
-with the edges, the cells, the loop stations per lane, ALINEA's loop and the ramp.
+"""The section and the detectors placed on it, on the plan and unrolled along x
+(``arzsumo network``; the two panels: docs/networks.md).
 
 Every artist that stands for a piece of the road carries a gid, so a test can count them:
 ``lane:EDGE:K`` (a lane's centre line on the plan), ``cell:K`` (a cell boundary along x),
@@ -90,24 +86,8 @@ def _along(ax: Axes, road: Any) -> None:
 
 
 def network_figure(road: Any, title: str = "") -> Figure:
-    """The section and its detectors, on the plan and along x.
-
-    Parameters
-    ----------
-    road : RoadGeometry-like
-        Read by attribute (:class:`arzsumo.sumo.geometry.RoadGeometry`): ``lane_edges``,
-        ``lane_roles``, ``lane_shapes`` ((n, 2) m each), ``light`` (2,), ``loops``,
-        ``downstream`` ((k, 2) m), ``loop_x``, ``downstream_x``, ``cell_x``, ``cells``
-        ((n + 1, 2, 2) m), ``edges``, ``edge_starts``, ``edge_lengths``, ``length``,
-        ``width``, ``lanes``, ``join_x``, ``light_x``, ``ramp_length`` (m), ``meter_tl``.
-    title : str, optional
-        The figure's title.
-
-    Returns
-    -------
-    Figure
-        Two panels: the plan (to scale) and the section along x.
-    """
+    """The section and its detectors, on the plan (to scale) and along x, of ``road`` (a
+    :class:`~arzsumo.sumo.geometry.RoadGeometry`, read by attribute; m)."""
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(11.0, 6.5), layout="constrained",
                                       height_ratios=(1.0, 1.0))
     _plan(top, road)

@@ -17,8 +17,7 @@ def regime_figure(rmap: RegimeMap, point: tuple[float, float] | None = None,
 
     ``point`` (rho_h, rho_a) in veh/m marks an equilibrium.
     """
-    rho_h = veh_m_to_veh_km(rmap.rho_h)
-    rho_a = veh_m_to_veh_km(rmap.rho_a)
+    rho_h, rho_a = veh_m_to_veh_km(rmap.rho_h), veh_m_to_veh_km(rmap.rho_a)
     lam4 = ms_to_kmh(rmap.lambda_4)
     fig, ax = plt.subplots(figsize=(6.4, 5.0), layout="constrained")
     span = np.nanmax(np.abs(lam4))

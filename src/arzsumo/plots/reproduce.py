@@ -1,17 +1,10 @@
-"""Figures of ``arzsumo reproduce``: release instants, penetration, sensitivity.
-
-The ``*_figure`` functions take arrays and return a Figure; the writer is
-:func:`arzsumo.outputs.reproduce.write_figures`.
-"""
+"""Figures of ``arzsumo reproduce``: release instants, penetration, sensitivity."""
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
 
-import matplotlib
-
-matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
@@ -20,31 +13,16 @@ from matplotlib.figure import Figure
 def release_instants_figure(names: Sequence[str], event_times: Sequence[np.ndarray],
                             release: Sequence[float], horizon: float,
                             paper: Mapping[str, str] | None = None) -> Figure:
-    """One row per run: a tick at each control update (s); the label gives the counts.
-
-    Parameters
-    ----------
-    names : sequence of str
-        Row labels (top to bottom).
-    event_times : sequence of ndarray
-        Update times of each run, s.
-    release : sequence of float
-        Total release time of each run, s (time without an update).
-    horizon : float
-        Simulated time, s.
-    paper : mapping, optional
-        Row label -> the paper's numbers, appended to the label.
-    """
+    """One row per run (``names`` top to bottom): a tick at each of its ``event_times``
+    (control updates, s) up to ``horizon`` (s); the label gives the count and the total
+    ``release`` time (s), and ``paper``'s numbers for that row label where given."""
     fig, ax = plt.subplots(figsize=(9, 0.45 * len(names) + 1.2))
     for k, times in enumerate(event_times):
         y = len(names) - 1 - k
         ax.vlines(times, y - 0.35, y + 0.35, lw=0.6, color="C0")
-    labels = []
-    for name, times, rel in zip(names, event_times, release, strict=True):
-        text = f"{name}: {times.size} / {rel:.0f} s"
-        if paper and name in paper:
-            text += f"  (paper {paper[name]})"
-        labels.append(text)
+    labels = [f"{name}: {times.size} / {rel:.0f} s"
+              + (f"  (paper {paper[name]})" if paper and name in paper else "")
+              for name, times, rel in zip(names, event_times, release, strict=True)]
     ax.set_yticks(range(len(names)))
     ax.set_yticklabels(labels[::-1], fontsize=8)
     ax.set_xlim(0, horizon)

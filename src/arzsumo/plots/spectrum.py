@@ -1,8 +1,7 @@
 """Where a speed field's fluctuations lie in time scale: the places' mean periodogram.
 
-One panel per class; one curve per run; bands of periods shaded (the stop-and-go band
-the control studies read and the short waves' band, as the caller names them). Takes
-arrays in SI and returns a Figure (power drawn in (km/h)^2 s).
+One panel per class, one curve per run, the caller's bands of periods shaded; arrays in
+SI, power drawn in (km/h)^2 s.
 """
 
 from __future__ import annotations
@@ -22,16 +21,9 @@ COLOURS = ("tab:red", "tab:blue", "tab:green")
 
 def spectrum_figure(curves: Mapping[str, Mapping[str, tuple[np.ndarray, np.ndarray]]],
                     bands: Mapping[str, tuple[float, float]], title: str = "") -> Figure:
-    """The figure (module docstring).
-
-    Parameters
-    ----------
-    curves : mapping
-        Run label -> class (``h``, ``a``) -> (periods s, mean periodogram density
-        (m/s)^2 s), as :func:`arzsumo.evaluation.waves.mean_periodogram` gives them.
-    bands : mapping
-        Label -> (shortest, longest period, s) of each band to shade.
-    """
+    """The figure (module docstring): ``curves`` maps a run label and a class to (periods s,
+    mean periodogram density (m/s)^2 s) as :func:`arzsumo.evaluation.waves.mean_periodogram`
+    gives them; ``bands`` a label to the (shortest, longest) period (s) of a band to shade."""
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), layout="constrained", sharey=True)
     for ax, cls in zip(axes, NAMES, strict=True):
         for (name, (lo, hi)), colour in zip(bands.items(), COLOURS, strict=False):

@@ -1,9 +1,6 @@
 """Figures of a sweep: triggers, release time (and, in SUMO, meter plan changes) against
 each study axis, mean over seeds with one standard deviation as error bars, the paper's
 values beside them where the paper gives numbers (tables diffpene and diffdemands).
-
-:func:`study_figure` and :func:`sensitivity_figure` take a table and return a Figure; the
-writer that picks the figures a sweep calls for is :func:`arzsumo.outputs.sweep.write_sweep_plots`.
 """
 
 from __future__ import annotations

@@ -1,9 +1,6 @@
 """Figures of a twin run: space-time fields per class (the paper's figures open-loop and
-cl_event, as heatmaps) and the control input with release instants (figure event-control).
-
-``*_figure`` functions take arrays and return a Figure; :func:`twin_figures` takes a
-:class:`arzsumo.engines.twin.TwinRun` and returns the three figures of a run by name.
-Nothing is written here: :func:`arzsumo.outputs.figures.save_figures` saves them.
+cl_event, as heatmaps) and the control input with release instants (figure event-control);
+:func:`twin_figures` gives them by name.
 """
 
 from __future__ import annotations
@@ -21,17 +18,10 @@ _CLASS = {"h": ("HVs", 0), "a": ("AVs", 2)}
 
 def fields_figure(t: np.ndarray, x: np.ndarray, fields: np.ndarray, cls: str,
                   star: tuple[float, float], title: str = "") -> Figure:
-    """Density (veh/km) and speed (km/h) of one class over (x, t), with the equilibrium.
+    """Density (veh/km) and speed (km/h) of class ``cls`` over (x, t), with the equilibrium.
 
-    Parameters
-    ----------
-    t, x : ndarray
-        Output times (s) and cell centres (m).
-    fields : ndarray (n_t, 4, n_x)
-        (rho_h, v_h, rho_a, v_a) in SI.
-    cls : {"h", "a"}
-    star : (rho*, v*)
-        Equilibrium density (veh/m) and speed (m/s) of the class, marked on the colour bars.
+    ``t`` output times (s), ``x`` cell centres (m), ``fields`` (n_t, 4, n_x) in SI; ``star``
+    (rho* veh/m, v* m/s) of the class is marked on the colour bars.
     """
     label, k = _CLASS[cls]
     rho = veh_m_to_veh_km(fields[:, k])
@@ -79,8 +69,7 @@ def control_figure(control_t: np.ndarray, u_applied: np.ndarray, events: np.ndar
     ax.legend(loc="upper right")
     ax.grid(alpha=0.3)
     ax = axes[1]
-    ev = control_t[events]
-    ax.vlines(ev, 0, 1, lw=0.8)
+    ax.vlines(control_t[events], 0, 1, lw=0.8)
     ax.set_yticks([])
     ax.set_ylabel("events")
     text = f"{int(events.sum())} updates of U (release instants)"
@@ -99,19 +88,8 @@ def control_figure(control_t: np.ndarray, u_applied: np.ndarray, events: np.ndar
 
 
 def twin_figures(run: Any) -> dict[str, Figure]:
-    """The figures of a twin run, by name: ``fields_h``, ``fields_a``, ``control``.
-
-    Parameters
-    ----------
-    run : TwinRun
-        Read by attribute (:class:`arzsumo.engines.twin.TwinRun`): the result's fields in
-        SI, the control history (veh/s), the events and the deviation norm.
-
-    Returns
-    -------
-    dict of str to Figure
-        Open figures; the caller saves and closes them.
-    """
+    """The open figures of a twin ``run`` (a :class:`~arzsumo.engines.twin.TwinRun`, read
+    by attribute), by name: ``fields_h``, ``fields_a``, ``control``."""
     r, eq = run.result, run.scenario.equilibrium
     tag = f"{run.scenario.name}, {r.controller.name}"
     if not r.complete:
