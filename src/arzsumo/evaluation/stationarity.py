@@ -59,8 +59,7 @@ def count_trend(count: np.ndarray, dt: float, block_s: float = 30.0) -> CountTre
     half = float(stats.t.ppf(0.975, nb - 2) * fit.stderr)
     kendall = stats.kendalltau(t_min, blocks)
     mean = float(n.mean())
-    window_min = n.size * dt / 60.0
-    drift = float(fit.slope * window_min / mean) if mean > 0 else math.nan
+    drift = float(fit.slope * (n.size * dt / 60.0) / mean) if mean > 0 else math.nan
     p = float(kendall.pvalue) if np.isfinite(kendall.pvalue) else 1.0   # constant series
     return CountTrend(float(fit.slope), float(fit.slope) - half, float(fit.slope) + half, p,
                       drift, mean, int(nb), per * dt)

@@ -1,13 +1,10 @@
 """The summary of one ``arzsumo run``: a typed record, written as ``summary.json``.
 
-:class:`RunSummary` is what :func:`arzsumo.outputs.bridge.summary` builds from a
-:class:`~arzsumo.bridge.result.CoSimResult`, and what the console table, ``compare`` and
-the sweep table read. Its blocks are typed where every run has them (identity, the
-control window's meter counts, the vehicle accounting) and mappings where their keys
-follow the scenario (the section's wave measures per lateral file, the estimator's
-scores). :meth:`RunSummary.to_dict` is ``summary.json``, key for key and in order; the
-unit of every key is in :data:`arzsumo.schema.RUN_SUMMARY` (``units_by_key``), and
-``docs/outputs.md`` describes each. SI throughout: veh, s, m; U and flows in veh/s.
+:func:`arzsumo.outputs.bridge.summary` builds it; the console table, ``compare`` and the
+sweep table read it. Its blocks are typed where every run has them and mappings where
+their keys follow the scenario. :meth:`RunSummary.to_dict` is ``summary.json``, key for
+key and in order; the unit of every key is in :data:`arzsumo.schema.RUN_SUMMARY`
+(``units_by_key``), and docs/outputs.md describes each. SI: veh, s, m; flows in veh/s.
 """
 
 from __future__ import annotations

@@ -40,7 +40,6 @@ def diagram_figure(blocks: Mapping[str, np.ndarray], models: Mapping[str, ModelP
     rho_op = np.array(operating_point)
     mix = rho_op[1] / rho_op[0]
     for col, cls in enumerate(("h", "a")):
-        i = 0 if cls == "h" else 1
         rho, v = blocks[f"rho_{cls}"], blocks[f"v_{cls}"]
         p_any = next(iter(models.values()))
         ao = area_occupancy(p_any, blocks["rho_h"], blocks["rho_a"])
@@ -57,7 +56,7 @@ def diagram_figure(blocks: Mapping[str, np.ndarray], models: Mapping[str, ModelP
                      label=label)
             bottom.plot(c_ao, ms_to_kmh(v_c), f"C{k}", lw=2, label=label)
         v_op = float(np.mean(v[np.isfinite(v)])) if v.size else np.nan
-        r0, q0 = rho_op[i], rho_op[i] * v_op
+        r0, q0 = rho_op[col], rho_op[col] * v_op
         dr = np.linspace(-0.5, 0.5, 2) * r0
         top.plot(veh_m_to_veh_km(r0 + dr), veh_s_to_veh_h(q0 + waves[cls] * dr), "k--",
                  lw=1.2, label=f"measured wave {ms_to_kmh(waves[cls]):.1f} km/h")

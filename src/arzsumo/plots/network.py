@@ -46,8 +46,7 @@ def _plan(ax: Axes, road: Any) -> None:
 
 def _lane_y(road: Any) -> np.ndarray:
     """Centres of the section's lanes across the road, m (lane 0 lowest)."""
-    w = road.width / road.lanes
-    return (np.arange(road.lanes) + 0.5) * w
+    return (np.arange(road.lanes) + 0.5) * (road.width / road.lanes)
 
 
 def _along(ax: Axes, road: Any) -> None:
