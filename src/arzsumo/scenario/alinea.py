@@ -1,22 +1,9 @@
 """The ``[alinea]`` section: ALINEA and PI-ALINEA as practitioners run them.
 
-Every key, its unit and the field of :class:`~arzsumo.control.alinea.AlineaSettings`
-it sets::
-
-    [alinea]
-    period_s = 40                   # the controller's own period (20-60 s)
-    loop_distance_m = 100           # its loop downstream of the merge nose (40-300 m)
-    target_pct = 20                 # occupancy target, just below the loop's critical
-                                    # occupancy (`arzsumo alinea-target`)
-    gain_veh_h_per_pct = 70         # K_R at gain_period_s ...
-    gain_period_s = 60              # ... scaled with the period: K_R T / T_ref
-    kp_veh_h_per_pct = 60           # PI-ALINEA's K_P (not scaled)
-    ki_veh_h_per_pct = 5            # PI-ALINEA's K_I at gain_period_s (scaled as K_R)
-
-Occupancy is written in % here and held as a fraction inside; gains per % of occupancy
-in veh/h are 100/3600 veh/s per unit occupancy (:data:`GAIN_FACTOR`). The loop is read
-in every run (open loop too), so the ``occupancy_out`` column of every periods table is
-its occupancy.
+Occupancy is written in % and held as a fraction inside; gains per % of occupancy in veh/h
+are 100/3600 veh/s per unit occupancy (:data:`GAIN_FACTOR`). The loop is read in every run
+(open loop too): it is the ``occupancy_out`` column of every periods table. Keys:
+docs/scenarios.md; the controllers: docs/sumo.md, "Baselines a practitioner would field".
 """
 
 from __future__ import annotations

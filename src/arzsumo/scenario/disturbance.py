@@ -1,17 +1,8 @@
 """The ``[disturbance]`` section: a reproducible perturbation of SUMO after control starts.
 
-Every key, its unit and the field of :class:`~arzsumo.sumo.disturbance.Slowdown` it sets::
-
-    [disturbance]
-    kind = "slowdown"     # none (default) or slowdown
-    edge = "down"         # main, merge or down (past the merge, where no meter acts)
-    speed_kmh = 10        # the edge's speed limit while it lasts
-    start_s = 0           # from this many s after the start of control ...
-    duration_s = 30       # ... for this long
-
-The disturbance acts in the control window only, so a scenario with it and one without
-share their warm-up (:func:`arzsumo.bridge.branches.warmup_key`): the disturbance
-experiment starts from the regulation experiment's state, seed by seed.
+It acts in the control window only, so a scenario with it and one without share their
+warm-up (:func:`arzsumo.bridge.branches.warmup_key`): the disturbance experiment starts
+from the regulation experiment's state, seed by seed. Keys: docs/scenarios.md.
 """
 
 from __future__ import annotations

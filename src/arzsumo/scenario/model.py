@@ -1,19 +1,9 @@
 """The ``[model]``, ``[equilibrium]`` and ``[design]`` sections of a scenario file.
 
-Keys carry their unit in their name (``_kmh``, ``_veh_km``, ``_veh_h``, ``_m``, ``_s``);
-the key tables below are where those units become SI, through :mod:`arzsumo.units`::
-
-    [model]
-    preset = "paper_base"
-    vehicle_width_m = 2.0
-    [equilibrium]
-    rho_h_veh_km = 110
-    rho_a_veh_km = 95
-    [design]
-    mu = 5e-4
-
-The model validates itself (:class:`~arzsumo.model.params.ModelParameters`); errors are
-restated with the key and the value as written (:func:`arzsumo.tables.in_user_terms`).
+Keys carry their unit in their name; the key tables below turn them into SI (keys:
+docs/scenarios.md). The model validates itself
+(:class:`~arzsumo.model.params.ModelParameters`); errors are restated with the key and the
+value as written (:func:`arzsumo.tables.in_user_terms`).
 """
 
 from __future__ import annotations

@@ -1,23 +1,9 @@
 """The ``[network]`` section: the laws on a SUMO network the user brings.
 
-Every key, its unit and the field of :class:`arzsumo.sumo.user_network.NetworkRequest` it
-sets::
-
-    [network]
-    net_file = "my.net.xml"          # relative to the scenario file
-    route_files = ["my.rou.xml"]     # optional: the user's demand and vTypes
-    section_edges = ["a", "b", "c"]  # the section from x = 0 to x = L, in driving order
-    meter_tls = "rm1"                # the light that meters the on-ramp
-    ramp_edge = "onramp"             # the ramp edge the meter holds (its queue storage)
-    av_types = ["cav"]               # vType ids counted as AVs (with route_files)
-    start_offset_m = 0               # the section starts this far along its first edge
-    end_offset_m = 0                 # ... and ends this far before its last edge's end
-    sublane = true                   # SUMO's sublane model (false: lane changes only)
-
 Here the table is read for its shape only; :func:`arzsumo.bridge.session.prepare_run`
 checks it against the network with sumolib before SUMO starts
 (:func:`arzsumo.sumo.user_network.read_layout`). Without the table a run uses the shipped
-network, as before.
+network. Keys: docs/scenarios.md; docs/networks.md.
 """
 
 from __future__ import annotations

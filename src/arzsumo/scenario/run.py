@@ -1,22 +1,7 @@
-"""The ``[run]`` section: what ``arzsumo run`` does around SUMO (human units in key names).
+"""The ``[run]`` section: what ``arzsumo run`` does around SUMO (keys: docs/scenarios.md).
 
-Example::
-
-    [run]
-    controller = "etc"          # a name of arzsumo.control.registry that runs in SUMO
-    warmup_s = 150              # nominal meter until control starts
-    start = "warmup"            # or "placement": vehicles placed from [initial] at t = 0
-    operating_point = "scenario"  # or "measured": mean of the last 60 s of the warm-up
-    kernel_cells = 100          # backstepping kernel grid
-    twin_cells = 100            # PDE twin grid (replay and reference)
-    twin_scheme = "muscl"       # or "first"
-    smoothing_s = 30            # time constant of the measured boundary data fed to the twins
-    constant_release_veh_h = 600  # release rate of the `constant` controller
-
-ALINEA's and PI-ALINEA's parameters are the ``[alinea]`` table
-(:mod:`arzsumo.scenario.alinea`).
-
-The control horizon, the control period and the seed are ``[sumo]`` keys.
+ALINEA's and PI-ALINEA's parameters are the ``[alinea]`` table; the control horizon, the
+control period and the seed are ``[sumo]`` keys.
 """
 
 from __future__ import annotations

@@ -1,15 +1,8 @@
 """The ``[sumo]`` section: how ``arzsumo run`` (and ``calibrate``) drive SUMO.
 
-Every key of the table, its unit and its conversion to the SI field of
-:class:`arzsumo.sumo.config.SumoConfig`::
-
-    [sumo]
-    step_length_s = 0.1
-    demand_h_veh_h = 4104
-    demand_a_veh_h = 1560
-    ramp_demand_veh_h = 1200
-    meter_cycle_s = 6
-    meter_curve = "calibration/meter_curve.toml"   # relative to the scenario file
+Every key, its unit and its conversion to the SI field of
+:class:`arzsumo.sumo.config.SumoConfig`: :data:`SUMO_KEYS` (docs/scenarios.md). A relative
+``meter_curve`` is read relative to the scenario file.
 """
 
 from __future__ import annotations
