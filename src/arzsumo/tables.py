@@ -12,12 +12,14 @@ from __future__ import annotations
 import difflib
 import math
 import re
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeVar
 
 from arzsumo.errors import ArzsumoError, ScenarioError
 from arzsumo.io import toml_value
+
+T = TypeVar("T")
 
 #: what a value of each kind must be (the type part of error messages)
 KIND_TEXT = {"number": "a finite number", "integer": "an integer", "string": "a string",
@@ -190,3 +192,14 @@ def in_user_terms(exc: ArzsumoError, at: str, table: Mapping[str, Any],
             return ScenarioError(f"{at} {key} = {written(exc.value)} (the default) is not "
                                  f"allowed: {allowed}")
     return ScenarioError(f"{at} {_user_names(str(exc), keys)}")
+
+
+def read_section(make: Callable[..., T], table: Mapping[str, Any], keys: Mapping[str, Key],
+                 at: str, **extra: Any) -> T:
+    """``make(**SI values of the keys of table, **extra)``: the record of a table whose key
+    names are already checked; errors name the key and the value as written."""
+    si = read_keys(table, keys, at)       # its own errors name key and value
+    try:
+        return make(**si, **extra)
+    except ArzsumoError as exc:
+        raise in_user_terms(exc, at, table, keys) from None

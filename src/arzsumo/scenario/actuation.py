@@ -17,8 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from arzsumo.errors import ArzsumoError, ScenarioError, require
-from arzsumo.tables import Key, in_user_terms, not_allowed, read_keys
+from arzsumo.errors import ScenarioError, require
+from arzsumo.tables import Key, not_allowed, read_section
 from arzsumo.units import KMH_PER_MS, VEH_H_PER_VEH_S, VEH_KM_PER_VEH_M
 
 #: what a PDE law's U can drive
@@ -123,13 +123,8 @@ class ActuationSettings:
 
 
 def actuation_section(table: Mapping[str, Any], at: str) -> ActuationSettings:
-    """The ActuationSettings of an ``[actuation]`` table (keys already checked); errors
-    name the key and the value as written."""
-    si = read_keys(table, ACTUATION_KEYS, at)
-    try:
-        return ActuationSettings(**si)
-    except ArzsumoError as exc:
-        raise in_user_terms(exc, at, table, ACTUATION_KEYS) from None
+    """The ActuationSettings of an ``[actuation]`` table."""
+    return read_section(ActuationSettings, table, ACTUATION_KEYS, at)
 
 
 def delay_horizon(eigenvalues: np.ndarray, length: float) -> float:

@@ -12,8 +12,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from arzsumo.control.alinea import AlineaSettings
-from arzsumo.errors import ArzsumoError
-from arzsumo.tables import Key, in_user_terms, not_allowed, read_keys
+from arzsumo.tables import Key, not_allowed, read_section
 from arzsumo.units import VEH_H_PER_VEH_S
 
 #: veh/h per % of occupancy per (veh/s per unit occupancy): 3600 / 100 = 36
@@ -49,13 +48,8 @@ ALINEA_KEYS: dict[str, Key] = {
 
 
 def alinea_section(table: Mapping[str, Any], at: str) -> AlineaSettings:
-    """The AlineaSettings of an ``[alinea]`` table (keys already checked); errors name
-    the key and the value as written."""
-    si = read_keys(table, ALINEA_KEYS, at)
-    try:
-        return AlineaSettings(**si)
-    except ArzsumoError as exc:
-        raise in_user_terms(exc, at, table, ALINEA_KEYS) from None
+    """The AlineaSettings of an ``[alinea]`` table."""
+    return read_section(AlineaSettings, table, ALINEA_KEYS, at)
 
 
 def check_alinea_period(settings: AlineaSettings, control_period: float, at: str,

@@ -10,9 +10,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from arzsumo.errors import ArzsumoError
 from arzsumo.sumo.disturbance import EDGES, KINDS, Slowdown
-from arzsumo.tables import Key, in_user_terms, read_keys
+from arzsumo.tables import Key, read_section
 from arzsumo.units import KMH_PER_MS
 
 #: [disturbance] key -> Slowdown field (SI)
@@ -31,10 +30,5 @@ DISTURBANCE_KEYS: dict[str, Key] = {
 
 
 def disturbance_section(table: Mapping[str, Any], at: str) -> Slowdown:
-    """The Slowdown of a ``[disturbance]`` table (keys already checked); errors name the
-    key and the value as written."""
-    si = read_keys(table, DISTURBANCE_KEYS, at)
-    try:
-        return Slowdown(**si)
-    except ArzsumoError as exc:
-        raise in_user_terms(exc, at, table, DISTURBANCE_KEYS) from None
+    """The Slowdown of a ``[disturbance]`` table."""
+    return read_section(Slowdown, table, DISTURBANCE_KEYS, at)

@@ -14,13 +14,13 @@ from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from typing import Any
 
-from arzsumo.errors import ArzsumoError, ScenarioError, require
+from arzsumo.errors import ScenarioError, require
 from arzsumo.estimate.enkf import EnkfOptions
 from arzsumo.estimate.observations import LoopNoise, ProbeNoise
 from arzsumo.estimate.smoothing import AsmParameters
 from arzsumo.sumo.loops import BOUNDARY_GAP, INLET_GAP, placed_positions
 from arzsumo.sumo.sensing import SensorLayout
-from arzsumo.tables import Key, in_user_terms, read_keys
+from arzsumo.tables import Key, read_section
 from arzsumo.units import KMH_PER_MS, VEH_H_PER_VEH_S, kmh_to_ms
 
 METHODS = ("none", "smoothing", "enkf")
@@ -191,9 +191,5 @@ def check_sensors(est: EstimationSettings, layout: SensorLayout, length: float,
 
 
 def estimation_section(table: Mapping[str, Any], at: str) -> EstimationSettings:
-    """The EstimationSettings of an ``[estimation]`` table (keys already checked)."""
-    si = read_keys(table, ESTIMATION_KEYS, at)       # its own errors name key and value
-    try:
-        return EstimationSettings(**si)
-    except ArzsumoError as exc:
-        raise in_user_terms(exc, at, table, ESTIMATION_KEYS) from None
+    """The EstimationSettings of an ``[estimation]`` table."""
+    return read_section(EstimationSettings, table, ESTIMATION_KEYS, at)

@@ -12,9 +12,9 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from arzsumo.errors import ArzsumoError, ScenarioError
+from arzsumo.errors import ScenarioError
 from arzsumo.sumo.user_network import NetworkRequest
-from arzsumo.tables import Key, in_user_terms, read_keys
+from arzsumo.tables import Key, read_section
 
 #: [network] key -> NetworkRequest field (SI)
 NETWORK_KEYS: dict[str, Key] = {
@@ -56,9 +56,5 @@ def network_section(table: Mapping[str, Any], at: str, source: str) -> NetworkRe
     if missing:
         raise ScenarioError(f"{at} needs the keys {', '.join(REQUIRED)}; missing: "
                             f"{', '.join(missing)}")
-    si = read_keys(table, NETWORK_KEYS, at)
     base = Path(source).parent if Path(source).is_file() else Path(".")
-    try:
-        return NetworkRequest(**si, base=str(base.resolve()))
-    except ArzsumoError as exc:
-        raise in_user_terms(exc, at, table, NETWORK_KEYS) from None
+    return read_section(NetworkRequest, table, NETWORK_KEYS, at, base=str(base.resolve()))

@@ -11,8 +11,8 @@ from dataclasses import asdict, dataclass
 from typing import Any
 
 from arzsumo.control.registry import controller_names
-from arzsumo.errors import ArzsumoError, ScenarioError, require
-from arzsumo.tables import Key, in_user_terms, not_allowed, read_keys
+from arzsumo.errors import ScenarioError, require
+from arzsumo.tables import Key, not_allowed, read_section
 from arzsumo.units import VEH_H_PER_VEH_S
 
 #: backstepping kernel grid of both `arzsumo run` and `arzsumo twin` (one default)
@@ -90,13 +90,8 @@ class RunSettings:
 
 
 def run_section(table: dict[str, Any], at: str) -> RunSettings:
-    """The RunSettings of a ``[run]`` table (keys already checked); errors name the key
-    and the value as written."""
-    si = read_keys(table, RUN_KEYS, at)       # its own errors name key and value
-    try:
-        return RunSettings(**si)
-    except ArzsumoError as exc:
-        raise in_user_terms(exc, at, table, RUN_KEYS) from None
+    """The RunSettings of a ``[run]`` table."""
+    return read_section(RunSettings, table, RUN_KEYS, at)
 
 
 def check_constant_release(settings: RunSettings, low: float, high: float, at: str,

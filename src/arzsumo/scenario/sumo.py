@@ -12,7 +12,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from arzsumo.errors import ArzsumoError, ScenarioError
+from arzsumo.errors import ScenarioError
 from arzsumo.sumo.car_following import ignored, readers
 from arzsumo.sumo.config import (
     AV_MODELS,
@@ -22,7 +22,7 @@ from arzsumo.sumo.config import (
     METER_MODES,
     SumoConfig,
 )
-from arzsumo.tables import Key, in_user_terms, read_keys, written
+from arzsumo.tables import Key, read_section, written
 from arzsumo.units import KMH_PER_MS, VEH_H_PER_VEH_S
 
 _DEMAND = "a demand >= 0 veh/h"
@@ -240,11 +240,7 @@ def sumo_section(table: Mapping[str, Any], at: str, source: str = "<dict>") -> S
     A relative ``meter_curve`` is read from the directory of ``source`` (the working
     directory for a scenario not read from a file) and made absolute; the file must exist.
     """
-    changes = read_keys(table, SUMO_KEYS, at)
-    try:
-        cfg = SumoConfig(**changes)
-    except ArzsumoError as exc:
-        raise in_user_terms(exc, at, table, SUMO_KEYS) from None
+    cfg = read_section(SumoConfig, table, SUMO_KEYS, at)
     refuse_inert_meter_keys(table, at, cfg.meter_mode)
     refuse_ignored_car_following(table, at, cfg)
     if not cfg.meter_curve:
