@@ -1,10 +1,8 @@
 """Progress bars on stderr (no dependency), silent with ``enabled=False``.
 
-:class:`Progress` counts units of equal cost (the runs of a sweep). :class:`RunProgress`
+:class:`Progress` counts units of equal cost (the runs of a sweep); :class:`RunProgress`
 follows a run made of named phases of unequal cost (a SUMO run: warm-up, control window,
-drain, outputs); its time left comes from :class:`PhaseClock`, which estimates the rest of
-the current phase from the phase's own recent rate and the phases still to come from
-their expected cost, calibrated on the phases measured so far.
+drain, outputs), its time left from :class:`PhaseClock`.
 """
 
 from __future__ import annotations

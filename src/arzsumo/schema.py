@@ -349,13 +349,8 @@ def scenario_field_unit(field: str) -> str | None:
 
 
 def with_units(table: pa.Table, columns: Mapping[str, Column], name: str) -> pa.Table:
-    """``table`` with each field's ``unit`` and ``description`` and table metadata.
-
-    Raises
-    ------
-    KeyError
-        A column of ``table`` is missing from ``columns``: every written column must
-        state its unit (a programming error, caught by the tests).
+    """``table`` with each field's ``unit`` and ``description`` and table metadata; a
+    column missing from ``columns`` raises KeyError (every written column states its unit).
     """
     missing = [c for c in table.column_names if c not in columns]
     if missing:

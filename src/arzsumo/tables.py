@@ -62,11 +62,8 @@ def where(source: str, table: str) -> str:
 
 def not_allowed(at: str, key: str, value: Any, allowed: str,
                 error: type[ArzsumoError] = ScenarioError) -> ArzsumoError:
-    """``error``: ``{at} {key} = {value as written} is not allowed: {allowed}``.
-
-    The error keeps ``at``, ``key`` and ``allowed`` as attributes, so that a caller who
-    set the value from elsewhere (a command-line option) can name it there
-    (:func:`restated`)."""
+    """``error``: ``{at} {key} = {value as written} is not allowed: {allowed}``, keeping
+    ``at``, ``key`` and ``allowed`` for a caller that names the value its way (:func:`restated`)."""
     exc = error(f"{at} {key} = {written(value)} is not allowed: {allowed}")
     exc.at, exc.key, exc.allowed = at, key, allowed
     return exc
@@ -173,13 +170,10 @@ def _user_names(text: str, keys: Mapping[str, Key]) -> str:
 
 def in_user_terms(exc: ArzsumoError, at: str, table: Mapping[str, Any],
                   keys: Mapping[str, Key]) -> ScenarioError:
-    """``exc`` (raised in SI with a field name) restated with the key and written value.
-
-    The result is a :class:`ScenarioError` (a bad value of the file). A field that a key
-    of ``table`` sets is named by that key with the value as written; a same-unit field
-    left at its default is named by its key with the default; anything else keeps its
-    message, prefixed by ``at``.
-    """
+    """``exc`` (raised in SI with a field name) restated as a :class:`ScenarioError`: a
+    field that a key of ``table`` sets is named by that key with the value as written; a
+    same-unit field left at its default by its key with the default; anything else keeps
+    its message, prefixed by ``at``."""
     field = getattr(exc, "field", None)
     matches = [key for key, spec in keys.items() if field is not None and spec.field == field]
     for key in sorted(matches, key=lambda k: k not in table):     # keys written first

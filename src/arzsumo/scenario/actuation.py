@@ -137,8 +137,7 @@ def delay_horizon(eigenvalues: np.ndarray, length: float) -> float:
 def check_delay_horizon(settings: ActuationSettings, eigenvalues: np.ndarray, length: float,
                         at: str, written_value: Any = None, why: str = "") -> None:
     """Refuse ``delay_compensation_s`` >= L / max |lambda| (``eigenvalues`` in m/s,
-    ``length`` in m) with one line naming ``at`` (``file: [actuation]``), the key and the
-    value as written; ``why`` names the equilibrium when it is not the scenario's."""
+    ``length`` in m); ``why`` names the equilibrium when it is not the scenario's."""
     theta = settings.delay_compensation
     horizon = delay_horizon(eigenvalues, length)
     if theta >= horizon:
@@ -153,8 +152,7 @@ def check_speed_limit(settings: ActuationSettings, down_speed: float, slowed_edg
                       at: str, table: Mapping[str, Any]) -> None:
     """Refuse a speed-limit actuator whose range leaves out the outlet's own limit
     ``down_speed`` (m/s, the open loop's), or that shares its edge with a slowdown
-    (``slowed_edge``: the edge a ``[disturbance]`` slows, None without one); one line
-    naming ``at`` (``file: [actuation]``), the key and the value as written."""
+    (``slowed_edge``: the edge a ``[disturbance]`` slows, None without one)."""
     if settings.actuator != "speed_limit":
         return
     if not settings.speed_limit_min <= down_speed <= settings.speed_limit_max:

@@ -55,7 +55,7 @@ def alinea_section(table: Mapping[str, Any], at: str) -> AlineaSettings:
 def check_alinea_period(settings: AlineaSettings, control_period: float, at: str,
                         written_value: Any = None) -> None:
     """Refuse an ALINEA period that is not a whole number of the closed loop's control
-    periods (``[sumo] control_period_s``, s), in one line naming ``at`` and the key."""
+    periods (``[sumo] control_period_s``, s)."""
     n = round(settings.period / control_period)
     if n < 1 or abs(n * control_period - settings.period) > 1e-6:
         value = settings.period if written_value is None else written_value

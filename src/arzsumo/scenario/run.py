@@ -97,8 +97,7 @@ def run_section(table: dict[str, Any], at: str) -> RunSettings:
 def check_constant_release(settings: RunSettings, low: float, high: float, at: str,
                            written_value: Any = None) -> None:
     """Refuse a ``constant`` controller whose release rate lies outside the meter's
-    bounds ``[low, high]`` (veh/s), in one line naming ``at`` (``file: [run]``), the key
-    and the value as written."""
+    bounds ``[low, high]`` (veh/s)."""
     r = settings.constant_release
     if settings.controller == "constant" and not low - 1e-12 <= r <= high + 1e-12:
         value = written_value if written_value is not None else r * VEH_H_PER_VEH_S

@@ -227,9 +227,8 @@ def refuse_inert_meter_keys(table: Mapping[str, Any], at: str, mode: str) -> Non
     for other, keys in MODE_ONLY_KEYS.items():
         bad = [k for k in keys if k in table and other != mode]
         if bad:
-            k = bad[0]
             raise ScenarioError(
-                f"{at} {k} = {written(table[k])} is not allowed with meter_mode = "
+                f"{at} {bad[0]} = {written(table[bad[0]])} is not allowed with meter_mode = "
                 f"{written(mode)}: it acts only under meter_mode = {written(other)}; "
                 f"allowed: remove it, or set meter_mode = {written(other)}")
 

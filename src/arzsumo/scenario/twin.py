@@ -90,17 +90,16 @@ class TwinConfig:
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready summary (SI)."""
-        s = self.solver
+        s, ini = self.solver, self.initial
         return {"cells": s.cells, "scheme": s.scheme, "flux": s.flux, "limiter": s.limiter,
                 "cfl": s.cfl, "horizon": s.horizon, "control_period": s.control_period,
                 "output_period": s.output_period, "u_min": s.u_min, "u_max": s.u_max,
                 "controller": self.controller, "constant_u": self.constant_u,
                 "seed": self.seed, "kernel_cells": self.kernel_cells,
-                "design": asdict(self.design), "initial": {"kind": self.initial.kind,
-                                               "amplitude": list(self.initial.amplitude),
-                                               "wavenumber": list(self.initial.wavenumber),
-                                               "phase": list(self.initial.phase),
-                                               "seed": self.initial.seed}}
+                "design": asdict(self.design),
+                "initial": {"kind": ini.kind, "amplitude": list(ini.amplitude),
+                            "wavenumber": list(ini.wavenumber), "phase": list(ini.phase),
+                            "seed": ini.seed}}
 
 
 def seeded(initial: InitialCondition, seed: int) -> InitialCondition:
