@@ -23,7 +23,6 @@ from arzsumo.schema import (
     TWIN_FIELDS,
     TWIN_SUMMARY,
     markdown,
-    units_of,
     with_units,
 )
 from arzsumo.sweep import run_sweep, sweep_from_dict
@@ -33,6 +32,11 @@ from tests.twin.test_config_cli import SHORT
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "outputs.md"
+
+
+def units_of(table: pa.Table) -> dict[str, str]:
+    """Column -> unit of a table written by arzsumo ("" where none is stored)."""
+    return {f.name: (f.metadata or {}).get(b"unit", b"").decode() for f in table.schema}
 
 
 def _assert_all_units(table: pa.Table) -> dict[str, str]:

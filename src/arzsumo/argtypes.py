@@ -16,21 +16,16 @@ from typing import Any
 SEED_LIMIT = 2**31
 
 
-def _number(text: str, kind: type) -> Any:
-    try:
-        value = kind(text)
-    except ValueError:
-        what = "an integer" if kind is int else "a number"
-        raise argparse.ArgumentTypeError(f"{text} is not allowed: {what}") from None
-    return value
-
-
 def checked(name: str, kind: type, ok: Callable[[Any], bool], allowed: str,
             doc: str) -> Callable[[str], Any]:
     """An argparse ``type=``: ``text`` read as ``kind`` and kept when ``ok``; otherwise
     refused as "TEXT is not allowed: ALLOWED"."""
     def parse(text: str) -> Any:
-        value = _number(text, kind)
+        try:
+            value = kind(text)
+        except ValueError:
+            what = "an integer" if kind is int else "a number"
+            raise argparse.ArgumentTypeError(f"{text} is not allowed: {what}") from None
         if not ok(value):
             raise argparse.ArgumentTypeError(f"{text} is not allowed: {allowed}")
         return value

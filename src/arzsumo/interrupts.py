@@ -48,12 +48,10 @@ class ParentGone(BaseException):
 def die_with_parent(sig: int = signal.SIGKILL) -> None:
     """Linux: have the kernel send ``sig`` to this process when its parent dies;
     elsewhere nothing (the parent's own cleanup still ends its children)."""
-    try:
+    with contextlib.suppress(OSError, AttributeError):
         import ctypes
 
         ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, int(sig))
-    except (OSError, AttributeError):
-        pass
 
 
 def _parent_gone(signum: int, frame: object) -> None:

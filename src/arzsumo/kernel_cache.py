@@ -3,10 +3,8 @@
 A repeated run skips the kernel solve. Each entry stores its key and a checksum of its
 arrays; an entry that does not load, does not match its key, fails its checksum or holds
 non-finite values is recomputed and rewritten, never trusted. The cache directory is
-``$ARZSUMO_CACHE`` if set, else ``~/.cache/arzsumo``.
-
-Not part of the math (it reads and writes files): a room of its own above ``control``,
-imported by the twin's controller registry, the bridge and the CLI.
+``$ARZSUMO_CACHE`` if set, else ``~/.cache/arzsumo``. It reads and writes files, so it is
+a room of its own above ``control`` (docs/layout.md).
 """
 
 from __future__ import annotations

@@ -1,21 +1,14 @@
 """Where results go: one policy for every command that writes a results directory.
 
-A results directory is filled in a hidden partial directory beside it
-(``.NAME.partial.PID.XXXX``) that is renamed into place only when complete, so a result
-appears whole or not at all. Every result carries a marker file :data:`MARKER` (JSON
-``{"kind": ..., "version": ...}``) that says which command wrote it. A target may be
-
-* missing (its parents are created) or an empty directory: written;
-* a previous result of the same kind: replaced, but only with ``overwrite`` (``--overwrite``);
-* anything else (a regular file, a non-empty directory without the marker, a result of
-  another kind): refused with an :class:`OutputError`, and left untouched.
-
-Only directories carrying our marker (or our own empty partial directories) are ever
-removed. The target is checked, and the partial directory created, before the work starts,
-so an impossible ``--out`` ends the command at once. While an :class:`OutputDir` is open,
-SUMO's temporary files go to a scratch directory inside the partial directory
-(:func:`arzsumo.sumo.paths.scratch_dir`), so an interrupted or killed run leaves them in one
-place, and the next run that targets the same place removes such leftovers.
+A result is filled in a hidden partial directory beside its target
+(``.NAME.partial.PID.XXXX``), renamed into place only when complete, and carries a marker
+file :data:`MARKER` (JSON ``{"kind": ..., "version": ...}``). Only a new or empty target,
+or a previous result of the same kind with ``overwrite``, is written; only directories
+carrying our marker (or our own empty partial directories) are ever removed. The target is
+checked, and the partial directory created, before the work starts. While an
+:class:`OutputDir` is open, SUMO's temporary files go to a scratch directory inside the
+partial directory (:func:`arzsumo.sumo.paths.scratch_dir`); the next run that targets the
+same place removes what a killed run left. For users: docs/outputs.md, "Where results go".
 """
 
 from __future__ import annotations
@@ -96,6 +89,33 @@ def where(user: str, path: Path, flag: str = "--out") -> str:
     return text if user == str(path) else f"{text} ({path})"
 
 
+def _refused(here: str, what: str, kind: str) -> OutputError:
+    return OutputError(f"{here} {what}; allowed: " + ALLOWED.format(kind=kind))
+
+
+def _why(exc: OSError) -> str:
+    """Why a directory could not be created, for the user."""
+    if isinstance(exc, FileExistsError | NotADirectoryError):
+        return "a parent is a file, not a directory"
+    return exc.strerror or type(exc).__name__
+
+
+def _named_target(path: str | os.PathLike[str], kind: str, flag: str) -> tuple[Path, str]:
+    """The absolute target and the location as the user wrote it; a root is refused."""
+    target = Path(path).expanduser().resolve()
+    here = where(str(path), target, flag)
+    if target == target.parent:
+        raise _refused(here, "has no name", kind)
+    return target, here
+
+
+def _restore_scratch(previous: str | None) -> None:
+    if previous is None:
+        os.environ.pop(SCRATCH_ENV, None)
+    else:
+        os.environ[SCRATCH_ENV] = previous
+
+
 def _pid_alive(pid: int) -> bool:
     if pid == os.getpid():
         return False  # our own leftovers of an earlier, finished attempt
@@ -149,32 +169,19 @@ def check_target(path: str | os.PathLike[str], kind: str, *, overwrite: bool = F
                  flag: str = "--out") -> None:
     """Refuse ``path`` as :class:`OutputDir` would, without claiming or creating anything
     (``--dry-run``: valid means the real run would start)."""
-    target = Path(path).expanduser().resolve()
-    here = where(str(path), target, flag)
-    if target == target.parent:
-        raise OutputError(f"{here} has no name; allowed: " + ALLOWED.format(kind=kind))
+    target, here = _named_target(path, kind, flag)
     judge(target, kind, here, overwrite=overwrite)
 
 
 class OutputDir:
-    """A results directory of ``kind`` being written: checked and claimed on creation.
+    """A results directory of ``kind`` (``run``, ``twin``...) being written: checked and
+    claimed on creation.
 
-    Parameters
-    ----------
-    path : str or path
-        The target directory as the user wrote it (made absolute, ``.`` included).
-    kind : str
-        What writes it (``run``, ``twin``, ``reproduce``, ``calibration``...).
-    overwrite : bool
-        Replace a previous result of the same kind.
-    flag : str
-        How the user named the location, for messages (``--out``).
-    scratch : bool
-        Send SUMO's temporary files into the partial directory while this is open (for a
-        claim that spans a simulation; not needed to only write files).
-
-    Use as a context manager: write into :attr:`tmp`, call :meth:`commit`; on any exit
-    without a commit (an error, Ctrl-C) the partial directory is removed.
+    ``path`` is the target as the user wrote it with ``flag`` (``--out``), for messages;
+    ``overwrite`` replaces a previous result of the same kind; ``scratch`` sends SUMO's
+    temporary files into the partial directory while this is open (for a claim that spans
+    a simulation). Use as a context manager: write into :attr:`tmp`, call :meth:`commit`;
+    on any exit without a commit (an error, Ctrl-C) the partial directory is removed.
     """
 
     def __init__(self, path: str | os.PathLike[str], kind: str, *, overwrite: bool = False,
@@ -193,9 +200,6 @@ class OutputDir:
     def where(self) -> str:
         return where(self.user, self.path, self.flag)
 
-    def refuse(self, what: str) -> OutputError:
-        return OutputError(f"{self.where()} {what}; allowed: " + ALLOWED.format(kind=self.kind))
-
     def check(self) -> None:
         """Refuse a target that must not be written (see the module docstring)."""
         judge(self.path, self.kind, self.where(), overwrite=self.overwrite)
@@ -208,10 +212,7 @@ class OutputDir:
                                         dir=self.path.parent))
         except OSError as exc:
             self._drop_parents()
-            why = exc.strerror or type(exc).__name__
-            if isinstance(exc, FileExistsError | NotADirectoryError):
-                why = "a parent is a file, not a directory"
-            raise self.refuse(f"cannot be created: {why}") from None
+            raise _refused(self.where(), f"cannot be created: {_why(exc)}", self.kind) from None
         write_marker(tmp, self.kind)
         (tmp / SCRATCH).mkdir()
         return tmp
@@ -250,12 +251,8 @@ class OutputDir:
         if self.closed:
             return
         self.closed = True
-        if not self._scratch:
-            pass
-        elif self._env is None:
-            os.environ.pop(SCRATCH_ENV, None)
-        else:
-            os.environ[SCRATCH_ENV] = self._env
+        if self._scratch:
+            _restore_scratch(self._env)
         if not self.committed:
             shutil.rmtree(self.tmp, ignore_errors=True)
             self._drop_parents()
@@ -278,10 +275,7 @@ def resumable_dir(path: str | os.PathLike[str], kind: str, *,
     temporary files go to a ``.scratch.PID.*`` directory inside it, removed on exit (and,
     if the process was killed, by the next run into ``path``).
     """
-    target = Path(path).expanduser().resolve()
-    here = where(str(path), target, flag)
-    if target == target.parent:
-        raise OutputError(f"{here} has no name; allowed: " + ALLOWED.format(kind=kind))
+    target, here = _named_target(path, kind, flag)
     state = judge(target, kind, here, resumable=True)
     try:
         target.mkdir(parents=True, exist_ok=True)
@@ -289,11 +283,7 @@ def resumable_dir(path: str | os.PathLike[str], kind: str, *,
             write_marker(target, kind)
         scratch = Path(tempfile.mkdtemp(prefix=f".scratch.{os.getpid()}.", dir=target))
     except OSError as exc:
-        why = exc.strerror or type(exc).__name__
-        if isinstance(exc, FileExistsError | NotADirectoryError):
-            why = "a parent is a file, not a directory"
-        raise OutputError(f"{here} cannot be created: {why}; allowed: "
-                          + ALLOWED.format(kind=kind)) from None
+        raise _refused(here, f"cannot be created: {_why(exc)}", kind) from None
     for p in target.glob(".scratch.*"):
         pid = p.name.split(".")[2]
         if p != scratch and pid.isdigit() and not _pid_alive(int(pid)):
@@ -303,10 +293,7 @@ def resumable_dir(path: str | os.PathLike[str], kind: str, *,
     try:
         yield target
     finally:
-        if previous is None:
-            os.environ.pop(SCRATCH_ENV, None)
-        else:
-            os.environ[SCRATCH_ENV] = previous
+        _restore_scratch(previous)
         shutil.rmtree(scratch, ignore_errors=True)
 
 

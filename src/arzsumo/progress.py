@@ -1,10 +1,8 @@
 """Progress bars on stderr (no dependency), silent with ``enabled=False``.
 
-:class:`Progress` counts units of equal cost (the runs of a sweep). :class:`RunProgress`
+:class:`Progress` counts units of equal cost (the runs of a sweep); :class:`RunProgress`
 follows a run made of named phases of unequal cost (a SUMO run: warm-up, control window,
-drain, outputs); its time left comes from :class:`PhaseClock`, which estimates the rest of
-the current phase from the phase's own recent rate and the phases still to come from
-their expected cost, calibrated on the phases measured so far.
+drain, outputs), its time left from :class:`PhaseClock`.
 """
 
 from __future__ import annotations
@@ -42,11 +40,8 @@ class Progress:
                  clock: Clock = time.perf_counter) -> None:
         self.total, self.label, self.enabled = max(float(total), 1e-12), label, enabled
         self.stream = stream or sys.stderr
-        self.interval = interval
-        self.clock = clock
-        self.start = clock()
-        self._last = -1e9
-        self._tenth = -1
+        self.interval, self.clock, self.start = interval, clock, clock()
+        self._last, self._tenth = -1e9, -1
         self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
 
     def update(self, done: float) -> None:
@@ -76,22 +71,12 @@ class Progress:
 
 @dataclass(frozen=True)
 class Phase:
-    """One named phase of a run.
+    """One named phase of a run (``name`` shown on screen: "warm-up", "control", ...).
 
-    Parameters
-    ----------
-    name : str
-        Shown on screen ("warm-up", "control", ...).
-    work : float
-        Units of the phase (simulated s, vehicles, 1 for a single step); ``unit`` names them.
-    cost : float
-        Expected wall time of the whole phase, in a unit shared by the run's phases (only
-        ratios between phases matter).
-    settle : float
-        Fraction of the phase whose rate does not predict the rest (a SUMO network that
-        fills from empty steps faster than a full one); no rate is taken from it.
-    unit : str
-        Name of the units of ``work`` on screen ("" for a single step: none shown).
+    ``work`` is its units (simulated s, vehicles, 1 for a single step), named ``unit`` on
+    screen ("": none shown); ``cost`` its expected wall time, in a unit shared by the run's
+    phases (only ratios matter); ``settle`` the fraction of it whose rate does not predict
+    the rest (a SUMO network that fills from empty steps faster than a full one).
     """
 
     name: str
@@ -126,9 +111,7 @@ class PhaseClock:
         self.start = clock()
         self.index = 0
         self.durations: dict[str, float] = {}
-        self._entered = self.start
-        self._done = 0.0
-        self._offset = 0.0
+        self._entered, self._done, self._offset = self.start, 0.0, 0.0
         self._samples: deque[tuple[float, float]] = deque()
         self._per_cost: float | None = None   # seconds per unit of cost, last measured
         self._settled_at: tuple[float, float] | None = None   # (clock, done) on settling
@@ -240,8 +223,7 @@ class RunProgress:
         self.label, self.enabled, self.interval = label, enabled, interval
         self.stream = stream or sys.stderr
         self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
-        self._last = -1e9
-        self._tenth = -1
+        self._last, self._tenth = -1e9, -1
         self._closed = False
 
     def enter(self, name: str, work: float | None = None, offset: float = 0.0) -> None:

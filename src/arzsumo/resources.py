@@ -1,9 +1,7 @@
 """Files shipped inside the package: scenario files, sweep files and the SUMO network.
 
 They live in ``arzsumo/data/`` and are found through :mod:`importlib.resources`, so an
-installed package (``pip install .``, not editable) runs from any working directory. A
-source checkout keeps the paths users know: ``scenarios/`` and ``sumo_nets/`` at the
-repository root are symbolic links to these directories.
+installed package runs from any working directory (docs/install.md, docs/layout.md).
 """
 
 from __future__ import annotations

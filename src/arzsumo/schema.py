@@ -1,16 +1,11 @@
 """Units and meanings of every column arzsumo writes to Parquet and of the summary keys.
 
-One place for the output schema (explained for users in ``docs/outputs.md``): the column
-tables of ``periods.parquet`` and ``cells.parquet`` (``arzsumo run``), ``fields.parquet``
-and ``control.parquet`` (``arzsumo twin``), the fixed columns of a sweep's
-``summaries.parquet``, and the units of the keys of ``summary.json`` (run and twin), whose
-dotted names are also the sweep table's columns.
-
-:func:`with_units` attaches a table's units to an Arrow table as field metadata ``unit``
-and ``description`` plus table metadata (arzsumo version, a note on units). Unit strings:
-SI (``veh/s``, ``veh/m``, ``m/s``, ``m``, ``s``), ``1`` for a dimensionless number
-(fractions, ratios), ``count`` for a number of events or vehicles counted, ``-`` for what
-is not a quantity (text, identifiers, flags).
+One place for the output schema (explained for users in ``docs/outputs.md``, whose column
+tables :func:`render_doc` generates from here): the columns of ``periods.parquet`` and
+``cells.parquet`` (``arzsumo run``), ``fields.parquet`` and ``control.parquet`` (``arzsumo
+twin``), the fixed columns of a sweep's ``summaries.parquet``, and the units of the keys of
+``summary.json`` (run and twin), whose dotted names are also the sweep table's columns.
+:func:`with_units` attaches a table's units to an Arrow table as field metadata.
 """
 
 from __future__ import annotations
@@ -37,14 +32,6 @@ class Column(NamedTuple):
 
 
 _PERIOD = "over the control period [t_s, t_s + control period]"
-#: The meter's two counts, defined once (docs/outputs.md "Counts", ``arzsumo run --help``)
-PLAN_CHANGE = ("a plan change: a command that asks the meter for a timing other than the one "
-               "it holds (a green share's green steps, a release rate's cycle in whole SUMO "
-               "steps), counted when asked whether or not it ever runs (several asked "
-               "within one cycle all count; the last one runs)")
-LIGHT_CHANGE = ("a light change: a green begins or ends on the ramp light (green, yellow, red "
-                "is one change: the clearance yellow is not counted; the queue override's "
-                "greens are counted)")
 
 #: ``periods.parquet`` of ``arzsumo run``: one row per control period
 PERIODS: dict[str, Column] = {
@@ -362,13 +349,8 @@ def scenario_field_unit(field: str) -> str | None:
 
 
 def with_units(table: pa.Table, columns: Mapping[str, Column], name: str) -> pa.Table:
-    """``table`` with each field's ``unit`` and ``description`` and table metadata.
-
-    Raises
-    ------
-    KeyError
-        A column of ``table`` is missing from ``columns``: every written column must
-        state its unit (a programming error, caught by the tests).
+    """``table`` with each field's ``unit`` and ``description`` and table metadata; a
+    column missing from ``columns`` raises KeyError (every written column states its unit).
     """
     missing = [c for c in table.column_names if c not in columns]
     if missing:
@@ -380,11 +362,6 @@ def with_units(table: pa.Table, columns: Mapping[str, Column], name: str) -> pa.
     meta.update({b"arzsumo.table": name.encode(), b"arzsumo.version": __version__.encode(),
                  b"arzsumo.units": UNITS_NOTE.encode()})
     return pa.Table.from_arrays(table.columns, schema=pa.schema(fields, metadata=meta))
-
-
-def units_of(table: pa.Table) -> dict[str, str]:
-    """Column -> unit of a table written by arzsumo ("" where none is stored)."""
-    return {f.name: (f.metadata or {}).get(b"unit", b"").decode() for f in table.schema}
 
 
 def markdown(columns: Mapping[str, Column]) -> str:

@@ -1,12 +1,10 @@
 """Scenario tables read in the user's terms: shape, types, SI conversion, and errors.
 
-Every parser of a scenario table (``[model]``, ``[equilibrium]``, ``[sumo]``, ``[run]``,
-``[twin]``, ``[initial]``, ``[design]``) describes its keys with :class:`Key` and reads
-them with :func:`read_keys`. The dataclasses behind the tables check their meaning in SI
-with internal field names (:func:`arzsumo.errors.require`); :func:`in_user_terms` turns
-such an error back into the key as written and the value as written, so every message
-reads like ``scenarios/x.toml: [sumo] demand_h_veh_h = -100 is not allowed: a demand >= 0
-veh/h``.
+Every parser of a scenario table describes its keys with :class:`Key` and reads them with
+:func:`read_keys`. The dataclasses behind the tables check their meaning in SI with
+internal field names (:func:`arzsumo.errors.require`); :func:`in_user_terms` turns such an
+error back into the key and the value as written: ``scenarios/x.toml: [sumo]
+demand_h_veh_h = -100 is not allowed: a demand >= 0 veh/h``.
 """
 
 from __future__ import annotations
@@ -14,12 +12,14 @@ from __future__ import annotations
 import difflib
 import math
 import re
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeVar
 
 from arzsumo.errors import ArzsumoError, ScenarioError
 from arzsumo.io import toml_value
+
+T = TypeVar("T")
 
 #: what a value of each kind must be (the type part of error messages)
 KIND_TEXT = {"number": "a finite number", "integer": "an integer", "string": "a string",
@@ -29,28 +29,13 @@ KIND_TEXT = {"number": "a finite number", "integer": "an integer", "string": "a 
 
 @dataclass(frozen=True)
 class Key:
-    """One key of a scenario table.
-
-    Parameters
-    ----------
-    field : str
-        The SI field it sets (of the dataclass behind the table).
-    kind : str
-        ``"number"`` (finite int or float), ``"integer"``, ``"string"``, ``"bool"`` or
-        ``"numbers"`` (a non-empty list of finite numbers, read as a tuple) or
-        ``"strings"`` (a non-empty list of strings, each among ``choices``, read as a tuple).
-    factor : float
-        User units per SI unit: 3.6 for km/h, 3600 for veh/h, 1000 for veh/km, 1 for SI.
-    allowed : str, optional
-        What is allowed, in the key's units; replaces the SI check's text when that
-        would mislead (numbers in veh/s, m/s or veh/m).
-    choices : tuple of str
-        The allowed strings of a ``"string"`` or ``"strings"`` key (empty: any string).
-    unit : str
-        The key's unit as written in files ("km/h", "veh/h", "s", "m"; "" for none):
-        what ``docs/scenarios.md`` states.
-    doc : str
-        What the key means (one line, for ``docs/scenarios.md``).
+    """One key of a scenario table: the SI ``field`` it sets (of the dataclass behind the
+    table) and its ``kind``: ``"number"`` (finite int or float), ``"integer"``,
+    ``"string"``, ``"bool"``, ``"numbers"`` or ``"strings"`` (non-empty lists, read as
+    tuples). ``factor`` is user units per SI unit (3.6 for km/h, 3600 for veh/h, 1000 for
+    veh/km); ``allowed`` what is allowed in the key's units, replacing the SI check's text
+    where that would mislead; ``choices`` the allowed strings (empty: any). ``unit`` (as
+    written in files, "" for none) and ``doc`` (one line) are what docs/scenarios.md states.
     """
 
     field: str
@@ -77,11 +62,8 @@ def where(source: str, table: str) -> str:
 
 def not_allowed(at: str, key: str, value: Any, allowed: str,
                 error: type[ArzsumoError] = ScenarioError) -> ArzsumoError:
-    """``error``: ``{at} {key} = {value as written} is not allowed: {allowed}``.
-
-    The error keeps ``at``, ``key`` and ``allowed`` as attributes, so that a caller who
-    set the value from elsewhere (a command-line option) can name it there
-    (:func:`restated`)."""
+    """``error``: ``{at} {key} = {value as written} is not allowed: {allowed}``, keeping
+    ``at``, ``key`` and ``allowed`` for a caller that names the value its way (:func:`restated`)."""
     exc = error(f"{at} {key} = {written(value)} is not allowed: {allowed}")
     exc.at, exc.key, exc.allowed = at, key, allowed
     return exc
@@ -121,11 +103,13 @@ def check_renamed(table: Mapping[str, Any], renamed: Mapping[str, str], at: str)
 
 
 def sub_table(data: Mapping[str, Any], name: str, allowed: set[str] | Mapping[str, Any],
-              source: str) -> dict[str, Any]:
-    """The ``[name]`` table of ``data`` (empty if absent), its keys checked."""
+              source: str, renamed: Mapping[str, str] | None = None) -> dict[str, Any]:
+    """The ``[name]`` table of ``data`` (empty if absent), its keys checked (``renamed``:
+    old -> new names, refused with a hint)."""
     value = data.get(name, {})
     if not isinstance(value, Mapping):
         raise not_allowed(f"{source}:", name, value, f"a table [{name}]")
+    check_renamed(value, renamed or {}, where(source, name))
     check_keys(value, allowed, where(source, name))
     return dict(value)
 
@@ -186,13 +170,10 @@ def _user_names(text: str, keys: Mapping[str, Key]) -> str:
 
 def in_user_terms(exc: ArzsumoError, at: str, table: Mapping[str, Any],
                   keys: Mapping[str, Key]) -> ScenarioError:
-    """``exc`` (raised in SI with a field name) restated with the key and written value.
-
-    The result is a :class:`ScenarioError` (a bad value of the file). A field that a key
-    of ``table`` sets is named by that key with the value as written; a same-unit field
-    left at its default is named by its key with the default; anything else keeps its
-    message, prefixed by ``at``.
-    """
+    """``exc`` (raised in SI with a field name) restated as a :class:`ScenarioError`: a
+    field that a key of ``table`` sets is named by that key with the value as written; a
+    same-unit field left at its default by its key with the default; anything else keeps
+    its message, prefixed by ``at``."""
     field = getattr(exc, "field", None)
     matches = [key for key, spec in keys.items() if field is not None and spec.field == field]
     for key in sorted(matches, key=lambda k: k not in table):     # keys written first
@@ -205,3 +186,14 @@ def in_user_terms(exc: ArzsumoError, at: str, table: Mapping[str, Any],
             return ScenarioError(f"{at} {key} = {written(exc.value)} (the default) is not "
                                  f"allowed: {allowed}")
     return ScenarioError(f"{at} {_user_names(str(exc), keys)}")
+
+
+def read_section(make: Callable[..., T], table: Mapping[str, Any], keys: Mapping[str, Key],
+                 at: str, **extra: Any) -> T:
+    """``make(**SI values of the keys of table, **extra)``: the record of a table whose key
+    names are already checked; errors name the key and the value as written."""
+    si = read_keys(table, keys, at)       # its own errors name key and value
+    try:
+        return make(**si, **extra)
+    except ArzsumoError as exc:
+        raise in_user_terms(exc, at, table, keys) from None

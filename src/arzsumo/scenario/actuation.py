@@ -1,52 +1,11 @@
 """The ``[actuation]`` section: limits between the controller's U and the ramp meter.
 
-Every key, its unit and the field of :class:`ActuationSettings` it sets::
-
-    [actuation]
-    u_max_fraction = 0.2          # |U| <= 0.2 q*          (0: off)
-    u_rate_max_veh_h_s = 100      # |U_k - U_k-1| <= 100 veh/h per s x control period (0: off)
-    ramp_bound = true             # U within what the meter and the ramp can deliver
-    anti_windup = true            # controllers with state see the U actually applied
-    delay_compensation_s = 12     # PDE laws act on the state predicted 12 s ahead (0: off)
-    meter_gain = 2                # PDE laws: the outflow moves 2 veh/h per veh/h of release
-    hold_plan_in_range = true     # a held U moves the plan only when the range leaves it
-    actuator = "speed_limit"      # PDE laws act on the outlet's speed limit, not the meter
-    speed_limit_gain_veh_h_per_kmh = 40   # dq(L)/dv_limit
-    speed_limit_min_kmh = 10      # the limit's range ...
-    speed_limit_max_kmh = 60
-    speed_limit_step_kmh = 1      # ... and its resolution (0: continuous)
-
-Without the table every limit is off and a run is today's: the meter receives the
-controller's U unchanged (the meter itself still saturates its green share to
-``[sumo] green_share_min .. green_share_max``).
-
-``delay_compensation_s`` is the dead time theta from a command to the section's outflow
-(10-14 s measured in SUMO, ``arzsumo study meter-dynamics``): backstepping and the ETC then
-evaluate control_law on the scaled Riemann state predicted theta seconds ahead
-(:func:`arzsumo.control.predictor.predict_riemann`, with the U applied in the last theta
-seconds; :class:`arzsumo.control.compensation.DelayCompensated`). It must be shorter than
-L / max |lambda| at the equilibrium (one boundary reflection at most):
-:func:`check_delay_horizon`. The limits act in
-:func:`arzsumo.bridge.actuator.limit_u`; the ramp bound's rule is in
-:func:`arzsumo.bridge.actuator.ramp_range`.
-
-``meter_gain`` is -dq(L)/dr, the change of the section's outflow per change of the ramp
-release (about 2 on the default's merge, measured by the premise's actuator staircase):
-a PDE law's U is handed to the meter divided by it
-(:class:`arzsumo.control.meter_gain.MeterGain`). ``hold_plan_in_range``: while a law
-holds its U (between an ETC's events, or a held meter), the plan stays where it is as
-long as it lies in the range; it moves only when the range (the ramp bound moves with the
-queue) leaves it (:class:`arzsumo.bridge.actuator.MeterActuator`).
-
-``actuator`` names what a PDE law's U drives. ``"meter"`` (the default) is the paper's
-ramp meter. ``"speed_limit"`` is mainstream control at the section's outlet: the speed
-limit of the edge past the merge (``down``, the bottleneck whose discharge sets q(L)) is
-``v_nominal + U / speed_limit_gain`` (:class:`arzsumo.bridge.speed_actuator.SpeedLimitActuator`),
-within ``[speed_limit_min, speed_limit_max]`` and rounded to ``speed_limit_step``; the
-meter keeps its nominal plan. The boundary input is the same q(L) - q* as the paper's;
-only its actuator differs, one whose range is several times the meter's on a stream
-where the ramp's share of the flow is small. ALINEA, PI-ALINEA and the held meter
-command the ramp meter whatever ``actuator`` says.
+Without the table every limit is off and the meter receives the controller's U unchanged
+(it still saturates its green share to ``[sumo] green_share_min .. green_share_max``). The
+limits act in :func:`arzsumo.bridge.actuator.limit_u` (docs/sumo.md, "Actuation limits");
+``delay_compensation_s`` must stay below L / max |lambda| (:func:`check_delay_horizon`);
+``actuator = "speed_limit"`` hands a PDE law's U to the outlet's speed limit instead of the
+meter (docs/sumo.md, "The outlet's speed limit as the actuator"). Keys: docs/scenarios.md.
 """
 
 from __future__ import annotations
@@ -58,8 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from arzsumo.errors import ArzsumoError, ScenarioError, require
-from arzsumo.tables import Key, in_user_terms, not_allowed, read_keys
+from arzsumo.errors import ScenarioError, require
+from arzsumo.tables import Key, not_allowed, read_section
 from arzsumo.units import KMH_PER_MS, VEH_H_PER_VEH_S, VEH_KM_PER_VEH_M
 
 #: what a PDE law's U can drive
@@ -117,17 +76,11 @@ ACTUATION_KEYS: dict[str, Key] = {
 
 @dataclass(frozen=True)
 class ActuationSettings:
-    """Limits on U between controller and meter (SI).
+    """Limits on U between controller and meter: the fields of :data:`ACTUATION_KEYS` in SI.
 
-    ``u_max_fraction`` bounds |U| by that fraction of q* (0: off); ``u_rate_max`` (veh/s
-    per s) bounds the change of U between control periods (0: off); ``ramp_bound`` limits
-    U to the meter's and the ramp's range; ``anti_windup`` tells the controller the U
-    applied (:meth:`arzsumo.control.base.Controller.applied`); ``delay_compensation``
-    (s, 0: off) is the dead time theta the PDE laws predict over; ``meter_gain``
-    (dimensionless) is -dq(L)/dr; ``hold_plan_in_range`` keeps a held U's plan while it
-    lies in the range; ``actuator`` what a PDE law's U drives, with the speed limit's
-    ``speed_limit_gain`` (veh/s per m/s = veh/m), range ``speed_limit_min ..
-    speed_limit_max`` (m/s) and resolution ``speed_limit_step`` (m/s, 0: continuous).
+    Units: ``u_rate_max`` veh/s per s, ``delay_compensation`` s, ``speed_limit_gain`` veh/m
+    (veh/s per m/s), ``speed_limit_*`` m/s; ``u_max_fraction``, ``u_rate_max`` and
+    ``delay_compensation`` at 0 are off, ``speed_limit_step`` at 0 is continuous.
     """
 
     u_max_fraction: float = 0.0
@@ -144,28 +97,21 @@ class ActuationSettings:
     speed_limit_step: float = 0.0
 
     def __post_init__(self) -> None:
-        require(math.isfinite(self.u_max_fraction) and 0.0 <= self.u_max_fraction <= 1.0,
-                "u_max_fraction", self.u_max_fraction, "a fraction in [0, 1]", ScenarioError)
-        require(math.isfinite(self.u_rate_max) and self.u_rate_max >= 0.0, "u_rate_max",
-                self.u_rate_max, "a rate >= 0 veh/s per s", ScenarioError)
-        require(math.isfinite(self.delay_compensation) and self.delay_compensation >= 0.0,
-                "delay_compensation", self.delay_compensation, "a dead time >= 0 s",
-                ScenarioError)
-        require(math.isfinite(self.meter_gain) and self.meter_gain > 0.0, "meter_gain",
-                self.meter_gain, "a gain > 0", ScenarioError)
+        def check(name: str, ok: bool, allowed: str) -> None:
+            value = getattr(self, name)
+            require(math.isfinite(value) and ok, name, value, allowed, ScenarioError)
+
+        check("u_max_fraction", 0.0 <= self.u_max_fraction <= 1.0, "a fraction in [0, 1]")
+        check("u_rate_max", self.u_rate_max >= 0.0, "a rate >= 0 veh/s per s")
+        check("delay_compensation", self.delay_compensation >= 0.0, "a dead time >= 0 s")
+        check("meter_gain", self.meter_gain > 0.0, "a gain > 0")
         require(self.actuator in ACTUATORS, "actuator", self.actuator,
                 f"one of {', '.join(ACTUATORS)}", ScenarioError)
-        require(math.isfinite(self.speed_limit_gain) and self.speed_limit_gain > 0.0,
-                "speed_limit_gain", self.speed_limit_gain, "a gain > 0 veh/m",
-                ScenarioError)
-        require(math.isfinite(self.speed_limit_min) and self.speed_limit_min > 0.0,
-                "speed_limit_min", self.speed_limit_min, "a speed > 0 m/s", ScenarioError)
-        require(math.isfinite(self.speed_limit_max)
-                and self.speed_limit_max > self.speed_limit_min, "speed_limit_max",
-                self.speed_limit_max, "a speed above speed_limit_min", ScenarioError)
-        require(math.isfinite(self.speed_limit_step) and self.speed_limit_step >= 0.0,
-                "speed_limit_step", self.speed_limit_step, "a step >= 0 m/s",
-                ScenarioError)
+        check("speed_limit_gain", self.speed_limit_gain > 0.0, "a gain > 0 veh/m")
+        check("speed_limit_min", self.speed_limit_min > 0.0, "a speed > 0 m/s")
+        check("speed_limit_max", self.speed_limit_max > self.speed_limit_min,
+              "a speed above speed_limit_min")
+        check("speed_limit_step", self.speed_limit_step >= 0.0, "a step >= 0 m/s")
 
     @property
     def active(self) -> bool:
@@ -177,13 +123,8 @@ class ActuationSettings:
 
 
 def actuation_section(table: Mapping[str, Any], at: str) -> ActuationSettings:
-    """The ActuationSettings of an ``[actuation]`` table (keys already checked); errors
-    name the key and the value as written."""
-    si = read_keys(table, ACTUATION_KEYS, at)
-    try:
-        return ActuationSettings(**si)
-    except ArzsumoError as exc:
-        raise in_user_terms(exc, at, table, ACTUATION_KEYS) from None
+    """The ActuationSettings of an ``[actuation]`` table."""
+    return read_section(ActuationSettings, table, ACTUATION_KEYS, at)
 
 
 def delay_horizon(eigenvalues: np.ndarray, length: float) -> float:
@@ -196,8 +137,7 @@ def delay_horizon(eigenvalues: np.ndarray, length: float) -> float:
 def check_delay_horizon(settings: ActuationSettings, eigenvalues: np.ndarray, length: float,
                         at: str, written_value: Any = None, why: str = "") -> None:
     """Refuse ``delay_compensation_s`` >= L / max |lambda| (``eigenvalues`` in m/s,
-    ``length`` in m) with one line naming ``at`` (``file: [actuation]``), the key and the
-    value as written; ``why`` names the equilibrium when it is not the scenario's."""
+    ``length`` in m); ``why`` names the equilibrium when it is not the scenario's."""
     theta = settings.delay_compensation
     horizon = delay_horizon(eigenvalues, length)
     if theta >= horizon:
@@ -212,8 +152,7 @@ def check_speed_limit(settings: ActuationSettings, down_speed: float, slowed_edg
                       at: str, table: Mapping[str, Any]) -> None:
     """Refuse a speed-limit actuator whose range leaves out the outlet's own limit
     ``down_speed`` (m/s, the open loop's), or that shares its edge with a slowdown
-    (``slowed_edge``: the edge a ``[disturbance]`` slows, None without one); one line
-    naming ``at`` (``file: [actuation]``), the key and the value as written."""
+    (``slowed_edge``: the edge a ``[disturbance]`` slows, None without one)."""
     if settings.actuator != "speed_limit":
         return
     if not settings.speed_limit_min <= down_speed <= settings.speed_limit_max:

@@ -1,22 +1,9 @@
 """The ``[alinea]`` section: ALINEA and PI-ALINEA as practitioners run them.
 
-Every key, its unit and the field of :class:`~arzsumo.control.alinea.AlineaSettings`
-it sets::
-
-    [alinea]
-    period_s = 40                   # the controller's own period (20-60 s)
-    loop_distance_m = 100           # its loop downstream of the merge nose (40-300 m)
-    target_pct = 20                 # occupancy target, just below the loop's critical
-                                    # occupancy (`arzsumo alinea-target`)
-    gain_veh_h_per_pct = 70         # K_R at gain_period_s ...
-    gain_period_s = 60              # ... scaled with the period: K_R T / T_ref
-    kp_veh_h_per_pct = 60           # PI-ALINEA's K_P (not scaled)
-    ki_veh_h_per_pct = 5            # PI-ALINEA's K_I at gain_period_s (scaled as K_R)
-
-Occupancy is written in % here and held as a fraction inside; gains per % of occupancy
-in veh/h are 100/3600 veh/s per unit occupancy (:data:`GAIN_FACTOR`). The loop is read
-in every run (open loop too), so the ``occupancy_out`` column of every periods table is
-its occupancy.
+Occupancy is written in % and held as a fraction inside; gains per % of occupancy in veh/h
+are 100/3600 veh/s per unit occupancy (:data:`GAIN_FACTOR`). The loop is read in every run
+(open loop too): it is the ``occupancy_out`` column of every periods table. Keys:
+docs/scenarios.md; the controllers: docs/sumo.md, "Baselines a practitioner would field".
 """
 
 from __future__ import annotations
@@ -25,8 +12,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from arzsumo.control.alinea import AlineaSettings
-from arzsumo.errors import ArzsumoError
-from arzsumo.tables import Key, in_user_terms, not_allowed, read_keys
+from arzsumo.tables import Key, not_allowed, read_section
 from arzsumo.units import VEH_H_PER_VEH_S
 
 #: veh/h per % of occupancy per (veh/s per unit occupancy): 3600 / 100 = 36
@@ -62,19 +48,14 @@ ALINEA_KEYS: dict[str, Key] = {
 
 
 def alinea_section(table: Mapping[str, Any], at: str) -> AlineaSettings:
-    """The AlineaSettings of an ``[alinea]`` table (keys already checked); errors name
-    the key and the value as written."""
-    si = read_keys(table, ALINEA_KEYS, at)
-    try:
-        return AlineaSettings(**si)
-    except ArzsumoError as exc:
-        raise in_user_terms(exc, at, table, ALINEA_KEYS) from None
+    """The AlineaSettings of an ``[alinea]`` table."""
+    return read_section(AlineaSettings, table, ALINEA_KEYS, at)
 
 
 def check_alinea_period(settings: AlineaSettings, control_period: float, at: str,
                         written_value: Any = None) -> None:
     """Refuse an ALINEA period that is not a whole number of the closed loop's control
-    periods (``[sumo] control_period_s``, s), in one line naming ``at`` and the key."""
+    periods (``[sumo] control_period_s``, s)."""
     n = round(settings.period / control_period)
     if n < 1 or abs(n * control_period - settings.period) > 1e-6:
         value = settings.period if written_value is None else written_value

@@ -1,17 +1,8 @@
 """The ``[disturbance]`` section: a reproducible perturbation of SUMO after control starts.
 
-Every key, its unit and the field of :class:`~arzsumo.sumo.disturbance.Slowdown` it sets::
-
-    [disturbance]
-    kind = "slowdown"     # none (default) or slowdown
-    edge = "down"         # main, merge or down (past the merge, where no meter acts)
-    speed_kmh = 10        # the edge's speed limit while it lasts
-    start_s = 0           # from this many s after the start of control ...
-    duration_s = 30       # ... for this long
-
-The disturbance acts in the control window only, so a scenario with it and one without
-share their warm-up (:func:`arzsumo.bridge.branches.warmup_key`): the disturbance
-experiment starts from the regulation experiment's state, seed by seed.
+It acts in the control window only, so a scenario with it and one without share their
+warm-up (:func:`arzsumo.bridge.branches.warmup_key`): the disturbance experiment starts
+from the regulation experiment's state, seed by seed. Keys: docs/scenarios.md.
 """
 
 from __future__ import annotations
@@ -19,9 +10,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from arzsumo.errors import ArzsumoError
 from arzsumo.sumo.disturbance import EDGES, KINDS, Slowdown
-from arzsumo.tables import Key, in_user_terms, read_keys
+from arzsumo.tables import Key, read_section
 from arzsumo.units import KMH_PER_MS
 
 #: [disturbance] key -> Slowdown field (SI)
@@ -40,10 +30,5 @@ DISTURBANCE_KEYS: dict[str, Key] = {
 
 
 def disturbance_section(table: Mapping[str, Any], at: str) -> Slowdown:
-    """The Slowdown of a ``[disturbance]`` table (keys already checked); errors name the
-    key and the value as written."""
-    si = read_keys(table, DISTURBANCE_KEYS, at)
-    try:
-        return Slowdown(**si)
-    except ArzsumoError as exc:
-        raise in_user_terms(exc, at, table, DISTURBANCE_KEYS) from None
+    """The Slowdown of a ``[disturbance]`` table."""
+    return read_section(Slowdown, table, DISTURBANCE_KEYS, at)

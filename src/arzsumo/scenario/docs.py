@@ -1,8 +1,7 @@
 """``docs/scenarios.md``, generated from the key tables (one place per section).
 
-``python -m arzsumo.scenario.docs > docs/scenarios.md`` writes it again; a test checks the
-file is up to date, so every key, its unit, its SI conversion, its default and its
-meaning are documented exactly as the parser reads them.
+``python -m arzsumo.scenario.docs > docs/scenarios.md`` writes it again; a test checks that
+the file is up to date.
 """
 
 from __future__ import annotations

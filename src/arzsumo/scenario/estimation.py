@@ -1,28 +1,10 @@
 """The ``[estimation]`` section: what the controller of ``arzsumo run`` acts on.
 
-Every key, its unit and the field of :class:`EstimationSettings` it sets::
-
-    [estimation]
-    method = "enkf"                 # "none" (raw cells), "smoothing" (ASM) or "enkf"
-    members = 32                    # EnKF ensemble size
-    inflation = 1.05                # EnKF multiplicative inflation per analysis
-    localisation_m = 150            # EnKF Gaspari-Cohn half-width
-    seed = 0                        # EnKF random draws
-    loop_density_sd_veh_km = 8      # assumed error sd of a loop's density, per period
-    model_sd_rho_h_veh_km = 2       # EnKF model-error noise per forecast (also _v_h_kmh,
-                                    # _rho_a_veh_km, _v_a_kmh; defaults 2, 1, 1, 1)
-    asm_sigma_m = 75                # ASM kernel width in space
-
-Without the table (``method = "none"``) the controller acts on the cells of the full
-probe. ``smoothing`` and ``enkf`` read the ``[sensing]`` loops and AV
-probes (``enkf`` needs loop stations at both boundaries: its twins' inflow and outflow).
-The noise levels are the estimators' assumed measurement errors (the weights of the data
-and the EnKF's R); nothing is added to SUMO's readings.
-
-The ASM defaults are not the published ones (sigma 150 m, tau 15 s, crossover 60 km/h):
-fitted to this model's waves (3 of its 4 characteristic families travel downstream even
-in congestion), sigma 75 m, tau 10 s and a 30 km/h crossover won on HV density
-(``tests/estimate/test_smoothing.py``).
+Without the table (``method = "none"``) the controller acts on the cells of the full probe;
+``smoothing`` (ASM) and ``enkf`` read the ``[sensing]`` loops and AV probes (``enkf`` needs
+loop stations at both boundaries). The noise levels are the estimators' assumed
+measurement errors; nothing is added to SUMO's readings. Keys: docs/scenarios.md; the
+estimators and their defaults: docs/sumo.md, "Estimation in the closed loop".
 """
 
 from __future__ import annotations
@@ -32,24 +14,20 @@ from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from typing import Any
 
-from arzsumo.errors import ArzsumoError, ScenarioError, require
+from arzsumo.errors import ScenarioError, require
 from arzsumo.estimate.enkf import EnkfOptions
 from arzsumo.estimate.observations import LoopNoise, ProbeNoise
 from arzsumo.estimate.smoothing import AsmParameters
 from arzsumo.sumo.loops import BOUNDARY_GAP, INLET_GAP, placed_positions
 from arzsumo.sumo.sensing import SensorLayout
-from arzsumo.tables import Key, in_user_terms, read_keys
+from arzsumo.tables import Key, read_section
 from arzsumo.units import KMH_PER_MS, VEH_H_PER_VEH_S, kmh_to_ms
 
 METHODS = ("none", "smoothing", "enkf")
 #: what a PDE controller's deviations are measured from (:mod:`arzsumo.bridge.reference`)
 REFERENCES = ("equilibrium", "warmup")
 #: default EnKF model-error sd per forecast (rho_h veh/m, v_h m/s, rho_a veh/m, v_a m/s):
-#: 2 veh/km, 1 km/h, 1 veh/km, 1 km/h, chosen offline on SUMO records of the default
-#: scenario (seeds 1-2, loops every 250 m + AV probes; ``arzsumo study enkf-noise``,
-#: research/readings/enkf_model_noise.md): RMSE / spread fell from 5.1, 7.5, 7.9, 8.1 to 3.0, 3.4,
-#: 4.2, 1.8 at RMSE +12 %, -1 %, +8 %, -48 %; larger noise or inflation raised the spread and the
-#: error together (density RMSE x 1.5-3 for RMSE / spread 2-3).
+#: 2 veh/km, 1 km/h, 1 veh/km, 1 km/h (research/readings/enkf_model_noise.md)
 MODEL_SD = (2e-3, float(kmh_to_ms(1.0)), 1e-3, float(kmh_to_ms(1.0)))
 
 #: [estimation] key -> EstimationSettings field (SI)
@@ -117,14 +95,8 @@ ESTIMATION_KEYS: dict[str, Key] = {
 
 @dataclass(frozen=True)
 class EstimationSettings:
-    """The estimator of a run (SI: veh/s, m/s, veh/m, m, s).
-
-    ``method`` is one of :data:`METHODS`; the EnKF's ``members``, ``inflation``,
-    ``localisation`` (m) and ``seed``; the assumed sensor errors (standard deviations,
-    per period: loop flow veh/s, loop speed m/s, loop density veh/m, probe speed m/s);
-    the ASM kernels (widths ``asm_sigma`` m and ``asm_tau`` s, crossover ``asm_v_crit``
-    and width ``asm_dv`` m/s, wave speeds ``asm_c_free`` > 0 and ``asm_c_cong`` < 0 m/s).
-    """
+    """The estimator of a run: the fields of :data:`ESTIMATION_KEYS` in SI (veh/s, m/s,
+    veh/m, m, s); the sensor errors are standard deviations per period."""
 
     method: str = "none"
     members: int = 32
@@ -219,9 +191,5 @@ def check_sensors(est: EstimationSettings, layout: SensorLayout, length: float,
 
 
 def estimation_section(table: Mapping[str, Any], at: str) -> EstimationSettings:
-    """The EstimationSettings of an ``[estimation]`` table (keys already checked)."""
-    si = read_keys(table, ESTIMATION_KEYS, at)       # its own errors name key and value
-    try:
-        return EstimationSettings(**si)
-    except ArzsumoError as exc:
-        raise in_user_terms(exc, at, table, ESTIMATION_KEYS) from None
+    """The EstimationSettings of an ``[estimation]`` table."""
+    return read_section(EstimationSettings, table, ESTIMATION_KEYS, at)

@@ -1,19 +1,9 @@
 """The ``[model]``, ``[equilibrium]`` and ``[design]`` sections of a scenario file.
 
-Keys carry their unit in their name (``_kmh``, ``_veh_km``, ``_veh_h``, ``_m``, ``_s``);
-the key tables below are where those units become SI, through :mod:`arzsumo.units`::
-
-    [model]
-    preset = "paper_base"
-    vehicle_width_m = 2.0
-    [equilibrium]
-    rho_h_veh_km = 110
-    rho_a_veh_km = 95
-    [design]
-    mu = 5e-4
-
-The model validates itself (:class:`~arzsumo.model.params.ModelParameters`); errors are
-restated with the key and the value as written (:func:`arzsumo.tables.in_user_terms`).
+Keys carry their unit in their name; the key tables below turn them into SI (keys:
+docs/scenarios.md). The model validates itself
+(:class:`~arzsumo.model.params.ModelParameters`); errors are restated with the key and the
+value as written (:func:`arzsumo.tables.in_user_terms`).
 """
 
 from __future__ import annotations
@@ -32,7 +22,7 @@ from arzsumo.model.equilibrium import (
     equilibrium_from_densities,
 )
 from arzsumo.model.params import FAMILIES, PRESETS, ModelParameters, Preset, get_preset
-from arzsumo.tables import Key, checked, in_user_terms, read_keys, written
+from arzsumo.tables import Key, checked, in_user_terms, read_keys, read_section, written
 from arzsumo.units import KMH_PER_MS, VEH_H_PER_VEH_S, VEH_KM_PER_VEH_M
 
 _SPEED = "a speed > 0 km/h"
@@ -226,8 +216,4 @@ def design_toml(design: EtcDesign, comment: str = "") -> str:
 
 def design_section(table: Mapping[str, Any], at: str) -> EtcDesign:
     """The ETC design of a ``[design]`` table (the paper's values for missing keys)."""
-    changes = read_keys(table, DESIGN_KEYS, at)
-    try:
-        return PAPER_DESIGN.with_(**changes)
-    except ArzsumoError as exc:
-        raise in_user_terms(exc, at, table, DESIGN_KEYS) from None
+    return read_section(PAPER_DESIGN.with_, table, DESIGN_KEYS, at)

@@ -1,23 +1,9 @@
 """The ``[network]`` section: the laws on a SUMO network the user brings.
 
-Every key, its unit and the field of :class:`arzsumo.sumo.user_network.NetworkRequest` it
-sets::
-
-    [network]
-    net_file = "my.net.xml"          # relative to the scenario file
-    route_files = ["my.rou.xml"]     # optional: the user's demand and vTypes
-    section_edges = ["a", "b", "c"]  # the section from x = 0 to x = L, in driving order
-    meter_tls = "rm1"                # the light that meters the on-ramp
-    ramp_edge = "onramp"             # the ramp edge the meter holds (its queue storage)
-    av_types = ["cav"]               # vType ids counted as AVs (with route_files)
-    start_offset_m = 0               # the section starts this far along its first edge
-    end_offset_m = 0                 # ... and ends this far before its last edge's end
-    sublane = true                   # SUMO's sublane model (false: lane changes only)
-
 Here the table is read for its shape only; :func:`arzsumo.bridge.session.prepare_run`
 checks it against the network with sumolib before SUMO starts
 (:func:`arzsumo.sumo.user_network.read_layout`). Without the table a run uses the shipped
-network, as before.
+network. Keys: docs/scenarios.md; docs/networks.md.
 """
 
 from __future__ import annotations
@@ -26,9 +12,9 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from arzsumo.errors import ArzsumoError, ScenarioError
+from arzsumo.errors import ScenarioError
 from arzsumo.sumo.user_network import NetworkRequest
-from arzsumo.tables import Key, in_user_terms, read_keys
+from arzsumo.tables import Key, read_section
 
 #: [network] key -> NetworkRequest field (SI)
 NETWORK_KEYS: dict[str, Key] = {
@@ -70,9 +56,5 @@ def network_section(table: Mapping[str, Any], at: str, source: str) -> NetworkRe
     if missing:
         raise ScenarioError(f"{at} needs the keys {', '.join(REQUIRED)}; missing: "
                             f"{', '.join(missing)}")
-    si = read_keys(table, NETWORK_KEYS, at)
     base = Path(source).parent if Path(source).is_file() else Path(".")
-    try:
-        return NetworkRequest(**si, base=str(base.resolve()))
-    except ArzsumoError as exc:
-        raise in_user_terms(exc, at, table, NETWORK_KEYS) from None
+    return read_section(NetworkRequest, table, NETWORK_KEYS, at, base=str(base.resolve()))

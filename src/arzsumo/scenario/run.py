@@ -1,22 +1,7 @@
-"""The ``[run]`` section: what ``arzsumo run`` does around SUMO (human units in key names).
+"""The ``[run]`` section: what ``arzsumo run`` does around SUMO (keys: docs/scenarios.md).
 
-Example::
-
-    [run]
-    controller = "etc"          # a name of arzsumo.control.registry that runs in SUMO
-    warmup_s = 150              # nominal meter until control starts
-    start = "warmup"            # or "placement": vehicles placed from [initial] at t = 0
-    operating_point = "scenario"  # or "measured": mean of the last 60 s of the warm-up
-    kernel_cells = 100          # backstepping kernel grid
-    twin_cells = 100            # PDE twin grid (replay and reference)
-    twin_scheme = "muscl"       # or "first"
-    smoothing_s = 30            # time constant of the measured boundary data fed to the twins
-    constant_release_veh_h = 600  # release rate of the `constant` controller
-
-ALINEA's and PI-ALINEA's parameters are the ``[alinea]`` table
-(:mod:`arzsumo.scenario.alinea`).
-
-The control horizon, the control period and the seed are ``[sumo]`` keys.
+ALINEA's and PI-ALINEA's parameters are the ``[alinea]`` table; the control horizon, the
+control period and the seed are ``[sumo]`` keys.
 """
 
 from __future__ import annotations
@@ -26,8 +11,8 @@ from dataclasses import asdict, dataclass
 from typing import Any
 
 from arzsumo.control.registry import controller_names
-from arzsumo.errors import ArzsumoError, ScenarioError, require
-from arzsumo.tables import Key, in_user_terms, not_allowed, read_keys
+from arzsumo.errors import ScenarioError, require
+from arzsumo.tables import Key, not_allowed, read_section
 from arzsumo.units import VEH_H_PER_VEH_S
 
 #: backstepping kernel grid of both `arzsumo run` and `arzsumo twin` (one default)
@@ -105,20 +90,14 @@ class RunSettings:
 
 
 def run_section(table: dict[str, Any], at: str) -> RunSettings:
-    """The RunSettings of a ``[run]`` table (keys already checked); errors name the key
-    and the value as written."""
-    si = read_keys(table, RUN_KEYS, at)       # its own errors name key and value
-    try:
-        return RunSettings(**si)
-    except ArzsumoError as exc:
-        raise in_user_terms(exc, at, table, RUN_KEYS) from None
+    """The RunSettings of a ``[run]`` table."""
+    return read_section(RunSettings, table, RUN_KEYS, at)
 
 
 def check_constant_release(settings: RunSettings, low: float, high: float, at: str,
                            written_value: Any = None) -> None:
     """Refuse a ``constant`` controller whose release rate lies outside the meter's
-    bounds ``[low, high]`` (veh/s), in one line naming ``at`` (``file: [run]``), the key
-    and the value as written."""
+    bounds ``[low, high]`` (veh/s)."""
     r = settings.constant_release
     if settings.controller == "constant" and not low - 1e-12 <= r <= high + 1e-12:
         value = written_value if written_value is not None else r * VEH_H_PER_VEH_S

@@ -1,16 +1,7 @@
 """The ``[sensing]`` section: which sensors ``arzsumo run`` reads in SUMO.
 
-Every key, its unit and the field of :class:`arzsumo.sumo.sensing.SensorLayout` it sets::
-
-    [sensing]
-    kinds = ["loops", "av_probes"]   # any of "probe", "loops", "av_probes"
-    loop_spacing_m = 250             # stations at 0, 250, ..., L (or loop_positions_m)
-    loop_speed = "harmonic"          # loops report the harmonic mean speed (default time_mean)
-    av_probe_share = 0.5             # half of the AVs report
-    av_probe_seed = 1                # which half
-
-Without the table a run has today's sensor, ``kinds = ["probe"]``: every vehicle on the
-section, binned into cells and periods.
+Without the table a run reads ``kinds = ["probe"]``: every vehicle on the section, binned
+into cells and periods. Keys: docs/scenarios.md; docs/sumo.md, "Sensing layouts".
 """
 
 from __future__ import annotations

@@ -1,15 +1,8 @@
 """The ``[sumo]`` section: how ``arzsumo run`` (and ``calibrate``) drive SUMO.
 
-Every key of the table, its unit and its conversion to the SI field of
-:class:`arzsumo.sumo.config.SumoConfig`::
-
-    [sumo]
-    step_length_s = 0.1
-    demand_h_veh_h = 4104
-    demand_a_veh_h = 1560
-    ramp_demand_veh_h = 1200
-    meter_cycle_s = 6
-    meter_curve = "calibration/meter_curve.toml"   # relative to the scenario file
+Every key, its unit and its conversion to the SI field of
+:class:`arzsumo.sumo.config.SumoConfig`: :data:`SUMO_KEYS` (docs/scenarios.md). A relative
+``meter_curve`` is read relative to the scenario file.
 """
 
 from __future__ import annotations
@@ -19,7 +12,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from arzsumo.errors import ArzsumoError, ScenarioError
+from arzsumo.errors import ScenarioError
 from arzsumo.sumo.car_following import ignored, readers
 from arzsumo.sumo.config import (
     AV_MODELS,
@@ -29,7 +22,7 @@ from arzsumo.sumo.config import (
     METER_MODES,
     SumoConfig,
 )
-from arzsumo.tables import Key, in_user_terms, read_keys, written
+from arzsumo.tables import Key, read_section, written
 from arzsumo.units import KMH_PER_MS, VEH_H_PER_VEH_S
 
 _DEMAND = "a demand >= 0 veh/h"
@@ -234,9 +227,8 @@ def refuse_inert_meter_keys(table: Mapping[str, Any], at: str, mode: str) -> Non
     for other, keys in MODE_ONLY_KEYS.items():
         bad = [k for k in keys if k in table and other != mode]
         if bad:
-            k = bad[0]
             raise ScenarioError(
-                f"{at} {k} = {written(table[k])} is not allowed with meter_mode = "
+                f"{at} {bad[0]} = {written(table[bad[0]])} is not allowed with meter_mode = "
                 f"{written(mode)}: it acts only under meter_mode = {written(other)}; "
                 f"allowed: remove it, or set meter_mode = {written(other)}")
 
@@ -247,11 +239,7 @@ def sumo_section(table: Mapping[str, Any], at: str, source: str = "<dict>") -> S
     A relative ``meter_curve`` is read from the directory of ``source`` (the working
     directory for a scenario not read from a file) and made absolute; the file must exist.
     """
-    changes = read_keys(table, SUMO_KEYS, at)
-    try:
-        cfg = SumoConfig(**changes)
-    except ArzsumoError as exc:
-        raise in_user_terms(exc, at, table, SUMO_KEYS) from None
+    cfg = read_section(SumoConfig, table, SUMO_KEYS, at)
     refuse_inert_meter_keys(table, at, cfg.meter_mode)
     refuse_ignored_car_following(table, at, cfg)
     if not cfg.meter_curve:

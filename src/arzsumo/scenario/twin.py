@@ -1,31 +1,7 @@
 """The ``[twin]`` and ``[initial]`` sections: what ``arzsumo twin`` (and ``reproduce``) runs.
 
-Example::
-
-    [twin]
-    cells = 200
-    scheme = "first"            # or "muscl"
-    flux = "hll"                # or "rusanov"
-    limiter = "vanleer"         # muscl only: "minmod", "vanleer", "mc"
-    cfl = 0.9
-    horizon_s = 450
-    control_period_s = 1
-    output_period_s = 1
-    u_min_veh_h = -2000         # feasible range of U; default -q* .. +q*
-    u_max_veh_h = 2000
-    controller = "open"         # a name of arzsumo.control.registry that runs in the twin
-    constant_u_veh_h = 0        # for controller = "constant"
-    seed = 0                    # draws the [initial] kind = "random" wave; else recorded only
-    kernel_cells = 200          # grid of the backstepping kernels (PDE controllers)
-
-    [initial]
-    kind = "sinusoid"           # equilibrium, sinusoid, nonrecurrent, linear, random
-    amplitude = [0.05, -0.05, 0.05, -0.05]   # fractions of (rho_h*, v_h*, rho_a*, v_a*)
-    wavenumber = 2              # periods over the road (one number or four); random: highest mode
-    phase_rad = 0
-    fraction = 0.25             # nonrecurrent / linear: the paper's 1/4
-
 The [twin] keys configure ``arzsumo twin`` only; ``arzsumo run`` reads [sumo] and [run].
+Keys: docs/scenarios.md; docs/twin.md.
 """
 
 from __future__ import annotations
@@ -114,17 +90,16 @@ class TwinConfig:
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready summary (SI)."""
-        s = self.solver
+        s, ini = self.solver, self.initial
         return {"cells": s.cells, "scheme": s.scheme, "flux": s.flux, "limiter": s.limiter,
                 "cfl": s.cfl, "horizon": s.horizon, "control_period": s.control_period,
                 "output_period": s.output_period, "u_min": s.u_min, "u_max": s.u_max,
                 "controller": self.controller, "constant_u": self.constant_u,
                 "seed": self.seed, "kernel_cells": self.kernel_cells,
-                "design": asdict(self.design), "initial": {"kind": self.initial.kind,
-                                               "amplitude": list(self.initial.amplitude),
-                                               "wavenumber": list(self.initial.wavenumber),
-                                               "phase": list(self.initial.phase),
-                                               "seed": self.initial.seed}}
+                "design": asdict(self.design),
+                "initial": {"kind": ini.kind, "amplitude": list(ini.amplitude),
+                            "wavenumber": list(ini.wavenumber), "phase": list(ini.phase),
+                            "seed": ini.seed}}
 
 
 def seeded(initial: InitialCondition, seed: int) -> InitialCondition:
