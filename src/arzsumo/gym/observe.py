@@ -67,15 +67,6 @@ class Observer:
             return self.x_loops.size
         return 2
 
-    @property
-    def x(self) -> np.ndarray:
-        """Where the columns stand, m (the boundary: the two ends)."""
-        if self.kind == "state":
-            return self.x_cells
-        if self.kind == "loops":
-            return self.x_loops
-        return self.x_loops[[0, -1]] if self.x_loops.size else self.x_cells[[0, -1]]
-
     def __call__(self, state: np.ndarray, loops: np.ndarray | None) -> np.ndarray:
         """The observation of ``state`` (4, cells, SI) and the stations' ``loops`` (4,
         stations, SI; None without loops)."""
