@@ -150,9 +150,8 @@ class TwinRampMeterEnv(RampMeterEnv):
     def _rest_of_horizon(self, rec: StepRecord) -> StepRecord | None:
         """An episode that leaves the model's domain is charged the rest of its horizon as
         one period of the section standing jammed: the classes in the equilibrium's
-        proportion at the HVs' AO_max, speeds 0. Without it an agent paid in minus
-        vehicle-hours learns to empty the section until the twin leaves its domain (the
-        inlet's density turns negative) and so stops paying: ending early never pays."""
+        proportion at the HVs' AO_max, speeds 0, so that ending early never pays
+        (docs/gym.md, "Ending episodes and SUMO")."""
         rest = self.options.horizon - rec.t
         if rest <= 0.0:
             return None
