@@ -18,7 +18,8 @@ Lemma mbound guarantees m < 0 under continuous monitoring. With periodic checks 
 condition can be violated between checks unseen, so m may creep above zero: every such
 check is counted in the log (``m_nonnegative``), never clamped.
 
-Not in the paper, each off by default (the docs named argue each against the theorems):
+Not in the paper; without them the mechanism is the paper's (the docs named argue each
+against the theorems):
 
 * Noise dead band (``noise_sd``: the sd of each scaled Riemann variable's noise, m/s,
   taken as independent between grid nodes and checks; or ``noise_from_estimate``: s_U
@@ -26,10 +27,10 @@ Not in the paper, each off by default (the docs named argue each against the the
   Steps 3 and 4 use d_delta = sign(d) max(|d| - delta, 0) instead of d, delta = noise_k
   sqrt(2) s_U, s_U = sqrt(sum_i noise_sd_i^2 ||gain_i||^2) the sd of U-bar (gain: the
   law's weights on w-bar). docs/design.md, "Noise dead band".
-* Anti-windup. With the actuator's range handed over (:meth:`EventTriggered.applied`),
-  d = sat(U-bar(t_k)) - sat(U-bar(t)), both projected on the range in force, in mdyna
-  and defdynamic; the rate limit is left out (it delays the held command, which then
-  arrives). docs/sumo.md, "Actuation limits".
+* Anti-windup. With the actuator's range handed over (:meth:`EventTriggered.applied`;
+  none: infinite bounds), d = sat(U-bar(t_k)) - sat(U-bar(t)), both projected on the
+  range in force, in mdyna and defdynamic; the rate limit is left out (it delays the held
+  command, which then arrives). docs/sumo.md, "Actuation limits".
 * ``trigger_energy = "acted"``: defdynamic and mdyna use V_U = U-bar^2 / (h^T W^-1 h),
   the least V of a target state on which control_law gives the present U-bar (h: the
   law's weights in target variables, with -R at alpha(L); W: V's weights).

@@ -67,7 +67,7 @@ class RampMeterEnv(gymnasium.Env):
     """The ramp meter of a scenario, one step per control period (module docstring).
 
     Subclasses set :attr:`engine` and implement ``_start``, ``_advance``, ``_close``,
-    ``_law_state`` and ``_build_law``.
+    ``_law_state`` and ``_told``.
     """
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": []}
