@@ -13,15 +13,6 @@ from arzsumo.control.registry import (
     pde_controller_names,
 )
 
-__all__ = [
-    "ConstantControl",
-    "ControlLog",
-    "Controller",
-    "MacroState",
-    "OpenLoop",
-    "controller_names",
-    "controller_spec",
-    "is_pde",
-    "make_controller",
-    "pde_controller_names",
-]
+__all__ = ["ConstantControl", "ControlLog", "Controller", "MacroState", "OpenLoop",
+           "controller_names", "controller_spec", "is_pde", "make_controller",
+           "pde_controller_names"]

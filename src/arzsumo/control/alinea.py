@@ -1,38 +1,23 @@
 """ALINEA and PI-ALINEA as practitioners run them: local occupancy feedback on the release rate.
 
-ALINEA (Papageorgiou, Hadj-Salem and Blosseville, Transp. Res. Rec. 1320, 1991) updates
-the ramp's release rate once per control period T (20-60 s in the field) from the
-occupancy o(k) of one loop 40-300 m downstream of the merge nose, averaged over the
-period:
+ALINEA (Papageorgiou, Hadj-Salem and Blosseville, Transp. Res. Rec. 1320, 1991) and
+PI-ALINEA (Wang, Kosmatopoulos, Papageorgiou and Papamichail, IEEE T-ITS 15(5), 2014):
 
     r(k) = r(k-1) + K_R (o_target - o(k)),
+    r(k) = r(k-1) - K_P (o(k) - o(k-1)) + K_I (o_target - o(k)),
 
-PI-ALINEA (Wang, Kosmatopoulos, Papageorgiou and Papamichail, IEEE T-ITS 15(5), 2014)
-adds a proportional term for bottlenecks further downstream:
+o(k) the occupancy of one loop downstream of the merge nose averaged over the period T,
+r clamped to [r_min, r_max] after each update (clamping the state is ALINEA's
+anti-windup). K_R and K_I are given at a reference period T_ref and scaled as
+K(T) = K(T_ref) T / T_ref, which keeps the integral action per second; K_P is not
+scaled. The closed loop checks every controller every control period (1 s); these
+average the occupancy samples of those checks over their own period and hold their
+command in between. The command is U = r_nominal - r (veh/s). docs/sumo.md, "Baselines
+a practitioner would field".
 
-    r(k) = r(k-1) - K_P (o(k) - o(k-1)) + K_I (o_target - o(k)).
-
-r is clamped to [r_min, r_max] after each update; clamping the *state* r(k) (not only the
-output) is ALINEA's anti-windup: the rate leaves a bound at the first update whose
-increment points back inside.
-
-Gains. K_R (and K_I) integrate the error once per period, so the integral action per
-unit time is K_R / T; practice quotes K_R = 70 veh/h per % of occupancy for T = 60 s.
-:class:`AlineaSettings` holds the gain at a reference period T_ref and uses
-K_R(T) = K_R(T_ref) T / T_ref, which keeps K_R / T, hence the loop's bandwidth, when
-the period changes (46.7 veh/h per % at 40 s). K_P multiplies a change of occupancy,
-not an accumulated error, and is not scaled.
-
-The closed loop checks every controller every control period of the co-simulation
-(1 s); these controllers average the occupancy samples of those checks over their own
-period and hold their command in between, so the command changes at most once per
-period. The command is the outflow deviation of every controller, U = r_nominal - r
-(veh/s): the meter maps it back to r (one vehicle per green,
-``arzsumo.sumo.meter_release.release_rate_for``).
-
-SI throughout: rates veh/s, occupancy a fraction (SUMO's loop occupancy, the share of
-time the loop is occupied; it can exceed 1 with vehicles side by side under the sublane
-model), gains veh/s per unit occupancy, times s.
+SI throughout: rates veh/s, occupancy a fraction (SUMO's loop occupancy; it can exceed 1
+with vehicles side by side under the sublane model), gains veh/s per unit occupancy,
+times s.
 """
 
 from __future__ import annotations
@@ -40,7 +25,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from arzsumo.control.base import Controller, MacroState
+from arzsumo.control.base import ConstantControl, Controller, MacroState
 from arzsumo.errors import ModelError, ScenarioError, require
 
 #: 70 veh/h per % of occupancy (the field's K_R at a 60 s period), veh/s per unit occupancy
@@ -54,33 +39,16 @@ DISTANCE_RANGE = (40.0, 300.0)
 class AlineaSettings:
     """Parameters of ALINEA and PI-ALINEA (SI; the ``[alinea]`` table of a scenario).
 
-    Parameters
-    ----------
-    period : float
-        Control period T of the controller, s, in [20, 60].
-    loop_distance : float
-        Distance of its loop downstream of the merge nose (the end of ``merge``), m,
-        in [40, 300].
-    target : float
-        Occupancy target o_target (fraction, > 0): just below the loop's critical
-        occupancy (``arzsumo alinea-target``).
-    gain : float
-        K_R at ``gain_period``, veh/s per unit occupancy (> 0).
-    gain_period : float
-        Reference period T_ref of ``gain`` and ``ki``, s (> 0).
-    kp : float
-        PI-ALINEA's K_P, veh/s per unit occupancy (>= 0; not scaled with the period).
-    ki : float
-        PI-ALINEA's K_I at ``gain_period``, veh/s per unit occupancy (>= 0).
+    ``target`` sits just below the loop's critical occupancy (``arzsumo alinea-target``).
     """
 
-    period: float = 40.0
-    loop_distance: float = 100.0
-    target: float = 0.2
-    gain: float = GAIN_70
-    gain_period: float = 60.0
-    kp: float = 60.0 * 100.0 / 3600.0
-    ki: float = 5.0 * 100.0 / 3600.0
+    period: float = 40.0                # T, s, in [20, 60]
+    loop_distance: float = 100.0        # m past the merge nose (end of ``merge``), in [40, 300]
+    target: float = 0.2                 # o_target, an occupancy fraction > 0
+    gain: float = GAIN_70               # K_R at ``gain_period``, veh/s per unit occupancy, > 0
+    gain_period: float = 60.0           # T_ref of ``gain`` and ``ki``, s, > 0
+    kp: float = 60.0 * 100.0 / 3600.0   # PI-ALINEA's K_P, >= 0 (not scaled with the period)
+    ki: float = 5.0 * 100.0 / 3600.0    # PI-ALINEA's K_I at ``gain_period``, >= 0
 
     def __post_init__(self) -> None:
         def check(ok: bool, name: str, allowed: str) -> None:
@@ -136,15 +104,8 @@ def pi_alinea_step(r_prev: float, occupancy: float, occupancy_prev: float, targe
 class Alinea(Controller):
     """ALINEA on the release rate, updated once per its own period (module docstring).
 
-    Parameters
-    ----------
-    settings : AlineaSettings
-        Period, target and gains.
-    rates : ReleaseRates
-        Nominal release rate (the start, r(0)) and the clamp [r_min, r_max], veh/s.
-    check_period : float
-        Period of the closed loop's checks, s; ``settings.period`` must be a whole
-        multiple of it.
+    ``rates`` gives r(0) (the nominal rate) and the clamp [r_min, r_max], veh/s;
+    ``settings.period`` must be a whole multiple of ``check_period``, the closed loop's, s.
     """
 
     name = "alinea"
@@ -212,16 +173,11 @@ class PiAlinea(Alinea):
                               max(self.rates.low, lo), min(self.rates.high, hi))
 
 
-class HeldMeter(Controller):
+class HeldMeter(ConstantControl):
     """The meter held at its least release rate from the start of control:
     U = r_nominal - r_min (veh/s), constant."""
 
     name = "held"
 
     def __init__(self, rates: ReleaseRates) -> None:
-        super().__init__()
-        self.u = rates.nominal - rates.low
-
-    def decide(self, state: MacroState) -> float:
-        self.log.record(state.t, self.u, self.u, not self.log.t)
-        return self.u
+        super().__init__(rates.nominal - rates.low)

@@ -6,13 +6,8 @@ equilibrium then map to U (veh/s) through one precomputed gain matrix:
 
     U = U-bar / u_bar_per_u,  U-bar = sum_j G_j . w-bar(x_j) = sum_j (T^T E_j G_j) . z(x_j),
 
-so one evaluation is a dot product of two (4, n_cells+1) arrays.
-
-Anti-windup: none needed. control_law is a static state feedback: U(t) depends
-on the present state alone, the controller keeps no state (no integrator, no held value)
-that a saturated or rate-limited actuator could wind up, so it keeps the default
-:meth:`~arzsumo.control.base.Controller.applied` (nothing). The limited U still acts on
-the plant, and the next check sees its effect through the measured state.
+so one evaluation is a dot product of two (4, n_cells+1) arrays. A static state feedback
+keeps nothing to wind up: no anti-windup (docs/sumo.md, "Actuation limits").
 """
 
 from __future__ import annotations
@@ -21,7 +16,7 @@ import numpy as np
 
 from arzsumo.control.base import Controller, MacroState
 from arzsumo.control.kernels import Kernels
-from arzsumo.control.transform import BacksteppingLaw, BacksteppingTransform
+from arzsumo.control.transform import BacksteppingLaw
 from arzsumo.model.characteristic import Linearization
 
 
@@ -78,13 +73,9 @@ class StateMap:
 class Backstepping(Controller):
     """Continuous backstepping: U(t) from control_law at every check.
 
-    Parameters
-    ----------
-    lin : Linearization
-        Linearisation at a congested equilibrium.
-    kernels : Kernels
-        Kernels solved for ``lin.system`` (see :func:`arzsumo.control.kernels.solve_kernels`
-        or the cached :func:`arzsumo.kernel_cache.cached_kernels`).
+    ``lin`` linearises at a congested equilibrium; ``kernels`` are solved for ``lin.system``
+    (:func:`arzsumo.control.kernels.solve_kernels`, or cached by
+    :func:`arzsumo.kernel_cache.cached_kernels`).
     """
 
     name = "backstepping"
@@ -92,9 +83,7 @@ class Backstepping(Controller):
     def __init__(self, lin: Linearization, kernels: Kernels) -> None:
         super().__init__()
         self.lin = lin
-        self.kernels = kernels
         self.law = BacksteppingLaw(lin.system, kernels)
-        self.transform = BacksteppingTransform(kernels)
         self.state_map = StateMap(lin, kernels.x)
         # gains on z: U = sum(gain_z * z)
         self.gain_z = np.einsum("aj,ab->bj", self.law.gain * self.state_map.scaling, lin.T) \

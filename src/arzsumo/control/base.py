@@ -167,18 +167,15 @@ class Controller(ABC):
         :meth:`check`, and U is limited to ``[lower, upper]`` (veh/s) at present.
 
         Called after every check whose U reaches the meter (``[actuation] anti_windup``).
-        The default does nothing: a static law (continuous backstepping, control_law,
-        computes U from the present state alone and keeps no state to wind up).
-        Controllers with state override it: the ETC's trigger
-        (:class:`arzsumo.control.etc.EventTriggered`) and the observer
-        (:class:`arzsumo.control.observer.ObserverEtc`).
+        The default does nothing (a static law keeps no state to wind up); laws with state
+        override it (:class:`arzsumo.control.etc.EventTriggered`,
+        :class:`arzsumo.control.observer.ObserverEtc`).
         """
         return None
 
     @property
     def has_trigger(self) -> bool:
-        """Whether the law holds U between events (an event trigger to size); the
-        default has none."""
+        """Whether the law holds U between events (an event trigger to size)."""
         return False
 
     def set_output_noise(self, sd: float) -> bool:
@@ -192,10 +189,8 @@ class Controller(ABC):
         """The meter received ``u`` (veh/s) for the U of the last :meth:`check`.
 
         Called after every check whose U reaches the meter, whatever ``[actuation]
-        anti_windup`` says: a history of what was applied, not a limit the law adapts to.
-        The default does nothing; the delay compensator
-        (:class:`arzsumo.control.compensation.DelayCompensated`) keeps the commands of the
-        last theta seconds for its prediction.
+        anti_windup`` says: a history, not a limit. The default does nothing
+        (:class:`arzsumo.control.compensation.DelayCompensated` keeps it to predict).
         """
         return None
 

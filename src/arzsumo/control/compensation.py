@@ -1,26 +1,15 @@
 """Delay compensation: a PDE law evaluated on the state predicted theta seconds ahead.
 
-The ramp meter moves the section's outflow only a dead time theta after a command (10-14 s
-in SUMO, ``arzsumo study meter-dynamics``): the U-bar issued at t enters the
-boundary condition clpsys4 at t + theta. :class:`DelayCompensated` wraps a law that takes
-scaled Riemann states (continuous backstepping, control_law; the full-state ETC, control
-law sam with defdynamic) and, at every check t,
-
-1. maps the controller's state to w-bar(t) = E(x) T z on the kernel grid (clpsys1),
-2. predicts w-bar(t + theta) by :func:`arzsumo.control.predictor.predict_riemann`, with
-   the U-bar that reaches the boundary in (t, t + theta]: the commands applied in
-   [t - theta, t) (:func:`arzsumo.control.predictor.committed`; after the actuator's
-   limits, told through :meth:`DelayCompensated.actuated`),
-3. evaluates the wrapped law on the prediction (its ``check_riemann``).
-
-So the command acts on the state it will meet (predictor feedback). The prediction and
-the law are one place for both laws. With theta = 0 the prediction is the identity and
-the command is the wrapped law's exactly; the closed loop does not wrap at theta = 0.
-
-The boundary observer of the observer-ETC is not wrapped: its boundary model ob-sys2-bd
-integrates the U-bar it is handed as the one acting now, which under a dead time is the
-command of theta seconds ago; predicting its estimate alone would compensate a state
-that already assumed no delay. Pure math: no SUMO, no files.
+The meter moves the section's outflow a dead time theta after a command: the U-bar issued
+at t enters clpsys4 at t + theta. :class:`DelayCompensated` wraps a law on scaled Riemann
+states (continuous backstepping, control_law; the full-state ETC, control law sam with
+defdynamic) and, at every check t, maps the state to w-bar(t) (clpsys1), predicts
+w-bar(t + theta) with the commands applied in [t - theta, t)
+(:mod:`arzsumo.control.predictor`; after the actuator's limits, told through
+:meth:`DelayCompensated.actuated`) and evaluates the wrapped law on the prediction. With
+theta = 0 the command is the wrapped law's exactly. The observer-ETC's boundary observer
+is not wrapped: its ob-sys2-bd already takes each command as acting at once.
+docs/sumo.md, "Actuation limits" (delay compensation).
 """
 
 from __future__ import annotations
@@ -58,14 +47,8 @@ class RiemannLaw(Protocol):
 
 
 class DelayCompensated(Controller):
-    """``inner`` evaluated on the state predicted ``delay`` s ahead (module docstring).
-
-    Parameters
-    ----------
-    inner : Backstepping or EventTriggered
-        The law (anything with ``lin``, ``state_map`` and ``check_riemann``).
-    delay : float
-        Dead time theta, s, in [0, L / max |lambda|).
+    """``inner`` (a :class:`RiemannLaw`) evaluated on the state predicted ``delay`` s
+    (theta, in [0, L / max |lambda|)) ahead (module docstring).
 
     The log is the inner law's (same records as without compensation); the applied
     commands are kept in :attr:`times` (s) and :attr:`u_bar` (scaled, clpsys4).

@@ -58,25 +58,16 @@ MARGIN = 2.0
 class DesignChoice:
     """What :func:`design_for` chose and what it predicts.
 
-    Attributes
-    ----------
-    design : EtcDesign
-    cannot_hold : tuple of str
-        Conditions no design can meet for this system, named as
-        :meth:`DesignReport.failing` names them ("esthm #1"); empty when feasible.
-    why : tuple of str
-        One sentence per entry of ``cannot_hold``.
-    ratio : float
-        r* = mu / gamma at the chosen mu (> 1: esthm #1 holds).
-    coupling : float
-        S of gamma, 1/s.
+    ``cannot_hold`` names the conditions no design can meet for this system as
+    :meth:`DesignReport.failing` names them ("esthm #1"; empty when feasible), ``why``
+    gives one sentence for each.
     """
 
     design: EtcDesign
     cannot_hold: tuple[str, ...]
     why: tuple[str, ...]
-    ratio: float
-    coupling: float
+    ratio: float        # r* = mu / gamma at the chosen mu (> 1: esthm #1 holds)
+    coupling: float     # S of gamma, 1/s
 
     @property
     def feasible(self) -> bool:
@@ -130,20 +121,9 @@ def design_for(system: CharacteristicSystem, kernels: Kernels,
                base: EtcDesign = PAPER_DESIGN) -> DesignChoice:
     """Choose mu, sigma, zeta, A, B, varsigma and eta for a system (module docstring).
 
-    Parameters
-    ----------
-    system : CharacteristicSystem
-        The linearisation's characteristic form (clpsys1-clpsys4).
-    kernels : Kernels
-        Its backstepping kernels (the grid design_check will use).
-    base : EtcDesign
-        Supplies the fields the theorems do not fix (m0, the noise dead band).
-
-    Returns
-    -------
-    DesignChoice
-        The design, and the conditions that cannot hold (only esthm #1 can be
-        infeasible: every other one is met by construction).
+    ``kernels`` are the system's backstepping kernels (the grid design_check will use);
+    ``base`` supplies the fields the theorems do not fix (m0, the noise dead band). Only
+    esthm #1 can be infeasible: every other condition is met by construction.
     """
     coupling = coupling_bound(system, kernels, inverse_p1(kernels))
     mu, ratio = best_mu(system, coupling)

@@ -129,15 +129,6 @@ def coupling_bound(system: CharacteristicSystem, kernels: Kernels, p1: float) ->
     return sig_pp_max + (1 + 1 / p1) * sig_pm_max
 
 
-def _norm_equivalences(system: CharacteristicSystem, kernels: Kernels,
-                       design: EtcDesign) -> tuple[float, float]:
-    """p_1 (:func:`inverse_p1`) and p_3 = the smallest weight of V."""
-    lam, lm, A = system.lam_plus, system.lam_minus, np.array(design.A)
-    p3 = float(min((A / lam * np.exp(-design.mu * system.length / lam)).min(),
-                   design.B / lm))
-    return inverse_p1(kernels), p3
-
-
 def _inverse_kernel_bounds(system: CharacteristicSystem, kernels: Kernels,
                            sig: np.ndarray) -> tuple[float, float, float]:
     """c_1, c_2, c_3 of bounddt from the inverse kernels' last row L(L, xi), N(L, xi)."""
@@ -165,7 +156,9 @@ def _constants(system: CharacteristicSystem, kernels: Kernels, design: EtcDesign
     r_norm = float(np.linalg.norm(r))
     b_exp = design.B * math.exp(design.mu * system.length / lm)
     eps = boundary_eps(system, kernels)
-    p1, p3 = _norm_equivalences(system, kernels, design)
+    p1 = inverse_p1(kernels)
+    # p_3: the smallest weight of V
+    p3 = float(min((A / lam * np.exp(-design.mu * system.length / lam)).min(), design.B / lm))
     c1, c2, c3 = _inverse_kernel_bounds(system, kernels, sig)
     s_pm_l = sig[-1, :n, n]
     phi1 = (8 * kernels.N[-1, -1] ** 2 * lm**2 + 2 * float(r @ s_pm_l) ** 2) * r_norm**2

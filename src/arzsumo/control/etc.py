@@ -14,73 +14,29 @@ as small as the plant time step for continuous monitoring) the mechanism
 4. triggers an event when zeta B e^{mu L/Lambda-} d^2 >= zeta mu sigma V - m (defdynamic;
    the paper's second bullet drops the first zeta, a typo: Lemma mbound uses it).
 
-Noise dead band (not in the paper; off by default). With ``noise_sd`` given (the sd of
-each scaled Riemann variable's noise on the state the controller sees, m/s, taken as
-independent between grid nodes and checks), U-bar carries noise of sd
-s_U = sqrt(sum_i noise_sd_i^2 ||gain_i||^2) (gain: the law's weights on w-bar), and the
-difference d of two noisy samples sd sqrt(2) s_U. Steps 3 and 4 then use
-d_delta = sign(d) max(|d| - delta, 0) instead of d, with delta = noise_k sqrt(2) s_U:
-pure noise of that level (|d| <= delta) neither raises m nor triggers. With delta = 0
-this is the paper's mechanism.
-
-Measured dead band (``noise_from_estimate``). Instead of ``noise_sd``, the sd s_U of the
-law's output noise can be measured where the noise arises, on the estimate the controller
-will see: :func:`output_noise_sd` of the continuous law's U-bar over a stretch of checks
-with no control (the closed loop uses the warm-up's last minutes), handed to
-:meth:`EventTrigger.set_output_noise`. delta is then noise_k sqrt(2) s_U as above, with
-no assumption on how the noise is spread over the grid. Against defdynamic: between
-events |d| <= delta + the paper's bound, so the closed loop is the paper's with an input
-perturbation bounded by delta, practically (not asymptotically) stable with an ultimate
-bound that scales with delta (the dead-zone regularisation of event triggering under
-measurement noise, Borgers & Heemels 2014). On a noise-free state s_U -> 0, delta -> 0,
-and the mechanism is the paper's.
-
-Anti-windup. When the actuator limits U to a range [U_lo, U_hi] (saturation:
-:func:`arzsumo.bridge.actuator.limit_u`), the boundary input the plant receives is
-sat(U-bar(t_k)), not control law sam's U-bar(t_k), and a d of dt computed on the raw values
-misjudges what reaches the boundary: changes of the law inside the saturated region would
-fire events that change nothing at the meter. With the range handed to the controller
-(:meth:`EventTriggered.applied`), the mechanism uses the discrepancy of what the actuator
-delivers, d(t) = sat(U-bar(t_k)) - sat(U-bar(t)) (both projected on the range in force), in
-V's forcing of mdyna and in defdynamic. A law that stays beyond a bound then gives d = 0:
-no event fires for a command that cannot arrive. Without a range (the default, infinite
-bounds) d is dt's exactly. The rate limit is left out of the projection: it only delays
-the held command (as the meter's cycle does), which then arrives; it is no windup. The
-noise dead band acts on the projected d.
-
-The trigger's energy (``trigger_energy``; not in the paper). ``"state"`` (the default) is
-the paper's: defdynamic and mdyna use the V of the whole state. ``"acted"`` uses, in
-both, V_U = U-bar^2 / (h^T W^-1 h), the least V of any target state (alpha, beta) on
-which control_law gives the present U-bar = h^T (alpha, beta) (h: the law's weights in
-target variables, :attr:`BacksteppingLaw.target_gain` with -R at alpha(L); W: V's
-weights). The proofs carry over: Lemma mbound's comparison needs only that the trigger
-and mdyna use the same energy (B e^{mu L/Lambda-} d^2 - mu sigma V_U <= -m / zeta
-between events, so m' <= -(eta + 1/zeta) m - ... and m < 0), and Theorem esthm's
-derivative of V_d = V - m picks up +mu sigma V_U <= mu sigma V from -m', so the same
-decay rate mu (1 - sigma) - gamma holds. The minimal dwell time (Theorem minimalthm)
-is not claimed; checks every Delta seconds bound the event rate anyway. It matters where
-V lies in components the law's integral does not see (an estimate of a stream far from
-the model's equilibrium, with stop-and-go and noise): there the paper's m accumulates
--sigma mu V and its threshold zeta mu sigma V - m outgrows every d the actuator can
-produce (on SUMO's IDM stream d^2 stays below 0.13 % of sigma mu V), while V_U weighs d
-against the law's own output.
-
-The noise band alone (``trigger = "band"``; not in the paper). An event whenever the
-hold error leaves the noise band, |d| > delta (d projected on the actuator's range, delta
-as above: ``noise_sd`` or ``noise_from_estimate``); V and m are computed and logged but
-decide nothing. It is the static, absolute-threshold trigger of sampled-data practice
-(send-on-delta), sized by the noise rather than by the Lyapunov budget. Against the
-paper: with delta = 0 (a noise-free state) every check whose law moved is an event, and
-the closed loop is continuous backstepping sampled every Delta seconds, whose
-exponential stability the paper proves for the continuous law; with delta > 0 the hold
-error stays within delta between events, an input perturbation bounded by delta, and the
-closed loop is practically stable with an ultimate bound that scales with delta (Borgers
-& Heemels 2014). What it gives up is the paper's saving on a noise-free state: there it
-updates at every check.
-
 Lemma mbound guarantees m < 0 under continuous monitoring. With periodic checks the
 condition can be violated between checks unseen, so m may creep above zero: every such
 check is counted in the log (``m_nonnegative``), never clamped.
+
+Not in the paper; without them the mechanism is the paper's (the docs named argue each
+against the theorems):
+
+* Noise dead band (``noise_sd``: the sd of each scaled Riemann variable's noise, m/s,
+  taken as independent between grid nodes and checks; or ``noise_from_estimate``: s_U
+  measured by :func:`output_noise_sd` and handed to :meth:`EventTrigger.set_output_noise`).
+  Steps 3 and 4 use d_delta = sign(d) max(|d| - delta, 0) instead of d, delta = noise_k
+  sqrt(2) s_U, s_U = sqrt(sum_i noise_sd_i^2 ||gain_i||^2) the sd of U-bar (gain: the
+  law's weights on w-bar). docs/design.md, "Noise dead band".
+* Anti-windup. With the actuator's range handed over (:meth:`EventTriggered.applied`;
+  none: infinite bounds), d = sat(U-bar(t_k)) - sat(U-bar(t)), both projected on the
+  range in force, in mdyna and defdynamic; the rate limit is left out (it delays the held
+  command, which then arrives). docs/sumo.md, "Actuation limits".
+* ``trigger_energy = "acted"``: defdynamic and mdyna use V_U = U-bar^2 / (h^T W^-1 h),
+  the least V of a target state on which control_law gives the present U-bar (h: the
+  law's weights in target variables, with -R at alpha(L); W: V's weights).
+  docs/design.md, "The trigger's energy".
+* ``trigger = "band"``: an event whenever |d| > delta (d projected as above); V and m
+  are logged but decide nothing. docs/design.md, "The noise band alone".
 """
 
 from __future__ import annotations
@@ -107,16 +63,11 @@ TRIGGERS = ("defdynamic", "band")
 class EtcDesign:
     """Design parameters of the dynamic triggering mechanism (section 5 values by default).
 
-    ``m0`` (m(0) < 0) is not given in the paper; -0.01 is our choice. m decays at rate eta,
-    so it matters only for the first seconds.
-
-    ``noise_sd`` (m/s, one per scaled Riemann variable, or empty: no dead band) and
-    ``noise_k`` (dimensionless) set the noise dead band of the trigger (module docstring);
-    ``noise_from_estimate`` asks for the dead band to be measured on the estimate instead
-    (:meth:`EventTrigger.set_output_noise`). They are not part of the paper's design and
-    the theorems do not see them. ``trigger_energy`` is the V defdynamic compares d with
-    (module docstring): ``"state"``, the paper's, or ``"acted"``; ``trigger`` the
-    mechanism: ``"defdynamic"``, the paper's, or ``"band"``, the noise band alone.
+    ``m0`` (m(0) < 0) is not given in the paper; -0.01 is our choice (m decays at rate eta,
+    so it matters only for the first seconds). ``noise_sd`` (m/s, one per scaled Riemann
+    variable; empty: no dead band), ``noise_k``, ``noise_from_estimate``,
+    ``trigger_energy`` and ``trigger`` are the module docstring's additions ("state" and
+    "defdynamic": the paper's); the theorems do not see them.
     """
 
     zeta: float = 8e-3
@@ -219,12 +170,8 @@ def noise_dead_band(design: EtcDesign, gain: np.ndarray) -> float:
 
 def output_noise_sd(u: np.ndarray) -> float:
     """The sd of the white noise on a series of law outputs ``u`` (any unit), from its
-    successive differences: 1.4826 MAD(diff u) / sqrt(2).
-
-    Differencing removes what moves slowly (the signal the law should follow); the median
-    absolute deviation ignores the few large steps of a real change. NaN with fewer than
-    three finite values.
-    """
+    successive differences: 1.4826 MAD(diff u) / sqrt(2) (docs/design.md, "Measured on
+    the estimate"); NaN with fewer than three finite values."""
     u = np.asarray(u, float)
     du = np.diff(u[np.isfinite(u)])
     if du.size < 2:
@@ -327,17 +274,7 @@ class EventTrigger:
 class TriggeredLaw(Controller):
     """A law whose U an :class:`EventTrigger` holds between events: what the full-state
     (:class:`EventTriggered`) and the observer-based ETC
-    (:class:`arzsumo.control.observer.ObserverEtc`) share.
-
-    Parameters
-    ----------
-    lin : Linearization
-        The linearisation the law and its trigger act on.
-    kernels : Kernels
-        The backstepping kernels on their grid.
-    design : EtcDesign
-        The mechanism's parameters.
-    """
+    (:class:`arzsumo.control.observer.ObserverEtc`) share."""
 
     def __init__(self, lin: Linearization, kernels: Kernels,
                  design: EtcDesign = PAPER_DESIGN) -> None:
@@ -360,8 +297,7 @@ class TriggeredLaw(Controller):
         return True
 
     def _record(self, t: float, r: CheckResult, **extra: float) -> float:
-        """Log the check ``r`` at ``t`` (s) in U (veh/s), with its diagnostics and
-        ``extra``; returns the held U-bar (m/s)."""
+        """Log the check ``r`` at ``t`` (s) in U (veh/s); returns the held U-bar (m/s)."""
         per = self.lin.u_bar_per_u
         self.log.record(t, r.u_bar_held / per, r.u_bar_continuous / per, r.triggered,
                         V=r.V, d=r.d, m=r.m, m_nonnegative=float(r.m >= 0), **extra)

@@ -14,25 +14,15 @@ from arzsumo.control.base import ControlLog
 def release_time(t: ArrayLike, triggered: ArrayLike, horizon: float) -> float:
     """Total release time (s): the time during which the applied control stayed unchanged.
 
-    Parameters
-    ----------
-    t : array_like
-        Check times, s, increasing (a :class:`ControlLog`'s ``t``).
-    triggered : array_like of bool
-        Whether the check updated the control (a log's ``triggered``, or the twin's
-        :func:`arzsumo.pde.metrics.events`).
-    horizon : float
-        End of the run, s.
+    ``t`` are the check times, s, increasing (a :class:`ControlLog`'s ``t``); ``triggered``
+    whether each check updated the control (a log's ``triggered``, or the twin's
+    :func:`arzsumo.pde.metrics.events`); ``horizon`` the end of the run, s.
 
-    Notes
-    -----
     Every check that does not update the control releases the signal until the next check
     (the last one until ``horizon``). With checks every Delta from t = 0 this is
     T - N Delta for N events (t_0 included), which matches the paper's pairs (160, 291 s),
-    (101, 349 s), (245, 206 s), (358, 93 s) over T = 450 s to within one period.
-    Continuous backstepping updates at every check: release time 0. An empty log (no
-    check, so no update) gives ``horizon``: the control was held all along, T - N Delta
-    with N = 0.
+    (101, 349 s), (245, 206 s), (358, 93 s) over T = 450 s to within one period; an empty
+    log (no check, so no update) gives ``horizon`` (N = 0).
     """
     t = np.asarray(t, float)
     if t.size == 0:

@@ -62,25 +62,14 @@ from arzsumo.model.characteristic import CharacteristicSystem
 class Kernels:
     """Kernels on the grid x_j = j h, j = 0..n_cells; entry [.., j, l] is at (x_j, xi_l).
 
-    Entries with l > j (outside the triangle) are zero.
-
-    Attributes
-    ----------
-    x : array (n_cells+1,)
-        Grid, m.
-    K : array (n, n_cells+1, n_cells+1)
-        k_1..k_n, 1/m.
-    M : array (n_cells+1, n_cells+1)
-        1/m.
-    L, N : arrays like K and M
-        Inverse kernels of invback, 1/m.
+    Entries with l > j (outside the triangle) are zero. Kernels in 1/m.
     """
 
-    x: np.ndarray
-    K: np.ndarray
-    M: np.ndarray
-    L: np.ndarray
-    N: np.ndarray
+    x: np.ndarray       # the grid (n_cells+1,), m
+    K: np.ndarray       # k_1..k_n, (n, n_cells+1, n_cells+1)
+    M: np.ndarray       # (n_cells+1, n_cells+1)
+    L: np.ndarray       # inverse kernels of invback, like K
+    N: np.ndarray       # and like M
 
     @property
     def n_cells(self) -> int:
@@ -136,12 +125,8 @@ class _KernelProblem:
 def solve_kernels(system: CharacteristicSystem, n_cells: int) -> Kernels:
     """Solve the kernel equations (module docstring) on ``n_cells`` uniform cells.
 
-    Parameters
-    ----------
-    system : CharacteristicSystem
-        The n+1 system (any n >= 1).
-    n_cells : int
-        Number of cells; the grid has n_cells + 1 nodes. Cost O(n_cells^2).
+    ``system`` is any n+1 system (n >= 1); the grid has n_cells + 1 nodes; cost
+    O(n_cells^2).
     """
     require(isinstance(n_cells, int | np.integer) and n_cells >= 4, "n_cells", n_cells,
             "an integer >= 4", ModelError)

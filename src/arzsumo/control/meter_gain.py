@@ -1,17 +1,12 @@
 """A law designed for a unit actuator, on a meter whose release moves the outflow g times.
 
-The paper's boundary input U is the section outflow's deviation from q* (clpsys4). The
-closed loop realises it by a change of the ramp meter's release,
-r = r_nominal - U_cmd (:func:`arzsumo.sumo.meter_release.release_rate_for`), which
-assumes that one released ramp vehicle takes one mainline slot at the merge:
-dq(L) / dr = -1. SUMO's merge is measured at about -2 (the premise's actuator staircase,
-research/premise.md): the loop's gain is then twice the one the kernels were designed for.
-
-:class:`MeterGain` hands the meter U_cmd = U / g, so that the outflow moves by the U the
-law asked for, and tells the law what reached the boundary in its own units: g times the
-U applied, and g times the range in force (anti-windup). The delay compensator and the
-event trigger inside it therefore see outflow changes, as in the paper. Pure math: no
-SUMO, no files.
+The closed loop realises the paper's boundary input U (clpsys4) by a change of the ramp
+meter's release, r = r_nominal - U_cmd (:func:`arzsumo.sumo.meter_release.release_rate_for`),
+which assumes dq(L) / dr = -1; SUMO's merge is measured at about -2 (the premise's
+actuator staircase, research/premise.md). :class:`MeterGain` hands the meter U_cmd = U / g
+and tells the law what reached the boundary in its own units: g times the U applied and
+g times the range in force (anti-windup), so the delay compensator and the event trigger
+inside it see outflow changes, as in the paper.
 """
 
 from __future__ import annotations
@@ -23,14 +18,8 @@ from arzsumo.errors import ModelError, require
 
 
 class MeterGain(Controller):
-    """``inner`` (a law in outflow units, veh/s) on a meter of gain ``gain``.
-
-    Parameters
-    ----------
-    inner : Controller
-        The law; its U is the outflow deviation it wants at x = L, veh/s.
-    gain : float
-        -dq(L) / dr of the meter, dimensionless, > 0 (1: the unit actuator).
+    """``inner`` (a law whose U is the outflow deviation it wants at x = L, veh/s) on a
+    meter of gain ``gain`` (-dq(L) / dr, > 0; 1: the unit actuator).
 
     The log holds what the meter is asked for (U / g, veh/s), with the inner law's
     events and diagnostics.

@@ -26,11 +26,9 @@ converges in finite time by the inlet condition alone.
 Observer-based ETC. The law bs_control_of and its sampled version bs_control_of_etc are
 control_law and the mechanism of defdynamic applied to the estimate (discrepancy dtof).
 
-Anti-windup. The observer's boundary condition ob-sys2-bd takes the U-bar the
-plant receives. When the actuator limits U, that is the U applied, not the held command:
-:meth:`ObserverEtc.applied` hands it over and the observer integrates the next interval
-with it (otherwise, as before, with the held command); the trigger projects dtof on the
-actuator's range as the full-state ETC does (:mod:`arzsumo.control.etc`).
+Anti-windup (:meth:`ObserverEtc.applied`): ob-sys2-bd integrates the next interval with
+the U-bar applied (without it, the held command); the trigger projects dtof on the
+actuator's range as the full-state ETC does.
 """
 
 from __future__ import annotations
@@ -60,10 +58,8 @@ def observer_gains(system: CharacteristicSystem, n_cells: int) -> np.ndarray:
     """P(x) = (P+(x), P-(x)) on x_j = j L / n_cells, shape (n+1, n_cells+1), 1/s."""
     dual = solve_kernels(dual_system(system), n_cells)
     mu = system.lam_minus
-    # F(x_j, 0) = K~(L, L - x_j), G(x_j, 0) = M~(L, L - x_j)
-    p_plus = -mu * dual.K[:, -1, ::-1]
-    p_minus = -mu * dual.M[-1, ::-1]
-    return np.vstack([p_plus, p_minus])
+    # P+ = -mu F(x_j, 0) with F(x_j, 0) = K~(L, L - x_j); P- likewise with G = M~
+    return np.vstack([-mu * dual.K[:, -1, ::-1], -mu * dual.M[-1, ::-1]])
 
 
 class BoundaryObserver:

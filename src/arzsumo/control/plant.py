@@ -43,15 +43,8 @@ class PlantHistory:
 class LinearPlant:
     """The n+1 linear hyperbolic plant on nodes x_j = j L / n_cells.
 
-    Parameters
-    ----------
-    system : CharacteristicSystem
-    n_cells : int
-    cfl : float, optional
-        Courant number of the fastest wave, in (0, 1]. Default 1.
-    scheme : {"cubic", "upwind"}
-    dt : float, optional
-        Time step (s), at most the CFL step; default the CFL step.
+    ``cfl`` is the Courant number of the fastest wave, in (0, 1]; ``scheme`` "cubic" or
+    "upwind" (module docstring); ``dt`` the time step (s), at most (default) the CFL step.
     """
 
     def __init__(self, system: CharacteristicSystem, n_cells: int, cfl: float = 1.0,

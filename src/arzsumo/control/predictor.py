@@ -1,16 +1,12 @@
 """Delay predictor: the scaled Riemann state theta seconds ahead by linear transport.
 
-The ramp meter moves the section's outflow only after a dead time theta
-(``arzsumo study meter-dynamics``): a command U-bar issued at t reaches the boundary
-condition w-(L) = R w+(L) + U-bar (clpsys4) at t + theta. A law evaluated on the predicted
-state w-bar(t + theta) instead of w-bar(t) (a predictor in the sense of Smith, for
-hyperbolic boundary control: Krstic's predictor feedback) compensates it: the command
-then acts on the state it will meet.
-
-The prediction follows the characteristics of the linearised system (clpsys1-clpsys4)
-over theta: in scaled variables the diagonal of the source is absorbed, and the
-in-domain coupling Sigma(x) (zero diagonal) is neglected over the short horizon (error
-O(theta ||Sigma||), ||Sigma|| below 0.02 1/s on paper_base and the default). So
+A command U-bar issued at t reaches w-(L) = R w+(L) + U-bar (clpsys4) at t + theta; a law
+evaluated on the predicted w-bar(t + theta) compensates the dead time (Krstic's
+predictor feedback; :mod:`arzsumo.control.compensation`). The prediction follows the
+characteristics of clpsys1-clpsys4 over theta: in scaled variables the diagonal of the
+source is absorbed, and the in-domain coupling Sigma(x) (zero diagonal) is neglected over
+the short horizon (error O(theta ||Sigma||), ||Sigma|| below 0.02 1/s on paper_base and
+the default). So
 
 * w+_i(x, t + theta) = w+_i(x - lambda_i theta, t) where the foot lies in [0, L]; else
   the characteristic left x = 0 at t + s, s = theta - x / lambda_i, where
@@ -21,8 +17,7 @@ O(theta ||Sigma||), ||Sigma|| below 0.02 1/s on paper_base and the default). So
   already committed: with a dead time theta it is the command issued at t + s - theta,
   in the past, so the controller knows it (``u_bar_ahead``).
 
-theta must be shorter than L / max |lambda| (one boundary reflection at most). Pure
-math: no SUMO, no files.
+theta must be shorter than L / max |lambda| (one boundary reflection at most).
 """
 
 from __future__ import annotations

@@ -1,25 +1,21 @@
 """The one registry of controllers: names, what each needs, and how to build one.
 
-Every list of controller names in the package comes from here: the ``[twin] controller``
-and ``[run] controller`` keys of scenario files, ``arzsumo run --controller``, the sweep
-and the closed loop in SUMO. An entry says whether the controller is a PDE controller
-(it needs backstepping kernels and a congested equilibrium), where it runs (the twin,
-``arzsumo twin``; SUMO, ``arzsumo run``) and how to build a fresh instance from
-:class:`ControllerInputs`. The caller supplies the kernels (this room solves nothing: the
-kernel cache lives above it)::
+Every list of controller names in the package comes from here (the ``[twin]`` and
+``[run] controller`` keys, ``arzsumo run --controller``, the sweep, the closed loop in
+SUMO). An entry says whether the controller is a PDE controller (it needs backstepping
+kernels and a congested equilibrium), where it runs (the twin; SUMO) and how to build a
+fresh instance from :class:`ControllerInputs`. The caller supplies the kernels (this room
+solves nothing: the kernel cache lives above it)::
 
     spec = controller_spec("etc")
     kernels = cached_kernels(lin.system, cells) if spec.pde else None
     ctrl = spec.build(ControllerInputs(lin, kernels, design))
 
-Scenario files are validated when they are read, so an entry must exist before then:
-:func:`register_controller` adds one. Installed packages add theirs through the entry-point
-group ``arzsumo.controllers`` (:data:`PLUGIN_GROUP`), read the first time a name is looked
-up: that is how a controller reaches every process of a sweep (a worker process imports
-the package afresh and never sees a registration made at run time in another process).
-An entry point names a :class:`ControllerSpec`, or a :class:`~arzsumo.control.base.
-Controller` subclass (registered under the entry point's name, built with no argument or
-with the :class:`ControllerInputs`).
+Installed packages add entries through the entry-point group ``arzsumo.controllers``
+(:data:`PLUGIN_GROUP`), read the first time a name is looked up: a
+:class:`ControllerSpec`, or a :class:`~arzsumo.control.base.Controller` subclass
+(registered under the entry point's name). docs/api.md, "``register_controller``, and
+controllers in other processes".
 """
 
 from __future__ import annotations

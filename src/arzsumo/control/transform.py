@@ -22,7 +22,6 @@ class BacksteppingTransform:
 
     def __init__(self, kernels: Kernels) -> None:
         w = trapezoid_weights(kernels.n_cells, kernels.h)
-        self.kernels = kernels
         self._fk = w[None] * kernels.K            # (n, N+1, N+1)
         self._fm = w * kernels.M
         self._il = w[None] * kernels.L

@@ -19,6 +19,7 @@ import numpy as np
 from arzsumo.control.backstepping import Backstepping
 from arzsumo.control.base import Controller
 from arzsumo.control.etc import PAPER_DESIGN, EventTriggered, Lyapunov
+from arzsumo.control.events import event_summary, lyapunov_convergence_time
 from arzsumo.control.kernels import Kernels, solve_kernels
 from arzsumo.control.observer import ObserverEtc
 from arzsumo.control.plant import LinearPlant, step_dividing
@@ -128,8 +129,6 @@ class ClosedLoopRun:
     log: object
 
     def summary(self) -> dict[str, float | int | str]:
-        from arzsumo.control.events import event_summary, lyapunov_convergence_time
-
         ev = event_summary(self.log, self.horizon)
         m = np.asarray(self.log.extra.get("m", [np.nan]))
         m_stats = (float(m.min()), float(m.max())) if np.isfinite(m).all() else (np.nan, np.nan)
@@ -244,9 +243,6 @@ def sensitivity(lin: Linearization, kernels: Kernels, parameter: str,
     ...). The convergence time is the first time after which V stays below ``fraction``
     V(0) (sensitivity subsection of section 5).
     """
-    from arzsumo.control.etc import PAPER_DESIGN
-    from arzsumo.control.events import lyapunov_convergence_time
-
     base = design or PAPER_DESIGN
     rows = []
     for value in values:

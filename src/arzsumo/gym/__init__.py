@@ -1,27 +1,12 @@
 """The ramp meter as Gymnasium environments: learn on the PDE twin, test in SUMO.
 
 ``import arzsumo.gym`` registers two environments with the same spaces, period and
-action range on a scenario (``pip install 'arzsumo[gym]'``; docs/gym.md)::
-
-    import gymnasium as gym
-    import arzsumo.gym
-
-    env = gym.make("arzsumo/SumoRampMeter-v0", scenario="default", seed=1)
-    pi = arzsumo.gym.policy("etc", env)
-    obs, info = env.reset(seed=1)
-    done = False
-    while not done:
-        obs, reward, terminated, truncated, info = env.step(pi(obs))
-        done = terminated or truncated
-    print(info["summary"]["TTT"])     # scored as `arzsumo run` scores it
-    env.close()
-
-* ``arzsumo/TwinRampMeter-v0``: :class:`TwinRampMeterEnv`, the nonlinear PDE twin;
-* ``arzsumo/SumoRampMeter-v0``: :class:`SumoRampMeterEnv`, SUMO with the closed loop of
-  ``arzsumo run`` (warm-up in ``reset``; ``close`` leaves no SUMO running);
-* :func:`policy`: the package's controllers as policies;
-* :mod:`arzsumo.gym.rewards`: the named rewards and :class:`StepRecord`;
-* :mod:`arzsumo.gym.observe`: the observations and their normalisation.
+action range on a scenario (``pip install 'arzsumo[gym]'``; a first episode: docs/gym.md):
+``arzsumo/TwinRampMeter-v0`` (:class:`TwinRampMeterEnv`, the nonlinear PDE twin) and
+``arzsumo/SumoRampMeter-v0`` (:class:`SumoRampMeterEnv`, SUMO with the closed loop of
+``arzsumo run``: warm-up in ``reset``; ``close`` leaves no SUMO running). :func:`policy`
+offers the package's controllers as policies, :mod:`arzsumo.gym.rewards` the named
+rewards and :class:`StepRecord`, :mod:`arzsumo.gym.observe` the observations.
 """
 
 from __future__ import annotations

@@ -8,9 +8,9 @@ under U) and ``_close()``. Everything the two must agree on lives here: the acti
 (:mod:`arzsumo.gym.observe`), the seeds, the rewards (:mod:`arzsumo.gym.rewards`) and the
 package laws a policy stands in for (:func:`arzsumo.gym.policy`).
 
-Seeds: ``reset(seed=s)`` runs the episode of seed ``s`` (SUMO's seed; the twin's random
-initial wave) and seeds :attr:`np_random`; ``reset()`` runs the constructor's ``seed``
-(else the scenario's ``[sumo] seed``) first, then seeds drawn from :attr:`np_random`.
+Seeds: ``reset(seed=s)`` runs the episode of seed ``s`` and seeds :attr:`np_random`;
+``reset()`` runs the constructor's ``seed`` (else the scenario's) first, then seeds drawn
+from :attr:`np_random` (docs/gym.md, "Seeds").
 """
 
 from __future__ import annotations
@@ -67,7 +67,7 @@ class RampMeterEnv(gymnasium.Env):
     """The ramp meter of a scenario, one step per control period (module docstring).
 
     Subclasses set :attr:`engine` and implement ``_start``, ``_advance``, ``_close``,
-    ``_law_state`` and ``_build_law``.
+    ``_law_state`` and ``_told``.
     """
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": []}
@@ -174,12 +174,11 @@ class RampMeterEnv(gymnasium.Env):
         if self.law_name not in (None, name):
             raise refuse("policy", name, f"{self.law_name!r}: the law this environment "
                                          "was made for (law=...)")
-        if self.law_name != name and self._running:
-            self.law_name = name
+        restart = self.law_name != name and self._running
+        self.law_name = name
+        if restart:     # the running episode was not made for the law
             self._running = False
             self._close()
-            return
-        self.law_name = name
 
     def law_action(self) -> np.ndarray:
         """The law's command at the present check, clipped to the action space (the law

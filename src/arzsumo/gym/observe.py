@@ -1,25 +1,16 @@
 """What an agent observes, the same on the twin and in SUMO: spaces and normalisation.
 
-Three observations (``observation=`` of both environments), each an array of 4 rows,
-(rho_h, v_h, rho_a, v_a), over places, ``float32``:
+Three observations (``observation=``; docs/gym.md, "Spaces"), each an array of 4 rows,
+(rho_h, v_h, rho_a, v_a), over places, ``float32``: ``"state"``, the estimated state on
+the ``[sumo]`` cells (in SUMO the estimate the controllers act on, before any warm-up
+reference is subtracted); ``"loops"``, the ``[sensing]`` loop stations' readings of the
+period (a speed no vehicle gave is the fundamental diagram's at the station's densities);
+``"boundary"``, the stations at x = 0 and x = L (without loops, the first and last cells).
+On the twin, its own state at the same places (ideal loops).
 
-* ``"state"``: the estimated macroscopic state on the cells of the scenario's ``[sumo]``
-  grid (``cell_length_m``; 20 cells of 50 m on the 1 km road): in SUMO the estimate the
-  controllers act on (``[estimation]``, before any warm-up reference is subtracted), on
-  the twin its own state at the same cell centres. Shape (4, cells).
-* ``"loops"``: the loop stations' readings of the period (``[sensing]`` loops; density
-  from occupancy and the loop speed per class; a speed no vehicle gave is the
-  fundamental diagram's at the station's densities). On the twin, ideal loops: its
-  state at the stations. Shape (4, stations).
-* ``"boundary"``: what the observer-ETC acts on in SUMO with an estimator, the two
-  boundary stations (x = 0 and x = L) of the loops; without loops, the first and last
-  cells of the state. Shape (4, 2).
-
-Normalisation: every row is divided by its equilibrium value (the scenario's
-``[equilibrium]``: rho_h*, v_h*, rho_a*, v_a*), so 1 is the operating point; a class with
-no equilibrium density is divided by the total density rho_h* + rho_a*. A value no
-sensor gave (NaN) is 1; values are clipped below at 0. The space is
-``Box(0, inf, shape, float32)``. :func:`denormalise` undoes it.
+Every row is divided by its equilibrium value (a class with no equilibrium density by the
+total density rho_h* + rho_a*), so 1 is the operating point; a value no sensor gave
+(NaN) is 1; values are clipped below at 0. :func:`denormalise` undoes it.
 """
 
 from __future__ import annotations
@@ -75,15 +66,6 @@ class Observer:
         if self.kind == "loops":
             return self.x_loops.size
         return 2
-
-    @property
-    def x(self) -> np.ndarray:
-        """Where the columns stand, m (the boundary: the two ends)."""
-        if self.kind == "state":
-            return self.x_cells
-        if self.kind == "loops":
-            return self.x_loops
-        return self.x_loops[[0, -1]] if self.x_loops.size else self.x_cells[[0, -1]]
 
     def __call__(self, state: np.ndarray, loops: np.ndarray | None) -> np.ndarray:
         """The observation of ``state`` (4, cells, SI) and the stations' ``loops`` (4,

@@ -14,7 +14,9 @@ from pathlib import Path
 from typing import Any
 
 from arzsumo.bridge.road import with_network
+from arzsumo.control.registry import controller_names
 from arzsumo.errors import ArzsumoError, EnvError
+from arzsumo.gym.rewards import reward_of
 from arzsumo.scenario import Scenario
 
 #: what the observation holds (:mod:`arzsumo.gym.observe`)
@@ -103,8 +105,6 @@ class EnvOptions:
     def of(cls, scenario: Any, seed: Any, reward: Any, observation: Any, warmup_s: Any,
            horizon_s: Any, law: Any = None) -> EnvOptions:
         """Check every argument (module docstring) and resolve the scenario."""
-        from arzsumo.gym.rewards import reward_of
-
         reward_of(reward)      # refused here, before the scenario is read
         sc = with_network(scenario_of(scenario))   # L, lanes and cells of a [network]
         period = sc.sumo.control_period
@@ -126,8 +126,6 @@ class EnvOptions:
 
 def check_law(value: object) -> str | None:
     """``value``: None or a registered controller that runs in SUMO."""
-    from arzsumo.control.registry import controller_names
-
     if value is None:
         return None
     return check_choice(value, "law", controller_names("sumo"))

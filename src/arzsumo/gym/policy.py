@@ -1,16 +1,12 @@
 """The package's controllers as policies: observation in, action out.
 
-``policy("etc", env)`` makes ``env`` stand in for the law (from its next ``reset``: in
-SUMO the run is prepared as ``arzsumo run --controller etc`` prepares it) and returns a
-callable that, handed an observation, returns the action the law takes at the present
-check: the law is checked on the environment's own state (``env.unwrapped.state``, the
-estimate the law acts on in ``arzsumo run``, not the normalised observation) and told
-what the actuator applied, so it acts exactly as in ``arzsumo run``. Its U is clipped to
-the action space; stepping with that action applies the law's own command, limited by
-the actuator as in ``arzsumo run``.
-
-Call the policy once per step, with the observation of the present check (it reads the
-environment, not its argument, which is there for the Gymnasium convention).
+``policy("etc", env)`` makes ``env`` stand in for the law from its next ``reset`` and
+returns a callable that returns the law's action at the present check: the law is
+checked on the environment's own state (``env.unwrapped.state``, not the normalised
+observation) and told what the actuator applied, as in ``arzsumo run`` (docs/gym.md,
+"The package's controllers as policies"). Call the policy once per step, with the
+observation of the present check (it reads the environment, not its argument, which is
+there for the Gymnasium convention).
 """
 
 from __future__ import annotations
@@ -65,8 +61,6 @@ def policy(name: str, env: Any) -> LawPolicy:
         An unknown law, one that does not run on the twin, or an environment made for
         another law.
     """
-    from arzsumo.control.registry import controller_names
-
     base = getattr(env, "unwrapped", env)
     if not isinstance(base, RampMeterEnv):
         raise refuse("env", env, "an environment of arzsumo.gym (arzsumo/TwinRampMeter-v0, "

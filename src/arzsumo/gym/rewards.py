@@ -2,28 +2,11 @@
 
 ``reward=`` of both environments is a name, a mapping of names to weights (their
 weighted sum), or any callable taking a :class:`StepRecord` (a callable with a
-``reset()`` method is reset at every episode's start). The names:
-
-``"vehicle-hours"``
-    Minus the vehicle-hours spent on the section x in [0, L] during the period
-    (:attr:`StepRecord.section_veh_h`): its sum over an episode is minus the section's
-    total time spent (``summary["TTT"]["total"]`` / 3600 in SUMO, up to the cells'
-    aggregation). The ramp queue is not on the section: combine with ``"ramp-queue"``
-    to charge it.
-``"ramp-queue"``
-    Minus the vehicle-hours of the ramp queue during the period (the queue at the period's
-    end times the period; 0 on the twin, which has no ramp).
-``"band-power"``
-    Minus a per-period proxy of the HV speed's stop-and-go band power
-    (``summary["section"]["waves"]["h"]["band_power_kmh2"]``, periods of 60 to 600 s):
-    the HV speed's 100 m block means are filtered by two exponential means of time
-    constants 60 s and 600 s (both started at the first period's speeds), and the
-    reward is minus the mean over blocks of their difference squared, (km/h)^2. The
-    summary's band power is a periodogram over the whole window; this is its causal
-    stand-in, zero on a stationary stream.
-``"plan-changes"``
-    Minus the meter's plan changes in the period (new timings asked of the meter; on the
-    twin, a change of the U applied).
+``reset()`` method is reset at every episode's start). The names (docs/gym.md,
+"Rewards"): ``"vehicle-hours"`` (its sum over an episode is minus the section's total
+time spent, ``summary["TTT"]["total"]`` / 3600 in SUMO up to the cells' aggregation; the
+ramp queue is not on the section), ``"ramp-queue"`` (the queue at the period's end times
+the period), ``"band-power"`` (:class:`BandPower`) and ``"plan-changes"``.
 """
 
 from __future__ import annotations
@@ -103,7 +86,14 @@ def plan_changes(r: StepRecord) -> float:
 
 
 class BandPower:
-    """Minus the band-power proxy of the module docstring, (km/h)^2; reset per episode."""
+    """Minus a per-period proxy of the HV speed's stop-and-go band power, (km/h)^2.
+
+    The HV speed's 100 m block means are filtered by two exponential means of time
+    constants 60 s and 600 s (both started at the first period's speeds); the reward is
+    minus the mean over blocks of their difference squared. A causal stand-in for the
+    summary's ``["section"]["waves"]["h"]["band_power_kmh2"]`` (a periodogram over the
+    whole window, periods of 60 to 600 s), zero on a stationary stream; reset per episode.
+    """
 
     def __init__(self) -> None:
         self.fast: np.ndarray | None = None

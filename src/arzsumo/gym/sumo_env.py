@@ -1,22 +1,15 @@
 """``arzsumo/SumoRampMeter-v0``: the ramp meter in SUMO, one step per control period.
 
 ``reset`` prepares the run as ``arzsumo run`` does
-(:func:`arzsumo.bridge.session.prepare_run`, with the episode's seed, ``warmup_s`` and
-``horizon_s``), starts SUMO and runs the warm-up under the nominal meter; every ``step``
-is one control period of the closed loop of :mod:`arzsumo.bridge.loop` with the agent's U
-in the law's place (:mod:`arzsumo.gym.sumo_episode`). At the horizon the episode ends
-(``truncated``) and, with ``summary=True``, the drain runs and ``info["summary"]`` is the
-run's ``summary.json`` as ``arzsumo run`` writes it (:func:`arzsumo.outputs.bridge.summary`).
+(:func:`arzsumo.bridge.session.prepare_run`) and runs the warm-up under the nominal meter;
+every ``step`` is one control period of the closed loop of :mod:`arzsumo.bridge.loop`
+with the agent's U in the law's place (:mod:`arzsumo.gym.sumo_episode`). docs/gym.md.
 
 An agent's run is prepared as the ``constant`` controller's (:data:`AGENT_RUN`: a law
 that is not a PDE law and drives the meter, so the estimate is the full-state one, the
 reference twin runs the open loop and the meter follows U) and its summary names the
-controller ``"agent"``. An environment standing in for a package law (``law="etc"``, or
-made so by :func:`arzsumo.gym.policy`) is prepared as that law's run: the summary of an
-episode driven by the law's policy is that of ``arzsumo run --controller LAW``.
-
-libsumo runs one simulation per process: close one environment before resetting another
-in the same process, or pass ``frontend="traci"`` (SUMO in a child process).
+controller ``"agent"``; an environment standing in for a package law (``law="etc"``, or
+made so by :func:`arzsumo.gym.policy`) is prepared as that law's run.
 """
 
 from __future__ import annotations
@@ -77,6 +70,8 @@ class SumoRampMeterEnv(RampMeterEnv):
         The package law episodes stand in for (its run's estimator, reference twin and
         summary); None: an agent.
     frontend : {"libsumo", "traci"}
+        libsumo runs one simulation per process (close one environment before resetting
+        another); traci runs SUMO in a child process.
     summary : bool
         At the horizon, drain and score the run as ``arzsumo run`` (``info["summary"]``);
         False ends the episode at the horizon without (faster, for training).
@@ -117,6 +112,11 @@ class SumoRampMeterEnv(RampMeterEnv):
         except ArzsumoError as exc:
             raise EnvError(f"scenario {self.scenario.name}: {exc}") from None
 
+    def _running_episode(self) -> SumoEpisode:
+        if self._episode is None:
+            raise EnvError("the environment has no episode running: call reset() first")
+        return self._episode
+
     # -- the engine's stages --------------------------------------------------------------
     def _start(self, seed: int) -> np.ndarray:
         self._episode = ep = SumoEpisode(self._prepare(seed), self.frontend,
@@ -126,9 +126,7 @@ class SumoRampMeterEnv(RampMeterEnv):
         return self._observe()
 
     def _observe(self) -> np.ndarray:
-        ep = self._episode
-        if ep is None:
-            raise EnvError("the environment has no episode running: call reset() first")
+        ep = self._running_episode()
         s, m = ep.state, ep.c.loop.m
         loops = (None if m.loops is None else
                  self.observer.loop_fields(m.loops.density, m.loops.speed))
@@ -136,9 +134,7 @@ class SumoRampMeterEnv(RampMeterEnv):
 
     def _advance(self, u: float
                  ) -> tuple[StepRecord, np.ndarray, bool, bool, dict[str, Any]]:
-        ep = self._episode
-        if ep is None:
-            raise EnvError("the environment has no episode running: call reset() first")
+        ep = self._running_episode()
         self._u_loop = self.command(u)
         act, meter = ep.step(*self._u_loop)
         loop = ep.c.loop
@@ -153,21 +149,14 @@ class SumoRampMeterEnv(RampMeterEnv):
                                 "max_queue": meter.max_queue,
                                 "green_share": meter.green_share, "override": meter.override}
         obs = self._observe()
-        done = loop.t >= self.options_horizon() - 1e-9
+        done = loop.t >= ep.run.sumo.horizon - 1e-9
         if done:
             info["summary"] = self._finish()
         return rec, obs, False, done, info
 
-    def options_horizon(self) -> float:
-        """The control horizon of the episode, s."""
-        ep = self._episode
-        return ep.run.sumo.horizon if ep is not None else self.options.horizon
-
     def _finish(self) -> dict[str, Any] | None:
         """The horizon's check, then the run's summary (or SUMO closed without it)."""
-        ep = self._episode
-        if ep is None:
-            raise EnvError("the environment has no episode running: call reset() first")
+        ep = self._running_episode()
         if self.law is not None:
             self._advice = None
             ep.last_check(*self.command(float(self.law_action()[0])))
@@ -185,19 +174,11 @@ class SumoRampMeterEnv(RampMeterEnv):
             ep.close()
 
     def _check_law(self) -> Command:
-        ep = self._episode
-        if ep is None:
-            raise EnvError("the environment has no episode running: call reset() first")
-        return ep.stand_in.advise(self._law_state(), self._told())
+        return self._running_episode().stand_in.advise(self._law_state(), self._told())
 
     def _law_state(self) -> MacroState:
-        ep = self._episode
-        if ep is None:
-            raise EnvError("the environment has no episode running: call reset() first")
+        ep = self._running_episode()
         return ep.c.loop.acting_on(ep.state)
 
     def _told(self) -> Applied | None:
-        ep = self._episode
-        if ep is None:
-            raise EnvError("the environment has no episode running: call reset() first")
-        return ep.c.loop.told
+        return self._running_episode().c.loop.told

@@ -1,25 +1,14 @@
-"""``arzsumo/TwinRampMeter-v0``: the ramp meter on the nonlinear PDE twin.
+"""``arzsumo/TwinRampMeter-v0``: the ramp meter on the nonlinear PDE twin (docs/gym.md).
 
 The twin of the scenario's model at its equilibrium (:class:`arzsumo.pde.solver.
 TwinStepper`, the ``[run]`` twin grid and scheme, the paper's boundary conditions: the
 inlet at the equilibrium, the outlet flow q* + U) with the spaces, the control period and
 the action range of the SUMO environment on the same scenario, so that a policy learned
-here runs there unchanged.
-
-``reset`` sets the initial condition: the scenario's ``[initial]`` profile
-(``initial="scenario"``; a ``random`` kind drawn with the episode's seed), or a random
-stop-and-go wave of the seed (``initial="random"``: the ``[initial]`` amplitudes, 5 % where
-they are zero, up to 3 periods over the road). Every ``step`` holds U (limited as in SUMO
-by ``[actuation]``: the range and the rate) for one control period. The twin has no
-ramp: the queue is 0 and a *plan change* is a change of the U applied.
-
-The episode ends at the horizon (``truncated``), or ``terminated`` when the state would
-leave the model's physical domain (``info["status"]`` says where); then the last step's
-reward also charges the rest of the horizon as the section standing jammed
-(``info["termination_reward"]``), so that ending an episode early never pays. ``info["summary"]``
-at the end: the section's indices (``TTT``, ``total_delay``, ``J_fuel``, ``J_discom``,
-computed as ``arzsumo run`` computes SUMO's, on the observation's cells), vehicle-hours,
-plan changes, and whether the run completed.
+here runs there unchanged. Every ``step`` holds U (limited as in SUMO by ``[actuation]``:
+the range and the rate) for one control period. The twin has no ramp: the queue is 0 and
+a *plan change* is a change of the U applied. An episode ends at the horizon
+(``truncated``) or when the state would leave the model's physical domain
+(``terminated``, ``info["status"]`` says where; :meth:`TwinRampMeterEnv._rest_of_horizon`).
 """
 
 from __future__ import annotations
@@ -69,7 +58,9 @@ class TwinRampMeterEnv(RampMeterEnv):
     accepted and unused: the twin starts from its initial condition), and
 
     initial : {"scenario", "random"}
-        The initial condition (module docstring).
+        The initial condition: the scenario's ``[initial]`` profile (a ``random`` kind
+        drawn with the episode's seed), or a random stop-and-go wave of the seed (the
+        ``[initial]`` amplitudes, 5 % where they are zero, up to 3 periods over the road).
     """
 
     engine = "twin"
@@ -95,7 +86,7 @@ class TwinRampMeterEnv(RampMeterEnv):
             twin_law(law, self)            # refused now, not at the first reset
 
     def initial_condition(self, seed: int) -> InitialCondition:
-        """The episode's initial condition (module docstring)."""
+        """The episode's initial condition (``initial``, class docstring)."""
         ic = self.scenario.initial
         if self.initial == "scenario":
             return ic if ic.kind != "random" else InitialCondition(
@@ -159,9 +150,8 @@ class TwinRampMeterEnv(RampMeterEnv):
     def _rest_of_horizon(self, rec: StepRecord) -> StepRecord | None:
         """An episode that leaves the model's domain is charged the rest of its horizon as
         one period of the section standing jammed: the classes in the equilibrium's
-        proportion at the HVs' AO_max, speeds 0. Without it an agent paid in minus
-        vehicle-hours learns to empty the section until the twin leaves its domain (the
-        inlet's density turns negative) and so stops paying: ending early never pays."""
+        proportion at the HVs' AO_max, speeds 0, so that ending early never pays
+        (docs/gym.md, "Ending episodes and SUMO")."""
         rest = self.options.horizon - rec.t
         if rest <= 0.0:
             return None
@@ -183,7 +173,9 @@ class TwinRampMeterEnv(RampMeterEnv):
         self.record["u"].append(u)
 
     def summary(self) -> dict[str, Any]:
-        """The episode's scores so far (module docstring)."""
+        """The episode's scores so far: the section's ``TTT``, ``total_delay``, ``J_fuel``,
+        ``J_discom`` (as ``arzsumo run`` computes SUMO's, on the observation's cells),
+        vehicle-hours, plan changes, and whether the run completed."""
         t = np.asarray(self.record["t"])
         perf = performance(self.scenario.params, t, self.observer.x_cells,
                            np.stack(self.record["fields"]))
