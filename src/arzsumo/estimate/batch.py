@@ -32,12 +32,6 @@ from arzsumo.pde.source import relax
 from arzsumo.pde.state import RHO_A, RHO_H, cell_centres, to_conserved, to_primitive
 
 
-def _sel(w: Waves, idx: slice) -> Waves:
-    """``w`` restricted to the cells ``idx`` (last axis) of every member."""
-    return Waves(w.q[..., idx], w.f[..., idx], w.v_h[..., idx], w.v_a[..., idx],
-                 w.lo[..., idx], w.hi[..., idx])
-
-
 def ghost_flux(p: ModelParameters, ghost: np.ndarray) -> np.ndarray:
     """Physical flux (4, M) of primitive ghost states (4, M) at x = 0.
 
@@ -120,7 +114,7 @@ class BatchStepper:
             ) -> tuple[np.ndarray, np.ndarray]:
         """dq/dt (4, M, n) and the largest wave speed of each member (M,), m/s."""
         cells = waves(self.p, q)
-        flux, smax = self.riemann(_sel(cells, slice(None, -1)), _sel(cells, slice(1, None)))
+        flux, smax = self.riemann(cells.sel(slice(None, -1)), cells.sel(slice(1, None)))
         s = np.maximum(np.maximum(smax.max(axis=-1), -cells.lo[:, 0]), cells.hi[:, -1])
         full = np.empty((*q.shape[:2], q.shape[2] + 1))
         full[..., 0] = ghost_flux(self.p, ghost)

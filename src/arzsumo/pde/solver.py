@@ -1,17 +1,11 @@
-"""The time loop of the nonlinear twin: CFL-adaptive stepping, controller hook, guard.
+"""The time loop of the nonlinear twin: CFL-adaptive stepping, controller hook, guard
+(docs/twin.md, "Time loop and guard").
 
-:class:`TwinStepper` owns the one time loop (as PyClaw's controller does): it advances
-the state to a requested time with a held outflow q* + U, choosing each step from the CFL
-condition, redoing a step whose waves turned out faster than Courant 1, and stopping with
-:class:`TwinStoppedError` (time, position, variable) when the state leaves the physical domain,
-keeping the last valid state. The SUMO bridge can drive it directly
-(``advance(t, u)`` / ``macro_state()`` / ``set_state(...)``).
-
-:func:`simulate` runs a whole experiment on top of it: it calls the controller once per
-control period through :meth:`Controller.check` and holds U in between, saturates U to a
-feasible range (and counts the time spent saturated), stores fields at output instants and
-returns a :class:`TwinResult`, marked ``complete=False`` with the stop message if the run
-ended early. The numerics of one step are in :mod:`arzsumo.pde.scheme`.
+:class:`TwinStepper` owns the one time loop (as PyClaw's controller does): it advances the
+state with a held outflow q* + U, redoes a step whose waves turned out faster than Courant
+1, and stops with :class:`TwinStoppedError` when the state leaves the physical domain,
+keeping the last valid state; the SUMO bridge drives it directly. :func:`simulate` runs a
+whole experiment on it and returns a :class:`TwinResult`. One step: :mod:`arzsumo.pde.scheme`.
 """
 
 from __future__ import annotations
