@@ -10,7 +10,6 @@ import math
 from dataclasses import dataclass
 from typing import Literal
 
-import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
 from arzsumo.errors import DemandError, ModelError, require
@@ -107,9 +106,7 @@ def equilibrium_from_densities(params: ModelParameters, rho_h: float, rho_a: flo
     """
     eq = Equilibrium(params, float(rho_h), float(rho_a))
     for name, stated, computed in (("v_h", v_h, eq.v_h), ("v_a", v_a, eq.v_a)):
-        if stated is None:
-            continue
-        if abs(stated - computed) > tolerance * abs(computed):
+        if stated is not None and abs(stated - computed) > tolerance * abs(computed):
             reason = (f"{ms_to_kmh(stated):.2f} km/h disagrees with the fundamental diagram "
                       f"Ve = {ms_to_kmh(computed):.2f} km/h at these densities by more than "
                       f"{tolerance:.0%}; omit the speed or change the densities or parameters")
@@ -152,21 +149,15 @@ def equilibrium_from_demand(params: ModelParameters, q_h: float, q_a: float,
     require(branch in ("congested", "free"), "branch", branch, "'congested' or 'free'")
     ao_cap, f_cap = demand_capacity_ao(params, q_h, q_a)
     if f_cap < 0.0:
-        ratio = q_h / (q_h + q_a)
-        carried = _max_total_flow(params, ratio)
+        carried = _max_total_flow(params, q_h / (q_h + q_a))
         raise DemandError(
             f"demand = {veh_s_to_veh_h(q_h + q_a):.0f} veh/h (HV {veh_s_to_veh_h(q_h):.0f}, "
             f"AV {veh_s_to_veh_h(q_a):.0f}) exceeds what the fundamental diagram can carry "
             f"at this mix; allowed: at most {veh_s_to_veh_h(carried):.0f} veh/h"
         )
-    if branch == "congested":
-        lo, hi = ao_cap, params.ao_max * (1.0 - 1e-12)
-    else:
-        lo, hi = 1e-12, ao_cap
-    if f_cap == 0.0:
-        ao = ao_cap
-    else:
-        ao = brentq(lambda a: _ao_residual(params, q_h, q_a, a), lo, hi, xtol=1e-14, rtol=1e-14)
+    lo, hi = (ao_cap, params.ao_max * (1.0 - 1e-12)) if branch == "congested" else (1e-12, ao_cap)
+    ao = ao_cap if f_cap == 0.0 else brentq(
+        lambda a: _ao_residual(params, q_h, q_a, a), lo, hi, xtol=1e-14, rtol=1e-14)
     ve_h, ve_a = speed_of_ao(params, ao)
     return Equilibrium(params, q_h / float(ve_h), q_a / float(ve_a))
 
@@ -236,9 +227,3 @@ def equilibrium_at_penetration(params: ModelParameters, q: float, penetration: f
     rho = rho_cap if q == q_cap else brentq(
         lambda r: _mix_flow(params, r, penetration) - q, lo, hi, xtol=1e-15, rtol=1e-14)
     return Equilibrium(params, (1.0 - penetration) * rho, penetration * rho)
-
-
-def flows(params: ModelParameters, rho_h: np.ndarray, rho_a: np.ndarray) -> tuple[np.ndarray, ...]:
-    """Equilibrium class flows (veh/s) at the given densities (veh/m)."""
-    ve_h, ve_a = equilibrium_speeds(params, rho_h, rho_a)
-    return np.asarray(rho_h) * ve_h, np.asarray(rho_a) * ve_a

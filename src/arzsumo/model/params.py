@@ -1,14 +1,9 @@
 """Physical parameters of the mixed-autonomy ARZ model (paper, section 2) and named presets.
 
 All fields are SI: metres, seconds, m/s. The presets come from the paper's
-"Simulation settings" subsection (section 5).
-
-A note on the vehicle width ``d``: the paper never states it. With d = 2.0 m the base
-equilibrium (110 HV/km, 95 AV/km, s_h = 8 m, s_a = 15 m) gives Ve_h = 35.9 km/h and
-Ve_a = 18.2 km/h, not the stated 32 and 15 km/h; those need d close to 2.07 m
-(AO = 0.734). The s_a = 12 m case, on the other hand, gives the stated 48 and 28 km/h
-with d = 2.0 m. We keep d = 2.0 m as the default and let scenarios override it; speeds
-are always computed from the fundamental diagram, never set independently.
+"Simulation settings" subsection (section 5). The paper never states the vehicle width d:
+the default 2.0 m and what it gives against the paper's speeds are in
+docs/characteristic_form.md, section 6. Speeds always follow from the fundamental diagram.
 """
 
 from __future__ import annotations
