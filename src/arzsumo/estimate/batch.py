@@ -1,23 +1,15 @@
 """A batch of first-order twins advanced together: one vectorised step for all members.
 
-The ensemble Kalman filter advances M copies of the twin every period. Looping over M
-:class:`arzsumo.pde.TwinStepper` objects costs M times the Python overhead of a step;
-here the conserved state carries a member axis, ``q`` of shape (4, M, n) (component,
-member, cell), and every operation of the twin's first-order scheme
-(:mod:`arzsumo.pde.scheme`: Strang splitting of the exact relaxation and a forward-Euler
-transport step with the HLL or Rusanov flux of :mod:`arzsumo.pde.flux`) runs once on the
-whole batch. The twin's flux functions are reused as they are (they are elementwise in
-the member axis).
-
-Boundaries are those of the SUMO bridge (:class:`arzsumo.bridge.twins.MeasuredInlet`,
-``TwinPair``): at x = 0 a ghost state (rho_h, v_h, rho_a, v_a) whose physical flux enters,
-per member; at x = L the metered outflow of :func:`arzsumo.pde.boundary.outlet_flux`
-(split between the classes by their arriving flows, floored by the demand in free
-flow), per member. All members share one time step, the CFL step of the fastest member,
-so member k equals a single twin driven to the same step times (tested to 1e-12).
-
-A member whose step leaves the physical domain is projected back onto it
-(:func:`project`) instead of stopping the batch.
+The ensemble Kalman filter advances M copies of the twin every period; rather than M
+:class:`arzsumo.pde.TwinStepper` objects (M times the Python overhead of a step), the
+conserved state carries a member axis, ``q`` of shape (4, M, n) (component, member, cell),
+and the twin's first-order scheme (:mod:`arzsumo.pde.scheme`, with the flux functions of
+:mod:`arzsumo.pde.flux` as they are) runs once on the whole batch. Boundaries, per member,
+are those of the SUMO bridge (:mod:`arzsumo.bridge.twins`): at x = 0 the physical flux of a
+primitive ghost state, at x = L the metered outflow of
+:func:`arzsumo.pde.boundary.outlet_flux`. All members share the CFL step of the fastest
+one, so member k equals a single twin driven to the same step times. A member whose step
+leaves the physical domain is projected back onto it (:func:`project`).
 """
 
 from __future__ import annotations
@@ -69,12 +61,8 @@ def project(p: ModelParameters, z: np.ndarray, rho_min: float = 1e-4,
     become the bounds' nearest (0 speed, ``rho_min``).
     """
     z = np.nan_to_num(np.array(z, float), nan=0.0, posinf=0.0, neginf=0.0)
-    z[0] = np.maximum(z[0], rho_min)
-    z[2] = np.maximum(z[2], rho_min)
-    ao = area_occupancy(p, z[0], z[2])
-    scale = np.minimum(1.0, ao_fraction * p.ao_max / ao)
-    z[0] *= scale
-    z[2] *= scale
+    z[[0, 2]] = np.maximum(z[[0, 2]], rho_min)
+    z[[0, 2]] *= np.minimum(1.0, ao_fraction * p.ao_max / area_occupancy(p, z[0], z[2]))
     z[1] = np.clip(z[1], 0.0, p.v_free_h)
     z[3] = np.clip(z[3], 0.0, p.v_free_a)
     return z
@@ -89,17 +77,8 @@ def outside(p: ModelParameters, q: np.ndarray) -> np.ndarray:
 
 
 class BatchStepper:
-    """First-order twin scheme for a batch of members, q of shape (4, M, n).
-
-    Parameters
-    ----------
-    params : ModelParameters
-    cells : int
-        Cells on [0, L].
-    flux : {"hll", "rusanov"}
-    cfl : float
-        Target Courant number, in (0, 1].
-    """
+    """First-order twin scheme for a batch of members, q of shape (4, M, n), on ``cells``
+    cells of [0, L] with target Courant number ``cfl`` in (0, 1]."""
 
     def __init__(self, params: ModelParameters, cells: int, flux: str = "hll",
                  cfl: float = 0.9) -> None:

@@ -39,9 +39,6 @@ from arzsumo.errors import require
 from arzsumo.estimate.observations import LoopObservation, ProbeObservation
 from arzsumo.units import kmh_to_ms
 
-#: Estimated quantities, in the twin's primitive order.
-QUANTITIES = ("rho_h", "v_h", "rho_a", "v_a")
-
 #: Kernel products per chunk of the vectorised sums (memory bound).
 _CHUNK = 2_000_000
 
@@ -89,9 +86,9 @@ class AsmParameters:
 @dataclass(frozen=True)
 class DataPoints:
     """Data at N space-time points: positions x (m) and times t (s), (N,); values and
-    weights 1/sd^2 of the quantities of :data:`QUANTITIES`, (N, 4), weight 0 (value 0)
-    where a point has no datum of that quantity. A loop station's period is one point
-    with all four quantities, so the kernels are evaluated once for them."""
+    weights 1/sd^2 of (rho_h, v_h, rho_a, v_a), (N, 4), weight 0 (value 0) where a point
+    has no datum of that quantity. A loop station's period is one point with all four
+    quantities, so the kernels are evaluated once for them."""
 
     x: np.ndarray
     t: np.ndarray
@@ -222,13 +219,8 @@ def smooth(points: DataPoints, x: np.ndarray, t: np.ndarray,
 class CausalSmoother:
     """Real-time ASM on a fixed grid: add each period's data, estimate the present.
 
-    Keeps the data of the last :attr:`AsmParameters.window` seconds.
-
-    Parameters
-    ----------
-    x : array (n,)
-        Output positions (the controller's cell centres), m.
-    params : AsmParameters, optional
+    ``x`` (m) are the output positions (the controller's cell centres); the data of the
+    last :attr:`AsmParameters.window` seconds are kept.
     """
 
     def __init__(self, x: np.ndarray, params: AsmParameters | None = None) -> None:

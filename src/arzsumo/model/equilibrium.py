@@ -15,7 +15,7 @@ from scipy.optimize import brentq, minimize_scalar
 from arzsumo.errors import DemandError, ModelError, require
 from arzsumo.model.fd import area_occupancy, equilibrium_speeds, speed_of_ao
 from arzsumo.model.params import ModelParameters
-from arzsumo.units import ms_to_kmh, veh_m_to_veh_km, veh_s_to_veh_h
+from arzsumo.units import ms_to_kmh, veh_s_to_veh_h
 
 Branch = Literal["congested", "free"]
 
@@ -79,20 +79,10 @@ class Equilibrium:
         """AV penetration rate rho_a* / (rho_h* + rho_a*), dimensionless."""
         return self.rho_a / (self.rho_h + self.rho_a)
 
-    def as_dict(self, human: bool = False) -> dict[str, float]:
-        """The equilibrium as a flat dict, SI or (``human``) km/h, veh/km, veh/h."""
-        if not human:
-            return {"rho_h": self.rho_h, "rho_a": self.rho_a, "v_h": self.v_h, "v_a": self.v_a,
-                    "q_h": self.q_h, "q_a": self.q_a, "ao": self.ao,
-                    "penetration": self.penetration}
-        return {
-            "rho_h_veh_km": float(veh_m_to_veh_km(self.rho_h)),
-            "rho_a_veh_km": float(veh_m_to_veh_km(self.rho_a)),
-            "v_h_kmh": float(ms_to_kmh(self.v_h)), "v_a_kmh": float(ms_to_kmh(self.v_a)),
-            "q_h_veh_h": float(veh_s_to_veh_h(self.q_h)),
-            "q_a_veh_h": float(veh_s_to_veh_h(self.q_a)),
-            "ao": self.ao, "penetration": self.penetration,
-        }
+    def as_dict(self) -> dict[str, float]:
+        """The equilibrium as a flat dict, SI."""
+        return {"rho_h": self.rho_h, "rho_a": self.rho_a, "v_h": self.v_h, "v_a": self.v_a,
+                "q_h": self.q_h, "q_a": self.q_a, "ao": self.ao, "penetration": self.penetration}
 
 
 def equilibrium_from_densities(params: ModelParameters, rho_h: float, rho_a: float, *,

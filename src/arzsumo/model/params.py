@@ -139,28 +139,23 @@ class Preset:
 
 
 _BASE = ModelParameters()
+#: the paper's equilibrium densities, 110 HV/km and 95 AV/km, in veh/m
+_RHO_H, _RHO_A = float(veh_km_to_veh_m(110)), float(veh_km_to_veh_m(95))
 
-PRESETS: dict[str, Preset] = {
-    "paper_base": Preset(
-        "paper_base", _BASE, float(veh_km_to_veh_m(110)), float(veh_km_to_veh_m(95)),
-        "Section 5 base case: s_h = 8 m, s_a = 15 m, 110 HV/km and 95 AV/km",
-    ),
-    "paper_s12": Preset(
-        "paper_s12", _BASE.with_(spacing_a=12.0), float(veh_km_to_veh_m(110)),
-        float(veh_km_to_veh_m(95)),
-        "Different spacing policy: s_a = 12 m (paper's stated speeds 48 and 28 km/h)",
-    ),
+PRESETS: dict[str, Preset] = {preset.name: preset for preset in (
+    Preset("paper_base", _BASE, _RHO_H, _RHO_A,
+           "Section 5 base case: s_h = 8 m, s_a = 15 m, 110 HV/km and 95 AV/km"),
+    Preset("paper_s12", _BASE.with_(spacing_a=12.0), _RHO_H, _RHO_A,
+           "Different spacing policy: s_a = 12 m (paper's stated speeds 48 and 28 km/h)"),
     # The paper says the aggressive case "adjusts accordingly" the free-flow speeds and
     # maximum AOs without giving them; we swap the class behaviours along with the
     # spacings (HV: 60 km/h, AO_max 0.85; AV: 80 km/h, AO_max 0.9).
-    "paper_aggressive": Preset(
-        "paper_aggressive",
-        _BASE.with_(spacing_h=15.0, spacing_a=8.0, v_free_h=float(kmh_to_ms(60)),
-                    v_free_a=float(kmh_to_ms(80)), ao_max_h=0.85, ao_max_a=0.9),
-        float(veh_km_to_veh_m(110)), float(veh_km_to_veh_m(95)),
-        "Aggressive AV spacing: s_h = 15 m, s_a = 8 m, class behaviours swapped",
-    ),
-}
+    Preset("paper_aggressive",
+           _BASE.with_(spacing_h=15.0, spacing_a=8.0, v_free_h=float(kmh_to_ms(60)),
+                       v_free_a=float(kmh_to_ms(80)), ao_max_h=0.85, ao_max_a=0.9),
+           _RHO_H, _RHO_A,
+           "Aggressive AV spacing: s_h = 15 m, s_a = 8 m, class behaviours swapped"),
+)}
 
 
 def get_preset(name: str) -> Preset:

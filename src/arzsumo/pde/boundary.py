@@ -93,24 +93,12 @@ class Inlet:
 
 def outlet_flux(q_last: np.ndarray, v_h: float, v_a: float, total: float,
                 congested: bool = True) -> tuple[np.ndarray, bool]:
-    """Flux (4,) through x = L carrying ``total`` veh/s, split by the rule above.
+    """Flux (4,) through x = L carrying the metered outflow ``total`` = q* + U (veh/s),
+    split by the rule above, and whether the arriving demand (or 0), not ``total``, set it.
 
-    Parameters
-    ----------
-    q_last : ndarray, shape (4,)
-        Conserved state at the outlet face (last cell, or its reconstructed east value).
-    v_h, v_a : float
-        Speeds there, m/s.
-    total : float
-        Metered outflow q* + U, veh/s.
-    congested : bool
-        Whether the smallest characteristic speed at the outlet is negative.
-
-    Returns
-    -------
-    flux : ndarray, shape (4,)
-    limited : bool
-        True when the arriving demand (or 0) and not ``total`` set the outflow.
+    ``q_last`` is the conserved state at the outlet face (the last cell, or its
+    reconstructed east value), ``v_h``, ``v_a`` the speeds there (m/s), ``congested``
+    whether the smallest characteristic speed there is negative.
     """
     rho_h, y_h, rho_a, y_a = (float(c) for c in q_last)
     q_h, q_a = rho_h * v_h, rho_a * v_a

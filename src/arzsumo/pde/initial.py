@@ -104,11 +104,8 @@ def _profile(ic: InitialCondition, x: np.ndarray, length: float) -> np.ndarray:
 def initial_fields(ic: InitialCondition, eq: Equilibrium, x: np.ndarray) -> np.ndarray:
     """Primitive fields (rho_h, v_h, rho_a, v_a), shape (4, n), on cell centres ``x`` (m).
 
-    Raises
-    ------
-    ModelError
-        If the profile leaves the physical domain (negative density, AO >= AO_max, ...);
-        the message names the variable, value and position.
+    Raises :class:`ModelError` naming the variable, value and position if the profile leaves
+    the physical domain (negative density, AO >= AO_max, ...).
     """
     x = np.asarray(x, float)
     p = eq.params

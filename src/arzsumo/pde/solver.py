@@ -179,11 +179,6 @@ class TwinStepper:
     t0 : float
         Initial time, s.
 
-    Notes
-    -----
-    The boundary conditions are those of section 2, posed for a congested equilibrium
-    (lambda_4 < 0); a free-flow equilibrium is accepted with a logged warning.
-
     Attributes
     ----------
     t : float
@@ -303,17 +298,12 @@ def simulate(eq: Equilibrium, initial: np.ndarray, *, controller: Controller | N
 
     Parameters
     ----------
-    eq : Equilibrium
-        Reference equilibrium: q* for the outlet, rho_i* and q* for the default inlet.
-    initial : ndarray, shape (4, cells)
-        (rho_h veh/m, v_h m/s, rho_a veh/m, v_a m/s) on the cell centres
-        (see :func:`arzsumo.pde.initial.initial_fields`).
+    eq, initial, options, inlet
+        As for :class:`TwinStepper` (``initial``: e.g.
+        :func:`arzsumo.pde.initial.initial_fields`).
     controller : Controller, optional
         Reset, then checked once per control period via :meth:`Controller.check`
         (first check at t = 0); its U is held until the next check. Default open loop.
-    options : SolverOptions, optional
-    inlet : Inlet, optional
-        Default :meth:`Inlet.at_equilibrium` of the linearisation at ``eq``.
     callback : callable, optional
         ``callback(t, q, vehicles_in, vehicles_out)`` after every accepted step with the
         conserved state and the vehicles that crossed each boundary during the step.

@@ -101,25 +101,10 @@ class ReceivingCapacity:
         """The inflow ``flux`` (4,) into a cell with densities ``rho_h``, ``rho_a``, limited
         to the cell's supply (and, with ``sender``, raised to a congested sender's demand).
 
-        Parameters
-        ----------
-        flux : ndarray, shape (4,)
-            The physical flux (rho_h v_h, y_h v_h, rho_a v_a, y_a v_a) of the boundary
-            state, veh/s and veh/s^2.
-        rho_h, rho_a : float
-            The receiving cell's densities, veh/m.
-        sender : (float, float), optional
-            The boundary state's densities (veh/m): its demand is then the flux times
-            D_e / Phi_e there (module docstring); without it, the flux.
-
-        Returns
-        -------
-        flux : ndarray, shape (4,)
-            ``flux`` itself where the demand is the flux and within the supply, else
-            ``theta * flux``.
-        theta : float
-            The factor (>= 0); 1.0 where neither the supply nor the sender's demand
-            changed the flux.
+        ``flux`` is the boundary state's physical flux (veh/s and veh/s^2), ``rho_h``,
+        ``rho_a`` the receiving cell's densities and ``sender`` the boundary state's (veh/m).
+        Returns ``flux`` itself and 1.0 where neither the supply nor the sender's demand
+        changes it, else ``theta * flux`` and theta (>= 0).
         """
         carried = self._ah * float(flux[RHO_H]) + self._aa * float(flux[RHO_A])
         if carried <= 0.0:
