@@ -25,10 +25,8 @@ from arzsumo.pde.state import RHO_A, RHO_H, cell_centres, to_conserved, to_primi
 
 
 def ghost_flux(p: ModelParameters, ghost: np.ndarray) -> np.ndarray:
-    """Physical flux (4, M) of primitive ghost states (4, M) at x = 0.
-
-    The same arithmetic as :meth:`arzsumo.pde.boundary.Inlet.boundary_flux`.
-    """
+    """Physical flux (4, M) of primitive ghost states (4, M) at x = 0: the arithmetic of
+    :meth:`arzsumo.pde.boundary.Inlet.boundary_flux`."""
     rho_h, v_h, rho_a, v_a = ghost
     ve_h, ve_a = speed_of_ao(p, area_occupancy(p, rho_h, rho_a))
     y_h, y_a = rho_h * (v_h - ve_h), rho_a * (v_a - ve_a)
@@ -36,11 +34,8 @@ def ghost_flux(p: ModelParameters, ghost: np.ndarray) -> np.ndarray:
 
 
 def outlet_fluxes(out: Waves, total: np.ndarray) -> np.ndarray:
-    """Outlet flux (4, M) of :func:`arzsumo.pde.boundary.outlet_flux`, per member.
-
-    ``out`` holds the last cell of each member (arrays (4, M) and (M,)); ``total`` the
-    metered outflow q* + U of each member, veh/s.
-    """
+    """Outlet flux (4, M) of :func:`arzsumo.pde.boundary.outlet_flux` per member, from the
+    last cell of each (``out``) and the metered outflow q* + U of each (``total``, veh/s)."""
     rho_h, y_h, rho_a, y_a = out.q
     q_h, q_a = rho_h * out.v_h, rho_a * out.v_a
     arriving = q_h + q_a
@@ -103,11 +98,8 @@ class BatchStepper:
 
     def step(self, q: np.ndarray, dt: float, ghost: np.ndarray, outflow: np.ndarray
              ) -> tuple[np.ndarray, np.ndarray]:
-        """One Strang-split step of ``dt`` s: relaxation dt/2, transport, relaxation dt/2.
-
-        ``ghost`` (4, M) primitive inlet states, ``outflow`` (M,) veh/s. Returns the new q
-        and the largest wave speed of each member (M,).
-        """
+        """One Strang-split step of ``dt`` s with primitive inlet states ``ghost`` (4, M) and
+        ``outflow`` (M,) veh/s: the new q and the largest wave speed of each member (M,)."""
         q = relax(self.p, q, 0.5 * dt)
         dq, s = self.rhs(q, ghost, outflow)
         return relax(self.p, q + dt * dq, 0.5 * dt), s

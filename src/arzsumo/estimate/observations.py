@@ -33,17 +33,9 @@ def _sd(name: str, value: float) -> None:
 
 @dataclass(frozen=True)
 class LoopNoise:
-    """Measurement-error standard deviations of a loop station, per period and class.
-
-    Parameters
-    ----------
-    flow : float
-        Count-based flow, veh/s.
-    speed : float
-        Loop speed (time-mean or harmonic), m/s.
-    density : float
-        Density (from occupancy), veh/m.
-    """
+    """Measurement-error standard deviations of a loop station, per period and class, of
+    the count-based flow (veh/s), the loop speed (time-mean or harmonic, m/s) and the density
+    (from occupancy, veh/m)."""
 
     flow: float = 0.1
     speed: float = 1.5

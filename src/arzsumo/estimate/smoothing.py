@@ -45,23 +45,10 @@ _CHUNK = 2_000_000
 
 @dataclass(frozen=True)
 class AsmParameters:
-    """Parameters of the adaptive smoothing method (SI).
-
-    Parameters
-    ----------
-    c_free : float
-        Propagation speed of perturbations in free flow, m/s (> 0; default 80 km/h).
-    c_cong : float
-        Propagation speed in congestion, m/s (< 0; default -15 km/h).
-    sigma : float
-        Smoothing width in space, m.
-    tau : float
-        Smoothing width in time, s.
-    v_crit : float
-        Crossover speed between the two kernels, m/s (default 60 km/h).
-    dv : float
-        Width of the crossover, m/s (default 20 km/h).
-    """
+    """Parameters of the adaptive smoothing method (SI): the propagation speeds of
+    perturbations in free flow ``c_free`` > 0 and in congestion ``c_cong`` < 0 (m/s), the
+    smoothing widths in space ``sigma`` (m) and in time ``tau`` (s), the crossover speed
+    ``v_crit`` between the two kernels and its width ``dv`` (m/s)."""
 
     c_free: float = float(kmh_to_ms(80.0))
     c_cong: float = float(kmh_to_ms(-15.0))

@@ -140,7 +140,8 @@ class Linearization:
     @cached_property
     def kappa(self) -> np.ndarray:
         """kappa_j = v_h nu_1j + rho_h nu_2j + v_a nu_3j + rho_a nu_4j (flow per unit w_j)."""
-        return _flow_gradient(self.equilibrium) @ self.T_inv
+        eq = self.equilibrium          # (v_h, rho_h, v_a, rho_a) . z: linearised flow deviation
+        return np.array([eq.v_h, eq.rho_h, eq.v_a, eq.rho_a]) @ self.T_inv
 
     @property
     def regime(self) -> str:
@@ -205,13 +206,9 @@ class Linearization:
         return np.exp(-np.outer(x, np.diag(self.j_hat) / self.eigenvalues))
 
 
-def _flow_gradient(eq: Equilibrium) -> np.ndarray:
-    """g with g . z = linearised total flow deviation: (v_h, rho_h, v_a, rho_a)."""
-    return np.array([eq.v_h, eq.rho_h, eq.v_a, eq.rho_a])
-
-
 def quasi_linear_matrix(eq: Equilibrium) -> np.ndarray:
-    """A of z_t + A z_x = B z at the equilibrium (module docstring), m/s and mixed units."""
+    """A of z_t + A z_x = B z at the equilibrium, m/s and mixed units (docs/characteristic_form.md,
+    section 1)."""
     s = speed_jacobian(eq.params, eq.rho_h, eq.rho_a)
     rh, ra, vh, va = eq.rho_h, eq.rho_a, eq.v_h, eq.v_a
     return np.array([
@@ -247,7 +244,7 @@ def characteristic_speeds(p: ModelParameters, rho_h: ArrayLike, rho_a: ArrayLike
 
 
 def _riemann_matrix(eq: Equilibrium, lam: np.ndarray) -> np.ndarray:
-    """T with rows the normalised left eigenvectors of A (module docstring)."""
+    """T with rows the normalised left eigenvectors of A (docs/characteristic_form.md, 3)."""
     s = speed_jacobian(eq.params, eq.rho_h, eq.rho_a)
     area = np.array([eq.params.area_h, eq.params.area_a])
     rho = np.array([eq.rho_h, eq.rho_a])

@@ -1,9 +1,8 @@
 """Area-occupancy fundamental diagrams (paper, section 2, labels AOrelation and eq. (3)).
 
-Pure vectorised functions of a :class:`ModelParameters` and density arrays (veh/m).
-Each family defines its speed Ve_i(AO) and its slope dVe_i/dAO once (:data:`_FAMILY`), so
-every consumer (equilibria, characteristic speeds, kernels, the twin's flux, the observer,
-the identification) reads them from the same definition:
+Pure vectorised functions of a :class:`ModelParameters` and density arrays (veh/m). Each
+family defines its speed Ve_i(AO) and slope dVe_i/dAO once (:data:`_FAMILY`), for every
+consumer:
 
 ``power`` (the paper's eq. (3))
     Ve_i(AO) = V_i (1 - (AO / AO_max,i)^gamma_i).

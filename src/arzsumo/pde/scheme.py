@@ -1,11 +1,6 @@
-"""Spatial discretisation and one Strang-split time step of the twin.
-
-:class:`Transport` evaluates -(F_{j+1/2} - F_{j-1/2}) / dx with the numerical flux of
-:mod:`arzsumo.pde.flux` between cells (``first``) or between MUSCL face values
-(``muscl``), and the boundary fluxes of :mod:`arzsumo.pde.boundary`; :meth:`Transport.step`
-advances by dt with Strang splitting: exact relaxation over dt/2
-(:mod:`arzsumo.pde.source`), forward Euler (first order) or SSP-RK2 / Heun (MUSCL) for
-the transport, relaxation over dt/2. Vectorised over cells.
+"""Spatial discretisation and one Strang-split time step of the twin: numerical fluxes
+between cells (``first``) or MUSCL face values (``muscl``), the boundary fluxes, and forward
+Euler (first order) or SSP-RK2 / Heun (MUSCL) for the transport. Vectorised over cells.
 """
 
 from __future__ import annotations
