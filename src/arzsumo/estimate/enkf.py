@@ -18,8 +18,8 @@ flows rho_i v_i) linearly at the sensors; s is the per-variable model-error sd
 research/readings/enkf_model_noise.md); rho is the Gaspari & Cohn (1999) taper of the
 distance, half-width :attr:`EnkfOptions.localisation`; R is diagonal from the records'
 noise models. After each analysis the members are projected onto the physical domain
-(:func:`arzsumo.estimate.batch.project`). Observations: loop densities, speeds and flows
-per class, probe speeds of their class.
+(:func:`arzsumo.estimate.batch.project`). Observations: loop densities, speeds (taken as
+the field's speed at the station) and flows per class, probe speeds of their class.
 """
 
 from __future__ import annotations
