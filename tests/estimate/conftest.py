@@ -16,9 +16,10 @@ import pytest
 
 from arzsumo.model.characteristic import linearize
 from arzsumo.model.equilibrium import Equilibrium
-from arzsumo.pde import InitialCondition, Inlet, SolverOptions, TwinStepper, initial_fields
+from arzsumo.pde import InitialCondition, SolverOptions, TwinStepper, initial_fields
 from arzsumo.pde.state import cell_centres
 from arzsumo.scenario import load_scenario
+from tests.twin.demands import inlet_from_demands
 
 ROOT = Path(__file__).resolve().parents[2]
 HORIZON = 300
@@ -50,7 +51,7 @@ def truth() -> Truth:
                                            wavenumber=1.5), eq, x)
     times = np.arange(0.0, HORIZON + 11.0, 10.0)
     wave = 2 * np.pi * times / 150.0
-    inlet = Inlet.from_demands(lin, times, eq.q_h * (0.985 + 0.012 * np.sin(wave)),
+    inlet = inlet_from_demands(lin, times, eq.q_h * (0.985 + 0.012 * np.sin(wave)),
                                eq.q_a * (0.985 + 0.012 * np.sin(wave + 1.0)))
     stepper = TwinStepper(eq, init, SolverOptions(cells=FINE, scheme="muscl"), inlet)
     fields = [stepper.primitive()]

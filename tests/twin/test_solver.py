@@ -143,10 +143,10 @@ def test_options_validate_themselves():
 
 def test_inlet_demand_series_sets_the_inflow(base_lin):
     """A class-demand ramp at the inlet: the vehicles entering are its integral."""
-    from arzsumo.pde import Inlet
+    from .demands import inlet_from_demands
 
     eq = base_lin.equilibrium
-    inlet = Inlet.from_demands(base_lin, np.array([0.0, 30.0, 60.0]),
+    inlet = inlet_from_demands(base_lin, np.array([0.0, 30.0, 60.0]),
                                np.array([eq.q_h, 0.95 * eq.q_h, 0.95 * eq.q_h]),
                                np.array([eq.q_a, eq.q_a, eq.q_a]))
     res = simulate(eq, _init(eq, kind="equilibrium"), inlet=inlet,

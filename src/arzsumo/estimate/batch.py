@@ -1,23 +1,15 @@
 """A batch of first-order twins advanced together: one vectorised step for all members.
 
-The ensemble Kalman filter advances M copies of the twin every period. Looping over M
-:class:`arzsumo.pde.TwinStepper` objects costs M times the Python overhead of a step;
-here the conserved state carries a member axis, ``q`` of shape (4, M, n) (component,
-member, cell), and every operation of the twin's first-order scheme
-(:mod:`arzsumo.pde.scheme`: Strang splitting of the exact relaxation and a forward-Euler
-transport step with the HLL or Rusanov flux of :mod:`arzsumo.pde.flux`) runs once on the
-whole batch. The twin's flux functions are reused as they are (they are elementwise in
-the member axis).
-
-Boundaries are those of the SUMO bridge (:class:`arzsumo.bridge.twins.MeasuredInlet`,
-``TwinPair``): at x = 0 a ghost state (rho_h, v_h, rho_a, v_a) whose physical flux enters,
-per member; at x = L the metered outflow of :func:`arzsumo.pde.boundary.outlet_flux`
-(split between the classes by their arriving flows, floored by the demand in free
-flow), per member. All members share one time step, the CFL step of the fastest member,
-so member k equals a single twin driven to the same step times (tested to 1e-12).
-
-A member whose step leaves the physical domain is projected back onto it
-(:func:`project`) instead of stopping the batch.
+The ensemble Kalman filter advances M copies of the twin every period; rather than M
+:class:`arzsumo.pde.TwinStepper` objects (M times the Python overhead of a step), the
+conserved state carries a member axis, ``q`` of shape (4, M, n) (component, member, cell),
+and the twin's first-order scheme (:mod:`arzsumo.pde.scheme`, with the flux functions of
+:mod:`arzsumo.pde.flux` as they are) runs once on the whole batch. Boundaries, per member,
+are those of the SUMO bridge (:mod:`arzsumo.bridge.twins`): at x = 0 the physical flux of a
+primitive ghost state, at x = L the metered outflow of
+:func:`arzsumo.pde.boundary.outlet_flux`. All members share the CFL step of the fastest
+one, so member k equals a single twin driven to the same step times. A member whose step
+leaves the physical domain is projected back onto it (:func:`project`).
 """
 
 from __future__ import annotations
@@ -32,17 +24,9 @@ from arzsumo.pde.source import relax
 from arzsumo.pde.state import RHO_A, RHO_H, cell_centres, to_conserved, to_primitive
 
 
-def _sel(w: Waves, idx: slice) -> Waves:
-    """``w`` restricted to the cells ``idx`` (last axis) of every member."""
-    return Waves(w.q[..., idx], w.f[..., idx], w.v_h[..., idx], w.v_a[..., idx],
-                 w.lo[..., idx], w.hi[..., idx])
-
-
 def ghost_flux(p: ModelParameters, ghost: np.ndarray) -> np.ndarray:
-    """Physical flux (4, M) of primitive ghost states (4, M) at x = 0.
-
-    The same arithmetic as :meth:`arzsumo.pde.boundary.Inlet.boundary_flux`.
-    """
+    """Physical flux (4, M) of primitive ghost states (4, M) at x = 0: the arithmetic of
+    :meth:`arzsumo.pde.boundary.Inlet.boundary_flux`."""
     rho_h, v_h, rho_a, v_a = ghost
     ve_h, ve_a = speed_of_ao(p, area_occupancy(p, rho_h, rho_a))
     y_h, y_a = rho_h * (v_h - ve_h), rho_a * (v_a - ve_a)
@@ -50,11 +34,8 @@ def ghost_flux(p: ModelParameters, ghost: np.ndarray) -> np.ndarray:
 
 
 def outlet_fluxes(out: Waves, total: np.ndarray) -> np.ndarray:
-    """Outlet flux (4, M) of :func:`arzsumo.pde.boundary.outlet_flux`, per member.
-
-    ``out`` holds the last cell of each member (arrays (4, M) and (M,)); ``total`` the
-    metered outflow q* + U of each member, veh/s.
-    """
+    """Outlet flux (4, M) of :func:`arzsumo.pde.boundary.outlet_flux` per member, from the
+    last cell of each (``out``) and the metered outflow q* + U of each (``total``, veh/s)."""
     rho_h, y_h, rho_a, y_a = out.q
     q_h, q_a = rho_h * out.v_h, rho_a * out.v_a
     arriving = q_h + q_a
@@ -75,12 +56,8 @@ def project(p: ModelParameters, z: np.ndarray, rho_min: float = 1e-4,
     become the bounds' nearest (0 speed, ``rho_min``).
     """
     z = np.nan_to_num(np.array(z, float), nan=0.0, posinf=0.0, neginf=0.0)
-    z[0] = np.maximum(z[0], rho_min)
-    z[2] = np.maximum(z[2], rho_min)
-    ao = area_occupancy(p, z[0], z[2])
-    scale = np.minimum(1.0, ao_fraction * p.ao_max / ao)
-    z[0] *= scale
-    z[2] *= scale
+    z[[0, 2]] = np.maximum(z[[0, 2]], rho_min)
+    z[[0, 2]] *= np.minimum(1.0, ao_fraction * p.ao_max / area_occupancy(p, z[0], z[2]))
     z[1] = np.clip(z[1], 0.0, p.v_free_h)
     z[3] = np.clip(z[3], 0.0, p.v_free_a)
     return z
@@ -95,17 +72,8 @@ def outside(p: ModelParameters, q: np.ndarray) -> np.ndarray:
 
 
 class BatchStepper:
-    """First-order twin scheme for a batch of members, q of shape (4, M, n).
-
-    Parameters
-    ----------
-    params : ModelParameters
-    cells : int
-        Cells on [0, L].
-    flux : {"hll", "rusanov"}
-    cfl : float
-        Target Courant number, in (0, 1].
-    """
+    """First-order twin scheme for a batch of members, q of shape (4, M, n), on ``cells``
+    cells of [0, L] with target Courant number ``cfl`` in (0, 1]."""
 
     def __init__(self, params: ModelParameters, cells: int, flux: str = "hll",
                  cfl: float = 0.9) -> None:
@@ -120,7 +88,7 @@ class BatchStepper:
             ) -> tuple[np.ndarray, np.ndarray]:
         """dq/dt (4, M, n) and the largest wave speed of each member (M,), m/s."""
         cells = waves(self.p, q)
-        flux, smax = self.riemann(_sel(cells, slice(None, -1)), _sel(cells, slice(1, None)))
+        flux, smax = self.riemann(cells.sel(slice(None, -1)), cells.sel(slice(1, None)))
         s = np.maximum(np.maximum(smax.max(axis=-1), -cells.lo[:, 0]), cells.hi[:, -1])
         full = np.empty((*q.shape[:2], q.shape[2] + 1))
         full[..., 0] = ghost_flux(self.p, ghost)
@@ -130,11 +98,8 @@ class BatchStepper:
 
     def step(self, q: np.ndarray, dt: float, ghost: np.ndarray, outflow: np.ndarray
              ) -> tuple[np.ndarray, np.ndarray]:
-        """One Strang-split step of ``dt`` s: relaxation dt/2, transport, relaxation dt/2.
-
-        ``ghost`` (4, M) primitive inlet states, ``outflow`` (M,) veh/s. Returns the new q
-        and the largest wave speed of each member (M,).
-        """
+        """One Strang-split step of ``dt`` s with primitive inlet states ``ghost`` (4, M) and
+        ``outflow`` (M,) veh/s: the new q and the largest wave speed of each member (M,)."""
         q = relax(self.p, q, 0.5 * dt)
         dq, s = self.rhs(q, ghost, outflow)
         return relax(self.p, q + dt * dq, 0.5 * dt), s

@@ -1,31 +1,25 @@
 """Ensemble Kalman filter on the PDE twin (stochastic EnKF with perturbed observations).
 
-Every control period the ensemble of M first-order twins (:class:`BatchStepper`, one
-vectorised step for all members) is advanced with the period's boundary data, each
-member with its own draw of the boundary noise, given additive model-error noise, then
-updated with the period's loop and probe data (Evensen 1994; Burgers, van Leeuwen &
-Evensen 1998; Houtekamer & Mitchell 2001)::
+Every control period the M first-order twins (:class:`BatchStepper`) are advanced with the
+period's boundary data, each member with its own draw of the boundary noise, given additive
+model-error noise, then updated with the period's loop and probe data (Evensen 1994;
+Burgers, van Leeuwen & Evensen 1998; Houtekamer & Mitchell 2001)::
 
     X^f <- X^f + eta_k,  eta_k ~ N(0, diag(s)^2 C)         model error, per forecast
     X^f <- mean + lambda (X^f - mean)                     multiplicative inflation
     K   = (rho_xo o P H^T) (rho_oo o H P H^T + R)^-1      localised gain
     X^a = X^f + K (y + eps_k - h(X^f_k)),  eps_k ~ N(0, R)
 
-The analysed state is the primitive fields (rho_h, v_h, rho_a, v_a) on the cells,
-stacked; P H^T and H P H^T are ensemble covariances; h interpolates a member's fields (or
-its class flows rho_i v_i) linearly at the sensor positions; s the per-variable model-error
-sd of one forecast (:attr:`EnkfOptions.model_sd`, SI) and C a Gaussian correlation in
-space over :attr:`EnkfOptions.model_length` (the twin's own error: without it the
-ensemble, driven by one model, is far more confident than it is right when the data come
-from SUMO rather than from the twin); rho is the Gaspari & Cohn
-(1999) taper of the distance between state cells and sensors, half-width
-:attr:`EnkfOptions.localisation`; R is diagonal from the records' noise models. After
-each analysis the members are projected onto the physical domain
-(:func:`arzsumo.estimate.batch.project`: densities > 0, AO below AO_max, speeds in
-[0, V_i]).
-
-Observations used: loop densities, time-mean speeds and flows per class (the speed taken
-as the field's speed at the station), probe speeds of their class.
+The analysed state is the stacked primitive fields (rho_h, v_h, rho_a, v_a) on the cells;
+P H^T and H P H^T are ensemble covariances; h interpolates a member's fields (or its class
+flows rho_i v_i) linearly at the sensors; s is the per-variable model-error sd
+(:attr:`EnkfOptions.model_sd`) and C a Gaussian correlation over
+:attr:`EnkfOptions.model_length` (how they were chosen:
+research/readings/enkf_model_noise.md); rho is the Gaspari & Cohn (1999) taper of the
+distance, half-width :attr:`EnkfOptions.localisation`; R is diagonal from the records'
+noise models. After each analysis the members are projected onto the physical domain
+(:func:`arzsumo.estimate.batch.project`). Observations: loop densities, speeds (taken as
+the field's speed at the station) and flows per class, probe speeds of their class.
 """
 
 from __future__ import annotations

@@ -1,21 +1,9 @@
 """Sensor observations handed to the estimators: loop stations and probe vehicles (SI).
 
-Two kinds of record, each frozen, validated on construction, with its own noise model
-(standard deviations of the measurement errors, assumed Gaussian, unbiased and
-independent between quantities, stations, vehicles and periods):
-
-* :class:`LoopObservation`: induction-loop stations at fixed positions x_j reporting, once
-  per period and per class i in (h, a), the count-based flow q_i (veh/s), a speed v_i
-  (m/s; NaN where no vehicle of the class passed: the time-mean or the harmonic mean of
-  the spot speeds, per ``[sensing] loop_speed``) and the density rho_i (veh/m, from the
-  occupancy: :func:`density_from_occupancy`).
-* :class:`ProbeObservation`: positions (m) and speeds (m/s) of individual vehicles of one
-  class at one instant (e.g. the AVs as mobile sensors), with the share of that class's
-  vehicles that report.
-
-Class index order everywhere: 0 = HV (h), 1 = AV (a). Estimators flatten the records into
-scalar data (:func:`arzsumo.estimate.smoothing.data_points`,
-:mod:`arzsumo.estimate.enkf`); nothing here reads SUMO.
+Two kinds of record, :class:`LoopObservation` and :class:`ProbeObservation`, each frozen,
+validated on construction, with its own noise model: standard deviations of measurement
+errors assumed Gaussian, unbiased and independent between quantities, stations, vehicles
+and periods. Class index order everywhere: 0 = HV (h), 1 = AV (a). Nothing here reads SUMO.
 """
 
 from __future__ import annotations
@@ -45,17 +33,9 @@ def _sd(name: str, value: float) -> None:
 
 @dataclass(frozen=True)
 class LoopNoise:
-    """Measurement-error standard deviations of a loop station, per period and class.
-
-    Parameters
-    ----------
-    flow : float
-        Count-based flow, veh/s.
-    speed : float
-        Loop speed (time-mean or harmonic), m/s.
-    density : float
-        Density (from occupancy), veh/m.
-    """
+    """Measurement-error standard deviations of a loop station, per period and class, of
+    the count-based flow (veh/s), the loop speed (time-mean or harmonic, m/s) and the density
+    (from occupancy, veh/m)."""
 
     flow: float = 0.1
     speed: float = 1.5
@@ -89,8 +69,10 @@ class LoopObservation:
     x : array (n_j,)
         Station positions, m, increasing.
     flow, speed, density : array (2, n_j)
-        Per class (h, a): flow veh/s, speed m/s (NaN: no vehicle of the class passed),
-        density veh/m. ``speed`` is what the estimators use.
+        Per class (h, a): count-based flow veh/s, speed m/s (NaN: no vehicle of the class
+        passed; the time-mean or the harmonic mean of the spot speeds, per ``[sensing]
+        loop_speed``), density veh/m (from the occupancy, :func:`density_from_occupancy`).
+        ``speed`` is what the estimators use.
     noise : LoopNoise
     time_mean, harmonic : array (2, n_j), optional
         Both means of the same spot speeds, m/s, when the reader has them (SUMO's loops,
@@ -176,15 +158,9 @@ class ProbeObservation:
 
 
 def density_from_occupancy(occupancy: ArrayLike, effective_length: float) -> np.ndarray:
-    """Density rho = occupancy / (vehicle length + loop length), veh/m.
-
-    Parameters
-    ----------
-    occupancy : array
-        Time fraction the loop was occupied, in [0, 1].
-    effective_length : float
-        Mean vehicle length plus the detection zone length, m.
-    """
+    """Density rho = occupancy / (vehicle length + loop length), veh/m, from the time
+    fraction ``occupancy`` in [0, 1] the loop was occupied and ``effective_length`` (m),
+    the mean vehicle length plus the detection zone length."""
     _sd("effective_length", effective_length)
     return np.asarray(occupancy, float) / effective_length
 

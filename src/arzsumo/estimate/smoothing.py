@@ -39,32 +39,16 @@ from arzsumo.errors import require
 from arzsumo.estimate.observations import LoopObservation, ProbeObservation
 from arzsumo.units import kmh_to_ms
 
-#: Estimated quantities, in the twin's primitive order.
-QUANTITIES = ("rho_h", "v_h", "rho_a", "v_a")
-
 #: Kernel products per chunk of the vectorised sums (memory bound).
 _CHUNK = 2_000_000
 
 
 @dataclass(frozen=True)
 class AsmParameters:
-    """Parameters of the adaptive smoothing method (SI).
-
-    Parameters
-    ----------
-    c_free : float
-        Propagation speed of perturbations in free flow, m/s (> 0; default 80 km/h).
-    c_cong : float
-        Propagation speed in congestion, m/s (< 0; default -15 km/h).
-    sigma : float
-        Smoothing width in space, m.
-    tau : float
-        Smoothing width in time, s.
-    v_crit : float
-        Crossover speed between the two kernels, m/s (default 60 km/h).
-    dv : float
-        Width of the crossover, m/s (default 20 km/h).
-    """
+    """Parameters of the adaptive smoothing method (SI): the propagation speeds of
+    perturbations in free flow ``c_free`` > 0 and in congestion ``c_cong`` < 0 (m/s), the
+    smoothing widths in space ``sigma`` (m) and in time ``tau`` (s), the crossover speed
+    ``v_crit`` between the two kernels and its width ``dv`` (m/s)."""
 
     c_free: float = float(kmh_to_ms(80.0))
     c_cong: float = float(kmh_to_ms(-15.0))
@@ -89,9 +73,9 @@ class AsmParameters:
 @dataclass(frozen=True)
 class DataPoints:
     """Data at N space-time points: positions x (m) and times t (s), (N,); values and
-    weights 1/sd^2 of the quantities of :data:`QUANTITIES`, (N, 4), weight 0 (value 0)
-    where a point has no datum of that quantity. A loop station's period is one point
-    with all four quantities, so the kernels are evaluated once for them."""
+    weights 1/sd^2 of (rho_h, v_h, rho_a, v_a), (N, 4), weight 0 (value 0) where a point
+    has no datum of that quantity. A loop station's period is one point with all four
+    quantities, so the kernels are evaluated once for them."""
 
     x: np.ndarray
     t: np.ndarray
@@ -222,13 +206,8 @@ def smooth(points: DataPoints, x: np.ndarray, t: np.ndarray,
 class CausalSmoother:
     """Real-time ASM on a fixed grid: add each period's data, estimate the present.
 
-    Keeps the data of the last :attr:`AsmParameters.window` seconds.
-
-    Parameters
-    ----------
-    x : array (n,)
-        Output positions (the controller's cell centres), m.
-    params : AsmParameters, optional
+    ``x`` (m) are the output positions (the controller's cell centres); the data of the
+    last :attr:`AsmParameters.window` seconds are kept.
     """
 
     def __init__(self, x: np.ndarray, params: AsmParameters | None = None) -> None:

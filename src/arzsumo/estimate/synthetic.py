@@ -22,11 +22,6 @@ from arzsumo.estimate.observations import (
 RHO_FLOOR = 1e-4
 
 
-def _at(x_grid: np.ndarray, fields: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """Fields (4, n) on ``x_grid`` linearly interpolated at ``x`` (held beyond the ends)."""
-    return np.vstack([np.interp(x, x_grid, row) for row in fields])
-
-
 def sample_loops(x_grid: np.ndarray, fields: np.ndarray, x_loops: np.ndarray, t: float,
                  period: float, noise: LoopNoise, rng: np.random.Generator | None
                  ) -> LoopObservation:
@@ -36,7 +31,8 @@ def sample_loops(x_grid: np.ndarray, fields: np.ndarray, x_loops: np.ndarray, t:
     are exact; otherwise each quantity gets N(0, sd^2) noise and densities and flows are
     floored at 0 (speeds at 0).
     """
-    z = _at(np.asarray(x_grid, float), np.asarray(fields, float), np.asarray(x_loops, float))
+    x_grid, x_loops = np.asarray(x_grid, float), np.asarray(x_loops, float)
+    z = np.vstack([np.interp(x_loops, x_grid, row) for row in np.asarray(fields, float)])
     rho, v = z[[0, 2]], z[[1, 3]]
     flow = rho * v
     if rng is not None:

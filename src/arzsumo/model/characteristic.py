@@ -1,44 +1,12 @@
 """Linearisation and characteristic (Riemann) form of the 4x4 model (paper, section 2).
 
-The derivation, with every sign and normalisation, is in ``docs/characteristic_form.md``;
-this docstring is its summary.
-
-Linearisation. With z = (rho_h~, v_h~, rho_a~, v_a~) the deviations from an equilibrium,
-the model linearises to z_t + A z_x = B z, where S_ij = dVe_i/drho_j (see
-:func:`arzsumo.model.fd.speed_jacobian`) and::
-
-    A = [[v_h,            rho_h,              0,              0          ],
-         [0,              v_h + rho_h S_hh,   S_ha (v_a-v_h), rho_a S_ha ],
-         [0,              0,                  v_a,            rho_a      ],
-         [S_ah (v_h-v_a), rho_h S_ah,         0,              v_a + rho_a S_aa]]
-
-    B = rows (0, [S_hh, -1, S_ha, 0] / tau_h, 0, [S_ah, 0, S_aa, -1] / tau_a).
-
-Eigenvalues, in the paper's order. The Lagrangian markers v_i - Ve_i(AO) are transported
-at the class speeds, so v_h* and v_a* are exact characteristic speeds. The other two are
-the eigenvalues of the 2x2 density Jacobian J_ij = delta_ij v_j + rho_i S_ij, a rank-one
-perturbation of diag(v) whose eigenvalues interlace with v_h, v_a. We therefore number
-
-    lambda_1 = v_h*,  lambda_2 = larger eigenvalue of J,  lambda_3 = v_a*,
-    lambda_4 = smaller eigenvalue of J,
-
-which satisfies the ordering condition after clpsys1-clpsys4,
-lambda_4 <= min(lambda_1, lambda_3) <= lambda_2 <= max(lambda_1, lambda_3).
-lambda_1..lambda_3 > 0 always; lambda_4 < 0 is congestion.
-
-Normalisation. Row j of T is a left eigenvector of A for lambda_j, scaled so that its
-coefficients on v_h~ and v_a~ sum to one: every Riemann variable w_j = (T z)_j is a speed
-in m/s (w_1 and w_3 are the linearised Lagrangian markers of HVs and AVs).
-
-Scaled Riemann variables. The diagonal of J_hat = T B T^-1 is removed by
-w-bar_i(x) = exp(-J_hat_ii x / lambda_i) w_i(x), giving clpsys1-clpsys4 with
-
-    Sigma_ij(x) = J_hat_ij exp((J_hat_jj / lambda_j - J_hat_ii / lambda_i) x),  i != j,
-
-Sigma_ii = 0, kappa_j = v_h nu_1j + rho_h nu_2j + v_a nu_3j + rho_a nu_4j (nu = T^-1),
-Q from the inlet conditions rho_h~(0) = rho_a~(0) = 0, kappa . w(0) = 0, and
-R_j = -(kappa_j / kappa_4) exp((J_hat_jj / lambda_j - J_hat_44 / lambda_4) L),
-U-bar = exp(-J_hat_44 L / lambda_4) U / kappa_4.
+The derivation, with every sign and normalisation, is in ``docs/characteristic_form.md``:
+z_t + A z_x = B z for the deviations z = (rho_h~, v_h~, rho_a~, v_a~) (section 1); the
+eigenvalues in the paper's order lambda_1 = v_h*, lambda_2 = larger eigenvalue of the
+density Jacobian J, lambda_3 = v_a*, lambda_4 = smaller one, lambda_4 < 0 in congestion
+(section 2); rows of T normalised so that every Riemann variable w = T z is a speed in m/s
+(section 3); the scaled variables w-bar and Sigma(x) of clpsys1-clpsys4 (section 4); Q, R,
+kappa and U-bar (section 5).
 """
 
 from __future__ import annotations
@@ -150,7 +118,7 @@ class Linearization:
     eigenvalues : array (4,)
         lambda_1..lambda_4 in the paper's order (module docstring), m/s.
     T : array (4, 4)
-        w = T z, rows normalised as stated in the module docstring.
+        w = T z, rows normalised as in docs/characteristic_form.md, section 3.
     """
 
     equilibrium: Equilibrium
@@ -172,7 +140,8 @@ class Linearization:
     @cached_property
     def kappa(self) -> np.ndarray:
         """kappa_j = v_h nu_1j + rho_h nu_2j + v_a nu_3j + rho_a nu_4j (flow per unit w_j)."""
-        return _flow_gradient(self.equilibrium) @ self.T_inv
+        eq = self.equilibrium          # (v_h, rho_h, v_a, rho_a) . z: linearised flow deviation
+        return np.array([eq.v_h, eq.rho_h, eq.v_a, eq.rho_a]) @ self.T_inv
 
     @property
     def regime(self) -> str:
@@ -232,22 +201,14 @@ class Linearization:
         """U-bar from the physical flow deviation U (veh/s)."""
         return np.asarray(u, float) * self.u_bar_per_u
 
-    def u_from_u_bar(self, u_bar: ArrayLike) -> np.ndarray | float:
-        """Physical U (veh/s) from U-bar."""
-        return np.asarray(u_bar, float) / self.u_bar_per_u
-
     def _scaling(self, x: ArrayLike) -> np.ndarray:
         x = np.atleast_1d(np.asarray(x, float))
         return np.exp(-np.outer(x, np.diag(self.j_hat) / self.eigenvalues))
 
 
-def _flow_gradient(eq: Equilibrium) -> np.ndarray:
-    """g with g . z = linearised total flow deviation: (v_h, rho_h, v_a, rho_a)."""
-    return np.array([eq.v_h, eq.rho_h, eq.v_a, eq.rho_a])
-
-
 def quasi_linear_matrix(eq: Equilibrium) -> np.ndarray:
-    """A of z_t + A z_x = B z at the equilibrium (module docstring), m/s and mixed units."""
+    """A of z_t + A z_x = B z at the equilibrium, m/s and mixed units (docs/characteristic_form.md,
+    section 1)."""
     s = speed_jacobian(eq.params, eq.rho_h, eq.rho_a)
     rh, ra, vh, va = eq.rho_h, eq.rho_a, eq.v_h, eq.v_a
     return np.array([
@@ -283,7 +244,7 @@ def characteristic_speeds(p: ModelParameters, rho_h: ArrayLike, rho_a: ArrayLike
 
 
 def _riemann_matrix(eq: Equilibrium, lam: np.ndarray) -> np.ndarray:
-    """T with rows the normalised left eigenvectors of A (module docstring)."""
+    """T with rows the normalised left eigenvectors of A (docs/characteristic_form.md, 3)."""
     s = speed_jacobian(eq.params, eq.rho_h, eq.rho_a)
     area = np.array([eq.params.area_h, eq.params.area_a])
     rho = np.array([eq.rho_h, eq.rho_a])

@@ -10,13 +10,12 @@ import math
 from dataclasses import dataclass
 from typing import Literal
 
-import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
 from arzsumo.errors import DemandError, ModelError, require
 from arzsumo.model.fd import area_occupancy, equilibrium_speeds, speed_of_ao
 from arzsumo.model.params import ModelParameters
-from arzsumo.units import ms_to_kmh, veh_m_to_veh_km, veh_s_to_veh_h
+from arzsumo.units import ms_to_kmh, veh_s_to_veh_h
 
 Branch = Literal["congested", "free"]
 
@@ -80,20 +79,10 @@ class Equilibrium:
         """AV penetration rate rho_a* / (rho_h* + rho_a*), dimensionless."""
         return self.rho_a / (self.rho_h + self.rho_a)
 
-    def as_dict(self, human: bool = False) -> dict[str, float]:
-        """The equilibrium as a flat dict, SI or (``human``) km/h, veh/km, veh/h."""
-        if not human:
-            return {"rho_h": self.rho_h, "rho_a": self.rho_a, "v_h": self.v_h, "v_a": self.v_a,
-                    "q_h": self.q_h, "q_a": self.q_a, "ao": self.ao,
-                    "penetration": self.penetration}
-        return {
-            "rho_h_veh_km": float(veh_m_to_veh_km(self.rho_h)),
-            "rho_a_veh_km": float(veh_m_to_veh_km(self.rho_a)),
-            "v_h_kmh": float(ms_to_kmh(self.v_h)), "v_a_kmh": float(ms_to_kmh(self.v_a)),
-            "q_h_veh_h": float(veh_s_to_veh_h(self.q_h)),
-            "q_a_veh_h": float(veh_s_to_veh_h(self.q_a)),
-            "ao": self.ao, "penetration": self.penetration,
-        }
+    def as_dict(self) -> dict[str, float]:
+        """The equilibrium as a flat dict, SI."""
+        return {"rho_h": self.rho_h, "rho_a": self.rho_a, "v_h": self.v_h, "v_a": self.v_a,
+                "q_h": self.q_h, "q_a": self.q_a, "ao": self.ao, "penetration": self.penetration}
 
 
 def equilibrium_from_densities(params: ModelParameters, rho_h: float, rho_a: float, *,
@@ -107,9 +96,7 @@ def equilibrium_from_densities(params: ModelParameters, rho_h: float, rho_a: flo
     """
     eq = Equilibrium(params, float(rho_h), float(rho_a))
     for name, stated, computed in (("v_h", v_h, eq.v_h), ("v_a", v_a, eq.v_a)):
-        if stated is None:
-            continue
-        if abs(stated - computed) > tolerance * abs(computed):
+        if stated is not None and abs(stated - computed) > tolerance * abs(computed):
             reason = (f"{ms_to_kmh(stated):.2f} km/h disagrees with the fundamental diagram "
                       f"Ve = {ms_to_kmh(computed):.2f} km/h at these densities by more than "
                       f"{tolerance:.0%}; omit the speed or change the densities or parameters")
@@ -152,21 +139,15 @@ def equilibrium_from_demand(params: ModelParameters, q_h: float, q_a: float,
     require(branch in ("congested", "free"), "branch", branch, "'congested' or 'free'")
     ao_cap, f_cap = demand_capacity_ao(params, q_h, q_a)
     if f_cap < 0.0:
-        ratio = q_h / (q_h + q_a)
-        carried = _max_total_flow(params, ratio)
+        carried = _max_total_flow(params, q_h / (q_h + q_a))
         raise DemandError(
             f"demand = {veh_s_to_veh_h(q_h + q_a):.0f} veh/h (HV {veh_s_to_veh_h(q_h):.0f}, "
             f"AV {veh_s_to_veh_h(q_a):.0f}) exceeds what the fundamental diagram can carry "
             f"at this mix; allowed: at most {veh_s_to_veh_h(carried):.0f} veh/h"
         )
-    if branch == "congested":
-        lo, hi = ao_cap, params.ao_max * (1.0 - 1e-12)
-    else:
-        lo, hi = 1e-12, ao_cap
-    if f_cap == 0.0:
-        ao = ao_cap
-    else:
-        ao = brentq(lambda a: _ao_residual(params, q_h, q_a, a), lo, hi, xtol=1e-14, rtol=1e-14)
+    lo, hi = (ao_cap, params.ao_max * (1.0 - 1e-12)) if branch == "congested" else (1e-12, ao_cap)
+    ao = ao_cap if f_cap == 0.0 else brentq(
+        lambda a: _ao_residual(params, q_h, q_a, a), lo, hi, xtol=1e-14, rtol=1e-14)
     ve_h, ve_a = speed_of_ao(params, ao)
     return Equilibrium(params, q_h / float(ve_h), q_a / float(ve_a))
 
@@ -236,9 +217,3 @@ def equilibrium_at_penetration(params: ModelParameters, q: float, penetration: f
     rho = rho_cap if q == q_cap else brentq(
         lambda r: _mix_flow(params, r, penetration) - q, lo, hi, xtol=1e-15, rtol=1e-14)
     return Equilibrium(params, (1.0 - penetration) * rho, penetration * rho)
-
-
-def flows(params: ModelParameters, rho_h: np.ndarray, rho_a: np.ndarray) -> tuple[np.ndarray, ...]:
-    """Equilibrium class flows (veh/s) at the given densities (veh/m)."""
-    ve_h, ve_a = equilibrium_speeds(params, rho_h, rho_a)
-    return np.asarray(rho_h) * ve_h, np.asarray(rho_a) * ve_a

@@ -1,9 +1,8 @@
 """Area-occupancy fundamental diagrams (paper, section 2, labels AOrelation and eq. (3)).
 
-Pure vectorised functions of a :class:`ModelParameters` and density arrays (veh/m).
-Each family defines its speed Ve_i(AO) and its slope dVe_i/dAO once (:data:`_FAMILY`), so
-every consumer (equilibria, characteristic speeds, kernels, the twin's flux, the observer,
-the identification) reads them from the same definition:
+Pure vectorised functions of a :class:`ModelParameters` and density arrays (veh/m). Each
+family defines its speed Ve_i(AO) and slope dVe_i/dAO once (:data:`_FAMILY`), for every
+consumer:
 
 ``power`` (the paper's eq. (3))
     Ve_i(AO) = V_i (1 - (AO / AO_max,i)^gamma_i).
@@ -123,12 +122,6 @@ def speed_terms_of_ao(p: ModelParameters, ao: ArrayLike) -> SpeedTerms:
     return ve_h, ve_a, d_h, d_a
 
 
-def dspeed_dao(p: ModelParameters, ao: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
-    """(dVe_h/dAO, dVe_a/dAO) in m/s per unit AO; both negative for 0 < AO < AO_max,i."""
-    _, _, d_h, d_a = speed_terms_of_ao(p, ao)
-    return d_h, d_a
-
-
 def equilibrium_speeds(p: ModelParameters, rho_h: ArrayLike,
                        rho_a: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """(Ve_h, Ve_a) in m/s at the given class densities (veh/m)."""
@@ -141,8 +134,7 @@ def speed_jacobian(p: ModelParameters, rho_h: ArrayLike, rho_a: ArrayLike) -> np
     ``out[..., i, j] = dVe_i / drho_j`` with i, j in (h, a). Because Ve_i depends on the
     densities only through AO, ``dVe_i/drho_j = Ve_i'(AO) a_j / W``: the matrix has rank one.
     """
-    ao = area_occupancy(p, rho_h, rho_a)
-    d_h, d_a = dspeed_dao(p, ao)
+    _, _, d_h, d_a = speed_terms_of_ao(p, area_occupancy(p, rho_h, rho_a))
     slope = np.stack([d_h, d_a], axis=-1)[..., :, None]            # Ve_i'(AO)
     area = np.array([p.area_h, p.area_a])[None, :] / p.road_width  # a_j / W
     return slope * area

@@ -1,14 +1,9 @@
 """Physical parameters of the mixed-autonomy ARZ model (paper, section 2) and named presets.
 
 All fields are SI: metres, seconds, m/s. The presets come from the paper's
-"Simulation settings" subsection (section 5).
-
-A note on the vehicle width ``d``: the paper never states it. With d = 2.0 m the base
-equilibrium (110 HV/km, 95 AV/km, s_h = 8 m, s_a = 15 m) gives Ve_h = 35.9 km/h and
-Ve_a = 18.2 km/h, not the stated 32 and 15 km/h; those need d close to 2.07 m
-(AO = 0.734). The s_a = 12 m case, on the other hand, gives the stated 48 and 28 km/h
-with d = 2.0 m. We keep d = 2.0 m as the default and let scenarios override it; speeds
-are always computed from the fundamental diagram, never set independently.
+"Simulation settings" subsection (section 5). The paper never states the vehicle width d:
+the default 2.0 m and what it gives against the paper's speeds are in
+docs/characteristic_form.md, section 6. Speeds always follow from the fundamental diagram.
 """
 
 from __future__ import annotations
@@ -144,28 +139,23 @@ class Preset:
 
 
 _BASE = ModelParameters()
+#: the paper's equilibrium densities, 110 HV/km and 95 AV/km, in veh/m
+_RHO_H, _RHO_A = float(veh_km_to_veh_m(110)), float(veh_km_to_veh_m(95))
 
-PRESETS: dict[str, Preset] = {
-    "paper_base": Preset(
-        "paper_base", _BASE, float(veh_km_to_veh_m(110)), float(veh_km_to_veh_m(95)),
-        "Section 5 base case: s_h = 8 m, s_a = 15 m, 110 HV/km and 95 AV/km",
-    ),
-    "paper_s12": Preset(
-        "paper_s12", _BASE.with_(spacing_a=12.0), float(veh_km_to_veh_m(110)),
-        float(veh_km_to_veh_m(95)),
-        "Different spacing policy: s_a = 12 m (paper's stated speeds 48 and 28 km/h)",
-    ),
+PRESETS: dict[str, Preset] = {preset.name: preset for preset in (
+    Preset("paper_base", _BASE, _RHO_H, _RHO_A,
+           "Section 5 base case: s_h = 8 m, s_a = 15 m, 110 HV/km and 95 AV/km"),
+    Preset("paper_s12", _BASE.with_(spacing_a=12.0), _RHO_H, _RHO_A,
+           "Different spacing policy: s_a = 12 m (paper's stated speeds 48 and 28 km/h)"),
     # The paper says the aggressive case "adjusts accordingly" the free-flow speeds and
     # maximum AOs without giving them; we swap the class behaviours along with the
     # spacings (HV: 60 km/h, AO_max 0.85; AV: 80 km/h, AO_max 0.9).
-    "paper_aggressive": Preset(
-        "paper_aggressive",
-        _BASE.with_(spacing_h=15.0, spacing_a=8.0, v_free_h=float(kmh_to_ms(60)),
-                    v_free_a=float(kmh_to_ms(80)), ao_max_h=0.85, ao_max_a=0.9),
-        float(veh_km_to_veh_m(110)), float(veh_km_to_veh_m(95)),
-        "Aggressive AV spacing: s_h = 15 m, s_a = 8 m, class behaviours swapped",
-    ),
-}
+    Preset("paper_aggressive",
+           _BASE.with_(spacing_h=15.0, spacing_a=8.0, v_free_h=float(kmh_to_ms(60)),
+                       v_free_a=float(kmh_to_ms(80)), ao_max_h=0.85, ao_max_a=0.9),
+           _RHO_H, _RHO_A,
+           "Aggressive AV spacing: s_h = 15 m, s_a = 8 m, class behaviours swapped"),
+)}
 
 
 def get_preset(name: str) -> Preset:

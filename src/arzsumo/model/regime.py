@@ -23,11 +23,6 @@ class RegimeMap:
     rho_a: np.ndarray
     lambda_4: np.ndarray
 
-    @property
-    def congested(self) -> np.ndarray:
-        """Boolean mask of congested equilibria (lambda_4 < 0)."""
-        return np.nan_to_num(self.lambda_4, nan=np.inf) < 0
-
 
 def regime_map(params: ModelParameters, n: int = 200) -> RegimeMap:
     """lambda_4 on an n x n grid covering every feasible (rho_h*, rho_a*)."""

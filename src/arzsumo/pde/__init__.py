@@ -1,13 +1,7 @@
 """The nonlinear PDE twin: a finite-volume solver of the 4x4 mixed-autonomy ARZ model.
 
-Numerics only, in :mod:`state`, :mod:`flux`, :mod:`source`, :mod:`boundary`,
-:mod:`initial`, :mod:`scheme`, :mod:`solver`, :mod:`metrics` and :mod:`supply` (a
-cell's receiving capacity, for a bounded inlet flux): they may import only
-``control``, ``model``, ``units`` and ``errors`` (the "math" contract in
-``pyproject.toml``). Scenarios become twin runs elsewhere: the ``[twin]`` and
-``[initial]`` sections in :mod:`arzsumo.scenario.twin`, the controllers in
-:mod:`arzsumo.control.registry`, a run in :mod:`arzsumo.engines.twin`; runs are written by
-:mod:`arzsumo.outputs.twin`; paper reproduction lives in :mod:`arzsumo.workflows.paper`.
+Numerics only (its modules: docs/twin.md, "Pieces"); they may import only ``control``,
+``model``, ``units`` and ``errors`` (the "math" contract in ``pyproject.toml``).
 """
 
 from arzsumo.pde.boundary import Inlet, outlet_flux

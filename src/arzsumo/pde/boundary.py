@@ -1,35 +1,16 @@
-"""Boundary conditions of section 2 for the finite-volume twin.
+"""Boundary conditions of section 2 for the finite-volume twin (docs/twin.md, "Boundary
+conditions"); z = (rho_h, v_h, rho_a, v_a).
 
-Inlet (x = 0), three conditions for the three incoming families (lambda_1..3 > 0)::
+Inlet (x = 0): rho_i(0, t) = rho_i^in(t) and rho_h v_h + rho_a v_a = q^in(t) (defaults
+rho_i*, q_h* + q_a*). The fourth relation keeps the lambda_4 Riemann variable of the first
+cell, l_4 . z_b = l_4 . z_0 (l_4 = row 4 of T), a 2x2 linear system for (v_h, v_a) at the
+boundary; the inlet flux is the physical flux of z_b, so exactly q^in(t) enters.
 
-    rho_h(0, t) = rho_h^in(t),  rho_a(0, t) = rho_a^in(t),
-    rho_h v_h + rho_a v_a = q^in(t)                       (defaults: rho_i*, q_h* + q_a*)
-
-The fourth relation comes from the outgoing family lambda_4 < 0: the boundary state z_b
-keeps the lambda_4 Riemann variable of the first cell, l_4 . z_b = l_4 . z_0, with l_4
-the left eigenvector of the linearisation at the reference equilibrium (row 4 of T,
-docs/characteristic_form.md; z = (rho_h, v_h, rho_a, v_a)). This is a 2x2 linear system
-for (v_h, v_a) at the boundary; the inlet flux is the physical flux of z_b, so the total
-density flux through x = 0 is exactly q^in(t). At an equilibrium it returns the
-equilibrium state.
-
-Outlet (x = L), one condition for the one incoming family::
-
-    rho_h v_h + rho_a v_a = q* + U(t)
-
-Splitting rule (documented choice): the metered flow q* + U is shared between the classes
-in proportion to the class flows arriving in the last cell, F_rho_i = (q* + U) q_i / (q_h
-+ q_a), and each vehicle leaves with its own Lagrangian marker: F_y_i = w_i F_rho_i with
-w_i = v_i - Ve_i = y_i / rho_i of the last cell. At an equilibrium with U = 0 this is the
-equilibrium flux, and the class mix of the outflow equals that of the arriving traffic.
-
-A ramp meter limits the flow; it cannot pull vehicles that are not there. Where the last
-cell is congested (its smallest characteristic speed lambda_min < 0, so one family enters
-through x = L) the condition above is imposed as stated, with q* + U floored at 0. Where it
-is in free flow (lambda_min >= 0) every family leaves the domain and no condition can be
-imposed: the outflow is then the smaller of the meter rate and the arriving flow q_h + q_a
-(supply and demand, as in a cell transmission model). :func:`outlet_flux` reports when
-the arriving flow, not q* + U, set the outflow.
+Outlet (x = L): rho_h v_h + rho_a v_a = q* + U(t), split in proportion to the class flows
+arriving in the last cell, F_rho_i = (q* + U) q_i / (q_h + q_a), each vehicle leaving with
+its own marker, F_y_i = (y_i / rho_i) F_rho_i. Where the last cell is congested (lambda_min
+< 0) q* + U is imposed, floored at 0; in free flow no condition can be imposed and the
+outflow is min(q* + U, q_h + q_a): a meter cannot pull vehicles that are not there.
 """
 
 from __future__ import annotations
@@ -40,9 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from arzsumo.errors import ModelError, require
+from arzsumo.errors import ModelError
 from arzsumo.model.characteristic import Linearization
-from arzsumo.model.equilibrium import equilibrium_from_demand
 from arzsumo.model.fd import speed_of_ao
 from arzsumo.model.params import ModelParameters
 
@@ -86,34 +66,6 @@ class Inlet:
         eq = lin.equilibrium
         return cls(eq.rho_h, eq.rho_a, eq.q, lin.T[3])
 
-    @classmethod
-    def from_demands(cls, lin: Linearization, times: np.ndarray, demand_h: np.ndarray,
-                     demand_a: np.ndarray) -> Inlet:
-        """An inlet driven by class demand time series (veh/s at ``times`` s).
-
-        At each sample the inlet densities are those of the congested equilibrium that
-        carries the demands (:func:`equilibrium_from_demand`); densities and total flow
-        are interpolated linearly between samples and held beyond them.
-        """
-        times = np.asarray(times, float)
-        demand_h = np.asarray(demand_h, float)
-        demand_a = np.asarray(demand_a, float)
-        require(times.ndim == 1 and times.size >= 1 and times.shape == demand_h.shape
-                == demand_a.shape, "demand series", (times.shape, demand_h.shape,
-                                                     demand_a.shape),
-                "1-D arrays of equal length")
-        require(bool(np.all(np.diff(times) > 0)), "times", times.tolist()[:5],
-                "strictly increasing")
-        p = lin.equilibrium.params
-        eqs = [equilibrium_from_demand(p, float(qh), float(qa)) for qh, qa in
-               zip(demand_h, demand_a, strict=True)]
-        rho_h = np.array([e.rho_h for e in eqs])
-        rho_a = np.array([e.rho_a for e in eqs])
-        flow = demand_h + demand_a
-        return cls(lambda t: float(np.interp(t, times, rho_h)),
-                   lambda t: float(np.interp(t, times, rho_a)),
-                   lambda t: float(np.interp(t, times, flow)), lin.T[3])
-
     def boundary_primitive(self, t: float, z0: np.ndarray) -> np.ndarray:
         """Boundary state (rho_h, v_h, rho_a, v_a) at x = 0 given the first cell's ``z0``."""
         rho_h, rho_a, flow = _value(self.rho_h, t), _value(self.rho_a, t), _value(self.flow, t)
@@ -141,24 +93,12 @@ class Inlet:
 
 def outlet_flux(q_last: np.ndarray, v_h: float, v_a: float, total: float,
                 congested: bool = True) -> tuple[np.ndarray, bool]:
-    """Flux (4,) through x = L carrying ``total`` veh/s, split by the rule above.
+    """Flux (4,) through x = L carrying the metered outflow ``total`` = q* + U (veh/s),
+    split by the rule above, and whether the arriving demand (or 0), not ``total``, set it.
 
-    Parameters
-    ----------
-    q_last : ndarray, shape (4,)
-        Conserved state at the outlet face (last cell, or its reconstructed east value).
-    v_h, v_a : float
-        Speeds there, m/s.
-    total : float
-        Metered outflow q* + U, veh/s.
-    congested : bool
-        Whether the smallest characteristic speed at the outlet is negative.
-
-    Returns
-    -------
-    flux : ndarray, shape (4,)
-    limited : bool
-        True when the arriving demand (or 0) and not ``total`` set the outflow.
+    ``q_last`` is the conserved state at the outlet face (the last cell, or its
+    reconstructed east value), ``v_h``, ``v_a`` the speeds there (m/s), ``congested``
+    whether the smallest characteristic speed there is negative.
     """
     rho_h, y_h, rho_a, y_a = (float(c) for c in q_last)
     q_h, q_a = rho_h * v_h, rho_a * v_a

@@ -1,30 +1,15 @@
-"""Physical flux, wave-speed bounds, numerical fluxes and MUSCL reconstruction.
+"""Physical flux, wave-speed bounds, numerical fluxes and MUSCL reconstruction
+(docs/twin.md, "Numerical flux").
 
-Choice of the numerical flux
-----------------------------
-The paper's Algorithm 1 says "upwind". For this system a donor-cell flux taken from the
-left is not an upwind scheme: in congestion lambda_4 < 0, so one family of waves travels
-upstream and must be taken from the right. We use approximate Riemann solvers that upwind
-every family by the sign of its speed bounds:
-
-* ``hll`` (default): Harten-Lax-van Leer with S_L = min(lambda_min(q_L), lambda_min(q_R)),
-  S_R = max(lambda_max(q_L), lambda_max(q_R)). Where S_L >= 0 it *is* the donor-cell flux
-  from the left (free flow); where S_L < 0 < S_R it adds just enough dissipation to be
-  stable. Exact for an isolated shock of the extreme families; positivity-preserving
-  for densities under CFL <= 1.
-* ``rusanov``: local Lax-Friedrichs, with alpha = max |lambda|; more diffusive, kept as a
-  robust fallback and for comparison.
-
-Wave speeds come in closed form at the actual (non-equilibrium) state: in the variables
-(rho, v - Ve) the flux Jacobian is block upper triangular, with eigenvalues v_h, v_a (the
-Lagrangian markers) and those of the 2x2 density Jacobian J_ij = delta_ij v_i + rho_i
-dVe_i/drho_j evaluated with the actual speeds (docs/characteristic_form.md, section 2).
-
-Second order: ``muscl`` reconstructs the cell-wise linear profile of (rho_h, w_h, rho_a,
-w_a), w_i = v_i - Ve_i(AO), with a slope limiter (minmod, van Leer or MC), so densities at
-faces stay between neighbouring cell values and remain positive.
-
-All functions are vectorised over faces/cells; arrays are shaped (4, n).
+A donor-cell flux from the left is not upwind in congestion (lambda_4 < 0), so both
+fluxes upwind every family by the sign of its speed bounds: ``hll`` (default), with
+S_L = min(lambda_min(q_L), lambda_min(q_R)) and S_R = max(lambda_max(q_L), lambda_max(q_R)),
+is the donor cell from the left where S_L >= 0 and positivity-preserving for densities under
+CFL <= 1; ``rusanov`` (alpha = max |lambda|) is more diffusive. The wave speeds are v_h, v_a
+and the eigenvalues of J_ij = delta_ij v_i + rho_i dVe_i/drho_j at the actual state
+(docs/characteristic_form.md, section 2). ``muscl`` reconstructs (rho_h, w_h, rho_a, w_a),
+w_i = v_i - Ve_i(AO), with a slope limiter, so face densities stay between neighbouring
+cell values. All functions are vectorised; arrays are shaped (4, n).
 """
 
 from __future__ import annotations
@@ -52,12 +37,6 @@ def physical_flux(q: np.ndarray, v_h: np.ndarray, v_a: np.ndarray) -> np.ndarray
     return f
 
 
-def _fd_terms(p: ModelParameters, rho_h: np.ndarray, rho_a: np.ndarray) -> tuple[np.ndarray,
-                                                                                  ...]:
-    """Ve_h, Ve_a and dVe_h/dAO, dVe_a/dAO of the model's family (hot path)."""
-    return speed_terms_of_ao(p, (p.area_h * rho_h + p.area_a * rho_a) / p.road_width)
-
-
 class Waves(NamedTuple):
     """States with their physical flux and wave-speed bounds (all vectorised).
 
@@ -73,9 +52,8 @@ class Waves(NamedTuple):
     hi: np.ndarray
 
     def sel(self, idx: slice) -> Waves:
-        """The same data restricted to the cells ``idx``."""
-        return Waves(self.q[:, idx], self.f[:, idx], self.v_h[idx], self.v_a[idx],
-                     self.lo[idx], self.hi[idx])
+        """The same data restricted to the cells ``idx`` (the last axis)."""
+        return Waves(*(a[..., idx] for a in self))
 
 
 def state_speeds(p: ModelParameters, q: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -86,7 +64,8 @@ def state_speeds(p: ModelParameters, q: np.ndarray) -> tuple[np.ndarray, ...]:
     (lambda_4 = mu_low, lambda_2 = mu_high at an equilibrium).
     """
     rho_h, rho_a = q[RHO_H], q[RHO_A]
-    ve_h, ve_a, d_h, d_a = _fd_terms(p, rho_h, rho_a)
+    ao = (p.area_h * rho_h + p.area_a * rho_a) / p.road_width
+    ve_h, ve_a, d_h, d_a = speed_terms_of_ao(p, ao)
     v_h = q[Y_H] / rho_h + ve_h
     v_a = q[Y_A] / rho_a + ve_a
     ah, aa = p.area_h / p.road_width, p.area_a / p.road_width
@@ -106,15 +85,8 @@ def waves(p: ModelParameters, q: np.ndarray) -> Waves:
 
 
 def hll(left: Waves, right: Waves) -> tuple[np.ndarray, np.ndarray]:
-    """HLL numerical flux between ``left`` and ``right`` states, shape (4, n_faces).
-
-    Returns
-    -------
-    flux : ndarray, shape (4, n)
-        Numerical flux through each face.
-    s_max : ndarray, shape (n,)
-        Largest wave speed magnitude at each face (m/s), for the CFL condition.
-    """
+    """HLL flux (4, n_faces) between ``left`` and ``right`` states, and the largest wave
+    speed magnitude at each face (n_faces,), m/s, for the CFL condition."""
     s_l = np.minimum(left.lo, right.lo)
     s_r = np.maximum(left.hi, right.hi)
     sl0 = np.minimum(s_l, 0.0)
@@ -170,20 +142,8 @@ def from_reconstruction(r: np.ndarray) -> np.ndarray:
 
 
 def muscl_faces(r_padded: np.ndarray, limiter: Limiter) -> tuple[np.ndarray, np.ndarray]:
-    """Limited linear reconstruction at cell faces.
-
-    Parameters
-    ----------
-    r_padded : ndarray, shape (4, n + 2)
-        Reconstruction variables on the n cells plus one ghost cell at each end.
-    limiter : callable
-        One of :data:`LIMITERS`.
-
-    Returns
-    -------
-    east, west : ndarray, shape (4, n)
-        Values at the right (east) and left (west) face of each of the n cells.
-    """
+    """Values (4, n) at the east and west face of each cell, limited by one of
+    :data:`LIMITERS`, from reconstruction variables (4, n + 2) with one ghost at each end."""
     d = np.diff(r_padded, axis=1)                  # (4, n + 1)
     slope = limiter(d[:, :-1], d[:, 1:])           # (4, n), per cell width
     centre = r_padded[:, 1:-1]

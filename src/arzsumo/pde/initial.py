@@ -1,39 +1,15 @@
-"""Initial conditions of section 5 ("Simulation settings" and "Experiments with different
-initial traffic conditions"), as primitive fields (rho_h, v_h, rho_a, v_a) on cell centres.
+"""Initial conditions of section 5, as primitive fields (rho_h, v_h, rho_a, v_a) on cell
+centres (docs/twin.md, "Initial conditions").
 
-Kinds
------
-``equilibrium``
-    The uniform equilibrium.
-``sinusoid``
-    Stop-and-go: z_k(x, 0) = z_k* (1 + A_k sin(2 pi n_k x / L + phi_k)) for each of the
-    four variables k, with relative amplitude A_k and n_k periods over the road (spatial
-    wavenumber 2 pi n_k / L). Opposite signs for density and speed give stop-and-go
-    (dense and slow, then sparse and fast). The paper states no amplitude; the default is
-    10 %, two periods.
-``nonrecurrent``
-    The paper's non-recurrent profile: rho_i* (1 + f sin(pi x / L)), v_i* (1 - f sin(pi x /
-    L)), f = 1/4 as printed.
-``linear``
-    The lane-closure profile. As printed, rho_i(x, 0) = rho_i* x / 4 and v_i(x, 0) =
-    -v_i* x / 4 are dimensionally broken (density times metres; negative speeds; zero
-    density at the inlet, against the inlet condition). We implement the evident intent,
-    a perturbation growing linearly from zero at x = 0 to a fraction f of the equilibrium
-    at x = L: rho_i* (1 + f x / L), v_i* (1 - f x / L), f = 1/4 by default.
-``random``
-    A seeded stop-and-go wave: one random smooth shape g(x) = sum_m c_m sin(2 pi m x / L +
-    phi_m) over modes m = 1..M (M the wavenumber: at most M periods over the road),
-    normalised to max |g| = 1, then z_k* (1 + A_k g(x)). The amplitudes keep the
-    sinusoid's sign structure (dense where slow); the seed draws the coefficients
-    c_m ~ N(0, 1/m) and phases phi_m ~ U(0, 2 pi). Gives sweeps over seeds a spread of
-    initial waves where the paper's profiles are deterministic.
-``array``
-    Arbitrary fields (e.g. aggregated SUMO data) given as arrays on the cell centres.
-
-Note: with f = 1/4 both densities rise by 25 %, which on ``paper_base`` (AO* = 0.709) gives
-AO = 0.887, above AO_max = 0.85: the paper's printed amplitudes are outside the physical
-domain of this fundamental diagram. :func:`initial_fields` refuses such profiles and
-states the largest feasible fraction.
+Kinds: ``equilibrium`` (uniform); ``sinusoid``, stop-and-go z_k* (1 + A_k sin(2 pi n_k x / L
++ phi_k)) per variable k (the paper states no amplitude; default 10 %, two periods);
+``nonrecurrent``, rho_i* (1 + f sin(pi x / L)) and v_i* (1 - f sin(pi x / L)); ``linear``,
+the evident intent of the printed lane-closure profile, rho_i* (1 + f x / L) and
+v_i* (1 - f x / L); ``random``, a seeded wave z_k* (1 + A_k g(x)) with g = sum_m c_m
+sin(2 pi m x / L + phi_m) over modes m = 1..M, c_m ~ N(0, 1/m), phi_m ~ U(0, 2 pi),
+normalised to max |g| = 1; ``array``, given fields (e.g. aggregated SUMO data).
+:func:`initial_fields` refuses a profile outside the physical domain (the paper's f = 1/4
+is, on ``paper_base``) and states the largest feasible fraction.
 """
 
 from __future__ import annotations
@@ -104,11 +80,6 @@ class InitialCondition:
             require(-1.0 < self.amplitude[0] < 1.0, "amplitude", self.amplitude[0],
                     "a fraction f in (-1, 1)")
 
-    @classmethod
-    def paper(cls, kind: str, fraction: float = 0.25) -> InitialCondition:
-        """The paper's ``nonrecurrent`` or ``linear`` profile with fraction f."""
-        return cls(kind=kind, amplitude=fraction)
-
 
 def _profile(ic: InitialCondition, x: np.ndarray, length: float) -> np.ndarray:
     """Relative perturbation shapes, shape (4, n): z = z* (1 + shape)."""
@@ -133,11 +104,8 @@ def _profile(ic: InitialCondition, x: np.ndarray, length: float) -> np.ndarray:
 def initial_fields(ic: InitialCondition, eq: Equilibrium, x: np.ndarray) -> np.ndarray:
     """Primitive fields (rho_h, v_h, rho_a, v_a), shape (4, n), on cell centres ``x`` (m).
 
-    Raises
-    ------
-    ModelError
-        If the profile leaves the physical domain (negative density, AO >= AO_max, ...);
-        the message names the variable, value and position.
+    Raises :class:`ModelError` naming the variable, value and position if the profile leaves
+    the physical domain (negative density, AO >= AO_max, ...).
     """
     x = np.asarray(x, float)
     p = eq.params
@@ -156,7 +124,4 @@ def initial_fields(ic: InitialCondition, eq: Equilibrium, x: np.ndarray) -> np.n
             hint = f"; the largest feasible fraction here is f < {f_max:.3f}"
         raise ModelError(f"initial condition {ic.kind!r} leaves the physical domain: "
                          f"{problem}{hint}")
-    if np.any(prim[[0, 2]] <= 0):
-        raise ModelError(f"initial condition {ic.kind!r}: densities must be > 0 "
-                         "(the twin divides by rho_i)")
     return prim

@@ -1,18 +1,10 @@
 """Performance indices of section 5, "Traffic performance evaluation", and run diagnostics.
 
-For each class i in {h, a}, on the stored fields (uniform output times, cell centres)::
-
-    J_fuel,i   = int_0^T int_0^L max{0, b0 + b1 v_i + b2 v_i a_i + b3 v_i^3} rho_i dx dt
-    J_discom,i = int_0^T int_0^L (a_i^2 + (a_i)_t^2) rho_i dx dt
-    J_TTT,i    = int_0^T int_0^L rho_i dx dt                      (veh s)
-    TMT_i      = int_0^T int_0^L rho_i v_i dx dt                  (veh m)
-    TD_i       = TTT_i - TMT_i / V_i                              (veh s; V_i free-flow speed)
-
-with the local acceleration a_i = (v_i)_t + v_i (v_i)_x (m/s^2) by central differences
-(``numpy.gradient``). The paper writes one rho and one v; for mixed traffic we evaluate
-each class with its own density and speed and report the sum as the total. Integrals:
-cell sums times dx in space, trapezoidal rule in time. J_fuel has the units of the fuel
-rate b0 + ... (Treiber and Kesting, p. 485) times veh s; J_discom is in veh m^2 s^-3.
+J_fuel, J_discom, J_TTT, TMT and the total delay, with their formulas and units:
+docs/outputs.md, "The performance indices and their units". Each class i in {h, a} is
+evaluated with its own density and speed and the total is their sum; a_i = (v_i)_t +
+v_i (v_i)_x by central differences (``numpy.gradient``); integrals are cell sums times dx
+in space and the trapezoidal rule in time, on the stored fields.
 """
 
 from __future__ import annotations
@@ -57,8 +49,6 @@ class Performance:
 def _integrate(density: np.ndarray, t: np.ndarray, dx: float) -> float:
     """int int density dx dt for density shaped (n_t, n_x)."""
     per_time = density.sum(axis=1) * dx
-    if t.size < 2:
-        return 0.0
     return float(np.sum(0.5 * (per_time[1:] + per_time[:-1]) * np.diff(t)))
 
 

@@ -1,9 +1,4 @@
-"""What a twin run records besides its state: output samples and controller checks.
-
-:class:`Samples` holds the primitive fields every output period (preallocated);
-:class:`Checks` the controller's checks, once per control period, with U held between
-them and saturated to the feasible range (paper, section 5: U in [-q*, q*] by default).
-"""
+"""What a twin run records besides its state: output samples and controller checks."""
 
 from __future__ import annotations
 
@@ -32,7 +27,8 @@ class Samples:
 
 class Checks:
     """The controller's checks, once per control period: U held between them, saturated
-    to [u_min, u_max] (default -q* .. q*), and the time it spent saturated (s)."""
+    to [u_min, u_max] (paper, section 5: -q* .. q* by default), and the time it spent
+    saturated (s)."""
 
     def __init__(self, ctrl: Controller, period: float, horizon: float,
                  bounds: tuple[float, float]) -> None:

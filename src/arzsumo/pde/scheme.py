@@ -1,11 +1,6 @@
-"""Spatial discretisation and one Strang-split time step of the twin.
-
-:class:`Transport` evaluates -(F_{j+1/2} - F_{j-1/2}) / dx with the numerical flux of
-:mod:`arzsumo.pde.flux` between cells (``first``) or between MUSCL face values
-(``muscl``), and the boundary fluxes of :mod:`arzsumo.pde.boundary`; :meth:`Transport.step`
-advances by dt with Strang splitting: exact relaxation over dt/2
-(:mod:`arzsumo.pde.source`), forward Euler (first order) or SSP-RK2 / Heun (MUSCL) for
-the transport, relaxation over dt/2. Vectorised over cells.
+"""Spatial discretisation and one Strang-split time step of the twin: numerical fluxes
+between cells (``first``) or MUSCL face values (``muscl``), the boundary fluxes, and forward
+Euler (first order) or SSP-RK2 / Heun (MUSCL) for the transport. Vectorised over cells.
 """
 
 from __future__ import annotations
@@ -15,7 +10,7 @@ import numpy as np
 from arzsumo.model.fd import speed_of_ao
 from arzsumo.model.params import ModelParameters
 from arzsumo.pde.boundary import Inlet, outlet_flux
-from arzsumo.pde.flux import FLUXES, LIMITERS, from_reconstruction, waves
+from arzsumo.pde.flux import FLUXES, LIMITERS, from_reconstruction, muscl_faces, waves
 from arzsumo.pde.source import relax
 from arzsumo.pde.state import RHO_A, RHO_H, Y_A, Y_H
 
@@ -25,18 +20,8 @@ SCHEMES = ("first", "muscl")
 class Transport:
     """Right-hand side -(F_{j+1/2} - F_{j-1/2}) / dx with the boundary fluxes, and one step.
 
-    Parameters
-    ----------
-    params : ModelParameters
-    cells : int
-        Number of cells on [0, L].
-    scheme : {"first", "muscl"}
-    flux : str
-        Key of :data:`arzsumo.pde.flux.FLUXES`.
-    limiter : str
-        Key of :data:`arzsumo.pde.flux.LIMITERS` (``muscl`` only).
-    inlet : Inlet
-        Inlet data (:mod:`arzsumo.pde.boundary`).
+    ``cells`` divide [0, L]; ``flux`` and ``limiter`` (``muscl`` only) are keys of
+    :data:`arzsumo.pde.flux.FLUXES` and :data:`arzsumo.pde.flux.LIMITERS`.
     """
 
     def __init__(self, params: ModelParameters, cells: int, scheme: str, flux: str,
@@ -48,10 +33,8 @@ class Transport:
         self.second = scheme == "muscl"
         self.inlet = inlet
         self.limited = False        # outlet demand-limited at the last evaluation
-        n = cells
-        self._pad = np.empty((4, n + 2))
-        self._faces = np.empty((4, 2 * n))
-        self._full = np.empty((4, n + 1))
+        self._pad = np.empty((4, cells + 2))
+        self._full = np.empty((4, cells + 1))
 
     def _primitive_at(self, r: np.ndarray, j: int) -> np.ndarray:
         """(rho_h, v_h, rho_a, v_a) of cell ``j`` from reconstruction variables ``r``."""
@@ -77,12 +60,8 @@ class Transport:
             rb = np.array([qb[0], qb[1] / qb[0], qb[2], qb[3] / qb[2]])
             pad[:, 0] = 2.0 * rb - r[:, 0]
             pad[:, -1] = 2.0 * r[:, -1] - r[:, -2]
-            d = np.diff(pad, axis=1)
-            half = 0.5 * self.limiter(d[:, :-1], d[:, 1:])
-            rec = self._faces                        # east faces, then west faces
-            np.add(r, half, out=rec[:, :n])
-            np.subtract(r, half, out=rec[:, n:])
-            faces = waves(p, from_reconstruction(rec))
+            east, west = muscl_faces(pad, self.limiter)
+            faces = waves(p, from_reconstruction(np.concatenate([east, west], axis=1)))
             flux, smax = self.riemann(faces.sel(slice(0, n - 1)), faces.sel(slice(n + 1, None)))
             out = faces.sel(slice(n - 1, n))
             s = max(float(smax.max()), float(-faces.lo[n]), float(faces.hi[n - 1]))
@@ -102,9 +81,8 @@ class Transport:
         dq = (full[:, :-1] - full[:, 1:]) / self.dx
         return dq, s, float(f_in[RHO_H] + f_in[RHO_A]), float(f_out[RHO_H] + f_out[RHO_A])
 
-    def step(self, q: np.ndarray, t: float, dt: float, outflow: float) -> tuple[np.ndarray,
-                                                                                float, float,
-                                                                                float]:
+    def step(self, q: np.ndarray, t: float, dt: float,
+             outflow: float) -> tuple[np.ndarray, float, float, float]:
         """One Strang-split step: relaxation dt/2, transport dt, relaxation dt/2.
 
         Returns the new q, the largest wave speed met (m/s) and the vehicles that entered
@@ -119,7 +97,6 @@ class Transport:
         q2 = 0.5 * (q + q1 + dt * dq2)
         return (relax(self.p, q2, 0.5 * dt), max(s1, s2), 0.5 * dt * (fin1 + fin2),
                 0.5 * dt * (fout1 + fout2))
-
 
 
 def max_cell_speed(p: ModelParameters, q: np.ndarray) -> float:

@@ -1,17 +1,11 @@
-"""The time loop of the nonlinear twin: CFL-adaptive stepping, controller hook, guard.
+"""The time loop of the nonlinear twin: CFL-adaptive stepping, controller hook, guard
+(docs/twin.md, "Time loop and guard").
 
-:class:`TwinStepper` owns the one time loop (as PyClaw's controller does): it advances
-the state to a requested time with a held outflow q* + U, choosing each step from the CFL
-condition, redoing a step whose waves turned out faster than Courant 1, and stopping with
-:class:`TwinStoppedError` (time, position, variable) when the state leaves the physical domain,
-keeping the last valid state. The SUMO bridge can drive it directly
-(``advance(t, u)`` / ``macro_state()`` / ``set_state(...)``).
-
-:func:`simulate` runs a whole experiment on top of it: it calls the controller once per
-control period through :meth:`Controller.check` and holds U in between, saturates U to a
-feasible range (and counts the time spent saturated), stores fields at output instants and
-returns a :class:`TwinResult`, marked ``complete=False`` with the stop message if the run
-ended early. The numerics of one step are in :mod:`arzsumo.pde.scheme`.
+:class:`TwinStepper` owns the one time loop (as PyClaw's controller does): it advances the
+state with a held outflow q* + U, redoes a step whose waves turned out faster than Courant
+1, and stops with :class:`TwinStoppedError` when the state leaves the physical domain,
+keeping the last valid state; the SUMO bridge drives it directly. :func:`simulate` runs a
+whole experiment on it and returns a :class:`TwinResult`. One step: :mod:`arzsumo.pde.scheme`.
 """
 
 from __future__ import annotations
@@ -185,11 +179,6 @@ class TwinStepper:
     t0 : float
         Initial time, s.
 
-    Notes
-    -----
-    The boundary conditions are those of section 2, posed for a congested equilibrium
-    (lambda_4 < 0); a free-flow equilibrium is accepted with a logged warning.
-
     Attributes
     ----------
     t : float
@@ -309,17 +298,12 @@ def simulate(eq: Equilibrium, initial: np.ndarray, *, controller: Controller | N
 
     Parameters
     ----------
-    eq : Equilibrium
-        Reference equilibrium: q* for the outlet, rho_i* and q* for the default inlet.
-    initial : ndarray, shape (4, cells)
-        (rho_h veh/m, v_h m/s, rho_a veh/m, v_a m/s) on the cell centres
-        (see :func:`arzsumo.pde.initial.initial_fields`).
+    eq, initial, options, inlet
+        As for :class:`TwinStepper` (``initial``: e.g.
+        :func:`arzsumo.pde.initial.initial_fields`).
     controller : Controller, optional
         Reset, then checked once per control period via :meth:`Controller.check`
         (first check at t = 0); its U is held until the next check. Default open loop.
-    options : SolverOptions, optional
-    inlet : Inlet, optional
-        Default :meth:`Inlet.at_equilibrium` of the linearisation at ``eq``.
     callback : callable, optional
         ``callback(t, q, vehicles_in, vehicles_out)`` after every accepted step with the
         conserved state and the vehicles that crossed each boundary during the step.

@@ -1,11 +1,8 @@
-"""Relaxation source, integrated exactly (paper, section 2, right-hand sides).
+"""Relaxation source, integrated exactly (paper, section 2; docs/twin.md, "Source").
 
-In conservative variables the source is (0, -y_h / tau_h, 0, -y_a / tau_a): densities are
-untouched and each y_i decays linearly, because rho_i (Ve_i(AO) - v_i) / tau_i = -y_i / tau_i
-and rho_i (hence AO, hence Ve_i) does not change during the source step. The source ODE
-is therefore solved exactly by y_i(t + dt) = exp(-dt / tau_i) y_i(t), which is
-unconditionally stable however small tau_i and large dt are. The twin applies it by
-Strang splitting: half a source step, a transport step, half a source step.
+In conservative variables the source is (0, -y_h / tau_h, 0, -y_a / tau_a) and leaves the
+densities (hence AO and Ve_i) unchanged, so y_i(t + dt) = exp(-dt / tau_i) y_i(t) exactly:
+unconditionally stable. The twin applies it by Strang splitting.
 """
 
 from __future__ import annotations
@@ -19,17 +16,8 @@ from arzsumo.pde.state import Y_A, Y_H
 
 
 def relax(p: ModelParameters, q: np.ndarray, dt: float) -> np.ndarray:
-    """Exact solution of q_t = S(q) over ``dt`` seconds; returns a new array.
-
-    Parameters
-    ----------
-    p : ModelParameters
-        Supplies tau_h and tau_a (s).
-    q : ndarray, shape (4, n)
-        Conserved variables (rho_h, y_h, rho_a, y_a).
-    dt : float
-        Duration in s, >= 0.
-    """
+    """Exact solution of q_t = S(q) over ``dt`` >= 0 seconds for conserved ``q`` (4, ...);
+    returns a new array."""
     out = q.copy()
     out[Y_H] *= math.exp(-dt / p.tau_h)
     out[Y_A] *= math.exp(-dt / p.tau_a)

@@ -1,19 +1,8 @@
 """Conservative state of the nonlinear 4x4 model and its conversions (paper, section 2).
 
-The four equations at the start of section 2 are written in conservation form with the
-ARZ variable y_i = rho_i (v_i - Ve_i(AO)), i in {h, a}::
-
-    rho_i,t + (rho_i v_i)_x = 0
-    y_i,t   + (y_i v_i)_x   = -y_i / tau_i
-
-The second line is rho_i times the paper's speed equation plus (v_i - Ve_i) times the mass
-equation: the Lagrangian marker v_i - Ve_i(AO) is carried by the vehicles of class i and
-relaxes at rate 1/tau_i. Conserved vector, index order used everywhere in the twin::
-
-    q = (rho_h, y_h, rho_a, y_a)     shape (4, n_cells); veh/m, veh/s, veh/m, veh/s
-
-Primitive fields are (rho_h, v_h, rho_a, v_a) in veh/m and m/s. Pure vectorised functions;
-no loops over cells.
+Conserved q = (rho_h, y_h, rho_a, y_a), shape (4, n_cells), in veh/m, veh/s, veh/m, veh/s,
+with the ARZ variable y_i = rho_i (v_i - Ve_i(AO)) (docs/twin.md, "Conservation form");
+primitive fields (rho_h, v_h, rho_a, v_a) in veh/m and m/s. Pure vectorised functions.
 """
 
 from __future__ import annotations
@@ -28,26 +17,13 @@ from arzsumo.model.params import ModelParameters
 
 #: Names of the conserved components, in storage order.
 CONSERVED = ("rho_h", "y_h", "rho_a", "y_a")
-#: Names of the primitive fields, in storage order.
-PRIMITIVE = ("rho_h", "v_h", "rho_a", "v_a")
 
 RHO_H, Y_H, RHO_A, Y_A = 0, 1, 2, 3
 
 
 def speeds(p: ModelParameters, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Class speeds v_i = y_i / rho_i + Ve_i(AO), m/s, from conserved ``q`` (4, ...).
-
-    Parameters
-    ----------
-    p : ModelParameters
-    q : ndarray, shape (4, ...)
-        Conserved variables (rho_h, y_h, rho_a, y_a), veh/m and veh/s.
-
-    Returns
-    -------
-    v_h, v_a : ndarray
-        Speeds in m/s; densities must be positive.
-    """
+    """Class speeds v_i = y_i / rho_i + Ve_i(AO), m/s, from conserved ``q`` (4, ...);
+    densities must be positive."""
     ve_h, ve_a = speed_of_ao(p, area_occupancy(p, q[RHO_H], q[RHO_A]))
     return q[Y_H] / q[RHO_H] + ve_h, q[Y_A] / q[RHO_A] + ve_a
 
@@ -74,19 +50,13 @@ def cell_centres(length: float, cells: int) -> np.ndarray:
     """Centres (m) of ``cells`` equal cells on [0, length]."""
     if cells < 2:
         raise ModelError(f"cells = {cells!r} is not allowed: at least 2")
-    dx = length / cells
-    return (np.arange(cells) + 0.5) * dx
+    return (np.arange(cells) + 0.5) * (length / cells)
 
 
 def macro_state(p: ModelParameters, t: float, x: np.ndarray, q: np.ndarray) -> MacroState:
     """The :class:`MacroState` handed to controllers at time ``t`` (s)."""
     v_h, v_a = speeds(p, q)
     return MacroState(float(t), x, q[RHO_H].copy(), v_h, q[RHO_A].copy(), v_a)
-
-
-def from_macro_state(p: ModelParameters, state: MacroState) -> np.ndarray:
-    """Conserved variables from a :class:`MacroState` (e.g. aggregated SUMO fields)."""
-    return to_conserved(p, state.rho_h, state.v_h, state.rho_a, state.v_a)
 
 
 def total_vehicles(q: np.ndarray, dx: float) -> float:
@@ -107,11 +77,8 @@ def domain_violation(p: ModelParameters, q: np.ndarray, x: np.ndarray) -> str | 
         if (np.isfinite(q).all() and q[RHO_H].min() > 0.0 and q[RHO_A].min() > 0.0
                 and ao.max() < p.ao_max):
             return None                                   # fast path, every step
-    checks: list[tuple[np.ndarray, str, np.ndarray, str]] = []
-    for k, name in enumerate(CONSERVED):
-        checks.append((~np.isfinite(q[k]), name, q[k], "not finite"))
-    for k, name in ((RHO_H, "rho_h"), (RHO_A, "rho_a")):
-        checks.append((q[k] <= 0.0, name, q[k], "density not positive"))
+    checks = [(~np.isfinite(q[k]), name, q[k], "not finite") for k, name in enumerate(CONSERVED)]
+    checks += [(q[k] <= 0.0, CONSERVED[k], q[k], "density not positive") for k in (RHO_H, RHO_A)]
     checks.append((ao >= p.ao_max, "AO", ao, f"at or above AO_max = {p.ao_max:g}"))
     for bad, name, values, why in checks:
         if np.any(bad):

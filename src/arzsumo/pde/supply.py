@@ -1,44 +1,18 @@
-"""A cell's receiving capacity (supply), for an inlet flux limited as in a cell transmission
-model.
+"""A cell's receiving capacity (supply), for an inlet flux limited as in Daganzo's cell
+transmission model (docs/identify.md, "The inlet").
 
-Daganzo's cell transmission model lets into a cell the smaller of what the upstream cell
-would send (its demand) and what the cell can take (its supply); the supply falls to zero
-at the jam, so no inflow can push a cell past it. This module gives that supply for the
-mixed-autonomy model, in occupancy units, from the model's own diagram.
+In occupancy units (m/s; label AOrelation) a cell at AO with class shares phi_i = a_i rho_i
+/ (W AO) carries at equilibrium Phi_e(AO) = AO (phi_h Ve_h(AO) + phi_a Ve_a(AO)), with the
+family's Ve_i (:mod:`arzsumo.model.fd`). The supply is its non-increasing envelope from the
+right, S(AO) = max over AO' in [AO, AO_max) of Phi_e(AO'), the demand (sending function)
+its non-decreasing envelope from the left, D_e(AO) = max over AO' in (0, AO] of Phi_e(AO'),
+both at the cell's mix. S vanishes at AO_max when both classes share that jam occupancy.
 
-Occupancy flux. A class-i flow rho_i v_i (veh/s) carries the area occupancy
-(a_i / W) rho_i v_i per second across a section (m/s: AO times metres per second; label
-AOrelation). A cell at area occupancy AO whose occupancy is shared phi_h : phi_a between
-the classes (phi_i = a_i rho_i / (W AO), phi_h + phi_a = 1) carries at equilibrium::
-
-    Phi_e(AO) = AO (phi_h Ve_h(AO) + phi_a Ve_a(AO))
-
-with Ve_i the speed of the model's family (:mod:`arzsumo.model.fd`: eq. (3) for
-``power``, the smoothed Newell triangle for ``newell``; the same definition the twin's flux
-reads). The supply is the non-increasing envelope of Phi_e from the right::
-
-    S(AO) = max over AO' in [AO, AO_max) of Phi_e(AO')
-
-that is the capacity Phi_max below the critical occupancy and Phi_e(AO) above it
-(congestion), with the mix of the receiving cell. It vanishes at AO_max when both classes
-share that jam occupancy (where they do not, the class with the larger one still moves at
-AO_max, and its share of Phi_e stays positive there).
-
-The sending function (demand) is the mirror image, the non-decreasing envelope from the
-left: D_e(AO) = max over AO' in (0, AO] of Phi_e(AO'), Phi_e(AO) in free flow and the
-capacity in congestion (a queue sends at capacity).
-
-Limited inlet flux (:meth:`ReceivingCapacity.limit`). The boundary state (the ghost cell)
-carries the physical flux f, in occupancy units F = sum_i (a_i / W) f_rho_i. Its demand
-is F itself or, with ``sender`` (the cell transmission model's sending side), F D_e / Phi_e
-at the boundary state's occupancy and mix: F in free flow, raised to the capacity times
-the state's departure from the diagram in congestion. The flux entering is min(demand, S):
-where that differs from F the whole flux f is scaled by theta = min(demand, S) / F, so
-each class keeps its share of the entering occupancy and its vehicles their Lagrangian
-marker y_i / rho_i (the y-flux scales with the density flux). Where it does not, the flux
-is f itself, to the bit. The limit acts at x = 0 only; the interior scheme and the
-conservation of vehicles are unchanged (the limited flux is the flux the stepper counts as
-inflow).
+:meth:`ReceivingCapacity.limit` scales the boundary state's whole flux f by theta =
+min(demand, S) / F, F = sum_i (a_i / W) f_rho_i, so each class keeps its share and its
+vehicles their marker; where min(demand, S) = F it returns f itself, to the bit. The demand
+is F, or with ``sender`` F D_e / Phi_e at the boundary state. Only x = 0 is limited: the
+interior scheme and the conservation of vehicles are unchanged.
 """
 
 from __future__ import annotations
@@ -101,8 +75,8 @@ class ReceivingCapacity:
         ao = self.occupancy(rho_h, rho_a)
         if ao >= self.p.ao_max:
             return 0.0
-        own = self.equilibrium_flux(rho_h, rho_a)
-        return max(own, self._beyond(ao, self._ah * rho_h / ao if ao > 0.0 else 0.5))
+        share_h = self._ah * rho_h / ao if ao > 0.0 else 0.5
+        return max(self.equilibrium_flux(rho_h, rho_a), self._largest(ao, share_h, above=True))
 
     def sending(self, rho_h: float, rho_a: float) -> float:
         """D_e (m/s) of a cell with densities ``rho_h``, ``rho_a`` (veh/m): Phi_e in free
@@ -111,49 +85,26 @@ class ReceivingCapacity:
         ao = self.occupancy(rho_h, rho_a)
         share_h = self._ah * rho_h / ao if ao > 0.0 else 0.5
         if ao >= self.p.ao_max:
-            return self._below(self.p.ao_max, share_h)
-        return max(self.equilibrium_flux(rho_h, rho_a), self._below(ao, share_h))
+            return self._largest(self.p.ao_max, share_h, above=False)
+        return max(self.equilibrium_flux(rho_h, rho_a), self._largest(ao, share_h, above=False))
 
-    def _beyond(self, ao: float, share_h: float) -> float:
-        """Largest Phi_e (m/s) on the grid above ``ao`` with the HV share ``share_h``."""
+    def _largest(self, ao: float, share_h: float, above: bool) -> float:
+        """Largest Phi_e (m/s) on the grid above ``ao`` (or at or below it) with the HV
+        share ``share_h``; 0 where that part of the grid is empty."""
         k = int(np.searchsorted(self._ao, ao, side="right"))
-        if k >= self._ao.size:
-            return 0.0
-        mix = share_h * self._flux_h[k:] + (1.0 - share_h) * self._flux_a[k:]
-        return float(mix.max())
-
-    def _below(self, ao: float, share_h: float) -> float:
-        """Largest Phi_e (m/s) on the grid at or below ``ao`` with the HV share ``share_h``."""
-        k = int(np.searchsorted(self._ao, ao, side="right"))
-        if k == 0:
-            return 0.0
-        mix = share_h * self._flux_h[:k] + (1.0 - share_h) * self._flux_a[:k]
-        return float(mix.max())
+        part = slice(k, None) if above else slice(None, k)
+        mix = share_h * self._flux_h[part] + (1.0 - share_h) * self._flux_a[part]
+        return float(mix.max()) if mix.size else 0.0
 
     def limit(self, flux: np.ndarray, rho_h: float, rho_a: float,
               sender: tuple[float, float] | None = None) -> tuple[np.ndarray, float]:
         """The inflow ``flux`` (4,) into a cell with densities ``rho_h``, ``rho_a``, limited
         to the cell's supply (and, with ``sender``, raised to a congested sender's demand).
 
-        Parameters
-        ----------
-        flux : ndarray, shape (4,)
-            The physical flux (rho_h v_h, y_h v_h, rho_a v_a, y_a v_a) of the boundary
-            state, veh/s and veh/s^2.
-        rho_h, rho_a : float
-            The receiving cell's densities, veh/m.
-        sender : (float, float), optional
-            The boundary state's densities (veh/m): its demand is then the flux times
-            D_e / Phi_e there (module docstring); without it, the flux.
-
-        Returns
-        -------
-        flux : ndarray, shape (4,)
-            ``flux`` itself where the demand is the flux and within the supply, else
-            ``theta * flux``.
-        theta : float
-            The factor (>= 0); 1.0 where neither the supply nor the sender's demand
-            changed the flux.
+        ``flux`` is the boundary state's physical flux (veh/s and veh/s^2), ``rho_h``,
+        ``rho_a`` the receiving cell's densities and ``sender`` the boundary state's (veh/m).
+        Returns ``flux`` itself and 1.0 where neither the supply nor the sender's demand
+        changes it, else ``theta * flux`` and theta (>= 0).
         """
         carried = self._ah * float(flux[RHO_H]) + self._aa * float(flux[RHO_A])
         if carried <= 0.0:
