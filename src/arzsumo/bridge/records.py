@@ -20,21 +20,9 @@ from arzsumo.sumo.sensor import PeriodMeasurement
 
 @dataclass(frozen=True)
 class PeriodRecord:
-    """One control period (SI; flows veh/s, counts since the start of control).
-
-    ``u`` is the U applied after the check (veh/s; ``u_applied``, after the
-    ``[actuation]`` limits of :mod:`~arzsumo.bridge.actuator`), ``u_raw`` the U the
-    controller held (its law's, before the limits), ``saturated`` and ``rate_limited``
-    (1.0 or 0.0) which limits acted; ``u_continuous`` what the continuous
-    law gave, ``triggered`` an update of the held U (1.0 or 0.0), ``green_commanded`` the
-    green share asked of the meter, ``u_reference`` the reference twin's U,
-    ``controller_s`` the wall time of the check. The rest is the period that followed:
-    the running green share, cumulative light and plan changes, the ramp queue at its end
-    and its maximum so far (veh), class in- and outflows of the section, the occupancy
-    (fraction) and flow (veh/s) of the loop on ``down`` past the merge nose, the release
-    rate the meter was asked for (veh/s; NaN for a fixed-cycle meter), and whether the
-    meter's queue override was on at the period's end (1.0 or 0.0), and the outlet's
-    speed limit commanded after the check (m/s; NaN when the meter is the actuator).
+    """One control period (SI; flows veh/s, counts since the start of control; flags 1.0 or
+    0.0): the check at ``t`` and the period that followed. The columns of
+    ``periods.parquet``, each described in :data:`arzsumo.schema.PERIODS` (docs/outputs.md).
     """
 
     t: float

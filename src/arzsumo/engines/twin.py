@@ -58,8 +58,7 @@ class TwinRun:
     def summary(self) -> dict[str, Any]:
         """JSON-ready summary; SI units (veh, s, m); ``units_by_key`` gives each key's unit."""
         r = self.result
-        dx = r.dx
-        n0 = float(r.fields[0, [0, 2]].sum() * dx)
+        n0 = float(r.fields[0, [0, 2]].sum() * r.dx)
         n1 = float(r.extra["total_vehicles"])
         perf = self.performance.as_dict()
         ratio = float(self.norm[-1] / self.norm[0]) if self.norm[0] > 0 else math.nan
@@ -77,11 +76,8 @@ class TwinRun:
             "saturation_time": r.saturated_time,
             "outlet_limited_time": r.extra["outlet_limited_time"],
             "u_range": list(r.u_range),
-            "J_fuel": {k: v["J_fuel"] for k, v in perf.items()},
-            "J_discom": {k: v["J_discom"] for k, v in perf.items()},
-            "J_TTT": {k: v["J_TTT"] for k, v in perf.items()},
-            "TMT": {k: v["TMT"] for k, v in perf.items()},
-            "total_delay": {k: v["total_delay"] for k, v in perf.items()},
+            **{index: {k: v[index] for k, v in perf.items()}
+               for index in ("J_fuel", "J_discom", "J_TTT", "TMT", "total_delay")},
             "relative_to_open_loop_percent": (relative_change(self.performance, self.baseline)
                                               if self.baseline is not None else None),
             "open_loop_baseline": self.baseline_status,
