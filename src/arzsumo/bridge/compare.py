@@ -182,11 +182,8 @@ def legend(columns: list[str]) -> str:
 
 
 def summary_table(summaries: list[dict[str, Any]]) -> str:
-    """Text table of results (one row each) under a header line (:func:`header`).
-
-    The identity columns shared by every row are in the header, not the rows; the
-    columns follow :data:`COLUMNS`, each header with its unit, :data:`LEGEND` below.
-    """
+    """Text table of results (one row each, :data:`COLUMNS`) under a header line holding
+    the identity columns every row shares (:func:`header`), :data:`LEGEND` below."""
     df = pd.DataFrame([row_of(s) for s in summaries])
     mix = differing(df)
     drop = {c for c in ("scenario", "horizon_s", "warmup_s", "kind") if c not in mix}

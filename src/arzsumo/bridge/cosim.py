@@ -4,7 +4,7 @@
 that :func:`arzsumo.bridge.session.prepare_run` checked once; every stage reads the run's
 configuration from it alone:
 
-1. (those checks, not repeated here)
+1. (those checks)
 2. Start SUMO, with vehicles placed from ``[initial]`` if asked (:func:`open_run`).
 3. Warm up at the nominal plan, for the warm-up rounded up to whole control periods (at
    least one; :func:`warm_start`). It does not depend on the controller, so several
@@ -24,7 +24,6 @@ run's SUMO configuration and FCD output are kept in ``CoSimResult.files``
 
 from __future__ import annotations
 
-import logging
 import math
 import shutil
 import tempfile
@@ -73,8 +72,6 @@ from arzsumo.sumo.sensor import PeriodMeasurement
 from arzsumo.sumo.simulation import SumoSimulation, open_simulation
 from arzsumo.sumo.window import NetworkMeasures, WindowStart, measure_network
 from arzsumo.units import ms_to_kmh
-
-log = logging.getLogger(__name__)
 
 #: seconds of warm-up averaged for a measured equilibrium
 MEASURE_WINDOW = 60.0
@@ -161,8 +158,7 @@ def place_initial(params: ModelParameters, settings: RunSettings, cfg: SumoConfi
 @dataclass
 class Warmed:
     """The end of the warm-up (step 3 of the module docstring), the same for every
-    controller: the plant, the warm-up's measurements, its meter counts and the state of
-    the system as the control window opens."""
+    controller, and the state of the system as the control window opens."""
 
     plant: SumoPlant
     warm: list[PeriodMeasurement]
@@ -186,8 +182,7 @@ def warm_start(sim: SumoSimulation, run: PreparedRun, bar: RunProgress) -> Warme
 @dataclass
 class Controlled:
     """What the warm-up and the control window left: the loop (plant, controller, twins),
-    the design point, the warm-up's meter counts and the window's start; its trace is the
-    loop's (:attr:`trace`)."""
+    the design point, the warm-up's meter counts and the window's start."""
 
     loop: ClosedLoop
     ref_ctrl: Controller
@@ -274,9 +269,8 @@ def run_cosimulation(run: PreparedRun, *, progress: bool | RunProgress = False,
 
 def finish_run(opened: OpenRun, warmed: Warmed, run: PreparedRun,
                keep_measurements: bool = False) -> CoSimResult:
-    """From the end of the warm-up: the control window of ``run``, the drain, SUMO
-    closed, and the network measures read from SUMO's outputs (steps 4-7 of the module
-    docstring)."""
+    """From the end of the warm-up: the control window of ``run`` and what
+    :func:`close_window` does (steps 4-7 of the module docstring)."""
     return close_window(opened, control(warmed, run, opened.bar, keep_measurements), run)
 
 

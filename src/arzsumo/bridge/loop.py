@@ -1,25 +1,19 @@
 """One control period of the closed loop, in one place: sense, estimate, decide, actuate, record.
 
-1. **sense**: SUMO runs one period under the meter's present command
-   (:meth:`arzsumo.sumo.plant.SumoPlant.run_period`); the sensor is the only reader of SUMO.
-2. **estimate**: the measurement becomes the state the controller acts on (minus the
-   warm-up reference, :mod:`~arzsumo.bridge.reference`, when the scenario asks for it).
-3. **decide**: the controller, told what was applied for its previous check, checks on
-   the state; the reference twin's controller checks on the reference twin.
-4. **actuate**: the command's U, limited, becomes the meter's plan
-   (:mod:`~arzsumo.bridge.actuator`).
-5. **record**: the check and the period that followed become one
-   :class:`~arzsumo.bridge.records.PeriodRecord`; both twins advance over the period.
+A detector sample's path: ``SumoSensor.observe`` (every step; the sensor is the only
+reader of SUMO) -> ``PeriodMeasurement`` -> ``Estimator.estimate`` (minus the warm-up
+reference, :mod:`~arzsumo.bridge.reference`) -> ``MacroState`` -> ``Controller.step`` (told
+what was applied for its previous check) -> ``Command`` -> ``MeterActuator.apply`` (the
+limits, :mod:`~arzsumo.bridge.actuator`) -> ``MeterLight.set_plan`` -> the light, from the
+next cycle on. Each check and the period that followed become one
+:class:`~arzsumo.bridge.records.PeriodRecord`; the reference twin's controller checks on
+the reference twin, and both twins advance over the period.
 
 The first check is on the warm-up's last measurement (t = 0); no command follows the last
 check, at the horizon (no period follows it). :meth:`ClosedLoop.run` is
 :meth:`~ClosedLoop.begin`, then per period :meth:`~ClosedLoop.estimate`,
 :meth:`~ClosedLoop.decide` and :meth:`~ClosedLoop.advance`; an outside driver
 (:mod:`arzsumo.gym`) calls the same stages one period at a time.
-
-A detector sample's path: ``SumoSensor.observe`` (every step) -> ``PeriodMeasurement`` ->
-``Estimator.estimate`` -> ``MacroState`` -> ``Controller.step`` -> ``Command`` ->
-``MeterActuator.apply`` -> ``MeterLight.set_plan`` -> the light, from the next cycle on.
 """
 
 from __future__ import annotations

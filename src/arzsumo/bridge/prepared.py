@@ -26,16 +26,10 @@ class PreparedRun:
     """A run checked and resolved, ready for SUMO: what
     :func:`~arzsumo.bridge.session.prepare_run` returns.
 
-    Attributes
-    ----------
-    scenario : Scenario
-        The scenario with the caller's overrides applied; the one source of the run's
-        settings (:attr:`settings`, :attr:`sumo`, :attr:`design`).
-    initial : numpy.ndarray or None
-        Fields (4, cells on the micro grid) to place vehicles from at t = 0 with
-        ``[run] start = "placement"``; None otherwise.
-    curve : GreenShareCurve
-        The meter's green-share curve (``[sumo] meter_curve``, or the default).
+    ``scenario``: the scenario with the caller's overrides, the one source of the run's
+    settings (:attr:`settings`, :attr:`sumo`, :attr:`design`); ``initial``: fields (4,
+    cells on the micro grid) to place vehicles from at t = 0 with ``[run] start =
+    "placement"``, else None; ``curve``: the meter's green-share curve.
     """
 
     scenario: Scenario

@@ -1,8 +1,7 @@
 """What one control period of the closed loop leaves behind: a typed record per period.
 
 Record k pairs the check at ``t`` (s from the start of control) with the SUMO period that
-followed it under that check's command, ending at ``t + control_period``; the fields of
-that period's end are stored beside (see :class:`~arzsumo.bridge.result.CoSimResult`).
+followed it under that check's command (docs/outputs.md, ``periods.parquet``).
 """
 
 from __future__ import annotations
@@ -54,9 +53,8 @@ class PeriodRecord:
     @classmethod
     def of(cls, t: float, command: Command, act: Actuation, u_reference: float,
            controller_s: float, m: PeriodMeasurement, meter: MeterState) -> PeriodRecord:
-        """The record of the check at ``t`` (s from the start of control): what it decided
-        and what was applied, the reference twin's U (veh/s), the check's wall time (s),
-        and the period that followed (the sensor's measurement, the meter at its end)."""
+        """The record of the check at ``t`` (s from the start of control) and of the period
+        that followed (the sensor's measurement, the meter at its end); times in s."""
         c = m.cells
         return cls(t=t, u=act.u_applied, u_continuous=command.u_continuous,
                    triggered=float(command.triggered), green_commanded=act.green,
