@@ -70,12 +70,9 @@ def command_meter(meter: MeterLight, u: float, q_nominal: float) -> float:
 
 @dataclass(frozen=True)
 class ActuationLimits:
-    """The ``[actuation]`` limits in SI for one run (see the module docstring).
-
-    ``u_max`` (veh/s, inf: off), ``rate_step`` (veh/s per control period, inf: off),
-    ``ramp_bound``: U within the meter's range and above the ramp's floor, and
-    ``hold_plan``: a held U keeps its plan while it lies in the range.
-    """
+    """The ``[actuation]`` limits in SI for one run: ``u_max`` (veh/s) and ``rate_step``
+    (veh/s per control period; inf: off); ``ramp_bound``: U within the meter's range and
+    above the ramp's floor; ``hold_plan``: a held U keeps its plan while in the range."""
 
     u_max: float = INF
     rate_step: float = INF

@@ -21,12 +21,9 @@ RHO_FLOOR = 1e-4
 
 def measured_state(params: ModelParameters, rho_h: np.ndarray, v_h: np.ndarray,
                    rho_a: np.ndarray, v_a: np.ndarray) -> np.ndarray:
-    """Edie cells as a complete primitive state (4, n): (rho_h, v_h, rho_a, v_a), SI.
-
-    Speeds of empty cells (NaN) become Ve at the cell's raw densities
-    (:func:`arzsumo.bridge.estimator.fill_speeds`, paper eq. ``Ve``); densities are then
-    floored at :data:`RHO_FLOOR` veh/m.
-    """
+    """Edie cells as a complete primitive state (4, n): (rho_h, v_h, rho_a, v_a), SI; empty
+    cells' speeds (NaN) at Ve of the raw densities (paper eq. ``Ve``), then the densities
+    floored at :data:`RHO_FLOOR`."""
     v_h, v_a = fill_speeds(params, np.asarray(rho_h, float), np.asarray(v_h, float),
                            np.asarray(rho_a, float), np.asarray(v_a, float))
     return np.vstack([np.maximum(rho_h, RHO_FLOOR), v_h, np.maximum(rho_a, RHO_FLOOR), v_a])
@@ -61,11 +58,9 @@ def inlet_series(params: ModelParameters, start: np.ndarray, first_cells: np.nda
 
 
 def outflow_series(q0: float, outflow: np.ndarray, dt: float, tau: float) -> np.ndarray:
-    """The smoothed total outflow (T,) at x = L during each period, veh/s.
-
-    ``q0`` is the start value (the nominal meter's outflow), ``outflow[k]`` the total flow
-    SUMO measured at x = L over period k (veh/s); ``dt``, ``tau`` as :func:`inlet_series`.
-    """
+    """The smoothed total outflow (T,) at x = L during each period, veh/s, from ``q0`` (the
+    nominal meter's outflow) and SUMO's ``outflow[k]`` over period k; ``dt``, ``tau`` as
+    :func:`inlet_series`."""
     q, out = float(q0), np.empty(len(outflow))
     for k, value in enumerate(np.asarray(outflow, float)):
         q = smooth_step(q, float(value), dt, tau)

@@ -16,10 +16,8 @@ configuration from it alone:
 7. After the window, with ``[sumo] drain_max_s`` > 0, the drain (:mod:`arzsumo.bridge.drain`).
 
 Steps 4-7 are :func:`finish_run`. The meter's counts cover the control window only (the
-warm-up's: ``CoSimResult.warmup_meter``). SUMO's own outputs go to a scratch directory and
-become the network measures (:mod:`arzsumo.sumo.window`, ``CoSimResult.network``); the
-run's SUMO configuration and FCD output are kept in ``CoSimResult.files``
-(:mod:`arzsumo.sumo.run_files`).
+warm-up's: ``CoSimResult.warmup_meter``). SUMO's own outputs, written to a scratch
+directory, become the network measures (:mod:`arzsumo.sumo.window`).
 """
 
 from __future__ import annotations
@@ -194,8 +192,7 @@ class Controlled:
     settings: RunSettings
     stationary: tuple[np.ndarray, float]   # the warm-up's state and band (evaluation.decay)
     trigger_noise: float | None = None     # veh/s: the law's output noise sizing the dead band
-    law: Controller | None = None          # the law built for the run (the loop's, or
-                                           # the one an outside driver stands in for)
+    law: Controller | None = None          # the law built for the run (given to in_loop)
 
     @property
     def trace(self) -> Trace:

@@ -1,10 +1,9 @@
 """The drain: after the control window, the run goes on until every loaded vehicle has left.
 
-Every controller hands the meter to the same *drain policy*, the queue override held on
-(the largest release) until the network is empty, at most ``[sumo] drain_max_s``. No
-controller, sensor or twin runs; fuel and CO2 are summed every step (SUMO's emissions
-device cannot be read while running), so the window's measures stay the window's
-(:func:`arzsumo.sumo.window.finish_window`). Teleports are off, so vehicles at the merge
+Every controller hands the meter to the same *drain policy*, the queue override held on,
+until the network is empty, at most ``[sumo] drain_max_s``. No controller, sensor or twin
+runs; fuel and CO2 are summed every step (SUMO's emissions device cannot be read while
+running), so the window's measures stay the window's. Teleports are off, so vehicles at the merge
 can wait for each other for good (measured: 1 drain in 5 on the default); a drain with no
 arrival for :data:`STALL_S` while vehicles remain ends as ``gridlock``. docs/whole_demand.md.
 """

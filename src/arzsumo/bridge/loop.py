@@ -45,13 +45,9 @@ class Check:
 
 
 class ClosedLoop:
-    """The stages of the control window (module docstring), each one object.
-
-    ``actuator`` turns U into the meter's plan or the outlet's speed limit, ``twins`` are
-    the replay and reference twins, ``period`` the control period (s); ``anti_windup``
-    tells the controller the range its U was limited to; ``shift`` is the warm-up
-    reference subtracted from the estimate.
-    """
+    """The stages of the control window (module docstring), each one object; ``period``:
+    the control period (s); ``anti_windup``: tell the controller the range its U was
+    limited to; ``shift``: the warm-up reference subtracted from the estimate."""
 
     def __init__(self, plant: SumoPlant, estimator: Estimator, controller: Controller,
                  actuator: Actuator, twins: TwinPair, period: float,
@@ -61,8 +57,7 @@ class ClosedLoop:
         self.anti_windup, self.shift = anti_windup, shift
         self.timings = {"controller": 0.0, "twins": 0.0, "estimator": 0.0}
         # where the window stands (begin, advance): the start's SUMO time (s), the last
-        # measurement, its time from the start of control (s), what the controller is
-        # told at its next check, the trace so far
+        # measurement's time from it (s), what the controller is told at its next check
         self.t0, self.t = 0.0, 0.0
         self.told: Applied | None = None
         self.m: PeriodMeasurement | None = None

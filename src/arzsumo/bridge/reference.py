@@ -44,12 +44,9 @@ class ReferenceShift:
 
 def reference_shift(reference: str, warm_fields: Sequence[np.ndarray], eq: Equilibrium,
                     window: float, period: float) -> ReferenceShift:
-    """The shift of ``reference`` (:data:`REFERENCES`).
-
-    ``warm_fields``: the estimate (4, n) of every warm-up period, oldest first; the mean of
-    the last ``window`` seconds (periods of ``period`` s, at least one) minus the
-    equilibrium is the offset of ``"warmup"``; ``"equilibrium"`` has a zero offset.
-    """
+    """The shift of ``reference`` (:data:`REFERENCES`): zero for ``"equilibrium"``; for
+    ``"warmup"`` the mean of the last ``window`` s of ``warm_fields`` (the estimate (4, n)
+    of every warm-up period of ``period`` s, oldest first; one at least) minus ``eq``."""
     if reference not in REFERENCES:
         raise ValueError(f"reference {reference!r}: one of {REFERENCES}")
     n = np.asarray(warm_fields[-1]).shape[1]

@@ -1,12 +1,10 @@
 """The two PDE twins that run beside SUMO: *replay* and *reference*.
 
-Both start from the aggregated microscopic state at the start of control and hold SUMO's
-first cell, smoothed exponentially, in a ghost cell at x = 0. *replay* is given the
-outflow SUMO produced at x = L (smoothed alike, which keeps the vehicle count): how well
-the model explains SUMO. *reference* runs its own closed loop with a copy of the
-controller: what the design promised. A twin whose step would leave the model's domain
-(SUMO can hold occupancies the calibrated FD cannot) is re-synchronised to SUMO's state of
-that period, counted, and the period is left out of the fidelity measures (NaN fields).
+Both start from SUMO's state at the start of control and hold its first cell, smoothed,
+in a ghost cell at x = 0. *replay* is given SUMO's outflow at x = L, smoothed alike: how
+well the model explains SUMO. *reference* runs its own closed loop with a copy of the
+controller: what the design promised. A twin whose step would leave the model's domain is
+re-synchronised to SUMO's state, counted, and the period left out (NaN fields).
 """
 
 from __future__ import annotations
