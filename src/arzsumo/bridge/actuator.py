@@ -1,40 +1,13 @@
 """The actuation stage of the closed loop: the controller's U, limited, to a ramp-meter command.
 
-A PDE controller's U (veh/s) is the deviation of the section's outflow from q* (paper,
-section 2; the boundary input of control_law): the meter is asked for the mainline outflow
-``q_nominal + U``, where ``q_nominal`` is the outflow of the nominal plan on the meter's
-calibrated curve, so U = 0 is the open loop. The open loop itself never commands the
-meter: it keeps the nominal plan, and no plan change is counted.
-
-Between the controller and the meter, the ``[actuation]`` limits
-(:mod:`arzsumo.scenario.actuation`) act in :func:`limit_u`, in this order:
-
-1. the range ``[lower, upper]``: ``|U| <= u_max_fraction q*`` and, with ``ramp_bound``,
-   :func:`ramp_range`; the law's U outside it is *saturated*;
-2. the rate: ``|U_k - U_{k-1}| <= u_rate_max Delta`` from the U applied in the previous
-   period (0, the nominal plan, before the first); a change cut there is *rate limited*;
-3. the range again, so the output always lies in it: the range wins over the rate when
-   the range moved away from the previous U (the ramp bound moves with the queue).
-
-With ``hold_plan_in_range``, a U the law holds (the same value as at the previous check:
-an ETC between events, a held meter) keeps the U applied in the previous period while
-that U lies in the new range and no rate-limited approach is under way: the ramp bound
-moves with the queue, and clipping the held U to it anew at every period would change the
-meter's plan with no decision of the law. The plan then changes at an event, at a step of
-a rate-limited approach, and when the range leaves the plan (:meth:`MeterActuator.apply`);
-``plan_changes`` counts all three, ``triggers`` the events.
-
-Every limit off (the default) returns the law's U unchanged. While the meter's queue
-override is on (the ramp queue beyond its storage,
-:meth:`~arzsumo.sumo.meter.MeterLight.override`) the range collapses to the override's U,
-whatever the limits: the law sees a saturated actuator. The U applied, with the range in
-force, is what the controller is told at its next check
-(:class:`~arzsumo.control.base.Applied`; the range only with ``anti_windup``).
-
-Last, the meter's own bounds: the U applied becomes the realisation's plan variable
-(green share or release rate, :meth:`~arzsumo.sumo.meter.MeterLight.plan_for`), saturated
-to the plan's bounds here (:func:`command_meter`), the one place the meter's command is
-clamped. The realisation is chosen once per run; nothing here asks which it is.
+U (veh/s) is the deviation of the section's outflow from q* (paper, section 2): the meter is
+asked for the outflow ``q_nominal + U`` on its calibrated curve, so U = 0 is the nominal
+plan; the open loop keeps that plan and never commands the meter. The ``[actuation]``
+limits act in :func:`limit_u` (range, rate, range again); with ``hold_plan_in_range`` a
+held U keeps its plan while it lies in the range (:meth:`MeterActuator._keeps_plan`);
+while the queue override is on, the range collapses to the override's U, a saturation to
+the law. :func:`command_meter` is the one place the meter's command is clamped to the
+plan's bounds. docs/sumo.md, 'Actuation limits'; docs/outputs.md, 'Counts'.
 """
 
 from __future__ import annotations
@@ -64,23 +37,10 @@ def limit_u(u_raw: float, u_prev: float, lower: float = -INF, upper: float = INF
             rate_step: float = INF) -> Limited:
     """The U applied for the law's ``u_raw`` (veh/s): range, then rate, then range.
 
-    Parameters
-    ----------
-    u_raw : float
-        The controller's U, veh/s.
-    u_prev : float
-        The U applied in the previous control period, veh/s (0 before the first).
-    lower, upper : float
-        The range of U, veh/s (``lower <= upper``; infinite: off).
-    rate_step : float
-        Largest change of U over one control period, veh/s (u_rate_max x Delta; inf: off).
-
-    Returns
-    -------
-    Limited
-        ``u_applied`` in ``[lower, upper]`` always, within ``rate_step`` of ``u_prev``
-        whenever ``u_prev`` lies in the range; ``saturated`` where ``u_raw`` (or the
-        rate-limited value) lay outside the range, ``rate_limited`` where the rate cut it.
+    ``u_prev`` is the U applied in the previous period (0 before the first), ``lower``,
+    ``upper`` the range and ``rate_step`` the largest change per period (u_rate_max x
+    Delta), all veh/s (infinite: off). ``u_applied`` always lies in the range;
+    ``saturated`` where the range cut, ``rate_limited`` where the rate did.
     """
     u = min(max(u_raw, lower), upper)
     saturated = u != u_raw
@@ -110,12 +70,9 @@ def command_meter(meter: MeterLight, u: float, q_nominal: float) -> float:
 
 @dataclass(frozen=True)
 class ActuationLimits:
-    """The ``[actuation]`` limits in SI for one run (see the module docstring).
-
-    ``u_max`` (veh/s, inf: off), ``rate_step`` (veh/s per control period, inf: off),
-    ``ramp_bound``: U within the meter's range and above the ramp's floor, and
-    ``hold_plan``: a held U keeps its plan while it lies in the range.
-    """
+    """The ``[actuation]`` limits in SI for one run: ``u_max`` (veh/s) and ``rate_step``
+    (veh/s per control period; inf: off); ``ramp_bound``: U within the meter's range and
+    above the ramp's floor; ``hold_plan``: a held U keeps its plan while in the range."""
 
     u_max: float = INF
     rate_step: float = INF
@@ -182,21 +139,8 @@ class Actuator(Protocol):
 
 
 class MeterActuator:
-    """Commands ``meter`` with the outflow ``q_nominal + U``, U limited by ``limits``.
-
-    Parameters
-    ----------
-    meter : MeterLight
-        The meter of the open run (fixed cycle: the outflow ``q_nominal + U`` through its
-        curve; one per green: the release rate of
-        :func:`~arzsumo.sumo.meter_release.release_rate_for`).
-    q_nominal : float
-        Mainline outflow of the nominal plan, veh/s.
-    hold_nominal : bool
-        Keep the nominal plan whatever U is (the open loop).
-    limits : ActuationLimits, optional
-        The ``[actuation]`` limits (default: none).
-    """
+    """Commands ``meter`` with the outflow ``q_nominal + U`` (veh/s), U limited by ``limits``
+    (default: none); ``hold_nominal`` (the open loop) keeps the nominal plan whatever U is."""
 
     def __init__(self, meter: MeterLight, q_nominal: float, hold_nominal: bool,
                  limits: ActuationLimits | None = None) -> None:
@@ -207,12 +151,11 @@ class MeterActuator:
         self.range_prev = (-INF, INF)
 
     def apply(self, u: float) -> Actuation:
-        """Command U (veh/s), limited; return what was applied and the green share
-        commanded (in [0, 1])."""
+        """Command U (veh/s), limited; what was applied."""
         meter = self.meter
         if self.hold_nominal:
             return Actuation(u, 0.0, False, False, -INF, INF, meter.green_share,
-                             _rate(meter))
+                             release_rate(meter))
         lower, upper = self.limits.range(meter, self.q_nominal)
         rate_step = self.limits.rate_step
         if meter.override():
@@ -229,8 +172,7 @@ class MeterActuator:
         self.u_prev = lim.u_applied
         green = command_meter(meter, lim.u_applied, self.q_nominal)
         return Actuation(u, lim.u_applied, lim.saturated, lim.rate_limited, lower, upper,
-                         green, _rate(meter))
-
+                         green, release_rate(meter))
 
     def summary(self) -> dict[str, Any]:
         """Nothing beside the meter's own counts."""
@@ -240,14 +182,15 @@ class MeterActuator:
         """Nothing: the drain hands the meter to its own policy."""
 
     def _keeps_plan(self, u: float, lower: float, upper: float, rate_step: float) -> bool:
-        """Whether a held ``u`` keeps the previous U applied (module docstring): held,
-        settled under the range the plan was set under, and inside the new one."""
+        """Whether a held ``u`` keeps the previous U applied (docs/outputs.md, 'Counts'):
+        held, settled under the range the plan was set under, and inside the new one."""
         if not self.limits.hold_plan or u != self.u_raw_prev:
             return False
         settled = limit_u(u, self.u_prev, *self.range_prev, rate_step).u_applied
         return settled == self.u_prev and lower <= self.u_prev <= upper
 
 
-def _rate(meter: MeterLight) -> float:
+def release_rate(meter: MeterLight) -> float:
+    """The release rate ``meter`` was asked for, veh/s (NaN for a fixed cycle)."""
     rate = meter.release_rate
     return math.nan if rate is None else rate

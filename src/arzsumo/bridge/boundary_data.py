@@ -1,18 +1,9 @@
 """What the PDE twins take from SUMO: the measured state, and the smoothed boundary data.
 
-One pure function per quantity, shared by the twins that run beside SUMO (online, one
-control period at a time: :class:`~arzsumo.bridge.twins.TwinPair`) and by the
-identification (a whole run at once: :func:`~arzsumo.bridge.replay_data.replay_data_of`),
-so that both feed the twin the same numbers, bit for bit:
-
-* :func:`measured_state`: Edie cells as a complete state (empty cells get the
-  equilibrium speed at their densities, densities floored at :data:`RHO_FLOOR`);
-* :func:`smooth_step`: one step of the exponential smoothing with time constant tau,
-  z <- z + (1 - exp(-dt / tau)) (z_new - z), which keeps the mean of a constant signal
-  (and so the vehicle count of a smoothed flow);
-* :func:`inlet_series` and :func:`outflow_series`: the inlet state at x = 0 (SUMO's first
-  cell, measured) and the total outflow at x = L during each period, as the twins see
-  them.
+One pure function per quantity, shared by the twins beside SUMO (one period at a time,
+:class:`~arzsumo.bridge.twins.TwinPair`) and the identification (a whole run,
+:func:`~arzsumo.bridge.replay_data.replay_data_of`), so both feed the twin the same numbers,
+bit for bit.
 """
 
 from __future__ import annotations
@@ -30,12 +21,9 @@ RHO_FLOOR = 1e-4
 
 def measured_state(params: ModelParameters, rho_h: np.ndarray, v_h: np.ndarray,
                    rho_a: np.ndarray, v_a: np.ndarray) -> np.ndarray:
-    """Edie cells as a complete primitive state (4, n): (rho_h, v_h, rho_a, v_a), SI.
-
-    Speeds of empty cells (NaN) become Ve at the cell's raw densities
-    (:func:`arzsumo.bridge.estimator.fill_speeds`, paper eq. ``Ve``); densities are then
-    floored at :data:`RHO_FLOOR` veh/m.
-    """
+    """Edie cells as a complete primitive state (4, n): (rho_h, v_h, rho_a, v_a), SI; empty
+    cells' speeds (NaN) at Ve of the raw densities (paper eq. ``Ve``), then the densities
+    floored at :data:`RHO_FLOOR`."""
     v_h, v_a = fill_speeds(params, np.asarray(rho_h, float), np.asarray(v_h, float),
                            np.asarray(rho_a, float), np.asarray(v_a, float))
     return np.vstack([np.maximum(rho_h, RHO_FLOOR), v_h, np.maximum(rho_a, RHO_FLOOR), v_a])
@@ -45,12 +33,8 @@ def smooth_step(previous: np.ndarray | float, new: np.ndarray | float, dt: float
                 tau: float) -> np.ndarray | float:
     """One step of exponential smoothing: previous + (1 - exp(-dt / tau)) (new - previous).
 
-    Parameters
-    ----------
-    previous, new : float or ndarray
-        Smoothed value so far and the new measurement (same units).
-    dt, tau : float
-        Step and time constant, s.
+    ``dt``, ``tau``: step and time constant, s. It keeps the mean of a constant signal
+    (and so the vehicle count of a smoothed flow).
     """
     return previous + (1.0 - math.exp(-dt / tau)) * (new - previous)
 
@@ -59,18 +43,10 @@ def inlet_series(params: ModelParameters, start: np.ndarray, first_cells: np.nda
                  dt: float, tau: float) -> np.ndarray:
     """The inlet state (T, 4) the twins hold at x = 0 during each control period.
 
-    Parameters
-    ----------
-    params : ModelParameters
-        The model whose Ve fills an empty first cell.
-    start : ndarray (4,)
-        SUMO's first cell (rho_h, v_h, rho_a, v_a; NaN speed where empty) at the start of
-        control: the smoothing starts there, without history.
-    first_cells : ndarray (T, 4)
-        The first cell measured over each period k; the state of period k smooths it in
-        (the twin of period k advances after SUMO's period k is measured).
-    dt, tau : float
-        Control period and smoothing time constant, s.
+    The smoothing starts at ``start``, SUMO's first cell (4,) at the start of control (NaN
+    speed where empty; ``params``' Ve fills it), without history; period k smooths in
+    ``first_cells[k]``, the first cell measured over it (the twin of period k advances
+    after SUMO's period k is measured). ``dt``, ``tau``: control period and time constant, s.
     """
     state = measured_state(params, *np.asarray(start, float)[:, None])[:, 0]
     cells = np.asarray(first_cells, float)
@@ -82,11 +58,9 @@ def inlet_series(params: ModelParameters, start: np.ndarray, first_cells: np.nda
 
 
 def outflow_series(q0: float, outflow: np.ndarray, dt: float, tau: float) -> np.ndarray:
-    """The smoothed total outflow (T,) at x = L during each period, veh/s.
-
-    ``q0`` is the start value (the nominal meter's outflow), ``outflow[k]`` the total flow
-    SUMO measured at x = L over period k (veh/s); ``dt``, ``tau`` as :func:`inlet_series`.
-    """
+    """The smoothed total outflow (T,) at x = L during each period, veh/s, from ``q0`` (the
+    nominal meter's outflow) and SUMO's ``outflow[k]`` over period k; ``dt``, ``tau`` as
+    :func:`inlet_series`."""
     q, out = float(q0), np.empty(len(outflow))
     for k, value in enumerate(np.asarray(outflow, float)):
         q = smooth_step(q, float(value), dt, tau)

@@ -1,24 +1,12 @@
 """Several controllers after one warm-up: the runs of a seed share the warm-up's SUMO.
 
-An evaluation runs every controller on the same seeds, and the runs of a seed are the
-same SUMO run until the control window opens: the warm-up holds the nominal plan
-whatever the controller (:func:`~arzsumo.bridge.cosim.warm_start`). :func:`run_branched`
-simulates that warm-up once and forks one child per controller at its end
-(:mod:`arzsumo.sumo.fork`). Each child continues SUMO bit for bit, on output files of its
-own (:meth:`~arzsumo.sumo.simulation.SumoSimulation.branch_off`), and finishes its run as
-:func:`~arzsumo.bridge.cosim.run_cosimulation` would: its summary, periods, cells and
-tripinfo are those of a plain run of the same scenario, controller and seed
-(``tests/bridge/test_branches.py``).
-
-Runs share a warm-up when everything SUMO and the warm-up read is the same
-(:func:`warmup_key`): the scenario's tables except what acts only from the start of
-control (``[run] controller`` and ``constant_release_veh_h``, ``[disturbance]``), the
-resolved run settings and SUMO settings except those, and the placement profile.
-
-A child returns only what the caller's ``keep`` makes of its session (picklable; a
-:class:`~arzsumo.bridge.result.CoSimResult` holds open files and large arrays). A child
-that dies comes back as a :class:`~arzsumo.sumo.fork.BranchFailed`; the caller runs it
-again alone (:func:`arzsumo.sweep.worker.execute_group`).
+:func:`run_branched` simulates the warm-up once and forks one child per controller at its
+end (:mod:`arzsumo.sumo.fork`); each continues SUMO bit for bit on its own output files and
+finishes as :func:`~arzsumo.bridge.cosim.run_cosimulation` would
+(``tests/bridge/test_branches.py``). Runs share a warm-up when :func:`warmup_key` agrees:
+everything SUMO and the warm-up read except what acts only from the start of control. A
+child returns only what ``keep`` makes of its session (picklable); one that dies comes
+back as a :class:`~arzsumo.sumo.fork.BranchFailed`. docs/sweeps.md, 'One warm-up per seed'.
 """
 
 from __future__ import annotations

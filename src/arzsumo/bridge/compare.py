@@ -1,16 +1,9 @@
 """One table across co-simulation runs (``arzsumo compare``), as text, CSV and bar plot.
 
-Rows compare only when they measure the same thing: results of ``arzsumo run``
-(``summary.json["kind"] == "run"``) of one scenario (by name), one control horizon and one
-warm-up. Anything else is refused with one line naming the directories and values: a
-twin result (``arzsumo twin``, another summary layout), an older run result whose meter
-counts start at t = 0 of the warm-up (kind ``run-v0``), runs of other horizons. With
-``allow_mixed`` they are tabulated anyway and the table's header states the mix.
-
-The CSV holds every row with its identity (``scenario``, ``horizon_s``, ``warmup_s``,
-``controller``, ``seed``, ``kind``) and the metrics in human units (veh h, km/h); the bar
-figure shows means per controller with the seeds listed, or one bar per run. The files are
-written by :func:`arzsumo.outputs.compare.compare_runs`.
+Rows compare only when they are ``arzsumo run`` results of one scenario, control horizon
+and warm-up; anything else is refused in one line naming the directories and values, or,
+with ``allow_mixed``, tabulated under a header stating the mix. The files are written by
+:func:`arzsumo.outputs.compare.compare_runs`; docs/outputs.md, 'arzsumo compare'.
 """
 
 from __future__ import annotations
@@ -158,12 +151,8 @@ def as_text(value: Any) -> str:
 
 def differing(df: pd.DataFrame) -> dict[str, list[str]]:
     """Columns of :data:`MUST_AGREE` with more than one value: column -> values (as text)."""
-    out: dict[str, list[str]] = {}
-    for col in MUST_AGREE:
-        values = list(dict.fromkeys(as_text(v) for v in df[col]))
-        if len(values) > 1:
-            out[col] = values
-    return out
+    values = {col: list(dict.fromkeys(as_text(v) for v in df[col])) for col in MUST_AGREE}
+    return {col: vals for col, vals in values.items() if len(vals) > 1}
 
 
 def mix_text(mix: dict[str, list[str]]) -> str:
@@ -183,8 +172,7 @@ def header(df: pd.DataFrame) -> str:
 
 
 def _render(df: pd.DataFrame, columns: list[str]) -> str:
-    heads = dict(COLUMNS)
-    body = df[columns].rename(columns=heads)
+    body = df[columns].rename(columns=dict(COLUMNS))
     return body.to_string(index=False, float_format=lambda v: f"{v:.3g}")
 
 
@@ -194,11 +182,8 @@ def legend(columns: list[str]) -> str:
 
 
 def summary_table(summaries: list[dict[str, Any]]) -> str:
-    """Text table of results (one row each) under a header line (:func:`header`).
-
-    The identity columns shared by every row are in the header, not the rows; the
-    columns follow :data:`COLUMNS`, each header with its unit, :data:`LEGEND` below.
-    """
+    """Text table of results (one row each, :data:`COLUMNS`) under a header line holding
+    the identity columns every row shares (:func:`header`), :data:`LEGEND` below."""
     df = pd.DataFrame([row_of(s) for s in summaries])
     mix = differing(df)
     drop = {c for c in ("scenario", "horizon_s", "warmup_s", "kind") if c not in mix}

@@ -1,49 +1,27 @@
 """The closed loop in SUMO: sense, estimate, decide, actuate; two PDE twins alongside.
 
-Sequence of :func:`run_cosimulation` (``arzsumo run``), on the run object
-(:class:`~arzsumo.bridge.prepared.PreparedRun`) that
-:func:`arzsumo.bridge.session.prepare_run` made of a scenario and checked once (among
-others: no PDE controller at a free-flow scenario equilibrium, a dead time it can
-compensate); every stage below reads the run's configuration from it alone:
+:func:`run_cosimulation` (``arzsumo run``) runs the :class:`~arzsumo.bridge.prepared.PreparedRun`
+that :func:`arzsumo.bridge.session.prepare_run` checked once; every stage reads the run's
+configuration from it alone:
 
-1. (the checks above, not repeated here)
-2. Start SUMO, with vehicles placed from the scenario's ``[initial]`` profile if asked.
-3. Warm up: the same step loop as control, under the nominal meter plan, for the
-   warm-up rounded up to whole control periods (at least one, to measure from).
-4. With ``equilibrium = "measured"``, take the mean Edie densities of the last 60 s of the
-   warm-up as the equilibrium of the (calibrated) model, and check its regime and the
-   dead time at it.
-5. Build the controller (kernels solved or loaded; ALINEA's settings from ``[alinea]``),
-   the actuator and both twins from the measured state at the start of control.
-6. Every control period: sense, estimate, decide, actuate, record, in one place
-   (:class:`~arzsumo.bridge.loop.ClosedLoop`, whose docstring follows a detector sample
-   from SUMO to the meter).
-7. After the window, with ``[sumo] drain_max_s`` > 0, the drain
-   (:func:`~arzsumo.bridge.drain.drain`) through the same step loop
-   (:class:`~arzsumo.sumo.plant.SumoPlant`).
+1. (those checks)
+2. Start SUMO, with vehicles placed from ``[initial]`` if asked (:func:`open_run`).
+3. Warm up at the nominal plan, for the warm-up rounded up to whole control periods (at
+   least one; :func:`warm_start`). It does not depend on the controller, so several
+   controllers can continue one (:mod:`arzsumo.bridge.branches`).
+4. With ``equilibrium = "measured"``, the mean Edie densities of the warm-up's last 60 s
+   are the model's equilibrium; its regime and the dead time are checked at it.
+5. Build the controller, the actuator and both twins from the measured state at t = 0.
+6. Every control period: :class:`~arzsumo.bridge.loop.ClosedLoop`.
+7. After the window, with ``[sumo] drain_max_s`` > 0, the drain (:mod:`arzsumo.bridge.drain`).
 
-Steps 2, 3 and 4-7 are :func:`open_run`, :func:`warm_start` and :func:`finish_run`; the
-warm-up does not depend on the controller, so several controllers can continue one
-(:mod:`arzsumo.bridge.branches`).
-
-The meter's counts (plan and light changes, queue maximum) cover the control window only:
-the meter's window is closed at the start of control and the warm-up's counts are kept
-apart (``CoSimResult.warmup_meter``).
-
-SUMO writes its own outputs (tripinfo of every loaded vehicle with emissions, edge data,
-statistics; :func:`~arzsumo.sumo.network_measures.network_options`) into a scratch
-directory; after the run they become the network measures of the control window and of
-the whole run (:mod:`arzsumo.sumo.window`, ``CoSimResult.network``), the sensor's speed
-moments of the section (``CoSimResult.section_speed``; its lateral snapshots:
-``CoSimResult.lateral``), and the compressed tripinfo kept with the results. The run's
-SUMO configuration (``run.sumocfg`` and its files) and, with ``[sumo] fcd``, SUMO's FCD
-output are kept in ``CoSimResult.files`` (:mod:`arzsumo.sumo.run_files`) for the results
-directory.
+Steps 4-7 are :func:`finish_run`. The meter's counts cover the control window only (the
+warm-up's: ``CoSimResult.warmup_meter``). SUMO's own outputs, written to a scratch
+directory, become the network measures (:mod:`arzsumo.sumo.window`).
 """
 
 from __future__ import annotations
 
-import logging
 import math
 import shutil
 import tempfile
@@ -92,8 +70,6 @@ from arzsumo.sumo.sensor import PeriodMeasurement
 from arzsumo.sumo.simulation import SumoSimulation, open_simulation
 from arzsumo.sumo.window import NetworkMeasures, WindowStart, measure_network
 from arzsumo.units import ms_to_kmh
-
-log = logging.getLogger(__name__)
 
 #: seconds of warm-up averaged for a measured equilibrium
 MEASURE_WINDOW = 60.0
@@ -147,21 +123,16 @@ def operating_point(settings: RunSettings, eq: Equilibrium,
     return measured
 
 
-def meter_rates(cfg: SumoConfig) -> ReleaseRates:
-    """The meter's nominal release rate and bounds (veh/s): ALINEA's and the held meter's
-    r_nominal, r_min, r_max (U = r_nominal - r)."""
-    return ReleaseRates(cfg.release_rate, cfg.release_rate_min, cfg.release_rate_max)
-
-
 def build_controller(name: str, lin: Linearization, kernels: Any,
                      run: PreparedRun) -> Controller:
     """A reset controller of ``name`` for the closed loop (the registry's builder), with
     the run's ``[design]`` and ``[alinea]``; the ``constant`` controller holds the release
     rate ``[run] constant_release_veh_h``."""
     cfg = run.sumo
+    rates = ReleaseRates(cfg.release_rate, cfg.release_rate_min, cfg.release_rate_max)
     inputs = ControllerInputs(lin, kernels, run.design,
                               constant_u=cfg.release_rate - run.settings.constant_release,
-                              alinea=run.scenario.alinea, rates=meter_rates(cfg),
+                              alinea=run.scenario.alinea, rates=rates,
                               check_period=cfg.control_period)
     ctrl = controller_spec(name, "sumo").build(inputs)
     ctrl.reset()
@@ -185,8 +156,7 @@ def place_initial(params: ModelParameters, settings: RunSettings, cfg: SumoConfi
 @dataclass
 class Warmed:
     """The end of the warm-up (step 3 of the module docstring), the same for every
-    controller: the plant, the warm-up's measurements, its meter counts and the state of
-    the system as the control window opens."""
+    controller, and the state of the system as the control window opens."""
 
     plant: SumoPlant
     warm: list[PeriodMeasurement]
@@ -210,8 +180,7 @@ def warm_start(sim: SumoSimulation, run: PreparedRun, bar: RunProgress) -> Warme
 @dataclass
 class Controlled:
     """What the warm-up and the control window left: the loop (plant, controller, twins),
-    the design point, the warm-up's meter counts and the window's start; its trace is the
-    loop's (:attr:`trace`)."""
+    the design point, the warm-up's meter counts and the window's start."""
 
     loop: ClosedLoop
     ref_ctrl: Controller
@@ -223,8 +192,7 @@ class Controlled:
     settings: RunSettings
     stationary: tuple[np.ndarray, float]   # the warm-up's state and band (evaluation.decay)
     trigger_noise: float | None = None     # veh/s: the law's output noise sizing the dead band
-    law: Controller | None = None          # the law built for the run (the loop's, or
-                                           # the one an outside driver stands in for)
+    law: Controller | None = None          # the law built for the run (given to in_loop)
 
     @property
     def trace(self) -> Trace:
@@ -285,25 +253,11 @@ def run_cosimulation(run: PreparedRun, *, progress: bool | RunProgress = False,
                      frontend: str = "libsumo") -> CoSimResult:
     """Run SUMO with the controller of ``run`` and both twins (module docstring).
 
-    Parameters
-    ----------
-    run : PreparedRun
-        What :func:`arzsumo.bridge.session.prepare_run` made of a scenario and the
-        caller's overrides: everything the run is configured by.
-    progress : bool or RunProgress
-        As in :func:`open_run`.
-    keep_measurements : bool
-        Keep every period's measurement, warm-up included, in ``estimator.measurements``
-        (for offline estimation, :mod:`arzsumo.bridge.sensor_record`).
-    frontend : str
-        "libsumo", "traci" or "gui" (watch the run in sumo-gui;
-        :mod:`arzsumo.sumo.frontend`).
-
-    Returns
-    -------
-    CoSimResult
-        The run's records; its SUMO configuration, and with ``[sumo] fcd`` its FCD output,
-        are kept in ``files`` (:mod:`arzsumo.sumo.run_files`).
+    ``progress`` as in :func:`open_run`; ``keep_measurements`` keeps every period's
+    measurement, warm-up included, in ``estimator.measurements`` (offline estimation,
+    :mod:`arzsumo.bridge.sensor_record`); ``frontend``: "libsumo", "traci" or "gui"
+    (:mod:`arzsumo.sumo.frontend`). The result keeps the run's SUMO configuration and,
+    with ``[sumo] fcd``, its FCD output in ``files`` (:mod:`arzsumo.sumo.run_files`).
     """
     with open_run(run, progress=progress, frontend=frontend) as opened:
         warmed = warm_start(opened.sim, run, opened.bar)
@@ -312,9 +266,8 @@ def run_cosimulation(run: PreparedRun, *, progress: bool | RunProgress = False,
 
 def finish_run(opened: OpenRun, warmed: Warmed, run: PreparedRun,
                keep_measurements: bool = False) -> CoSimResult:
-    """From the end of the warm-up: the control window of ``run``, the drain, SUMO
-    closed, and the network measures read from SUMO's outputs (steps 4-7 of the module
-    docstring)."""
+    """From the end of the warm-up: the control window of ``run`` and what
+    :func:`close_window` does (steps 4-7 of the module docstring)."""
     return close_window(opened, control(warmed, run, opened.bar, keep_measurements), run)
 
 

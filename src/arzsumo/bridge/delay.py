@@ -1,18 +1,10 @@
 """Delay compensation in the closed loop (``[actuation] delay_compensation_s``).
 
-The PDE controller that acts (continuous backstepping or the full-state ETC, also the ETC
-that an ``observer-etc`` run becomes with an ``[estimation] method``) is wrapped in
-:class:`arzsumo.control.compensation.DelayCompensated`: its law sees the scaled Riemann
-state predicted theta seconds ahead, with the U applied in the last theta seconds (the
-closed loop tells it through :meth:`arzsumo.control.base.Controller.actuated`). theta = 0
-(the default) wraps nothing: today's loop. The reference twin's controller is never
-wrapped (the twin has no dead time).
-
-Refused before SUMO starts, in one line naming the key: theta >= L / max |lambda| at the
-design equilibrium (also after a measured equilibrium, before control starts), and the
-observer-ETC on its own boundary observer (``[estimation] method = "none"``), whose
-boundary model takes the command as acting at once
-(:mod:`arzsumo.control.compensation`).
+The acting backstepping or ETC law is wrapped in
+:class:`arzsumo.control.compensation.DelayCompensated` (theta = 0: nothing wrapped); the
+reference twin's controller never is. Refused before SUMO starts: theta >= L / max |lambda|,
+and the observer-ETC on its own boundary observer. docs/sumo.md, 'Actuation limits'
+(Delay compensation).
 """
 
 from __future__ import annotations

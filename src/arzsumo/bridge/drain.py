@@ -1,23 +1,11 @@
 """The drain: after the control window, the run goes on until every loaded vehicle has left.
 
-The demand is finite (flows end with the control window, :mod:`arzsumo.sumo.demand`), so
-a controller that stored vehicles on the ramp or upstream leaves them in the system at
-the window's end. Every controller then hands the meter to the same *drain policy*: the
-queue override held on, so the meter releases at its largest rate (one per green:
-``release_rate_max``; the fixed cycle: green) until the network is empty, at most
-``[sumo] drain_max_s``. The policy is the one field meters fall back to when the queue
-reaches the ramp's storage, it needs no state of the controller, and it empties the ramp
-as fast as the meter can: what each controller left is charged the same way, at the
-least cost the meter allows. No controller, sensor or twin runs during the drain; fuel
-and CO2 are summed every step (SUMO's emissions device cannot be read while running) so
-that the control window's measures stay those of the window
-(:func:`arzsumo.sumo.window.finish_window`).
-
-Teleports are off, so a gridlock (measured: vehicles at the merge that wait for each other
-for good, 1 drain in 5 on the default) would hold the run until ``drain_max_s``. A drain in
-which no vehicle arrives for :data:`STALL_S` while vehicles remain ends there as
-``gridlock``: the run is then incomplete (its whole-demand measures charge vehicles only to
-the end), which the summary and the evaluation report.
+Every controller hands the meter to the same *drain policy*, the queue override held on,
+until the network is empty, at most ``[sumo] drain_max_s``. No controller, sensor or twin
+runs; fuel and CO2 are summed every step (SUMO's emissions device cannot be read while
+running), so the window's measures stay the window's. Teleports are off, so vehicles at the merge
+can wait for each other for good (measured: 1 drain in 5 on the default); a drain with no
+arrival for :data:`STALL_S` while vehicles remain ends as ``gridlock``. docs/whole_demand.md.
 """
 
 from __future__ import annotations

@@ -1,11 +1,8 @@
 """The estimation stage of the closed loop: a period's measurement to a :class:`MacroState`.
 
-An estimator turns what the sensor read (:class:`~arzsumo.sumo.sensor.PeriodMeasurement`)
-into the macroscopic fields a controller is checked on. The first one,
-:class:`FundamentalDiagramFill`, takes the Edie cells as they are and gives cells that no
-vehicle of a class visited the fundamental diagram's equilibrium speed at the cell's
-densities: a speed is needed everywhere, and an empty cell's vehicles would drive at
-Ve (paper, eq. ``Ve``). Later estimators (smoothing, filters) plug in here.
+:class:`FundamentalDiagramFill` takes the Edie cells as they are, cells no vehicle of a
+class visited at the equilibrium speed Ve of their densities (paper, eq. ``Ve``); the
+sparse-sensor estimators are in :mod:`arzsumo.bridge.estimators`.
 """
 
 from __future__ import annotations

@@ -1,31 +1,13 @@
 """Estimators of the closed loop on sparse sensors: ASM smoothing and the EnKF.
 
-The ``[estimation] method`` of a scenario picks what the controller acts on:
-
-* ``"none"``: :class:`~arzsumo.bridge.estimator.FundamentalDiagramFill`, the full
-  probe's cells (today's rule, unchanged);
-* ``"smoothing"``: :class:`SmoothingEstimator`, the causal adaptive smoothing method
-  (:class:`arzsumo.estimate.smoothing.CausalSmoother`) of the period's loop records and
-  AV probes, evaluated at the end of the period on the controller's cells;
-* ``"enkf"``: :class:`EnkfEstimator`, the ensemble Kalman filter on batched first-order
-  twins (:class:`arzsumo.estimate.enkf.EnsembleKalmanFilter`): every period each member
-  is advanced with the inflow state of the station at x = 0 and the outflow of the
-  station at x = L (:meth:`~arzsumo.estimate.enkf.BoundaryInput.from_loops`), then
-  assimilates the loop and probe records.
-
-Both read only the sparse sensors (``PeriodMeasurement.loops`` and ``.probes``), never
-the full probe's cells, which stay the ground truth of the scoring. Where a method has no
-datum of a quantity in reach, a density is the design equilibrium's and a speed Ve at
-the cell's densities (paper, eq. ``Ve``): the controller needs a value everywhere.
-
-``observer-etc`` in SUMO with an estimator is the ETC (the paper's full-state mechanism,
-defdynamic) on the estimate from the two boundary stations only (:func:`boundary_only`),
-instead of the paper's boundary observer, which has no output injection for this model
-(P = 0) and hardly acts in SUMO. With ``method = "none"`` it keeps the paper's observer.
-
-:class:`RecordedEstimator` wraps any of them and keeps, per control period, the fields
-the controller got, the EnKF's spread and the linear interpolation between the loop
-stations (the baseline an estimator must beat), for ``summary.json["estimation"]``.
+``[estimation] method`` picks what the controller acts on: ``"none"``, the full probe's
+cells (:class:`~arzsumo.bridge.estimator.FundamentalDiagramFill`); ``"smoothing"``
+(:class:`SmoothingEstimator`); ``"enkf"`` (:class:`EnkfEstimator`). Both read only the
+loops and AV probes; where they have no datum, a density is the design equilibrium's and
+a speed Ve. ``observer-etc`` with a method is the ETC on the estimate from the two
+boundary stations only (:func:`boundary_only`). :class:`RecordedEstimator` keeps what
+the controller got, for ``summary.json["estimation"]``. docs/sumo.md, 'Estimation in the
+closed loop'.
 """
 
 from __future__ import annotations
@@ -68,18 +50,12 @@ def _state(t: float, x: np.ndarray, z: np.ndarray, m: PeriodMeasurement) -> Macr
     return MacroState(t, x, z[0], z[1], z[2], z[3], m.occupancy_out)
 
 
-class SparseData:
-    """The sparse records of a measurement an estimator uses (all, or boundary loops)."""
-
-    def __init__(self, boundary: bool) -> None:
-        self.boundary = boundary
-
-    def __call__(self, m: PeriodMeasurement
-                 ) -> tuple[list[LoopObservation], list[ProbeObservation]]:
-        loops = [] if m.loops is None else [boundary_only(m.loops) if self.boundary
-                                            else m.loops]
-        probes = [] if m.probes is None or self.boundary else [m.probes]
-        return loops, probes
+def sparse_data(m: PeriodMeasurement, boundary: bool
+                ) -> tuple[list[LoopObservation], list[ProbeObservation]]:
+    """The sparse records of ``m`` an estimator uses (all, or the boundary loops only)."""
+    loops = [] if m.loops is None else [boundary_only(m.loops) if boundary else m.loops]
+    probes = [] if m.probes is None or boundary else [m.probes]
+    return loops, probes
 
 
 class SmoothingEstimator:
@@ -89,28 +65,25 @@ class SmoothingEstimator:
                  boundary: bool = False) -> None:
         self.eq, self.x = eq, np.asarray(x, float)
         self.smoother = CausalSmoother(self.x, settings.asm)
-        self.data = SparseData(boundary)
+        self.boundary = boundary
         self.sd: np.ndarray | None = None
 
     def estimate(self, measurement: PeriodMeasurement, t: float) -> MacroState:
-        self.smoother.add(*self.data(measurement))
+        self.smoother.add(*sparse_data(measurement, self.boundary))
         z = filled(self.eq, self.smoother.estimate(measurement.t))
         return _state(t, self.x, z, measurement)
 
 
 class EnkfEstimator:
-    """EnKF on the cells ``x`` (m), started at the first measurement; see the module.
-
-    The first guess is the linear interpolation between the loop stations of the first
-    record (:func:`filled`); the ensemble spreads around it by the filter's initial
-    spread. :attr:`sd` is the ensemble spread (4, n) of the last estimate.
-    """
+    """EnKF on the cells ``x`` (m), started at the first measurement from the interpolation
+    between its loop stations (:func:`filled`); :attr:`sd` the ensemble spread (4, n) of
+    the last estimate."""
 
     def __init__(self, eq: Equilibrium, x: np.ndarray, settings: EstimationSettings,
                  boundary: bool = False) -> None:
         self.eq, self.x = eq, np.asarray(x, float)
         self.options = settings.enkf(self.x.size)
-        self.data = SparseData(boundary)
+        self.boundary = boundary
         self.filter: EnsembleKalmanFilter | None = None
         self.sd: np.ndarray | None = None
 
@@ -118,7 +91,7 @@ class EnkfEstimator:
         m = measurement
         if m.loops is None:
             raise RuntimeError("the EnKF needs loop records (open SUMO with the loops)")
-        loops, probes = self.data(m)
+        loops, probes = sparse_data(m, self.boundary)
         p = self.eq.params
         if self.filter is None:
             first = filled(self.eq, interpolate_loops(loops[0], self.x))
@@ -172,11 +145,8 @@ class RecordedEstimator:
         its estimate (4, n) of each (for the warm-up reference, :mod:`.reference`)."""
         if self.measurements is not None:
             self.measurements.extend(warm)
-        out = []
-        for m in warm:
-            s = self.inner.estimate(m, m.t - t0)
-            out.append(np.vstack([s.rho_h, s.v_h, s.rho_a, s.v_a]))
-        return out
+        states = (self.inner.estimate(m, m.t - t0) for m in warm)
+        return [np.vstack([s.rho_h, s.v_h, s.rho_a, s.v_a]) for s in states]
 
 
 def acting_controller(method: str, controller: str) -> str:
@@ -189,13 +159,11 @@ def acting_controller(method: str, controller: str) -> str:
 def estimation_stage(settings: EstimationSettings, layout: SensorLayout, controller: str,
                      eq: Equilibrium, x: np.ndarray, keep: bool = False
                      ) -> tuple[RecordedEstimator, str]:
-    """The estimator of a run and the controller that acts on it.
-
-    ``controller`` is the run's; ``observer-etc`` with a method other than ``none``
-    becomes ``etc`` on the boundary stations' estimate (module docstring). ``keep``:
-    the estimator keeps every measurement (:attr:`RecordedEstimator.measurements`).
-    """
-    boundary = controller == "observer-etc" and settings.method != "none"
+    """The estimator of a run of ``controller`` and the controller that acts on it
+    (:func:`acting_controller`); ``keep``: the estimator keeps every measurement
+    (:attr:`RecordedEstimator.measurements`)."""
+    acting = acting_controller(settings.method, controller)
+    boundary = acting != controller        # observer-etc on the boundary stations
     inner: Estimator
     if settings.method == "smoothing":
         inner = SmoothingEstimator(eq, x, settings, boundary)
@@ -209,5 +177,4 @@ def estimation_stage(settings: EstimationSettings, layout: SensorLayout, control
                  "loops (boundaries)": "loops (boundaries, harmonic speed)"}
         sensors = tuple(named.get(k, k) for k in sensors)
     return (RecordedEstimator(inner, settings.method, sensors, eq,
-                              measurements=[] if keep else None),
-            acting_controller(settings.method, controller))
+                              measurements=[] if keep else None), acting)

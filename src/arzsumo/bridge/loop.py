@@ -1,40 +1,19 @@
 """One control period of the closed loop, in one place: sense, estimate, decide, actuate, record.
 
-:meth:`ClosedLoop.run` is the whole control window. Each stage is one call, and what it
-returns flows forward only:
+A detector sample's path: ``SumoSensor.observe`` (every step; the sensor is the only
+reader of SUMO) -> ``PeriodMeasurement`` -> ``Estimator.estimate`` (minus the warm-up
+reference, :mod:`~arzsumo.bridge.reference`) -> ``MacroState`` -> ``Controller.step`` (told
+what was applied for its previous check) -> ``Command`` -> ``MeterActuator.apply`` (the
+limits, :mod:`~arzsumo.bridge.actuator`) -> ``MeterLight.set_plan`` -> the light, from the
+next cycle on. Each check and the period that followed become one
+:class:`~arzsumo.bridge.records.PeriodRecord`; the reference twin's controller checks on
+the reference twin, and both twins advance over the period.
 
-1. **sense**: SUMO runs one control period under the meter's present command
-   (:meth:`arzsumo.sumo.plant.SumoPlant.run_period`): the sensor's
-   :class:`~arzsumo.sumo.sensor.PeriodMeasurement` and the meter's state at the period's
-   end (:class:`~arzsumo.sumo.meter.MeterState`). The sensor is the only reader of SUMO.
-2. **estimate**: the measurement becomes the macroscopic state the controller acts on
-   (:class:`~arzsumo.bridge.estimator.Estimator`; minus the warm-up reference,
-   :mod:`~arzsumo.bridge.reference`, when the scenario asks for it).
-3. **decide**: the controller takes what the actuator applied for its previous check and
-   checks on the state (:meth:`arzsumo.control.base.Controller.step`, a
-   :class:`~arzsumo.control.base.Command`); the reference twin's controller checks on
-   the reference twin.
-4. **actuate**: the command's U, limited by ``[actuation]``, the queue override and the
-   meter's bounds, becomes the meter's plan (:class:`~arzsumo.bridge.actuator.MeterActuator`,
-   an :class:`~arzsumo.bridge.actuator.Actuation`); what it applied is told to the
-   controller at the next check.
-5. **record**: the check and the period that followed become one
-   :class:`~arzsumo.bridge.records.PeriodRecord`; both twins advance over the period
-   (:class:`~arzsumo.bridge.twins.TwinPair`) and their fields are kept beside SUMO's.
-
-The first check is on the warm-up's last measurement (t = 0). No command follows the
-last check, at the horizon: no period follows it, and a plan change there would never run.
-
-:meth:`ClosedLoop.run` is :meth:`~ClosedLoop.begin`, then per period
-:meth:`~ClosedLoop.estimate`, :meth:`~ClosedLoop.decide` and :meth:`~ClosedLoop.advance`;
-an outside driver (the Gymnasium environment :mod:`arzsumo.gym`) calls the same stages
-one period at a time, with the loop keeping where it is (:attr:`~ClosedLoop.m`,
-:attr:`~ClosedLoop.t`, :attr:`~ClosedLoop.told`, :attr:`~ClosedLoop.trace`).
-
-A detector sample's path: ``SumoSensor.observe`` (libsumo, every step) ->
-``PeriodMeasurement`` -> ``Estimator.estimate`` -> ``MacroState`` -> ``Controller.step``
--> ``Command`` -> ``MeterActuator.apply`` (limits, override, the meter's bounds) ->
-``MeterLight.set_plan`` -> the light, set by ``MeterLight.step`` from the next cycle on.
+The first check is on the warm-up's last measurement (t = 0); no command follows the last
+check, at the horizon (no period follows it). :meth:`ClosedLoop.run` is
+:meth:`~ClosedLoop.begin`, then per period :meth:`~ClosedLoop.estimate`,
+:meth:`~ClosedLoop.decide` and :meth:`~ClosedLoop.advance`; an outside driver
+(:mod:`arzsumo.gym`) calls the same stages one period at a time.
 """
 
 from __future__ import annotations
@@ -66,27 +45,9 @@ class Check:
 
 
 class ClosedLoop:
-    """The stages of the control window (module docstring), each one object.
-
-    Parameters
-    ----------
-    plant : SumoPlant
-        SUMO with its sensor and meter.
-    estimator : Estimator
-        Measurement -> the state the controller acts on.
-    controller : Controller
-        The acting law.
-    actuator : Actuator
-        U -> the meter's plan, or the outlet's speed limit.
-    twins : TwinPair
-        The replay and reference PDE twins beside SUMO.
-    period : float
-        Control period, s.
-    anti_windup : bool
-        Tell the controller the range its U was limited to (``[actuation] anti_windup``).
-    shift : ReferenceShift, optional
-        The warm-up reference subtracted from the estimate.
-    """
+    """The stages of the control window (module docstring), each one object; ``period``:
+    the control period (s); ``anti_windup``: tell the controller the range its U was
+    limited to; ``shift``: the warm-up reference subtracted from the estimate."""
 
     def __init__(self, plant: SumoPlant, estimator: Estimator, controller: Controller,
                  actuator: Actuator, twins: TwinPair, period: float,
@@ -96,8 +57,7 @@ class ClosedLoop:
         self.anti_windup, self.shift = anti_windup, shift
         self.timings = {"controller": 0.0, "twins": 0.0, "estimator": 0.0}
         # where the window stands (begin, advance): the start's SUMO time (s), the last
-        # measurement, its time from the start of control (s), what the controller is
-        # told at its next check, the trace so far
+        # measurement's time from it (s), what the controller is told at its next check
         self.t0, self.t = 0.0, 0.0
         self.told: Applied | None = None
         self.m: PeriodMeasurement | None = None

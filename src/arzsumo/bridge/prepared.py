@@ -1,12 +1,8 @@
 """The run object: one scenario checked and resolved for SUMO, what the engine runs.
 
-:func:`arzsumo.bridge.session.prepare_run` makes a :class:`PreparedRun` from a scenario
-and the caller's overrides (``arzsumo run`` options); :func:`arzsumo.bridge.cosim.
-run_cosimulation` and its stages read everything a run is configured by from it. The
-configuration lives once, in the scenario: the run settings, SUMO settings and ETC design
-are its ``[run]``, ``[sumo]`` and ``[design]`` tables, and the run adds only what
-``prepare_run`` derived from them (the placement profile, the meter curve). A variant of
-a run is a changed scenario (:meth:`arzsumo.scenario.Scenario.with_`) prepared again.
+:func:`arzsumo.bridge.session.prepare_run` makes it; the configuration lives once, in the
+scenario (its ``[run]``, ``[sumo]`` and ``[design]``), and the run adds only what
+``prepare_run`` derived from them. A variant of a run is a changed scenario prepared again.
 """
 
 from __future__ import annotations
@@ -30,16 +26,10 @@ class PreparedRun:
     """A run checked and resolved, ready for SUMO: what
     :func:`~arzsumo.bridge.session.prepare_run` returns.
 
-    Attributes
-    ----------
-    scenario : Scenario
-        The scenario with the caller's overrides applied; the one source of the run's
-        settings (:attr:`settings`, :attr:`sumo`, :attr:`design`).
-    initial : numpy.ndarray or None
-        Fields (4, cells on the micro grid) to place vehicles from at t = 0 with
-        ``[run] start = "placement"``; None otherwise.
-    curve : GreenShareCurve
-        The meter's green-share curve (``[sumo] meter_curve``, or the default).
+    ``scenario``: the scenario with the caller's overrides, the one source of the run's
+    settings (:attr:`settings`, :attr:`sumo`, :attr:`design`); ``initial``: fields (4,
+    cells on the micro grid) to place vehicles from at t = 0 with ``[run] start =
+    "placement"``, else None; ``curve``: the meter's green-share curve.
     """
 
     scenario: Scenario

@@ -1,8 +1,7 @@
 """What one control period of the closed loop leaves behind: a typed record per period.
 
 Record k pairs the check at ``t`` (s from the start of control) with the SUMO period that
-followed it under that check's command, ending at ``t + control_period``; the fields of
-that period's end are stored beside (see :class:`~arzsumo.bridge.result.CoSimResult`).
+followed it under that check's command (docs/outputs.md, ``periods.parquet``).
 """
 
 from __future__ import annotations
@@ -20,21 +19,9 @@ from arzsumo.sumo.sensor import PeriodMeasurement
 
 @dataclass(frozen=True)
 class PeriodRecord:
-    """One control period (SI; flows veh/s, counts since the start of control).
-
-    ``u`` is the U applied after the check (veh/s; ``u_applied``, after the
-    ``[actuation]`` limits of :mod:`~arzsumo.bridge.actuator`), ``u_raw`` the U the
-    controller held (its law's, before the limits), ``saturated`` and ``rate_limited``
-    (1.0 or 0.0) which limits acted; ``u_continuous`` what the continuous
-    law gave, ``triggered`` an update of the held U (1.0 or 0.0), ``green_commanded`` the
-    green share asked of the meter, ``u_reference`` the reference twin's U,
-    ``controller_s`` the wall time of the check. The rest is the period that followed:
-    the running green share, cumulative light and plan changes, the ramp queue at its end
-    and its maximum so far (veh), class in- and outflows of the section, the occupancy
-    (fraction) and flow (veh/s) of the loop on ``down`` past the merge nose, the release
-    rate the meter was asked for (veh/s; NaN for a fixed-cycle meter), and whether the
-    meter's queue override was on at the period's end (1.0 or 0.0), and the outlet's
-    speed limit commanded after the check (m/s; NaN when the meter is the actuator).
+    """One control period (SI; flows veh/s, counts since the start of control; flags 1.0 or
+    0.0): the check at ``t`` and the period that followed. The columns of
+    ``periods.parquet``, each described in :data:`arzsumo.schema.PERIODS` (docs/outputs.md).
     """
 
     t: float
@@ -66,9 +53,8 @@ class PeriodRecord:
     @classmethod
     def of(cls, t: float, command: Command, act: Actuation, u_reference: float,
            controller_s: float, m: PeriodMeasurement, meter: MeterState) -> PeriodRecord:
-        """The record of the check at ``t`` (s from the start of control): what it decided
-        and what was applied, the reference twin's U (veh/s), the check's wall time (s),
-        and the period that followed (the sensor's measurement, the meter at its end)."""
+        """The record of the check at ``t`` (s from the start of control) and of the period
+        that followed (the sensor's measurement, the meter at its end); times in s."""
         c = m.cells
         return cls(t=t, u=act.u_applied, u_continuous=command.u_continuous,
                    triggered=float(command.triggered), green_commanded=act.green,

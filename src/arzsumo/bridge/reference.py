@@ -1,17 +1,14 @@
 """The state a PDE controller regulates to: the model's equilibrium, or the mean state SUMO
-held in the warm-up.
+held in the warm-up (``[estimation] reference``, docs/scenarios.md).
 
-The backstepping law (paper, eq. ``control_law``) and the ETC's trigger act on deviations
-from the equilibrium (rho*, v*) of the model. Where the model's fundamental diagram and
-SUMO disagree about the speed at the densities SUMO holds, a state SUMO holds for minutes
-under the nominal plan is a constant deviation to the law, and it answers with a constant
-U: on the default scenario's open-loop runs -610 veh/h, against q* = 4464 veh/h (the mean
-field of 450 s gives v_h 39.9 and v_a 14.5 km/h where the identified FD says 43.7 and
-19.2). ``reference = "warmup"`` measures the deviations from the mean of the estimate over
-the warm-up's last ``reference_window`` seconds instead: the state the nominal plan holds
-gets U = 0, and the law acts on what moves about it. The laws are linear in the fields
-(:class:`arzsumo.control.backstepping.StateMap`), so this is the same as subtracting the
-law's answer to the constant offset.
+Where the model's fundamental diagram and SUMO disagree about the speed at SUMO's
+densities, a state SUMO holds for minutes under the nominal plan is a constant deviation
+to the law (paper, eq. ``control_law``), answered with a constant U: on the default
+scenario's open-loop runs -610 veh/h against q* = 4464 veh/h (the mean field of 450 s
+gives v_h 39.9 and v_a 14.5 km/h where the identified FD says 43.7 and 19.2). With
+``reference = "warmup"`` that state gets U = 0; the laws being linear in the fields
+(:class:`arzsumo.control.backstepping.StateMap`), this subtracts the law's answer to the
+constant offset.
 """
 
 from __future__ import annotations
@@ -47,12 +44,9 @@ class ReferenceShift:
 
 def reference_shift(reference: str, warm_fields: Sequence[np.ndarray], eq: Equilibrium,
                     window: float, period: float) -> ReferenceShift:
-    """The shift of ``reference`` (:data:`REFERENCES`).
-
-    ``warm_fields``: the estimate (4, n) of every warm-up period, oldest first; the mean of
-    the last ``window`` seconds (periods of ``period`` s, at least one) minus the
-    equilibrium is the offset of ``"warmup"``; ``"equilibrium"`` has a zero offset.
-    """
+    """The shift of ``reference`` (:data:`REFERENCES`): zero for ``"equilibrium"``; for
+    ``"warmup"`` the mean of the last ``window`` s of ``warm_fields`` (the estimate (4, n)
+    of every warm-up period of ``period`` s, oldest first; one at least) minus ``eq``."""
     if reference not in REFERENCES:
         raise ValueError(f"reference {reference!r}: one of {REFERENCES}")
     n = np.asarray(warm_fields[-1]).shape[1]

@@ -1,24 +1,10 @@
 """One SUMO run as identification data: :func:`replay_data_of`.
 
-A :class:`~arzsumo.bridge.result.CoSimResult` becomes an
-:class:`arzsumo.identify.ReplayData` holding what the bridge's *replay* twin was given and
-what it was compared with:
-
-* ``fields``: SUMO's Edie cells at the end of every control period (``res.micro``; NaN
-  speeds where a class left a cell empty: unobserved);
-* ``initial``: the measured state at the start of control (``res.start``), complete:
-  empty cells at the equilibrium speed of their densities, densities floored
-  (:func:`~arzsumo.bridge.boundary_data.measured_state`);
-* ``inlet``: SUMO's first cell, smoothed, period by period
-  (:func:`~arzsumo.bridge.boundary_data.inlet_series`, the function the twins use);
-* ``outflow``: the total outflow at x = L, smoothed the same way from the nominal
-  meter's outflow (:func:`~arzsumo.bridge.boundary_data.outflow_series`);
-* ``scale``: the run's equilibrium (rho_h*, v_h*, rho_a*, v_a*), for relative errors.
-
-With :func:`replay_options_of` (the run's twin grid, scheme and AO limit, and the bridge's
-``ghost`` inlet), :func:`arzsumo.identify.replay` of this data under the run's parameters
-reproduces the bridge's replay field of a run without re-synchronisations (``tests/bridge/
-test_replay_data.py`` states the tolerance).
+A :class:`~arzsumo.bridge.result.CoSimResult` becomes an :class:`arzsumo.identify.ReplayData`
+holding what the bridge's *replay* twin was given (from :mod:`~arzsumo.bridge.boundary_data`,
+as the twins) and what it was compared with; under :func:`replay_options_of` the
+identification's replay reproduces the bridge's replay field (``tests/bridge/
+test_replay_data.py``). docs/identify.md, 'What it does'.
 """
 
 from __future__ import annotations
@@ -46,23 +32,13 @@ def replay_options_of(settings: RunSettings, inlet: str = "ghost") -> ReplayOpti
 
 def replay_data_of(res: CoSimResult, *, params: ModelParameters | None = None,
                    name: str | None = None) -> ReplayData:
-    """The run ``res`` as :class:`~arzsumo.identify.ReplayData` (module docstring).
+    """The run ``res`` as :class:`~arzsumo.identify.ReplayData` (module docstring), SI.
 
-    Parameters
-    ----------
-    res : CoSimResult
-        A finished co-simulation (it must hold ``start``, the state at control start).
-    params : ModelParameters, optional
-        The model whose equilibrium speed fills empty cells of the initial and inlet
-        states; default the run's (``res.equilibrium.params``, as its twins did).
-    name : str, optional
-        Label of the run in reports; default ``seed N``.
-
-    Returns
-    -------
-    ReplayData
-        SI units; periods of ``res.sumo.control_period`` s, smoothing time constant
-        ``res.settings.smoothing`` s.
+    ``res`` must hold ``start``, the state at control start (a result of
+    :func:`~arzsumo.bridge.cosim.run_cosimulation`). ``params``: the model whose Ve fills
+    empty cells of the initial and inlet states (default the run's, as its twins did);
+    ``name``: the run's label in reports (default ``seed N``). Periods of
+    ``res.sumo.control_period`` s, smoothing time constant ``res.settings.smoothing`` s.
     """
     if res.start is None:
         raise ArzsumoError("the run holds no state at the start of control; "

@@ -58,7 +58,6 @@ class CoSimResult:
     #: (``speed_mean_kmh``, ``speed_spread_kmh`` and its former name ``speed_sd_kmh``,
     #: ``speed_samples``)
     section_speed: dict[str, dict[str, float]] = field(default_factory=dict)
-    #: micro state at the start of control (4, cells), as ``micro``
     start: np.ndarray | None = None
     #: what the controller acted on, aligned with ``micro`` (periods, 4, cells), and the
     #: estimator's record (:class:`~arzsumo.bridge.estimators.RecordedEstimator`)

@@ -1,14 +1,9 @@
 """A ``[network]`` scenario checked against its network and resolved for the run.
 
-:func:`with_network` is called by :func:`arzsumo.bridge.session.prepare_run`, so the API
-(``arzsumo.run``, ``arzsumo.prepare``), ``arzsumo run --dry-run`` and ``arzsumo run`` all
-check a user's network before SUMO starts. It reads the network with sumolib
-(:func:`arzsumo.sumo.user_network.read_layout`), takes the road length L and width W
-from it (``[model] length_m`` and ``road_width_m``: when written they must match),
-sizes the ramp's storage from the ramp edge (unless ``[sumo] ramp_storage_veh`` is
-written) and puts the :class:`~arzsumo.sumo.layout.RoadLayout` on the run's
-:class:`~arzsumo.sumo.config.SumoConfig`. Settings that name the shipped network's own
-edges are refused with a user's network.
+:func:`with_network`, called by :func:`arzsumo.bridge.session.prepare_run` (so every run
+and ``--dry-run`` checks a user's network before SUMO starts), reads the network with
+sumolib, takes L and W from it, sizes the ramp's storage and puts the
+:class:`~arzsumo.sumo.layout.RoadLayout` on the run's SUMO settings. docs/networks.md.
 """
 
 from __future__ import annotations

@@ -1,11 +1,9 @@
 """The phases of a SUMO run on the progress bar, weighted by what each costs.
 
-A run is the warm-up, the control window, the drain (until the last vehicle has left)
-and its outputs: SUMO's tripinfo read into the network measures, then (``arzsumo run``)
-the results written. The phases do not cost the same per simulated second, so the bar
-(:class:`arzsumo.progress.RunProgress`) weighs each by its expected cost, in seconds of
-a full network's warm-up, measured on the default scenario (2 cores; see the constants).
-Only ratios matter: the bar calibrates them on the run's own rate.
+Warm-up, control window, drain, network measures and (``arzsumo run``) writing the
+results; each phase is weighted by its expected cost in seconds of a full network's
+warm-up, measured on the default scenario (2 cores). Only ratios matter: the bar
+(:class:`arzsumo.progress.RunProgress`) calibrates them on the run's own rate.
 """
 
 from __future__ import annotations

@@ -1,20 +1,13 @@
 """Estimation offline: one SUMO run's sensor data, replayed through any layout and estimator.
 
-The estimate does not act in an open-loop run, so every sensor layout and estimator sees
-the same traffic on the same seed. :func:`record_run` makes one open-loop run with a
-*superset* of sensors (loop stations every :data:`SUPERSET_SPACING` m, both boundaries
-included, and every AV a probe) and keeps every period's measurement, warm-up included,
-as a :class:`SensorRecord` (arrays; ``.npz`` on disk). :func:`replay_estimation` then
-hands a layout's share of those records (:meth:`SensorRecord.measurements`: the stations
-of the layout, the AV probes if it has them) to the estimator of a scenario, in the order
-and with the times of the closed loop (the warm-up's records first, then the start of
-control at t = 0, then one per period), and :func:`estimation_scores` scores what it gave
-against the full probe's cells as ``summary.json["estimation"]`` does. The numbers equal
-those of the same estimator inside a run (``tests/bridge/test_sensor_record.py``: 1e-9),
-because the stations read each vehicle independently and loading them moves no vehicle.
-The record holds both loop speeds, the time-mean (``speed``) and the harmonic
-(``speed_harmonic``), whatever the recorded scenario's ``[sensing] loop_speed``: the
-layout replayed chooses (:meth:`SensorRecord.measurements`).
+:func:`record_run` makes one open-loop run with a *superset* of sensors (loop stations
+every :data:`SUPERSET_SPACING` m, both boundaries, every AV a probe) and keeps every
+period's measurement, warm-up included, as a :class:`SensorRecord` (``.npz`` on disk),
+both loop speeds included. :func:`replay_estimation` hands a layout's share of it to a
+scenario's estimator as the closed loop would, and :func:`estimation_scores` scores it as
+``summary.json["estimation"]`` does; the numbers equal those inside a run to 1e-9
+(``tests/bridge/test_sensor_record.py``: loading stations moves no vehicle).
+research/readings/estimation_layouts.md.
 """
 
 from __future__ import annotations

@@ -110,11 +110,15 @@ def _check_model(sc: Scenario, cfg: SumoConfig) -> None:
                             "allowed: parameters that keep them finite")
 
 
+def _chosen_at(sc: Scenario, settings: RunSettings, option: str | None) -> str:
+    """Where the controller was chosen (``option``: the caller's name; None: the file)."""
+    return (f"{option} = {settings.controller}" if option else
+            f"{sc.source}: [run] controller = {written(settings.controller)}")
+
+
 def _check_regime(sc: Scenario, settings: RunSettings, option: str | None) -> None:
-    """:func:`check_before_start`, its refusal naming where the controller was chosen
-    (``option``: the caller's name for it; None: the scenario file)."""
-    at = (f"{option} = {settings.controller}" if option else
-          f"{sc.source}: [run] controller = {written(settings.controller)}")
+    """:func:`check_before_start`, its refusal naming where the controller was chosen."""
+    at = _chosen_at(sc, settings, option)
     check_before_start(settings, sc.equilibrium, at, f"the [equilibrium] of {sc.source}")
 
 
@@ -122,8 +126,7 @@ def _check_estimation(sc: Scenario, settings: RunSettings, option: str | None) -
     """observer-etc with an estimator acts on the boundary stations: it needs loops."""
     method = sc.estimation.method
     if settings.controller == "observer-etc" and method != "none" and not sc.sensing.loops:
-        at = (f"{option} = {settings.controller}" if option else
-              f"{sc.source}: [run] controller = {written(settings.controller)}")
+        at = _chosen_at(sc, settings, option)
         raise ScenarioError(f"{at} is not allowed with [estimation] method = "
                             f"{written(method)} and no loops: it acts on the estimate from "
                             "the boundary stations; add \"loops\" to [sensing] kinds")
@@ -131,14 +134,10 @@ def _check_estimation(sc: Scenario, settings: RunSettings, option: str | None) -
 
 def check_warmup(sc: Scenario, warmup: float | None, horizon: float | None,
                  allow_short: bool, names: Mapping[str, str] = CLI_NAMES) -> None:
-    """Refuse control that starts inside the scenario's fill phase.
-
-    A scenario with ``[sumo] fill_s`` > 0 sends a fill demand from t = 0 until the queue
-    of the merge has filled the section; control is meant to start after it. With a
-    warm-up (``warmup``, s, else ``[run] warmup_s``) shorter than the fill, the control
-    window (``horizon``, s, else ``[sumo] horizon_s``) measures the fill, not the
-    controller: refused in one line naming the values, unless ``allow_short``
-    (``--allow-short-warmup``).
+    """Refuse control that starts inside the scenario's fill phase (``[sumo] fill_s``):
+    with a warm-up (``warmup``, s, else ``[run] warmup_s``) shorter than the fill, the
+    control window (``horizon``, s, else ``[sumo] horizon_s``) measures the fill, not the
+    controller; refused in one line naming the values, unless ``allow_short``.
     """
     fill = sc.sumo.fill_duration
     warm = sc.run.warmup if warmup is None else float(warmup)
@@ -159,20 +158,14 @@ def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None
                 names: Mapping[str, str] = CLI_NAMES) -> PreparedRun:
     """Everything ``arzsumo run`` checks before SUMO starts, without starting it.
 
-    Applies the caller's overrides to the ``run`` and ``sumo`` sections of ``sc``
-    (``--controller``, ``--seed`` in [0, 2^31), ``--horizon`` of at least one control
-    period, s; ``--warmup``, s >= 0; ``--fcd``; validated again by
-    :meth:`~arzsumo.scenario.Scenario.with_`), checks that
-    ``[sumo] cell_length_m`` divides the road and that the characteristic speeds are
-    finite, refuses a PDE controller at a free-flow scenario equilibrium and a
-    ``[actuation] delay_compensation_s`` it cannot apply
-    (:func:`~arzsumo.bridge.delay.check_delay`), refuses a warm-up shorter than the
-    scenario's fill phase when not ``allow_short_warmup`` (:func:`check_warmup`: the public
-    API and the CLI ask for it; the engine's own callers, sweeps and studies, decide
-    their warm-ups themselves), and draws
-    the placement profile of ``start = "placement"``. Raises an
-    :class:`arzsumo.errors.ArzsumoError` naming the key, or the override as ``names`` call
-    it (:data:`CLI_NAMES` or :data:`API_NAMES`).
+    Applies the caller's overrides to ``sc`` (validated again by
+    :meth:`~arzsumo.scenario.Scenario.with_`), checks the road and the characteristic
+    speeds, refuses a PDE controller at a free-flow scenario equilibrium, a
+    ``delay_compensation_s`` it cannot apply (:func:`~arzsumo.bridge.delay.check_delay`) and,
+    unless ``allow_short_warmup`` (the API and the CLI ask for it; sweeps and studies decide
+    their warm-ups themselves), a warm-up inside the fill phase (:func:`check_warmup`), and
+    draws the placement profile. Raises an :class:`arzsumo.errors.ArzsumoError` naming the
+    key, or the override as ``names`` call it (:data:`CLI_NAMES` or :data:`API_NAMES`).
     """
     base = sc
     if controller is not None:
@@ -220,31 +213,12 @@ def run_in_sumo(sc: Scenario, *, controller: str | None = None, seed: int | None
                 frontend: str = "libsumo", allow_short_warmup: bool = True) -> SumoSession:
     """Run the closed loop of ``sc`` in SUMO (overrides win over the scenario's tables).
 
-    Parameters
-    ----------
-    sc : Scenario
-        Validated scenario with ``[sumo]`` and ``[run]`` tables (defaults otherwise).
-    controller : str, optional
-        Overrides ``[run] controller``.
-    seed : int, optional
-        Overrides ``[sumo] seed``; an integer in [0, 2^31). The SUMO seed also draws a
-        ``[initial] kind = "random"`` wave when vehicles are placed (``start =
-        "placement"``).
-    horizon : float, optional
-        Overrides ``[sumo] horizon_s``, s; at least one control period.
-    warmup : float, optional
-        Overrides ``[run] warmup_s``, s.
-    fcd : bool, optional
-        Overrides ``[sumo] fcd`` (SUMO's FCD output kept with the results).
-    progress : bool
-        Draw a progress bar on stderr.
-    frontend : str
-        What drives SUMO: "libsumo" (default), "traci", or "gui" to watch the run in
-        sumo-gui (:mod:`arzsumo.sumo.frontend`).
-    allow_short_warmup : bool
-        Allow a warm-up shorter than the scenario's fill phase.
-
-    All checks happen in :func:`prepare_run` before SUMO starts.
+    ``controller``, ``seed`` (in [0, 2^31); it also draws a random ``[initial]`` wave when
+    vehicles are placed), ``horizon`` (s, at least one control period), ``warmup`` (s) and
+    ``fcd`` override ``[run]`` and ``[sumo]``; ``progress`` draws a bar on stderr;
+    ``frontend``: "libsumo", "traci" or "gui" (:mod:`arzsumo.sumo.frontend`);
+    ``allow_short_warmup`` allows a warm-up shorter than the fill phase. All checks happen
+    in :func:`prepare_run` before SUMO starts.
     """
     run = prepare_run(sc, controller=controller, seed=seed, horizon=horizon, warmup=warmup,
                       fcd=fcd, allow_short_warmup=allow_short_warmup)

@@ -1,21 +1,11 @@
 """The actuation stage on the outlet's speed limit: a PDE law's U as mainstream control.
 
-The paper's boundary input U is the section outflow's deviation from q* (clpsys4). With
-``[actuation] actuator = "speed_limit"`` it is realised by the speed limit of the edge
-past the merge, the bottleneck whose discharge is q(L) plus the ramp's release
-(:class:`~arzsumo.sumo.speed_limit.OutletSpeedLimit`): the limit is
-
-    v = v_nominal + U / g,
-
-g = ``speed_limit_gain`` = dq(L)/dv (veh/m), rounded to ``speed_limit_step`` from
-v_nominal and kept in ``[speed_limit_min, speed_limit_max]`` (:func:`limit_for`). The U
-applied is what that limit realises on the linear map, g (v - v_nominal), so the law's
-anti-windup sees the rounding and the range; a limit rounded past the rate limit is the
-grid's next one toward the previous limit. The ``[actuation]`` limits act first, as
-for the meter (:func:`~arzsumo.bridge.actuator.limit_u`: range, rate, range), the range
-being the limit's range mapped to U and cut by ``u_max_fraction``; ``ramp_bound`` and the
-queue override are the meter's and do not act here. The meter keeps its nominal plan.
-A limit change is counted as the meter counts a plan change: a new value asked.
+The limit of the edge past the merge is v = v_nominal + U / g (paper's U, clpsys4; g =
+``speed_limit_gain`` = dq(L)/dv, veh/m), rounded and kept in range by :func:`limit_for`;
+the U applied is what that limit realises on the linear map, g (v - v_nominal). The
+``[actuation]`` limits act first, as for the meter (:func:`~arzsumo.bridge.actuator.limit_u`);
+``ramp_bound`` and the queue override do not act, and the meter keeps its nominal plan.
+docs/sumo.md, 'The outlet's speed limit as the actuator'.
 """
 
 from __future__ import annotations
@@ -23,7 +13,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from arzsumo.bridge.actuator import INF, Actuation, ActuationLimits, MeterActuator, limit_u
+from arzsumo.bridge.actuator import Actuation, ActuationLimits, MeterActuator, limit_u, release_rate
 from arzsumo.control.registry import is_pde
 from arzsumo.scenario.actuation import ActuationSettings
 from arzsumo.sumo.meter import MeterLight
@@ -42,7 +32,7 @@ def limit_for(u: float, nominal: float, settings: ActuationSettings) -> float:
     return min(settings.speed_limit_max, max(settings.speed_limit_min, nominal + dv))
 
 
-def u_range(nominal: float, settings: ActuationSettings, u_max: float = INF
+def u_range(nominal: float, settings: ActuationSettings, u_max: float = math.inf
             ) -> tuple[float, float]:
     """``(lower, upper)`` of U (veh/s): the limit's range about ``nominal`` (m/s) on the
     linear map, cut to ``|U| <= u_max``."""
@@ -52,19 +42,9 @@ def u_range(nominal: float, settings: ActuationSettings, u_max: float = INF
 
 
 class SpeedLimitActuator:
-    """Commands the outlet's speed limit with U (veh/s), limited by ``limits``.
-
-    Parameters
-    ----------
-    outlet : OutletSpeedLimit
-        The edge past the merge, its limit as the network holds it the nominal.
-    meter : MeterLight
-        The ramp meter, at its nominal plan (read for the record only).
-    settings : ActuationSettings
-        The gain, range and resolution of the limit.
-    limits : ActuationLimits
-        ``u_max`` and the rate limit (the meter's ``ramp_bound`` does not act).
-    """
+    """Commands the outlet's speed limit (``outlet``, its nominal the network's) with U
+    (veh/s), limited by ``limits`` (the meter's ``ramp_bound`` does not act); ``meter``
+    stays at its nominal plan, read for the record only."""
 
     def __init__(self, outlet: OutletSpeedLimit, meter: MeterLight,
                  settings: ActuationSettings, limits: ActuationLimits) -> None:
@@ -78,18 +58,16 @@ class SpeedLimitActuator:
         lim = limit_u(u, self.u_prev, lower, upper, self.limits.rate_step)
         nominal, g = self.outlet.nominal, self.settings.speed_limit_gain
         speed = limit_for(lim.u_applied, nominal, self.settings)
-        if abs(g * (speed - nominal) - self.u_prev) > self.limits.rate_step + 1e-12:
-            # rounded past the rate limit: the grid's next limit toward the previous one
-            back = self.settings.speed_limit_step * (1 if g * (speed - nominal) < self.u_prev
-                                                     else -1)
-            speed = limit_for(g * (speed + back - nominal), nominal, self.settings)
         applied = g * (speed - nominal)
+        if abs(applied - self.u_prev) > self.limits.rate_step + 1e-12:
+            # rounded past the rate limit: the grid's next limit toward the previous one
+            back = self.settings.speed_limit_step * (1 if applied < self.u_prev else -1)
+            speed = limit_for(g * (speed + back - nominal), nominal, self.settings)
+            applied = g * (speed - nominal)
         self.outlet.set(speed)
         self.u_prev = applied
-        rate = self.meter.release_rate
         return Actuation(u, applied, lim.saturated, lim.rate_limited, lower, upper,
-                         self.meter.green_share, math.nan if rate is None else rate,
-                         speed_limit=speed)
+                         self.meter.green_share, release_rate(self.meter), speed_limit=speed)
 
     def summary(self) -> dict[str, Any]:
         """The outlet's changes over the window and its limits (m/s)."""

@@ -1,16 +1,10 @@
 """The event trigger's dead band measured on the estimate (``[design] noise_from_estimate``).
 
-The ETC's trigger compares the held U with the law's present output; on SUMO's estimate
-that output carries noise from one check to the next, and the paper's trigger
-(defdynamic) takes every draw of it for a change worth an event. The dead band
-(:mod:`arzsumo.control.etc`) lets pure noise of a known level pass; here its level is
-measured where the noise arises, before control starts: a copy of the acting controller
-is checked on the estimate of the warm-up's last ``reference_window`` seconds, the
-nominal plan applied throughout, and the sd of its continuous output's noise
-(:func:`arzsumo.control.etc.output_noise_sd`) sizes the dead band of the controller that
-will act. The warm-up is shared by every controller of a seed, so a law's band on a
-seed is the same in every experiment that forks from it; each law has its own (the
-observer-ETC's estimate is not the ETC's).
+Before control starts, a copy of the acting controller is checked on the estimate of the
+warm-up's last ``reference_window`` seconds, the nominal plan applied, and the sd of its
+continuous output's noise (:func:`arzsumo.control.etc.output_noise_sd`) sizes the dead
+band of the controller that will act (paper, defdynamic). docs/design.md, 'Measured on
+the estimate'.
 """
 
 from __future__ import annotations

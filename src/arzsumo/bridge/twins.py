@@ -1,18 +1,10 @@
 """The two PDE twins that run beside SUMO: *replay* and *reference*.
 
-Both start from the aggregated microscopic state at the start of control and take the
-measured state of SUMO's first cell, smoothed exponentially, as their boundary state at
-x = 0 (a ghost cell), so their inflow follows SUMO's.
-
-* *replay* is given the outflow SUMO produced at x = L (smoothed with the same time
-  constant, which keeps the vehicle count): how well the model explains SUMO.
-* *reference* runs its own closed loop with a copy of the controller: what the design
-  promised.
-
-When a step would leave the model's physical domain (SUMO can hold area occupancies the
-calibrated fundamental diagram cannot), a twin is re-synchronised to the aggregated micro
-state of that period and goes on; every re-synchronisation is counted, and the period it
-happens in is excluded from the fidelity measures (NaN fields).
+Both start from SUMO's state at the start of control and hold its first cell, smoothed,
+in a ghost cell at x = 0. *replay* is given SUMO's outflow at x = L, smoothed alike: how
+well the model explains SUMO. *reference* runs its own closed loop with a copy of the
+controller: what the design promised. A twin whose step would leave the model's domain is
+re-synchronised to SUMO's state, counted, and the period left out (NaN fields).
 """
 
 from __future__ import annotations
@@ -45,13 +37,10 @@ TWIN_AO_LIMIT = 0.9
 
 def to_twin_grid(params: ModelParameters, data: CellData, x_twin: np.ndarray,
                  ao_limit: float = TWIN_AO_LIMIT) -> tuple[np.ndarray, float]:
-    """Micro cell data interpolated to the twin's cells, made admissible for the model.
-
-    The measured state (:func:`~arzsumo.bridge.boundary_data.measured_state`) is
-    interpolated linearly to ``x_twin`` and its densities are scaled down where the model
-    could not hold them (AO above ``ao_limit`` of its maximum), as the identification's
-    replay twin starts (:func:`arzsumo.identify.replay.run_replay`); returns the fields
-    (4, n) and the vehicles removed (veh).
+    """Micro cell data interpolated to the twin's cells ``x_twin``, densities scaled down
+    where the model could not hold them (AO above ``ao_limit`` AO_max), as the
+    identification's replay twin starts; returns the fields (4, n) and the vehicles
+    removed (veh).
     """
     measured = on_grid(measured_state(params, data.rho_h, data.v_h, data.rho_a, data.v_a),
                        data.x, x_twin)
@@ -84,14 +73,9 @@ class _GhostInlet(Inlet):
 
 
 class MeasuredInlet:
-    """Exponentially smoothed inlet state measured in SUMO's first cell, for the twins.
-
-    The measured first cell (:func:`~arzsumo.bridge.boundary_data.measured_state`) is
-    smoothed with time constant ``tau`` (s) (:func:`~arzsumo.bridge.boundary_data.smooth_step`,
-    as :func:`~arzsumo.bridge.boundary_data.inlet_series` does for a whole run); the
-    ghost cell holds it with densities scaled to AO <= ``ao_limit`` AO_max, as the
-    identification's replay twin holds its inlet data.
-    """
+    """SUMO's first cell, measured and smoothed with time constant ``tau`` (s) as
+    :func:`~arzsumo.bridge.boundary_data.inlet_series` does for a whole run; the ghost cell
+    holds it with densities scaled to AO <= ``ao_limit`` AO_max."""
 
     def __init__(self, eq: Equilibrium, lin: Linearization, tau: float,
                  ao_limit: float = TWIN_AO_LIMIT) -> None:
@@ -158,20 +142,10 @@ class Twin:
 class TwinPair:
     """The replay and reference twins, started from the measured state at control start.
 
-    Parameters
-    ----------
-    eq, lin : Equilibrium, Linearization
-        The design's operating point.
-    start : CellData
-        Micro state at the start of control (t = 0 of both twins).
-    opts : SolverOptions
-        Twin grid, scheme, horizon and control period.
-    smoothing : float
-        Time constant of the measured boundary data, s.
-    reference_controller : Controller
-        The reference twin's own controller (already reset).
-    q_nominal : float
-        Outflow of the nominal meter plan, veh/s: the replayed outflow's start value.
+    ``eq``, ``lin``: the design's operating point; ``start``: the micro state at t = 0;
+    ``opts``: twin grid, scheme, horizon and control period; ``smoothing``: time constant
+    of the measured boundary data, s; ``reference_controller``: the reference twin's own
+    (reset); ``q_nominal``: outflow of the nominal plan, veh/s, the replayed outflow's start.
     """
 
     def __init__(self, eq: Equilibrium, lin: Linearization, start: CellData,

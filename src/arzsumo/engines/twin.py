@@ -58,8 +58,7 @@ class TwinRun:
     def summary(self) -> dict[str, Any]:
         """JSON-ready summary; SI units (veh, s, m); ``units_by_key`` gives each key's unit."""
         r = self.result
-        dx = r.dx
-        n0 = float(r.fields[0, [0, 2]].sum() * dx)
+        n0 = float(r.fields[0, [0, 2]].sum() * r.dx)
         n1 = float(r.extra["total_vehicles"])
         perf = self.performance.as_dict()
         ratio = float(self.norm[-1] / self.norm[0]) if self.norm[0] > 0 else math.nan
@@ -77,11 +76,8 @@ class TwinRun:
             "saturation_time": r.saturated_time,
             "outlet_limited_time": r.extra["outlet_limited_time"],
             "u_range": list(r.u_range),
-            "J_fuel": {k: v["J_fuel"] for k, v in perf.items()},
-            "J_discom": {k: v["J_discom"] for k, v in perf.items()},
-            "J_TTT": {k: v["J_TTT"] for k, v in perf.items()},
-            "TMT": {k: v["TMT"] for k, v in perf.items()},
-            "total_delay": {k: v["total_delay"] for k, v in perf.items()},
+            **{index: {k: v[index] for k, v in perf.items()}
+               for index in ("J_fuel", "J_discom", "J_TTT", "TMT", "total_delay")},
             "relative_to_open_loop_percent": (relative_change(self.performance, self.baseline)
                                               if self.baseline is not None else None),
             "open_loop_baseline": self.baseline_status,
@@ -114,17 +110,10 @@ def run_twin(scenario: Scenario, config: TwinConfig | None = None, *,
              controller: Controller | None = None, baseline: bool = True) -> TwinRun:
     """Run the twin on ``scenario``.
 
-    Parameters
-    ----------
-    scenario : Scenario
-        Model and equilibrium; its ``twin`` section (``[twin]``, ``[initial]``,
-        ``[design]``) is the configuration unless ``config`` is passed.
-    config : TwinConfig, optional
-    controller : Controller, optional
-        Overrides the configured controller name (for callers holding an instance).
-    baseline : bool
-        Also run the open loop of the same scenario to report relative changes (skipped
-        when the controller is the open loop).
+    ``config`` defaults to the scenario's ``[twin]``, ``[initial]`` and ``[design]``;
+    ``controller`` (an instance) overrides the configured controller; ``baseline`` also
+    runs the open loop of the same scenario to report relative changes (skipped when the
+    controller is the open loop).
     """
     cfg = config or scenario.twin
     eq = scenario.equilibrium
@@ -148,20 +137,12 @@ def run_twin(scenario: Scenario, config: TwinConfig | None = None, *,
 
 def compare_to_open_loop(run: TwinRun, open_loop: Performance, complete: bool,
                          status: str) -> TwinRun:
-    """``run`` with the indices of the open loop of the same scenario as its baseline.
-
-    Parameters
-    ----------
-    run : TwinRun
-        A controlled run.
-    open_loop : Performance
-        Indices of the open-loop simulation from the same initial fields and solver
-        options (the caller guarantees it; :func:`arzsumo.workflows.paper.reproduce.reproduce`
-        shares one open loop among the controllers of a scenario).
-    complete, status
-        Whether that open loop completed, and its status message. Indices over
-        different horizons are not comparable, so an incomplete run on either side
-        gives no baseline.
+    """``run`` with the indices ``open_loop`` of the open loop of the same scenario (same
+    initial fields and solver options: the caller guarantees it, e.g.
+    :func:`arzsumo.workflows.paper.reproduce.reproduce` sharing one open loop) as its
+    baseline. ``complete``, ``status``: whether that open loop completed, and its status;
+    indices over different horizons are not comparable, so an incomplete run on either
+    side gives no baseline.
     """
     res = run.result
     if complete and res.complete:
