@@ -255,7 +255,7 @@ def run_cosimulation(run: PreparedRun, *, progress: bool | RunProgress = False,
 
     ``progress`` as in :func:`open_run`; ``keep_measurements`` keeps every period's
     measurement, warm-up included, in ``estimator.measurements`` (offline estimation,
-    :mod:`arzsumo.bridge.sensor_record`); ``frontend``: "libsumo", "traci" or "gui"
+    :mod:`arzsumo_studies.estimation.sensor_record`); ``frontend``: "libsumo", "traci" or "gui"
     (:mod:`arzsumo.sumo.frontend`). The result keeps the run's SUMO configuration and,
     with ``[sumo] fcd``, its FCD output in ``files`` (:mod:`arzsumo.sumo.run_files`).
     """

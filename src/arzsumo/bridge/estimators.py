@@ -13,6 +13,7 @@ closed loop'.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -22,7 +23,9 @@ from arzsumo.estimate.enkf import BoundaryInput, EnsembleKalmanFilter
 from arzsumo.estimate.observations import LoopObservation, ProbeObservation
 from arzsumo.estimate.smoothing import CausalSmoother
 from arzsumo.estimate.synthetic import interpolate_loops
+from arzsumo.evaluation.fields import field_rmse
 from arzsumo.model.equilibrium import Equilibrium
+from arzsumo.model.params import VARIABLES
 from arzsumo.scenario.estimation import EstimationSettings
 from arzsumo.sumo.sensing import SensorLayout
 from arzsumo.sumo.sensor import PeriodMeasurement
@@ -114,7 +117,7 @@ class RecordedEstimator:
     (None otherwise); ``interpolation`` the linear interpolation between the period's
     loop stations, speeds filled with Ve (when there are loops); ``measurements``, when
     not None, every measurement handed over (warm-up included: the record an offline pass
-    replays, :mod:`arzsumo.bridge.sensor_record`).
+    replays, :mod:`arzsumo_studies.estimation.sensor_record`).
     """
 
     inner: Estimator
@@ -178,3 +181,27 @@ def estimation_stage(settings: EstimationSettings, layout: SensorLayout, control
         sensors = tuple(named.get(k, k) for k in sensors)
     return (RecordedEstimator(inner, settings.method, sensors, eq,
                               measurements=[] if keep else None), acting)
+
+
+def _rmse(truth: np.ndarray, est: np.ndarray, ref: tuple[float, ...]) -> dict[str, Any]:
+    value, n = field_rmse(truth, est, 1, 1)
+    return {name: {"absolute": float(value[k]), "relative": float(value[k] / ref[k]),
+                   "samples": int(n[k])} for k, name in enumerate(VARIABLES)}
+
+
+def estimation_scores(truth: np.ndarray, est: RecordedEstimator,
+                      eq: Equilibrium) -> dict[str, Any]:
+    """``summary.json["estimation"]`` of an estimator's record against ``truth``
+    (periods, 4, n): RMSE per variable (absolute SI, relative to the equilibrium,
+    samples), the EnKF's mean spread, the RMSE of interpolation between the loops."""
+    ref = (eq.rho_h, eq.v_h, eq.rho_a, eq.v_a)
+    spread = None
+    if len(est.sd) > 1:
+        sd = np.asarray(est.sd[1:]).mean(axis=(0, 2))
+        spread = {name: {"absolute": float(sd[k]), "relative": float(sd[k] / ref[k])}
+                  for k, name in enumerate(VARIABLES)}
+    interp = (_rmse(truth, np.asarray(est.interpolation[1:]), ref)
+              if len(est.interpolation) > 1 else None)
+    return {"method": est.method, "sensors": list(est.sensors),
+            **_rmse(truth, np.asarray(est.fields[1:]), ref), "spread": spread,
+            "interpolation": interp}

@@ -77,7 +77,7 @@ class LoopObservation:
     time_mean, harmonic : array (2, n_j), optional
         Both means of the same spot speeds, m/s, when the reader has them (SUMO's loops,
         :mod:`arzsumo.sumo.loops`; ``speed`` is one of them): an offline pass over a
-        recorded run can use either (:mod:`arzsumo.bridge.sensor_record`).
+        recorded run can use either (:mod:`arzsumo_studies.estimation.sensor_record`).
     """
 
     t: float

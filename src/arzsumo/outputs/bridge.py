@@ -21,8 +21,8 @@ import pyarrow.parquet as pq
 from arzsumo.bridge.compare import row_of
 from arzsumo.bridge.delay import compensated_delay
 from arzsumo.bridge.estimator import fill_speeds
+from arzsumo.bridge.estimators import estimation_scores
 from arzsumo.bridge.result import CoSimResult
-from arzsumo.bridge.sensor_record import estimation_scores
 from arzsumo.control.base import ControlLog
 from arzsumo.control.events import release_time
 from arzsumo.evaluation.authority import authority
@@ -110,7 +110,7 @@ def section_trend(res: CoSimResult) -> dict[str, Any] | None:
 
 def estimation_summary(res: CoSimResult) -> dict[str, Any] | None:
     """How well the state the controller acted on matched the full probe's cells
-    (:func:`arzsumo.bridge.sensor_record.estimation_scores`), and the reference of a PDE
+    (:func:`arzsumo.bridge.estimators.estimation_scores`), and the reference of a PDE
     controller's deviations (docs/outputs.md, ``estimation.*``); None without an estimate."""
     est = res.estimator
     if est is None or res.estimate is None or not res.estimate.size:

@@ -57,8 +57,8 @@ def settings(sd: Sequence[float], inflation: float, length: float = 150.0) -> di
 
 def score(job: Job) -> dict[str, Any]:
     """RMSE and mean spread (relative) per variable of one record, layout and setting."""
-    from arzsumo.bridge.sensor_record import SensorRecord
     from arzsumo.scenario import scenario_from_dict
+    from arzsumo_studies.estimation.sensor_record import SensorRecord
 
     path, tables, seed, layout, extra = job
     rec, _ = SensorRecord.load(Path(path))

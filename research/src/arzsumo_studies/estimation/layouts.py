@@ -4,11 +4,11 @@
 Per seed ONE open-loop SUMO run of the scenario (default: the former default lateral_files, its fill
 as warm-up + its control horizon) records the sensor data of a superset of sensors (loop
 stations every 50 m with both boundaries, every AV a probe) and the truth (the full
-probe's cells): :func:`arzsumo.bridge.sensor_record.record_run`, cached as ``.npz`` in
+probe's cells): :func:`arzsumo_studies.estimation.sensor_record.record_run`, cached as ``.npz`` in
 ``$ARZSUMO_CACHE/estimation-runs`` (:func:`record`). Every layout x estimator is then an
 offline pass over the recorded observations
-(:func:`~arzsumo.bridge.sensor_record.replay_estimation`), with the numbers the estimator
-gives inside the closed loop. ``interpolation`` is linear interpolation between the
+(:func:`~arzsumo_studies.estimation.sensor_record.replay_estimation`), with the numbers
+the estimator gives inside the closed loop. ``interpolation`` is linear interpolation between the
 layout's loop stations (speeds filled with Ve), the baseline; with the full probe the
 controller acts on the truth itself (RMSE 0). The table gives the relative RMSE (1 = the
 equilibrium value) per variable, one row per layout, method and seed; the page its means
@@ -88,8 +88,8 @@ def cache_path(run: StudyRun) -> Path:
 
 def record(run: StudyRun) -> dict[str, Any]:
     """The cached record of ``run`` (one SUMO run if missing): ``{"path": ...}``."""
-    from arzsumo.bridge.sensor_record import record_run
     from arzsumo.scenario import scenario_from_dict
+    from arzsumo_studies.estimation.sensor_record import record_run
 
     path = cache_path(run)
     if not path.exists():
@@ -103,7 +103,8 @@ def offline(rec: Any, sc: Any, layout: str, method: str,
             extra: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """The estimation scores of one layout and method on a record (``extra``: more
     scenario keys, e.g. EnKF settings)."""
-    from arzsumo.bridge.sensor_record import estimation_scores, replay_estimation
+    from arzsumo.bridge.estimators import estimation_scores
+    from arzsumo_studies.estimation.sensor_record import replay_estimation
 
     if not LAYOUTS[layout]:
         return {v: {"relative": 0.0} for v in VARS} | {"spread": None}
@@ -117,8 +118,8 @@ def offline(rec: Any, sc: Any, layout: str, method: str,
 
 def rows_of(task: tuple[str, Mapping[str, Any], int]) -> list[dict[str, Any]]:
     """(record path, scenario tables, seed) -> every layout x method on that record."""
-    from arzsumo.bridge.sensor_record import SensorRecord
     from arzsumo.scenario import scenario_from_dict
+    from arzsumo_studies.estimation.sensor_record import SensorRecord
 
     path, tables, seed = task
     rec, _ = SensorRecord.load(Path(path))

@@ -44,7 +44,8 @@ METHODS = ("smoothing", "enkf")
 def offsets(rec: Any, sc: Any, loop_speed: str, method: str) -> list[dict[str, Any]]:
     """Per variable (report units): truth mean, estimate - truth, estimate - equilibrium,
     relative RMSE."""
-    from arzsumo.bridge.sensor_record import estimation_scores, replay_estimation
+    from arzsumo.bridge.estimators import estimation_scores
+    from arzsumo_studies.estimation.sensor_record import replay_estimation
 
     s = sc.with_({**LAYOUT, "sensing.loop_speed": loop_speed, "estimation.method": method})
     est = replay_estimation(rec, s)
@@ -151,8 +152,8 @@ def run_loop_speed(opts: LoopSpeedOptions, *, progress: bool = True) -> LoopSpee
         The table, the station notes and the files written (``loop_speed.csv``,
         ``loop_speed.md`` in ``opts.out``).
     """
-    from arzsumo.bridge.sensor_record import SensorRecord
     from arzsumo.scenario import scenario_from_dict
+    from arzsumo_studies.estimation.sensor_record import SensorRecord
 
     runs = design(opts)
     rows, notes = [], []

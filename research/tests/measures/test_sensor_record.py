@@ -8,13 +8,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-from arzsumo.bridge.sensor_record import (
+from arzsumo_studies.estimation.sensor_record import (
     SensorRecord,
     estimation_scores,
     record_run,
     replay_estimation,
 )
+
 from arzsumo.bridge.session import run_in_sumo
 from arzsumo.outputs.bridge import VARIABLES, summary
 from arzsumo.scenario import load_scenario

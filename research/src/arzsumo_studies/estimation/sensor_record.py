@@ -4,9 +4,10 @@
 every :data:`SUPERSET_SPACING` m, both boundaries, every AV a probe) and keeps every
 period's measurement, warm-up included, as a :class:`SensorRecord` (``.npz`` on disk),
 both loop speeds included. :func:`replay_estimation` hands a layout's share of it to a
-scenario's estimator as the closed loop would, and :func:`estimation_scores` scores it as
+scenario's estimator as the closed loop would, and
+:func:`arzsumo.bridge.estimators.estimation_scores` scores it as
 ``summary.json["estimation"]`` does; the numbers equal those inside a run to 1e-9
-(``tests/bridge/test_sensor_record.py``: loading stations moves no vehicle).
+(``research/tests/measures/test_sensor_record.py``: loading stations moves no vehicle).
 research/readings/estimation_layouts.md.
 """
 
@@ -21,10 +22,7 @@ import numpy as np
 
 from arzsumo.bridge.estimators import RecordedEstimator, estimation_stage
 from arzsumo.estimate.observations import LoopObservation, ProbeObservation
-from arzsumo.evaluation.fields import field_rmse
 from arzsumo.io import atomic_file
-from arzsumo.model.equilibrium import Equilibrium
-from arzsumo.model.params import VARIABLES
 from arzsumo.scenario import Scenario
 from arzsumo.scenario.estimation import EstimationSettings
 from arzsumo.sumo.loops import placed_positions
@@ -188,30 +186,6 @@ def replay_estimation(record: SensorRecord, scenario: Scenario,
     for m in ms[record.start + 1:]:
         est.estimate(m, m.t - start.t)
     return est
-
-
-def _rmse(truth: np.ndarray, est: np.ndarray, ref: tuple[float, ...]) -> dict[str, Any]:
-    value, n = field_rmse(truth, est, 1, 1)
-    return {name: {"absolute": float(value[k]), "relative": float(value[k] / ref[k]),
-                   "samples": int(n[k])} for k, name in enumerate(VARIABLES)}
-
-
-def estimation_scores(truth: np.ndarray, est: RecordedEstimator,
-                      eq: Equilibrium) -> dict[str, Any]:
-    """``summary.json["estimation"]`` of an estimator's record against ``truth``
-    (periods, 4, n): RMSE per variable (absolute SI, relative to the equilibrium,
-    samples), the EnKF's mean spread, the RMSE of interpolation between the loops."""
-    ref = (eq.rho_h, eq.v_h, eq.rho_a, eq.v_a)
-    spread = None
-    if len(est.sd) > 1:
-        sd = np.asarray(est.sd[1:]).mean(axis=(0, 2))
-        spread = {name: {"absolute": float(sd[k]), "relative": float(sd[k] / ref[k])}
-                  for k, name in enumerate(VARIABLES)}
-    interp = (_rmse(truth, np.asarray(est.interpolation[1:]), ref)
-              if len(est.interpolation) > 1 else None)
-    return {"method": est.method, "sensors": list(est.sensors),
-            **_rmse(truth, np.asarray(est.fields[1:]), ref), "spread": spread,
-            "interpolation": interp}
 
 
 def record_run(scenario: Scenario, seed: int, warmup: float, horizon: float
