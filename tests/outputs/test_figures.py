@@ -1,16 +1,19 @@
 """The output layer saves the figures of :mod:`arzsumo.plots`: the file names of a run, the
-resolution asked for, and every figure closed, also when saving fails."""
+resolution asked for, and every figure closed, also when saving fails; a figure an earlier
+call drew is removed when this call draws none, and nothing else."""
 
 from __future__ import annotations
 
 import struct
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from arzsumo.evaluation.critical_occupancy import critical_occupancy
 from arzsumo.outputs.alinea import write_alinea_target
-from arzsumo.outputs.figures import save_figures, save_png
+from arzsumo.outputs.evaluation import FIGURE, write_evaluation
+from arzsumo.outputs.figures import remove_stale_figures, save_figures, save_png
 from arzsumo.plots import plt
 from arzsumo.plots.bridge import bridge_figures
 from arzsumo.plots.twin import twin_figures
@@ -70,3 +73,24 @@ def test_alinea_target_writes_its_four_files(tmp_path):
     assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == [
         "curve.csv", "curve.png", "samples.csv", "target.json"]
     assert _png_size(out / "curve.png") == (770, 506)          # 7 x 4.6 in at 110 dpi
+
+
+def test_only_a_regular_file_is_removed_as_a_stale_figure(tmp_path):
+    figure, folder, link = tmp_path / "map.png", tmp_path / "shift.png", tmp_path / "u.png"
+    figure.write_bytes(b"png")
+    folder.mkdir()
+    theirs = tmp_path / "elsewhere.png"
+    theirs.write_bytes(b"the user's")
+    link.symlink_to(theirs)
+    assert remove_stale_figures(figure, folder, link, tmp_path / "none.png") == [figure]
+    assert not figure.exists() and folder.is_dir() and link.is_symlink()
+    assert theirs.read_bytes() == b"the user's"
+
+
+def test_an_evaluation_written_without_plots_drops_its_earlier_figure(tmp_path):
+    (tmp_path / FIGURE).write_bytes(b"an earlier call's")
+    long = pd.DataFrame(columns=["measure", "controller"])
+    written = write_evaluation(tmp_path, long, pd.DataFrame(), ["open", "etc"], "# head",
+                               plots=False)
+    assert [p.name for p in written] == ["evaluation.csv", "evaluation.md"]
+    assert not (tmp_path / FIGURE).exists()

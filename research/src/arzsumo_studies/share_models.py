@@ -41,10 +41,10 @@ import pandas as pd
 from arzsumo.errors import require
 from arzsumo.io import dump_toml
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.pages import markdown_table, publish, write_csv, write_text
 from arzsumo.units import VEH_H_PER_VEH_S, kmh_to_ms, ms_to_kmh
 from arzsumo_studies import checks
 from arzsumo_studies.common import RESULTS_DIR, StudyError, scenario_data, shipped_scenario
+from arzsumo_studies.outputs.pages import markdown_table, publish, write_csv, write_text
 from arzsumo_studies.premise.map_points import MapPoint, demand, mapped_points
 from arzsumo_studies.premise.map_study import map_demands
 

@@ -12,7 +12,7 @@ import pandas as pd
 
 from arzsumo.evaluation.report import MEASURES, Measure, markdown, paired_differences
 from arzsumo.io import atomic_file
-from arzsumo.outputs.pages import remove_stale_figures
+from arzsumo.outputs.figures import remove_stale_figures
 
 CSV, MARKDOWN, FIGURE = "evaluation.csv", "evaluation.md", "paired_differences.png"
 

@@ -64,3 +64,15 @@ def write_kernels_plot(path: str | Path, kernels: Kernels, title: str = "") -> P
 
     fig = kernels_figure(kernels.x, kernels.K, kernels.M, kernels.L, kernels.N, title)
     return save_png(fig, path, dpi=110)
+
+
+def remove_stale_figures(*paths: Path) -> list[Path]:
+    """Remove the figures ``paths`` that this call did not redraw (``--no-plots``, or
+    nothing to draw), so that none of an earlier call is left beside tables it no longer
+    matches; return those removed. A directory or symbolic link of that name is left."""
+    removed = []
+    for path in map(Path, paths):
+        if path.is_file() and not path.is_symlink():
+            path.unlink()
+            removed.append(path)
+    return removed

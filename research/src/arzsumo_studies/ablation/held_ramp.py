@@ -26,7 +26,6 @@ from arzsumo.evaluation.report import MEASURES as EVALUATION_MEASURES
 from arzsumo.evaluation.report import Measure, paired_cell, seed_values
 from arzsumo.io import dump_toml
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.pages import publish, write_text
 from arzsumo.sweep.evaluate import BASELINE, run_evaluation
 from arzsumo.sweep.worker import FINISHED
 from arzsumo_studies import checks
@@ -37,6 +36,7 @@ from arzsumo_studies.common import (
     StudyError,
     seed_text,
 )
+from arzsumo_studies.outputs.pages import publish, write_text
 
 NAME = "held-ramp"
 #: the results page this study keeps a block of (the ablation's)

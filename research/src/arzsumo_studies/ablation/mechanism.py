@@ -32,11 +32,12 @@ import numpy as np
 import pandas as pd
 
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.pages import publish, remove_stale_figures, write_csv, write_text
+from arzsumo.outputs.figures import remove_stale_figures
 from arzsumo.sweep.evaluate import BASELINE
 from arzsumo.units import s_to_h
 from arzsumo_studies.ablation import study as ablation
 from arzsumo_studies.common import RESULTS_DIR, StudyError
+from arzsumo_studies.outputs.pages import publish, write_csv, write_text
 
 NAME = "ablation-mechanism"
 #: the results page this study keeps a block of (the ablation's)

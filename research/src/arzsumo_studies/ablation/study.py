@@ -41,7 +41,6 @@ import pandas as pd
 from arzsumo.evaluation.report import MEASURES as EVALUATION_MEASURES
 from arzsumo.io import dump_toml
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.pages import publish, write_csv, write_text
 from arzsumo.sweep.evaluate import BASELINE, run_evaluation
 from arzsumo.sweep.worker import FINISHED
 from arzsumo_studies import checks
@@ -69,6 +68,7 @@ from arzsumo_studies.common import (  # noqa: F401 (scenario_data, shipped_scena
     seed_text,
     shipped_scenario,
 )
+from arzsumo_studies.outputs.pages import publish, write_csv, write_text
 
 log = logging.getLogger(__name__)
 

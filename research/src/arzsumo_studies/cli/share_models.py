@@ -10,10 +10,10 @@ from typing import Any
 
 from arzsumo.argtypes import non_negative_float, positive_int
 from arzsumo.model.params import FAMILIES
-from arzsumo.outputs.pages import markdown_table
 from arzsumo.workflows.identify.study import JAM_FLOORS
 from arzsumo_studies.cli.options import add_output, add_runs
 from arzsumo_studies.common import fraction_list, print_list, seed_list
+from arzsumo_studies.outputs.pages import markdown_table
 from arzsumo_studies.share_models import (
     BASE,
     NAME,

@@ -73,7 +73,6 @@ from arzsumo.errors import ArzsumoError, require
 from arzsumo.evaluation.report import Measure, paired_cell, seed_values
 from arzsumo.io import dump_toml, read_toml
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.pages import publish, write_text
 from arzsumo.resources import default_scenario
 from arzsumo.scenario import scenario_from_dict
 from arzsumo.sweep.evaluate import BASELINE, evaluation_spec
@@ -102,6 +101,7 @@ from arzsumo_studies.control.ablation_steps import (
     is_step,
     own_open_loop,
 )
+from arzsumo_studies.outputs.pages import publish, write_text
 from arzsumo_studies.recorded import RecordedRuns, recorded_evaluation
 from arzsumo_studies.records import copy_records, is_store, records_table
 

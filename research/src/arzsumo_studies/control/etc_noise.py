@@ -32,7 +32,6 @@ from arzsumo.engines.twin import run_twin, twin_controller
 from arzsumo.evaluation.stats import mean_ci
 from arzsumo.model.characteristic import linearize
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.pages import markdown_table, publish, write_csv, write_text
 from arzsumo.resources import shipped_scenarios_dir
 from arzsumo.scenario import load_scenario
 from arzsumo.units import veh_s_to_veh_h
@@ -44,6 +43,7 @@ from arzsumo_studies.common import (
     seed_text,
 )
 from arzsumo_studies.measures.state_noise import NoisyState
+from arzsumo_studies.outputs.pages import markdown_table, publish, write_csv, write_text
 
 log = logging.getLogger(__name__)
 

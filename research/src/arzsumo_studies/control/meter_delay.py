@@ -29,9 +29,9 @@ import pandas as pd
 
 from arzsumo.errors import require
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.pages import markdown_table, publish, write_csv, write_text
 from arzsumo_studies import checks
 from arzsumo_studies.common import RESULTS_DIR, StudyError, seed_text
+from arzsumo_studies.outputs.pages import markdown_table, publish, write_csv, write_text
 
 log = logging.getLogger(__name__)
 

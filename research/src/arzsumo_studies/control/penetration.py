@@ -34,19 +34,14 @@ import pandas as pd
 
 from arzsumo.evaluation.stats import MeanCI, bootstrap_mean_ci, mean_ci
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.pages import (
-    markdown_table,
-    publish,
-    remove_stale_figures,
-    write_csv,
-    write_text,
-)
+from arzsumo.outputs.figures import remove_stale_figures
 from arzsumo.resources import shipped_sweeps_dir
 from arzsumo.sweep.evaluate import BASELINE
 from arzsumo.sweep.spec import SweepSpec, load_sweep
 from arzsumo.sweep.worker import FINISHED
 from arzsumo_studies import checks
 from arzsumo_studies.common import RESULTS_DIR, StudyError
+from arzsumo_studies.outputs.pages import markdown_table, publish, write_csv, write_text
 from arzsumo_studies.outputs.penetration import PENETRATION_FIGURE
 from arzsumo_studies.recorded import check_store
 from arzsumo_studies.records import copy_records, records_table

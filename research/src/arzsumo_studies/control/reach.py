@@ -43,15 +43,10 @@ import pandas as pd
 from arzsumo.errors import require
 from arzsumo.evaluation.authority import window_means
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.pages import (
-    markdown_table,
-    publish,
-    remove_stale_figures,
-    write_csv,
-    write_text,
-)
+from arzsumo.outputs.figures import remove_stale_figures
 from arzsumo_studies.common import RESULTS_DIR, StudyError
 from arzsumo_studies.measures.coherence import BoundaryShares, boundary_shares, travel_lags
+from arzsumo_studies.outputs.pages import markdown_table, publish, write_csv, write_text
 
 NAME = "reach"
 #: the results page (``research/results/PAGE.md``) this study keeps a block of

@@ -26,13 +26,13 @@ from arzsumo.control.registry import controller_names
 from arzsumo.errors import require
 from arzsumo.io import dump_toml
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.pages import markdown_table, publish, write_text
 from arzsumo.resources import default_scenario
 from arzsumo.scenario import Scenario
 from arzsumo.sweep.spec import deciding
 from arzsumo_studies import checks
 from arzsumo_studies.common import RESULTS_DIR, StudyError, scenario_data
 from arzsumo_studies.control.study import ALL_EXPERIMENTS, experiment_scenario
+from arzsumo_studies.outputs.pages import markdown_table, publish, write_text
 
 log = logging.getLogger(__name__)
 

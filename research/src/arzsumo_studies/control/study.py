@@ -40,13 +40,14 @@ from arzsumo.evaluation.report import Measure, deadlocked_seeds, evaluate, markd
 from arzsumo.io import dump_toml, read_toml
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.evaluation import paired_figure
-from arzsumo.outputs.pages import publish, remove_stale_figures, write_csv, write_text
+from arzsumo.outputs.figures import remove_stale_figures
 from arzsumo.resources import default_scenario
 from arzsumo.sweep.evaluate import BASELINE, check_controllers
 from arzsumo_studies import checks
 from arzsumo_studies.common import RESULTS_DIR, StudyError, seed_text
 from arzsumo_studies.control.claims import claims_table
 from arzsumo_studies.control.files import MIN_SHARE, files_table
+from arzsumo_studies.outputs.pages import publish, write_csv, write_text
 from arzsumo_studies.recorded import RecordedRuns, recorded_evaluation
 
 log = logging.getLogger(__name__)

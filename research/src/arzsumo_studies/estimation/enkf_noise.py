@@ -26,7 +26,6 @@ import numpy as np
 import pandas as pd
 
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.pages import publish, write_csv, write_text
 from arzsumo.sweep.driver import default_workers, map_runs
 from arzsumo_studies import checks
 from arzsumo_studies.common import (
@@ -37,6 +36,7 @@ from arzsumo_studies.common import (
     shipped_scenario,
 )
 from arzsumo_studies.estimation import layouts
+from arzsumo_studies.outputs.pages import publish, write_csv, write_text
 
 NAME = "enkf-noise"
 #: the results page this study keeps a block of

@@ -32,7 +32,6 @@ import pandas as pd
 from scipy import stats
 
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.pages import publish, write_csv
 from arzsumo.sweep.driver import default_workers
 from arzsumo_studies import checks
 from arzsumo_studies.common import (
@@ -44,6 +43,7 @@ from arzsumo_studies.common import (
     study_spec,
 )
 from arzsumo_studies.design import StudyRun, design_runs
+from arzsumo_studies.outputs.pages import publish, write_csv
 
 NAME = "estimation-layouts"
 #: the results page this study keeps a block of

@@ -22,12 +22,12 @@ import numpy as np
 import pandas as pd
 
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.pages import markdown_table, publish, write_csv, write_text
 from arzsumo.units import KMH_PER_MS, VEH_KM_PER_VEH_M, ms_to_kmh
 from arzsumo_studies import checks
 from arzsumo_studies.common import FORMER_DEFAULT, RESULTS_DIR, shipped_scenario
 from arzsumo_studies.design import StudyRun
 from arzsumo_studies.estimation import layouts as estimation_layouts
+from arzsumo_studies.outputs.pages import markdown_table, publish, write_csv, write_text
 
 NAME = "loop-speed"
 #: the results page this study keeps a block of

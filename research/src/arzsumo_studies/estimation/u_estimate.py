@@ -18,12 +18,7 @@ import numpy as np
 import pandas as pd
 
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.pages import (
-    markdown_table,
-    publish,
-    remove_stale_figures,
-    write_csv,
-)
+from arzsumo.outputs.figures import remove_stale_figures
 from arzsumo.sweep.spec import SweepSpec
 from arzsumo.sweep.table import run_dir
 from arzsumo.sweep.worker import FINISHED
@@ -35,6 +30,7 @@ from arzsumo_studies.common import (
     shipped_scenario,
     study_spec,
 )
+from arzsumo_studies.outputs.pages import markdown_table, publish, write_csv
 
 NAME = "u-estimate"
 #: the results page this study keeps a block of

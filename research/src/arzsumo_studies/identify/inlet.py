@@ -28,7 +28,6 @@ import numpy as np
 import pandas as pd
 
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.pages import markdown_table, publish, write_csv
 from arzsumo.sweep.driver import map_runs
 from arzsumo_studies import checks
 from arzsumo_studies.common import (
@@ -37,6 +36,7 @@ from arzsumo_studies.common import (
     StudyError,
     shipped_scenario,
 )
+from arzsumo_studies.outputs.pages import markdown_table, publish, write_csv
 
 NAME = "inlet"
 #: the results page this study keeps a block of (the identification's)

@@ -11,7 +11,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from arzsumo.outputs.pages import remove_stale_figures, write_csv
+from arzsumo.outputs.figures import remove_stale_figures
+from arzsumo_studies.outputs.pages import write_csv
 
 
 def write_map(out: Path, long: pd.DataFrame, wide: pd.DataFrame, gates: Sequence[str],

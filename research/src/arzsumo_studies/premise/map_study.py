@@ -37,7 +37,6 @@ from typing import Any
 import pandas as pd
 
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.pages import publish
 from arzsumo.units import VEH_H_PER_VEH_S
 from arzsumo_studies import checks
 from arzsumo_studies.common import (
@@ -48,6 +47,7 @@ from arzsumo_studies.common import (
     study_spec,
 )
 from arzsumo_studies.design import StudyRun, design_runs, run_design
+from arzsumo_studies.outputs.pages import publish
 from arzsumo_studies.outputs.premise_map import write_map
 from arzsumo_studies.premise.map_points import (
     MAPPING_SEED,

@@ -12,12 +12,12 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from arzsumo.outputs.pages import markdown_table
 from arzsumo.scenario import Scenario
 from arzsumo.units import VEH_H_PER_VEH_S, VEH_KM_PER_VEH_M, ms_to_kmh
 from arzsumo_studies.gates import GateResult, PremiseThresholds
 from arzsumo_studies.gates.instability import round_trip_time
 from arzsumo_studies.gates.queue_tail import queue_tail
+from arzsumo_studies.outputs.pages import markdown_table
 from arzsumo_studies.premise.floors import (
     LATE_SHARE,
     class_fields,

@@ -27,7 +27,7 @@ from typing import Any
 import pandas as pd
 
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.pages import publish, remove_stale_figures, write_csv
+from arzsumo.outputs.figures import remove_stale_figures
 from arzsumo_studies import checks
 from arzsumo_studies.common import (
     FORMER_DEFAULT,
@@ -39,6 +39,7 @@ from arzsumo_studies.common import (
     study_spec,
 )
 from arzsumo_studies.design import StudyRun, design_runs, run_design
+from arzsumo_studies.outputs.pages import publish, write_csv
 
 NAME = "approach"
 #: the results page this study keeps a block of

@@ -21,7 +21,6 @@ from typing import Any
 import pandas as pd
 
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.pages import markdown_table, publish, write_csv
 from arzsumo.units import veh_s_to_veh_h
 from arzsumo_studies import checks
 from arzsumo_studies.common import (
@@ -34,6 +33,7 @@ from arzsumo_studies.common import (
     study_spec,
 )
 from arzsumo_studies.design import StudyRun, design_runs, run_design
+from arzsumo_studies.outputs.pages import markdown_table, publish, write_csv
 
 NAME = "fill"
 #: the results page this study keeps a block of

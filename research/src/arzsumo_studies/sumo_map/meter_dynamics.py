@@ -33,7 +33,7 @@ import pandas as pd
 
 from arzsumo.errors import require
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.pages import publish, remove_stale_figures, write_csv, write_text
+from arzsumo.outputs.figures import remove_stale_figures
 from arzsumo_studies import checks
 from arzsumo_studies.common import (
     FORMER_DEFAULT,
@@ -46,6 +46,7 @@ from arzsumo_studies.common import (
     study_spec,
 )
 from arzsumo_studies.design import StudyRun, design_runs, run_design
+from arzsumo_studies.outputs.pages import publish, write_csv, write_text
 from arzsumo_studies.sumo_map import meter_fit
 
 NAME = "meter-dynamics"

@@ -40,7 +40,6 @@ import pandas as pd
 
 from arzsumo.evaluation.stats import paired_difference
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.pages import publish, write_csv
 from arzsumo.sweep.spec import SweepSpec
 from arzsumo.units import S_PER_H
 from arzsumo_studies import checks
@@ -51,6 +50,7 @@ from arzsumo_studies.common import (
     shipped_scenario,
     study_spec,
 )
+from arzsumo_studies.outputs.pages import publish, write_csv
 
 NAME = "sumo-options"
 PAGE = "sumo_options"

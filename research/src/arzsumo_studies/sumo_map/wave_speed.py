@@ -24,7 +24,6 @@ import numpy as np
 import pandas as pd
 
 from arzsumo.outdir import resumable_dir
-from arzsumo.outputs.pages import markdown_table, publish, write_csv
 from arzsumo.units import ms_to_kmh
 from arzsumo_studies import checks
 from arzsumo_studies.common import (
@@ -35,6 +34,7 @@ from arzsumo_studies.common import (
     study_spec,
 )
 from arzsumo_studies.design import StudyRun, design_runs, run_design
+from arzsumo_studies.outputs.pages import markdown_table, publish, write_csv
 
 NAME = "wave-speed"
 #: the results page this study keeps a block of

@@ -4,15 +4,7 @@ block, and published files land in the page's folder."""
 from __future__ import annotations
 
 import pandas as pd
-
-from arzsumo.outputs.evaluation import FIGURE, write_evaluation
-from arzsumo.outputs.pages import (
-    END,
-    markdown_table,
-    merged_page,
-    publish,
-    remove_stale_figures,
-)
+from arzsumo_studies.outputs.pages import END, markdown_table, merged_page, publish
 
 
 def test_a_new_page_is_its_title_and_the_block():
@@ -76,24 +68,3 @@ def test_publish_replaces_nothing_of_a_page_written_by_hand(tmp_path):
     (docs / "page.md").write_text(merged_page(None, "study", "Title", "old"))
     publish(docs, "page", "study", "Title", "new", [src])     # the study's own page
     assert (docs / "page" / "table.csv").read_text() == "ours\n"
-
-
-def test_only_a_regular_file_is_removed_as_a_stale_figure(tmp_path):
-    figure, folder, link = tmp_path / "map.png", tmp_path / "shift.png", tmp_path / "u.png"
-    figure.write_bytes(b"png")
-    folder.mkdir()
-    theirs = tmp_path / "elsewhere.png"
-    theirs.write_bytes(b"the user's")
-    link.symlink_to(theirs)
-    assert remove_stale_figures(figure, folder, link, tmp_path / "none.png") == [figure]
-    assert not figure.exists() and folder.is_dir() and link.is_symlink()
-    assert theirs.read_bytes() == b"the user's"
-
-
-def test_an_evaluation_written_without_plots_drops_its_earlier_figure(tmp_path):
-    (tmp_path / FIGURE).write_bytes(b"an earlier call's")
-    long = pd.DataFrame(columns=["measure", "controller"])
-    written = write_evaluation(tmp_path, long, pd.DataFrame(), ["open", "etc"], "# head",
-                               plots=False)
-    assert [p.name for p in written] == ["evaluation.csv", "evaluation.md"]
-    assert not (tmp_path / FIGURE).exists()

@@ -1,4 +1,4 @@
-"""Writers of the studies (:mod:`arzsumo_studies`): tables, text, and the results page.
+"""Writers of the studies: tables, text, and the results page.
 
 With ``--docs`` a study :func:`publish`-es its files into ``DOCS/<page>/`` and its
 generated block, between :data:`BEGIN` and :data:`END` (named for the study), into the
@@ -33,18 +33,6 @@ def write_text(text: str, path: Path) -> Path:
     with atomic_file(path) as tmp:
         tmp.write_text(text.rstrip("\n") + "\n", encoding="utf-8")
     return Path(path)
-
-
-def remove_stale_figures(*paths: Path) -> list[Path]:
-    """Remove the figures ``paths`` that this call did not redraw (``--no-plots``, or
-    nothing to draw), so that none of an earlier call is left beside tables it no longer
-    matches; return those removed. A directory or symbolic link of that name is left."""
-    removed = []
-    for path in map(Path, paths):
-        if path.is_file() and not path.is_symlink():
-            path.unlink()
-            removed.append(path)
-    return removed
 
 
 def generated_block(name: str, body: str) -> str:
