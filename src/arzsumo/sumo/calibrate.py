@@ -1,18 +1,12 @@
-"""Calibration: what SUMO actually does, in the model's terms.
+"""Calibration: what SUMO actually does, in the model's terms (docs/sumo.md, "Calibration").
 
-Runs the scenario's network over demand levels and meter green shares (libsumo holds one
-simulation per process, so runs go to worker processes): the paper's class demands
-(:data:`DEMANDS`) on the shipped network or a user's without route files; on a user's
-network whose route files carry the demand, that demand scaled by SUMO's ``--scale``
-(:data:`SCALES`). Then it
-
-* fits the area-occupancy fundamental diagram Ve_i(AO) = V_i (1 - (AO / AO_max_i)^gamma_i)
-  per class to Edie cell data (scipy ``curve_fit``), with R^2 and RMSE, and scores the
-  paper's curves on the same data;
-* measures the mainline outflow against the green share at medium demand (the curve the
-  actuator inverts);
-* measures the equilibrium SUMO holds at medium demand with the meter at its nominal
-  green share, and its regime under the calibrated model (sign of lambda_4).
+Runs the scenario's network over demand levels (:data:`DEMANDS`, or :data:`SCALES` of the
+user's route files' demand) and meter green shares in worker processes (libsumo holds one
+simulation per process); fits the area-occupancy fundamental diagram
+Ve_i(AO) = V_i (1 - (AO / AO_max_i)^gamma_i) per class to Edie cell data and scores the
+paper's curves on the same data; measures the mainline outflow against the green share
+(the curve the actuator inverts) and the equilibrium SUMO holds at medium demand and
+nominal green share, with its regime under the calibrated model (sign of lambda_4).
 """
 
 from __future__ import annotations
@@ -247,9 +241,9 @@ def calibrate(params: ModelParameters, base: SumoConfig, plan: CalibrationPlan |
     medium = sorted((r for r in runs if r.level == "medium"), key=lambda r: r.green_share)
     curve = GreenShareCurve(tuple(r.green_share for r in medium),
                             tuple(r.outflow for r in medium))
-    cal = Calibration(params, calibrated, fits, curve, points)
-    cal.equilibrium = measured_equilibrium(runs, calibrated, base.green_share)
-    cal.runs = [{"level": r.level, "green_share": r.green_share, "outflow": r.outflow,
-                 "inflow": r.inflow, "delivered": r.delivered, "collisions": r.collisions,
-                 **{f"meter_{k}": v for k, v in r.meter.items()}} for r in runs]
-    return cal
+    return Calibration(params, calibrated, fits, curve, points,
+                       measured_equilibrium(runs, calibrated, base.green_share),
+                       [{"level": r.level, "green_share": r.green_share, "outflow": r.outflow,
+                         "inflow": r.inflow, "delivered": r.delivered,
+                         "collisions": r.collisions,
+                         **{f"meter_{k}": v for k, v in r.meter.items()}} for r in runs])

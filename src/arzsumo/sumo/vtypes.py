@@ -34,11 +34,6 @@ class VehicleType:
     car_follow_model: str
     attrs: tuple[tuple[str, str], ...]
 
-    @property
-    def spacing(self) -> float:
-        """length + minGap, m (the model's spacing policy s_i)."""
-        return self.length + self.min_gap
-
     def to_xml(self) -> str:
         """The ``<vType .../>`` element."""
         base = {"id": self.id, "length": f"{self.length:.4f}", "minGap": f"{self.min_gap:.4f}",
