@@ -201,7 +201,8 @@ def test_placement_rejects_bad_profiles():
 
 
 def test_fd_fit_recovers_parameters_and_scores_paper_curve():
-    from arzsumo.sumo.calibrate import fd_speed, fit_class
+    from arzsumo.model.fd import power_law_speed as fd_speed
+    from arzsumo.sumo.calibrate import fit_class
 
     ao = np.linspace(0.02, 0.6, 200)
     v = fd_speed(ao, 20.0, 0.7, 2.0)

@@ -66,9 +66,8 @@ class CalibrationPlan:
             demand = ({"demand_scale": SCALES[level]} if scaled else
                       {"demand_h": float(veh_h_to_veh_s(qh)),
                        "demand_a": float(veh_h_to_veh_s(qa))})
-            cfg = base.with_(**demand, horizon=self.horizon, control_period=self.window,
-                             green_share=g)
-            out.append((level, g, cfg))
+            out.append((level, g, base.with_(**demand, horizon=self.horizon,
+                                             control_period=self.window, green_share=g)))
         return out
 
 
@@ -123,11 +122,7 @@ def run_calibration_runs(params: ModelParameters, base: SumoConfig, plan: Calibr
     return results
 
 
-# -- fundamental diagram fit ----------------------------------------------------------------
-#: the power law of one class, V (1 - (AO / AO_max)^gamma) in m/s (AO clipped at 0)
-fd_speed = power_law_speed
-
-
+# -- fundamental diagram fit: V (1 - (AO / AO_max)^gamma) per class, m/s ------------------
 @dataclass(frozen=True)
 class ClassFit:
     """Fitted FD of one class: V (m/s), AO_max, gamma; R^2 and RMSE (m/s); paper's R^2."""
@@ -161,10 +156,10 @@ def fit_class(ao: np.ndarray, v: np.ndarray, paper: tuple[float, float, float]) 
     v_cap = 1.02 * paper[0]
     p0 = (min(max(float(v.max()), 1.0), v_cap), min(0.99, max(0.3, float(ao.max()) * 1.05)),
           1.5)
-    popt, _ = curve_fit(fd_speed, ao, v, p0=p0, bounds=([0.5, 0.05, 0.1], [v_cap, 1.0, 8.0]),
-                        maxfev=20000)
-    r2, rmse = _scores(v, fd_speed(ao, *popt))
-    r2p, rmsep = _scores(v, np.maximum(fd_speed(ao, *paper), 0.0))
+    popt, _ = curve_fit(power_law_speed, ao, v, p0=p0,
+                        bounds=([0.5, 0.05, 0.1], [v_cap, 1.0, 8.0]), maxfev=20000)
+    r2, rmse = _scores(v, power_law_speed(ao, *popt))
+    r2p, rmsep = _scores(v, np.maximum(power_law_speed(ao, *paper), 0.0))
     return ClassFit(*(float(p) for p in popt), r2, rmse, int(ao.size), r2p, rmsep)
 
 
@@ -214,8 +209,7 @@ def measured_equilibrium(runs: list[RunData], calibrated: ModelParameters,
                           "v_a": q_a / ma if ma else float("nan"),
                           "outflow": run.outflow, "inflow": run.inflow,
                           "delivered": run.delivered}
-    ao = (calibrated.area_h * mh + calibrated.area_a * ma) / calibrated.road_width
-    eq["ao"] = ao
+    eq["ao"] = (calibrated.area_h * mh + calibrated.area_a * ma) / calibrated.road_width
     try:
         model_eq = Equilibrium(calibrated, mh, ma)
         lin = linearize(model_eq)

@@ -1,15 +1,8 @@
 """Calibration results as text and data, and the meter curve read back.
 
 :func:`arzsumo.outputs.calibration.write_calibration` (``arzsumo calibrate --out DIR``)
-writes, atomically as one directory:
-
-* ``calibrated_model.toml``: a scenario file (``arzsumo model --scenario ...``) whose
-  ``[model]`` holds the fitted FD and whose ``[equilibrium]`` is the state SUMO held, with
-  the meter curve beside it and, on a user's network, its ``[network]`` table;
-* ``meter_curve.toml``: the outflow against green share curve the actuator inverts
-  (:func:`load_green_share_curve`);
-* ``calibration.json``: every number (SI), ``calibration_points.npz``: the fitted points;
-* ``calibration.png``: data against fit and the paper's curves, and the outflow curve.
+writes them as one directory: its files are listed in docs/outputs.md, "arzsumo
+calibrate --out DIR".
 """
 
 from __future__ import annotations

@@ -151,11 +151,9 @@ def check_columns(road_width: float, vehicle_width: float, resolution: float,
 
 
 def layout_route_text(params: ModelParameters, cfg: SumoConfig) -> str:
-    """The route file on a user's network (``cfg.layout``): nothing when the user's
-    route files carry the demand; else the run's vTypes, the mainline route from the first
-    section edge and the ramp route, and the ``[sumo]`` demand as flows on them, each
-    vehicle entering the lane SUMO finds freest (``departLane="free"``; mainline vehicles
-    laterally at the lane's centre unless ``depart_pos_lat`` names a SUMO value)."""
+    """The route file on a user's network (``cfg.layout``; docs/networks.md, "What the run
+    takes from the network"): empty when the user's route files carry the demand; mainline
+    vehicles laterally at the lane's centre unless ``depart_pos_lat`` names a SUMO value."""
     lay = cfg.layout
     if lay is None or lay.route_files:
         return xml_file("routes", [])

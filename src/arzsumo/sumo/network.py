@@ -249,9 +249,8 @@ def rebuild_network(out_dir: Path, spec: NetworkSpec | None = None, *,
         raise SumoError(f"out = {str(out_dir)!r} cannot be written: {exc.strerror}; allowed: "
                         "a writable directory") from None
     lengths = edge_lengths(net)
-    wanted = {MAIN: spec.length}
     ids = approach_edges(spec.approach_length, spec.approach_piece)
-    wanted |= {e: spec.approach_length / len(ids) for e in ids}
+    wanted = {MAIN: spec.length} | {e: spec.approach_length / len(ids) for e in ids}
     for edge, length in wanted.items():
         if abs(lengths.get(edge, -1.0) - length) > 1e-6:
             raise SumoError(f"{edge} edge length = {lengths.get(edge)} m differs from the "

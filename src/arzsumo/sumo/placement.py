@@ -108,26 +108,12 @@ def _fill_columns(cand: list[tuple[float, str, int]], kinds: dict[str, VehicleTy
 def place_vehicles(params: ModelParameters, cfg: SumoConfig, x: ArrayLike, rho_h: ArrayLike,
                    v_h: ArrayLike, rho_a: ArrayLike, v_a: ArrayLike,
                    ) -> tuple[list[InitialVehicle], PlacementReport]:
-    """Initial vehicles reproducing density profiles on [0, L].
+    """Initial vehicles reproducing density profiles on [0, L], and what the placement did.
 
-    Parameters
-    ----------
-    params : ModelParameters
-        Road length, width, vehicle width and spacings.
-    cfg : SumoConfig
-        Run settings (seed, lateral gap) used for the vehicle types.
-    x : array_like
-        Cell centres, m, increasing in (0, L).
-    rho_h, rho_a : array_like
-        Class densities on ``x``, veh/m.
-    v_h, v_a : array_like
-        Class speeds on ``x``, m/s.
-
-    Returns
-    -------
-    vehicles : list of InitialVehicle
-        Sorted by id; HV ids ``hv_init.k``, AV ids ``av_init.k``.
-    report : PlacementReport
+    The profiles are the class densities ``rho_h``, ``rho_a`` (veh/m) and speeds ``v_h``,
+    ``v_a`` (m/s) on the cell centres ``x`` (m, increasing in (0, L)); ``params`` gives the
+    road and the spacings, ``cfg`` the seed and the vehicle types. The vehicles are sorted
+    by id (HVs ``hv_init.k``, AVs ``av_init.k``).
     """
     x = np.asarray(x, float)
     arrays = [np.asarray(a, float) for a in (rho_h, v_h, rho_a, v_a)]

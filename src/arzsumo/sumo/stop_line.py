@@ -1,12 +1,10 @@
 """The meter's stop-line detector: what the sensor reads for the meter every step.
 
-The meter needs two readings of SUMO each step: the ramp queue (halted vehicles on
-``ramp_up`` plus ramp vehicles still waiting to be inserted) for its queue override, and
-the vehicles that crossed its stop line (*releases*) to end a one-vehicle green. Both are
-read by the sensor (:class:`arzsumo.sumo.sensor.SumoSensor`) and handed to the meter as a
-:class:`MeterReading`; the meter itself only writes the light. The stop line also counts
-safety events at the meter: SUMO's emergency stops of vehicles on ``ramp_up``, and
-emergency braking episodes of the :data:`HEAD_VEHICLES` vehicles nearest the line.
+The ramp queue (halted vehicles on ``ramp_up`` plus ramp vehicles still waiting to be
+inserted) for the queue override and the releases (vehicles that crossed the stop line)
+that end a one-vehicle green, handed to the meter as a :class:`MeterReading` by
+:class:`arzsumo.sumo.sensor.SumoSensor`; and the safety events at the meter
+(docs/sumo.md, "Meter realisation").
 """
 
 from __future__ import annotations
@@ -39,11 +37,8 @@ def ramp_queue(lib: ModuleType, pending: Sequence[str] | None = None, edge: str 
     ``is_ramp``: which are ramp vehicles, by default ids starting with ``ramp``)."""
     if pending is None:
         pending = lib.simulation.getPendingVehicles()
-    if is_ramp is None:
-        waiting = sum(1 for v in pending if v.startswith("ramp"))
-    else:
-        waiting = sum(1 for v in pending if is_ramp(v))
-    return int(lib.edge.getLastStepHaltingNumber(edge)) + waiting
+    ramp = is_ramp or (lambda v: v.startswith("ramp"))
+    return int(lib.edge.getLastStepHaltingNumber(edge)) + sum(1 for v in pending if ramp(v))
 
 
 class StopLine:
