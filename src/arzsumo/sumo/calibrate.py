@@ -1,12 +1,9 @@
 """Calibration: what SUMO actually does, in the model's terms (docs/sumo.md, "Calibration").
 
-Runs the scenario's network over demand levels (:data:`DEMANDS`, or :data:`SCALES` of the
+Runs the scenario's network over demand levels (:data:`DEMANDS`, or :data:`SCALES` of a
 user's route files' demand) and meter green shares in worker processes (libsumo holds one
-simulation per process); fits the area-occupancy fundamental diagram
-Ve_i(AO) = V_i (1 - (AO / AO_max_i)^gamma_i) per class to Edie cell data and scores the
-paper's curves on the same data; measures the mainline outflow against the green share
-(the curve the actuator inverts) and the equilibrium SUMO holds at medium demand and
-nominal green share, with its regime under the calibrated model (sign of lambda_4).
+simulation per process) and fits Ve_i(AO) = V_i (1 - (AO / AO_max_i)^gamma_i) per class
+to Edie cell data; measures the meter curve and the equilibrium SUMO holds.
 """
 
 from __future__ import annotations

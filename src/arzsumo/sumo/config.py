@@ -1,7 +1,5 @@
-"""Settings of a SUMO run (:class:`SumoConfig`, SI: s, m, veh/s).
-
-Scenario files set them in their ``[sumo]`` table, in the units the key names state; the
-keys and their conversions are listed once, in :mod:`arzsumo.scenario.sumo`.
+"""Settings of a SUMO run (:class:`SumoConfig`, SI: s, m, veh/s; the ``[sumo]`` keys that
+set them, in the units their names state, and the conversions: :mod:`arzsumo.scenario.sumo`).
 """
 
 from __future__ import annotations
@@ -46,9 +44,8 @@ class SumoConfig:
     """One SUMO run: numerics, demand, measurement grid and ramp meter (SI units).
 
     Every field but ``layout`` is a ``[sumo]`` key: docs/scenarios.md, "[sumo]", gives
-    each one's meaning, default and range (its "SI field" column names the field), and
+    each one's meaning, default and range (its "SI field" column names the field);
     :mod:`arzsumo.sumo.car_following` says which model reads which car-following field.
-    Beyond that table:
 
     * ``ramp_storage`` = -1 (the default) becomes what the ramp holds at jam spacing,
       :func:`ramp_capacity`;

@@ -111,11 +111,8 @@ def _mainline(fid: str, vtype: str, lats: Sequence[float | str], hold: float, fi
 def demand_flows(cfg: SumoConfig, road_width: float = 6.5,
                  vehicle_width: float = 2.0) -> list[Flow]:
     """The class flows of ``cfg``, mainline flows split into columns (zero rates left out;
-    one flow per class when ``cfg.depart_pos_lat`` is a SUMO value).
-
-    With a fill phase, each mainline column is two flows: the fill demand from 0 to
-    ``cfg.fill_duration``, then the hold demand to the end.
-    """
+    one flow per class when ``cfg.depart_pos_lat`` is a SUMO value); with a fill phase two
+    per column, the fill demand up to ``cfg.fill_duration``, then the hold demand."""
     ramp_a = cfg.ramp_demand * cfg.ramp_av_share
     hv_lats: Sequence[float | str] = insertion_columns(road_width, vehicle_width, HV_COLUMNS)
     av_lats: Sequence[float | str] = [0.0] * AV_COLUMNS

@@ -26,48 +26,24 @@ from arzsumo.errors import ScenarioError, require
 class RoadLayout:
     """The section, the meter and the vehicle classes of a user's network (SI: m).
 
-    Parameters
-    ----------
-    net_file : Path
-        The network file.
-    route_files : tuple of Path
-        The user's route files (demand and vTypes); empty: the ``[sumo]`` demand keys make
-        flows on :attr:`main_route` and :attr:`ramp_route`.
-    main_route : tuple of str
-        The mainline's edges in driving order, from the first section edge to a sink.
-    starts, lengths : tuple of float
-        x of each :attr:`main_route` edge's start (the first is ``-start_offset``) and its
-        length, m.
-    sections : int
-        How many edges of :attr:`main_route` (its first ones) are the section.
-    length : float
-        Section length L, m.
-    lane_widths : tuple of float
-        Widths of the section's lanes, m (the same on every section edge).
-    internal : tuple of tuple of str
-        Per section edge boundary, the internal edges a vehicle crosses between them
-        (counted at the next edge's start).
-    meter_tl, meter_links : str, int
-        The traffic light that meters the ramp, and its signals (links): its state strings
-        are this long.
-    ramp_links : tuple of int
-        Link indices of the light that lead out of the ramp edge: the meter switches
-        these; every other link of the light stays green.
-    ramp_edge, ramp_route : str, tuple of str
-        The ramp edge the meter holds (its queue storage); the ramp's edges from it to the
-        mainline, then the mainline to its sink.
-    ramp_length : float
-        Length of ``ramp_edge`` times its lanes, m (the queue storage).
-    outlet_edge, outlet_length, outlet_lanes : str, float, int
-        The mainline edge that carries the downstream loop (ALINEA's): the edge past the
-        one the ramp joins (that one if the route ends there); its length (m) and lanes.
-    av_types : frozenset of str
-        vType IDs counted as AVs.
-    sublane : bool
-        Run SUMO's sublane model (``--lateral-resolution``); False: lane changes only.
-    ramp_free_time : float
-        Free-flow travel time over ``ramp_edge`` (its length over its speed limit), s:
-        what a ramp vehicle's wait at the meter is net of.
+    ``main_route`` holds the mainline's edges in driving order, from the first section edge
+    to a sink, with each one's start x (``starts``; the first is ``-start_offset``) and
+    ``lengths``; its first ``sections`` edges are the section, of length L (``length``)
+    and the same lanes (``lane_widths``) on every edge. ``internal`` lists, per boundary
+    between section edges, the internal edges a vehicle crosses there (counted at the next
+    edge's start). Without ``route_files`` the ``[sumo]`` demand keys make flows on
+    ``main_route`` and ``ramp_route``.
+
+    The light ``meter_tl`` has ``meter_links`` signals (its state strings are this long);
+    the meter switches those leading out of ``ramp_edge`` (``ramp_links``), every other
+    link stays green. ``ramp_route`` runs from ``ramp_edge`` to the mainline, then along
+    it to its sink; ``ramp_length`` is ``ramp_edge``'s length times its lanes (the queue
+    storage) and ``ramp_free_time`` its length over its speed limit, s (what a ramp
+    vehicle's wait at the meter is net of). ``outlet_edge`` (``outlet_length`` m,
+    ``outlet_lanes`` lanes) carries ALINEA's loop: the edge past the one the ramp joins
+    (that one if the route ends there). ``av_types`` are the vType IDs counted as AVs;
+    ``sublane`` False runs lane changes only, no sublane model. docs/networks.md, "What
+    the run takes from the network", says how a run uses each.
     """
 
     net_file: Path

@@ -1,14 +1,11 @@
 """The ramp-metering network: plain XML sources and the netconvert build.
 
-The layout (``main`` [0, L], the acceleration lane of ``merge``, the bottleneck ``down``,
-the ramp ``ramp_up`` and ``ramp_dn`` through the light ``meter``, one signal, link index
-0) is drawn in docs/sumo.md, "Network". With ``approach_length`` La > 0 an ``approach``
-edge Q(-La) -> A(0) (same lane, speed and priority as ``main``) comes first: mainline
-vehicles are inserted there and may queue, so a queue from the merge that reaches x = 0
-no longer blocks insertion. With ``approach_piece`` P > 0 it is cut into ceil(La / P)
-equal edges ``approach0``, ``approach1``, ... in driving order (priority junctions
-between them): the same road, on which SUMO's sublane step, whose follower search and
-collision check walk every pair of vehicles on a lane, costs less (docs/sumo.md, "What
+The layout is drawn in docs/sumo.md, "Network" (the light ``meter`` has one signal, link
+index 0). With ``approach_length`` La > 0 an ``approach`` edge Q(-La) -> A(0), like
+``main``, comes first: mainline vehicles are inserted there and may queue, so a queue
+from the merge that reaches x = 0 no longer blocks insertion. With ``approach_piece``
+P > 0 it is cut into ceil(La / P) equal edges ``approach0``, ``approach1``, ... in driving
+order: the same road, on which SUMO's sublane step costs less (docs/sumo.md, "What
 SUMO's step costs").
 """
 
@@ -67,9 +64,9 @@ class NetworkSpec:
             if f.name in ("approach_length", "approach_piece"):
                 require(isinstance(value, int | float) and 0 <= value < 1e6, f.name, value,
                         "a length in [0, 1e6) m (0: no approach edge / one edge)")
-                continue
-            require(isinstance(value, int | float) and value > 0, f.name, value,
-                    "a number greater than 0")
+            else:
+                require(isinstance(value, int | float) and value > 0, f.name, value,
+                        "a number greater than 0")
         require(self.lane_width <= 20.0, "lane_width", self.lane_width, "at most 20 m")
 
 
@@ -192,12 +189,9 @@ def deterministic_net(data: bytes) -> bytes:
 
 
 def run_netconvert(src_dir: Path, out_dir: Path) -> tuple[Path, bool]:
-    """Build ``ramp.net.xml`` in ``out_dir`` from the sources in ``src_dir``.
-
-    netconvert runs in a temporary directory on copies of the sources, so the header
-    comment names only ``ramp.*.xml``; the result replaces ``out_dir/ramp.net.xml`` only
-    if its bytes differ. Returns the path and whether the file was (re)written.
-    """
+    """Build ``ramp.net.xml`` in ``out_dir`` from the sources in ``src_dir``; its path and
+    whether it was (re)written (only when its bytes differ). netconvert runs in a temporary
+    directory on copies of the sources, so the header comment names only ``ramp.*.xml``."""
     missing = [n for n in SOURCE_FILES if not (src_dir / n).is_file()]
     if missing:
         raise SumoError(f"sources = {missing} are missing in {src_dir}; allowed: a directory "

@@ -1,13 +1,10 @@
-"""Macro to micro: initial vehicles on ``main`` from density and speed profiles per class.
+"""Macro to micro: initial vehicles on ``main`` from density and speed profiles per class
+(docs/sumo.md, "Macro to micro").
 
 Each class's cumulative count N_i(x) = integral of rho_i (profiles piecewise constant on
 the cells) is inverted at N_i = k + 1/2, which puts the k-th vehicle's front at the
-middle of its share of the road. Vehicles go to lateral columns (best fit, docs/sumo.md,
-"Macro to micro"), at least the follower's minimum gap behind the leader's back; one
-that fits nowhere at its target is moved upstream, or dropped when it would leave the
-road (both reported). The seed only decides ties between columns. The vehicles go into
-the route file with ``insertionChecks="none"`` (libsumo's ``vehicle.add`` takes no
-lateral position).
+middle of its share of the road. The seed only decides ties between columns. The
+vehicles go into the route file, as libsumo's ``vehicle.add`` takes no lateral position.
 """
 
 from __future__ import annotations

@@ -1,11 +1,10 @@
-"""What a run keeps of SUMO for its results directory: the configuration it ran, its FCD.
+"""What a run keeps of SUMO for its results directory: the configuration it ran, its FCD
+(docs/outputs.md, "run.sumocfg and sumo/").
 
-The kept files and how to open them are in docs/outputs.md, "run.sumocfg and sumo/". The
-configuration runs the meter's nominal plan as a static program of the light
-(:func:`meter_program_text`): the open loop. The files are gathered under
-:func:`~arzsumo.sumo.paths.scratch_dir` while the run lasts (:class:`RunFiles`) and placed
-into the results directory by :meth:`RunFiles.place`: hard-linked, or copied in chunks
-across file systems, never read into memory (an FCD file is large).
+The files are gathered under :func:`~arzsumo.sumo.paths.scratch_dir` while the run lasts
+(:class:`RunFiles`) and placed into the results directory by :meth:`RunFiles.place`:
+hard-linked, or copied in chunks across file systems, never read into memory (an FCD
+file is large).
 """
 
 from __future__ import annotations

@@ -1,10 +1,7 @@
-"""The meter's stop-line detector: what the sensor reads for the meter every step.
-
-The ramp queue (halted vehicles on ``ramp_up`` plus ramp vehicles still waiting to be
-inserted) for the queue override and the releases (vehicles that crossed the stop line)
-that end a one-vehicle green, handed to the meter as a :class:`MeterReading` by
-:class:`arzsumo.sumo.sensor.SumoSensor`; and the safety events at the meter
-(docs/sumo.md, "Meter realisation").
+"""The meter's stop-line detector: what the sensor (:class:`arzsumo.sumo.sensor.SumoSensor`)
+reads for the meter every step and hands it as a :class:`MeterReading` (the ramp queue for
+the queue override, the releases that end a one-vehicle green), and the safety events at
+the meter (docs/sumo.md, "Meter realisation").
 """
 
 from __future__ import annotations
@@ -42,12 +39,9 @@ def ramp_queue(lib: ModuleType, pending: Sequence[str] | None = None, edge: str 
 
 
 class StopLine:
-    """The detector at the stop line of ``ramp_up`` (libsumo, read every step).
-
-    A vehicle is *released* when its front leaves ``ramp_up`` (crosses the stop line).
-    Emergency braking is a deceleration beyond the vehicle type's ``decel`` by more than
-    :data:`BRAKING_MARGIN`, counted once per vehicle and episode.
-    """
+    """The detector at the stop line of ``ramp_up`` (libsumo, read every step): a vehicle
+    is *released* when its front leaves ``ramp_up``; an emergency braking episode is
+    counted once per vehicle (docs/sumo.md, "Meter realisation")."""
 
     def __init__(self, lib: ModuleType, edge: str = RAMP_UP) -> None:
         self.lib, self.edge = lib, edge

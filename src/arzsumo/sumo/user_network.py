@@ -103,8 +103,8 @@ def _route_types(req: NetworkRequest, at: str) -> set[str]:
         except ET.ParseError as exc:
             raise not_allowed(at, "route_files", list(req.route_files),
                               f"route files that parse ({name}: {exc})") from None
-        types |= {e.get("id", "") for e in root.iter() if e.tag in ("vType",
-                                                                     "vTypeDistribution")}
+        types |= {e.get("id", "") for e in root.iter()
+                  if e.tag in ("vType", "vTypeDistribution")}
     return types
 
 
@@ -224,12 +224,6 @@ def _offsets(req: NetworkRequest, edges: list[Any], at: str) -> None:
                           f"the edge's length {first:g} m")
 
 
-def _join_index(ramp: list[Any], route: list[Any]) -> int:
-    """Index in ``route`` of the first mainline edge on the ramp's route."""
-    on = set(route)
-    return route.index(next(e for e in ramp if e in on))
-
-
 def read_layout(req: NetworkRequest, at: str) -> RoadLayout:
     """Check ``req`` against its network with sumolib; the run's :class:`RoadLayout`.
 
@@ -254,7 +248,7 @@ def read_layout(req: NetworkRequest, at: str) -> RoadLayout:
                                    for c in a.getConnections(b) if c.getViaLaneID()}))
                      for a, b in itertools.pairwise(edges))
     ramp_edge = ramp[0]
-    join = _join_index(ramp, route)
+    join = route.index(next(e for e in ramp if e in route))   # where the ramp joins
     outlet = route[min(join + 1, len(route) - 1)]
     return RoadLayout(
         net_file=req.path(req.net_file).resolve(),
