@@ -96,7 +96,8 @@ class RoadGeometry:
 
     def placements(self) -> list[str]:
         """The detectors in words, one line each (``arzsumo network`` prints them)."""
-        out = [f"section {', '.join(self.edges[:self._sections()])}: L = {self.length:g} m, "
+        sections = sum(1 for s in self.edge_starts if s < self.length - 1e-9)
+        out = [f"section {', '.join(self.edges[:sections])}: L = {self.length:g} m, "
                f"{self.lanes} lane(s), W = {self.width:g} m, {self.cell_x.size - 1} cells of "
                f"{self.cell_x[1] - self.cell_x[0]:g} m"]
         for x in self.loop_x:
@@ -109,9 +110,6 @@ class RoadGeometry:
         out.append(f"meter {self.meter_tl} at the end of {self.ramp_edge}, "
                    f"{-self.light_x:.1f} m before the ramp joins at x = {self.join_x:g} m")
         return out
-
-    def _sections(self) -> int:
-        return sum(1 for s in self.edge_starts if s < self.length - 1e-9)
 
     def locate(self, x: float) -> tuple[str, float]:
         """(edge, position on it, m) of x along the mainline route."""
