@@ -1,6 +1,7 @@
 """SUMO-side pure pieces: config table, Edie grid, meter timing and curve, placement."""
 
 import itertools
+import math
 
 import numpy as np
 import pytest
@@ -13,9 +14,22 @@ from arzsumo.sumo.demand import Flow, demand_flows, route_file_text
 from arzsumo.sumo.green_share import GreenShareCurve, plan_green_steps
 from arzsumo.sumo.measure import EdieGrid
 from arzsumo.sumo.placement import place_vehicles
-from arzsumo.sumo.vtypes import vehicle_types
+from arzsumo.sumo.vtypes import VehicleType, vehicle_types
 
 PARAMS = get_preset("paper_base").params
+
+
+def requested(flow: Flow, t: float) -> int:
+    """Vehicles of ``flow`` due by time ``t`` (s): departures at begin + k period < end, <= t."""
+    if flow.rate <= 0 or t < flow.begin:
+        return 0
+    last = min(t, math.nextafter(flow.end, -math.inf))
+    return math.floor((last - flow.begin) / flow.period + 1e-9) + 1
+
+
+def spacing(vtype: VehicleType) -> float:
+    """length + minGap of ``vtype``, m (the model's spacing policy s_i)."""
+    return vtype.length + vtype.min_gap
 
 
 def test_sumo_table_converts_units():
@@ -57,8 +71,8 @@ def test_scenario_sumo_table_is_validated_and_reachable():
 
 def test_vtypes_follow_spacing_policy():
     hv, av = vehicle_types(PARAMS, SumoConfig())
-    assert hv.spacing == pytest.approx(PARAMS.spacing_h)
-    assert av.spacing == pytest.approx(PARAMS.spacing_a)
+    assert spacing(hv) == pytest.approx(PARAMS.spacing_h)
+    assert spacing(av) == pytest.approx(PARAMS.spacing_a)
     assert hv.width == av.width == PARAMS.vehicle_width
     assert hv.max_speed == pytest.approx(80 / 3.6) and av.max_speed == pytest.approx(60 / 3.6)
     assert av.car_follow_model == "ACC" and 'sigma="0.500"' in hv.to_xml()
@@ -66,9 +80,9 @@ def test_vtypes_follow_spacing_policy():
 
 def test_flows_request_exactly_and_are_sorted():
     f = Flow("x", "hv", "r_main", 0.5, 1.0, 10.0)
-    assert [f.requested(t) for t in (0.9, 1.0, 2.9, 3.0, 9.99, 100)] == [0, 1, 1, 2, 5, 5]
+    assert [requested(f, t) for t in (0.9, 1.0, 2.9, 3.0, 9.99, 100)] == [0, 1, 1, 2, 5, 5]
     flows = demand_flows(SumoConfig(horizon=3600))
-    total = sum(fl.requested(3600) for fl in flows)
+    total = sum(requested(fl, 3600) for fl in flows)
     assert total == pytest.approx(4104 + 1560 + 1200, abs=4)
     text = route_file_text(PARAMS, SumoConfig())
     begins = [float(s.split('begin="')[1].split('"')[0]) for s in text.splitlines()
@@ -90,10 +104,10 @@ def test_a_fill_phase_requests_the_fill_demand_then_the_hold_demand():
     flows = [f for f in demand_flows(cfg) if f.route == "r_main"]
     by = {c: [f for f in flows if f.type == c] for c in ("hv", "av")}
     # 10 min at the fill rate, then 10 min at the hold rate, per class (+- one per column)
-    assert sum(f.requested(600) for f in by["hv"]) == pytest.approx(1200, abs=2)
-    assert sum(f.requested(1200) for f in by["hv"]) == pytest.approx(1200 + 600, abs=2)
-    assert sum(f.requested(600) for f in by["av"]) == pytest.approx(240, abs=2)
-    assert sum(f.requested(1200) for f in by["av"]) == pytest.approx(240 + 120, abs=2)
+    assert sum(requested(f, 600) for f in by["hv"]) == pytest.approx(1200, abs=2)
+    assert sum(requested(f, 1200) for f in by["hv"]) == pytest.approx(1200 + 600, abs=2)
+    assert sum(requested(f, 600) for f in by["av"]) == pytest.approx(240, abs=2)
+    assert sum(requested(f, 1200) for f in by["av"]) == pytest.approx(240 + 120, abs=2)
     assert len({f.id for f in flows}) == len(flows)
     assert min(f.begin for f in flows if f.rate == pytest.approx(0.5)) >= 600
     short = [f for f in demand_flows(cfg.with_(horizon=300)) if f.route == "r_main"]
@@ -187,7 +201,8 @@ def test_placement_rejects_bad_profiles():
 
 
 def test_fd_fit_recovers_parameters_and_scores_paper_curve():
-    from arzsumo.sumo.calibrate import fd_speed, fit_class
+    from arzsumo.model.fd import power_law_speed as fd_speed
+    from arzsumo.sumo.calibrate import fit_class
 
     ao = np.linspace(0.02, 0.6, 200)
     v = fd_speed(ao, 20.0, 0.7, 2.0)

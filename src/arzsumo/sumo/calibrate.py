@@ -1,18 +1,9 @@
-"""Calibration: what SUMO actually does, in the model's terms.
+"""Calibration: what SUMO actually does, in the model's terms (docs/sumo.md, "Calibration").
 
-Runs the scenario's network over demand levels and meter green shares (libsumo holds one
-simulation per process, so runs go to worker processes): the paper's class demands
-(:data:`DEMANDS`) on the shipped network or a user's without route files; on a user's
-network whose route files carry the demand, that demand scaled by SUMO's ``--scale``
-(:data:`SCALES`). Then it
-
-* fits the area-occupancy fundamental diagram Ve_i(AO) = V_i (1 - (AO / AO_max_i)^gamma_i)
-  per class to Edie cell data (scipy ``curve_fit``), with R^2 and RMSE, and scores the
-  paper's curves on the same data;
-* measures the mainline outflow against the green share at medium demand (the curve the
-  actuator inverts);
-* measures the equilibrium SUMO holds at medium demand with the meter at its nominal
-  green share, and its regime under the calibrated model (sign of lambda_4).
+Runs the scenario's network over demand levels (:data:`DEMANDS`, or :data:`SCALES` of a
+user's route files' demand) and meter green shares in worker processes (libsumo holds one
+simulation per process) and fits Ve_i(AO) = V_i (1 - (AO / AO_max_i)^gamma_i) per class
+to Edie cell data; measures the meter curve and the equilibrium SUMO holds.
 """
 
 from __future__ import annotations
@@ -72,9 +63,8 @@ class CalibrationPlan:
             demand = ({"demand_scale": SCALES[level]} if scaled else
                       {"demand_h": float(veh_h_to_veh_s(qh)),
                        "demand_a": float(veh_h_to_veh_s(qa))})
-            cfg = base.with_(**demand, horizon=self.horizon, control_period=self.window,
-                             green_share=g)
-            out.append((level, g, cfg))
+            out.append((level, g, base.with_(**demand, horizon=self.horizon,
+                                             control_period=self.window, green_share=g)))
         return out
 
 
@@ -129,11 +119,7 @@ def run_calibration_runs(params: ModelParameters, base: SumoConfig, plan: Calibr
     return results
 
 
-# -- fundamental diagram fit ----------------------------------------------------------------
-#: the power law of one class, V (1 - (AO / AO_max)^gamma) in m/s (AO clipped at 0)
-fd_speed = power_law_speed
-
-
+# -- fundamental diagram fit: V (1 - (AO / AO_max)^gamma) per class, m/s ------------------
 @dataclass(frozen=True)
 class ClassFit:
     """Fitted FD of one class: V (m/s), AO_max, gamma; R^2 and RMSE (m/s); paper's R^2."""
@@ -167,10 +153,10 @@ def fit_class(ao: np.ndarray, v: np.ndarray, paper: tuple[float, float, float]) 
     v_cap = 1.02 * paper[0]
     p0 = (min(max(float(v.max()), 1.0), v_cap), min(0.99, max(0.3, float(ao.max()) * 1.05)),
           1.5)
-    popt, _ = curve_fit(fd_speed, ao, v, p0=p0, bounds=([0.5, 0.05, 0.1], [v_cap, 1.0, 8.0]),
-                        maxfev=20000)
-    r2, rmse = _scores(v, fd_speed(ao, *popt))
-    r2p, rmsep = _scores(v, np.maximum(fd_speed(ao, *paper), 0.0))
+    popt, _ = curve_fit(power_law_speed, ao, v, p0=p0,
+                        bounds=([0.5, 0.05, 0.1], [v_cap, 1.0, 8.0]), maxfev=20000)
+    r2, rmse = _scores(v, power_law_speed(ao, *popt))
+    r2p, rmsep = _scores(v, np.maximum(power_law_speed(ao, *paper), 0.0))
     return ClassFit(*(float(p) for p in popt), r2, rmse, int(ao.size), r2p, rmsep)
 
 
@@ -220,8 +206,7 @@ def measured_equilibrium(runs: list[RunData], calibrated: ModelParameters,
                           "v_a": q_a / ma if ma else float("nan"),
                           "outflow": run.outflow, "inflow": run.inflow,
                           "delivered": run.delivered}
-    ao = (calibrated.area_h * mh + calibrated.area_a * ma) / calibrated.road_width
-    eq["ao"] = ao
+    eq["ao"] = (calibrated.area_h * mh + calibrated.area_a * ma) / calibrated.road_width
     try:
         model_eq = Equilibrium(calibrated, mh, ma)
         lin = linearize(model_eq)
@@ -247,9 +232,9 @@ def calibrate(params: ModelParameters, base: SumoConfig, plan: CalibrationPlan |
     medium = sorted((r for r in runs if r.level == "medium"), key=lambda r: r.green_share)
     curve = GreenShareCurve(tuple(r.green_share for r in medium),
                             tuple(r.outflow for r in medium))
-    cal = Calibration(params, calibrated, fits, curve, points)
-    cal.equilibrium = measured_equilibrium(runs, calibrated, base.green_share)
-    cal.runs = [{"level": r.level, "green_share": r.green_share, "outflow": r.outflow,
-                 "inflow": r.inflow, "delivered": r.delivered, "collisions": r.collisions,
-                 **{f"meter_{k}": v for k, v in r.meter.items()}} for r in runs]
-    return cal
+    return Calibration(params, calibrated, fits, curve, points,
+                       measured_equilibrium(runs, calibrated, base.green_share),
+                       [{"level": r.level, "green_share": r.green_share, "outflow": r.outflow,
+                         "inflow": r.inflow, "delivered": r.delivered,
+                         "collisions": r.collisions,
+                         **{f"meter_{k}": v for k, v in r.meter.items()}} for r in runs])

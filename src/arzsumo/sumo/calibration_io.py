@@ -1,28 +1,18 @@
 """Calibration results as text and data, and the meter curve read back.
 
 :func:`arzsumo.outputs.calibration.write_calibration` (``arzsumo calibrate --out DIR``)
-writes, atomically as one directory:
-
-* ``calibrated_model.toml``: a scenario file (``arzsumo model --scenario ...``) whose
-  ``[model]`` holds the fitted FD and whose ``[equilibrium]`` is the state SUMO held, with
-  the meter curve beside it and, on a user's network, its ``[network]`` table;
-* ``meter_curve.toml``: the outflow against green share curve the actuator inverts
-  (:func:`load_green_share_curve`);
-* ``calibration.json``: every number (SI), ``calibration_points.npz``: the fitted points;
-* ``calibration.png``: data against fit and the paper's curves, and the outflow curve.
+writes them as one directory: its files are listed in docs/outputs.md, "arzsumo
+calibrate --out DIR".
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from arzsumo.errors import ArzsumoError
-from arzsumo.io import dump_toml, read_toml, toml_value
+from arzsumo.io import dump_toml, json_safe, read_toml, toml_value
 from arzsumo.sumo.calibrate import Calibration
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.green_share import GreenShareCurve
@@ -103,21 +93,9 @@ def load_green_share_curve(path: str | Path) -> GreenShareCurve:
                            tuple(float(veh_h_to_veh_s(q)) for q in data["outflow_veh_h"]))
 
 
-def _jsonable(obj: Any) -> Any:
-    if isinstance(obj, dict):
-        return {k: _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [_jsonable(v) for v in obj]
-    if isinstance(obj, float | np.floating):
-        return float(obj) if math.isfinite(obj) else None
-    if isinstance(obj, np.integer):
-        return int(obj)
-    return obj
-
-
 def calibration_json(cal: Calibration, cfg: SumoConfig) -> dict[str, Any]:
     """All calibration numbers, SI."""
-    return _jsonable({
+    return json_safe({
         "units": "SI (m, s, veh/m, m/s, veh/s)",
         "fits": {c: f.__dict__ for c, f in cal.fits.items()},
         "calibrated_params": {k: getattr(cal.calibrated, k)

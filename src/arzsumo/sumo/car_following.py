@@ -1,30 +1,12 @@
 """The car-following parameters a scenario can set, and which model reads which.
 
 Each :class:`Attribute` maps a :class:`~arzsumo.sumo.config.SumoConfig` field (SI) to the
-SUMO vType attribute it writes and names the car-following models that read it. SUMO
-ignores an attribute its model does not read, silently (``sigma`` under IDM does
-nothing); :func:`ignored` finds such a setting so that the scenario can refuse it.
-
-An optional attribute whose field is None is not written: SUMO's own default holds, and
-the vTypes of a scenario that sets none of them are byte for byte what they were before
-these keys existed.
-
-What SUMO does with each (SUMO's car-following documentation):
-
-* ``accel``, ``decel`` (m/s^2): the largest acceleration and the comfortable deceleration
-  of every model;
-* ``sigma`` (Krauss, in [0, 1]): driver imperfection, a random slowdown drawn every
-  ``sigmaStep`` seconds (default: every simulation step, which dilutes it at small steps,
-  SUMO issues #10494 and #10497);
-* ``delta`` (IDM, EIDM): the acceleration exponent (SUMO's default 4); ``stepping``
-  (IDM, EIDM, s): the internal step of the follow-speed integration (default 0.25 s);
-* ``treaction`` (EIDM, s): the reaction time (default 0.5 s); ``sigmaerror``,
-  ``sigmagap``, ``sigmaleader`` (EIDM): the driver's estimation errors of the own speed,
-  the gap and the leader's speed (defaults 0.1, 0.1, 0.02);
-* ACC (AVs): ``speedControlGain`` (speed-control mode, 1/s, default -0.4),
-  ``gapControlGainSpace`` (1/s^2, default 0.23) and ``gapControlGainSpeed`` (1/s,
-  default 0.07) of the gap-control mode; CACC adds ``gapControlGainGap`` (default 0.45)
-  and ``gapControlGainGapDot`` (default 0.0125).
+SUMO vType attribute it writes and names the car-following models that read it; what
+SUMO does with each, its unit and SUMO's default are in docs/scenarios.md, "[sumo]".
+SUMO ignores an attribute its model does not read, silently (``sigma`` under IDM does
+nothing); :func:`ignored` finds such a setting so that the scenario can refuse it. An
+optional attribute whose field is None is not written: SUMO's own default holds (that of
+``sigmaStep``, every step, dilutes ``sigma`` at small steps: SUMO issues #10494, #10497).
 """
 
 from __future__ import annotations
@@ -87,16 +69,12 @@ BY_FIELD = {a.field: a for a in ATTRIBUTES}
 MODEL_ONLY: dict[str, tuple[str, ...]] = {"hv_sigma": ("Krauss",)}
 
 
-def _fmt(value: float) -> str:
-    return f"{value:g}"
-
-
 def vtype_attributes(values: dict[str, float | None], cls: str,
                      model: str) -> tuple[tuple[str, str], ...]:
     """(SUMO name, text) of the optional attributes of class ``cls`` that are set (not
     None) and that ``model`` reads, in :data:`ATTRIBUTES` order; accel and decel are
     written by the caller in their place."""
-    return tuple((a.name, _fmt(v)) for a in ATTRIBUTES
+    return tuple((a.name, f"{v:g}") for a in ATTRIBUTES
                  if a.cls == cls and a.name not in ("accel", "decel")
                  and (v := values.get(a.field)) is not None and a.reads(model))
 

@@ -1,12 +1,11 @@
-"""Settings of a SUMO run (:class:`SumoConfig`, SI: s, m, veh/s).
-
-Scenario files set them in their ``[sumo]`` table, in the units the key names state; the
-keys and their conversions are listed once, in :mod:`arzsumo.scenario.sumo`.
+"""Settings of a SUMO run (:class:`SumoConfig`, SI: s, m, veh/s; the ``[sumo]`` keys that
+set them, in the units their names state, and the conversions: :mod:`arzsumo.scenario.sumo`).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
@@ -44,133 +43,17 @@ def ramp_capacity(length: float | None = None, spacing: float = RAMP_JAM_SPACING
 class SumoConfig:
     """One SUMO run: numerics, demand, measurement grid and ramp meter (SI units).
 
-    Parameters
-    ----------
-    step_length : float
-        SUMO step, s (ACC/CACC need small steps; default 0.1 s).
-    lateral_resolution : float
-        Sublane width, m; must divide the 6.5 m lane (0.65 or 1.3).
-    seed : int
-        SUMO random seed.
-    horizon : float
-        End time of the run, s.
-    demand_h, demand_a : float
-        Class flows requested at x = 0, veh/s.
-    ramp_demand : float
-        Ramp flow requested, veh/s (HVs, or AVs with probability ``ramp_av_share``).
-    ramp_av_share : float
-        Share of AVs in the ramp demand, in [0, 1].
-    cell_length : float
-        Measurement cell length, m (must divide the mainline length).
-    control_period : float
-        Measurement window and meter update period, s (a multiple of the step).
-    meter_cycle, min_green, min_red : float
-        Meter signal cycle and its minimum green and red times, s.
-    green_share : float
-        Nominal green share of the meter cycle, in [0, 1].
-    green_share_min, green_share_max : float
-        Saturation limits of commanded green shares, 0 <= min <= max <= 1.
-    ramp_storage : int
-        Vehicles the ramp stores (veh): while the ramp queue exceeds it, the queue override
-        forces green (fixed cycle) or the highest release rate (one per green), as field
-        meters do; 0 disables the override. Default (-1): what ``ramp_up`` holds at jam
-        spacing, :func:`ramp_capacity`.
-    drain_max : float
-        After the control window no vehicles are requested and the run goes on, the meter
-        at its drain policy (the queue override held on: the highest release rate), until
-        every loaded vehicle has left the network, at most this long, s; 0 (default) ends
-        the run with the control window.
-    meter_mode : str
-        "fixed_cycle" (green share of a fixed cycle, default) or "one_per_green" (one
-        vehicle per green at a commanded release rate).
-    meter_clearance : float
-        Yellow shown before every red of the meter, s; 0 (default) switches green to red.
-    max_green : float
-        Longest green of "one_per_green", s: the green lasts ``min_green``, extended until
-        the head vehicle crosses the stop line, at most this.
-    release_rate, release_rate_min, release_rate_max : float
-        Release rate of "one_per_green" at the nominal plan (the open loop), and its
-        bounds, veh/s.
-    time_to_teleport : float
-        SUMO's --time-to-teleport, s; -1 disables teleports (default).
-    hv_model, hv_sigma : str, float
-        HV car-following model ("Krauss", "IDM" or "EIDM") and Krauss's driver
-        imperfection in [0, 1].
-    av_model : str
-        AV car-following model ("ACC" or "CACC").
-    hv_accel, hv_decel, av_accel, av_decel : float
-        Largest acceleration and comfortable deceleration per class, m/s^2.
-    hv_sigma_step, hv_delta, hv_stepping, hv_reaction, hv_sigma_error, hv_sigma_gap,
-    hv_sigma_leader, av_speed_gain, av_gap_gain_space, av_gap_gain_speed, av_gap_gain_gap,
-    av_gap_gain_gap_dot : float or None
-        The models' own parameters (:mod:`arzsumo.sumo.car_following` says which model
-        reads which, and what SUMO does with it); None: not written, SUMO's default.
-    min_gap_lat : float
-        Lateral gap kept by both classes, m.
-    lat_alignment : str
-        Both classes' preferred lateral position in the lane (SUMO's ``latAlignment``, one
-        of :data:`LAT_ALIGNMENTS`; default "arbitrary": where they happen to be).
-    lc_sublane, lc_speed_gain, lc_pushy : float
-        Both classes' eagerness for sublane changes (>= 0), for changes that gain speed
-        (>= 0) and their willingness to encroach laterally (in [0, 1]): SUMO's
-        ``lcSublane``, ``lcSpeedGain``, ``lcPushy``.
-    lc_assertive, lc_impatience : float or None
-        Both classes' acceptance of smaller lane-change gaps (> 0; SUMO divides the
-        required gap by it) and its growth while they wait (in [0, 1]): SUMO's
-        ``lcAssertive`` and ``lcImpatience``, written only when set. Under IDM a ramp
-        vehicle at the acceleration lane's end can otherwise wait for a gap that never
-        opens, and the merge gridlocks (docs/sumo.md).
-    depart_pos_lat : str
-        Lateral insertion on the mainline: "columns" (default; fixed columns, two HV
-        columns at the lane's edges and one AV column at its centre) or a SUMO
-        ``departPosLat`` for every mainline vehicle (:data:`DEPART_POS_LAT`).
-    hv_tau : float
-        HVs' desired time headway (SUMO's ``tau``), s.
-    hv_action_step : float
-        HVs' action step (SUMO's ``actionStepLength``: how often a driver decides, a
-        reaction time), s; 0 (default) decides every simulation step. A multiple of the step.
-    down_speed, down_length : float
-        Speed limit (m/s) and length (m) of the downstream bottleneck edge ``down``.
-    meter_curve : str
-        Meter-curve file (``meter_curve.toml`` of ``arzsumo calibrate``: mainline outflow
-        against green share) that the actuator inverts; "" keeps the built-in
-        :data:`arzsumo.sumo.meter.DEFAULT_CURVE`. :mod:`arzsumo.scenario.sumo` makes it absolute.
-    approach_length : float
-        Length of the ``approach`` edge before x = 0 where mainline vehicles are inserted
-        and may queue, m; 0 (default) inserts them at x = 0 on the shipped network.
-    demand_scale : float
-        SUMO's ``--scale``: every vehicle of the demand, the route files' included, is
-        loaded this many times on average (1: as written; 0.5: every other one).
-    approach_piece : float
-        Longest edge the approach is cut into, m; 0 (default) keeps it one edge. The same
-        road in shorter edges: SUMO's sublane step costs less (docs/sumo.md).
-    hv_max_speed, av_max_speed : float
-        The vehicle types' maxSpeed, m/s; 0 (default) takes the model's free-flow speed
-        V_i. A scenario whose model is identified from SUMO states the speeds its SUMO
-        runs used, so that the fitted V_i do not change the traffic they were fitted to.
-    fill_duration : float
-        Length of the fill phase from t = 0 of SUMO, s; 0 (default) has none.
-    fill_demand_h, fill_demand_a : float
-        Class flows requested at the mainline entrance during the fill phase, veh/s; the
-        demand above then holds from ``fill_duration`` to the end. A fill above the
-        bottleneck's discharge builds the congested section fast; the hold
-        demand, a little above the discharge, keeps it without filling the approach.
-    eager_insert : bool
-        SUMO's ``--eager-insert``: every vehicle waiting for insertion (the virtual queues
-        of the mainline and the ramp) is tried every step, not only each edge's first
-        (default True).
-    collision_check : bool
-        SUMO's collision detection (``--collision.action warn``, junctions included), to
-        count collisions (``summary.json["collisions"]``). Off by default
-        (``--collision.action none``): with ``warn`` a detected collision changes no
-        vehicle, so every trajectory is the same to the last bit, and the pairwise check
-        costs about a third of the sublane step on this road (docs/sumo.md).
-    fcd : bool
-        Have SUMO write its floating-car data (every vehicle every step: position, lateral
-        position, speed, lane, type) into ``fcd.xml.gz`` of ``arzsumo run``'s directory.
-    layout : RoadLayout, optional
-        The user's network of a ``[network]`` table, checked by
-        :func:`arzsumo.sumo.user_network.read_layout`; None (default): the shipped one.
+    Every field but ``layout`` is a ``[sumo]`` key: docs/scenarios.md, "[sumo]", gives
+    each one's meaning, default and range (its "SI field" column names the field);
+    :mod:`arzsumo.sumo.car_following` says which model reads which car-following field.
+
+    * ``ramp_storage`` = -1 (the default) becomes what the ramp holds at jam spacing,
+      :func:`ramp_capacity`;
+    * ``hv_max_speed``, ``av_max_speed``: a scenario whose model is identified from SUMO
+      states the speeds its SUMO runs used, so that the fitted V_i do not change the
+      traffic they were fitted to;
+    * ``layout``: the user's network of a ``[network]`` table, checked by
+      :func:`arzsumo.sumo.user_network.read_layout`; None (default): the shipped one.
     """
 
     step_length: float = 0.1
@@ -244,32 +127,20 @@ class SumoConfig:
     layout: RoadLayout | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
-        def pos(name: str) -> None:
-            v = getattr(self, name)
-            require(isinstance(v, int | float) and math.isfinite(v) and v > 0, name, v,
-                    "a finite number greater than 0", ScenarioError)
-
-        def unit(name: str) -> None:
-            v = getattr(self, name)
-            require(isinstance(v, int | float) and 0.0 <= v <= 1.0, name, v,
-                    "a number in [0, 1]", ScenarioError)
-
-        for name in ("step_length", "lateral_resolution", "horizon", "cell_length",
-                     "control_period", "meter_cycle", "min_gap_lat", "max_green",
-                     "release_rate", "release_rate_min", "release_rate_max", "hv_tau",
-                     "down_speed", "down_length", "demand_scale"):
-            pos(name)
-        for name in ("demand_h", "demand_a", "ramp_demand", "min_green", "min_red",
-                     "approach_length", "approach_piece", "meter_clearance",
-                     "fill_duration", "drain_max", "fill_demand_h", "fill_demand_a",
-                     "hv_max_speed", "av_max_speed",
-                     "lc_sublane", "lc_speed_gain", "hv_action_step"):
-            v = getattr(self, name)
-            require(isinstance(v, int | float) and math.isfinite(v) and v >= 0, name, v,
-                    "a finite number of at least 0", ScenarioError)
-        for name in ("ramp_av_share", "green_share", "hv_sigma", "green_share_min",
-                     "green_share_max", "lc_pushy"):
-            unit(name)
+        self._each(("step_length", "lateral_resolution", "horizon", "cell_length",
+                    "control_period", "meter_cycle", "min_gap_lat", "max_green",
+                    "release_rate", "release_rate_min", "release_rate_max", "hv_tau",
+                    "down_speed", "down_length", "demand_scale"),
+                   lambda v: math.isfinite(v) and v > 0, "a finite number greater than 0")
+        self._each(("demand_h", "demand_a", "ramp_demand", "min_green", "min_red",
+                    "approach_length", "approach_piece", "meter_clearance",
+                    "fill_duration", "drain_max", "fill_demand_h", "fill_demand_a",
+                    "hv_max_speed", "av_max_speed",
+                    "lc_sublane", "lc_speed_gain", "hv_action_step"),
+                   lambda v: math.isfinite(v) and v >= 0, "a finite number of at least 0")
+        self._each(("ramp_av_share", "green_share", "hv_sigma", "green_share_min",
+                    "green_share_max", "lc_pushy"),
+                   lambda v: 0.0 <= v <= 1.0, "a number in [0, 1]")
         self._check_gap_acceptance()
         require(self.green_share_min <= self.green_share_max, "green_share_min",
                 self.green_share_min, f"at most green_share_max = {self.green_share_max}",
@@ -297,12 +168,17 @@ class SumoConfig:
         self._resolve_storage()
         require(self.time_to_teleport == -1 or self.time_to_teleport > 0, "time_to_teleport",
                 self.time_to_teleport, "-1 (off) or a time > 0 s", ScenarioError)
-        require(isinstance(self.fcd, bool), "fcd", self.fcd, "true or false", ScenarioError)
-        require(isinstance(self.eager_insert, bool), "eager_insert", self.eager_insert,
-                "true or false", ScenarioError)
-        require(isinstance(self.collision_check, bool), "collision_check",
-                self.collision_check, "true or false", ScenarioError)
+        for name in ("fcd", "eager_insert", "collision_check"):
+            require(isinstance(getattr(self, name), bool), name, getattr(self, name),
+                    "true or false", ScenarioError)
         self._check_behaviour()
+
+    def _each(self, names: tuple[str, ...], ok: Callable[[float], bool],
+              allowed: str) -> None:
+        """Each field of ``names`` is a number for which ``ok`` holds."""
+        for name in names:
+            v = getattr(self, name)
+            require(isinstance(v, int | float) and ok(v), name, v, allowed, ScenarioError)
 
     def _check_resolution(self) -> None:
         """The sublane width divides the lane (the section's lanes on a user's network

@@ -1,15 +1,11 @@
 """Demand: the route file with vehicle types, routes, class flows and initial vehicles.
 
-Mainline flows enter at x = 0 with ``departSpeed="desired"`` in fixed lateral columns:
-HVs alternate between the two outer columns (``hv_0``, ``hv_1``), AVs use the centre
-(``av_0``). On the 6.5 m lane, ``departPosLat="free"`` put every HV into one file at the
-right edge and delivered only about 70 % of 4104 + 1560 veh/h; the columns deliver all of
-it. Ramp flows ``ramp_hv`` and ``ramp_av`` enter at the start of ``ramp_up``. Flows are
-evenly spaced (``period``), so the requested number by time t is known exactly.
-
-With ``cfg.approach_length > 0`` the mainline route ``r_main`` starts on ``approach``
-(upstream of x = 0, where vehicles may queue); initial vehicles, placed on ``main``, then
-follow ``r_section`` (``main`` onwards).
+Mainline flows enter at x = 0 with ``departSpeed="desired"`` in fixed lateral columns
+(HVs alternating between the lane's two edges, ``hv_0`` and ``hv_1``, AVs at its centre,
+``av_0``; why: docs/sumo.md, "Vehicle types and demand"); ramp flows ``ramp_hv`` and
+``ramp_av`` at the start of ``ramp_up``. With ``cfg.approach_length > 0`` the mainline
+route ``r_main`` starts on ``approach``; initial vehicles, placed on ``main``, then follow
+``r_section`` (``main`` onwards).
 """
 
 from __future__ import annotations
@@ -26,7 +22,7 @@ from arzsumo.errors import ScenarioError
 from arzsumo.io import atomic_file
 from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.network import DOWN, MAIN, MERGE, RAMP_DN, RAMP_UP, approach_edges
+from arzsumo.sumo.network import DOWN, MAIN, MERGE, RAMP_DN, RAMP_UP, approach_edges, xml_file
 from arzsumo.sumo.vtypes import AV_TYPE, HV_TYPE, vehicle_types
 
 ROUTE_MAIN, ROUTE_RAMP, ROUTE_SECTION = "r_main", "r_ramp", "r_section"
@@ -53,21 +49,12 @@ class Flow:
         """Headway between departures, s."""
         return 1.0 / self.rate
 
-    def requested(self, t: float) -> int:
-        """Vehicles due by time ``t`` (s): departures at begin + k period < end, <= t."""
-        if self.rate <= 0 or t < self.begin:
-            return 0
-        last = min(t, math.nextafter(self.end, -math.inf))
-        return math.floor((last - self.begin) / self.period + 1e-9) + 1
-
     def to_xml(self) -> str:
-        lat = self.lat
         speed = self.depart_speed or ("desired" if self.route == ROUTE_MAIN else "max")
         attrs = {"id": self.id, "type": self.type, "route": self.route,
                  "begin": f"{self.begin:.6g}", "end": f"{self.end:.6g}",
                  "period": f"{self.period:.9g}", "departLane": self.depart_lane,
-                 "departPos": "base",
-                 "departPosLat": lat, "departSpeed": speed}
+                 "departPos": "base", "departPosLat": self.lat, "departSpeed": speed}
         return "<flow " + " ".join(f"{k}={quoteattr(v)}" for k, v in attrs.items()) + "/>"
 
 
@@ -94,10 +81,8 @@ HV_COLUMNS, AV_COLUMNS = 2, 1
 
 
 def insertion_columns(road_width: float, vehicle_width: float, n: int) -> list[float]:
-    """Lateral offsets (m, from the lane centre) of ``n`` HV columns at the lane edges.
-
-    ``n = 1`` is the centre; ``n = 2`` the two lane edges.
-    """
+    """Lateral offsets (m, from the lane centre) of ``n`` columns evenly from one lane edge
+    to the other (``n = 1``: the centre)."""
     edge = max(0.0, (road_width - vehicle_width) / 2.0)
     return [0.0] if n == 1 else list(np.linspace(-edge, edge, n))
 
@@ -126,11 +111,8 @@ def _mainline(fid: str, vtype: str, lats: Sequence[float | str], hold: float, fi
 def demand_flows(cfg: SumoConfig, road_width: float = 6.5,
                  vehicle_width: float = 2.0) -> list[Flow]:
     """The class flows of ``cfg``, mainline flows split into columns (zero rates left out;
-    one flow per class when ``cfg.depart_pos_lat`` is a SUMO value).
-
-    With a fill phase, each mainline column is two flows: the fill demand from 0 to
-    ``cfg.fill_duration``, then the hold demand to the end.
-    """
+    one flow per class when ``cfg.depart_pos_lat`` is a SUMO value); with a fill phase two
+    per column, the fill demand up to ``cfg.fill_duration``, then the hold demand."""
     ramp_a = cfg.ramp_demand * cfg.ramp_av_share
     hv_lats: Sequence[float | str] = insertion_columns(road_width, vehicle_width, HV_COLUMNS)
     av_lats: Sequence[float | str] = [0.0] * AV_COLUMNS
@@ -165,20 +147,13 @@ def check_columns(road_width: float, vehicle_width: float, resolution: float,
         used.append((lo, hi))
 
 
-def _routes_file(lines: list[str]) -> str:
-    body = "\n".join(f"    {ln}" for ln in lines)
-    return f'<?xml version="1.0" encoding="UTF-8"?>\n<routes>\n{body}\n</routes>\n'
-
-
 def layout_route_text(params: ModelParameters, cfg: SumoConfig) -> str:
-    """The route file on a user's network (``cfg.layout``): nothing when the user's
-    route files carry the demand; else the run's vTypes, the mainline route from the first
-    section edge and the ramp route, and the ``[sumo]`` demand as flows on them, each
-    vehicle entering the lane SUMO finds freest (``departLane="free"``; mainline vehicles
-    laterally at the lane's centre unless ``depart_pos_lat`` names a SUMO value)."""
+    """The route file on a user's network (``cfg.layout``; docs/networks.md, "What the run
+    takes from the network"): empty when the user's route files carry the demand; mainline
+    vehicles laterally at the lane's centre unless ``depart_pos_lat`` names a SUMO value."""
     lay = cfg.layout
     if lay is None or lay.route_files:
-        return _routes_file([])
+        return xml_file("routes", [])
     hv, av = vehicle_types(params, cfg)
     lines = [hv.to_xml(), av.to_xml(),
              f'<route id="{ROUTE_MAIN}" edges={quoteattr(" ".join(lay.main_route))}/>',
@@ -187,7 +162,7 @@ def layout_route_text(params: ModelParameters, cfg: SumoConfig) -> str:
     flows = [replace(f, depart_lane="free")
              for f in demand_flows(replace(cfg, depart_pos_lat=lat))]
     lines += [f.to_xml() for f in sorted(flows, key=lambda f: f.begin)]
-    return _routes_file(lines)
+    return xml_file("routes", lines)
 
 
 def route_file_text(params: ModelParameters, cfg: SumoConfig,
@@ -224,7 +199,7 @@ def route_file_text(params: ModelParameters, cfg: SumoConfig,
                  for f in flows]
     # SUMO drops departures listed out of time order: sort the flows by their begin
     lines += [f.to_xml() for f in sorted(flows, key=lambda f: f.begin)]
-    return _routes_file(lines)
+    return xml_file("routes", lines)
 
 
 def write_route_file(path: Path, params: ModelParameters, cfg: SumoConfig,

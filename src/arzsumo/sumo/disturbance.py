@@ -9,9 +9,7 @@ through the section, the same on every controller of a seed: the edge, the times
 speed are fixed by the scenario, and up to the start of control every run of a seed is
 the same run (:mod:`arzsumo.bridge.branches`).
 
-:class:`DisturbanceSchedule` applies it to a running SUMO: it is checked once per SUMO
-step by the plant (:meth:`arzsumo.sumo.plant.SumoPlant.step`) and sets the edge's speed
-with ``edge.setMaxSpeed`` when a time is passed, restoring the speed it read before.
+:class:`DisturbanceSchedule` applies it to a running SUMO (``edge.setMaxSpeed``).
 """
 
 from __future__ import annotations
@@ -72,7 +70,8 @@ class DisturbanceSchedule:
                                         "ended_s": None, "original_speed_m_s": None}
 
     def due(self, t: float) -> None:
-        """Apply what is due at SUMO time ``t`` (s); the plant calls it after every step."""
+        """Apply what is due at SUMO time ``t`` (s); the plant calls it after every step
+        (:meth:`arzsumo.sumo.plant.SumoPlant.step`)."""
         eps = 1e-9
         if self.applied["began_s"] is None and t >= self.begin - eps:
             edge = self.disturbance.edge

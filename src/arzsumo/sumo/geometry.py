@@ -2,15 +2,10 @@
 
 :func:`road_geometry` turns a :class:`~arzsumo.sumo.layout.RoadLayout` and the run's
 detector settings into a :class:`RoadGeometry`: the lane shapes of the section, of the
-mainline past it and of the ramp (the network's own x/y, m), and where the loop stations,
-ALINEA's downstream loop, the meter's light and the cells' boundaries sit, both on the
-plan and along the section (x from the section's start, m). The figure of the section
-(:func:`arzsumo.outputs.network.network_figure`) draws it; it is what the run places
-(:func:`arzsumo.sumo.loops.write_loops`, :func:`~arzsumo.sumo.loops.write_downstream_loop`,
-:class:`~arzsumo.sumo.measure.MainlineSensor`).
-
-:func:`shipped_layout` gives the shipped network a layout too (its section ``main``, its
-light ``meter`` on ``ramp_up``), so a scenario without ``[network]`` is drawn the same way.
+mainline past it and of the ramp, and where the loop stations, ALINEA's loop, the meter's
+light and the cells' boundaries sit, on the plan (the network's x/y, m) and along the
+section (x, m), as the run places them. :func:`shipped_layout` gives the shipped network
+a layout too, so a scenario without ``[network]`` is drawn the same way.
 """
 
 from __future__ import annotations
@@ -101,7 +96,8 @@ class RoadGeometry:
 
     def placements(self) -> list[str]:
         """The detectors in words, one line each (``arzsumo network`` prints them)."""
-        out = [f"section {', '.join(self.edges[:self._sections()])}: L = {self.length:g} m, "
+        sections = sum(1 for s in self.edge_starts if s < self.length - 1e-9)
+        out = [f"section {', '.join(self.edges[:sections])}: L = {self.length:g} m, "
                f"{self.lanes} lane(s), W = {self.width:g} m, {self.cell_x.size - 1} cells of "
                f"{self.cell_x[1] - self.cell_x[0]:g} m"]
         for x in self.loop_x:
@@ -114,9 +110,6 @@ class RoadGeometry:
         out.append(f"meter {self.meter_tl} at the end of {self.ramp_edge}, "
                    f"{-self.light_x:.1f} m before the ramp joins at x = {self.join_x:g} m")
         return out
-
-    def _sections(self) -> int:
-        return sum(1 for s in self.edge_starts if s < self.length - 1e-9)
 
     def locate(self, x: float) -> tuple[str, float]:
         """(edge, position on it, m) of x along the mainline route."""
@@ -148,10 +141,9 @@ def _at(lane: Any, pos: float) -> np.ndarray:
     return np.array(geomhelper.positionAtShapeOffset(shape, pos * scale), float)
 
 
-def _lanes_of(net: Any, layout: RoadLayout) -> tuple[list[str], list[str], list[np.ndarray]]:
+def _lanes_of(net: Any, layout: RoadLayout,
+              ramp: tuple[str, ...]) -> tuple[list[str], list[str], list[np.ndarray]]:
     edges, roles, shapes = [], [], []
-    join = next(e for e in layout.ramp_route if e in layout.main_route)
-    ramp = layout.ramp_route[:layout.ramp_route.index(join)]
     for k, e in enumerate((*layout.main_route, *ramp)):
         role = "section" if k < layout.sections else \
             "mainline" if k < len(layout.main_route) else "ramp"
@@ -196,19 +188,11 @@ def _boundaries(net: Any, layout: RoadLayout, cell_x: np.ndarray) -> np.ndarray:
 
 def road_geometry(layout: RoadLayout, loop_x: Sequence[float], cell_length: float,
                   downstream_distance: float) -> RoadGeometry:
-    """The road and detectors of a run on ``layout`` (read with sumolib).
-
-    Parameters
-    ----------
-    layout : RoadLayout
-        The section, ramp and light (:func:`shipped_layout` for the shipped network).
-    loop_x : sequence of float
-        The loop stations asked for (``[sensing]``, m); placed as the run places them.
-    cell_length : float
-        The cells' length, m (``[sumo] cell_length_m``).
-    downstream_distance : float
-        ALINEA's loop past the start of the outlet edge, m (``[alinea] loop_distance_m``).
-    """
+    """The road and detectors of a run on ``layout`` (read with sumolib;
+    :func:`shipped_layout` for the shipped network): the loop stations asked for at
+    ``loop_x`` (``[sensing]``, m) placed as the run places them, cells of ``cell_length``
+    (m) and ALINEA's loop ``downstream_distance`` (m, ``[alinea] loop_distance_m``) past
+    the start of the outlet edge."""
     import sumolib
 
     net = sumolib.net.readNet(str(layout.net_file))
@@ -219,9 +203,9 @@ def road_geometry(layout: RoadLayout, loop_x: Sequence[float], cell_length: floa
     pos = min(downstream_distance, layout.outlet_length - BOUNDARY_GAP)
     outlet = net.getEdge(layout.outlet_edge).getLanes()
     join = next(e for e in layout.ramp_route if e in layout.main_route)
-    between = layout.ramp_route[1:layout.ramp_route.index(join)]
+    ramp = layout.ramp_route[:layout.ramp_route.index(join)]
     ramp_lanes = net.getEdge(layout.ramp_edge).getLanes()
-    edges, roles, shapes = _lanes_of(net, layout)
+    edges, roles, shapes = _lanes_of(net, layout, ramp)
     return RoadGeometry(
         lane_edges=tuple(edges), lane_roles=tuple(roles), lane_shapes=tuple(shapes),
         light=np.mean([np.asarray(ln.getShape()[-1][:2], float) for ln in ramp_lanes], 0),
@@ -232,6 +216,6 @@ def road_geometry(layout: RoadLayout, loop_x: Sequence[float], cell_length: floa
         edge_starts=layout.starts, edge_lengths=layout.lengths, length=layout.length,
         width=layout.width, lanes=layout.lanes,
         join_x=layout.starts[layout.main_route.index(join)],
-        light_x=-float(sum(net.getEdge(e).getLength() for e in between)),
+        light_x=-float(sum(net.getEdge(e).getLength() for e in ramp[1:])),
         ramp_length=float(net.getEdge(layout.ramp_edge).getLength()),
         meter_tl=layout.meter_tl, ramp_edge=layout.ramp_edge)

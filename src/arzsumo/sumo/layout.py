@@ -1,16 +1,12 @@
 """The road a run measures and meters: which edges are the section, which light the meter.
 
-Without a ``[network]`` table a run uses the shipped network (:mod:`arzsumo.sumo.network`:
-the section is ``main``, the light ``meter``) and no :class:`RoadLayout` exists: every
-module keeps its fixed IDs, so the default stays what it was. A ``[network]`` table names
-the user's edges, light and vehicle types; :func:`arzsumo.sumo.user_network.read_layout`
-checks them against the network with sumolib and returns a :class:`RoadLayout`, which the
-run carries on :attr:`arzsumo.sumo.config.SumoConfig.layout`.
-
-Positions: x is the distance from the section's start (x = 0, ``start_offset`` metres
-along the first section edge) to the vehicle's front, over the section's edges in order;
-the section ends at x = L. The route edges past the section (``main_route``) continue the
-same x, so a detector "d metres past the section" is placed by :meth:`RoadLayout.locate`.
+Without a ``[network]`` table no :class:`RoadLayout` exists and every module keeps the
+shipped network's fixed IDs (:mod:`arzsumo.sumo.network`: the section ``main``, the light
+``meter``); with one, :func:`arzsumo.sumo.user_network.read_layout` returns the layout the
+run carries on :attr:`arzsumo.sumo.config.SumoConfig.layout`. x is the distance from the
+section's start (``start_offset`` metres along the first section edge) to the vehicle's
+front, over the section's edges in order to x = L and on along ``main_route`` past it, so
+a detector "d metres past the section" is placed by :meth:`RoadLayout.locate`.
 """
 
 from __future__ import annotations
@@ -30,55 +26,24 @@ from arzsumo.errors import ScenarioError, require
 class RoadLayout:
     """The section, the meter and the vehicle classes of a user's network (SI: m).
 
-    Parameters
-    ----------
-    net_file : Path
-        The network file.
-    route_files : tuple of Path
-        The user's route files (demand and vTypes); empty: the ``[sumo]`` demand keys make
-        flows on :attr:`main_route` and :attr:`ramp_route`.
-    main_route : tuple of str
-        The mainline's edges in driving order, from the first section edge to a sink.
-    starts : tuple of float
-        x of each :attr:`main_route` edge's start, m (the first is ``-start_offset``).
-    lengths : tuple of float
-        Each :attr:`main_route` edge's length, m.
-    sections : int
-        How many edges of :attr:`main_route` (its first ones) are the section.
-    length : float
-        Section length L, m.
-    lane_widths : tuple of float
-        Widths of the section's lanes, m (the same on every section edge).
-    internal : tuple of tuple of str
-        Per section edge boundary, the internal edges a vehicle crosses between them
-        (counted at the next edge's start).
-    meter_tl : str
-        The traffic light that meters the ramp.
-    meter_links : int
-        Signals (links) of that light: its state strings are this long.
-    ramp_links : tuple of int
-        Link indices of the light that lead out of the ramp edge: the meter switches
-        these; every other link of the light stays green.
-    ramp_edge : str
-        The ramp edge the meter holds (its queue storage).
-    ramp_route : tuple of str
-        The ramp's edges from ``ramp_edge`` to the mainline, then the mainline to its sink.
-    ramp_length : float
-        Length of ``ramp_edge`` times its lanes, m (the queue storage).
-    outlet_edge : str
-        The mainline edge that carries the downstream loop (ALINEA's): the edge past the
-        one the ramp joins (that one if the route ends there).
-    outlet_length : float
-        Its length, m.
-    outlet_lanes : int
-        Its lanes.
-    av_types : frozenset of str
-        vType IDs counted as AVs.
-    sublane : bool
-        Run SUMO's sublane model (``--lateral-resolution``); False: lane changes only.
-    ramp_free_time : float
-        Free-flow travel time over ``ramp_edge`` (its length over its speed limit), s:
-        what a ramp vehicle's wait at the meter is net of.
+    ``main_route`` holds the mainline's edges in driving order, from the first section edge
+    to a sink, with each one's start x (``starts``; the first is ``-start_offset``) and
+    ``lengths``; its first ``sections`` edges are the section, of length L (``length``)
+    and the same lanes (``lane_widths``) on every edge. ``internal`` lists, per boundary
+    between section edges, the internal edges a vehicle crosses there (counted at the next
+    edge's start). Without ``route_files`` the ``[sumo]`` demand keys make flows on
+    ``main_route`` and ``ramp_route``.
+
+    The light ``meter_tl`` has ``meter_links`` signals (its state strings are this long);
+    the meter switches those leading out of ``ramp_edge`` (``ramp_links``), every other
+    link stays green. ``ramp_route`` runs from ``ramp_edge`` to the mainline, then along
+    it to its sink; ``ramp_length`` is ``ramp_edge``'s length times its lanes (the queue
+    storage) and ``ramp_free_time`` its length over its speed limit, s (what a ramp
+    vehicle's wait at the meter is net of). ``outlet_edge`` (``outlet_length`` m,
+    ``outlet_lanes`` lanes) carries ALINEA's loop: the edge past the one the ramp joins
+    (that one if the route ends there). ``av_types`` are the vType IDs counted as AVs;
+    ``sublane`` False runs lane changes only, no sublane model. docs/networks.md, "What
+    the run takes from the network", says how a run uses each.
     """
 
     net_file: Path
@@ -194,9 +159,7 @@ class VehicleClasses:
     def recorded(self, vid: str) -> bool:
         """Whether ``vid`` entered from the ramp, from what :meth:`ramp` learnt while SUMO
         ran (no SUMO call: usable once it has closed). The run asks :meth:`ramp` of every
-        vehicle SUMO loads (:meth:`arzsumo.sumo.simulation.SumoSimulation.step`), so every
-        vehicle of its tripinfo is known; one never asked is a mainline vehicle. Without a
-        layout: the id (``ramp...``)."""
+        vehicle SUMO loads, so one never asked is a mainline vehicle."""
         if self.layout is None or self.lib is None:
             return vid.startswith("ramp")
         return self._ramp.get(vid, False)

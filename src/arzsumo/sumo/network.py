@@ -1,26 +1,12 @@
 """The ramp-metering network: plain XML sources and the netconvert build.
 
-Layout (x along the mainline, metres)::
-
-    A(0) --main, 1 lane 6.5 m, 1000 m--> B(L) --merge, 2 lanes--> C --down (bottleneck)--> D
-                                          ^
-    R --ramp_up (queue storage)--> M(meter, traffic light) --ramp_dn--/
-
-``main`` is the controlled road [0, L]. The ramp joins the right lane (acceleration lane)
-of ``merge`` at x = L; that lane ends, so ramp vehicles must merge into the 6.5 m lane
-before C. ``down`` is slower than ``main``: a capacity bottleneck, so ramp inflow takes
-mainline capacity and the meter sets the mainline outflow q(L, t). The traffic light
-``meter`` at node M has one signal (link index 0) on the ramp.
-
-With ``approach_length`` La > 0 an ``approach`` edge Q(-La) -> A(0) (same lane, speed
-and priority as ``main``) comes first: mainline vehicles are inserted there and may queue,
-so a queue from the merge that reaches x = 0 no longer blocks insertion and the inflow at
-x = 0 is set by traffic. With La = 0 (default) the network is the shipped one. With
-``approach_piece`` P > 0 the approach is cut into ceil(La / P) equal edges in a row
-(``approach0``, ``approach1``, ... in driving order, priority junctions between them): the
-same road, but SUMO's sublane step, whose follower search and collision check walk every
-pair of vehicles on a lane, sees a tenth of the approach's queue per lane (docs/sumo.md,
-"What SUMO's step costs").
+The layout is drawn in docs/sumo.md, "Network" (the light ``meter`` has one signal, link
+index 0). With ``approach_length`` La > 0 an ``approach`` edge Q(-La) -> A(0), like
+``main``, comes first: mainline vehicles are inserted there and may queue, so a queue
+from the merge that reaches x = 0 no longer blocks insertion. With ``approach_piece``
+P > 0 it is cut into ceil(La / P) equal edges ``approach0``, ``approach1``, ... in driving
+order: the same road, on which SUMO's sublane step costs less (docs/sumo.md, "What
+SUMO's step costs").
 """
 
 from __future__ import annotations
@@ -53,25 +39,10 @@ SOURCE_FILES = ("ramp.nod.xml", "ramp.edg.xml", "ramp.con.xml", "ramp.tll.xml")
 class NetworkSpec:
     """Geometry and speed limits of the ramp network (SI: m, m/s).
 
-    Parameters
-    ----------
-    length : float
-        Mainline length L, m (exactly the ``main`` edge length).
-    lane_width : float
-        Mainline lane width W, m.
-    main_speed : float
-        Mainline speed limit, m/s (vehicle types cap themselves below it).
-    merge_length, acc_lane_width : float
-        Length of the merge section and width of its acceleration lane, m.
-    down_length, down_speed : float
-        Length (m) and speed limit (m/s) of the downstream bottleneck.
-    ramp_length, ramp_dn_length, ramp_speed : float
-        Queue storage upstream of the meter (m), ramp length from meter to merge (m),
-        ramp speed limit (m/s).
-    approach_length : float
-        Length of the ``approach`` edge before x = 0, m (0: no approach edge).
-    approach_piece : float
-        Longest edge the approach is cut into, m (0: one edge; :func:`approach_edges`).
+    ``length`` is L, exactly the ``main`` edge's; ``lane_width`` the mainline lane's W;
+    ``ramp_length`` the queue storage ``ramp_up`` upstream of the meter, ``ramp_dn_length``
+    the ramp from the meter to the merge; ``approach_length`` 0: no approach edge,
+    ``approach_piece`` 0: one edge (:func:`approach_edges`).
     """
 
     length: float = 1000.0
@@ -93,13 +64,14 @@ class NetworkSpec:
             if f.name in ("approach_length", "approach_piece"):
                 require(isinstance(value, int | float) and 0 <= value < 1e6, f.name, value,
                         "a length in [0, 1e6) m (0: no approach edge / one edge)")
-                continue
-            require(isinstance(value, int | float) and value > 0, f.name, value,
-                    "a number greater than 0")
+            else:
+                require(isinstance(value, int | float) and value > 0, f.name, value,
+                        "a number greater than 0")
         require(self.lane_width <= 20.0, "lane_width", self.lane_width, "at most 20 m")
 
 
-def _xml(root: str, lines: list[str]) -> str:
+def xml_file(root: str, lines: list[str]) -> str:
+    """An XML file of element ``root`` holding ``lines``, each indented by four spaces."""
     body = "\n".join(f"    {line}" for line in lines)
     return f'<?xml version="1.0" encoding="UTF-8"?>\n<{root}>\n{body}\n</{root}>\n'
 
@@ -151,10 +123,10 @@ def network_sources(spec: NetworkSpec) -> dict[str, str]:
         f'<connection {_attrs(**{"from": RAMP_UP}, to=RAMP_DN, fromLane=0, toLane=0, tl=METER_TL, linkIndex=0)}/>',  # noqa: E501
     ]
     return {
-        "ramp.nod.xml": _xml("nodes", nodes),
-        "ramp.edg.xml": _xml("edges", edges),
-        "ramp.con.xml": _xml("connections", cons),
-        "ramp.tll.xml": _xml("tlLogics", tll),
+        "ramp.nod.xml": xml_file("nodes", nodes),
+        "ramp.edg.xml": xml_file("edges", edges),
+        "ramp.con.xml": xml_file("connections", cons),
+        "ramp.tll.xml": xml_file("tlLogics", tll),
     }
 
 
@@ -201,11 +173,9 @@ def write_if_changed(path: Path, data: bytes) -> bool:
 def write_sources(spec: NetworkSpec, out_dir: Path) -> list[Path]:
     """Write the plain-XML sources of ``spec`` into ``out_dir`` (changed files only)."""
     out_dir.mkdir(parents=True, exist_ok=True)
-    paths = []
     for name, text in network_sources(spec).items():
         write_if_changed(out_dir / name, text.encode("utf-8"))
-        paths.append(out_dir / name)
-    return paths
+    return [out_dir / name for name in SOURCE_FILES]
 
 
 #: netconvert's header comment starts with the build time; no option drops it (SUMO 1.28),
@@ -219,12 +189,9 @@ def deterministic_net(data: bytes) -> bytes:
 
 
 def run_netconvert(src_dir: Path, out_dir: Path) -> tuple[Path, bool]:
-    """Build ``ramp.net.xml`` in ``out_dir`` from the sources in ``src_dir``.
-
-    netconvert runs in a temporary directory on copies of the sources, so the header
-    comment names only ``ramp.*.xml``; the result replaces ``out_dir/ramp.net.xml`` only
-    if its bytes differ. Returns the path and whether the file was (re)written.
-    """
+    """Build ``ramp.net.xml`` in ``out_dir`` from the sources in ``src_dir``; its path and
+    whether it was (re)written (only when its bytes differ). netconvert runs in a temporary
+    directory on copies of the sources, so the header comment names only ``ramp.*.xml``."""
     missing = [n for n in SOURCE_FILES if not (src_dir / n).is_file()]
     if missing:
         raise SumoError(f"sources = {missing} are missing in {src_dir}; allowed: a directory "
@@ -258,12 +225,8 @@ def edge_lengths(net_file: Path) -> dict[str, float]:
 
 def build_network(out_dir: Path, spec: NetworkSpec | None = None, *,
                   write: bool = True) -> Path:
-    """Write the sources of ``spec`` (unless ``write`` is False) and build the network.
-
-    Checks that the mainline (and the approach) is exactly as long as ``spec`` says in the
-    built network.
-    See :func:`rebuild_network` for whether anything changed.
-    """
+    """Write the sources of ``spec`` (unless ``write`` is False) and build the network,
+    checked to have the mainline (and the approach) exactly as long as ``spec`` says."""
     return rebuild_network(out_dir, spec, write=write)[0]
 
 
@@ -280,9 +243,8 @@ def rebuild_network(out_dir: Path, spec: NetworkSpec | None = None, *,
         raise SumoError(f"out = {str(out_dir)!r} cannot be written: {exc.strerror}; allowed: "
                         "a writable directory") from None
     lengths = edge_lengths(net)
-    wanted = {MAIN: spec.length}
     ids = approach_edges(spec.approach_length, spec.approach_piece)
-    wanted |= {e: spec.approach_length / len(ids) for e in ids}
+    wanted = {MAIN: spec.length} | {e: spec.approach_length / len(ids) for e in ids}
     for edge, length in wanted.items():
         if abs(lengths.get(edge, -1.0) - length) > 1e-6:
             raise SumoError(f"{edge} edge length = {lengths.get(edge)} m differs from the "

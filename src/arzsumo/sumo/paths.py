@@ -1,10 +1,9 @@
 """Where the SUMO binaries and the shipped network live.
 
 The binaries come from the ``eclipse-sumo`` wheel (``sumo.SUMO_HOME/bin``). The network
-ships inside the package (``arzsumo/data/sumo_nets``, :mod:`arzsumo.resources`; the
-repository's ``sumo_nets/`` links to it); the environment variable ``ARZSUMO_SUMO_NETS``
-or an explicit argument overrides it. SUMO's temporary files (route,
-detector and statistics files) go under :func:`scratch_dir`.
+ships inside the package (:mod:`arzsumo.resources`); ``ARZSUMO_SUMO_NETS`` or an explicit
+argument overrides it (docs/sumo.md, "Network"). SUMO's temporary files (route, detector
+and statistics files) go under :func:`scratch_dir`.
 """
 
 from __future__ import annotations
@@ -52,9 +51,7 @@ def sumo_binary(name: str) -> Path:
 def default_nets_dir() -> Path:
     """The network directory: ``$ARZSUMO_SUMO_NETS`` or the one shipped in the package."""
     env = os.environ.get(NETS_ENV)
-    if env:
-        return Path(env)
-    return shipped_nets_dir()
+    return Path(env) if env else shipped_nets_dir()
 
 
 def build_nets_dir(override: str | os.PathLike[str] | None = None) -> Path:
@@ -67,9 +64,8 @@ def build_nets_dir(override: str | os.PathLike[str] | None = None) -> Path:
     if override is not None:
         return Path(override)
     path = default_nets_dir()
-    if os.environ.get(NETS_ENV):
-        return path
-    refuse_installed_nets(path)
+    if not os.environ.get(NETS_ENV):
+        refuse_installed_nets(path)
     return path
 
 

@@ -1,15 +1,10 @@
-"""Macro to micro: initial vehicles on ``main`` from density and speed profiles per class.
+"""Macro to micro: initial vehicles on ``main`` from density and speed profiles per class
+(docs/sumo.md, "Macro to micro").
 
 Each class's cumulative count N_i(x) = integral of rho_i (profiles piecewise constant on
 the cells) is inverted at N_i = k + 1/2, which puts the k-th vehicle's front at the
-middle of its share of the road: a 100 m stretch receives its target count to within one
-vehicle, exactly for uniform profiles. Vehicles go to lateral columns (the insertion
-columns at the lane edges and the centre) and, within a column, keep at least the
-follower's minimum gap behind the leader's back; a vehicle that does not fit in any
-column at its target is moved upstream (reported), or dropped when it would leave the
-road (reported). The seed only decides ties between columns, so the result is
-deterministic. The vehicles go into the route file with ``insertionChecks="none"``
-(libsumo's ``vehicle.add`` takes no lateral position).
+middle of its share of the road. The seed only decides ties between columns. The
+vehicles go into the route file, as libsumo's ``vehicle.add`` takes no lateral position.
 """
 
 from __future__ import annotations
@@ -22,7 +17,7 @@ from numpy.typing import ArrayLike
 from arzsumo.errors import ModelError, require
 from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.demand import InitialVehicle
+from arzsumo.sumo.demand import InitialVehicle, insertion_columns
 from arzsumo.sumo.vtypes import AV_TYPE, HV_TYPE, VehicleType, vehicle_types
 
 #: Number of lateral columns for initial vehicles (d = 2 m on a 6.5 m lane).
@@ -51,12 +46,6 @@ def _targets(x: np.ndarray, rho: np.ndarray, length: float) -> np.ndarray:
     n = int(np.floor(cum[-1] + 0.5))
     pos = np.interp(np.arange(n) + 0.5, cum, edges)
     return pos[::-1]
-
-
-def column_offsets(road_width: float, vehicle_width: float, n: int = COLUMNS) -> np.ndarray:
-    """Lateral offsets (m) of ``n`` columns between the lane edges."""
-    edge = max(0.0, (road_width - vehicle_width) / 2.0)
-    return np.linspace(-edge, edge, n) if n > 1 else np.zeros(1)
 
 
 def _check_profiles(params: ModelParameters, x: np.ndarray, arrays: list[np.ndarray]) -> None:
@@ -90,11 +79,9 @@ def _column(allowed: np.ndarray, target: float, order: np.ndarray) -> int:
 def _fill_columns(cand: list[tuple[float, str, int]], kinds: dict[str, VehicleType],
                   lats: np.ndarray, length: float, rng: np.random.Generator,
                   ) -> tuple[list[tuple[str, str, float, float]], int, float, int]:
-    """Put the candidates, downstream first, into the lateral columns ``lats`` (m).
-
-    Returns (id, class, front m, lateral offset m) of each placed vehicle, the number moved
-    upstream, the largest shift (m) and the number dropped.
-    """
+    """Put the candidates, downstream first, into the lateral columns ``lats`` (m): (id,
+    class, front m, lateral offset m) of each placed vehicle, the number moved upstream,
+    the largest shift (m) and the number dropped."""
     # back of the last vehicle placed in each column (+inf: free)
     back = np.full(lats.size, np.inf)
     placed: list[tuple[str, str, float, float]] = []
@@ -118,26 +105,12 @@ def _fill_columns(cand: list[tuple[float, str, int]], kinds: dict[str, VehicleTy
 def place_vehicles(params: ModelParameters, cfg: SumoConfig, x: ArrayLike, rho_h: ArrayLike,
                    v_h: ArrayLike, rho_a: ArrayLike, v_a: ArrayLike,
                    ) -> tuple[list[InitialVehicle], PlacementReport]:
-    """Initial vehicles reproducing density profiles on [0, L].
+    """Initial vehicles reproducing density profiles on [0, L], and what the placement did.
 
-    Parameters
-    ----------
-    params : ModelParameters
-        Road length, width, vehicle width and spacings.
-    cfg : SumoConfig
-        Run settings (seed, lateral gap) used for the vehicle types.
-    x : array_like
-        Cell centres, m, increasing in (0, L).
-    rho_h, rho_a : array_like
-        Class densities on ``x``, veh/m.
-    v_h, v_a : array_like
-        Class speeds on ``x``, m/s.
-
-    Returns
-    -------
-    vehicles : list of InitialVehicle
-        Sorted by id; HV ids ``hv_init.k``, AV ids ``av_init.k``.
-    report : PlacementReport
+    The profiles are the class densities ``rho_h``, ``rho_a`` (veh/m) and speeds ``v_h``,
+    ``v_a`` (m/s) on the cell centres ``x`` (m, increasing in (0, L)); ``params`` gives the
+    road and the spacings, ``cfg`` the seed and the vehicle types. The vehicles are sorted
+    by id (HVs ``hv_init.k``, AVs ``av_init.k``).
     """
     x = np.asarray(x, float)
     arrays = [np.asarray(a, float) for a in (rho_h, v_h, rho_a, v_a)]
@@ -146,8 +119,8 @@ def place_vehicles(params: ModelParameters, cfg: SumoConfig, x: ArrayLike, rho_h
     speeds = {HV_TYPE: arrays[1], AV_TYPE: arrays[3]}
     placed, moved, max_shift, dropped = _fill_columns(
         _candidates(x, arrays[0], arrays[2], params.length), {HV_TYPE: hv_t, AV_TYPE: av_t},
-        column_offsets(params.road_width, params.vehicle_width), params.length,
-        np.random.default_rng(cfg.seed))
+        np.array(insertion_columns(params.road_width, params.vehicle_width, COLUMNS)),
+        params.length, np.random.default_rng(cfg.seed))
     out = [InitialVehicle(vid, vtype, front, float(np.interp(front, x, speeds[vtype])), lat)
            for vid, vtype, front, lat in placed]
     out.sort(key=lambda v: v.id)

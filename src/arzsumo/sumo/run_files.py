@@ -1,17 +1,10 @@
-"""What a run keeps of SUMO for its results directory: the configuration it ran, its FCD.
-
-The configuration: the network, the route file and the additional files (loops) the run
-loaded, copied into ``sumo/``, and ``run.sumocfg`` naming them relative to itself with
-the run's options (:func:`~arzsumo.sumo.demand.sumocfg_text`), so that ``sumo-gui -c
-RUN/run.sumocfg`` opens the same scenario. A run drives the meter's light every step
-through libsumo; the kept configuration runs the nominal plan instead, as a static
-program of the light (``sumo/meter.add.xml``, :func:`meter_program_text`): the open loop.
-With ``[sumo] fcd``, SUMO's FCD output (``fcd.xml.gz``) joins them.
+"""What a run keeps of SUMO for its results directory: the configuration it ran, its FCD
+(docs/outputs.md, "run.sumocfg and sumo/").
 
 The files are gathered under :func:`~arzsumo.sumo.paths.scratch_dir` while the run lasts
 (:class:`RunFiles`) and placed into the results directory by :meth:`RunFiles.place`:
 hard-linked, or copied in chunks across file systems, never read into memory (an FCD
-file is large). The gathering directory goes when its :class:`RunFiles` does.
+file is large).
 """
 
 from __future__ import annotations

@@ -29,14 +29,10 @@ def network_spec(cfg: SumoConfig) -> NetworkSpec:
 
 
 def network_file(cfg: SumoConfig, net_dir: Path | None, workdir: Path) -> Path:
-    """The network of a run with ``cfg``.
-
-    An explicit ``net_dir`` (or ``$ARZSUMO_SUMO_NETS``) is used as it is and must have an
-    ``approach`` edge of ``cfg.approach_length`` (none for 0) and the shipped ``down``.
-    Otherwise the shipped network serves the shipped geometry, and any other
-    (:func:`network_spec`) is built with netconvert into ``workdir`` (about 0.5 s; it
-    goes with the run's temporary files).
-    """
+    """The network of a run with ``cfg``: an explicit ``net_dir`` (or
+    ``$ARZSUMO_SUMO_NETS``) as it is, checked to have the approach of ``cfg`` and the
+    shipped ``down``; else the shipped network for the shipped geometry, and any other
+    (:func:`network_spec`) built with netconvert into ``workdir`` (about 0.5 s)."""
     if cfg.layout is not None:       # a [network] table: the user's network, checked
         return cfg.layout.net_file
     spec = network_spec(cfg)

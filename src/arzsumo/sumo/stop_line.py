@@ -1,12 +1,7 @@
-"""The meter's stop-line detector: what the sensor reads for the meter every step.
-
-The meter needs two readings of SUMO each step: the ramp queue (halted vehicles on
-``ramp_up`` plus ramp vehicles still waiting to be inserted) for its queue override, and
-the vehicles that crossed its stop line (*releases*) to end a one-vehicle green. Both are
-read by the sensor (:class:`arzsumo.sumo.sensor.SumoSensor`) and handed to the meter as a
-:class:`MeterReading`; the meter itself only writes the light. The stop line also counts
-safety events at the meter: SUMO's emergency stops of vehicles on ``ramp_up``, and
-emergency braking episodes of the :data:`HEAD_VEHICLES` vehicles nearest the line.
+"""The meter's stop-line detector: what the sensor (:class:`arzsumo.sumo.sensor.SumoSensor`)
+reads for the meter every step and hands it as a :class:`MeterReading` (the ramp queue for
+the queue override, the releases that end a one-vehicle green), and the safety events at
+the meter (docs/sumo.md, "Meter realisation").
 """
 
 from __future__ import annotations
@@ -39,20 +34,14 @@ def ramp_queue(lib: ModuleType, pending: Sequence[str] | None = None, edge: str 
     ``is_ramp``: which are ramp vehicles, by default ids starting with ``ramp``)."""
     if pending is None:
         pending = lib.simulation.getPendingVehicles()
-    if is_ramp is None:
-        waiting = sum(1 for v in pending if v.startswith("ramp"))
-    else:
-        waiting = sum(1 for v in pending if is_ramp(v))
-    return int(lib.edge.getLastStepHaltingNumber(edge)) + waiting
+    ramp = is_ramp or (lambda v: v.startswith("ramp"))
+    return int(lib.edge.getLastStepHaltingNumber(edge)) + sum(1 for v in pending if ramp(v))
 
 
 class StopLine:
-    """The detector at the stop line of ``ramp_up`` (libsumo, read every step).
-
-    A vehicle is *released* when its front leaves ``ramp_up`` (crosses the stop line).
-    Emergency braking is a deceleration beyond the vehicle type's ``decel`` by more than
-    :data:`BRAKING_MARGIN`, counted once per vehicle and episode.
-    """
+    """The detector at the stop line of ``ramp_up`` (libsumo, read every step): a vehicle
+    is *released* when its front leaves ``ramp_up``; an emergency braking episode is
+    counted once per vehicle (docs/sumo.md, "Meter realisation")."""
 
     def __init__(self, lib: ModuleType, edge: str = RAMP_UP) -> None:
         self.lib, self.edge = lib, edge

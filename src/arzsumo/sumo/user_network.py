@@ -3,17 +3,8 @@
 :class:`NetworkRequest` is the ``[network]`` table as the user wrote it (file names
 relative to the scenario file); :func:`read_layout` checks it against the network and
 returns the :class:`~arzsumo.sumo.layout.RoadLayout` the run uses. Each refusal is one
-:class:`~arzsumo.errors.ScenarioError` naming the key and the value as written:
-
-* ``net_file`` and ``route_files`` exist and parse;
-* every ``section_edges`` edge exists, and each leads into the next (driving order);
-* the section has the same lanes (number and widths) along its length;
-* ``start_offset_m`` and ``end_offset_m`` leave a section inside the first and last edges;
-* ``ramp_edge`` exists and reaches the mainline past the section's end (its first or
-  second edge past it), not inside the section;
-* ``meter_tls`` exists and controls a link out of ``ramp_edge``;
-* ``av_types`` are vTypes of the route files (without route files: none, the run's own
-  vTypes are used).
+:class:`~arzsumo.errors.ScenarioError` naming the key and the value as written; the
+checks and their messages are listed in docs/networks.md, "Checked before SUMO starts".
 """
 
 from __future__ import annotations
@@ -43,25 +34,8 @@ WIDTH_TOLERANCE = 0.01
 class NetworkRequest:
     """The ``[network]`` table (SI), as written: names, offsets, files relative to ``base``.
 
-    Parameters
-    ----------
-    net_file : str
-        The network file, relative to ``base`` (or absolute).
-    section_edges : tuple of str
-        The section's edges from x = 0 to x = L, in driving order.
-    meter_tls, ramp_edge : str
-        The light that meters the ramp and the ramp edge it holds.
-    route_files : tuple of str
-        The user's route files (may be empty).
-    av_types : tuple of str
-        vType IDs counted as AVs (only with route files).
-    start_offset, end_offset : float
-        Where the section starts along its first edge and how far before the last
-        edge's end it ends, m.
-    sublane : bool
-        Run SUMO's sublane model.
-    base : str
-        Directory the file names are relative to (the scenario file's).
+    The fields are the table's keys (docs/scenarios.md, "[network]"); ``base`` is the
+    directory the file names are relative to (the scenario file's).
     """
 
     net_file: str
@@ -129,8 +103,8 @@ def _route_types(req: NetworkRequest, at: str) -> set[str]:
         except ET.ParseError as exc:
             raise not_allowed(at, "route_files", list(req.route_files),
                               f"route files that parse ({name}: {exc})") from None
-        types |= {e.get("id", "") for e in root.iter() if e.tag in ("vType",
-                                                                     "vTypeDistribution")}
+        types |= {e.get("id", "") for e in root.iter()
+                  if e.tag in ("vType", "vTypeDistribution")}
     return types
 
 
@@ -157,9 +131,8 @@ def _section(net: Any, req: NetworkRequest, at: str) -> list[Any]:
     widths = [lane.getWidth() for lane in edges[0].getLanes()]
     for e in edges[1:]:
         w = [lane.getWidth() for lane in e.getLanes()]
-        if len(w) != len(widths) or max(abs(p - q) for p, q in zip(w, widths,
-                                                                    strict=True)) > \
-                WIDTH_TOLERANCE:
+        if len(w) != len(widths) or any(abs(p - q) > WIDTH_TOLERANCE
+                                        for p, q in zip(w, widths, strict=True)):
             raise not_allowed(at, "section_edges", value,
                               f"a section with the same lanes along its length "
                               f"({edges[0].getID()!r} has {len(widths)} lane(s) "
@@ -251,12 +224,6 @@ def _offsets(req: NetworkRequest, edges: list[Any], at: str) -> None:
                           f"the edge's length {first:g} m")
 
 
-def _join_index(ramp: list[Any], route: list[Any]) -> int:
-    """Index in ``route`` of the first mainline edge on the ramp's route."""
-    on = set(route)
-    return route.index(next(e for e in ramp if e in on))
-
-
 def read_layout(req: NetworkRequest, at: str) -> RoadLayout:
     """Check ``req`` against its network with sumolib; the run's :class:`RoadLayout`.
 
@@ -275,16 +242,13 @@ def read_layout(req: NetworkRequest, at: str) -> RoadLayout:
     ramp = _ramp_route(net, req, route, len(edges), at)
     links, ramp_links = _meter(net, req, at)
     lengths = [float(e.getLength()) for e in route]
-    starts, x = [], -req.start_offset
-    for length in lengths:
-        starts.append(x)
-        x += length
+    starts = itertools.accumulate(lengths[:-1], initial=-req.start_offset)
     section = sum(lengths[:len(edges)]) - req.start_offset - req.end_offset
     internal = tuple(tuple(sorted({c.getViaLaneID().rsplit("_", 1)[0]
                                    for c in a.getConnections(b) if c.getViaLaneID()}))
                      for a, b in itertools.pairwise(edges))
     ramp_edge = ramp[0]
-    join = _join_index(ramp, route)
+    join = route.index(next(e for e in ramp if e in route))   # where the ramp joins
     outlet = route[min(join + 1, len(route) - 1)]
     return RoadLayout(
         net_file=req.path(req.net_file).resolve(),

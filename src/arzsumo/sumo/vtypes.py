@@ -1,10 +1,6 @@
-"""HV and AV vehicle types from the model parameters.
-
-The spacing policy becomes ``length + minGap = s_i``, the width is the model's ``d``, the
-free-flow speed ``V_i`` caps the vehicle's speed. HVs drive a human car-following model
-with noise (Krauss with ``sigma`` or IDM with speed noise); AVs drive SUMO's ACC or CACC.
-Both use the sublane model (by default ``latAlignment="arbitrary"``, so they spread over
-the whole 6.5 m lane; ``[sumo] lat_alignment`` and the ``lc_*`` keys change it).
+"""HV and AV vehicle types from the model parameters (docs/sumo.md, "Vehicle types and
+demand"): ``length + minGap = s_i``, the width ``d``, the speed capped at ``V_i``; HVs
+drive Krauss, IDM or EIDM, AVs SUMO's ACC or CACC, both under the sublane model.
 """
 
 from __future__ import annotations
@@ -33,11 +29,6 @@ class VehicleType:
     max_speed: float
     car_follow_model: str
     attrs: tuple[tuple[str, str], ...]
-
-    @property
-    def spacing(self) -> float:
-        """length + minGap, m (the model's spacing policy s_i)."""
-        return self.length + self.min_gap
 
     def to_xml(self) -> str:
         """The ``<vType .../>`` element."""
