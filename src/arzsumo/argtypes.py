@@ -74,26 +74,3 @@ def seed_list(text: str) -> list[int]:
     if len(set(seeds)) != len(seeds):
         raise argparse.ArgumentTypeError(f"{text} is not allowed: a seed repeats")
     return seeds
-
-
-def number_list(text: str) -> list[float]:
-    """Comma-separated finite numbers: ``0.2,0.5,0.8``."""
-    try:
-        values = [float(v) for v in text.split(",") if v.strip()]
-    except ValueError:
-        values = []
-    if not values or not all(math.isfinite(v) for v in values):
-        raise argparse.ArgumentTypeError(f"{text} is not allowed: comma-separated numbers")
-    return values
-
-
-def fraction_list(text: str) -> list[float]:
-    """Comma-separated numbers in [0, 1] (shares): ``0.2,0.5,0.8``."""
-    try:
-        values = number_list(text)
-    except argparse.ArgumentTypeError:
-        values = []
-    if not values or not all(0.0 <= v <= 1.0 for v in values):
-        raise argparse.ArgumentTypeError(f"{text} is not allowed: comma-separated numbers "
-                                         "in [0, 1]")
-    return values

@@ -14,7 +14,9 @@ draw take ``--no-plots``.
 
 from __future__ import annotations
 
+import argparse
 import copy
+import math
 from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
@@ -23,10 +25,8 @@ from typing import Any
 from arzsumo.argtypes import (  # noqa: F401 (the studies' option types, re-exported)
     SEED_LIMIT,
     fraction,
-    fraction_list,
     non_negative_float,
     non_negative_int,
-    number_list,
     positive_float,
     positive_int,
     seed_list,
@@ -142,3 +142,26 @@ def print_list(run_ids: list[str],
     for run_id in run_ids:
         print(run_id)
     return 0
+
+
+def number_list(text: str) -> list[float]:
+    """Comma-separated finite numbers: ``0.2,0.5,0.8``."""
+    try:
+        values = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        values = []
+    if not values or not all(math.isfinite(v) for v in values):
+        raise argparse.ArgumentTypeError(f"{text} is not allowed: comma-separated numbers")
+    return values
+
+
+def fraction_list(text: str) -> list[float]:
+    """Comma-separated numbers in [0, 1] (shares): ``0.2,0.5,0.8``."""
+    try:
+        values = number_list(text)
+    except argparse.ArgumentTypeError:
+        values = []
+    if not values or not all(0.0 <= v <= 1.0 for v in values):
+        raise argparse.ArgumentTypeError(f"{text} is not allowed: comma-separated numbers "
+                                         "in [0, 1]")
+    return values

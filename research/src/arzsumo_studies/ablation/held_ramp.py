@@ -23,7 +23,7 @@ import numpy as np
 import pandas as pd
 
 from arzsumo.evaluation.report import MEASURES as EVALUATION_MEASURES
-from arzsumo.evaluation.report import Measure, paired_cell, seed_values
+from arzsumo.evaluation.report import Measure
 from arzsumo.io import dump_toml
 from arzsumo.outdir import resumable_dir
 from arzsumo.sweep.evaluate import BASELINE, run_evaluation
@@ -37,6 +37,7 @@ from arzsumo_studies.common import (
     seed_text,
 )
 from arzsumo_studies.outputs.pages import publish, write_text
+from arzsumo_studies.paired import paired_cell, seed_values
 
 NAME = "held-ramp"
 #: the results page this study keeps a block of (the ablation's)

@@ -70,7 +70,7 @@ from pathlib import Path
 import pandas as pd
 
 from arzsumo.errors import ArzsumoError, require
-from arzsumo.evaluation.report import Measure, paired_cell, seed_values
+from arzsumo.evaluation.report import Measure
 from arzsumo.io import dump_toml, read_toml
 from arzsumo.outdir import resumable_dir
 from arzsumo.resources import default_scenario
@@ -102,6 +102,7 @@ from arzsumo_studies.control.ablation_steps import (
     own_open_loop,
 )
 from arzsumo_studies.outputs.pages import publish, write_text
+from arzsumo_studies.paired import paired_cell, seed_values
 from arzsumo_studies.recorded import RecordedRuns, recorded_evaluation
 from arzsumo_studies.records import copy_records, is_store, records_table
 

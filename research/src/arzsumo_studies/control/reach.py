@@ -192,7 +192,7 @@ def deadlocked_before_control(run: Path) -> bool:
     """Whether SUMO deadlocked in the run before its control window opened (its drain
     ended in a gridlock with a mainline vehicle standing since before the window): its
     field is a standstill's, not the stream's (as the studies' tables leave such seeds
-    out, :func:`arzsumo.evaluation.report.deadlocked_seeds`)."""
+    out, :func:`arzsumo_studies.paired.deadlocked_seeds`)."""
     summary = json.loads((run / "summary.json").read_text(encoding="utf-8"))
     drain = (summary.get("network_whole_demand") or {}).get("drain") or {}
     standstill = summary.get("longest_standstill_main")

@@ -36,7 +36,7 @@ import numpy as np
 import pandas as pd
 
 from arzsumo.evaluation.report import MEASURES as EVALUATION_MEASURES
-from arzsumo.evaluation.report import Measure, deadlocked_seeds, evaluate, markdown
+from arzsumo.evaluation.report import Measure, evaluate, markdown
 from arzsumo.io import dump_toml, read_toml
 from arzsumo.outdir import resumable_dir
 from arzsumo.outputs.evaluation import paired_figure
@@ -48,6 +48,7 @@ from arzsumo_studies.common import RESULTS_DIR, StudyError, seed_text
 from arzsumo_studies.control.claims import claims_table
 from arzsumo_studies.control.files import MIN_SHARE, files_table
 from arzsumo_studies.outputs.pages import publish, write_csv, write_text
+from arzsumo_studies.paired import deadlocked_seeds
 from arzsumo_studies.recorded import RecordedRuns, recorded_evaluation
 
 log = logging.getLogger(__name__)
