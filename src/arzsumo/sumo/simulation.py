@@ -1,9 +1,8 @@
 """The SUMO run lifecycle: start with a fixed seed, step, count, close on every exit path.
 
-libsumo holds one simulation per process; :class:`SumoSimulation` refuses a second one
-while the first is open and can be started again after :meth:`SumoSimulation.close`.
-A SUMO error ends the run as a :class:`~arzsumo.sumo.paths.SumoError` whose message is
-SUMO's cause in one line. Use it as a context manager::
+One open simulation per process (libsumo holds one); a SUMO error ends the run as a
+:class:`~arzsumo.sumo.paths.SumoError` with SUMO's cause in one line (docs/sumo.md,
+"Lifecycle"). Use it as a context manager::
 
     with open_simulation(params, cfg) as sim:
         while sim.time < cfg.horizon:
@@ -96,25 +95,11 @@ class RunReport:
 class SumoSimulation:
     """One run of ``net_file`` with ``route_file`` under ``cfg``, driven by libsumo or TraCI.
 
-    Parameters
-    ----------
-    net_file, route_file : Path
-        Network and route files.
-    cfg : SumoConfig
-        Step length, seed, lateral resolution, teleport setting, horizon.
-    requested_initial : int
-        Vehicles placed at t = 0 by the route file (added to the requested count).
-    workdir : Path, optional
-        Directory for SUMO's statistics output; a temporary one by default.
-    extra_args : sequence of str
-        Further SUMO options.
-    output_dir : Path, optional
-        Where SUMO's statistics output goes instead, kept after the run (for
-        :mod:`arzsumo.sumo.network_measures`).
-    frontend : str
-        What drives the run, one choice for module and binary
-        (:mod:`arzsumo.sumo.frontend`): "libsumo" (default), "traci" (traci to ``sumo``)
-        or "gui" (traci to ``sumo-gui``).
+    ``requested_initial``: vehicles placed at t = 0 by the route file; ``workdir``: for
+    SUMO's statistics output (a temporary one by default), or ``output_dir``, kept after
+    the run (for :mod:`arzsumo.sumo.network_measures`); ``cleanup``: directories removed
+    at the close; ``frontend``: what drives the run (:mod:`arzsumo.sumo.frontend`:
+    "libsumo", "traci" or "gui").
     """
 
     def __init__(self, net_file: Path, route_file: Path, cfg: SumoConfig, *,
@@ -216,14 +201,11 @@ class SumoSimulation:
         except Exception as exc:
             self.close()
             raise SumoError(f"SUMO stopped at t = {self.time:.2f} s: {_one_line(exc)}") from None
-        loaded = sim.getLoadedIDList()
+        loaded, departed = sim.getLoadedIDList(), sim.getDepartedIDList()
         self.loaded += len(loaded)
-        if loaded:
-            self.loaded_ramp += sum(1 for v in loaded if self.classes.ramp(v))
-        departed = sim.getDepartedIDList()
+        self.loaded_ramp += sum(map(self.classes.ramp, loaded))
         self.inserted += len(departed)
-        if departed:
-            self.inserted_ramp += sum(1 for v in departed if self.classes.ramp(v))
+        self.inserted_ramp += sum(map(self.classes.ramp, departed))
         self.arrived += sim.getArrivedNumber()
         #: vehicles due but not yet inserted after this step (ids), read once per step
         self.pending = sim.getPendingVehicles()
@@ -237,18 +219,11 @@ class SumoSimulation:
         self.time = float(sim.getTime())
         return self.time
 
-    def run_until(self, t_end: float) -> float:
-        """Step until the time reaches ``t_end`` (s)."""
-        while self.time < t_end - 1e-9:
-            self.step()
-        return self.time
-
     def requested(self, ramp_only: bool = False) -> int:
         """Vehicles due by the current time (initial vehicles plus flows; or ramp flows).
 
-        SUMO's own count: the vehicles it loaded, each when its departure time came.
-        (Counting from the flows' nominal periods drifted by about a vehicle per flow:
-        SUMO keeps a flow's period in whole ms.)
+        SUMO's own count of the vehicles it loaded: it keeps a flow's period in whole ms,
+        so a count from the flows' nominal periods would drift.
         """
         return self.loaded_ramp if ramp_only else self.loaded
 
@@ -303,10 +278,8 @@ class SumoSimulation:
         """In a child forked from this open run (:mod:`arzsumo.sumo.fork`): continue on
         files of its own.
 
-        SUMO's outputs written so far are copied into ``out_dir`` and the rest of the
-        run writes there (:func:`~arzsumo.sumo.fork.own_files`; the statistics output
-        too, :attr:`stats_file`); the route and network files are read at offsets of the
-        child's own; :meth:`close` then removes nothing of the parent's.
+        SUMO's outputs so far are copied into ``out_dir``, where the rest of the run writes
+        (:func:`~arzsumo.sumo.fork.own_files`); :meth:`close` removes nothing of the parent's.
         """
         from arzsumo.sumo.fork import own_files
 
@@ -347,16 +320,13 @@ def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
     """A started simulation of the network of :func:`network_file` with the demand of
     ``cfg``.
 
-    The route file (and, with ``loops``, an E1 loop station at each of those
-    positions on ``main``, m in [0, L], see :mod:`arzsumo.sumo.loops`; always, the E1
-    loop on ``down`` at ``downstream_loop`` m past the merge nose that the sensor reads,
-    :func:`~arzsumo.sumo.loops.write_downstream_loop`) goes to a
-    temporary directory (under
+    The route file and the E1 loops (with ``loops``, a station at each of those positions
+    on ``main``, m in [0, L]; always, the loop on ``down`` at ``downstream_loop`` m past the
+    merge nose: :mod:`arzsumo.sumo.loops`) go to a temporary directory (under
     :func:`~arzsumo.sumo.paths.scratch_dir`) removed when the run closes. With
     ``output_dir``, SUMO's statistics output is written there and kept. With ``keep``,
-    the network, route and additional files are copied there with a ``run.sumocfg``
-    (:meth:`~arzsumo.sumo.run_files.RunFiles.keep_config`). ``frontend``: what drives
-    the run (:mod:`arzsumo.sumo.frontend`).
+    the run's files are copied there with a ``run.sumocfg``
+    (:meth:`~arzsumo.sumo.run_files.RunFiles.keep_config`).
     """
     Frontend(frontend).check()   # no display for sumo-gui: refused before any file
     workdir = Path(tempfile.mkdtemp(prefix="arzsumo-", dir=scratch_dir()))
