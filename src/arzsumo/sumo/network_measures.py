@@ -178,18 +178,17 @@ def edge_left(path: Path, edge: str = MAIN) -> tuple[int, float, float]:
 
 def _split(df: pd.DataFrame, column: str) -> dict[str, float]:
     by = df.groupby("origin")[column].sum()
-    out = {o: float(by.get(o, 0.0)) for o in ORIGINS}
-    out["total"] = float(df[column].sum())
-    return out
+    return {**{o: float(by.get(o, 0.0)) for o in ORIGINS}, "total": float(df[column].sum())}
+
+
+def origin_counts(df: pd.DataFrame) -> dict[str, int]:
+    """The vehicles (rows) of ``df`` per origin and in all (``total``)."""
+    return {**{o: int((df["origin"] == o).sum()) for o in ORIGINS}, "total": len(df)}
 
 
 def _counts(df: pd.DataFrame) -> dict[str, dict[str, int]]:
-    def split(sub: pd.DataFrame) -> dict[str, int]:
-        n = {o: int((sub["origin"] == o).sum()) for o in ORIGINS}
-        return {**n, "total": len(sub)}
-    out = {"loaded": split(df)}
-    out.update({s: split(df[df["state"] == s]) for s in STATES})
-    return out
+    return {"loaded": origin_counts(df),
+            **{s: origin_counts(df[df["state"] == s]) for s in STATES}}
 
 
 def _check(df: pd.DataFrame, stats: dict[str, float], end_time: float | None) -> None:

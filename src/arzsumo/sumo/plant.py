@@ -92,26 +92,15 @@ class SumoPlant:
                       reads: OpenLoopReads = NOTHING_MORE,
                       green_shares: bool = False) -> OpenLoopEnd:
         """Step the open loop from a period's boundary: ``periods`` control periods, or
-        until SUMO time ``until`` (s; the last period may be cut short).
+        until SUMO time ``until`` (s; the last period may be cut short); ``on_period`` is
+        called at each period's end with its :class:`OpenLoopPeriod`.
 
-        Parameters
-        ----------
-        on_period : callable, optional
-            Called at each period's end with its :class:`OpenLoopPeriod`.
-        plans : sequence of (float, float)
-            The schedule: (t, plan) sets the meter's plan (``set_plan``: a green share or
-            a release rate, veh/s) before the step that starts at SUMO time t (s); a t
-            already passed never runs.
-        reads : OpenLoopReads
-            What to read besides the sensor (:mod:`arzsumo.sumo.period_reads`).
-        green_shares : bool
-            The plans are green shares of the fixed-cycle meter, run as they are, past
-            ``[sumo] green_share_min`` and ``green_share_max``.
-
-        Returns
-        -------
-        OpenLoopEnd
-            The periods run and what ``reads`` asked for at the end.
+        ``plans``: the schedule, (t, plan) sets the meter's plan (``set_plan``: a green
+        share or a release rate, veh/s) before the step that starts at SUMO time t (s; a t
+        already passed never runs); ``reads``: what to read besides the sensor;
+        ``green_shares``: the plans are green shares of the fixed-cycle meter, run as they
+        are, past ``[sumo] green_share_min`` and ``green_share_max``. Returns the periods
+        run and what ``reads`` asked for at the end.
         """
         if (periods is None) == (until is None):
             raise ValueError("run_open_loop needs periods or until, one of the two")

@@ -50,11 +50,9 @@ class PeriodMeasurement:
     """What the sensor read over one control period ending at ``cells.t`` (SI).
 
     ``cells`` are the Edie aggregates of the mainline; ``occupancy_out`` and
-    ``flow_out_loop`` the occupancy (fraction of the period) and the flow (veh/s) of the
-    loop on ``down`` past the merge nose over the period;
-    ``ramp_queue`` the ramp queue at the period's last step, vehicles; ``loops`` the loop
-    stations' record of the period and ``probes`` the AV probes at its last step (None
-    when the layout has none).
+    ``flow_out_loop`` the occupancy (fraction) and the flow (veh/s) of the loop on ``down``
+    over the period; ``ramp_queue`` the ramp queue at its last step, veh; ``loops`` the
+    stations' record and ``probes`` the AV probes at its last step (None without them).
     """
 
     cells: CellData
@@ -78,9 +76,7 @@ class SpeedMoments:
     CLASSES = ("h", "a")
 
     def __init__(self) -> None:
-        self.n = np.zeros(2)
-        self.s1 = np.zeros(2)
-        self.s2 = np.zeros(2)
+        self.n, self.s1, self.s2 = np.zeros(2), np.zeros(2), np.zeros(2)
 
     def add(self, speed: np.ndarray, av: np.ndarray) -> None:
         """One step's speeds (m/s) and AV mask."""

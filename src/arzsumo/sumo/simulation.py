@@ -23,7 +23,7 @@ from types import ModuleType, TracebackType
 
 from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.demand import InitialVehicle, demand_flows, write_route_file
+from arzsumo.sumo.demand import InitialVehicle, write_route_file
 from arzsumo.sumo.frontend import Frontend
 from arzsumo.sumo.layout import VehicleClasses
 from arzsumo.sumo.loops import DOWNSTREAM_DISTANCE, write_downstream_loop
@@ -115,7 +115,6 @@ class SumoSimulation:
         self.extra_args = tuple(extra_args)
         self.output_dir = Path(output_dir) if output_dir is not None else None
         self._cleanup = tuple(cleanup)
-        self._flows = demand_flows(cfg)
         self._lib: ModuleType | None = None
         #: which vehicles are AVs and ramp vehicles (by id on the shipped network)
         self.classes = VehicleClasses(None, cfg.layout)

@@ -23,11 +23,11 @@ import pandas as pd
 from arzsumo.sumo.network import MAIN
 from arzsumo.sumo.network_measures import (
     MG_PER_G,
-    ORIGINS,
     TRIPINFO_FILE,
     RampTest,
     aggregate,
     network_summary,
+    origin_counts,
     read_trips,
 )
 
@@ -173,11 +173,9 @@ def window_trips(trips: pd.DataFrame, start: WindowStart, end: float,
     """The per-vehicle rows of ``trips`` (:func:`read_trips`) restricted to the control
     window [start.t_s, end]: vehicles not arrived by t_w, their times clipped and their
     accumulated values net of those at t_w (module docstring). Same columns, plus
-    ``due_s`` (wanted departure, s) and ``in_system_at_start`` (bool).
-
-    When the run went on after ``end`` (a drain, ending at ``run_end``), ``finish`` holds
-    the values at ``end``: accumulated values are taken net of those after it and
-    ``state`` is each vehicle's at ``end``.
+    ``due_s`` (wanted departure, s) and ``in_system_at_start`` (bool). When the run went
+    on after ``end`` (a drain, ending at ``run_end``), ``finish`` holds the values at
+    ``end``: accumulated values are net of those after it, ``state`` is each vehicle's then.
     """
     t_w, last = start.t_s, end if run_end is None else run_end
     df = trips.copy()
@@ -206,17 +204,12 @@ def window_summary(trips: pd.DataFrame, start: WindowStart, end: float,
                    run_end: float | None = None) -> dict[str, Any]:
     """The ``network`` dict of the control window (same layout as
     :func:`~arzsumo.sumo.network_measures.aggregate`), with ``window`` and
-    ``vehicles.in_system_at_start``.
-
-    ``outlet_left``: vehicles that crossed the section outlet x = L in the window;
-    ``finish``, ``run_end``: the values at ``end`` of a run that went on to ``run_end``
-    (s; :func:`window_trips`).
+    ``vehicles.in_system_at_start``; ``outlet_left``: vehicles that crossed the section
+    outlet x = L in the window; ``finish``, ``run_end``: as for :func:`window_trips`.
     """
     df = window_trips(trips, start, end, finish, run_end)
     out = aggregate(df, start.t_s, end, outlet_left)
-    at = df[df["in_system_at_start"]]
-    out["vehicles"]["in_system_at_start"] = {
-        **{o: int((at["origin"] == o).sum()) for o in ORIGINS}, "total": len(at)}
+    out["vehicles"]["in_system_at_start"] = origin_counts(df[df["in_system_at_start"]])
     return {"window": "control window: each vehicle's time inside [begin_s, end_s] "
                       "(end of warm-up to end of the control horizon)", **out}
 
