@@ -1,11 +1,9 @@
 """The fixed-cycle meter's calibration: mainline outflow against green share, and its plans.
 
 :class:`GreenShareCurve` is the measured mainline outflow at the merge against the
-meter's green share (``arzsumo calibrate``); the fixed-cycle meter
-(:class:`arzsumo.sumo.meter.RampMeter`) inverts it to turn an outflow command into a green
-share, which :func:`plan_green_steps` makes a timing of whole SUMO steps. The U range and
-the ramp's floor of that meter follow from the curve (:func:`fixed_cycle_u_range`,
-:func:`fixed_cycle_ramp_floor`). Pure functions; no SUMO.
+meter's green share (``arzsumo calibrate``), which :class:`arzsumo.sumo.meter.RampMeter`
+inverts; :func:`plan_green_steps` makes a green share a timing of whole SUMO steps; the U
+range and the ramp's floor of that meter follow from the curve. Pure functions; no SUMO.
 """
 
 from __future__ import annotations

@@ -1,14 +1,11 @@
 """The ramp-meter actuator: commanded mainline outflow -> green share -> signal program.
 
-:class:`RampMeter` (the fixed cycle) inverts the calibrated curve of mainline outflow
-against green share (:class:`~arzsumo.sumo.green_share.GreenShareCurve`) to a green share
-g and runs green for g C seconds, then red; :class:`MeterLight` holds what both
-realisations share: the light, the clearance yellow, the queue override and the counts
-over a window. The other realisation is
-:class:`arzsumo.sumo.meter_release.OnePerGreenMeter`;
-:func:`arzsumo.sumo.meter_release.make_meter` builds the one ``[sumo] meter_mode`` names.
-Plan and light changes, clearance, override and window: docs/sumo.md, "Ramp meter" and
-"Meter realisation".
+:class:`RampMeter`, the fixed cycle, inverts the calibrated outflow-against-green-share
+curve (:class:`~arzsumo.sumo.green_share.GreenShareCurve`) to a green share g: green for
+g C seconds, then red. :class:`MeterLight` holds what both realisations share (light,
+clearance yellow, queue override, counts over a window: docs/sumo.md, "Ramp meter" and
+"Meter realisation"); the other is :class:`arzsumo.sumo.meter_release.OnePerGreenMeter`,
+and :func:`arzsumo.sumo.meter_release.make_meter` builds the one ``[sumo] meter_mode`` names.
 
 The meter reads nothing from SUMO: every step the sensor hands it a
 :class:`~arzsumo.sumo.stop_line.MeterReading` (the ramp queue and the stop line's

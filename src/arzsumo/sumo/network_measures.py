@@ -117,20 +117,15 @@ def read_trips(path: Path, ramp: RampTest = None) -> pd.DataFrame:
     Returns
     -------
     pandas.DataFrame
-        Columns:
-
-        * ``id``, ``vtype``; ``origin``: mainline or ramp; ``state`` at the end:
-          completed, en_route or waiting (not inserted yet);
-        * ``depart_s``, ``arrival_s``: s, -1 when not inserted or not arrived;
-        * ``duration_s``: s from insertion to arrival or end, 0 when not inserted;
-        * ``sumo_time_loss_s``: SUMO's timeLoss, s, without the depart delay;
-        * ``depart_delay_s``: s, insertion minus wanted departure (waiting vehicles: end
-          minus wanted departure);
-        * ``waiting_time_s``: s at a speed below 0.1 m/s;
-        * ``distance_m``: m driven (0 when not inserted);
-        * ``fuel_g``, ``co2_g``: g (SUMO writes mg);
-        * ``time_spent_s`` = duration + depart delay, s;
-        * ``time_loss_s`` = SUMO's timeLoss + depart delay, s.
+        Columns: ``id``, ``vtype``; ``origin``: mainline or ramp; ``state`` at the end:
+        completed, en_route or waiting (not inserted yet); ``depart_s``, ``arrival_s``: s,
+        -1 when not inserted or not arrived; ``duration_s``: s from insertion to arrival
+        or end, 0 when not inserted; ``sumo_time_loss_s``: SUMO's timeLoss, s, without the
+        depart delay; ``depart_delay_s``: s, insertion minus wanted departure (waiting
+        vehicles: end minus wanted departure); ``waiting_time_s``: s at a speed below
+        0.1 m/s; ``distance_m``: m driven (0 when not inserted); ``fuel_g``, ``co2_g``: g
+        (SUMO writes mg); ``time_spent_s`` = duration + depart delay, s; ``time_loss_s`` =
+        SUMO's timeLoss + depart delay, s.
     """
     import sumolib
 

@@ -149,8 +149,7 @@ class SumoPlant:
         return due, plan
 
     def outlet_speed_limit(self) -> OutletSpeedLimit:
-        """The speed limit of the edge past the merge, as an actuator
-        (:mod:`arzsumo.sumo.speed_limit`)."""
+        """The speed limit of the edge past the merge, as an actuator."""
         return OutletSpeedLimit(self.sim.lib)
 
     def run_period(self) -> tuple[PeriodMeasurement, MeterState]:

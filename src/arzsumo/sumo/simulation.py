@@ -17,16 +17,17 @@ import shutil
 import tempfile
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from types import ModuleType, TracebackType
 
 from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.demand import InitialVehicle, write_route_file
+from arzsumo.sumo.fork import own_files
 from arzsumo.sumo.frontend import Frontend
 from arzsumo.sumo.layout import VehicleClasses
-from arzsumo.sumo.loops import DOWNSTREAM_DISTANCE, write_downstream_loop
+from arzsumo.sumo.loops import DOWNSTREAM_DISTANCE, write_downstream_loop, write_loops
 from arzsumo.sumo.paths import SumoError, scratch_dir
 from arzsumo.sumo.run_files import RunFiles
 from arzsumo.sumo.run_network import network_file
@@ -233,11 +234,9 @@ class SumoSimulation:
                  if not self.classes.ramp(v)}   # the meter's queue stands by design
         still = max(waits, key=waits.__getitem__, default="")
         return RunReport(self.time, self.requested(), self.loaded, self.inserted,
-                         len(sim.getPendingVehicles()), self.arrived,
-                         int(veh.getIDCount()),
+                         len(sim.getPendingVehicles()), self.arrived, int(veh.getIDCount()),
                          self.collisions if self.cfg.collision_check else None,
-                         self.teleports,
-                         self.emergency_stops, self.emergency_braking,
+                         self.teleports, self.emergency_stops, self.emergency_braking,
                          self.requested(ramp_only=True), self.inserted_ramp,
                          waits.get(still, 0.0), still)
 
@@ -262,8 +261,7 @@ class SumoSimulation:
             self.closed, _ACTIVE = True, None
         self.emergency_braking = self._read_braking()
         if self.report is not None:
-            self.report = RunReport(**{**self.report.__dict__,
-                                       "emergency_braking": self.emergency_braking})
+            self.report = replace(self.report, emergency_braking=self.emergency_braking)
             if warn and self.report.delivered_main < 0.98:
                 log.warning("mainline demand not delivered: %s", self.report.summary())
             if warn and self.report.standstill_main_s > DEADLOCK_S:
@@ -280,8 +278,6 @@ class SumoSimulation:
         SUMO's outputs so far are copied into ``out_dir``, where the rest of the run writes
         (:func:`~arzsumo.sumo.fork.own_files`); :meth:`close` removes nothing of the parent's.
         """
-        from arzsumo.sumo.fork import own_files
-
         out_dir = Path(out_dir)
         out_dir.mkdir(parents=True, exist_ok=True)
         for src in dict.fromkeys([self.output_dir or self.workdir, self.workdir]):
@@ -335,8 +331,6 @@ def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
         adds = [write_downstream_loop(workdir / "e1_down.add.xml", downstream_loop,
                                       cfg.layout)]
         if len(loops):
-            from arzsumo.sumo.loops import write_loops
-
             adds.append(write_loops(workdir / "e1.add.xml", loops, params.length,
                                     cfg.layout))
         extra_args = ("--additional-files", ",".join(map(str, adds)), *extra_args)
