@@ -132,8 +132,7 @@ class LoopSensor:
                  speed: str = "time_mean", layout: RoadLayout | None = None) -> None:
         require(steps_per_period >= 1, "steps_per_period", steps_per_period, "at least 1")
         require(speed in LOOP_SPEEDS, "loop_speed", speed, f"one of {', '.join(LOOP_SPEEDS)}")
-        self.lib, self.dt, self.steps_per_period = lib, dt, steps_per_period
-        self.speed = speed
+        self.lib, self.dt, self.steps_per_period, self.speed = lib, dt, steps_per_period, speed
         self.x = placed_positions(x, length)
         self.ids = loop_ids(self.x.size)
         #: the E1 loops of each station (one; one per lane on a user's section), and the
@@ -155,8 +154,7 @@ class LoopSensor:
 
     def _read(self, j: int, t: float) -> None:
         """Add station ``j``'s vehicles of the step ending at ``t`` (s)."""
-        on = set()
-        t0 = t - self.dt
+        on, t0 = set(), t - self.dt
         for vid, length, t_in, t_out, vtype in _vehicle_data(self.lib, self.lanes[j]):
             c = 1 if vtype in self.av_types else 0
             on.add(vid)

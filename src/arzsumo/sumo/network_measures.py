@@ -38,9 +38,8 @@ from arzsumo.sumo.run_files import FCD_FILE
 from arzsumo.units import veh_s_to_veh_h
 
 TRIPINFO_FILE, EDGEDATA_FILE, STATISTICS_FILE = "tripinfo.xml", "edgedata.xml", "statistics.xml"
-#: what the FCD output (:data:`~arzsumo.sumo.run_files.FCD_FILE`, every vehicle every
-#: step) records per vehicle besides its id: vType id, speed in m/s, pos in m from the
-#: lane's start, lane id, posLat in m from the lane centre (left positive)
+#: what the FCD output (:data:`~arzsumo.sumo.run_files.FCD_FILE`) records per vehicle
+#: besides its id (units and meaning: docs/outputs.md, ``fcd.xml.gz``)
 FCD_ATTRIBUTES = ("type", "speed", "pos", "lane", "posLat")
 OUTPUT_FILES = (TRIPINFO_FILE, EDGEDATA_FILE, STATISTICS_FILE, FCD_FILE)
 ORIGINS = ("mainline", "ramp")

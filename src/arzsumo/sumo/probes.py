@@ -54,11 +54,9 @@ class AvProbes:
 
     def observe(self, t: float, ids: Sequence[str], pos: np.ndarray, speed: np.ndarray,
                 av: np.ndarray) -> ProbeObservation:
-        """The record at ``t`` (s) from one step's sample of ``main``.
-
-        ``ids``, ``pos`` (m), ``speed`` (m/s) and ``av`` (AV mask) describe every vehicle
-        on ``main`` (as :meth:`~arzsumo.sumo.measure.MainlineSensor.sample` returns them).
-        """
+        """The record at ``t`` (s) from one step's sample of every vehicle on ``main``:
+        ``ids``, ``pos`` (m), ``speed`` (m/s) and ``av`` (AV mask), as
+        :meth:`~arzsumo.sumo.measure.MainlineSensor.sample` returns them."""
         av = np.asarray(av, bool)
         av_ids = [vid for vid, a in zip(ids, av, strict=True) if a]
         keep = self.mask(av_ids)

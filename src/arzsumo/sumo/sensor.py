@@ -1,15 +1,14 @@
 """The sensing stage of the closed loop: every libsumo read of a control period.
 
-One :class:`SumoSensor` per run. After each SUMO step :meth:`SumoSensor.observe` samples
-the vehicles on ``main`` (:class:`~arzsumo.sumo.measure.MainlineSensor`), the E1 loop on
-``down`` (ALINEA's measurement, :class:`~arzsumo.sumo.loops.DownstreamLoop`), the ramp
-queue and stop line for the meter (a :class:`~arzsumo.sumo.stop_line.MeterReading`), and,
-as its :class:`~arzsumo.sumo.sensing.SensorLayout` holds them, loop stations and AV
-probes; until the control window opens, fuel and CO2 (for the window's network measures),
-in it the speed moments and lateral offsets, after it (the drain) only the meter's
-reading and fuel and CO2. A complete control period gives one :class:`PeriodMeasurement`.
-Nothing else in the closed loop reads SUMO while it steps (an open-loop study's further
-reads: :mod:`arzsumo.sumo.period_reads`); the meter only writes the traffic light.
+One :class:`SumoSensor` per run. After each SUMO step :meth:`SumoSensor.observe` reads the
+vehicles on ``main`` (:class:`~arzsumo.sumo.measure.MainlineSensor`), the E1 loop on
+``down`` (ALINEA's, :class:`~arzsumo.sumo.loops.DownstreamLoop`), the meter's
+:class:`~arzsumo.sumo.stop_line.MeterReading` and the stations and AV probes of its
+:class:`~arzsumo.sumo.sensing.SensorLayout`; fuel and CO2 before the control window and
+in the drain after it, the speed moments and lateral offsets in it. A complete control
+period gives one :class:`PeriodMeasurement`. Nothing else in the closed loop reads SUMO
+while it steps (an open-loop study's further reads: :mod:`arzsumo.sumo.period_reads`);
+the meter only writes the traffic light.
 """
 
 from __future__ import annotations

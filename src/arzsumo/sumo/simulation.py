@@ -41,8 +41,7 @@ _ACTIVE: SumoSimulation | None = None
 
 
 def _one_line(exc: BaseException) -> str:
-    text = str(exc).strip() or type(exc).__name__
-    return text.splitlines()[0]
+    return (str(exc).strip() or type(exc).__name__).splitlines()[0]
 
 
 @dataclass(frozen=True)
@@ -220,11 +219,9 @@ class SumoSimulation:
         return self.time
 
     def requested(self, ramp_only: bool = False) -> int:
-        """Vehicles due by the current time (initial vehicles plus flows; or ramp flows).
-
-        SUMO's own count of the vehicles it loaded: it keeps a flow's period in whole ms,
-        so a count from the flows' nominal periods would drift.
-        """
+        """Vehicles due by the current time (initial vehicles plus flows; or ramp flows):
+        SUMO's count of the vehicles it loaded (it keeps a flow's period in whole ms, so a
+        count from the flows' nominal periods would drift)."""
         return self.loaded_ramp if ramp_only else self.loaded
 
     def take_report(self) -> RunReport:

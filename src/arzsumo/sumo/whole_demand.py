@@ -1,12 +1,10 @@
 """Whole-demand accounting: every loaded vehicle, from its insertion request to its arrival.
 
 A ramp meter that holds vehicles back looks free when the measures stop at the end of the
-control window: its queue is still there, uncharged. With ``[sumo] drain_max_s`` > 0 the
-run goes on after the window until every loaded vehicle has left the network
-(:mod:`arzsumo.bridge.drain`), and ``summary.json["network_whole_demand"]`` holds SUMO's
-tripinfo measures of every vehicle, the drain, the per-step integral of vehicles in the
-system and the ramp vehicles' waits at the meter (docs/outputs.md, "Whole demand";
-docs/whole_demand.md).
+control window, its queue uncharged. With ``[sumo] drain_max_s`` > 0 the run goes on until
+every loaded vehicle has left (:mod:`arzsumo.bridge.drain`), and ``network_whole_demand``
+holds SUMO's tripinfo measures of every vehicle, the drain, the per-step integral of
+vehicles in the system and the ramp waits (docs/outputs.md, "Whole demand").
 """
 
 from __future__ import annotations
