@@ -24,6 +24,7 @@ from arzsumo.sumo.network import (
 from arzsumo.sumo.paths import NET_FILE, SumoError, default_nets_dir
 from arzsumo.sumo.period_reads import approach_queue
 from arzsumo.sumo.simulation import open_simulation
+from tests.sumo import run_until
 
 PARAMS = get_preset("paper_base").params
 FAST = SumoConfig(horizon=40.0, step_length=0.2, control_period=1.0)
@@ -146,7 +147,7 @@ def test_a_network_that_does_not_match_the_approach_length_is_refused(tmp_path):
         open_simulation(PARAMS, FAST, net_dir=tmp_path)
     with open_simulation(PARAMS, FAST.with_(approach_length=200.0, horizon=2.0),
                          net_dir=tmp_path) as sim:
-        sim.run_until(2.0)
+        run_until(sim, 2.0)
     assert sim.report is not None and sim.report.inserted > 0
 
 

@@ -13,6 +13,7 @@ from arzsumo.sumo.placement import place_vehicles
 from arzsumo.sumo.plant import SumoPlant
 from arzsumo.sumo.runner import run_fixed_meter
 from arzsumo.sumo.simulation import open_simulation
+from tests.sumo import run_until
 
 pytestmark = pytest.mark.sumo
 
@@ -56,7 +57,7 @@ def test_no_emergency_braking_without_merging_traffic():
 def test_edie_density_of_single_step_is_count_over_length():
     cfg = FAST.with_(horizon=30.0)
     with open_simulation(PARAMS, cfg) as sim:
-        sim.run_until(25.0)
+        run_until(sim, 25.0)
         sensor = MainlineSensor(sim.lib, PARAMS.length, 50.0, cfg.step_length, 1)
         data = sensor.collect(sim.step())
         ids = sim.lib.edge.getLastStepVehicleIDs(MAIN)
@@ -99,7 +100,7 @@ def test_meter_counts_plan_and_light_changes():
         assert command_meter(meter, 1e6, 0.0) == pytest.approx(0.2, abs=0.02)
         assert command_meter(meter, 0.0, 0.0) == pytest.approx(0.8, abs=0.02)
         assert meter.plan_changes == 2
-        sim.run_until(30.0)
+        run_until(sim, 30.0)
 
 
 def test_meter_window_restarts_the_counts_but_not_the_light():
@@ -166,7 +167,7 @@ def test_lifecycle_close_twice_one_at_a_time_and_errors_in_one_line():
         open_simulation(PARAMS, FAST, extra_args=["--no-such-option", "1"])
     assert "SUMO did not start" in str(info.value) and "\n" not in str(info.value)
     with open_simulation(PARAMS, FAST) as again:       # libsumo restarts in one process
-        again.run_until(2.0)
+        run_until(again, 2.0)
         r = again.take_report()
         # counts start again from zero; in 2 s no vehicle leaves the edge it entered
         assert r.time == pytest.approx(2.0) and r.inserted == r.on_network > 0
@@ -222,7 +223,7 @@ def test_a_mainline_vehicle_held_still_is_the_longest_standstill_and_told(caplog
     cfg = FAST.with_(horizon=100.0, ramp_demand=0.0, collision_check=True)
     with caplog.at_level("WARNING", logger="arzsumo.sumo.simulation"), \
             open_simulation(PARAMS, cfg) as sim:
-        sim.run_until(20.0)
+        run_until(sim, 20.0)
         veh = sim.lib.vehicle
         held = max((v for v in veh.getIDList() if not v.startswith("ramp")),
                    key=veh.getLanePosition)           # the front one: nothing ahead
@@ -243,7 +244,7 @@ def test_a_mainline_vehicle_held_still_is_the_longest_standstill_and_told(caplog
 def test_a_flowing_run_stands_nobody_still_for_long():
     cfg = FAST.with_(horizon=60.0, ramp_demand=0.0)
     with open_simulation(PARAMS, cfg) as sim:
-        sim.run_until(60.0)
+        run_until(sim, 60.0)
         rep = sim.take_report()
     assert rep.on_network > 20 and rep.standstill_main_s < 5.0
 

@@ -1,19 +1,14 @@
 """Branches of one SUMO run: several continuations of one simulated state.
 
 A child process forked from a process that holds an open libsumo simulation continues
-SUMO bit for bit (every vehicle, lane-change model and random number generator is in the
-inherited memory; ``tests/sumo/test_warm_start.py``), where SUMO's saveState/loadState
-does not. :func:`run_branches` uses this to share a warm-up: the caller warms up once,
-then each branch runs in its own child, one after the other, from that same state, and
-sends its (picklable) result back through a pipe.
-
-A child ends with ``os._exit``: it runs no cleanup of the parent's (temporary files,
-SUMO's own outputs), so the parent's simulation and files stay as they were. A child
-inherits the parent's open files too, offsets included: a branch that lets SUMO write
-its outputs calls :func:`own_files` first, so that it writes into copies of its own and
-reads at offsets of its own. A branch
-whose child dies or raises comes back as a :class:`BranchFailed`; the caller re-runs it
-alone. Forking is POSIX-only: :func:`can_fork` says whether this process may.
+SUMO bit for bit (all its state is in the inherited memory;
+``tests/sumo/test_warm_start.py``), where SUMO's saveState/loadState does not.
+:func:`run_branches` runs each branch in a child of its own, one after the other, from the
+caller's state, and sends its (picklable) result back through a pipe; a child that dies
+or raises comes back as a :class:`BranchFailed` (the caller re-runs it alone). A child
+ends with ``os._exit``, running no cleanup of the parent's; one that lets SUMO write its
+outputs calls :func:`own_files` first, since it inherits the parent's open files, offsets
+included. Forking is POSIX-only: :func:`can_fork` says whether this process may.
 """
 
 from __future__ import annotations
@@ -34,7 +29,6 @@ from arzsumo.interrupts import die_with_parent
 
 #: where Linux lists a process's open files and their offsets and flags
 PROC_FD, PROC_FDINFO = Path("/proc/self/fd"), Path("/proc/self/fdinfo")
-
 
 
 @dataclass(frozen=True)

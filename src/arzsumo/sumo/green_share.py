@@ -1,11 +1,9 @@
 """The fixed-cycle meter's calibration: mainline outflow against green share, and its plans.
 
 :class:`GreenShareCurve` is the measured mainline outflow at the merge against the
-meter's green share (``arzsumo calibrate``); the fixed-cycle meter
-(:class:`arzsumo.sumo.meter.RampMeter`) inverts it to turn an outflow command into a green
-share, which :func:`plan_green_steps` makes a timing of whole SUMO steps. The U range and
-the ramp's floor of that meter follow from the curve (:func:`fixed_cycle_u_range`,
-:func:`fixed_cycle_ramp_floor`). Pure functions; no SUMO.
+meter's green share (``arzsumo calibrate``), which :class:`arzsumo.sumo.meter.RampMeter`
+inverts; :func:`plan_green_steps` makes a green share a timing of whole SUMO steps; the U
+range and the ramp's floor of that meter follow from the curve. Pure functions; no SUMO.
 """
 
 from __future__ import annotations
@@ -80,7 +78,6 @@ def plan_green_steps(g: float, cycle: int, min_green: int, min_red: int) -> int:
     return green
 
 
-
 def fixed_cycle_u_range(curve: GreenShareCurve, cfg: SumoConfig,
                         q_nominal: float) -> tuple[float, float]:
     """The U (veh/s) a fixed-cycle meter can command: the monotone curve's outflow between
@@ -95,13 +92,10 @@ def fixed_cycle_ramp_floor(curve: GreenShareCurve, cfg: SumoConfig, q_nominal: f
                            queue: float) -> float:
     """Least U (veh/s) the ramp can deliver with ``queue`` vehicles waiting.
 
-    The merge passes ``q_open`` = the curve's mainline outflow at green share 0 (mainline
-    alone, ramp closed) in all, so each ramp vehicle released takes one from the
-    mainline. Over the next plan, ``H = max(meter cycle, control period)`` seconds, the
-    ramp can release at most its arrivals and its queue, ``r + queue / H`` veh/s (``r``:
-    ``[sumo] ramp_demand``), so more ramp green cannot bring the mainline outflow below
-    ``q_open - r - queue / H``: U below that minus q* is not deliverable. Capped at 0
-    (the nominal plan is always allowed), so it only bounds U < 0 (more ramp release).
+    ``q_open - r - queue / H - q*`` capped at 0, with ``q_open`` the curve's outflow at
+    green share 0, ``r`` ``[sumo] ramp_demand`` and ``H = max(meter cycle, control
+    period)`` s: the ramp releases at most its arrivals and its queue, each release taking
+    one mainline vehicle's place (docs/sumo.md, "Actuation limits").
     """
     q_open = curve.monotone().outflow_at(0.0)
     horizon = max(cfg.meter_cycle, cfg.control_period)

@@ -1,12 +1,9 @@
 """Lateral positions of the vehicles on ``main``, once per control period.
 
-In SUMO's sublane model vehicles ride side by side in the wide lane, in *lateral files*
-that can keep very different speeds; wave measures per file
-(:mod:`arzsumo.evaluation.waves`) need each vehicle's lateral offset. Reading it costs
-one libsumo call per vehicle, so it is read once per control period, at the period's
-last step, with the positions, speeds and classes the mainline sensor read at that step
-(:class:`~arzsumo.sumo.measure.MainlineSensor`), and only during the control window; the
-per-step loop does not change.
+Wave measures per lateral file (:mod:`arzsumo.evaluation.waves`) need each vehicle's
+lateral offset. It costs one libsumo call per vehicle, so it is read at a control
+period's last step only, beside what the mainline sensor read at that step
+(:class:`~arzsumo.sumo.measure.MainlineSensor`), and only during the control window.
 """
 
 from __future__ import annotations

@@ -1,11 +1,10 @@
 """Open-loop runs that record ALINEA's loop: the samples of its flow-occupancy curve.
 
-:func:`record_downstream_loop` runs SUMO with the meter at its nominal plan (the open
-loop) for ``cfg.horizon`` seconds from t = 0, fill included (the fill is where the loop
-sees the free branch of the curve), and returns the occupancy and flow of the E1 loop on
-``down`` at ``distance`` m past the merge nose per control period
-(:class:`~arzsumo.sumo.loops.DownstreamLoop`). The math on top (period means,
-triangular fit, target) is :mod:`arzsumo.evaluation.critical_occupancy`.
+:func:`record_downstream_loop` runs the open loop from t = 0, fill included (where the
+loop sees the free branch of the curve), and returns the occupancy and flow of the E1
+loop on ``down`` per control period (:class:`~arzsumo.sumo.loops.DownstreamLoop`). The
+math on top (period means, triangular fit, target) is
+:mod:`arzsumo.evaluation.critical_occupancy`.
 """
 
 from __future__ import annotations
@@ -37,7 +36,7 @@ class LoopSeries:
 def record_downstream_loop(params: ModelParameters, cfg: SumoConfig, distance: float,
                            curve: GreenShareCurve = DEFAULT_CURVE) -> LoopSeries:
     """Run ``cfg.horizon`` s of open loop (nominal meter; ``curve`` for a fixed-cycle
-    meter); the loop's series (module docstring)."""
+    meter); the series of the loop ``distance`` m past the merge nose."""
     t_out, occ, flow = [], [], []
 
     def keep(p: OpenLoopPeriod) -> None:

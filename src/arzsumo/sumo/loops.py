@@ -1,40 +1,20 @@
 """Induction loops (E1) on ``main``: per-class counts, mean spot speeds and occupancy.
 
-A loop station at x_j is one SUMO E1 detector across the whole 6.5 m lane (an E1 sees
-every vehicle whose body passes its position, whatever its sublane: measured against
-vehicle positions in ``tests/sumo/test_loops.py``). Stations at the section's
-boundaries sit just inside it: x = L- is :data:`BOUNDARY_GAP` before the end (a loop
-must lie on the lane), x = 0+ is at :data:`INLET_GAP` = 6 m, beyond the front of every
-vehicle inserted at x = 0 (SUMO puts it at the vehicle's length plus 0.1 m, at most
-5.1 m), so that inserted vehicles drive over it. A loop at 0.1 m saw inserted vehicles
-appear across it: their occupancy covered only their last 0.1 m, and the density it
-gave was half the one downstream (24 against 51 veh/km of HVs,
-``scenarios/legacy_default.toml``); one at 5.1 m still saw AVs appear on it.
+A loop station at x_j is one SUMO E1 detector across the whole 6.5 m lane (one per lane
+on a user's section). Every SUMO step :class:`LoopSensor` reads
+``inductionloop.getVehicleData`` of each station and, once per control period of length
+T, returns a :class:`~arzsumo.estimate.observations.LoopObservation` per class i (h, a):
 
-Every SUMO step :class:`LoopSensor` reads ``inductionloop.getVehicleData`` of each
-station (one call per station per step: the vehicles on the loop during the step, with
-their length, entry and exit times and type) and, once per control period of length T,
-returns a :class:`~arzsumo.estimate.observations.LoopObservation` per class i (h, a):
-
-* flow q_i = N_i / T, veh/s, with N_i the vehicles whose front reached x_j in the period
-  (SUMO's entry; a vehicle inserted across the loop enters at its departure);
-* speed v_i, m/s, from the spot speeds v_k of those N_i vehicles at the end of the step
-  their front reached x_j (a speed trap's reading; NaN when N_i = 0; the same vehicles as
-  the flow), per ``[sensing] loop_speed``: the *time-mean* speed sum v_k / N_i (the
-  default), or the *harmonic* mean N_i / sum 1/max(v_k, :data:`V_MIN`), Wardrop's
-  estimate of the *space-mean* speed that q = rho v and the model use (in stop-and-go
-  traffic the time-mean speed exceeds it: fast vehicles cross a point more often per
-  unit time). Both are kept on every record (``time_mean``, ``harmonic``);
+* flow q_i = N_i / T, veh/s, with N_i the vehicles whose front reached x_j in the period;
+* speed v_i, m/s, from the spot speeds v_k of those vehicles at the end of the step their
+  front reached x_j, per ``[sensing] loop_speed``: the time-mean sum v_k / N_i or the
+  harmonic mean N_i / sum 1/max(v_k, :data:`V_MIN`) (both kept on every record);
 * density rho_i = (1/T) sum_k tau_k / l_k, veh/m, with tau_k the time vehicle k spent on
-  the loop within the period and l_k its length: occupancy over the effective length
-  (:func:`~arzsumo.estimate.observations.density_from_occupancy`), summed per vehicle.
-  Vehicles side by side each count, so the summed occupancy may exceed 1 (SUMO's E1
-  output does the same under the sublane model); it is Edie's density over a zone of
-  one vehicle length, exact for any speed, queues on the loop included.
+  the loop within the period and l_k its length (Edie's density over a zone of one
+  vehicle length; vehicles side by side each count).
 
-SUMO's interval getters (``getLastIntervalVehicleNumber``, ``...MeanSpeed``) were not
-used: they report every vehicle on the loop during the interval, so a vehicle crossing
-a period boundary counts in both periods (measured: 77 counted against 68 passing).
+Where the boundary stations sit, and why SUMO's interval getters are not used:
+docs/sumo.md, "Sensing layouts".
 """
 
 from __future__ import annotations
@@ -57,13 +37,10 @@ BOUNDARY_GAP = 0.1
 #: Position of the upstream boundary station, m: beyond the front of any vehicle inserted
 #: at x = 0 (vtypes.MAX_LENGTH + 0.1 m; a test checks it).
 INLET_GAP = 6.0
-#: Floor of the spot speeds in the harmonic mean, m/s. A vehicle can reach the loop and
-#: stop within the same step, so its reading (the speed at the step's end) may be 0 and
-#: 1/v infinite: one such vehicle would make the period's mean 0. 0.5 m/s (1.8 km/h) is
-#: 5x SUMO's halting threshold (0.1 m/s) and far below the class means the estimators
-#: work with (14-40 km/h on the default), so it only caps the weight of a vehicle that
-#: crawls over the loop at 1/V_MIN = 2 s/m (the time a stopped queue takes to advance
-#: one metre); the time-mean speed is not floored.
+#: Floor of the spot speeds in the harmonic mean, m/s: a vehicle can reach the loop and
+#: stop within the step (its reading 0, 1/v infinite, the period's mean 0). 5x SUMO's
+#: halting threshold and far below the class means (14-40 km/h on the default), it only
+#: caps the weight of a vehicle crawling over the loop; the time-mean is not floored.
 V_MIN = 0.5
 #: what a loop reports as a class's speed: the arithmetic (time-mean) or the harmonic
 #: mean of the spot speeds of the vehicles that crossed it in the period
@@ -99,22 +76,31 @@ def lane_loop_ids(station: str, lanes: int) -> list[str]:
     return [f"{station}_{k}" for k in range(lanes)]
 
 
+def _e1(det: str, lane: str, pos: float) -> dict[str, str]:
+    """An E1 element of an additional file (its file output off: libsumo reads it)."""
+    return {"id": det, "lane": lane, "pos": f"{pos:.3f}", "period": "3600", "file": "NUL"}
+
+
+def _vehicle_data(lib: ModuleType, ids: Sequence[str]) -> Sequence[tuple]:
+    """The vehicles on the E1 loops ``ids`` in the step (every lane's)."""
+    data = lib.inductionloop.getVehicleData
+    return data(ids[0]) if len(ids) == 1 else [row for i in ids for row in data(i)]
+
+
 def write_loops(path: Path, x: Sequence[float], length: float,
                 layout: RoadLayout | None = None) -> Path:
     """Write an additional file with one E1 station per position of ``main_0``; on a
     user's section (``layout``) a station is one E1 per lane of the edge at x."""
     placed = placed_positions(x, length)
+    ids = loop_ids(placed.size)
     if layout is None:
-        elements = [{"id": det, "lane": f"{MAIN}_0", "pos": f"{pos:.3f}", "period": "3600",
-                     "file": "NUL"}
-                    for det, pos in zip(loop_ids(placed.size), placed, strict=True)]
-        return write_additional(path, "inductionLoop", elements)
-    elements = []
-    for station, xj in zip(loop_ids(placed.size), placed, strict=True):
-        edge, pos = layout.locate(float(xj))
-        elements += [{"id": det, "lane": f"{edge}_{k}", "pos": f"{pos:.3f}",
-                      "period": "3600", "file": "NUL"}
-                     for k, det in enumerate(lane_loop_ids(station, layout.lanes))]
+        elements = [_e1(det, f"{MAIN}_0", pos) for det, pos in zip(ids, placed, strict=True)]
+    else:
+        elements = []
+        for station, xj in zip(ids, placed, strict=True):
+            edge, pos = layout.locate(float(xj))
+            elements += [_e1(det, f"{edge}_{k}", pos)
+                         for k, det in enumerate(lane_loop_ids(station, layout.lanes))]
     return write_additional(path, "inductionLoop", elements)
 
 
@@ -122,20 +108,9 @@ def speed_means(entered: np.ndarray, speed_sum: np.ndarray, inverse_sum: np.ndar
                 ) -> tuple[np.ndarray, np.ndarray]:
     """Time-mean and harmonic speeds, m/s, from per-loop sums of N spot speeds.
 
-    Parameters
-    ----------
-    entered : array
-        N, vehicles counted.
-    speed_sum : array
-        Sum of their spot speeds v_k, m/s.
-    inverse_sum : array
-        Sum of 1 / max(v_k, :data:`V_MIN`), s/m.
-
-    Returns
-    -------
-    time_mean, harmonic : array
-        sum v_k / N and N / sum 1/max(v_k, V_MIN), m/s; NaN where N = 0. By the AM-HM
-        inequality harmonic <= time-mean wherever no v_k < V_MIN (equal for N = 1).
+    ``entered``: N; ``speed_sum``: sum of the spot speeds v_k, m/s; ``inverse_sum``: sum of
+    1 / max(v_k, :data:`V_MIN`), s/m. NaN where N = 0; by the AM-HM inequality harmonic <=
+    time-mean wherever no v_k < V_MIN (equal for N = 1).
     """
     with np.errstate(invalid="ignore", divide="ignore"):
         time_mean = np.where(entered > 0, speed_sum / entered, np.nan)
@@ -146,22 +121,10 @@ def speed_means(entered: np.ndarray, speed_sum: np.ndarray, inverse_sum: np.ndar
 class LoopSensor:
     """Reads the stations of :func:`write_loops` every step; one record per period.
 
-    Parameters
-    ----------
-    lib : module
-        The libsumo module of the open run (started with the loops' additional file).
-    x : sequence of float
-        Station positions asked for, m (the same as given to :func:`write_loops`).
-    length : float
-        Section length L, m.
-    dt : float
-        SUMO step, s.
-    steps_per_period : int
-        Steps per counting period (the control period).
-    noise : LoopNoise
-        Noise model attached to the records (for the estimators).
-    speed : {"time_mean", "harmonic"}
-        Which mean of the spot speeds the records' ``speed`` is (both are kept on them).
+    ``x``: station positions asked for, m (as given to :func:`write_loops`) on a section of
+    ``length`` L, m; ``dt``: SUMO step, s; ``noise``: attached to the records (for the
+    estimators); ``speed``: which mean of the spot speeds the records' ``speed`` is
+    (:data:`LOOP_SPEEDS`; both are kept on them).
     """
 
     def __init__(self, lib: ModuleType, x: Sequence[float], length: float, dt: float,
@@ -169,8 +132,7 @@ class LoopSensor:
                  speed: str = "time_mean", layout: RoadLayout | None = None) -> None:
         require(steps_per_period >= 1, "steps_per_period", steps_per_period, "at least 1")
         require(speed in LOOP_SPEEDS, "loop_speed", speed, f"one of {', '.join(LOOP_SPEEDS)}")
-        self.lib, self.dt, self.steps_per_period = lib, dt, steps_per_period
-        self.speed = speed
+        self.lib, self.dt, self.steps_per_period, self.speed = lib, dt, steps_per_period, speed
         self.x = placed_positions(x, length)
         self.ids = loop_ids(self.x.size)
         #: the E1 loops of each station (one; one per lane on a user's section), and the
@@ -180,7 +142,6 @@ class LoopSensor:
         self.av_types = frozenset({AV_TYPE}) if layout is None else layout.av_types
         self.noise = noise or LoopNoise()
         self._on: list[set[str]] = [set() for _ in self.ids]
-        self.records: list[LoopObservation] = []
         self._reset()
 
     def _reset(self) -> None:
@@ -193,9 +154,8 @@ class LoopSensor:
 
     def _read(self, j: int, t: float) -> None:
         """Add station ``j``'s vehicles of the step ending at ``t`` (s)."""
-        on = set()
-        t0 = t - self.dt
-        for vid, length, t_in, t_out, vtype in self._vehicle_data(j):
+        on, t0 = set(), t - self.dt
+        for vid, length, t_in, t_out, vtype in _vehicle_data(self.lib, self.lanes[j]):
             c = 1 if vtype in self.av_types else 0
             on.add(vid)
             if vid not in self._on[j]:
@@ -206,14 +166,6 @@ class LoopSensor:
             end = t if t_out < 0 else min(t_out, t)
             self.dwell[c, j] += max(end - max(t_in, t0), 0.0) / length
         self._on[j] = on
-
-    def _vehicle_data(self, j: int) -> list[tuple]:
-        """The vehicles on station ``j``'s loops in the step (every lane's)."""
-        data = self.lib.inductionloop.getVehicleData
-        ids = self.lanes[j]
-        if len(ids) == 1:
-            return list(data(ids[0]))
-        return [row for i in ids for row in data(i)]
 
     def observe(self, t: float) -> LoopObservation | None:
         """Read the step that ended at ``t`` (s); the period's record when it is complete."""
@@ -227,7 +179,6 @@ class LoopSensor:
         speed = harmonic if self.speed == "harmonic" else time_mean
         obs = LoopObservation(float(t), span, self.x, self.entered / span, speed,
                               self.dwell / span, self.noise, time_mean, harmonic)
-        self.records.append(obs)
         self._reset()
         return obs
 
@@ -240,9 +191,8 @@ DOWNSTREAM_DISTANCE = 100.0
 
 def downstream_ids(layout: RoadLayout | None) -> list[str]:
     """Ids of the downstream loop: one on ``down``, one per lane on a user's network."""
-    if layout is None:
-        return [DOWNSTREAM_LOOP]
-    return lane_loop_ids(DOWNSTREAM_LOOP, layout.outlet_lanes)
+    return [DOWNSTREAM_LOOP] if layout is None else \
+        lane_loop_ids(DOWNSTREAM_LOOP, layout.outlet_lanes)
 
 
 def write_downstream_loop(path: Path, distance: float = DOWNSTREAM_DISTANCE,
@@ -254,14 +204,12 @@ def write_downstream_loop(path: Path, distance: float = DOWNSTREAM_DISTANCE,
     require(0 < distance < 500, "loop_distance", distance,
             "a distance in (0, 500) m on the 500 m `down` edge", ScenarioError)
     if layout is None:
-        return write_additional(path, "inductionLoop", [
-            {"id": DOWNSTREAM_LOOP, "lane": f"{DOWN}_0", "pos": f"{distance:.3f}",
-             "period": "3600", "file": "NUL"}])
+        return write_additional(path, "inductionLoop",
+                                [_e1(DOWNSTREAM_LOOP, f"{DOWN}_0", distance)])
     pos = min(distance, layout.outlet_length - BOUNDARY_GAP)
-    return write_additional(path, "inductionLoop", [
-        {"id": det, "lane": f"{layout.outlet_edge}_{k}", "pos": f"{pos:.3f}",
-         "period": "3600", "file": "NUL"}
-        for k, det in enumerate(downstream_ids(layout))])
+    return write_additional(path, "inductionLoop",
+                            [_e1(det, f"{layout.outlet_edge}_{k}", pos)
+                             for k, det in enumerate(downstream_ids(layout))])
 
 
 class DownstreamLoop:
@@ -269,10 +217,9 @@ class DownstreamLoop:
     control period.
 
     Per period of T = ``steps_per_period`` steps of ``dt`` s: the occupancy o = (1/T) sum
-    tau_k (a fraction; tau_k the time vehicle k spent on the loop within the period;
-    vehicles side by side each count, so o may exceed 1 under the sublane model, as
-    SUMO's own E1 occupancy does) and the flow q = N / T (veh/s; N the vehicles whose
-    front reached the loop in the period).
+    tau_k (a fraction, the mean over the lanes' E1s; side-by-side vehicles each count, so
+    o may exceed 1, as SUMO's own E1 occupancy does) and the flow q = N / T (veh/s; N the
+    vehicles whose front reached the loop).
     """
 
     def __init__(self, lib: ModuleType, dt: float, steps_per_period: int,
@@ -291,10 +238,7 @@ class DownstreamLoop:
         """Read the step that ended at ``t`` (s); ``(occupancy, flow)`` (fraction, veh/s)
         of the period when it is complete, else None."""
         on, t0 = set(), t - self.dt
-        data = self.lib.inductionloop.getVehicleData
-        rows = data(self.ids[0]) if len(self.ids) == 1 else \
-            [row for i in self.ids for row in data(i)]
-        for vid, _length, t_in, t_out, _vtype in rows:
+        for vid, _length, t_in, t_out, _vtype in _vehicle_data(self.lib, self.ids):
             on.add(vid)
             self.entered += vid not in self._on
             end = t if t_out < 0 else min(t_out, t)
@@ -304,7 +248,6 @@ class DownstreamLoop:
         if self.steps < self.steps_per_period:
             return None
         span = self.steps * self.dt
-        occupied = self.occupied if len(self.ids) == 1 else self.occupied / len(self.ids)
-        out = (occupied / span, self.entered / span)
+        out = (self.occupied / len(self.ids) / span, self.entered / span)
         self._reset()
         return out

@@ -1,20 +1,15 @@
 """Micro to macro: Edie's space-time density, flow and speed per class on a cell grid.
 
-Every SUMO step the positions and speeds of the vehicles on ``main`` are collected with
-libsumo getters (measured fastest under libsumo: about 0.3 ms per step for 130 vehicles,
-against 0.5 ms for ``vehicle.getAllSubscriptionResults``; edge context subscriptions
-missed vehicles) and binned with ``numpy.bincount``. Over a window of n steps of length
-dt on a cell of length dx, Edie's definitions are
+Every SUMO step the positions and speeds of the vehicles on ``main`` are read with libsumo
+getters (the fastest way under libsumo: docs/sumo.md, "Micro to macro") and binned with
+``numpy.bincount``. Over a window of n steps of length dt on a cell of length dx,
 
     rho = sum(dt) / (dx n dt),   q = sum(v dt) / (dx n dt),   v = q / rho,
 
-the sums running over the vehicle samples in the cell. For a single-step window rho is
-the vehicle count over dx. Classes come from vehicle ids: the route files written by
-:mod:`arzsumo.sumo.demand` and :mod:`arzsumo.sumo.placement` start AV ids with ``av``.
-
-Class flows at x = 0 count vehicles that appeared on ``main`` (initial vehicles, whose ids
-contain ``_init``, excepted); at x = L vehicles that left ``main`` (set difference of
-consecutive id lists).
+the sums running over the vehicle samples in the cell. AV ids start with ``av`` (the route
+files of :mod:`arzsumo.sumo.demand` and :mod:`arzsumo.sumo.placement`). Class flows count
+the vehicles that appeared on ``main`` (x = 0; initial vehicles, ids with ``_init``,
+excepted) and that left it (x = L).
 """
 
 from __future__ import annotations
@@ -71,17 +66,8 @@ class CellData:
 
 
 class EdieGrid:
-    """Accumulates per-step vehicle samples on a uniform grid over [0, length].
-
-    Parameters
-    ----------
-    length : float
-        Road length L, m.
-    cell_length : float
-        Cell length dx, m; must divide L.
-    dt : float
-        Sampling step, s.
-    """
+    """Accumulates per-step vehicle samples on a uniform grid over [0, ``length``] (m):
+    cells of ``cell_length`` dx (m, dividing L), samples every ``dt`` s."""
 
     def __init__(self, length: float, cell_length: float, dt: float) -> None:
         n = length / cell_length
@@ -101,13 +87,8 @@ class EdieGrid:
     def add(self, pos: np.ndarray, speed: np.ndarray, av: np.ndarray) -> None:
         """Add one step's samples: positions (m), speeds (m/s), AV mask."""
         idx = np.minimum((pos / self.dx).astype(np.intp), self.n - 1) + self.n * av
-        self.add_binned(np.bincount(idx, minlength=2 * self.n).reshape(2, self.n),
-                        np.bincount(idx, weights=speed, minlength=2 * self.n).reshape(2, self.n))
-
-    def add_binned(self, counts: np.ndarray, speed_sums: np.ndarray) -> None:
-        """Add one step's per-cell vehicle counts and speed sums (m/s), shape (2, cells)."""
-        self._cnt += counts
-        self._dist += speed_sums
+        self._cnt += np.bincount(idx, minlength=2 * self.n).reshape(2, self.n)
+        self._dist += np.bincount(idx, weights=speed, minlength=2 * self.n).reshape(2, self.n)
         self.steps += 1
 
     def flush(self, t: float) -> CellData:
@@ -155,7 +136,6 @@ class MainlineSensor:
         self.layout = layout
         self.classes = classes or VehicleClasses(lib, layout)
         self._prev: set[str] = set()
-        self.log = MeasurementLog()
 
     def sample(self) -> tuple[tuple[str, ...], np.ndarray, np.ndarray, np.ndarray]:
         """(ids, positions m, speeds m/s, AV mask) of the vehicles on ``main`` now."""
@@ -196,21 +176,14 @@ class MainlineSensor:
         self.last_ids, self.last_pos, self.last_speed, self.last_av = ids, pos, speed, av
         self.grid.add(pos, speed, av)
         cur = set(ids)
-        entered = cur - self._prev
-        left = self._prev - cur
-        entered = {i for i in entered if "_init" not in i}   # placed at t = 0: not inflow
+        entered = {i for i in cur - self._prev if "_init" not in i}   # placed at t = 0: not inflow
         is_av_id = self.classes.av
-        if entered:
-            na = sum(1 for i in entered if is_av_id(i))
-            self.grid.flows[0] += len(entered) - na
-            self.grid.flows[1] += na
-        if left:
-            na = sum(1 for i in left if is_av_id(i))
-            self.grid.flows[2] += len(left) - na
-            self.grid.flows[3] += na
+        for k, moved in ((0, entered), (2, self._prev - cur)):       # in (0, 1), out (2, 3)
+            if moved:
+                na = sum(1 for i in moved if is_av_id(i))
+                self.grid.flows[k] += len(moved) - na
+                self.grid.flows[k + 1] += na
         self._prev = cur
         if self.grid.steps >= self.steps_per_window:
-            data = self.grid.flush(t)
-            self.log.append(data)
-            return data
+            return self.grid.flush(t)
         return None

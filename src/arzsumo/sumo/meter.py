@@ -1,36 +1,17 @@
 """The ramp-meter actuator: commanded mainline outflow -> green share -> signal program.
 
-The controller asks for a mainline outflow q* + U (veh/s). The calibrated curve of
-mainline outflow against the meter's green share
-(:class:`~arzsumo.sumo.green_share.GreenShareCurve`, decreasing: more ramp green, less
-mainline outflow) is inverted to a green share g in [0, 1], which
-becomes a fixed-cycle program: green for g C seconds, then red, with minimum green and
-red times (a shorter green becomes all-red or the minimum green, whichever is nearer; the
-same for red). A new timing is a *plan change* and takes effect at the next cycle start;
-each start or end of a green is a *light change*. With a clearance ``meter_clearance``
-> 0 every red is preceded by a yellow of that length (inside the cycle: green, yellow,
-red; the yellow's end is not a light change), so that ramp vehicles at the line stop
-without an emergency stop. The ramp queue (halted vehicles on ``ramp_up`` plus ramp
-vehicles waiting to be inserted), read by the sensor (:mod:`arzsumo.sumo.sensor`) and
-handed to :meth:`MeterLight.step` every step, and its maximum are tracked; an optional
-queue override forces green while the queue exceeds the ramp's storage
-(``ramp_storage``), and for good once :meth:`MeterLight.drain` hands the meter to the drain
-policy after the control window.
+:class:`RampMeter`, the fixed cycle, inverts the calibrated outflow-against-green-share
+curve (:class:`~arzsumo.sumo.green_share.GreenShareCurve`) to a green share g: green for
+g C seconds, then red. :class:`MeterLight` holds what both realisations share (light,
+clearance yellow, queue override, counts over a window: docs/sumo.md, "Ramp meter" and
+"Meter realisation"); the other is :class:`arzsumo.sumo.meter_release.OnePerGreenMeter`,
+and :func:`arzsumo.sumo.meter_release.make_meter` builds the one ``[sumo] meter_mode`` names.
 
 The meter reads nothing from SUMO: every step the sensor hands it a
-:class:`~arzsumo.sumo.stop_line.MeterReading`, the ramp queue and the vehicles that crossed
-its stop line (*releases*, counted per green interval, from one green's start to the next).
-The other realisation, one vehicle per green at a commanded release rate, is
-:class:`arzsumo.sumo.meter_release.OnePerGreenMeter`;
-:func:`arzsumo.sumo.meter_release.make_meter` builds the one ``[sumo] meter_mode`` names,
-once per run. Each realisation maps an outflow command U to its own plan variable (green
-share, release rate) and states the plan's bounds and the U it can realise; the actuator
-(:mod:`arzsumo.bridge.actuator`) saturates in one place.
-
-The counts (plan and light changes, override steps, releases, queue maximum) run over a
-*window*: from the meter's creation until :meth:`RampMeter.start_window`, which returns
-them and starts a new window (the co-simulation opens one at the start of control, so the
-warm-up is counted apart).
+:class:`~arzsumo.sumo.stop_line.MeterReading` (the ramp queue and the stop line's
+releases). Each realisation maps an outflow command U to its own plan variable and states
+the plan's bounds and the U it can realise; the actuator (:mod:`arzsumo.bridge.actuator`)
+saturates in one place.
 """
 
 from __future__ import annotations
@@ -85,9 +66,7 @@ class GreenRecord:
 class MeterLight:
     """The light, its clearance and the counts shared by both meter realisations.
 
-    Subclasses decide every step whether the plan wants green or red (:meth:`_plan`);
-    :meth:`step` reads the stop line, shows a yellow of ``cfg.meter_clearance`` before
-    every red, and counts light changes, releases per green interval and the queue.
+    Subclasses decide every step whether the plan wants green or red (:meth:`_plan`).
     """
 
     mode = ""
@@ -167,9 +146,8 @@ class MeterLight:
         self.light = state
 
     def step(self, reading: MeterReading) -> str:
-        """Call once after every SUMO step with the sensor's reading (the ramp queue and the
-        stop line's releases, :class:`~arzsumo.sumo.stop_line.MeterReading`): update the
-        override, the plan and the light; return the light."""
+        """Call once after every SUMO step with the sensor's reading: update the override,
+        the plan and the light; return the light."""
         queue, released = reading
         self.queue = queue
         self.max_queue = max(self.max_queue, queue)
@@ -219,16 +197,14 @@ class MeterLight:
 
     def drain(self) -> None:
         """Hand the meter to the drain policy for the rest of the run: the queue override
-        held on (the highest release rate; the fixed cycle: green), whatever was
-        commanded. Every controller leaves its queue to be discharged the same way."""
+        held on, whatever was commanded (every controller's queue discharged alike)."""
         self.draining = True
 
     def start_window(self) -> dict[str, Any]:
         """Close the current counting window: return its :meth:`summary`, then count anew.
 
-        Plan and light changes, override steps and releases restart from 0; the queue
-        maximum restarts from the next :meth:`step` (the light, the cycle and the pending
-        plan carry on unchanged).
+        The queue maximum restarts from the next :meth:`step`; the light, the cycle and
+        the pending plan carry on.
         """
         closed = self.summary()
         self.plan_changes = self.light_changes = self.override_steps = self.releases = 0
@@ -242,11 +218,8 @@ class MeterLight:
         raise NotImplementedError
 
     def summary(self) -> dict[str, Any]:
-        """Counts of the current window (see :meth:`start_window`): plan and light changes,
-        queue maximum (veh), override steps, releases (veh), green intervals begun and the
-        most releases in one; the last queue and
-        green share, the mode, clearance (s) and release rate (veh/s; None for the fixed
-        cycle)."""
+        """Counts of the current window (see :meth:`start_window`) and the meter's settings:
+        the ``meter`` block of summary.json (docs/outputs.md)."""
         greens = self.greens[self._window_greens:]
         return {"plan_changes": self.plan_changes, "light_changes": self.light_changes,
                 "max_queue": self.max_queue, "queue": self.queue,
@@ -267,15 +240,7 @@ class MeterLight:
 class RampMeter(MeterLight):
     """Drives the ramp traffic light of an open libsumo run at a fixed cycle.
 
-    Parameters
-    ----------
-    lib : module
-        The libsumo module of the open run.
-    cfg : SumoConfig
-        Cycle, minimum green and red, clearance, nominal green share, spillback
-        threshold, step.
-    curve : GreenShareCurve
-        Mainline outflow against green share, inverted by :meth:`plan_for`.
+    ``curve``: mainline outflow against green share, inverted by :meth:`plan_for`.
     """
 
     mode = "fixed_cycle"

@@ -1,21 +1,10 @@
 """One vehicle per green: the ramp meter at a commanded release rate, as the field runs it.
 
-The command is a release rate r (veh/s) in [``release_rate_min``, ``release_rate_max``];
-the cycle is 1 / r, rounded to whole SUMO steps. Each cycle begins with a green that
-lasts ``min_green``, extended until the head vehicle has crossed the stop line (read by
-the meter's :class:`~arzsumo.sumo.meter.StopLine`), at most ``max_green``; then the
-clearance (yellow, ``meter_clearance``) and red for the rest of the cycle. When green,
-clearance and ``min_red`` do not fit in 1 / r (a long green) the cycle is stretched to
-hold them. A new r is a *plan change* when its cycle differs by a step or more and takes
-effect at the next cycle start; light changes are counted as for the fixed cycle (starts
-and ends of greens). While the ramp queue exceeds ``ramp_storage`` (> 0), and while the meter
-drains after the control window, the queue override runs the cycles at
-``release_rate_max``.
-
-The controller's command is an outflow deviation U (veh/s) from the nominal outflow;
-:meth:`OnePerGreenMeter.plan_for` maps it to r by one rule: a released ramp vehicle takes
-one mainline slot at the merge, so r = r_nominal - U (``release_rate`` is r_nominal, the
-open loop's rate); the actuator saturates r to the rate bounds.
+The command is a release rate r (veh/s) in [``release_rate_min``, ``release_rate_max``],
+a cycle of 1 / r in whole SUMO steps, each beginning with a green of ``min_green``
+extended until the head vehicle has crossed the stop line, at most ``max_green``; an
+outflow command U maps to r = r_nominal - U (:func:`release_rate_for`). The cycle, plan
+changes and the queue override: docs/sumo.md, "Meter realisation".
 """
 
 from __future__ import annotations
@@ -32,24 +21,14 @@ from arzsumo.sumo.network import METER_TL
 
 def release_rate_for(u: float, cfg: SumoConfig) -> float:
     """Release rate r = r_nominal - U (veh/s) for the outflow command U (veh/s), before the
-    rate bounds: one released ramp vehicle takes one mainline slot at the merge, so
-    lowering the mainline outflow by U releases U more ramp vehicles (r_nominal:
-    ``cfg.release_rate``)."""
+    rate bounds: one released ramp vehicle takes one mainline slot at the merge
+    (r_nominal: ``cfg.release_rate``)."""
     require(math.isfinite(u), "U", u, "a finite flow in veh/s", ArzsumoError)
     return cfg.release_rate - u
 
 
 class OnePerGreenMeter(MeterLight):
-    """Drives the ramp traffic light of an open libsumo run, one vehicle per green.
-
-    Parameters
-    ----------
-    lib : module
-        The libsumo module of the open run.
-    cfg : SumoConfig
-        Nominal release rate and its bounds, minimum and maximum green, clearance,
-        minimum red, ramp storage (the override's threshold), step.
-    """
+    """Drives the ramp traffic light of an open libsumo run, one vehicle per green."""
 
     mode = "one_per_green"
 
@@ -94,7 +73,7 @@ class OnePerGreenMeter(MeterLight):
 
     def set_plan(self, plan: float) -> float:
         """Request release rate ``plan`` (veh/s); return the green share of the requested
-        plan. A changed cycle (whole steps) is a plan change."""
+        plan (a changed cycle is a plan change)."""
         self._check_plan(plan)
         self.rate = plan
         new = self._cycle(self.rate)
@@ -162,12 +141,9 @@ def make_meter(lib: ModuleType, cfg: SumoConfig,
 def nominal_phases(cfg: SumoConfig) -> list[tuple[str, int]]:
     """One cycle of the nominal plan (the open loop's) as (state, SUMO steps) phases.
 
-    The fixed cycle: ``meter_cycle`` with the green of ``green_share``
-    (:func:`~arzsumo.sumo.meter.plan_green_steps`), the clearance yellow, red for the rest.
-    One per green: the cycle 1 / ``release_rate`` rounded to steps, green ``min_green``,
-    the clearance yellow, red for the rest (the head vehicle crossing within the minimum
-    green; the run extends a green up to ``max_green`` when it does not). The queue
-    override is left out: it depends on the traffic.
+    Green, the clearance yellow, red for the rest, as the meters time them; one per green
+    as if the head vehicle crossed within the minimum green. The queue override is left
+    out: it depends on the traffic.
     """
     dt = cfg.step_length
     clear = round(cfg.meter_clearance / dt)

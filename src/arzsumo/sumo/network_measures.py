@@ -1,38 +1,26 @@
 """Network-wide measures of a SUMO run, from SUMO's own outputs.
 
 Measures integrated over the 1 km section miss the vehicles held on the ramp and those
-SUMO could not insert yet; a meter that keeps vehicles outside the section would look
-better than it is. Here every *loaded* vehicle counts, wherever it is at the end::
+SUMO could not insert yet. Here every *loaded* vehicle counts, wherever it is at the end::
 
     out = run_dir / "network"
     with open_simulation(params, cfg, extra_args=network_options(out), output_dir=out) as sim:
         ...
     network = network_summary(out)
 
-Outputs (files in ``out``; SUMO 1.28 checked):
+Outputs in ``out`` (SUMO 1.28 checked): ``tripinfo.xml`` with the vehicles still driving
+(``arrival = -1``) and those still waiting to be inserted (``depart = -1``,
+``departDelay`` = end minus the wanted departure; write-unfinished alone wrote 273 of 286
+vehicles of a 150 s always-red run), each with SUMO's emissions device (default HBEFA
+class, mg); ``edgedata.xml``, one interval, whose ``left`` on the section's last edge
+counts the vehicles past x = L (edge-based: no additional file to clash with the run's);
+``statistics.xml`` (:func:`~arzsumo.sumo.simulation.open_simulation`'s ``output_dir``),
+whose counts check that every loaded vehicle has a record.
 
-* ``tripinfo.xml`` (``--tripinfo-output``) with ``--tripinfo-output.write-unfinished``
-  (vehicles still driving at the end: ``arrival = -1``, ``duration`` up to the end) and
-  ``--tripinfo-output.write-undeparted`` (vehicles still waiting to be inserted:
-  ``depart = -1``, ``duration = 0``, ``departDelay`` = end minus the wanted departure).
-  write-unfinished alone leaves the waiting vehicles out (273 of 286 vehicles written in
-  a 150 s always-red run). ``--device.emissions.probability 1`` puts SUMO's emissions
-  device (default HBEFA class) on every vehicle, so each record has ``fuel_abs`` and
-  ``CO2_abs`` in mg (no ``--emissions.volumetric-fuel``).
-* ``edgedata.xml`` (``--edgedata-output``): one interval over the run; ``left`` on the
-  ``main`` edge counts the vehicles that crossed the section outlet x = L (edge-based, so
-  no additional file that would clash with the run's ``--additional-files``).
-* ``statistics.xml`` (SUMO's ``--statistic-output``, written to ``output_dir`` by
-  :func:`~arzsumo.sumo.simulation.open_simulation`): end time and SUMO's own vehicle
-  counts, used to check that every loaded vehicle has a record.
-
-Rule: a vehicle's time in the system is ``duration + departDelay``, i.e. from its wanted
-departure to its arrival or to the end of the run (SUMO's ``timeLoss`` excludes the depart
-delay, so ``time_loss_s`` adds it). Origin: on the shipped network ids starting with
-``ramp`` are ramp vehicles (the flow ids of :mod:`arzsumo.sumo.demand`), all others are
-mainline vehicles; on a user's network (``[network]``) the run passes ``ramp``, which
-tells them by route (:meth:`arzsumo.sumo.layout.VehicleClasses.recorded`: a vehicle
-whose route holds the ramp edge), whatever the ids of the user's route files.
+A vehicle's time in the system is ``duration + departDelay`` (SUMO's ``timeLoss`` excludes
+the depart delay, so ``time_loss_s`` adds it). Ramp vehicles: ids ``ramp...`` on the
+shipped network (the flows of :mod:`arzsumo.sumo.demand`), by route on a user's
+(``ramp``: :meth:`arzsumo.sumo.layout.VehicleClasses.recorded`).
 """
 
 from __future__ import annotations
@@ -50,9 +38,8 @@ from arzsumo.sumo.run_files import FCD_FILE
 from arzsumo.units import veh_s_to_veh_h
 
 TRIPINFO_FILE, EDGEDATA_FILE, STATISTICS_FILE = "tripinfo.xml", "edgedata.xml", "statistics.xml"
-#: what the FCD output (:data:`~arzsumo.sumo.run_files.FCD_FILE`, every vehicle every
-#: step) records per vehicle besides its id: vType id, speed in m/s, pos in m from the
-#: lane's start, lane id, posLat in m from the lane centre (left positive)
+#: what the FCD output (:data:`~arzsumo.sumo.run_files.FCD_FILE`) records per vehicle
+#: besides its id (units and meaning: docs/outputs.md, ``fcd.xml.gz``)
 FCD_ATTRIBUTES = ("type", "speed", "pos", "lane", "posLat")
 OUTPUT_FILES = (TRIPINFO_FILE, EDGEDATA_FILE, STATISTICS_FILE, FCD_FILE)
 ORIGINS = ("mainline", "ramp")
@@ -69,9 +56,8 @@ def network_options(out_dir: Path, fcd: bool = False) -> list[str]:
     with ``fcd`` also SUMO's FCD output, gzip-compressed (:data:`FCD_FILE`, attributes
     :data:`FCD_ATTRIBUTES`).
 
-    Pass ``output_dir=out_dir`` to :func:`~arzsumo.sumo.simulation.open_simulation` too,
-    so that SUMO's statistics output lands beside them. ``out_dir`` is created; existing
-    outputs in it are refused, never overwritten.
+    Pass ``output_dir=out_dir`` to :func:`~arzsumo.sumo.simulation.open_simulation` too.
+    ``out_dir`` is created; existing outputs in it are refused, never overwritten.
     """
     out_dir = Path(out_dir)
     taken = [n for n in OUTPUT_FILES if (out_dir / n).exists()]
@@ -130,20 +116,15 @@ def read_trips(path: Path, ramp: RampTest = None) -> pd.DataFrame:
     Returns
     -------
     pandas.DataFrame
-        Columns:
-
-        * ``id``, ``vtype``; ``origin``: mainline or ramp; ``state`` at the end:
-          completed, en_route or waiting (not inserted yet);
-        * ``depart_s``, ``arrival_s``: s, -1 when not inserted or not arrived;
-        * ``duration_s``: s from insertion to arrival or end, 0 when not inserted;
-        * ``sumo_time_loss_s``: SUMO's timeLoss, s, without the depart delay;
-        * ``depart_delay_s``: s, insertion minus wanted departure (waiting vehicles: end
-          minus wanted departure);
-        * ``waiting_time_s``: s at a speed below 0.1 m/s;
-        * ``distance_m``: m driven (0 when not inserted);
-        * ``fuel_g``, ``co2_g``: g (SUMO writes mg);
-        * ``time_spent_s`` = duration + depart delay, s;
-        * ``time_loss_s`` = SUMO's timeLoss + depart delay, s.
+        Columns: ``id``, ``vtype``; ``origin``: mainline or ramp; ``state`` at the end:
+        completed, en_route or waiting (not inserted yet); ``depart_s``, ``arrival_s``: s,
+        -1 when not inserted or not arrived; ``duration_s``: s from insertion to arrival
+        or end, 0 when not inserted; ``sumo_time_loss_s``: SUMO's timeLoss, s, without the
+        depart delay; ``depart_delay_s``: s, insertion minus wanted departure (waiting
+        vehicles: end minus wanted departure); ``waiting_time_s``: s at a speed below
+        0.1 m/s; ``distance_m``: m driven (0 when not inserted); ``fuel_g``, ``co2_g``: g
+        (SUMO writes mg); ``time_spent_s`` = duration + depart delay, s; ``time_loss_s`` =
+        SUMO's timeLoss + depart delay, s.
     """
     import sumolib
 
@@ -191,18 +172,17 @@ def edge_left(path: Path, edge: str = MAIN) -> tuple[int, float, float]:
 
 def _split(df: pd.DataFrame, column: str) -> dict[str, float]:
     by = df.groupby("origin")[column].sum()
-    out = {o: float(by.get(o, 0.0)) for o in ORIGINS}
-    out["total"] = float(df[column].sum())
-    return out
+    return {**{o: float(by.get(o, 0.0)) for o in ORIGINS}, "total": float(df[column].sum())}
+
+
+def origin_counts(df: pd.DataFrame) -> dict[str, int]:
+    """The vehicles (rows) of ``df`` per origin and in all (``total``)."""
+    return {**{o: int((df["origin"] == o).sum()) for o in ORIGINS}, "total": len(df)}
 
 
 def _counts(df: pd.DataFrame) -> dict[str, dict[str, int]]:
-    def split(sub: pd.DataFrame) -> dict[str, int]:
-        n = {o: int((sub["origin"] == o).sum()) for o in ORIGINS}
-        return {**n, "total": len(sub)}
-    out = {"loaded": split(df)}
-    out.update({s: split(df[df["state"] == s]) for s in STATES})
-    return out
+    return {"loaded": origin_counts(df),
+            **{s: origin_counts(df[df["state"] == s]) for s in STATES}}
 
 
 def _check(df: pd.DataFrame, stats: dict[str, float], end_time: float | None) -> None:
@@ -231,13 +211,9 @@ def aggregate(df: pd.DataFrame, begin: float, end: float, outlet_left: int) -> d
     outlet_rate = outlet_left / span if span > 0 else math.nan
     return {
         "begin_s": begin, "end_s": end,
-        "time_spent_s": _split(df, "time_spent_s"),
-        "time_loss_s": _split(df, "time_loss_s"),
-        "depart_delay_s": _split(df, "depart_delay_s"),
-        "waiting_time_s": _split(df, "waiting_time_s"),
-        "fuel_g": _split(df, "fuel_g"),
-        "co2_g": _split(df, "co2_g"),
-        "distance_m": _split(df, "distance_m"),
+        **{col: _split(df, col) for col in ("time_spent_s", "time_loss_s", "depart_delay_s",
+                                            "waiting_time_s", "fuel_g", "co2_g",
+                                            "distance_m")},
         "vehicles": _counts(df),
         "throughput_veh_h": {"section_outlet": float(veh_s_to_veh_h(outlet_rate)),
                              "network_exit": float(veh_s_to_veh_h(exit_rate))},
@@ -248,22 +224,13 @@ def network_summary(out_dir: Path, end_time: float | None = None,
                     outlet_edge: str = MAIN, ramp: RampTest = None) -> dict[str, Any]:
     """Network-wide measures of the run whose outputs are in ``out_dir`` (see module doc).
 
-    Parameters
-    ----------
-    out_dir : Path
-        Directory given to :func:`network_options` and to ``open_simulation(output_dir=)``.
-    end_time : float, optional
-        End of the run, s; checked against the outputs when given.
-    outlet_edge : str
-        Edge whose downstream end is the section outlet (``main``: x = L).
-    ramp : callable, optional
-        Which vehicle ids are ramp vehicles (:func:`read_trips`).
-
-    Returns
-    -------
-    dict
-        See :func:`aggregate`. Raises :class:`SumoError` when a file is missing or the
-        tripinfo records do not cover every vehicle SUMO loaded.
+    ``out_dir``: given to :func:`network_options` and ``open_simulation(output_dir=)``;
+    ``end_time``: end of the run, s, checked against the outputs when given;
+    ``outlet_edge``: the section's last edge, which holds x = L (``main``, at its end; a
+    user's last section edge, x = L inside it under ``end_offset_m``); ``ramp``: which
+    vehicle ids are ramp vehicles (:func:`read_trips`). Returns :func:`aggregate`'s dict;
+    raises :class:`SumoError` when a file is missing or the tripinfo records do not cover
+    every vehicle SUMO loaded.
     """
     out_dir = Path(out_dir)
     df = read_trips(out_dir / TRIPINFO_FILE, ramp)

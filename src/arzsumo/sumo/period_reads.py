@@ -1,27 +1,11 @@
 """What an open-loop run reads of SUMO beside the sensor, handed out as data.
 
-The open-loop runs (calibration, the loop curve, the approach, meter-dynamics and premise
-studies) all step through :meth:`arzsumo.sumo.plant.SumoPlant.run_open_loop`, which calls
-the run's hook once per control period with an :class:`OpenLoopPeriod`. Besides the
-sensor's :class:`~arzsumo.sumo.sensor.PeriodMeasurement` a study may ask
-(:class:`OpenLoopReads`) for
-
-* the vehicles on some edges at each period's end (``main``, ``approach``);
-* the ramp vehicles that passed the meter in each period: vehicles new on ``ramp_dn``
-  from one step to the next, summed over the period's steps (exact crossings, not the
-  stop line's releases, which end a green);
-* the downstream E1 loop's occupancy and flow per period when the sensor does not
-  measure (:class:`~arzsumo.sumo.loops.DownstreamLoop`; a measuring sensor reads it
-  itself);
-* a lateral snapshot of the vehicles on ``main`` at each period's last step
-  (:class:`~arzsumo.sumo.lateral.LateralSampler`, on the mainline sensor's sample of that
-  step, as the sensor takes it in a control window), returned at the run's end;
-* at the run's end, the vehicles on ``approach`` and its queue length
-  (:func:`approach_queue`).
-
-All of it is read here, in ``sumo/``, by :class:`PeriodReader`; nothing outside this
-package holds the open run's module (``tests/test_sim_handle.py``). The reads are libsumo
-getters: asking for more leaves the run's numbers unchanged.
+The open-loop runs step through :meth:`arzsumo.sumo.plant.SumoPlant.run_open_loop`, which
+calls the run's hook once per control period with an :class:`OpenLoopPeriod`; besides
+the sensor's measurement a study may ask (:class:`OpenLoopReads`) for more, read here by
+:class:`PeriodReader`, so that nothing outside this package holds the open run's module
+(``tests/test_sim_handle.py``). The reads are libsumo getters: asking for more leaves the
+run's numbers unchanged.
 """
 
 from __future__ import annotations
@@ -40,14 +24,15 @@ from arzsumo.sumo.sensor import PeriodMeasurement
 
 @dataclass(frozen=True)
 class OpenLoopReads:
-    """What an open-loop run reads beside the sensor (module docstring).
+    """What an open-loop run reads beside the sensor.
 
     ``edges``: edges whose vehicles are counted at each period's end; ``ramp_passed``:
-    count the ramp vehicles past the meter per period; ``downstream_loop``: the loop's
-    occupancy and flow per period (for a sensor that does not measure); ``lateral``: a
-    lateral snapshot per period (needs a measuring sensor); ``queued_below``: with a
-    speed (m/s), the approach's vehicles and queue at the run's end, a vehicle slower
-    than it counting as queued.
+    count the ramp vehicles past the meter per period (vehicles new on ``ramp_dn``: exact
+    crossings, not the stop line's releases); ``downstream_loop``: the E1 loop's occupancy
+    and flow per period (for a sensor that does not measure); ``lateral``: a lateral
+    snapshot of ``main`` at each period's last step (needs a measuring sensor);
+    ``queued_below``: with a speed (m/s), the approach's vehicles and queue at the run's
+    end (:func:`approach_queue`).
     """
 
     edges: tuple[str, ...] = ()
@@ -112,21 +97,8 @@ def approach_queue(lib: ModuleType, length: float, queued_below: float,
 
 class PeriodReader:
     """Reads what :class:`OpenLoopReads` asks for: :meth:`step` after every SUMO step,
-    :meth:`period` at each period's end.
-
-    Parameters
-    ----------
-    lib : module
-        The module of the open run.
-    reads : OpenLoopReads
-        What to read.
-    mainline : MainlineSensor
-        The sensor's mainline sample (the lateral snapshot's vehicles).
-    dt : float
-        SUMO step, s.
-    steps_per_period : int
-        Steps per control period (the downstream loop's period).
-    """
+    :meth:`period` at each period's end (``mainline``: the sensor's sample, the lateral
+    snapshot's vehicles; ``dt``: SUMO step, s)."""
 
     def __init__(self, lib: ModuleType, reads: OpenLoopReads, mainline: MainlineSensor,
                  dt: float, steps_per_period: int) -> None:

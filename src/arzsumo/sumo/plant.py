@@ -1,20 +1,13 @@
 """SUMO as the closed loop's plant: the simulation, its sensor and its meter, stepped as one.
 
 :meth:`SumoPlant.step` is the one step loop of every run: SUMO advances one step, the
-sensor reads it (the only reader of libsumo while SUMO steps, but for what an open-loop
-run asks to read beside it, :mod:`arzsumo.sumo.period_reads`) and hands the meter its
-reading; the meter sets the light for the next step. The warm-up and the open-loop runs
-(:meth:`SumoPlant.run_open_loop`), the control window (:meth:`SumoPlant.advance`, one
-control period) and the drain after the window (:func:`arzsumo.bridge.drain.drain`) all
-run through it.
-
-:meth:`SumoPlant.run_open_loop` is the one open-loop driver: control periods under a
-schedule of plans, a hook called at each period's end with the period's data
-(:class:`~arzsumo.sumo.period_reads.OpenLoopPeriod`: the sensor's measurement and what
-the run asked to read beside it). The closed loop's warm-up, calibration's fixed-plan
-runs (:func:`arzsumo.sumo.runner.run_fixed_meter`), the loop curve and the open-loop
-studies (approach and fill, meter dynamics, premise) run through it; none of them holds
-the open run's module.
+sensor reads it and hands the meter its reading; the meter sets the light for the next
+step. The warm-up, the control window (:meth:`SumoPlant.advance`) and the drain
+(:func:`arzsumo.bridge.drain.drain`) run through it. :meth:`SumoPlant.run_open_loop` is
+the one open-loop driver (the warm-up, calibration's fixed-plan runs, the loop curve and
+the open-loop studies): control periods under a schedule of plans, a hook called with
+each period's :class:`~arzsumo.sumo.period_reads.OpenLoopPeriod`; none of them holds the
+open run's module.
 """
 
 from __future__ import annotations
@@ -45,18 +38,9 @@ class SumoPlant:
     """An open SUMO run with its sensor and its meter (made once, from ``[sumo]
     meter_mode``: :func:`~arzsumo.sumo.meter_release.make_meter`).
 
-    Parameters
-    ----------
-    sim : SumoSimulation
-        The open run.
-    length : float
-        Length L of the measured section, m.
-    cfg : SumoConfig
-        The run's SUMO settings (meter, cells, control period).
-    curve : GreenShareCurve
-        The fixed-cycle meter's calibrated curve.
-    layout, loop_noise, probe_noise, window, measure
-        The sensor's (:class:`~arzsumo.sumo.sensor.SumoSensor`).
+    ``length``: L of the measured section, m; ``curve``: the fixed-cycle meter's calibrated
+    curve; ``layout``, ``loop_noise``, ``probe_noise``, ``window``, ``measure``: the
+    sensor's (:class:`~arzsumo.sumo.sensor.SumoSensor`).
     """
 
     def __init__(self, sim: SumoSimulation, length: float, cfg: SumoConfig,
@@ -108,30 +92,15 @@ class SumoPlant:
                       reads: OpenLoopReads = NOTHING_MORE,
                       green_shares: bool = False) -> OpenLoopEnd:
         """Step the open loop from a period's boundary: ``periods`` control periods, or
-        until SUMO time ``until`` (s; the last period may be cut short).
+        until SUMO time ``until`` (s; the last period may be cut short); ``on_period`` is
+        called at each period's end with its :class:`OpenLoopPeriod`.
 
-        Parameters
-        ----------
-        periods : int, optional
-            Control periods to run (or ``until``: one of the two).
-        on_period : callable, optional
-            Called at each period's end with its :class:`OpenLoopPeriod`.
-        until : float, optional
-            SUMO time to step to, s.
-        plans : sequence of (float, float)
-            The schedule: (t, plan) sets the meter's plan (``set_plan``: a green share or
-            a release rate, veh/s) before the step that starts at SUMO time t (s); a t
-            already passed never runs.
-        reads : OpenLoopReads
-            What to read besides the sensor (:mod:`arzsumo.sumo.period_reads`).
-        green_shares : bool
-            The plans are green shares of the fixed-cycle meter, run as they are, past
-            ``[sumo] green_share_min`` and ``green_share_max``.
-
-        Returns
-        -------
-        OpenLoopEnd
-            The periods run and what ``reads`` asked for at the end.
+        ``plans``: the schedule, (t, plan) sets the meter's plan (``set_plan``: a green
+        share or a release rate, veh/s) before the step that starts at SUMO time t (s; a t
+        already passed never runs); ``reads``: what to read besides the sensor;
+        ``green_shares``: the plans are green shares of the fixed-cycle meter, run as they
+        are, past ``[sumo] green_share_min`` and ``green_share_max``. Returns the periods
+        run and what ``reads`` asked for at the end.
         """
         if (periods is None) == (until is None):
             raise ValueError("run_open_loop needs periods or until, one of the two")
@@ -165,8 +134,8 @@ class SumoPlant:
 
     def _set_due(self, schedule: Sequence[tuple[float, float]], due: int,
                  plan: float | None, green_shares: bool) -> tuple[int, float | None]:
-        """Set the plans of ``schedule`` from index ``due`` on that start now (within
-        half a step); the next index and the plan requested last."""
+        """Set the plans of ``schedule`` from index ``due`` on that start now (within half
+        a step); the next index and the plan requested last."""
         now, tol = self.sim.time, self.cfg.step_length / 2
         while due < len(schedule) and schedule[due][0] <= now - tol:
             due += 1                         # passed: it never runs
@@ -180,8 +149,7 @@ class SumoPlant:
         return due, plan
 
     def outlet_speed_limit(self) -> OutletSpeedLimit:
-        """The speed limit of the edge past the merge, as an actuator
-        (:mod:`arzsumo.sumo.speed_limit`)."""
+        """The speed limit of the edge past the merge, as an actuator."""
         return OutletSpeedLimit(self.sim.lib)
 
     def run_period(self) -> tuple[PeriodMeasurement, MeterState]:

@@ -43,18 +43,9 @@ def run_fixed_meter(params: ModelParameters, cfg: SumoConfig, green_share: float
                     measure: bool = True, curve: GreenShareCurve = DEFAULT_CURVE) -> RunResult:
     """Run ``cfg.horizon`` seconds with the meter at ``green_share`` (default: nominal).
 
-    Parameters
-    ----------
-    params : ModelParameters
-        Model whose vehicle types are simulated.
-    cfg : SumoConfig
-        Run settings; ``cfg.control_period`` is the measurement window.
-    green_share : float, optional
-        Meter green share in [0, 1] (0: always red, 1: always green).
-    initial : sequence of InitialVehicle
-        Vehicles placed at t = 0.
-    measure : bool
-        Collect Edie aggregates every step (False: only the meter acts).
+    ``green_share`` in [0, 1] (0: always red, 1: always green); ``cfg.control_period`` is
+    the measurement window; ``initial``: vehicles placed at t = 0; ``measure``: collect
+    Edie aggregates every step (False: only the meter acts).
     """
     g = cfg.green_share if green_share is None else green_share
     cfg = cfg.with_(green_share=g)

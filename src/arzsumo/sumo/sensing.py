@@ -1,17 +1,10 @@
 """Which sensors a run has: :class:`SensorLayout`, chosen per scenario (``[sensing]``).
 
-Kinds, combinable:
-
-* ``"probe"``: every vehicle on ``main``, binned into cells and periods
-  (:class:`~arzsumo.sumo.measure.MainlineSensor`; the closed loop's sensor without [sensing]);
-* ``"loops"``: E1 loop stations at given positions, or every ``loop_spacing`` m from
-  x = 0, always with both boundaries (:mod:`arzsumo.sumo.loops`); with neither given,
-  the two boundary stations only; their speed is the time-mean or the harmonic mean of
-  the crossing vehicles' spot speeds (``loop_speed``, :data:`~arzsumo.sumo.loops.LOOP_SPEEDS`);
-* ``"av_probes"``: the positions and speeds of a share of the AVs on ``main``
-  (:mod:`arzsumo.sumo.probes`).
-
-The scenario keys are listed, with their units, in :mod:`arzsumo.scenario.sensing`.
+Kinds, combinable (docs/sumo.md, "Sensing layouts"): ``"probe"``, every vehicle on
+``main`` in cells and periods (:class:`~arzsumo.sumo.measure.MainlineSensor`); ``"loops"``,
+E1 loop stations (:mod:`arzsumo.sumo.loops`); ``"av_probes"``, the positions and speeds of
+a share of the AVs on ``main`` (:mod:`arzsumo.sumo.probes`). The scenario keys are listed,
+with their units, in :mod:`arzsumo.scenario.sensing`.
 """
 
 from __future__ import annotations
@@ -35,22 +28,11 @@ def _check(ok: bool, field: str, value: object, allowed: str) -> None:
 class SensorLayout:
     """The sensors of a run (SI).
 
-    Parameters
-    ----------
-    kinds : tuple of str
-        One or more of :data:`KINDS`, each once.
-    loop_spacing : float, optional
-        Distance between loop stations, m (> 0): stations at 0, s, 2s, ... and at L.
-    loop_positions : tuple of float
-        Explicit station positions, m in [0, L] (instead of a spacing).
-    av_probe_share : float
-        Share of the AVs that report, in (0, 1].
-    av_probe_seed : int
-        Seed of the draw of reporting AVs (>= 0).
-    loop_speed : {"time_mean", "harmonic"}
-        The loops' speed: the arithmetic mean of the crossing vehicles' spot speeds
-        (time-mean speed) or their harmonic mean (Wardrop's estimate of the space-mean
-        speed, the model's v in q = rho v; :mod:`arzsumo.sumo.loops`).
+    ``kinds``: one or more of :data:`KINDS`, each once; ``loop_spacing``: distance between
+    loop stations, m (> 0: stations at 0, s, 2s, ... and at L), or ``loop_positions``, m
+    in [0, L] (neither: the two boundaries); ``av_probe_share``: share of the AVs that
+    report, in (0, 1], drawn with ``av_probe_seed`` (>= 0); ``loop_speed``: the time-mean
+    or harmonic mean of the spot speeds (:mod:`arzsumo.sumo.loops`).
     """
 
     kinds: tuple[str, ...] = ("probe",)
@@ -87,11 +69,6 @@ class SensorLayout:
                "an integer >= 0")
         _check(self.loop_speed in LOOP_SPEEDS, "loop_speed", self.loop_speed,
                f"one of {', '.join(LOOP_SPEEDS)}")
-
-    @property
-    def probe(self) -> bool:
-        """Has the full probe of every vehicle."""
-        return "probe" in self.kinds
 
     @property
     def loops(self) -> bool:

@@ -1,30 +1,14 @@
 """The sensing stage of the closed loop: every libsumo read of a control period.
 
-One :class:`SumoSensor` per run. After each SUMO step :meth:`SumoSensor.observe` samples
-
-* the vehicles on ``main`` (Edie aggregates per class and cell, class flows at the
-  section boundaries, :class:`~arzsumo.sumo.measure.MainlineSensor`),
-* the occupancy and flow of the E1 loop on ``down`` past the merge nose (ALINEA's
-  measurement, :class:`~arzsumo.sumo.loops.DownstreamLoop`; every run has it,
-  ``open_simulation(..., downstream_loop=d)``), and
-* for the meter, every step: the ramp queue (halted vehicles on ``ramp_up`` plus ramp
-  vehicles still waiting to be inserted) and its stop line
-  (:class:`~arzsumo.sumo.stop_line.StopLine`), handed over as a
-  :class:`~arzsumo.sumo.stop_line.MeterReading`,
-* with a :class:`~arzsumo.sumo.sensing.SensorLayout` holding them, the E1 loop stations
-  (:class:`~arzsumo.sumo.loops.LoopSensor`; the run must be opened with their positions,
-  ``open_simulation(..., loops=layout.loop_x(L))``) and, at a period's last step, the
-  reporting AVs (:class:`~arzsumo.sumo.probes.AvProbes`, from the sample above),
-* until the control window opens (:meth:`SumoSensor.start_window`), every vehicle's fuel
-  and CO2 (:class:`~arzsumo.sumo.window.EmissionsLedger`); in the window, the speed moments
-  per class of the vehicles on ``main`` (:class:`SpeedMoments`, from the samples above)
-  and, at a period's last step, their lateral offsets
-  (:class:`~arzsumo.sumo.lateral.LateralSampler`); after it
-  (:meth:`SumoSensor.end_window`, the drain), only the meter's reading and fuel and CO2,
-
-and when a control period is complete returns one :class:`PeriodMeasurement`. Nothing
-else in the closed loop reads SUMO while it steps (an open-loop study's further reads are
-:mod:`arzsumo.sumo.period_reads`); the meter only writes the traffic light.
+One :class:`SumoSensor` per run. After each SUMO step :meth:`SumoSensor.observe` reads the
+vehicles on ``main`` (:class:`~arzsumo.sumo.measure.MainlineSensor`), the E1 loop on
+``down`` (ALINEA's, :class:`~arzsumo.sumo.loops.DownstreamLoop`), the meter's
+:class:`~arzsumo.sumo.stop_line.MeterReading` and the stations and AV probes of its
+:class:`~arzsumo.sumo.sensing.SensorLayout`; fuel and CO2 before the control window and
+in the drain after it, the speed moments and lateral offsets in it. A complete control
+period gives one :class:`PeriodMeasurement`. Nothing else in the closed loop reads SUMO
+while it steps (an open-loop study's further reads: :mod:`arzsumo.sumo.period_reads`);
+the meter only writes the traffic light.
 """
 
 from __future__ import annotations
@@ -65,11 +49,9 @@ class PeriodMeasurement:
     """What the sensor read over one control period ending at ``cells.t`` (SI).
 
     ``cells`` are the Edie aggregates of the mainline; ``occupancy_out`` and
-    ``flow_out_loop`` the occupancy (fraction of the period) and the flow (veh/s) of the
-    loop on ``down`` past the merge nose over the period;
-    ``ramp_queue`` the ramp queue at the period's last step, vehicles; ``loops`` the loop
-    stations' record of the period and ``probes`` the AV probes at its last step (None
-    when the layout has none).
+    ``flow_out_loop`` the occupancy (fraction) and the flow (veh/s) of the loop on ``down``
+    over the period; ``ramp_queue`` the ramp queue at its last step, veh; ``loops`` the
+    stations' record and ``probes`` the AV probes at its last step (None without them).
     """
 
     cells: CellData
@@ -87,18 +69,13 @@ class PeriodMeasurement:
 
 class SpeedMoments:
     """Count, sum and sum of squares of per-vehicle speeds (m/s) per class (HV, AV),
-    accumulated over vehicle-steps.
-
-    Their sd is the spread across vehicles: it pools lateral files riding at different
-    speeds, the mean speed profile along the section and waves alike; the waves alone
-    are measured on block speeds (:mod:`arzsumo.evaluation.waves`)."""
+    accumulated over vehicle-steps (their sd pools lateral files, the speed profile and
+    waves alike: docs/whole_demand.md)."""
 
     CLASSES = ("h", "a")
 
     def __init__(self) -> None:
-        self.n = np.zeros(2)
-        self.s1 = np.zeros(2)
-        self.s2 = np.zeros(2)
+        self.n, self.s1, self.s2 = np.zeros(2), np.zeros(2), np.zeros(2)
 
     def add(self, speed: np.ndarray, av: np.ndarray) -> None:
         """One step's speeds (m/s) and AV mask."""
@@ -109,8 +86,8 @@ class SpeedMoments:
 
     def summary(self) -> dict[str, dict[str, float]]:
         """``speed_mean_kmh``, ``speed_spread_kmh`` (sample sd across vehicle-steps, km/h;
-        NaN with fewer than two samples), ``speed_sd_kmh`` (the same, its former name, kept
-        for reports that read it) and ``speed_samples`` (vehicle-steps), per class."""
+        NaN with fewer than two samples; also as ``speed_sd_kmh``, for reports that read
+        that name) and ``speed_samples`` (vehicle-steps), per class."""
         out: dict[str, dict[str, float]] = {"speed_mean_kmh": {}, "speed_spread_kmh": {},
                                             "speed_sd_kmh": {}, "speed_samples": {}}
         for c, n, s1, s2 in zip(self.CLASSES, self.n, self.s1, self.s2, strict=True):
@@ -126,23 +103,11 @@ class SpeedMoments:
 class SumoSensor:
     """Reads an open libsumo run every step; yields one measurement per control period.
 
-    Parameters
-    ----------
-    lib : module
-        The libsumo module of the open run.
-    length : float
-        Length L of the measured section, m.
-    cfg : SumoConfig
-        Cell length, step length and control period.
-    window : bool
-        Keep the warm-up ledger and the section's speed moments for a control window
-        (:meth:`start_window`; the co-simulation does).
-    layout : SensorLayout, optional
-        Loop stations and AV probes read besides the cells (default: none).
-    loop_noise, probe_noise : LoopNoise, ProbeNoise, optional
-        Noise models attached to their records (the estimators' assumed errors).
-    measure : bool
-        Read the mainline and the loops (False: the meter's reading only).
+    ``length``: L of the measured section, m; ``window``: keep the warm-up ledger and the
+    speed moments for a control window (:meth:`start_window`); ``layout``: loop stations
+    and AV probes read besides the cells; ``loop_noise``, ``probe_noise``: attached to
+    their records (the estimators' assumed errors); ``measure``: read the mainline and the
+    loops (False: the meter's reading only).
     """
 
     def __init__(self, lib: ModuleType, length: float, cfg: SumoConfig,

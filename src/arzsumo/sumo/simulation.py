@@ -1,9 +1,8 @@
 """The SUMO run lifecycle: start with a fixed seed, step, count, close on every exit path.
 
-libsumo holds one simulation per process; :class:`SumoSimulation` refuses a second one
-while the first is open and can be started again after :meth:`SumoSimulation.close`.
-A SUMO error ends the run as a :class:`~arzsumo.sumo.paths.SumoError` whose message is
-SUMO's cause in one line. Use it as a context manager::
+One open simulation per process (libsumo holds one); a SUMO error ends the run as a
+:class:`~arzsumo.sumo.paths.SumoError` with SUMO's cause in one line (docs/sumo.md,
+"Lifecycle"). Use it as a context manager::
 
     with open_simulation(params, cfg) as sim:
         while sim.time < cfg.horizon:
@@ -18,16 +17,17 @@ import shutil
 import tempfile
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from types import ModuleType, TracebackType
 
 from arzsumo.model.params import ModelParameters
 from arzsumo.sumo.config import SumoConfig
-from arzsumo.sumo.demand import InitialVehicle, demand_flows, write_route_file
+from arzsumo.sumo.demand import InitialVehicle, write_route_file
+from arzsumo.sumo.fork import own_files
 from arzsumo.sumo.frontend import Frontend
 from arzsumo.sumo.layout import VehicleClasses
-from arzsumo.sumo.loops import DOWNSTREAM_DISTANCE, write_downstream_loop
+from arzsumo.sumo.loops import DOWNSTREAM_DISTANCE, write_downstream_loop, write_loops
 from arzsumo.sumo.paths import SumoError, scratch_dir
 from arzsumo.sumo.run_files import RunFiles
 from arzsumo.sumo.run_network import network_file
@@ -41,8 +41,7 @@ _ACTIVE: SumoSimulation | None = None
 
 
 def _one_line(exc: BaseException) -> str:
-    text = str(exc).strip() or type(exc).__name__
-    return text.splitlines()[0]
+    return (str(exc).strip() or type(exc).__name__).splitlines()[0]
 
 
 @dataclass(frozen=True)
@@ -96,25 +95,11 @@ class RunReport:
 class SumoSimulation:
     """One run of ``net_file`` with ``route_file`` under ``cfg``, driven by libsumo or TraCI.
 
-    Parameters
-    ----------
-    net_file, route_file : Path
-        Network and route files.
-    cfg : SumoConfig
-        Step length, seed, lateral resolution, teleport setting, horizon.
-    requested_initial : int
-        Vehicles placed at t = 0 by the route file (added to the requested count).
-    workdir : Path, optional
-        Directory for SUMO's statistics output; a temporary one by default.
-    extra_args : sequence of str
-        Further SUMO options.
-    output_dir : Path, optional
-        Where SUMO's statistics output goes instead, kept after the run (for
-        :mod:`arzsumo.sumo.network_measures`).
-    frontend : str
-        What drives the run, one choice for module and binary
-        (:mod:`arzsumo.sumo.frontend`): "libsumo" (default), "traci" (traci to ``sumo``)
-        or "gui" (traci to ``sumo-gui``).
+    ``requested_initial``: vehicles placed at t = 0 by the route file; ``workdir``: for
+    SUMO's statistics output (a temporary one by default), or ``output_dir``, kept after
+    the run (for :mod:`arzsumo.sumo.network_measures`); ``cleanup``: directories removed
+    at the close; ``frontend``: what drives the run (:mod:`arzsumo.sumo.frontend`:
+    "libsumo", "traci" or "gui").
     """
 
     def __init__(self, net_file: Path, route_file: Path, cfg: SumoConfig, *,
@@ -130,7 +115,6 @@ class SumoSimulation:
         self.extra_args = tuple(extra_args)
         self.output_dir = Path(output_dir) if output_dir is not None else None
         self._cleanup = tuple(cleanup)
-        self._flows = demand_flows(cfg)
         self._lib: ModuleType | None = None
         #: which vehicles are AVs and ramp vehicles (by id on the shipped network)
         self.classes = VehicleClasses(None, cfg.layout)
@@ -216,14 +200,11 @@ class SumoSimulation:
         except Exception as exc:
             self.close()
             raise SumoError(f"SUMO stopped at t = {self.time:.2f} s: {_one_line(exc)}") from None
-        loaded = sim.getLoadedIDList()
+        loaded, departed = sim.getLoadedIDList(), sim.getDepartedIDList()
         self.loaded += len(loaded)
-        if loaded:
-            self.loaded_ramp += sum(1 for v in loaded if self.classes.ramp(v))
-        departed = sim.getDepartedIDList()
+        self.loaded_ramp += sum(map(self.classes.ramp, loaded))
         self.inserted += len(departed)
-        if departed:
-            self.inserted_ramp += sum(1 for v in departed if self.classes.ramp(v))
+        self.inserted_ramp += sum(map(self.classes.ramp, departed))
         self.arrived += sim.getArrivedNumber()
         #: vehicles due but not yet inserted after this step (ids), read once per step
         self.pending = sim.getPendingVehicles()
@@ -237,19 +218,10 @@ class SumoSimulation:
         self.time = float(sim.getTime())
         return self.time
 
-    def run_until(self, t_end: float) -> float:
-        """Step until the time reaches ``t_end`` (s)."""
-        while self.time < t_end - 1e-9:
-            self.step()
-        return self.time
-
     def requested(self, ramp_only: bool = False) -> int:
-        """Vehicles due by the current time (initial vehicles plus flows; or ramp flows).
-
-        SUMO's own count: the vehicles it loaded, each when its departure time came.
-        (Counting from the flows' nominal periods drifted by about a vehicle per flow:
-        SUMO keeps a flow's period in whole ms.)
-        """
+        """Vehicles due by the current time (initial vehicles plus flows; or ramp flows):
+        SUMO's count of the vehicles it loaded (it keeps a flow's period in whole ms, so a
+        count from the flows' nominal periods would drift)."""
         return self.loaded_ramp if ramp_only else self.loaded
 
     def take_report(self) -> RunReport:
@@ -259,11 +231,9 @@ class SumoSimulation:
                  if not self.classes.ramp(v)}   # the meter's queue stands by design
         still = max(waits, key=waits.__getitem__, default="")
         return RunReport(self.time, self.requested(), self.loaded, self.inserted,
-                         len(sim.getPendingVehicles()), self.arrived,
-                         int(veh.getIDCount()),
+                         len(sim.getPendingVehicles()), self.arrived, int(veh.getIDCount()),
                          self.collisions if self.cfg.collision_check else None,
-                         self.teleports,
-                         self.emergency_stops, self.emergency_braking,
+                         self.teleports, self.emergency_stops, self.emergency_braking,
                          self.requested(ramp_only=True), self.inserted_ramp,
                          waits.get(still, 0.0), still)
 
@@ -288,8 +258,7 @@ class SumoSimulation:
             self.closed, _ACTIVE = True, None
         self.emergency_braking = self._read_braking()
         if self.report is not None:
-            self.report = RunReport(**{**self.report.__dict__,
-                                       "emergency_braking": self.emergency_braking})
+            self.report = replace(self.report, emergency_braking=self.emergency_braking)
             if warn and self.report.delivered_main < 0.98:
                 log.warning("mainline demand not delivered: %s", self.report.summary())
             if warn and self.report.standstill_main_s > DEADLOCK_S:
@@ -303,13 +272,9 @@ class SumoSimulation:
         """In a child forked from this open run (:mod:`arzsumo.sumo.fork`): continue on
         files of its own.
 
-        SUMO's outputs written so far are copied into ``out_dir`` and the rest of the
-        run writes there (:func:`~arzsumo.sumo.fork.own_files`; the statistics output
-        too, :attr:`stats_file`); the route and network files are read at offsets of the
-        child's own; :meth:`close` then removes nothing of the parent's.
+        SUMO's outputs so far are copied into ``out_dir``, where the rest of the run writes
+        (:func:`~arzsumo.sumo.fork.own_files`); :meth:`close` removes nothing of the parent's.
         """
-        from arzsumo.sumo.fork import own_files
-
         out_dir = Path(out_dir)
         out_dir.mkdir(parents=True, exist_ok=True)
         for src in dict.fromkeys([self.output_dir or self.workdir, self.workdir]):
@@ -347,16 +312,13 @@ def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
     """A started simulation of the network of :func:`network_file` with the demand of
     ``cfg``.
 
-    The route file (and, with ``loops``, an E1 loop station at each of those
-    positions on ``main``, m in [0, L], see :mod:`arzsumo.sumo.loops`; always, the E1
-    loop on ``down`` at ``downstream_loop`` m past the merge nose that the sensor reads,
-    :func:`~arzsumo.sumo.loops.write_downstream_loop`) goes to a
-    temporary directory (under
+    The route file and the E1 loops (with ``loops``, a station at each of those positions
+    on ``main``, m in [0, L]; always, the loop on ``down`` at ``downstream_loop`` m past the
+    merge nose: :mod:`arzsumo.sumo.loops`) go to a temporary directory (under
     :func:`~arzsumo.sumo.paths.scratch_dir`) removed when the run closes. With
     ``output_dir``, SUMO's statistics output is written there and kept. With ``keep``,
-    the network, route and additional files are copied there with a ``run.sumocfg``
-    (:meth:`~arzsumo.sumo.run_files.RunFiles.keep_config`). ``frontend``: what drives
-    the run (:mod:`arzsumo.sumo.frontend`).
+    the run's files are copied there with a ``run.sumocfg``
+    (:meth:`~arzsumo.sumo.run_files.RunFiles.keep_config`).
     """
     Frontend(frontend).check()   # no display for sumo-gui: refused before any file
     workdir = Path(tempfile.mkdtemp(prefix="arzsumo-", dir=scratch_dir()))
@@ -366,8 +328,6 @@ def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
         adds = [write_downstream_loop(workdir / "e1_down.add.xml", downstream_loop,
                                       cfg.layout)]
         if len(loops):
-            from arzsumo.sumo.loops import write_loops
-
             adds.append(write_loops(workdir / "e1.add.xml", loops, params.length,
                                     cfg.layout))
         extra_args = ("--additional-files", ",".join(map(str, adds)), *extra_args)

@@ -1,13 +1,10 @@
 """The outlet's speed limit as an actuator: mainstream control at x = L.
 
-The edge past the merge (``down``) is the bottleneck whose discharge sets the section's
-outflow q(L); its speed limit moves that discharge. :class:`OutletSpeedLimit` sets the
-limit of every lane of the edge with ``edge.setMaxSpeed``, from the next SUMO step on,
-and counts the changes over a window (from its creation, then from
-:meth:`OutletSpeedLimit.start_window` on), as the meter counts its plan changes. The
-mapping of a law's U to a limit is the actuator's
-(:class:`arzsumo.bridge.speed_actuator.SpeedLimitActuator`); this module only sets what it
-is told.
+:class:`OutletSpeedLimit` sets the limit of every lane of the edge past the merge
+(``down``) with ``edge.setMaxSpeed``, from the next SUMO step on, and counts the changes
+over a window, as the meter counts its plan changes. The mapping of a law's U to a limit
+is the actuator's (:class:`arzsumo.bridge.speed_actuator.SpeedLimitActuator`;
+docs/sumo.md, "The outlet's speed limit as the actuator").
 """
 
 from __future__ import annotations
@@ -18,15 +15,8 @@ from arzsumo.sumo.network import DOWN
 
 
 class OutletSpeedLimit:
-    """The speed limit of ``edge`` in the SUMO run ``lib`` (m/s).
-
-    Parameters
-    ----------
-    lib : module
-        The running SUMO (libsumo or traci).
-    edge : str
-        The edge whose limit is set (``down``: past the merge).
-    """
+    """The speed limit of ``edge`` (default ``down``, past the merge) in the SUMO run
+    ``lib`` (m/s)."""
 
     def __init__(self, lib: Any, edge: str = DOWN) -> None:
         self.lib, self.edge = lib, edge

@@ -1,23 +1,12 @@
 """Network measures over the control window: every vehicle's time clipped to [t_w, T].
 
-Controllers are judged on the control window (from the end of the warm-up t_w to the end
-of the run T), not on the warm-up they did not act in. SUMO's tripinfo output
-(:mod:`arzsumo.sumo.network_measures`) holds each vehicle's totals since its wanted
-departure; the control window's part is
-
-* times (time in the system, depart delay): the vehicle's interval clipped to [t_w, T]
-  (exact: the intervals are known from ``depart``, ``departDelay`` and ``arrival``);
-* accumulated quantities (SUMO's time loss, waiting time, distance, fuel, CO2): the
-  tripinfo total minus the value the vehicle had at t_w. :class:`EmissionsLedger` reads the
-  vehicles on the network at t_w with libsumo (``getTimeLoss``, ``getDistance``, the
-  tripinfo device's ``waitingTime``: equal to SUMO's tripinfo within its 2 decimals).
-  SUMO's emissions device cannot be read while running, so fuel and CO2 up to t_w are
-  summed every warm-up step from libsumo's ``getFuelConsumption`` and ``getCO2Emission``
-  (the same HBEFA model; measured within 0.3 % of the device's own totals).
-
-A vehicle counts in the window when it is in the system at some time in (t_w, T]: not
-arrived by t_w. Vehicles in the system at t_w (on the network or waiting to be inserted)
-are counted under ``vehicles.in_system_at_start``.
+From SUMO's tripinfo (:mod:`arzsumo.sumo.network_measures`): times are each vehicle's
+interval clipped to [t_w, T]; accumulated quantities (time loss, waiting time, distance,
+fuel, CO2) are the tripinfo totals minus their values at t_w, read with libsumo then
+(equal to tripinfo's within its 2 decimals; SUMO's emissions device cannot be read while
+running, so :class:`EmissionsLedger` sums fuel and CO2 every warm-up step). A vehicle
+counts when it is in the system at some time in (t_w, T]. docs/outputs.md, "Network
+measures".
 """
 
 from __future__ import annotations
@@ -33,15 +22,15 @@ import pandas as pd
 
 from arzsumo.sumo.network import MAIN
 from arzsumo.sumo.network_measures import (
-    ORIGINS,
+    MG_PER_G,
     TRIPINFO_FILE,
     RampTest,
     aggregate,
     network_summary,
+    origin_counts,
     read_trips,
 )
 
-MG_PER_G = 1000.0
 #: accumulated per-vehicle columns of :func:`~arzsumo.sumo.network_measures.read_trips`
 #: whose value at t_w is subtracted
 ACCUMULATED = ("sumo_time_loss_s", "waiting_time_s", "distance_m", "fuel_g", "co2_g")
@@ -63,19 +52,10 @@ class WindowStart:
 class EmissionsLedger:
     """Fuel and CO2 of every vehicle (mg) summed each step it is told to (:meth:`add`):
     the warm-up's until :meth:`close` reads the window's start, and the drain's after the
-    window's end (:func:`window_end`).
+    window's end (:func:`window_end`); ``dt``: the step, s.
 
-    Each step's rates are kept as arrays and summed per vehicle only when read
-    (:attr:`fuel_mg`, :attr:`co2_mg`): in step order, so the sums are those of adding
-    every step's ``rate * dt`` as it comes, without a dictionary update per vehicle and
-    step in the hot loop.
-
-    Parameters
-    ----------
-    lib : module
-        The libsumo module of the open run.
-    dt : float
-        Step length, s.
+    Each step's rates are kept as arrays and summed per vehicle, in step order, only when
+    read: no dictionary update per vehicle and step in the hot loop.
     """
 
     def __init__(self, lib: ModuleType, dt: float) -> None:
@@ -193,11 +173,9 @@ def window_trips(trips: pd.DataFrame, start: WindowStart, end: float,
     """The per-vehicle rows of ``trips`` (:func:`read_trips`) restricted to the control
     window [start.t_s, end]: vehicles not arrived by t_w, their times clipped and their
     accumulated values net of those at t_w (module docstring). Same columns, plus
-    ``due_s`` (wanted departure, s) and ``in_system_at_start`` (bool).
-
-    When the run went on after ``end`` (a drain, ending at ``run_end``), ``finish`` holds
-    the values at ``end``: accumulated values are taken net of those after it and
-    ``state`` is each vehicle's at ``end``.
+    ``due_s`` (wanted departure, s) and ``in_system_at_start`` (bool). When the run went
+    on after ``end`` (a drain, ending at ``run_end``), ``finish`` holds the values at
+    ``end``: accumulated values are net of those after it, ``state`` is each vehicle's then.
     """
     t_w, last = start.t_s, end if run_end is None else run_end
     df = trips.copy()
@@ -226,20 +204,14 @@ def window_summary(trips: pd.DataFrame, start: WindowStart, end: float,
                    run_end: float | None = None) -> dict[str, Any]:
     """The ``network`` dict of the control window (same layout as
     :func:`~arzsumo.sumo.network_measures.aggregate`), with ``window`` and
-    ``vehicles.in_system_at_start``.
-
-    ``outlet_left``: vehicles that crossed the section outlet x = L in the window;
-    ``finish``, ``run_end``: the values at ``end`` of a run that went on to ``run_end``
-    (s; :func:`window_trips`).
+    ``vehicles.in_system_at_start``; ``outlet_left``: vehicles that crossed the section
+    outlet x = L in the window; ``finish``, ``run_end``: as for :func:`window_trips`.
     """
     df = window_trips(trips, start, end, finish, run_end)
     out = aggregate(df, start.t_s, end, outlet_left)
-    at = df[df["in_system_at_start"]]
-    out["vehicles"]["in_system_at_start"] = {
-        **{o: int((at["origin"] == o).sum()) for o in ORIGINS}, "total": len(at)}
-    out = {"window": "control window: each vehicle's time inside [begin_s, end_s] "
-                     "(end of warm-up to end of the control horizon)", **out}
-    return out
+    out["vehicles"]["in_system_at_start"] = origin_counts(df[df["in_system_at_start"]])
+    return {"window": "control window: each vehicle's time inside [begin_s, end_s] "
+                      "(end of warm-up to end of the control horizon)", **out}
 
 
 @dataclass(frozen=True)
@@ -261,12 +233,9 @@ def measure_network(out_dir: Path, start: WindowStart, end: float,
     :func:`~arzsumo.sumo.network_measures.network_options` into ``out_dir``, whose control
     window ended at ``end`` (s) and the run at ``run_end`` (s; ``end`` without a drain,
     then ``finish`` holds the values at ``end``); ``outlet_left_window``: vehicles that
-    crossed x = L in the control window. Returns the measures and the per-vehicle rows
-    of the whole run (:func:`~arzsumo.sumo.network_measures.read_trips`).
-    ``outlet_edge``: the section's last edge, which holds x = L (``main``; a user's last
-    section edge, with x = L inside it under ``end_offset_m``);
-    ``ramp``: which vehicle ids are ramp vehicles (default: ids ``ramp...``; a user's
-    network: by route, :meth:`~arzsumo.sumo.layout.VehicleClasses.recorded`).
+    crossed x = L in the control window; ``outlet_edge`` and ``ramp`` as for
+    :func:`~arzsumo.sumo.network_measures.network_summary`. Returns the measures and the
+    per-vehicle rows of the whole run (:func:`~arzsumo.sumo.network_measures.read_trips`).
     """
     out_dir = Path(out_dir)
     last = end if run_end is None else run_end
