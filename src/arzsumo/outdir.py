@@ -14,6 +14,7 @@ same place removes what a killed run left. For users: docs/outputs.md, "Where re
 from __future__ import annotations
 
 import contextlib
+import itertools
 import json
 import os
 import shutil
@@ -157,12 +158,8 @@ def remove_leftovers(target: Path) -> list[Path]:
 
 def _created_parents(parent: Path) -> list[Path]:
     """The ancestors of ``parent`` (itself included) that do not exist yet, outermost first."""
-    missing = []
-    for p in (parent, *parent.parents):
-        if os.path.lexists(p):
-            break
-        missing.append(p)
-    return missing[::-1]
+    missing = itertools.takewhile(lambda p: not os.path.lexists(p), (parent, *parent.parents))
+    return list(missing)[::-1]
 
 
 def check_target(path: str | os.PathLike[str], kind: str, *, overwrite: bool = False,

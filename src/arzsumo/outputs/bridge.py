@@ -52,23 +52,24 @@ TRIPINFO_GZ = "tripinfo.xml.gz"
 SUMMARY_CSV = "summary.csv"
 
 
+#: summary index -> its attribute of :class:`arzsumo.pde.metrics.ClassIndices`
+_INDEX_ATTRS = {"TTT": "J_TTT", "total_delay": "total_delay", "J_fuel": "J_fuel",
+                "J_discom": "J_discom"}
+
+
 def _indices(res: CoSimResult, fields: np.ndarray) -> dict[str, Any]:
     """TTT, total delay, J_fuel, J_discom of fields (periods, 4, cells) up to their first NaN."""
     p = res.scenario.params
     ok = np.all(np.isfinite(fields[:, [0, 2]]), axis=(1, 2))
     n = int(np.argmin(ok)) if not ok.all() else ok.size
     if n < 2:
-        return {"TTT": None, "total_delay": None, "J_fuel": None, "J_discom": None,
-                "until_s": float(res.t[n - 1]) if n else 0.0}
+        return {**dict.fromkeys(_INDEX_ATTRS), "until_s": float(res.t[n - 1]) if n else 0.0}
     f = fields[:n].copy()
     f[:, 1], f[:, 3] = fill_speeds(p, f[:, 0], f[:, 1], f[:, 2], f[:, 3])
     perf = performance(p, res.t[:n], res.x, f)
-    out: dict[str, Any] = {}
-    for key, attr in (("TTT", "J_TTT"), ("total_delay", "total_delay"), ("J_fuel", "J_fuel"),
-                      ("J_discom", "J_discom")):
-        out[key] = {c: getattr(getattr(perf, c), attr) for c in ("h", "a", "total")}
-    out["until_s"] = float(res.t[n - 1])
-    return out
+    out: dict[str, Any] = {key: {c: getattr(getattr(perf, c), attr) for c in ("h", "a", "total")}
+                           for key, attr in _INDEX_ATTRS.items()}
+    return {**out, "until_s": float(res.t[n - 1])}
 
 
 #: resolution of ``rmse_blocks``: 100 m x 10 s keeps stop-and-go waves (hundreds of metres,
@@ -309,13 +310,10 @@ def trigger_terms(log: ControlLog, n: int) -> dict[str, np.ndarray]:
     """The event trigger's terms at each of the first ``n`` checks (defdynamic): the
     Lyapunov energy V of the state, the hold error d and the dynamic variable m, in the
     design's scaled units (:mod:`arzsumo.control.etc`); NaN for a law without a trigger."""
-    out = {}
-    for column, key in TRIGGER_TERMS.items():
-        values = np.full(n, np.nan)
-        logged = np.asarray(log.extra.get(key, ()), float)[:n]
-        values[:logged.size] = logged
-        out[column] = values
-    return out
+    logged = {column: np.asarray(log.extra.get(key, ()), float)[:n]
+              for column, key in TRIGGER_TERMS.items()}
+    return {column: np.pad(v, (0, n - v.size), constant_values=np.nan)
+            for column, v in logged.items()}
 
 
 def periods_table(res: CoSimResult) -> pa.Table:

@@ -98,14 +98,10 @@ class RunSummary:
     complete: bool = True
     disturbance: Mapping[str, Any] | None = None
 
-    @property
-    def whole_demand_complete(self) -> bool:
-        """Whether every loaded vehicle left (the drain ran and ended without gridlock)."""
-        return bool((self.network_whole_demand or {}).get("complete"))
-
     def whole_demand_tts_h(self) -> float:
-        """Whole-demand total time spent, veh h (NaN when the run is not complete)."""
-        if not self.whole_demand_complete:
+        """Whole-demand total time spent, veh h (NaN unless every loaded vehicle left: the
+        drain ran and ended without gridlock)."""
+        if not (self.network_whole_demand or {}).get("complete"):
             return math.nan
         return float(self.network_whole_demand["time_spent_s"]["total"]) / 3600.0
 

@@ -31,17 +31,15 @@ from arzsumo.pde.initial import InitialCondition
 from arzsumo.scenario.actuation import (
     ACTUATION_KEYS,
     ActuationSettings,
-    actuation_section,
     check_delay_horizon,
     check_speed_limit,
 )
-from arzsumo.scenario.alinea import ALINEA_KEYS, alinea_section, check_alinea_period
-from arzsumo.scenario.disturbance import DISTURBANCE_KEYS, disturbance_section
+from arzsumo.scenario.alinea import ALINEA_KEYS, check_alinea_period
+from arzsumo.scenario.disturbance import DISTURBANCE_KEYS
 from arzsumo.scenario.estimation import (
     ESTIMATION_KEYS,
     EstimationSettings,
     check_sensors,
-    estimation_section,
 )
 from arzsumo.scenario.model import (
     DESIGN_KEYS,
@@ -58,7 +56,6 @@ from arzsumo.scenario.run import (
     RUN_RENAMED,
     RunSettings,
     check_constant_release,
-    run_section,
 )
 from arzsumo.scenario.sensing import SENSING_KEYS, sensing_section
 from arzsumo.scenario.sumo import SUMO_KEYS, sumo_section
@@ -73,7 +70,7 @@ from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.disturbance import Slowdown
 from arzsumo.sumo.sensing import SensorLayout
 from arzsumo.sumo.user_network import NetworkRequest
-from arzsumo.tables import Key, check_keys, checked, sub_table, where
+from arzsumo.tables import Key, check_keys, checked, read_section, sub_table, where
 
 #: the ETC design parameters that a ``[sweep]`` table may vary (one number each)
 SWEEPABLE = tuple(sorted(set(DESIGN_KEYS) - {"A", "varsigma", "noise_sd_kmh",
@@ -191,7 +188,7 @@ def scenario_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scena
     initial = initial_section(t["initial"], at["initial"])
     twin = twin_section(t["twin"], at["twin"], initial, design)
     sumo = sumo_section(t["sumo"], at["sumo"], source)
-    run = run_section(t["run"], at["run"])
+    run = read_section(RunSettings, t["run"], RUN_KEYS, at["run"])
     check_constant_release(run, sumo.release_rate_min, sumo.release_rate_max, at["run"],
                            t["run"].get("constant_release_veh_h"))
     network = network_section(t["network"], at["network"], source)
@@ -203,17 +200,20 @@ def scenario_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Scena
         length = max([length, *asked]) if isinstance(asked, list) and all(
             isinstance(v, int | float) for v in asked) else length
     sensing = sensing_section(t["sensing"], at["sensing"], length)
-    estimation = estimation_section(t["estimation"], at["estimation"])
+    estimation = read_section(EstimationSettings, t["estimation"], ESTIMATION_KEYS,
+                              at["estimation"])
     check_sensors(estimation, sensing, length, at["estimation"])
-    actuation = actuation_section(t["actuation"], at["actuation"])
+    actuation = read_section(ActuationSettings, t["actuation"], ACTUATION_KEYS,
+                             at["actuation"])
     if actuation.delay_compensation > 0:
         check_delay_horizon(actuation, linearize(eq).eigenvalues, params.length,
                             at["actuation"], t["actuation"].get("delay_compensation_s"))
-    alinea = alinea_section(t["alinea"], at["alinea"])
+    alinea = read_section(AlineaSettings, t["alinea"], ALINEA_KEYS, at["alinea"])
     if uses_alinea(run.controller):
         check_alinea_period(alinea, sumo.control_period, at["alinea"],
                             t["alinea"].get("period_s"))
-    disturbance = disturbance_section(t["disturbance"], at["disturbance"])
+    disturbance = read_section(Slowdown, t["disturbance"], DISTURBANCE_KEYS,
+                               at["disturbance"])
     check_speed_limit(actuation, sumo.down_speed,
                       disturbance.edge if disturbance.active else None, at["actuation"],
                       t["actuation"])

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from arzsumo.errors import ScenarioError, require
-from arzsumo.tables import Key, not_allowed, read_section
+from arzsumo.tables import Key, not_allowed
 from arzsumo.units import KMH_PER_MS, VEH_H_PER_VEH_S, VEH_KM_PER_VEH_M
 
 #: what a PDE law's U can drive
@@ -120,11 +120,6 @@ class ActuationSettings:
 
     def as_dict(self) -> dict[str, Any]:
         return asdict(self)
-
-
-def actuation_section(table: Mapping[str, Any], at: str) -> ActuationSettings:
-    """The ActuationSettings of an ``[actuation]`` table."""
-    return read_section(ActuationSettings, table, ACTUATION_KEYS, at)
 
 
 def delay_horizon(eigenvalues: np.ndarray, length: float) -> float:

@@ -8,11 +8,10 @@ docs/scenarios.md; the controllers: docs/sumo.md, "Baselines a practitioner woul
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from typing import Any
 
 from arzsumo.control.alinea import AlineaSettings
-from arzsumo.tables import Key, not_allowed, read_section
+from arzsumo.tables import Key, not_allowed
 from arzsumo.units import VEH_H_PER_VEH_S
 
 #: veh/h per % of occupancy per (veh/s per unit occupancy): 3600 / 100 = 36
@@ -45,11 +44,6 @@ ALINEA_KEYS: dict[str, Key] = {
                             allowed="a gain >= 0 veh/h per % of occupancy",
                             doc="PI-ALINEA's K_I at gain_period_s (scaled as K_R)"),
 }
-
-
-def alinea_section(table: Mapping[str, Any], at: str) -> AlineaSettings:
-    """The AlineaSettings of an ``[alinea]`` table."""
-    return read_section(AlineaSettings, table, ALINEA_KEYS, at)
 
 
 def check_alinea_period(settings: AlineaSettings, control_period: float, at: str,

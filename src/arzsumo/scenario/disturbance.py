@@ -7,11 +7,8 @@ from the regulation experiment's state, seed by seed. Keys: docs/scenarios.md.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from typing import Any
-
-from arzsumo.sumo.disturbance import EDGES, KINDS, Slowdown
-from arzsumo.tables import Key, read_section
+from arzsumo.sumo.disturbance import EDGES, KINDS
+from arzsumo.tables import Key
 from arzsumo.units import KMH_PER_MS
 
 #: [disturbance] key -> Slowdown field (SI)
@@ -27,8 +24,3 @@ DISTURBANCE_KEYS: dict[str, Key] = {
     "duration_s": Key("duration", unit="s", allowed="a duration > 0 s",
                       doc="how long the slowdown lasts"),
 }
-
-
-def disturbance_section(table: Mapping[str, Any], at: str) -> Slowdown:
-    """The Slowdown of a ``[disturbance]`` table."""
-    return read_section(Slowdown, table, DISTURBANCE_KEYS, at)

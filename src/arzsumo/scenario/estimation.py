@@ -10,7 +10,6 @@ estimators and their defaults: docs/sumo.md, "Estimation in the closed loop".
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -20,7 +19,7 @@ from arzsumo.estimate.observations import LoopNoise, ProbeNoise
 from arzsumo.estimate.smoothing import AsmParameters
 from arzsumo.sumo.loops import BOUNDARY_GAP, INLET_GAP, placed_positions
 from arzsumo.sumo.sensing import SensorLayout
-from arzsumo.tables import Key, read_section
+from arzsumo.tables import Key
 from arzsumo.units import KMH_PER_MS, VEH_H_PER_VEH_S, kmh_to_ms
 
 METHODS = ("none", "smoothing", "enkf")
@@ -188,8 +187,3 @@ def check_sensors(est: EstimationSettings, layout: SensorLayout, length: float,
             raise ScenarioError(f"{at} method = \"enkf\" is not allowed with [sensing] "
                                 f"loop_positions_m without 0 and {length:g}: its twins "
                                 "take their inflow and outflow from the boundary stations")
-
-
-def estimation_section(table: Mapping[str, Any], at: str) -> EstimationSettings:
-    """The EstimationSettings of an ``[estimation]`` table."""
-    return read_section(EstimationSettings, table, ESTIMATION_KEYS, at)

@@ -12,7 +12,7 @@ from typing import Any
 
 from arzsumo.control.registry import controller_names
 from arzsumo.errors import ScenarioError, require
-from arzsumo.tables import Key, not_allowed, read_section
+from arzsumo.tables import Key, not_allowed
 from arzsumo.units import VEH_H_PER_VEH_S
 
 #: backstepping kernel grid of both `arzsumo run` and `arzsumo twin` (one default)
@@ -87,11 +87,6 @@ class RunSettings:
 
     def as_dict(self) -> dict[str, Any]:
         return asdict(self)
-
-
-def run_section(table: dict[str, Any], at: str) -> RunSettings:
-    """The RunSettings of a ``[run]`` table."""
-    return read_section(RunSettings, table, RUN_KEYS, at)
 
 
 def check_constant_release(settings: RunSettings, low: float, high: float, at: str,
