@@ -20,9 +20,6 @@ from numpy.typing import ArrayLike
 from arzsumo.errors import ArzsumoError
 from arzsumo.model.params import VARIABLES
 
-#: Their SI units.
-UNITS = ("veh/m", "m/s", "veh/m", "m/s")
-
 
 class IdentifyError(ArzsumoError, ValueError):
     """Invalid identification input: data shapes or values, parameter names, bounds."""

@@ -5,13 +5,11 @@
 reflective, bounds, forward-difference Jacobian) in the log coordinates z = log(p / p0).
 
 Uncertainty. With J the Jacobian of the residual in z at the optimum, m residuals, n
-parameters and s^2 = sum(r^2) / (m - n) the residual variance, the covariance of z is
-s^2 (J^T J)^-1 (pseudo-inverse where J is rank deficient), and that of p follows by the
-delta method, cov_p = diag(p) cov_z diag(p). It assumes independent residuals of equal
-variance, so it is a lower bound where model error (not noise) dominates, as it will on
-SUMO data. Optionally, a bootstrap over runs refits on runs drawn with replacement
-(seeded) and reports the spread of the refitted values, which also carries the run-to-run
-variation.
+parameters and s^2 = sum(r^2) / (m - n), the covariance of z is s^2 (J^T J)^-1
+(pseudo-inverse where J is rank deficient), that of p cov_p = diag(p) cov_z diag(p) (delta
+method): a lower bound where model error, not noise, dominates, as on SUMO data. The
+optional seeded bootstrap refits on runs drawn with replacement; its spread also carries
+the run-to-run variation.
 """
 
 from __future__ import annotations
@@ -74,11 +72,10 @@ class FitSettings:
     seed: int = 0
 
     def __post_init__(self) -> None:
-        for name in ("max_nfev", "bootstrap"):
+        for name, least in (("max_nfev", 1), ("bootstrap", 0)):
             value = getattr(self, name)
-            if not isinstance(value, int) or value < (1 if name == "max_nfev" else 0):
-                raise IdentifyError(f"{name} = {value!r} is not allowed: an integer >= "
-                                    f"{1 if name == 'max_nfev' else 0}")
+            if not isinstance(value, int) or value < least:
+                raise IdentifyError(f"{name} = {value!r} is not allowed: an integer >= {least}")
         for name in ("diff_step", "ftol", "xtol", "gtol", "x_scale"):
             value = getattr(self, name)
             if not (isinstance(value, int | float) and 0.0 < value < np.inf):

@@ -73,17 +73,14 @@ class ParameterSpace:
         if not which or len(set(which)) != len(which):
             raise IdentifyError(f"which = {list(which)} is not allowed: distinct names from "
                                 f"{', '.join(DEFAULT_BOUNDS)}")
-        unknown = [n for n in which if n not in DEFAULT_BOUNDS]
-        if unknown:
+        if unknown := [n for n in which if n not in DEFAULT_BOUNDS]:
             raise IdentifyError(f"which = {unknown} is not allowed: names from "
                                 f"{', '.join(DEFAULT_BOUNDS)}")
-        ignored = [n for n in which if n in guess.ignored_fields]
-        if ignored:
+        if ignored := [n for n in which if n in guess.ignored_fields]:
             raise IdentifyError(f"which = {ignored} is not allowed: family = "
                                 f"{guess.family!r} does not read them")
         given = dict(bounds or {})
-        extra = sorted(set(given) - set(which))
-        if extra:
+        if extra := sorted(set(given) - set(which)):
             raise IdentifyError(f"bounds for {extra} are not allowed: only fitted parameters "
                                 f"({', '.join(which)}) take bounds")
         lo, hi = [], []

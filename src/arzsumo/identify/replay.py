@@ -3,35 +3,21 @@
 :func:`run_replay` starts a :class:`arzsumo.pde.TwinStepper` from the data's initial
 state (interpolated to the twin grid), holds the inlet ghost cell at ``data.inlet[k]``
 and the outlet flow at ``data.outflow[k]`` during period k, and samples the primitive
-fields at ``data.x`` at every period end. This is what the SUMO closed loop does with its
-replay twin (a ghost-cell inlet and the measured outflow), with the boundary data given
-up front.
+fields at ``data.x`` at every period end: the SUMO closed loop's replay twin, with the
+boundary data given up front. The inlet flux (``ReplayOptions.inlet``: the ghost's, or
+bounded by the cell transmission model's supply and demand): ``docs/identify.md``, 'The
+inlet'.
 
-Inlet flux (``ReplayOptions.inlet``). ``ghost`` lets in the physical flux of the held
-state, whatever the first cell holds: the SUMO bridge's replay twin does this. When
-SUMO's queue tail reaches x = 0 the held (smoothed) state pairs a queue's density with
-the arriving vehicles' speed, and that flux can fill the first cell past AO_max.
-``supply`` lets in the smaller of that flux and the first cell's receiving capacity, the
-supply of the cell transmission model built on the model's own Ve_i
-(:class:`arzsumo.pde.supply.ReceivingCapacity`). ``ctm`` (default) is the cell
-transmission model's whole rule, min(demand, supply): a held state in congestion (above
-the diagram's critical occupancy) demands the capacity (times its own departure from
-the diagram), as a queue upstream of x = 0 would send; in free flow its demand is its
-flux. Where neither bound changes it the flux is the ghost's to the bit (a free-flow
-inlet); otherwise every class's flux is scaled by one factor.
+Outlet. The twin's outlet carries q* + U, q* the flow of its reference equilibrium: the
+uniform equilibrium at the spatial means of the initial densities (always admissible,
+AO being linear in the densities). U_k = outflow_k - q*, so the metered outlet flow is
+``outflow_k`` whatever the parameters. The ghost-cell inlet replaces the paper's l4
+inlet condition, so the replay is posed in free flow as in congestion.
 
-Outlet. The twin's outlet carries q* + U, with q* the flow of its reference equilibrium.
-We take the uniform equilibrium at the spatial means of the initial densities (always
-admissible, because AO is linear in the densities) and set U_k = outflow_k - q*, so the
-metered outlet flow equals ``outflow_k`` whatever the parameters. The reference
-equilibrium has no other role here: the ghost-cell inlet replaces the paper's l4 inlet
-condition, so the replay is posed in free flow as in congestion.
-
-Admissibility. A parameter set with a smaller AO_max may not hold a state the data holds.
-Densities of the initial state and of the inlet are scaled down where AO exceeds
-``ao_limit`` AO_max (as the SUMO bridge does at a twin start); if the twin still leaves
-the physical domain, the run stops there and the later periods are NaN (the fit turns
-them into a penalty).
+Admissibility. A smaller AO_max may not hold a state the data holds: densities of the
+initial state and of the inlet are scaled down where AO exceeds ``ao_limit`` AO_max (as
+the SUMO bridge does at a twin start); if the twin still leaves the physical domain, the
+run stops there and the later periods are NaN (the fit turns them into a penalty).
 """
 
 from __future__ import annotations
@@ -55,9 +41,7 @@ from arzsumo.pde.supply import ReceivingCapacity
 
 #: an inlet rule of :func:`run_replay`: (held state, first cell's state) -> boundary state
 InletRule = Callable[[np.ndarray, np.ndarray], np.ndarray]
-#: the inlet fluxes of :class:`ReplayOptions`: the cell transmission model's min(demand,
-#: supply), the held state's flux limited to the supply, that flux as it is (module
-#: docstring)
+#: the inlet fluxes of :class:`ReplayOptions`
 INLETS = ("ctm", "supply", "ghost")
 
 
@@ -80,8 +64,7 @@ class ReplayOptions:
     inlet : {"ctm", "supply", "ghost"}
         The inlet flux: min(demand of the held state, supply of the first cell)
         (``ctm``), the held state's physical flux limited to the supply (``supply``), or
-        that flux as it is (``ghost``, the bridge's replay twin and the replay before the
-        limit); module docstring.
+        that flux as it is (``ghost``, as the bridge's replay twin).
     """
 
     cells: int = 50
@@ -120,11 +103,9 @@ class HeldInlet(Inlet):
     """
 
     state: np.ndarray = field(default_factory=lambda: np.ones(4))
-    #: a boundary rule instead of the ghost cell: (held state, first cell's state) ->
-    #: boundary state, each (rho_h, v_h, rho_a, v_a) in SI
+    #: a boundary rule instead of the ghost cell (:data:`InletRule`)
     rule: InletRule | None = None
     supply: ReceivingCapacity | None = None
-    #: with ``supply``: a congested boundary state sends at capacity (``ctm``)
     sending: bool = False
     theta: np.ndarray = field(default_factory=lambda: np.ones(1))
 
@@ -182,22 +163,19 @@ class ReplayRun:
     inlet_limited: float = 0.0
 
 
-class _NoRegimeWarning(logging.Filter):
+def _not_regime(record: logging.LogRecord) -> bool:
     """Drop the twin's free-flow warning: it is about the l4 inlet, which is not used here."""
-
-    def filter(self, record: logging.LogRecord) -> bool:
-        return not str(record.msg).startswith("the equilibrium is in free flow")
+    return not str(record.msg).startswith("the equilibrium is in free flow")
 
 
 @contextmanager
 def _quiet_regime() -> Iterator[None]:
     logger = logging.getLogger("arzsumo.pde.solver")
-    flt = _NoRegimeWarning()
-    logger.addFilter(flt)
+    logger.addFilter(_not_regime)
     try:
         yield
     finally:
-        logger.removeFilter(flt)
+        logger.removeFilter(_not_regime)
 
 
 def replay_grid(params: ModelParameters, options: ReplayOptions) -> np.ndarray:
@@ -212,8 +190,7 @@ def admissible(params: ModelParameters, z: np.ndarray, ao_limit: float) -> np.nd
     if np.all(scale == 1.0):
         return z
     out = np.array(z, float)
-    out[0] *= scale
-    out[2] *= scale
+    out[[0, 2]] *= scale
     return out
 
 

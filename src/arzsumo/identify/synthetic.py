@@ -87,18 +87,16 @@ def synthetic_data(params: ModelParameters, run: SyntheticRun, *, horizon: float
     options : ReplayOptions, optional
         The generator's numerics (its grid is the data's ``x``).
     noise : float
-        Gaussian noise, fraction of the equilibrium value of each variable (the data's
-        reference scale).
-    seed : int
-        Seed of the noise.
+        Gaussian noise (seeded by ``seed``), fraction of the equilibrium value of each
+        variable (the data's reference scale).
     """
     opts = options if options is not None else ReplayOptions()
     t = np.arange(1, round(horizon / period) + 1) * period
     initial, inlet, outflow = boundary_data(params, run, t, opts.cells)
     eq = equilibrium_from_densities(params, run.rho_h, run.rho_a)
     scale = np.array([eq.rho_h, eq.v_h, eq.rho_a, eq.v_a])
-    return data_from_twin(params, t, initial, inlet, outflow, opts, noise=noise,
-                                seed=seed, scale=scale, name=name)
+    return data_from_twin(params, t, initial, inlet, outflow, opts, noise=noise, seed=seed,
+                          scale=scale, name=name)
 
 
 def data_from_twin(params: ModelParameters, t: ArrayLike, initial: ArrayLike,
@@ -117,12 +115,9 @@ def data_from_twin(params: ModelParameters, t: ArrayLike, initial: ArrayLike,
         State at t = 0 on the twin's cell centres (``options.cells``); the data's
         positions ``x`` are these centres, so a replay on the same grid reproduces
         the fields exactly.
-    options : ReplayOptions, optional
     noise : float
-        Standard deviation of the added Gaussian noise, as a fraction of ``scale``
-        per variable (e.g. 0.02); densities are kept > 0.
-    seed : int
-        Seed of the noise.
+        Standard deviation of the added Gaussian noise (seeded by ``seed``), as a
+        fraction of ``scale`` per variable (e.g. 0.02); densities are kept > 0.
     scale : array-like (4,), optional
         Reference scale for noise and relative errors; default the noiseless
         fields' mean per variable.
