@@ -1,21 +1,11 @@
 """What a replay error is judged against: the references on the same held-out runs.
 
-A second-order replay's block error means little alone: part of it is what no replay
-from boundary data can know (the phase of stop-and-go grown inside the section, the
-discreteness of a few vehicles in a 100 m x 10 s block). Three references bracket it, each
-scored on the same blocks as the model's replay (:data:`.scores.BLOCK_M`,
-:data:`.scores.BLOCK_S`):
-
-* ``three_detector``: Newell's exact kinematic-wave solution from the two boundary counts
-  and the initial state (:mod:`arzsumo.identify.three_detector`), on the triangle through
-  the training runs' mean state with the training runs' measured wave speed and the
-  model's HV free-flow speed: the classical first-order replay, waves carried undamped;
-* ``equilibrium``: every block at the run's equilibrium densities: the error of knowing
-  only the operating point;
-* ``place_mean``: every block at its own place's mean over the held-out run itself (an
-  oracle: it reads the data it is scored on). What is left is the blocks' variation in
-  time about each place's mean: no predictor that does not know the phase of the
-  section's fluctuations gets below it.
+Each reference (:data:`REFERENCES`) is scored on the same blocks as the model's replay
+(:data:`.scores.BLOCK_M`, :data:`.scores.BLOCK_S`): Newell's three-detector replay
+(:mod:`arzsumo.identify.three_detector`) on the triangle through the training runs' mean
+state with their measured wave speed and the model's HV free-flow speed; the equilibrium
+everywhere; each place's own mean over the held-out run (an oracle). What they mean:
+``docs/identify.md``, 'What a replay error is judged against'.
 """
 
 from __future__ import annotations
@@ -64,8 +54,7 @@ def _block_errors(data: ReplayData, blocks: np.ndarray, predicted: np.ndarray
 def _density_errors(data: ReplayData, predicted: np.ndarray) -> dict[str, float]:
     """Block RMSE of rho_h and rho_a over the run's equilibrium values."""
     rmse, _ = field_rmse(data.fields, predicted, *_block_shape(data))
-    scale = data.scale
-    return {"rho_h": float(rmse[0] / scale[0]), "rho_a": float(rmse[2] / scale[2])}
+    return {"rho_h": float(rmse[0] / data.scale[0]), "rho_a": float(rmse[2] / data.scale[2])}
 
 
 def decomposition(data: ReplayData, predicted: np.ndarray) -> dict[str, dict[str, float]]:

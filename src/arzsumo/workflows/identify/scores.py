@@ -88,6 +88,15 @@ def _beyond(params: ModelParameters, data: ReplayData) -> dict[str, int]:
             "a": int((ao[seen] > params.ao_max_a).sum()), "observed": int(seen.sum())}
 
 
+def _rmse(sums: np.ndarray, j: int, penalised: float) -> dict[str, float]:
+    """Absolute and relative RMSE of variable ``j`` from ``sums`` (as
+    :attr:`RunScore.sums`), NaN without samples; and the ``penalised`` one."""
+    n = sums[2, j]
+    return {"absolute": math.sqrt(sums[0, j] / n) if n else math.nan,
+            "relative": math.sqrt(sums[1, j] / n) if n else math.nan,
+            "penalised": float(penalised)}
+
+
 def score_run(params: ModelParameters, data: ReplayData, options: ReplayOptions,
               penalised: np.ndarray) -> RunScore:
     """:class:`RunScore` of ``data`` under ``params``; ``penalised`` (4,) from
@@ -98,16 +107,11 @@ def score_run(params: ModelParameters, data: ReplayData, options: ReplayOptions,
     sums = np.vstack([(err ** 2).sum(axis=(0, 2)),
                       ((err / data.scale[None, :, None]) ** 2).sum(axis=(0, 2)),
                       both.sum(axis=(0, 2))])
-    rmse = {}
-    for j, var in enumerate(VARIABLES):
-        n = sums[2, j]
-        rmse[var] = {"absolute": math.sqrt(sums[0, j] / n) if n else math.nan,
-                     "relative": math.sqrt(sums[1, j] / n) if n else math.nan,
-                     "penalised": float(penalised[j]), "samples": int(n)}
     blocks, n_blocks = field_rmse(data.fields, run.fields, *_block_shape(data))
-    for j, var in enumerate(VARIABLES):
-        rmse[var]["blocks_relative"] = float(blocks[j] / data.scale[j])
-        rmse[var]["blocks"] = int(n_blocks[j])
+    rmse = {var: {**_rmse(sums, j, penalised[j]), "samples": int(sums[2, j]),
+                  "blocks_relative": float(blocks[j] / data.scale[j]),
+                  "blocks": int(n_blocks[j])}
+            for j, var in enumerate(VARIABLES)}
     lost = int(np.isnan(run.fields).all(axis=(1, 2)).sum())
     return RunScore(data.name, rmse, run.stopped, run.reason, lost, _beyond(params, data),
                     run.fields, sums)
@@ -148,11 +152,6 @@ def score_set(params: ModelParameters, datasets: Sequence[ReplayData],
                  for i, d in enumerate(datasets))
     sums = sum(r.sums for r in runs)
     observed = np.array([d.mask.sum(axis=(0, 2)) for d in datasets], float)
-    pooled = {}
-    for j, var in enumerate(VARIABLES):
-        n = sums[2, j]
-        pooled[var] = {"absolute": math.sqrt(sums[0, j] / n) if n else math.nan,
-                       "relative": math.sqrt(sums[1, j] / n) if n else math.nan,
-                       "penalised": float(report.pooled[j])}
+    pooled = {var: _rmse(sums, j, report.pooled[j]) for j, var in enumerate(VARIABLES)}
     total = math.sqrt(float((report.rmse ** 2 * observed).sum() / observed.sum()))
     return SetScore(runs, report, pooled, total)
