@@ -41,12 +41,8 @@ class Claim:
 
 def penetration_records(rep: Reproduction) -> dict[int, RunRecord]:
     """The ETC runs of table diffpene that ``rep`` holds, by AV penetration (%)."""
-    out = {}
-    for pen in DIFFPENE:
-        rec = rep.get(f"penetration_{pen}_etc")
-        if rec is not None:
-            out[pen] = rec
-    return out
+    return {pen: rec for pen in DIFFPENE
+            if (rec := rep.get(f"penetration_{pen}_etc")) is not None}
 
 
 def trend(first: float, last: float) -> str:
