@@ -2,7 +2,7 @@
 
 :class:`ReplayData` is what the replay twin needs to reproduce a run, and what it is
 compared with. It is built from arrays (the SUMO layer aggregates its cells into them)
-or from a twin run (:func:`arzsumo.identify.synthetic.data_from_twin`, synthetic data with
+or from a twin run (:func:`arzsumo.identify.synthetic.synthetic_data`, synthetic data with
 known parameters).
 
 Periods: ``t`` holds the ends of the periods, t_0 < t_1 < ... (s, t_0 > 0); period k is

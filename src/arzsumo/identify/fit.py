@@ -211,15 +211,10 @@ def identify(datasets: Sequence[ReplayData], initial_guess: ModelParameters,
         Weights of the residuals of (rho_h, v_h, rho_a, v_a); default all 1.
     options : ReplayOptions, optional
         Numerics of the replay twin.
-    settings : FitSettings, optional
     penalty : float
         Residual (in scale units) of a value the replay could not predict.
     wave_target : WaveTarget, optional
         A measured wave speed lambda_4 should match: one more residual (its module).
-
-    Returns
-    -------
-    IdentificationResult
     """
     runs = check_datasets(datasets)
     space = ParameterSpace.make(initial_guess, which, bounds)

@@ -220,10 +220,8 @@ def run_replay(params: ModelParameters, data: ReplayData,
 
     Parameters
     ----------
-    params : ModelParameters
     data : ReplayData
         ``data.x`` must lie in [0, params.length].
-    options : ReplayOptions, optional
     inlet_rule : callable, optional
         The boundary state at x = 0 from the held (measured) state and the first cell's
         state, instead of the ghost cell holding the measured state (an alternative inlet

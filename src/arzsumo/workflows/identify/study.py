@@ -181,8 +181,7 @@ def check_seeds(train: Sequence[int], held_out: Sequence[int]) -> None:
         if not seeds or len(set(seeds)) != len(seeds):
             raise ScenarioError(f"{flag} = {','.join(map(str, seeds))} is not allowed: one "
                                 "or more distinct seeds")
-    both = sorted(set(train) & set(held_out))
-    if both:
+    if both := sorted(set(train) & set(held_out)):
         raise ScenarioError(f"--validate-seeds = {','.join(map(str, held_out))} is not "
                             f"allowed: seeds {both} are also training seeds; allowed: "
                             "held-out seeds not in --train-seeds")

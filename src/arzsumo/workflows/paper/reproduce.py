@@ -107,11 +107,6 @@ class _Task:
     group: int
 
 
-def _sweep_of(sc: Scenario) -> tuple[str, list[float]] | None:
-    """The design sweep of the scenario's ``[sweep]`` table (parameter, values), if any."""
-    return None if sc.sweep is None else (sc.sweep.parameter, list(sc.sweep.values))
-
-
 def _with(sc: Scenario, **tables: Mapping[str, Any]) -> Scenario:
     """``sc`` with some keys of some tables changed (validated again)."""
     return sc.with_({f"{name}.{key}": value for name, changes in tables.items()
@@ -154,9 +149,10 @@ def plan(scenarios: Sequence[Scenario], *, quick: bool = False,
         changes = {**(QUICK_TWIN if quick else {}), **(twin or {})}
         if changes:
             sc = _with(sc, twin=changes)
-        sweep = _sweep_of(sc)
+        sweep = sc.sweep
         items = ([(sc, None)] if sweep is None else
-                 [(_with(sc, design={sweep[0]: v}), (sweep[0], v)) for v in sweep[1]])
+                 [(_with(sc, design={sweep.parameter: v}), (sweep.parameter, v))
+                  for v in sweep.values])
         for item, sw in items:
             group = groups.setdefault(_baseline_key(item), len(groups))
             tasks.append(_Task(item, sw, group))
