@@ -137,11 +137,6 @@ class ReplayData:
         """Number of periods T."""
         return int(self.t.size)
 
-    @property
-    def observed(self) -> int:
-        """Number of observed (finite) values in ``fields``."""
-        return int(self.mask.sum())
-
     @classmethod
     def from_arrays(cls, t: ArrayLike, x: ArrayLike, fields: ArrayLike, initial: ArrayLike,
                     inlet: ArrayLike, outflow: ArrayLike, *, scale: ArrayLike | None = None,

@@ -143,17 +143,6 @@ class IdentificationResult:
             return None
         return np.std(self.bootstrap, axis=0, ddof=1)
 
-    def as_dict(self) -> dict[str, dict[str, float]]:
-        """{name: {"value", "sigma"[, "bootstrap_sigma"]}} in SI units."""
-        boot = self.bootstrap_sigma
-        out: dict[str, dict[str, float]] = {}
-        for i, name in enumerate(self.which):
-            row = {"value": float(self.values[i]), "sigma": float(self.sigma[i])}
-            if boot is not None:
-                row["bootstrap_sigma"] = float(boot[i])
-            out[name] = row
-        return out
-
 
 def covariance(jac: np.ndarray, residuals: np.ndarray, p: np.ndarray) -> np.ndarray:
     """Covariance of the parameters p (n,), s^2 (J^T J)^-1 in z mapped to p (module doc)."""

@@ -218,10 +218,6 @@ class ValidationReport:
     pooled: np.ndarray
     stopped: tuple[float | None, ...]
 
-    def as_dict(self) -> dict[str, float]:
-        """Pooled relative RMSE keyed ``rho_h``, ``v_h``, ``rho_a``, ``v_a``."""
-        return {v: float(e) for v, e in zip(VARIABLES, self.pooled, strict=True)}
-
 
 def validate(params: ModelParameters, datasets: Sequence[ReplayData],
              options: ReplayOptions | None = None,
