@@ -58,13 +58,8 @@ def _density_errors(data: ReplayData, predicted: np.ndarray) -> dict[str, float]
 
 
 def decomposition(data: ReplayData, predicted: np.ndarray) -> dict[str, dict[str, float]]:
-    """A replay's block density error split, per class (``rho_h``, ``rho_a``): ``offset``,
-    the mean error over every block (signed: < 0, the replay's section is emptier than
-    SUMO's); ``bias``, the RMS over places of each place's mean error over the run;
-    ``fluctuation``, the RMS of what is left (bias^2 + fluctuation^2 = the error^2; all
-    over the run's equilibrium value); ``correlation`` of the replay's and the run's
-    fluctuations about their places' means (1: the replay follows their phase; 0: it
-    does not)."""
+    """A replay's block density error split, per class: ``offset``, ``bias``,
+    ``fluctuation`` and ``correlation`` (``references.model`` in ``docs/outputs.md``)."""
     both = np.isfinite(data.fields) & np.isfinite(predicted)
     shape = _block_shape(data)
     obs = block_means(np.where(both, data.fields, np.nan), *shape)
@@ -87,9 +82,8 @@ def decomposition(data: ReplayData, predicted: np.ndarray) -> dict[str, dict[str
 
 
 def reference_scores(fd: Triangle, held_out: Sequence[ReplayData]) -> dict[str, object]:
-    """``{"triangle": its v_free, w, rho_jam (SI), "runs": {run name: {reference:
-    {"rho_h": error, "rho_a": error}}}}``: each reference's relative block density errors
-    per held-out run (module docstring)."""
+    """Each reference's relative block density errors per held-out run, and the triangle
+    (``references.triangle``, ``references.runs`` in ``docs/outputs.md``)."""
     runs = {}
     for d in held_out:
         constant = np.broadcast_to(d.scale[None, :, None], d.fields.shape).copy()
@@ -105,11 +99,9 @@ def reference_scores(fd: Triangle, held_out: Sequence[ReplayData]) -> dict[str, 
 def held_out_references(params: ModelParameters, train: Sequence[ReplayData],
                         held_out: Sequence[ReplayData], validation: SetScore,
                         own: SetScore) -> dict[str, Any] | None:
-    """``identification.json["references"]``: the references' block errors on the
-    held-out runs (:func:`reference_scores`) and the replay error split
-    (:func:`decomposition`) of the identified model (``model``, its ``validation``
-    scores) and of the scenario's own (``scenario_model``, ``own``); None where the
-    training runs show no wave to draw the reference's triangle with."""
+    """``identification.json["references"]``: :func:`reference_scores` and the
+    :func:`decomposition` of the identified model's (``validation``) and the scenario's
+    (``own``) replays; None where the training runs show no wave to draw the triangle with."""
     try:
         refs: dict[str, Any] = reference_scores(reference_triangle(params, train), held_out)
     except ArzsumoError as exc:

@@ -59,14 +59,8 @@ def start_params(params: ModelParameters, datasets: Sequence[ReplayData],
 class RunScore:
     """The replay of one run under one parameter set, against the run.
 
-    ``rmse[var]`` holds ``absolute`` (SI, over the values the replay predicted),
-    ``relative`` (the same over the run's equilibrium value), ``penalised`` (relative,
-    values the replay could not predict counted with the fit's penalty: what the fit
-    minimises) and ``samples``. ``stopped`` is when the replay twin left the physical
-    domain (None if it completed), ``periods_not_predicted`` the periods from there on.
-    ``beyond_ao_max`` counts observed cells (period x cell) whose AO exceeds the model's
-    AO_max (``model``: the smaller of the classes', where the model cannot go) and each
-    class's (``h``, ``a``), out of ``observed``.
+    ``rmse``, ``stopped`` (s), ``periods_not_predicted`` and ``beyond_ao_max`` are the
+    run's entries of ``identification.json`` (``docs/outputs.md``, 'identification.json').
     """
 
     name: str
@@ -130,12 +124,8 @@ def _block_shape(data: ReplayData) -> tuple[int, int]:
 
 @dataclass(frozen=True)
 class SetScore:
-    """Scores of a set of runs (training or validation) under one parameter set.
-
-    ``pooled[var]``: ``absolute``, ``relative`` and ``penalised`` RMSE over all runs'
-    values; ``total``: the penalised relative RMSE over every variable and value (the
-    fit's objective as an RMSE: sqrt(2 cost / residuals)).
-    """
+    """Scores of a set of runs (training or validation) under one parameter set;
+    ``pooled`` and ``total`` as ``rmse.SET`` of ``identification.json``."""
 
     runs: tuple[RunScore, ...]
     report: ValidationReport

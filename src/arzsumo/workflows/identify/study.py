@@ -268,8 +268,8 @@ class IdentifyStudy:
 
     ``measured`` is the mean (rho_h, rho_a) of the training runs' cells and periods, veh/m;
     ``equilibrium`` the identified model's equilibrium there (None where the identified
-    model cannot hold it: AO >= AO_max). ``wall`` holds wall times, s: ``sumo`` (the batch
-    of runs), ``sumo_runs`` (their sum), ``fit``, ``bootstrap``, ``validate``, ``total``.
+    model cannot hold it: AO >= AO_max); ``wall`` the wall times, s (``wall_time`` in
+    ``docs/outputs.md``).
     """
 
     setup: IdentifySetup
