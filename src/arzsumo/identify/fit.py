@@ -42,32 +42,21 @@ log = logging.getLogger(__name__)
 
 @dataclass(frozen=True)
 class FitSettings:
-    """Settings of :func:`scipy.optimize.least_squares` and of the bootstrap.
+    """Settings of :func:`scipy.optimize.least_squares` and of the bootstrap."""
 
-    Parameters
-    ----------
-    max_nfev : int
-        Largest number of residual evaluations outside the Jacobian (scipy's count).
-    diff_step : float
-        Forward-difference step in z, i.e. a relative step of the parameters (1e-3: the
-        replay is continuous in the parameters but its adaptive time step adds noise of
-        about 1e-6 relative, which a much smaller step would amplify).
-    ftol, xtol, gtol : float
-        scipy's stopping tolerances.
-    x_scale : float
-        Characteristic change of z (1: parameters move by factors of order e).
-    bootstrap : int
-        Number of bootstrap refits over runs (0: none).
-    seed : int
-        Seed of the bootstrap draws.
-    """
-
+    #: largest number of residual evaluations outside the Jacobian (scipy's count)
     max_nfev: int = 40
+    #: forward-difference step in z, i.e. a relative step of the parameters (1e-3: the
+    #: replay is continuous in the parameters but its adaptive time step adds noise of
+    #: about 1e-6 relative, which a much smaller step would amplify)
     diff_step: float = 1e-3
+    #: scipy's stopping tolerances
     ftol: float = 1e-6
     xtol: float = 1e-6
     gtol: float = 1e-8
+    #: characteristic change of z (1: parameters move by factors of order e)
     x_scale: float = 1.0
+    #: bootstrap refits over runs (0: none), and the seed of their draws
     bootstrap: int = 0
     seed: int = 0
 
@@ -84,55 +73,36 @@ class FitSettings:
 
 @dataclass(frozen=True)
 class IdentificationResult:
-    """The identified parameters, their uncertainties and the cost of the fit.
+    """The identified parameters, their uncertainties and the cost of the fit."""
 
-    Attributes
-    ----------
-    params : ModelParameters
-        The guess with the fitted parameters replaced.
-    which : tuple of str
-        The fitted parameters, in the order of the arrays below.
-    values, sigma : ndarray (n,)
-        Fitted values and 1-sigma uncertainties from the Jacobian (SI units).
-    correlation : ndarray (n, n)
-        Correlation matrix of the fitted parameters (from the same covariance).
-    at_bound : ndarray (n,) of bool
-        Parameters that ended on a bound (their sigma is not meaningful).
-    bootstrap : ndarray (B, n) or None
-        Refitted values, one row per bootstrap draw of runs.
-    training : ValidationReport
-        Relative RMSE per run and variable on the training runs at the optimum.
-    cost : float
-        Half the sum of squared residuals at the optimum.
-    residuals : int
-        Number of residuals m (observed values over all runs).
-    nfev : int
-        scipy's count of residual evaluations (without those of the Jacobian).
-    evaluations : int
-        All residual evaluations, Jacobian columns included (each replays every run).
-    wall_time : float
-        Seconds for the fit (bootstrap excluded).
-    failures : int
-        Replays that stopped (twin outside the physical domain) during the fit.
-    success : bool
-    message : str
-        scipy's status message.
-    """
-
+    #: the guess with the fitted parameters replaced
     params: ModelParameters
+    #: the fitted parameters, in the order of the arrays below
     which: tuple[str, ...]
+    #: fitted values and 1-sigma uncertainties from the Jacobian (n,), SI units
     values: np.ndarray
     sigma: np.ndarray
+    #: correlation matrix of the fitted parameters (n, n), from the same covariance
     correlation: np.ndarray
+    #: parameters that ended on a bound (their sigma is not meaningful), (n,) bool
     at_bound: np.ndarray
+    #: refitted values (B, n), one row per bootstrap draw of runs
     bootstrap: np.ndarray | None
+    #: relative RMSE per run and variable on the training runs at the optimum
     training: ValidationReport
+    #: half the sum of squared residuals at the optimum
     cost: float
+    #: number of residuals m (observed values over all runs)
     residuals: int
+    #: scipy's count of residual evaluations (without those of the Jacobian)
     nfev: int
+    #: all residual evaluations, Jacobian columns included (each replays every run)
     evaluations: int
+    #: seconds for the fit (bootstrap excluded)
     wall_time: float
+    #: replays that stopped (twin outside the physical domain) during the fit
     failures: int
+    #: scipy's status and message
     success: bool
     message: str
 

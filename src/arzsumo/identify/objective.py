@@ -198,24 +198,15 @@ class Objective:
 
 @dataclass(frozen=True)
 class ValidationReport:
-    """Relative RMSE of the replay against each run, per variable.
-
-    Attributes
-    ----------
-    names : tuple of str
-        The runs' names.
-    rmse : ndarray (runs, 4)
-        sqrt(mean((z_pred - z_obs)^2)) / scale per run and variable (rho_h, v_h, rho_a,
-        v_a), dimensionless; periods after a twin stop count with the penalty.
-    pooled : ndarray (4,)
-        The same over all runs' observed values together.
-    stopped : tuple of (float or None)
-        Per run, the time (s) at which the replay stopped, None if it completed.
-    """
+    """Relative RMSE of the replay against each run (``names``), per variable."""
 
     names: tuple[str, ...]
+    #: sqrt(mean((z_pred - z_obs)^2)) / scale per run and variable (runs, 4),
+    #: dimensionless; periods after a twin stop count with the penalty
     rmse: np.ndarray
+    #: the same over all runs' observed values together (4,)
     pooled: np.ndarray
+    #: per run, the time (s) at which the replay stopped, None if it completed
     stopped: tuple[float | None, ...]
 
 

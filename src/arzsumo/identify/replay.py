@@ -47,33 +47,24 @@ INLETS = ("ctm", "supply", "ghost")
 
 @dataclass(frozen=True)
 class ReplayOptions:
-    """Numerics of the replay twin.
+    """Numerics of the replay twin (``scheme``, ``flux``, ``limiter``, ``cfl`` and
+    ``max_steps``, the safety limit on the time steps of one replay, as
+    :class:`arzsumo.pde.SolverOptions`)."""
 
-    Parameters
-    ----------
-    cells : int
-        Finite volumes on [0, L] (50 cells of 20 m by default: see
-        ``benchmarks/bench_identify.py`` for cost and accuracy against finer grids).
-    scheme, flux, limiter, cfl :
-        As :class:`arzsumo.pde.SolverOptions`.
-    ao_limit : float
-        Densities of the initial and inlet states are scaled down to AO <= ao_limit AO_max
-        of the parameters being tried, in (0, 1).
-    max_steps : int
-        Safety limit on the time steps of one replay.
-    inlet : {"ctm", "supply", "ghost"}
-        The inlet flux: min(demand of the held state, supply of the first cell)
-        (``ctm``), the held state's physical flux limited to the supply (``supply``), or
-        that flux as it is (``ghost``, as the bridge's replay twin).
-    """
-
+    #: finite volumes on [0, L] (50 cells of 20 m by default: see
+    #: ``benchmarks/bench_identify.py`` for cost and accuracy against finer grids)
     cells: int = 50
     scheme: str = "first"
     flux: str = "hll"
     limiter: str = "vanleer"
     cfl: float = 0.9
+    #: densities of the initial and inlet states are scaled down to AO <= ao_limit AO_max
+    #: of the parameters being tried, in (0, 1)
     ao_limit: float = 0.98
     max_steps: int = 1_000_000
+    #: the inlet flux: min(demand of the held state, supply of the first cell) (``ctm``),
+    #: the held state's physical flux limited to the supply (``supply``), or that flux as
+    #: it is (``ghost``, as the bridge's replay twin)
     inlet: str = "ctm"
 
     def __post_init__(self) -> None:
@@ -128,38 +119,25 @@ class HeldInlet(Inlet):
 
 @dataclass(frozen=True)
 class ReplayRun:
-    """Fields of one replay and how it ended.
+    """Fields of one replay and how it ended (vehicle counts until the stop, if any)."""
 
-    Attributes
-    ----------
-    fields : ndarray (T, 4, N)
-        Predicted (rho_h, v_h, rho_a, v_a) at (data.t, data.x); NaN from the period in
-        which the twin stopped.
-    stopped : float or None
-        Time (s) at which the twin left the physical domain, None if it completed.
-    reason : str
-        The twin's stop message ("" if it completed).
-    steps : int
-        Time steps taken.
-    vehicles_out : float
-        Vehicles that left at x = L (until the stop, if any).
-    outlet_limited : float
-        Seconds during which the arriving flow, not ``data.outflow``, set the outflow (the
-        last cell was in free flow and could not deliver it).
-    vehicles_in : float
-        Vehicles that entered at x = 0 (until the stop, if any).
-    inlet_limited : float
-        Seconds during which the first cell's supply or the held state's demand, not the
-        held state's own flux, set the inflow (inlets ``ctm`` and ``supply``).
-    """
-
+    #: predicted (rho_h, v_h, rho_a, v_a) at (data.t, data.x), (T, 4, N); NaN from the
+    #: period in which the twin stopped
     fields: np.ndarray
+    #: time (s) at which the twin left the physical domain (None if it completed), and
+    #: the twin's stop message ("" if it completed)
     stopped: float | None
     reason: str
     steps: int
+    #: vehicles that left at x = L
     vehicles_out: float = 0.0
+    #: seconds during which the arriving flow, not ``data.outflow``, set the outflow (the
+    #: last cell was in free flow and could not deliver it)
     outlet_limited: float = 0.0
+    #: vehicles that entered at x = 0
     vehicles_in: float = 0.0
+    #: seconds during which the first cell's supply or the held state's demand, not the
+    #: held state's own flux, set the inflow (inlets ``ctm`` and ``supply``)
     inlet_limited: float = 0.0
 
 

@@ -22,36 +22,22 @@ from arzsumo.model.params import ModelParameters
 
 @dataclass(frozen=True)
 class SyntheticRun:
-    """One synthetic operating point and its excitation.
-
-    Parameters
-    ----------
-    rho_h, rho_a : float
-        Equilibrium densities, veh/m.
-    wave : float
-        Relative amplitude of the initial stop-and-go wave (densities +, speeds -).
-    periods : float
-        Periods of the initial wave over the road.
-    inlet : float
-        Relative amplitude of the inlet densities' oscillation (period ``inlet_period``).
-    outflow : float
-        Relative amplitude of the outflow's oscillation around q* (period
-        ``outflow_period``).
-    inlet_period, outflow_period : float
-        s.
-    inlet_speed : float
-        Relative amplitude of the inlet speeds' departure from Ve at the inlet densities
-        (a cosine of the inlet period), so that vehicles enter off the diagram.
-    """
+    """One synthetic operating point (equilibrium densities, veh/m) and its excitation
+    (relative amplitudes; periods in s)."""
 
     rho_h: float
     rho_a: float
+    #: the initial stop-and-go wave (densities +, speeds -) and its periods over the road
     wave: float = 0.15
     periods: float = 2.0
+    #: the inlet densities' oscillation (period ``inlet_period``)
     inlet: float = 0.1
+    #: the outflow's oscillation around q* (period ``outflow_period``)
     outflow: float = 0.15
     inlet_period: float = 90.0
     outflow_period: float = 70.0
+    #: the inlet speeds' departure from Ve at the inlet densities (a cosine of the inlet
+    #: period), so that vehicles enter off the diagram
     inlet_speed: float = 0.05
 
 
