@@ -13,22 +13,11 @@ the relaxation times tau_h, tau_a of the speed equations' right-hand sides
 optionally the spacings s_h, s_a that set the impact areas a_i = d s_i (labels
 ``impactHV``, ``impactAV``) and so AO (label ``AOrelation``).
 
-The residual. Each observed run is replayed by the nonlinear twin (:mod:`replay`): it
-starts from the run's initial state, its inlet ghost cell holds the run's measured
-boundary state and its outlet carries the run's measured outflow, period by period; its
-fields are sampled where and when the run was observed. The residual is the difference
-of predicted and observed (rho_h, v_h, rho_a, v_a), each divided by a reference scale
-of its run and variable (the equilibrium value, or the data's mean), unobserved values
-skipped, stacked over all runs (:mod:`objective`). A parameter set under which the twin
-leaves the physical domain gets a finite penalty for the periods it could not predict,
-and is counted. The fit is :func:`scipy.optimize.least_squares` with bounds in the log
-coordinates log(p / p0) and a forward-difference Jacobian (:mod:`fit`).
-
-The uncertainty. 1-sigma from the Jacobian at the optimum, covariance s^2 (J^T J)^-1
-with s^2 the residual variance, mapped from log coordinates to the parameters; and
-optionally a seeded bootstrap over runs (refit on runs drawn with replacement).
+The residual (:mod:`objective`) is the relative error of the replay twin (:mod:`replay`)
+against each observed run; :mod:`fit` minimises it and gives the uncertainty;
 :func:`validate` reports the relative RMSE per run, class and variable, e.g. on held-out
-runs. :mod:`synthetic` makes data with the twin itself, for recovery tests.
+runs; :mod:`synthetic` makes data with the twin itself, for recovery tests. The
+command's side: ``docs/identify.md``, 'What it does'.
 """
 
 from arzsumo.identify.data import VARIABLES, IdentifyError, ReplayData
@@ -46,24 +35,8 @@ from arzsumo.identify.replay import ReplayOptions, ReplayRun, replay, run_replay
 from arzsumo.identify.synthetic import SyntheticRun, synthetic_data
 
 __all__ = [
-    "DEFAULT_BOUNDS",
-    "DEFAULT_WHICH",
-    "VARIABLES",
-    "WHICH_BY_FAMILY",
-    "FitSettings",
-    "IdentificationResult",
-    "IdentifyError",
-    "Objective",
-    "ParameterSpace",
-    "ReplayData",
-    "ReplayOptions",
-    "ReplayRun",
-    "SyntheticRun",
-    "ValidationReport",
-    "covariance",
-    "identify",
-    "replay",
-    "run_replay",
-    "synthetic_data",
-    "validate",
+    "DEFAULT_BOUNDS", "DEFAULT_WHICH", "VARIABLES", "WHICH_BY_FAMILY", "FitSettings",
+    "IdentificationResult", "IdentifyError", "Objective", "ParameterSpace", "ReplayData",
+    "ReplayOptions", "ReplayRun", "SyntheticRun", "ValidationReport", "covariance",
+    "identify", "replay", "run_replay", "synthetic_data", "validate",
 ]

@@ -2,7 +2,7 @@
 
 :class:`ReplayData` is what the replay twin needs to reproduce a run, and what it is
 compared with. It is built from arrays (the SUMO layer aggregates its cells into them)
-or from a twin run (:func:`arzsumo.identify.synthetic.data_from_twin`, synthetic data with
+or from a twin run (:func:`arzsumo.identify.synthetic.synthetic_data`, synthetic data with
 known parameters).
 
 Periods: ``t`` holds the ends of the periods, t_0 < t_1 < ... (s, t_0 > 0); period k is
@@ -19,9 +19,6 @@ from numpy.typing import ArrayLike
 
 from arzsumo.errors import ArzsumoError
 from arzsumo.model.params import VARIABLES
-
-#: Their SI units.
-UNITS = ("veh/m", "m/s", "veh/m", "m/s")
 
 
 class IdentifyError(ArzsumoError, ValueError):
@@ -60,37 +57,26 @@ def _positive_densities(name: str, arr: np.ndarray, axis: int, strict: bool = Tr
 
 @dataclass(frozen=True)
 class ReplayData:
-    """One observed run, validated on construction. All SI.
+    """One observed run, validated on construction. All SI."""
 
-    Parameters
-    ----------
-    t : ndarray (T,)
-        Ends of the periods, s, strictly increasing, t[0] > 0.
-    x : ndarray (N,)
-        Observation positions (cell centres), m, strictly increasing, >= 0.
-    fields : ndarray (T, 4, N)
-        Observed (rho_h veh/m, v_h m/s, rho_a veh/m, v_a m/s) at (t[k], x); NaN where
-        unobserved (e.g. the speed of an empty cell); densities >= 0.
-    initial : ndarray (4, N)
-        State at t = 0 on ``x``, complete (no NaN), densities > 0.
-    inlet : ndarray (T, 4)
-        Boundary state (rho_h, v_h, rho_a, v_a) the inlet ghost cell holds during period k.
-    outflow : ndarray (T,)
-        Total outflow at x = L during period k, veh/s, >= 0.
-    scale : ndarray (4,), optional
-        Reference scale per variable for relative errors (e.g. the equilibrium values);
-        default: the mean of the observed values per variable.
-    name : str
-        A label for reports (e.g. "seed 3").
-    """
-
+    #: ends of the periods (T,), s, strictly increasing, t[0] > 0
     t: np.ndarray
+    #: observation positions (cell centres) (N,), m, strictly increasing, >= 0
     x: np.ndarray
+    #: observed (rho_h veh/m, v_h m/s, rho_a veh/m, v_a m/s) at (t[k], x), (T, 4, N); NaN
+    #: where unobserved (e.g. the speed of an empty cell); densities >= 0
     fields: np.ndarray
+    #: state at t = 0 on ``x`` (4, N), complete (no NaN), densities > 0
     initial: np.ndarray
+    #: boundary state (rho_h, v_h, rho_a, v_a) the inlet ghost cell holds during period k,
+    #: (T, 4)
     inlet: np.ndarray
+    #: total outflow at x = L during period k (T,), veh/s, >= 0
     outflow: np.ndarray
+    #: reference scale per variable (4,) for relative errors (e.g. the equilibrium
+    #: values); default: the mean of the observed values per variable
     scale: np.ndarray | None = None
+    #: a label for reports (e.g. "seed 3")
     name: str = "run"
     mask: np.ndarray = field(init=False, repr=False)
 
@@ -139,11 +125,6 @@ class ReplayData:
     def periods(self) -> int:
         """Number of periods T."""
         return int(self.t.size)
-
-    @property
-    def observed(self) -> int:
-        """Number of observed (finite) values in ``fields``."""
-        return int(self.mask.sum())
 
     @classmethod
     def from_arrays(cls, t: ArrayLike, x: ArrayLike, fields: ArrayLike, initial: ArrayLike,

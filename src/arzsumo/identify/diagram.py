@@ -1,21 +1,11 @@
 """Stage 1 of the identification: the fundamental diagram from stationary states.
 
-Traffic practice fits the diagram to stationary data and the relaxation times to
-transients (Fan, Herty & Seibold 2014; Dervisoglu et al. 2009): the congested branch's
-slope is the backward wave speed (Newell; Daganzo's cell transmission model), and the
-wave speed is read from the cross-correlation of detector series (Coifman & Wang 2005).
-Here:
-
-* :func:`block_states` averages a run's observed fields over blocks of cells and
-  periods (Edie's definitions within a block: density = mean density, speed = mean flow /
-  mean density) and keeps the blocks of a window: the stationary states, per class;
-* :func:`fit_diagram` fits a family's diagram parameters (for ``newell``: the wave speeds
-  w_i and jam occupancies AO_jam,i; the free-flow speeds and the corner stay as given) by
-  bounded least squares of two residuals of their own: the class speeds of the blocks
-  against Ve_i(AO) (relative to the mean observed speed), and the gap of lambda_4 at the
-  operating point to the measured wave speed c (relative to |c|), weighted like the
-  whole speed residual (:class:`~arzsumo.identify.wave_target.WaveTarget`);
-* the parameters' 1-sigma from the Jacobian, and optionally a bootstrap over runs.
+As traffic practice does (Fan, Herty & Seibold 2014; Dervisoglu et al. 2009; the wave
+speed from detector cross-correlation, Coifman & Wang 2005): :func:`block_states` gives
+a run's Edie block states, per class; :func:`fit_diagram` fits a family's diagram
+parameters to the block speeds and lambda_4 to the measured wave speed
+(:class:`~arzsumo.identify.wave_target.WaveTarget`), with the parameters' 1-sigma from
+the Jacobian and optionally a bootstrap over runs. ``docs/identify.md``, 'Two stages'.
 
 Pure: arrays in, a frozen :class:`DiagramFit` out. SI: veh/m, m/s.
 """
@@ -123,13 +113,11 @@ class DiagramFit:
 
     def as_dict(self) -> dict[str, object]:
         """Plain numbers (SI), for the result files."""
-        out: dict[str, object] = {n: float(v) for n, v in zip(self.which, self.values,
-                                                               strict=True)}
-        out.update({f"{n}_sigma": float(s) for n, s in zip(self.which, self.sigma,
-                                                            strict=True)})
-        if self.bootstrap_sigma is not None:
-            out.update({f"{n}_bootstrap_sigma": float(s) for n, s in
-                        zip(self.which, self.bootstrap_sigma, strict=True)})
+        columns = {"": self.values, "_sigma": self.sigma,
+                   "_bootstrap_sigma": self.bootstrap_sigma}
+        out: dict[str, object] = {f"{n}{suffix}": float(v) for suffix, col in columns.items()
+                                  if col is not None
+                                  for n, v in zip(self.which, col, strict=True)}
         out.update({"rmse_h": self.rmse["h"], "rmse_a": self.rmse["a"],
                     "lambda_4": self.lambda_4, "wave_speed": self.wave_speed,
                     "blocks": self.blocks, "family": self.params.family})
@@ -152,8 +140,7 @@ def _speed_residual(p: ModelParameters, s: StationaryStates, scale: float) -> np
 def _residual(p: ModelParameters, s: StationaryStates, target: WaveTarget,
               scale: float) -> np.ndarray:
     speed = _speed_residual(p, s, scale)
-    lam4 = target.lambda_4(p)
-    gap = INADMISSIBLE if not math.isfinite(lam4) else (lam4 - target.speed) / abs(target.speed)
+    gap = target.gap(p)
     return np.append(speed, target.weight * math.sqrt(speed.size) * gap / math.sqrt(2.0))
 
 

@@ -5,13 +5,11 @@
 reflective, bounds, forward-difference Jacobian) in the log coordinates z = log(p / p0).
 
 Uncertainty. With J the Jacobian of the residual in z at the optimum, m residuals, n
-parameters and s^2 = sum(r^2) / (m - n) the residual variance, the covariance of z is
-s^2 (J^T J)^-1 (pseudo-inverse where J is rank deficient), and that of p follows by the
-delta method, cov_p = diag(p) cov_z diag(p). It assumes independent residuals of equal
-variance, so it is a lower bound where model error (not noise) dominates, as it will on
-SUMO data. Optionally, a bootstrap over runs refits on runs drawn with replacement
-(seeded) and reports the spread of the refitted values, which also carries the run-to-run
-variation.
+parameters and s^2 = sum(r^2) / (m - n), the covariance of z is s^2 (J^T J)^-1
+(pseudo-inverse where J is rank deficient), that of p cov_p = diag(p) cov_z diag(p) (delta
+method): a lower bound where model error, not noise, dominates, as on SUMO data. The
+optional seeded bootstrap refits on runs drawn with replacement; its spread also carries
+the run-to-run variation.
 """
 
 from __future__ import annotations
@@ -44,41 +42,29 @@ log = logging.getLogger(__name__)
 
 @dataclass(frozen=True)
 class FitSettings:
-    """Settings of :func:`scipy.optimize.least_squares` and of the bootstrap.
+    """Settings of :func:`scipy.optimize.least_squares` and of the bootstrap."""
 
-    Parameters
-    ----------
-    max_nfev : int
-        Largest number of residual evaluations outside the Jacobian (scipy's count).
-    diff_step : float
-        Forward-difference step in z, i.e. a relative step of the parameters (1e-3: the
-        replay is continuous in the parameters but its adaptive time step adds noise of
-        about 1e-6 relative, which a much smaller step would amplify).
-    ftol, xtol, gtol : float
-        scipy's stopping tolerances.
-    x_scale : float
-        Characteristic change of z (1: parameters move by factors of order e).
-    bootstrap : int
-        Number of bootstrap refits over runs (0: none).
-    seed : int
-        Seed of the bootstrap draws.
-    """
-
+    #: largest number of residual evaluations outside the Jacobian (scipy's count)
     max_nfev: int = 40
+    #: forward-difference step in z, i.e. a relative step of the parameters (1e-3: the
+    #: replay is continuous in the parameters but its adaptive time step adds noise of
+    #: about 1e-6 relative, which a much smaller step would amplify)
     diff_step: float = 1e-3
+    #: scipy's stopping tolerances
     ftol: float = 1e-6
     xtol: float = 1e-6
     gtol: float = 1e-8
+    #: characteristic change of z (1: parameters move by factors of order e)
     x_scale: float = 1.0
+    #: bootstrap refits over runs (0: none), and the seed of their draws
     bootstrap: int = 0
     seed: int = 0
 
     def __post_init__(self) -> None:
-        for name in ("max_nfev", "bootstrap"):
+        for name, least in (("max_nfev", 1), ("bootstrap", 0)):
             value = getattr(self, name)
-            if not isinstance(value, int) or value < (1 if name == "max_nfev" else 0):
-                raise IdentifyError(f"{name} = {value!r} is not allowed: an integer >= "
-                                    f"{1 if name == 'max_nfev' else 0}")
+            if not isinstance(value, int) or value < least:
+                raise IdentifyError(f"{name} = {value!r} is not allowed: an integer >= {least}")
         for name in ("diff_step", "ftol", "xtol", "gtol", "x_scale"):
             value = getattr(self, name)
             if not (isinstance(value, int | float) and 0.0 < value < np.inf):
@@ -87,55 +73,36 @@ class FitSettings:
 
 @dataclass(frozen=True)
 class IdentificationResult:
-    """The identified parameters, their uncertainties and the cost of the fit.
+    """The identified parameters, their uncertainties and the cost of the fit."""
 
-    Attributes
-    ----------
-    params : ModelParameters
-        The guess with the fitted parameters replaced.
-    which : tuple of str
-        The fitted parameters, in the order of the arrays below.
-    values, sigma : ndarray (n,)
-        Fitted values and 1-sigma uncertainties from the Jacobian (SI units).
-    correlation : ndarray (n, n)
-        Correlation matrix of the fitted parameters (from the same covariance).
-    at_bound : ndarray (n,) of bool
-        Parameters that ended on a bound (their sigma is not meaningful).
-    bootstrap : ndarray (B, n) or None
-        Refitted values, one row per bootstrap draw of runs.
-    training : ValidationReport
-        Relative RMSE per run and variable on the training runs at the optimum.
-    cost : float
-        Half the sum of squared residuals at the optimum.
-    residuals : int
-        Number of residuals m (observed values over all runs).
-    nfev : int
-        scipy's count of residual evaluations (without those of the Jacobian).
-    evaluations : int
-        All residual evaluations, Jacobian columns included (each replays every run).
-    wall_time : float
-        Seconds for the fit (bootstrap excluded).
-    failures : int
-        Replays that stopped (twin outside the physical domain) during the fit.
-    success : bool
-    message : str
-        scipy's status message.
-    """
-
+    #: the guess with the fitted parameters replaced
     params: ModelParameters
+    #: the fitted parameters, in the order of the arrays below
     which: tuple[str, ...]
+    #: fitted values and 1-sigma uncertainties from the Jacobian (n,), SI units
     values: np.ndarray
     sigma: np.ndarray
+    #: correlation matrix of the fitted parameters (n, n), from the same covariance
     correlation: np.ndarray
+    #: parameters that ended on a bound (their sigma is not meaningful), (n,) bool
     at_bound: np.ndarray
+    #: refitted values (B, n), one row per bootstrap draw of runs
     bootstrap: np.ndarray | None
+    #: relative RMSE per run and variable on the training runs at the optimum
     training: ValidationReport
+    #: half the sum of squared residuals at the optimum
     cost: float
+    #: number of residuals m (observed values over all runs)
     residuals: int
+    #: scipy's count of residual evaluations (without those of the Jacobian)
     nfev: int
+    #: all residual evaluations, Jacobian columns included (each replays every run)
     evaluations: int
+    #: seconds for the fit (bootstrap excluded)
     wall_time: float
+    #: replays that stopped (twin outside the physical domain) during the fit
     failures: int
+    #: scipy's status and message
     success: bool
     message: str
 
@@ -145,17 +112,6 @@ class IdentificationResult:
         if self.bootstrap is None or len(self.bootstrap) < 2:
             return None
         return np.std(self.bootstrap, axis=0, ddof=1)
-
-    def as_dict(self) -> dict[str, dict[str, float]]:
-        """{name: {"value", "sigma"[, "bootstrap_sigma"]}} in SI units."""
-        boot = self.bootstrap_sigma
-        out: dict[str, dict[str, float]] = {}
-        for i, name in enumerate(self.which):
-            row = {"value": float(self.values[i]), "sigma": float(self.sigma[i])}
-            if boot is not None:
-                row["bootstrap_sigma"] = float(boot[i])
-            out[name] = row
-        return out
 
 
 def covariance(jac: np.ndarray, residuals: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -214,15 +170,10 @@ def identify(datasets: Sequence[ReplayData], initial_guess: ModelParameters,
         Weights of the residuals of (rho_h, v_h, rho_a, v_a); default all 1.
     options : ReplayOptions, optional
         Numerics of the replay twin.
-    settings : FitSettings, optional
     penalty : float
         Residual (in scale units) of a value the replay could not predict.
     wave_target : WaveTarget, optional
         A measured wave speed lambda_4 should match: one more residual (its module).
-
-    Returns
-    -------
-    IdentificationResult
     """
     runs = check_datasets(datasets)
     space = ParameterSpace.make(initial_guess, which, bounds)

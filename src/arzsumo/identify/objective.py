@@ -73,17 +73,14 @@ class ParameterSpace:
         if not which or len(set(which)) != len(which):
             raise IdentifyError(f"which = {list(which)} is not allowed: distinct names from "
                                 f"{', '.join(DEFAULT_BOUNDS)}")
-        unknown = [n for n in which if n not in DEFAULT_BOUNDS]
-        if unknown:
+        if unknown := [n for n in which if n not in DEFAULT_BOUNDS]:
             raise IdentifyError(f"which = {unknown} is not allowed: names from "
                                 f"{', '.join(DEFAULT_BOUNDS)}")
-        ignored = [n for n in which if n in guess.ignored_fields]
-        if ignored:
+        if ignored := [n for n in which if n in guess.ignored_fields]:
             raise IdentifyError(f"which = {ignored} is not allowed: family = "
                                 f"{guess.family!r} does not read them")
         given = dict(bounds or {})
-        extra = sorted(set(given) - set(which))
-        if extra:
+        if extra := sorted(set(given) - set(which)):
             raise IdentifyError(f"bounds for {extra} are not allowed: only fitted parameters "
                                 f"({', '.join(which)}) take bounds")
         lo, hi = [], []
@@ -201,29 +198,16 @@ class Objective:
 
 @dataclass(frozen=True)
 class ValidationReport:
-    """Relative RMSE of the replay against each run, per variable.
-
-    Attributes
-    ----------
-    names : tuple of str
-        The runs' names.
-    rmse : ndarray (runs, 4)
-        sqrt(mean((z_pred - z_obs)^2)) / scale per run and variable (rho_h, v_h, rho_a,
-        v_a), dimensionless; periods after a twin stop count with the penalty.
-    pooled : ndarray (4,)
-        The same over all runs' observed values together.
-    stopped : tuple of (float or None)
-        Per run, the time (s) at which the replay stopped, None if it completed.
-    """
+    """Relative RMSE of the replay against each run (``names``), per variable."""
 
     names: tuple[str, ...]
+    #: sqrt(mean((z_pred - z_obs)^2)) / scale per run and variable (runs, 4),
+    #: dimensionless; periods after a twin stop count with the penalty
     rmse: np.ndarray
+    #: the same over all runs' observed values together (4,)
     pooled: np.ndarray
+    #: per run, the time (s) at which the replay stopped, None if it completed
     stopped: tuple[float | None, ...]
-
-    def as_dict(self) -> dict[str, float]:
-        """Pooled relative RMSE keyed ``rho_h``, ``v_h``, ``rho_a``, ``v_a``."""
-        return {v: float(e) for v, e in zip(VARIABLES, self.pooled, strict=True)}
 
 
 def validate(params: ModelParameters, datasets: Sequence[ReplayData],

@@ -3,35 +3,21 @@
 :func:`run_replay` starts a :class:`arzsumo.pde.TwinStepper` from the data's initial
 state (interpolated to the twin grid), holds the inlet ghost cell at ``data.inlet[k]``
 and the outlet flow at ``data.outflow[k]`` during period k, and samples the primitive
-fields at ``data.x`` at every period end. This is what the SUMO closed loop does with its
-replay twin (a ghost-cell inlet and the measured outflow), with the boundary data given
-up front.
+fields at ``data.x`` at every period end: the SUMO closed loop's replay twin, with the
+boundary data given up front. The inlet flux (``ReplayOptions.inlet``: the ghost's, or
+bounded by the cell transmission model's supply and demand): ``docs/identify.md``, 'The
+inlet'.
 
-Inlet flux (``ReplayOptions.inlet``). ``ghost`` lets in the physical flux of the held
-state, whatever the first cell holds: the SUMO bridge's replay twin does this. When
-SUMO's queue tail reaches x = 0 the held (smoothed) state pairs a queue's density with
-the arriving vehicles' speed, and that flux can fill the first cell past AO_max.
-``supply`` lets in the smaller of that flux and the first cell's receiving capacity, the
-supply of the cell transmission model built on the model's own Ve_i
-(:class:`arzsumo.pde.supply.ReceivingCapacity`). ``ctm`` (default) is the cell
-transmission model's whole rule, min(demand, supply): a held state in congestion (above
-the diagram's critical occupancy) demands the capacity (times its own departure from
-the diagram), as a queue upstream of x = 0 would send; in free flow its demand is its
-flux. Where neither bound changes it the flux is the ghost's to the bit (a free-flow
-inlet); otherwise every class's flux is scaled by one factor.
+Outlet. The twin's outlet carries q* + U, q* the flow of its reference equilibrium: the
+uniform equilibrium at the spatial means of the initial densities (always admissible,
+AO being linear in the densities). U_k = outflow_k - q*, so the metered outlet flow is
+``outflow_k`` whatever the parameters. The ghost-cell inlet replaces the paper's l4
+inlet condition, so the replay is posed in free flow as in congestion.
 
-Outlet. The twin's outlet carries q* + U, with q* the flow of its reference equilibrium.
-We take the uniform equilibrium at the spatial means of the initial densities (always
-admissible, because AO is linear in the densities) and set U_k = outflow_k - q*, so the
-metered outlet flow equals ``outflow_k`` whatever the parameters. The reference
-equilibrium has no other role here: the ghost-cell inlet replaces the paper's l4 inlet
-condition, so the replay is posed in free flow as in congestion.
-
-Admissibility. A parameter set with a smaller AO_max may not hold a state the data holds.
-Densities of the initial state and of the inlet are scaled down where AO exceeds
-``ao_limit`` AO_max (as the SUMO bridge does at a twin start); if the twin still leaves
-the physical domain, the run stops there and the later periods are NaN (the fit turns
-them into a penalty).
+Admissibility. A smaller AO_max may not hold a state the data holds: densities of the
+initial state and of the inlet are scaled down where AO exceeds ``ao_limit`` AO_max (as
+the SUMO bridge does at a twin start); if the twin still leaves the physical domain, the
+run stops there and the later periods are NaN (the fit turns them into a penalty).
 """
 
 from __future__ import annotations
@@ -55,42 +41,30 @@ from arzsumo.pde.supply import ReceivingCapacity
 
 #: an inlet rule of :func:`run_replay`: (held state, first cell's state) -> boundary state
 InletRule = Callable[[np.ndarray, np.ndarray], np.ndarray]
-#: the inlet fluxes of :class:`ReplayOptions`: the cell transmission model's min(demand,
-#: supply), the held state's flux limited to the supply, that flux as it is (module
-#: docstring)
+#: the inlet fluxes of :class:`ReplayOptions`
 INLETS = ("ctm", "supply", "ghost")
 
 
 @dataclass(frozen=True)
 class ReplayOptions:
-    """Numerics of the replay twin.
+    """Numerics of the replay twin (``scheme``, ``flux``, ``limiter``, ``cfl`` and
+    ``max_steps``, the safety limit on the time steps of one replay, as
+    :class:`arzsumo.pde.SolverOptions`)."""
 
-    Parameters
-    ----------
-    cells : int
-        Finite volumes on [0, L] (50 cells of 20 m by default: see
-        ``benchmarks/bench_identify.py`` for cost and accuracy against finer grids).
-    scheme, flux, limiter, cfl :
-        As :class:`arzsumo.pde.SolverOptions`.
-    ao_limit : float
-        Densities of the initial and inlet states are scaled down to AO <= ao_limit AO_max
-        of the parameters being tried, in (0, 1).
-    max_steps : int
-        Safety limit on the time steps of one replay.
-    inlet : {"ctm", "supply", "ghost"}
-        The inlet flux: min(demand of the held state, supply of the first cell)
-        (``ctm``), the held state's physical flux limited to the supply (``supply``), or
-        that flux as it is (``ghost``, the bridge's replay twin and the replay before the
-        limit); module docstring.
-    """
-
+    #: finite volumes on [0, L] (50 cells of 20 m by default: see
+    #: ``benchmarks/bench_identify.py`` for cost and accuracy against finer grids)
     cells: int = 50
     scheme: str = "first"
     flux: str = "hll"
     limiter: str = "vanleer"
     cfl: float = 0.9
+    #: densities of the initial and inlet states are scaled down to AO <= ao_limit AO_max
+    #: of the parameters being tried, in (0, 1)
     ao_limit: float = 0.98
     max_steps: int = 1_000_000
+    #: the inlet flux: min(demand of the held state, supply of the first cell) (``ctm``),
+    #: the held state's physical flux limited to the supply (``supply``), or that flux as
+    #: it is (``ghost``, as the bridge's replay twin)
     inlet: str = "ctm"
 
     def __post_init__(self) -> None:
@@ -120,11 +94,9 @@ class HeldInlet(Inlet):
     """
 
     state: np.ndarray = field(default_factory=lambda: np.ones(4))
-    #: a boundary rule instead of the ghost cell: (held state, first cell's state) ->
-    #: boundary state, each (rho_h, v_h, rho_a, v_a) in SI
+    #: a boundary rule instead of the ghost cell (:data:`InletRule`)
     rule: InletRule | None = None
     supply: ReceivingCapacity | None = None
-    #: with ``supply``: a congested boundary state sends at capacity (``ctm``)
     sending: bool = False
     theta: np.ndarray = field(default_factory=lambda: np.ones(1))
 
@@ -147,57 +119,41 @@ class HeldInlet(Inlet):
 
 @dataclass(frozen=True)
 class ReplayRun:
-    """Fields of one replay and how it ended.
+    """Fields of one replay and how it ended (vehicle counts until the stop, if any)."""
 
-    Attributes
-    ----------
-    fields : ndarray (T, 4, N)
-        Predicted (rho_h, v_h, rho_a, v_a) at (data.t, data.x); NaN from the period in
-        which the twin stopped.
-    stopped : float or None
-        Time (s) at which the twin left the physical domain, None if it completed.
-    reason : str
-        The twin's stop message ("" if it completed).
-    steps : int
-        Time steps taken.
-    vehicles_out : float
-        Vehicles that left at x = L (until the stop, if any).
-    outlet_limited : float
-        Seconds during which the arriving flow, not ``data.outflow``, set the outflow (the
-        last cell was in free flow and could not deliver it).
-    vehicles_in : float
-        Vehicles that entered at x = 0 (until the stop, if any).
-    inlet_limited : float
-        Seconds during which the first cell's supply or the held state's demand, not the
-        held state's own flux, set the inflow (inlets ``ctm`` and ``supply``).
-    """
-
+    #: predicted (rho_h, v_h, rho_a, v_a) at (data.t, data.x), (T, 4, N); NaN from the
+    #: period in which the twin stopped
     fields: np.ndarray
+    #: time (s) at which the twin left the physical domain (None if it completed), and
+    #: the twin's stop message ("" if it completed)
     stopped: float | None
     reason: str
     steps: int
+    #: vehicles that left at x = L
     vehicles_out: float = 0.0
+    #: seconds during which the arriving flow, not ``data.outflow``, set the outflow (the
+    #: last cell was in free flow and could not deliver it)
     outlet_limited: float = 0.0
+    #: vehicles that entered at x = 0
     vehicles_in: float = 0.0
+    #: seconds during which the first cell's supply or the held state's demand, not the
+    #: held state's own flux, set the inflow (inlets ``ctm`` and ``supply``)
     inlet_limited: float = 0.0
 
 
-class _NoRegimeWarning(logging.Filter):
+def _not_regime(record: logging.LogRecord) -> bool:
     """Drop the twin's free-flow warning: it is about the l4 inlet, which is not used here."""
-
-    def filter(self, record: logging.LogRecord) -> bool:
-        return not str(record.msg).startswith("the equilibrium is in free flow")
+    return not str(record.msg).startswith("the equilibrium is in free flow")
 
 
 @contextmanager
 def _quiet_regime() -> Iterator[None]:
     logger = logging.getLogger("arzsumo.pde.solver")
-    flt = _NoRegimeWarning()
-    logger.addFilter(flt)
+    logger.addFilter(_not_regime)
     try:
         yield
     finally:
-        logger.removeFilter(flt)
+        logger.removeFilter(_not_regime)
 
 
 def replay_grid(params: ModelParameters, options: ReplayOptions) -> np.ndarray:
@@ -212,8 +168,7 @@ def admissible(params: ModelParameters, z: np.ndarray, ao_limit: float) -> np.nd
     if np.all(scale == 1.0):
         return z
     out = np.array(z, float)
-    out[0] *= scale
-    out[2] *= scale
+    out[[0, 2]] *= scale
     return out
 
 
@@ -243,10 +198,8 @@ def run_replay(params: ModelParameters, data: ReplayData,
 
     Parameters
     ----------
-    params : ModelParameters
     data : ReplayData
         ``data.x`` must lie in [0, params.length].
-    options : ReplayOptions, optional
     inlet_rule : callable, optional
         The boundary state at x = 0 from the held (measured) state and the first cell's
         state, instead of the ghost cell holding the measured state (an alternative inlet

@@ -1,12 +1,11 @@
 """Newell's three-detector method: the kinematic-wave replay a second-order model is judged by.
 
-A replay error only means something beside what the boundary data allow. This module
-gives the classical reference: the section's interior from its two boundary counts and
-its initial state alone, by the exact solution of the LWR model with a triangular
-fundamental diagram (Newell 1993, "A simplified theory of kinematic waves", parts I-II;
-Daganzo 2005's variational form). It has no relaxation and no second equation: waves
-entering at x = L travel upstream at the congested branch's slope, undamped and
-unamplified, and the vehicles' classes travel with them (first in, first out).
+The classical reference for a replay error (``docs/identify.md``, 'What a replay error is
+judged against'): the section's interior from its two boundary counts and its initial
+state alone, by the exact solution of the LWR model with a triangular fundamental diagram
+(Newell 1993, "A simplified theory of kinematic waves", parts I-II; Daganzo 2005's
+variational form). Waves entering at x = L travel upstream at the congested branch's
+slope, undamped and unamplified; the classes travel with their vehicles (FIFO).
 
 With N(x, t) the cumulative count (vehicle labels, decreasing downstream), free-flow speed
 ``v_free``, wave speed ``w`` (> 0, upstream) and jam density ``rho_jam``:

@@ -1,14 +1,11 @@
 """The measured upstream wave speed as a target of the identification.
 
-The replay residual alone fits the fundamental diagram to SUMO's fields, but nothing in
-it pins the characteristic speed lambda_4 at the operating point, which sets the
-backstepping kernels' transport times and the law's convergence time. On SUMO's coupled
-stream the replay fit alone gave lambda_4 = +2.6 km/h (a free-flow characteristic) where
-SUMO's fluctuations travel upstream at about -35 km/h. :class:`WaveTarget` adds one
-residual to the fit: the relative gap (lambda_4 - c) / |c| at the measured equilibrium,
-weighted as if every observed value carried it (``weight`` x sqrt(number of replay
-residuals)), so that weight 1 trades a 10 % wave-speed gap against a uniform 10 % replay
-error.
+The replay residual does not pin the characteristic speed lambda_4 at the operating point,
+which sets the backstepping kernels' transport times and the law's convergence time.
+:class:`WaveTarget` adds one residual to the fit: the relative gap (lambda_4 - c) / |c| at
+the measured equilibrium, weighted as if every observed value carried it (``weight`` x
+sqrt(number of replay residuals)), so that weight 1 trades a 10 % wave-speed gap against a
+uniform 10 % replay error. ``docs/identify.md``, 'What it does', item 2.
 """
 
 from __future__ import annotations
@@ -16,7 +13,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from arzsumo.errors import require
+from arzsumo.errors import ArzsumoError, require
 from arzsumo.identify.data import IdentifyError
 from arzsumo.model.params import ModelParameters
 
@@ -48,7 +45,6 @@ class WaveTarget:
     def lambda_4(self, params: ModelParameters) -> float:
         """lambda_4 (m/s) of ``params`` at the target's densities; NaN where the
         equilibrium is not admissible."""
-        from arzsumo.errors import ArzsumoError
         from arzsumo.model import Equilibrium
         from arzsumo.model.characteristic import linearize
 

@@ -1,19 +1,12 @@
 """Stage 1 of ``arzsumo identify --diagram FAMILY``: the diagram from the runs' windows.
 
-The open-loop runs' windows are the stationary states (the warm-up holds the fill; the
-premise's stationarity gate reads the same windows). From each run:
-
-* the Edie block states of the window (:func:`arzsumo.identify.diagram.block_states`,
-  100 m x 30 s blocks of the 50 m / 1 s cells);
-* the upstream wave speed of each class's speed field, read by the premise's reader
-  (:func:`arzsumo.evaluation.travel.wave_speed`: the lag of the peak
-  cross-correlation against the distance between places).
-
-:func:`fit_stage_one` starts the family from the scenario's model (free-flow speeds from
-the vehicle types' largest speeds, the scenario's corner), its wave speeds at the measured
-c and its jam occupancies above every observed block, and fits the diagram with the wave
-speed as a residual of its own. Stage 2 (the replay fit of tau_h, tau_a with the diagram
-fixed) is :func:`arzsumo.identify.identify` with ``which = ("tau_h", "tau_a")``.
+From each open-loop run's window (its stationary states): the Edie block states
+(:func:`arzsumo.identify.diagram.block_states`, 100 m x 30 s blocks of the 50 m / 1 s
+cells) and each class's upstream wave speed, read by the premise's reader
+(:func:`arzsumo.evaluation.travel.wave_speed`). :func:`fit_stage_one` then fits the
+family's diagram with the wave speed as a residual of its own; stage 2 is
+:func:`arzsumo.identify.identify` with ``which = ("tau_h", "tau_a")``.
+``docs/identify.md``, 'Two stages'.
 """
 
 from __future__ import annotations

@@ -1,21 +1,11 @@
 """What a replay error is judged against: the references on the same held-out runs.
 
-A second-order replay's block error means little alone: part of it is what no replay
-from boundary data can know (the phase of stop-and-go grown inside the section, the
-discreteness of a few vehicles in a 100 m x 10 s block). Three references bracket it, each
-scored on the same blocks as the model's replay (:data:`.scores.BLOCK_M`,
-:data:`.scores.BLOCK_S`):
-
-* ``three_detector``: Newell's exact kinematic-wave solution from the two boundary counts
-  and the initial state (:mod:`arzsumo.identify.three_detector`), on the triangle through
-  the training runs' mean state with the training runs' measured wave speed and the
-  model's HV free-flow speed: the classical first-order replay, waves carried undamped;
-* ``equilibrium``: every block at the run's equilibrium densities: the error of knowing
-  only the operating point;
-* ``place_mean``: every block at its own place's mean over the held-out run itself (an
-  oracle: it reads the data it is scored on). What is left is the blocks' variation in
-  time about each place's mean: no predictor that does not know the phase of the
-  section's fluctuations gets below it.
+Each reference (:data:`REFERENCES`) is scored on the same blocks as the model's replay
+(:data:`.scores.BLOCK_M`, :data:`.scores.BLOCK_S`): Newell's three-detector replay
+(:mod:`arzsumo.identify.three_detector`) on the triangle through the training runs' mean
+state with their measured wave speed and the model's HV free-flow speed; the equilibrium
+everywhere; each place's own mean over the held-out run (an oracle). What they mean:
+``docs/identify.md``, 'What a replay error is judged against'.
 """
 
 from __future__ import annotations
@@ -64,18 +54,12 @@ def _block_errors(data: ReplayData, blocks: np.ndarray, predicted: np.ndarray
 def _density_errors(data: ReplayData, predicted: np.ndarray) -> dict[str, float]:
     """Block RMSE of rho_h and rho_a over the run's equilibrium values."""
     rmse, _ = field_rmse(data.fields, predicted, *_block_shape(data))
-    scale = data.scale
-    return {"rho_h": float(rmse[0] / scale[0]), "rho_a": float(rmse[2] / scale[2])}
+    return {"rho_h": float(rmse[0] / data.scale[0]), "rho_a": float(rmse[2] / data.scale[2])}
 
 
 def decomposition(data: ReplayData, predicted: np.ndarray) -> dict[str, dict[str, float]]:
-    """A replay's block density error split, per class (``rho_h``, ``rho_a``): ``offset``,
-    the mean error over every block (signed: < 0, the replay's section is emptier than
-    SUMO's); ``bias``, the RMS over places of each place's mean error over the run;
-    ``fluctuation``, the RMS of what is left (bias^2 + fluctuation^2 = the error^2; all
-    over the run's equilibrium value); ``correlation`` of the replay's and the run's
-    fluctuations about their places' means (1: the replay follows their phase; 0: it
-    does not)."""
+    """A replay's block density error split, per class: ``offset``, ``bias``,
+    ``fluctuation`` and ``correlation`` (``references.model`` in ``docs/outputs.md``)."""
     both = np.isfinite(data.fields) & np.isfinite(predicted)
     shape = _block_shape(data)
     obs = block_means(np.where(both, data.fields, np.nan), *shape)
@@ -98,9 +82,8 @@ def decomposition(data: ReplayData, predicted: np.ndarray) -> dict[str, dict[str
 
 
 def reference_scores(fd: Triangle, held_out: Sequence[ReplayData]) -> dict[str, object]:
-    """``{"triangle": its v_free, w, rho_jam (SI), "runs": {run name: {reference:
-    {"rho_h": error, "rho_a": error}}}}``: each reference's relative block density errors
-    per held-out run (module docstring)."""
+    """Each reference's relative block density errors per held-out run, and the triangle
+    (``references.triangle``, ``references.runs`` in ``docs/outputs.md``)."""
     runs = {}
     for d in held_out:
         constant = np.broadcast_to(d.scale[None, :, None], d.fields.shape).copy()
@@ -116,11 +99,9 @@ def reference_scores(fd: Triangle, held_out: Sequence[ReplayData]) -> dict[str, 
 def held_out_references(params: ModelParameters, train: Sequence[ReplayData],
                         held_out: Sequence[ReplayData], validation: SetScore,
                         own: SetScore) -> dict[str, Any] | None:
-    """``identification.json["references"]``: the references' block errors on the
-    held-out runs (:func:`reference_scores`) and the replay error split
-    (:func:`decomposition`) of the identified model (``model``, its ``validation``
-    scores) and of the scenario's own (``scenario_model``, ``own``); None where the
-    training runs show no wave to draw the reference's triangle with."""
+    """``identification.json["references"]``: :func:`reference_scores` and the
+    :func:`decomposition` of the identified model's (``validation``) and the scenario's
+    (``own``) replays; None where the training runs show no wave to draw the triangle with."""
     try:
         refs: dict[str, Any] = reference_scores(reference_triangle(params, train), held_out)
     except ArzsumoError as exc:

@@ -1,20 +1,8 @@
-"""The content of an identification's files (``arzsumo identify --out DIR``), from an
-:class:`~arzsumo.workflows.identify.study.IdentifyStudy`; :func:`arzsumo.outputs.identify.
-write_identification` writes them:
-
-``identified.toml``
-    The input scenario, ready to run, with its ``[model]`` keys replaced by the identified
-    values (file units, a comment with +-1 sigma on each) and ``[equilibrium]`` set to the
-    mean measured densities of the training runs.
-``identification.json``
-    Parameters (value, 1-sigma, bounds, start, correlations), the fit, RMSE per run,
-    class and variable on the training and validation runs (and on the training runs at
-    the start parameters), replay failures, observed cells beyond AO_max, the runs, wall
-    times, the resolved scenario; SI units, listed in ``units_by_key``
-    (:data:`arzsumo.schema.IDENTIFY_SUMMARY`, ``docs/outputs.md``).
-``fields.png``, ``scatter.png``
-    SUMO against the replay twin of the identified model for the first validation run
-    (space-time), and predicted against observed per cell for every validation run.
+"""The content of an identification's files (``arzsumo identify --out DIR``) from an
+:class:`~arzsumo.workflows.identify.study.IdentifyStudy`: ``identified.toml``,
+``identification.json`` (SI, units in ``units_by_key``) and the figures' data;
+:func:`arzsumo.outputs.identify.write_identification` writes them. What each holds:
+``docs/identify.md``, 'What it writes', and ``docs/outputs.md``.
 """
 
 from __future__ import annotations
@@ -35,7 +23,7 @@ from arzsumo.evaluation.waves import (
     mean_periodogram,
     place_spectra,
 )
-from arzsumo.identify import VARIABLES, ReplayData
+from arzsumo.identify import DEFAULT_BOUNDS, VARIABLES, ReplayData
 from arzsumo.identify.diagram import DiagramFit
 from arzsumo.identify.objective import DEFAULT_PENALTY as PENALTY
 from arzsumo.io import dump_toml, json_safe
@@ -58,18 +46,24 @@ def _model_key(name: str) -> str:
     return next(k for k, spec in MODEL_KEYS.items() if spec.field == name)
 
 
+def _put(table: dict[str, Any], name: str, value: float) -> tuple[str, float, str]:
+    """Put ``value`` (SI) of parameter ``name`` into ``table`` in file units; its key,
+    factor and unit (" km/h"; "" without one)."""
+    key = _model_key(name)
+    spec = MODEL_KEYS[key]
+    table[key] = float(f"{value * spec.factor:.{DIGITS}g}")
+    return key, spec.factor, f" {spec.unit}" if spec.unit else ""
+
+
 def _model_table(study: IdentifyStudy, table: dict[str, Any]) -> dict[str, str]:
     """Put the identified values into ``table`` (file units); comments per key."""
     fit, boot = study.fit, study.fit.bootstrap_sigma
     notes = {}
     for i, name in enumerate(fit.which):
-        key = _model_key(name)
-        spec = MODEL_KEYS[key]
-        table[key] = float(f"{fit.values[i] * spec.factor:.{DIGITS}g}")
-        unit = f" {spec.unit}" if spec.unit else ""
-        note = f"+- {fit.sigma[i] * spec.factor:.3g}{unit} (1 sigma, Jacobian)"
+        key, factor, unit = _put(table, name, fit.values[i])
+        note = f"+- {fit.sigma[i] * factor:.3g}{unit} (1 sigma, Jacobian)"
         if boot is not None:
-            note += f", +- {boot[i] * spec.factor:.3g}{unit} (bootstrap)"
+            note += f", +- {boot[i] * factor:.3g}{unit} (bootstrap)"
         if fit.at_bound[i]:
             note += ", at a bound of the fit"
         notes[key] = note
@@ -84,20 +78,16 @@ def _diagram_table(diagram: DiagramFit, table: dict[str, Any]) -> dict[str, str]
     table["family"] = p.family
     for name in ("v_free_h", "v_free_a", "corner"):
         if name not in p.ignored_fields:
-            spec = MODEL_KEYS[_model_key(name)]
-            table[_model_key(name)] = float(f"{getattr(p, name) * spec.factor:.{DIGITS}g}")
+            _put(table, name, getattr(p, name))
     for key in [k for k in table if MODEL_KEYS.get(k) and
                 MODEL_KEYS[k].field in p.ignored_fields]:
         del table[key]
     notes = {"family": "stage 1: the diagram from the windows' stationary states"}
     for i, name in enumerate(diagram.which):
-        key = _model_key(name)
-        spec = MODEL_KEYS[key]
-        table[key] = float(f"{diagram.values[i] * spec.factor:.{DIGITS}g}")
-        unit = f" {spec.unit}" if spec.unit else ""
-        notes[key] = f"stage 1, +- {diagram.sigma[i] * spec.factor:.3g}{unit} (Jacobian)"
+        key, factor, unit = _put(table, name, diagram.values[i])
+        notes[key] = f"stage 1, +- {diagram.sigma[i] * factor:.3g}{unit} (Jacobian)"
         if diagram.bootstrap_sigma is not None:
-            notes[key] += f", +- {diagram.bootstrap_sigma[i] * spec.factor:.3g}{unit} (bootstrap)"
+            notes[key] += f", +- {diagram.bootstrap_sigma[i] * factor:.3g}{unit} (bootstrap)"
     return notes
 
 
@@ -156,26 +146,18 @@ def _set_dict(score: SetScore) -> dict[str, Any]:
 
 def _parameters(study: IdentifyStudy) -> tuple[dict[str, Any], dict[str, Any]]:
     fit, boot = study.fit, study.fit.bootstrap_sigma
-    lower, upper = fit_bounds(study)
     params: dict[str, Any] = {}
     for i, name in enumerate(fit.which):
+        lower, upper = DEFAULT_BOUNDS[name]
         params[name] = {"value": float(fit.values[i]), "sigma": float(fit.sigma[i]),
                         "start": float(getattr(study.setup.scenario.params, name)),
-                        "lower": lower[i], "upper": upper[i],
+                        "lower": lower, "upper": upper,
                         "at_bound": bool(fit.at_bound[i])}
         if boot is not None:
             params[name]["bootstrap_sigma"] = float(boot[i])
     corr = {a: {b: float(fit.correlation[i, j]) for j, b in enumerate(fit.which)}
             for i, a in enumerate(fit.which)}
     return params, corr
-
-
-def fit_bounds(study: IdentifyStudy) -> tuple[list[float], list[float]]:
-    """Lower and upper bounds (SI) of the fitted parameters, in their order."""
-    from arzsumo.identify import DEFAULT_BOUNDS
-
-    return ([DEFAULT_BOUNDS[n][0] for n in study.fit.which],
-            [DEFAULT_BOUNDS[n][1] for n in study.fit.which])
 
 
 def _equilibrium(study: IdentifyStudy) -> dict[str, Any]:
@@ -241,12 +223,6 @@ def stage_lambda_4(study: IdentifyStudy) -> dict[str, float]:
     return out
 
 
-def _stage_one(study: IdentifyStudy) -> dict[str, Any] | None:
-    if study.stage_one is None:
-        return None
-    return study.stage_one.as_dict(stage_lambda_4(study))
-
-
 def identification_json(study: IdentifyStudy) -> dict[str, Any]:
     """The content of ``identification.json`` (SI; units in ``units_by_key``)."""
     setup, fit, opts = study.setup, study.fit, study.setup.options
@@ -282,7 +258,8 @@ def identification_json(study: IdentifyStudy) -> dict[str, Any]:
                           for k, s in (("training", study.training),
                                        ("validation", study.validation))},
         "runs": _runs(study),
-        "stage_one": _stage_one(study),
+        "stage_one": (None if study.stage_one is None
+                      else study.stage_one.as_dict(stage_lambda_4(study))),
         "scenario_model_validation": (None if study.scenario_validation is None
                                       else _set_dict(study.scenario_validation)),
         "references": study.references,
@@ -304,16 +281,13 @@ def figures(study: IdentifyStudy) -> tuple[FieldsPanel, ScatterPanel]:
              "twin of the identified model; relative RMSE "
              + ", ".join(f"{v} {e:.1%}" for v, e in zip(VARIABLES, rel, strict=True)))
     fields = FieldsPanel(first.t, first.x, first.fields, run.predicted, title)
-    obs: list[np.ndarray] = []
-    pred: list[np.ndarray] = []
-    for j in range(4):
-        o = [d.fields[:, j][d.mask[:, j] & np.isfinite(r.predicted[:, j])]
+    pairs = [(d, r.predicted, d.mask & np.isfinite(r.predicted))
              for d, r in zip(data, score.runs, strict=True)]
-        p = [r.predicted[:, j][d.mask[:, j] & np.isfinite(r.predicted[:, j])]
-             for d, r in zip(data, score.runs, strict=True)]
-        obs.append(np.concatenate(o))
-        pred.append(np.concatenate(p))
-    scatter = ScatterPanel(tuple(obs), tuple(pred),
+    obs = tuple(np.concatenate([d.fields[:, j][seen[:, j]] for d, _, seen in pairs])
+                for j in range(4))
+    pred = tuple(np.concatenate([p[:, j][seen[:, j]] for _, p, seen in pairs])
+                 for j in range(4))
+    scatter = ScatterPanel(obs, pred,
                            tuple(score.pooled[v]["relative"] for v in VARIABLES),
                            f"{study.setup.base.name}: validation runs "
                            f"({', '.join(d.name for d in data)}), every cell and period")

@@ -59,14 +59,8 @@ def start_params(params: ModelParameters, datasets: Sequence[ReplayData],
 class RunScore:
     """The replay of one run under one parameter set, against the run.
 
-    ``rmse[var]`` holds ``absolute`` (SI, over the values the replay predicted),
-    ``relative`` (the same over the run's equilibrium value), ``penalised`` (relative,
-    values the replay could not predict counted with the fit's penalty: what the fit
-    minimises) and ``samples``. ``stopped`` is when the replay twin left the physical
-    domain (None if it completed), ``periods_not_predicted`` the periods from there on.
-    ``beyond_ao_max`` counts observed cells (period x cell) whose AO exceeds the model's
-    AO_max (``model``: the smaller of the classes', where the model cannot go) and each
-    class's (``h``, ``a``), out of ``observed``.
+    ``rmse``, ``stopped`` (s), ``periods_not_predicted`` and ``beyond_ao_max`` are the
+    run's entries of ``identification.json`` (``docs/outputs.md``, 'identification.json').
     """
 
     name: str
@@ -88,6 +82,15 @@ def _beyond(params: ModelParameters, data: ReplayData) -> dict[str, int]:
             "a": int((ao[seen] > params.ao_max_a).sum()), "observed": int(seen.sum())}
 
 
+def _rmse(sums: np.ndarray, j: int, penalised: float) -> dict[str, float]:
+    """Absolute and relative RMSE of variable ``j`` from ``sums`` (as
+    :attr:`RunScore.sums`), NaN without samples; and the ``penalised`` one."""
+    n = sums[2, j]
+    return {"absolute": math.sqrt(sums[0, j] / n) if n else math.nan,
+            "relative": math.sqrt(sums[1, j] / n) if n else math.nan,
+            "penalised": float(penalised)}
+
+
 def score_run(params: ModelParameters, data: ReplayData, options: ReplayOptions,
               penalised: np.ndarray) -> RunScore:
     """:class:`RunScore` of ``data`` under ``params``; ``penalised`` (4,) from
@@ -98,16 +101,11 @@ def score_run(params: ModelParameters, data: ReplayData, options: ReplayOptions,
     sums = np.vstack([(err ** 2).sum(axis=(0, 2)),
                       ((err / data.scale[None, :, None]) ** 2).sum(axis=(0, 2)),
                       both.sum(axis=(0, 2))])
-    rmse = {}
-    for j, var in enumerate(VARIABLES):
-        n = sums[2, j]
-        rmse[var] = {"absolute": math.sqrt(sums[0, j] / n) if n else math.nan,
-                     "relative": math.sqrt(sums[1, j] / n) if n else math.nan,
-                     "penalised": float(penalised[j]), "samples": int(n)}
     blocks, n_blocks = field_rmse(data.fields, run.fields, *_block_shape(data))
-    for j, var in enumerate(VARIABLES):
-        rmse[var]["blocks_relative"] = float(blocks[j] / data.scale[j])
-        rmse[var]["blocks"] = int(n_blocks[j])
+    rmse = {var: {**_rmse(sums, j, penalised[j]), "samples": int(sums[2, j]),
+                  "blocks_relative": float(blocks[j] / data.scale[j]),
+                  "blocks": int(n_blocks[j])}
+            for j, var in enumerate(VARIABLES)}
     lost = int(np.isnan(run.fields).all(axis=(1, 2)).sum())
     return RunScore(data.name, rmse, run.stopped, run.reason, lost, _beyond(params, data),
                     run.fields, sums)
@@ -126,12 +124,8 @@ def _block_shape(data: ReplayData) -> tuple[int, int]:
 
 @dataclass(frozen=True)
 class SetScore:
-    """Scores of a set of runs (training or validation) under one parameter set.
-
-    ``pooled[var]``: ``absolute``, ``relative`` and ``penalised`` RMSE over all runs'
-    values; ``total``: the penalised relative RMSE over every variable and value (the
-    fit's objective as an RMSE: sqrt(2 cost / residuals)).
-    """
+    """Scores of a set of runs (training or validation) under one parameter set;
+    ``pooled`` and ``total`` as ``rmse.SET`` of ``identification.json``."""
 
     runs: tuple[RunScore, ...]
     report: ValidationReport
@@ -148,11 +142,6 @@ def score_set(params: ModelParameters, datasets: Sequence[ReplayData],
                  for i, d in enumerate(datasets))
     sums = sum(r.sums for r in runs)
     observed = np.array([d.mask.sum(axis=(0, 2)) for d in datasets], float)
-    pooled = {}
-    for j, var in enumerate(VARIABLES):
-        n = sums[2, j]
-        pooled[var] = {"absolute": math.sqrt(sums[0, j] / n) if n else math.nan,
-                       "relative": math.sqrt(sums[1, j] / n) if n else math.nan,
-                       "penalised": float(report.pooled[j])}
+    pooled = {var: _rmse(sums, j, report.pooled[j]) for j, var in enumerate(VARIABLES)}
     total = math.sqrt(float((report.rmse ** 2 * observed).sum() / observed.sum()))
     return SetScore(runs, report, pooled, total)

@@ -1,21 +1,12 @@
 """Identify the macroscopic model from open-loop SUMO runs (``arzsumo identify``).
 
-1. Plan: every operating point (``--vary table.key=v1,v2``: the scenario with that key
-   changed, via :meth:`~arzsumo.scenario.Scenario.with_`; the product of several) times
-   every training and validation seed is one SUMO run of the open loop (controller
-   ``open``, the scenario's warm-up and control horizon unless overridden).
-2. Simulate: the runs go through the sweep engine (:func:`arzsumo.sweep.driver.map_runs`,
-   one SUMO per process); each returns its :class:`~arzsumo.identify.ReplayData`
-   (:func:`~arzsumo.bridge.replay_data.replay_data_of`).
-3. Fit: :func:`arzsumo.identify.identify` on the training runs, starting from the
-   scenario's ``[model]``, with the bridge's twin numerics
-   (:func:`~arzsumo.bridge.replay_data.replay_options_of`) and
-   :data:`~arzsumo.identify.DEFAULT_BOUNDS`.
-4. Validate: :func:`arzsumo.identify.validate` and :func:`replay_metrics` on the
-   training runs and, separately, on the held-out validation runs, at the identified
-   parameters (and on the training runs at the start parameters, for comparison).
-
-Nothing is written here: :mod:`arzsumo.outputs.identify` writes the results.
+Plan every (operating point, seed) run of the open loop (``--vary table.key=v1,v2``: the
+scenario with that key changed; the product of several), simulate them through the sweep
+engine (each a :class:`~arzsumo.identify.ReplayData`, taken from the run cache where it
+can), fit on the training runs (:func:`arzsumo.identify.identify`, after stage 1 with
+``--diagram``) and score the fit on the training and the held-out runs. The steps:
+``docs/identify.md``, 'What it does'. Nothing is written here: :mod:`.report` makes the
+files' content.
 """
 
 from __future__ import annotations
@@ -61,12 +52,8 @@ from arzsumo.workflows.identify.scores import (
 
 log = logging.getLogger(__name__)
 ROLES = ("training", "validation")
-#: the least jam occupancy stage 1 may fit. ``cells``: above every cell the replay is fed,
-#: so a replay never leaves the model's domain; ``blocks``: above every stationary block
-#: only, so the diagram's congested branch can pass through the blocks where the densest
-#: cells (stopped vehicles in stop-and-go, the compressed inlet) lie above a jam line
-#: through them; the replay scales such cells down to its AO limit and
-#: ``identification.json`` counts them (``beyond_ao_max``)
+#: the least jam occupancy stage 1 may fit: above every cell the replay is fed, or above
+#: every stationary block only (``docs/identify.md``, 'Two stages')
 JAM_FLOORS = ("cells", "blocks")
 
 
@@ -128,12 +115,9 @@ class IdentifySetup:
     #: the family whose diagram stage 1 fits from the windows' stationary states (stage 2
     #: then fits tau_h, tau_a by the replay); None: one replay fit of ``which``
     diagram: str | None = None
-    #: the replay's inlet flux (:data:`arzsumo.identify.replay.INLETS`): ``ctm`` the cell
-    #: transmission model's min(demand, supply), ``supply`` the ghost cell's flux limited
-    #: to the first cell's receiving capacity, ``ghost`` that flux as it is
+    #: the replay's inlet flux (:data:`arzsumo.identify.replay.INLETS`)
     inlet: str = "ctm"
-    #: the least jam occupancy stage 1 may fit (:data:`JAM_FLOORS`): above every cell the
-    #: replay is fed (``cells``) or above every stationary block (``blocks``)
+    #: the least jam occupancy stage 1 may fit (:data:`JAM_FLOORS`)
     jam_floor: str = "cells"
 
     @property
@@ -197,8 +181,7 @@ def check_seeds(train: Sequence[int], held_out: Sequence[int]) -> None:
         if not seeds or len(set(seeds)) != len(seeds):
             raise ScenarioError(f"{flag} = {','.join(map(str, seeds))} is not allowed: one "
                                 "or more distinct seeds")
-    both = sorted(set(train) & set(held_out))
-    if both:
+    if both := sorted(set(train) & set(held_out)):
         raise ScenarioError(f"--validate-seeds = {','.join(map(str, held_out))} is not "
                             f"allowed: seeds {both} are also training seeds; allowed: "
                             "held-out seeds not in --train-seeds")
@@ -227,11 +210,8 @@ def make_setup(sc: Scenario, train: Sequence[int], held_out: Sequence[int], *,
         raise ScenarioError(f"--which = {which} is not allowed with --diagram: stage 2 "
                             f"fits {', '.join(STAGE_TWO)}")
     check_seeds(train, held_out)
-    changes: dict[str, Any] = {"run.controller": "open"}
-    if horizon is not None:
-        changes["sumo.horizon_s"] = horizon
-    if warmup is not None:
-        changes["run.warmup_s"] = warmup
+    given = {"sumo.horizon_s": horizon, "run.warmup_s": warmup}
+    changes = {"run.controller": "open", **{k: v for k, v in given.items() if v is not None}}
     # a [network] table: checked with sumolib, L and W of the fit read from the network
     base, sc = sc, with_network(sc.with_(changes))
     names = STAGE_TWO if diagram is not None else parse_which(which, sc.params)
@@ -264,10 +244,9 @@ def plan(setup: IdentifySetup) -> list[RunTask]:
 
 def simulate(task: RunTask) -> SumoRun:
     """One open-loop SUMO run as identification data (the sweep engine's worker); taken
-    from the run cache (:mod:`.identify_cache`) when the same run was made before."""
+    from the run cache (:mod:`.cache`) when the same run was made before."""
     key = run_key(task.tables, task.seed)
-    cached = load_run(key, task.run_id)
-    if cached is not None:
+    if (cached := load_run(key, task.run_id)) is not None:
         data, info = cached
         return SumoRun(task, data, float(info["wall_time"]), int(info["resyncs"]),
                        float(info["delivered"]))
@@ -289,8 +268,8 @@ class IdentifyStudy:
 
     ``measured`` is the mean (rho_h, rho_a) of the training runs' cells and periods, veh/m;
     ``equilibrium`` the identified model's equilibrium there (None where the identified
-    model cannot hold it: AO >= AO_max). ``wall`` holds wall times, s: ``sumo`` (the batch
-    of runs), ``sumo_runs`` (their sum), ``fit``, ``bootstrap``, ``validate``, ``total``.
+    model cannot hold it: AO >= AO_max); ``wall`` the wall times, s (``wall_time`` in
+    ``docs/outputs.md``).
     """
 
     setup: IdentifySetup

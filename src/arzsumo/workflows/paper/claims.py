@@ -1,11 +1,9 @@
 """The claims of section 5, each checked on a reproduction by one small function.
 
-A claim compares scenarios as the paper states them (ETC against backstepping, more AVs,
-demand levels, spacings, initial profiles, sensitivity sweeps); it is *reproduced in
-direction* when ours orders the runs the same way. The per-claim checks each return their
-:class:`Claim` records, none when a run they need is missing; :func:`claims` runs them in
-the order of :data:`CLAIM_CHECKS`, then :func:`sensitivity_claims`. Pure functions, nothing
-is written here.
+A claim compares scenarios as the paper states them; what its verdict means:
+``docs/twin.md``, 'Verdicts'. Each check returns its :class:`Claim` records (none when a
+run it needs is missing); :func:`claims` runs them in the order of :data:`CLAIM_CHECKS`,
+then :func:`sensitivity_claims`. Pure functions, nothing is written here.
 """
 
 from __future__ import annotations
@@ -41,12 +39,8 @@ class Claim:
 
 def penetration_records(rep: Reproduction) -> dict[int, RunRecord]:
     """The ETC runs of table diffpene that ``rep`` holds, by AV penetration (%)."""
-    out = {}
-    for pen in DIFFPENE:
-        rec = rep.get(f"penetration_{pen}_etc")
-        if rec is not None:
-            out[pen] = rec
-    return out
+    return {pen: rec for pen in DIFFPENE
+            if (rec := rep.get(f"penetration_{pen}_etc")) is not None}
 
 
 def trend(first: float, last: float) -> str:

@@ -2,55 +2,46 @@
 
 Pure functions of a :class:`arzsumo.workflows.paper.reproduce.Reproduction`: they return rows
 (dicts, CSV-ready); the :class:`Claim` records come from :mod:`arzsumo.workflows.paper.claims`
-(re-exported here). Nothing is written here. Verdicts:
-
-- a relative change (tables diffperformance, totaldelay) is *reproduced in direction*
-  when ours has the paper's sign and is at least :data:`MIN_CHANGE` percent in size;
-- a comparison across scenarios (more AVs, demand levels, sensitivity) is reproduced in
-  direction when ours orders the scenarios as the paper states.
-
-Magnitudes are not expected to match: the vehicle width d (2.0 m here, never given in
-the paper), the initial amplitude (2 % here, not given), the profile fraction (0.15
-instead of the infeasible 1/4), the aggressive preset's free-flow speeds and maximum
-AOs (not given) and the discretisation all differ.
+(re-exported here). Nothing is written here. How the verdicts are reached, and why
+magnitudes are not expected to match: ``docs/twin.md``, 'Reproducing section 5'.
 """
 
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, TypeVar
 
 from arzsumo.units import veh_m_to_veh_km
 
-# The claims live in their own module; their names are re-exported here for callers of
-# this module (the CLI, the report, the tests).
+# re-exported for the CLI, the report and the tests
 from arzsumo.workflows.paper.claims import (
-    MIN_TREND,
     NOT_REPRODUCED,
     REPRODUCED,
     Claim,
     claims,
     penetration_records,
-    sensitivity_claims,
     trend,
 )
-from arzsumo.workflows.paper.reproduce import Reproduction
+from arzsumo.workflows.paper.reproduce import Reproduction, RunRecord
 from arzsumo.workflows.paper.values import (
     DIFFPENE,
     DIFFPERFORMANCE,
     EVENTS,
     SENSITIVITY,
     TOTALDELAY,
+    DelayRow,
+    EventRow,
+    PerformanceRow,
 )
 
-__all__ = ["MIN_CHANGE", "MIN_TREND", "MISSING", "NOT_REPRODUCED", "REPRODUCED", "Claim",
-           "claims", "delay_table", "direction", "events_table", "penetration_table",
-           "performance_table", "sensitivity_claims", "sensitivity_table", "trend"]
-
-MISSING = "not run"
+__all__ = ["MIN_CHANGE", "NOT_REPRODUCED", "REPRODUCED", "Claim", "claims", "delay_table",
+           "direction", "events_table", "penetration_table", "performance_table",
+           "sensitivity_table", "trend"]
 
 #: Smallest |relative change| (percent) we count as a change at all.
 MIN_CHANGE = 0.05
+
+_Row = TypeVar("_Row", PerformanceRow, DelayRow, EventRow)
 
 WHY_SMALL = ("the two-period stop-and-go wave adds no vehicles and the metering averages "
              "about q*, so vehicle-count indices (J_TTT, J_fuel, delay) move by less than "
@@ -105,32 +96,29 @@ def _compared_row(label: str, scenario: str, cells: list[tuple[str, float, float
     return row
 
 
+def _ran(rep: Reproduction, rows: tuple[_Row, ...]) -> list[tuple[_Row, RunRecord]]:
+    """The published ``rows`` whose scenario ``rep`` ran, each with its record."""
+    return [(p, rec) for p in rows if (rec := rep.get(p.scenario)) is not None]
+
+
 def performance_table(rep: Reproduction) -> list[dict[str, Any]]:
     """Table diffperformance: relative J_fuel, J_discom, J_TTT (%) and release time (s)."""
-    rows = []
-    for p in DIFFPERFORMANCE:
-        rec = rep.get(p.scenario)
-        if rec is None:
-            continue
-        cells = [(f"{key}_percent", getattr(p, key), rec.relative("total", key))
-                 for key in ("J_fuel", "J_discom", "J_TTT")]
-        rows.append(_compared_row(p.label, p.scenario, cells, {
-            "paper_release_time_s": p.release_time, "ours_release_time_s": rec.release_time,
-            "ours_triggers": rec.triggers}))
-    return rows
+    return [_compared_row(p.label, p.scenario,
+                          [(f"{key}_percent", getattr(p, key), rec.relative("total", key))
+                           for key in ("J_fuel", "J_discom", "J_TTT")],
+                          {"paper_release_time_s": p.release_time,
+                           "ours_release_time_s": rec.release_time,
+                           "ours_triggers": rec.triggers})
+            for p, rec in _ran(rep, DIFFPERFORMANCE)]
 
 
 def delay_table(rep: Reproduction) -> list[dict[str, Any]]:
     """Table totaldelay: change of TD_h, TD_a and TD_h + TD_a against the open loop (%)."""
-    rows = []
-    for p in TOTALDELAY:
-        rec = rep.get(p.scenario)
-        if rec is None:
-            continue
-        cells = [(f"{name}_delay_percent", getattr(p, part), rec.relative(part, "total_delay"))
-                 for part, name in (("h", "HV"), ("a", "AV"), ("total", "total"))]
-        rows.append(_compared_row(p.label, p.scenario, cells))
-    return rows
+    return [_compared_row(p.label, p.scenario,
+                          [(f"{name}_delay_percent", getattr(p, part),
+                            rec.relative(part, "total_delay"))
+                           for part, name in (("h", "HV"), ("a", "AV"), ("total", "total"))])
+            for p, rec in _ran(rep, TOTALDELAY)]
 
 
 def penetration_table(rep: Reproduction) -> list[dict[str, Any]]:
@@ -149,29 +137,20 @@ def penetration_table(rep: Reproduction) -> list[dict[str, Any]]:
 
 def events_table(rep: Reproduction) -> list[dict[str, Any]]:
     """Release and trigger numbers of the text and figures beside ours."""
-    rows = []
-    for e in EVENTS:
-        rec = rep.get(e.scenario)
-        if rec is None:
-            continue
-        rows.append({"label": e.label, "scenario": e.scenario, "where": e.where,
-                     "paper_triggers": e.triggers, "ours_triggers": rec.triggers,
-                     "paper_release_time_s": e.release_time,
-                     "ours_release_time_s": rec.release_time,
-                     "ours_final_norm_ratio": rec.summary["final_norm_ratio"],
-                     "ours_lyapunov_time_s": rec.lyapunov_time})
-    return rows
+    return [{"label": e.label, "scenario": e.scenario, "where": e.where,
+             "paper_triggers": e.triggers, "ours_triggers": rec.triggers,
+             "paper_release_time_s": e.release_time, "ours_release_time_s": rec.release_time,
+             "ours_final_norm_ratio": rec.summary["final_norm_ratio"],
+             "ours_lyapunov_time_s": rec.lyapunov_time}
+            for e, rec in _ran(rep, EVENTS)]
 
 
 def sensitivity_table(rep: Reproduction) -> list[dict[str, Any]]:
     """Triggers, release time and Lyapunov convergence time (s) of each sweep run."""
-    rows = []
-    for par in SENSITIVITY:
-        for rec in rep.sweep(par):
-            rows.append({"parameter": par, "value": rec.sweep[1] if rec.sweep else math.nan,
-                         "triggers": rec.triggers, "release_time_s": rec.release_time,
-                         "lyapunov_time_s": rec.lyapunov_time,
-                         "final_norm_ratio": rec.summary["final_norm_ratio"]})
-    return rows
+    return [{"parameter": par, "value": rec.sweep[1] if rec.sweep else math.nan,
+             "triggers": rec.triggers, "release_time_s": rec.release_time,
+             "lyapunov_time_s": rec.lyapunov_time,
+             "final_norm_ratio": rec.summary["final_norm_ratio"]}
+            for par in SENSITIVITY for rec in rep.sweep(par)]
 
 

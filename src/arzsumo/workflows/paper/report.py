@@ -1,18 +1,6 @@
 """The report of a reproduction: ``report.md``, CSV tables and figure data, written through
-:mod:`arzsumo.outputs.reproduce` (atomically).
-
-Layout of ``DIR`` (written with :func:`arzsumo.io.atomic_dir`)::
-
-    report.md              the paper's values beside ours, verdicts and reasons
-    diffperformance.csv    table diffperformance (relative J_fuel, J_discom, J_TTT %, release s)
-    totaldelay.csv         table totaldelay (relative TD_h, TD_a, total %)
-    diffpene.csv           table diffpene (release s, triggers per penetration)
-    events.csv             triggers / release time stated in the text and figures
-    sensitivity.csv        sweeps over mu, sigma, zeta (release s, Lyapunov time s)
-    claims.csv             every checked claim with its verdict
-    runs.csv               one row per run: the numbers of its summary (SI)
-    summaries.json         the full summary of every run
-    release_instants.png, penetration.png, sensitivity.png
+:mod:`arzsumo.outputs.reproduce` (atomically, :func:`arzsumo.io.atomic_dir`). The files
+and their columns: ``docs/outputs.md``, 'arzsumo reproduce'.
 """
 
 from __future__ import annotations
@@ -85,12 +73,9 @@ def markdown_table(rows: Sequence[dict[str, Any]], columns: Sequence[str],
 
 
 def _claims_md(items: Sequence[Claim]) -> str:
-    out = []
-    for c in items:
-        out.append(f"- **{c.verdict}** - {c.claim}. Paper: {c.paper}. Twin: {c.ours}."
-                   + (f" *{'Why' if c.verdict != REPRODUCED else 'Note'}:* {c.why}."
-                      if c.why else ""))
-    return "\n".join(out)
+    return "\n".join(f"- **{c.verdict}** - {c.claim}. Paper: {c.paper}. Twin: {c.ours}."
+                     + (f" *{'Why' if c.verdict != REPRODUCED else 'Note'}:* {c.why}."
+                        if c.why else "") for c in items)
 
 
 def _reasons(rows: Sequence[dict[str, Any]]) -> str:

@@ -1,18 +1,12 @@
 """Run every experiment of section 5 on the twin: the library behind ``arzsumo reproduce``.
 
 The experiments are the scenario files of one directory (``scenarios/paper/`` by
-default). A file with a ``[sweep]`` table (``parameter``, ``values``) stands for one ETC
-run per value of that design parameter (the sensitivity subsection). Files that differ
-only in ``[twin] controller``, ``kernel_cells``, ``[design]`` and ``[sweep]`` share their
-open loop: it is simulated once and every controller of the group is compared with it
-(tables diffperformance and totaldelay report changes against the open loop of the same
-scenario). The paper's numbers and the comparison live in
-:mod:`arzsumo.workflows.paper.values` and :mod:`arzsumo.workflows.paper.compare`; this module
-writes nothing (see :mod:`arzsumo.workflows.paper.report`).
-
-Runs are deterministic; with ``workers > 1`` they are spread over the sweep engine's
-process pool (:func:`arzsumo.sweep.driver.map_runs`) and the results are identical and in
-the same order.
+default); a file with a ``[sweep]`` table stands for one ETC run per value, and files
+that differ only in their controller and its design share one open loop
+(``docs/twin.md``, 'Reproducing section 5'). The paper's numbers and the comparison live
+in :mod:`.values` and :mod:`.compare`; this module writes nothing (see :mod:`.report`).
+Runs are deterministic: with ``workers > 1`` (the sweep engine's process pool,
+:func:`arzsumo.sweep.driver.map_runs`) the results are identical and in the same order.
 """
 
 from __future__ import annotations
@@ -113,11 +107,6 @@ class _Task:
     group: int
 
 
-def _sweep_of(sc: Scenario) -> tuple[str, list[float]] | None:
-    """The design sweep of the scenario's ``[sweep]`` table (parameter, values), if any."""
-    return None if sc.sweep is None else (sc.sweep.parameter, list(sc.sweep.values))
-
-
 def _with(sc: Scenario, **tables: Mapping[str, Any]) -> Scenario:
     """``sc`` with some keys of some tables changed (validated again)."""
     return sc.with_({f"{name}.{key}": value for name, changes in tables.items()
@@ -160,9 +149,10 @@ def plan(scenarios: Sequence[Scenario], *, quick: bool = False,
         changes = {**(QUICK_TWIN if quick else {}), **(twin or {})}
         if changes:
             sc = _with(sc, twin=changes)
-        sweep = _sweep_of(sc)
+        sweep = sc.sweep
         items = ([(sc, None)] if sweep is None else
-                 [(_with(sc, design={sweep[0]: v}), (sweep[0], v)) for v in sweep[1]])
+                 [(_with(sc, design={sweep.parameter: v}), (sweep.parameter, v))
+                  for v in sweep.values])
         for item, sw in items:
             group = groups.setdefault(_baseline_key(item), len(groups))
             tasks.append(_Task(item, sw, group))
@@ -182,23 +172,19 @@ def _record(run: TwinRun, sweep: tuple[str, float] | None) -> RunRecord:
 
 def _open_loop(task: _Task) -> tuple[Performance, bool, str, RunRecord | None]:
     """The open loop of a task's group; its record too when the task is the open loop."""
-    sc = task.scenario
-    cfg = sc.twin
-    run = run_twin(sc, replace(cfg, controller="open"), baseline=False)
-    own = cfg.controller == "open"
-    res = run.result
-    return run.performance, res.complete, res.status, (_record(run, task.sweep) if own else None)
+    cfg = task.scenario.twin
+    run = run_twin(task.scenario, replace(cfg, controller="open"), baseline=False)
+    own = _record(run, task.sweep) if cfg.controller == "open" else None
+    return run.performance, run.result.complete, run.result.status, own
 
 
-def _controlled(task: _Task, baseline: tuple[Performance, bool, str]) -> RunRecord:
+def _controlled(item: tuple[_Task, tuple[Performance, bool, str]]) -> RunRecord:
+    """A task's run, compared with the open loop of its group (``baseline``)."""
+    task, baseline = item
     run = run_twin(task.scenario, baseline=False)
     if run.result.controller.name != "open":
         run = compare_to_open_loop(run, *baseline)
     return _record(run, task.sweep)
-
-
-def _controlled_pair(item: tuple[_Task, tuple[Performance, bool, str]]) -> RunRecord:
-    return _controlled(*item)
 
 
 def _map(fn: Any, items: list[Any], workers: int, scheduler: str | None) -> list[Any]:
@@ -227,8 +213,7 @@ def reproduce(directory: str | Path = DEFAULT_DIR, *, quick: bool = False,
         ``[twin]`` keys (scenario-file names and units, e.g. ``{"scheme": "muscl"}``)
         set in every scenario; validated like the files.
     workers : int, optional
-        Processes (default 1: on the 2-core reference machine two processes were measured
-        slower, runs of about 1 s being shorter than process start and kernel loading).
+        Processes (default 1: faster for runs of about 1 s, ``docs/twin.md``, 'Speed').
         Results do not depend on it.
     scheduler : str, optional
         Address of a Dask scheduler to run on instead (``tcp://host:8786``).
@@ -246,14 +231,10 @@ def reproduce(directory: str | Path = DEFAULT_DIR, *, quick: bool = False,
     log.debug("%d open loops for %d runs", len(opens), len(tasks))   # the summary says it
     reused = {i for g, i in first.items() if opens[g][3] is not None}
     todo = [i for i in range(len(tasks)) if i not in reused]
-    done = _map(_controlled_pair, [(tasks[i], opens[tasks[i].group][:3]) for i in todo],
+    done = _map(_controlled, [(tasks[i], opens[tasks[i].group][:3]) for i in todo],
                 workers, scheduler)
-    records: list[RunRecord | None] = [None] * len(tasks)
-    for i, rec in zip(todo, done, strict=True):
-        records[i] = rec
-    for g, i in first.items():
-        if i in reused:
-            records[i] = opens[g][3]
-    return Reproduction(tuple(r for r in records if r is not None), len(opens), quick,
+    records = dict(zip(todo, done, strict=True)) | {i: opens[g][3] for g, i in first.items()
+                                                   if i in reused}
+    return Reproduction(tuple(records[i] for i in range(len(tasks))), len(opens), quick,
                         time.perf_counter() - start, str(directory), workers,
                         tuple(sc.name for sc in scenarios), dict(twin or {}))
