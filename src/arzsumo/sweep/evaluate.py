@@ -1,25 +1,11 @@
 """``arzsumo evaluate``: every controller on the same seeds in SUMO, compared with the open
 loop seed by seed.
 
-The runs are a sweep built in code (:func:`evaluation_spec`: the scenario as base, engine
-``sumo``, an axis ``controller`` over ``[run] controller``, the seeds last), executed by
-:func:`~arzsumo.sweep.driver.run_sweep`: in parallel on local processes or on Dask, and
-resumable (a second call with the same output directory runs only what is missing). The
-directory is an ``evaluation`` result (its own marker kind, so a sweep directory is not
-mistaken for it) laid out like a sweep, plus the report of
-:func:`arzsumo.outputs.evaluation.write_evaluation`::
-
-    OUT/  runs/<controller=...,seed=...>/   summary.json, periods.parquet (each run)
-          summaries.parquet, sweep.json, sweep.toml, executions.jsonl   (the sweep's)
-          evaluation.csv, evaluation.md, paired_differences.png        (the report)
-
-With ``baseline_from`` (``--baseline-from DIR``) the open-loop runs are not run again but
-taken from an earlier evaluation in DIR (:func:`borrowed_baseline`), allowed only when
-their resolved scenarios differ from this evaluation's in nothing that acts on an open-loop
-SUMO run (:data:`OPEN_LOOP_INERT`; and :data:`PLACEMENT_ONLY` when SUMO fills the road
-itself and is given the same route file): an ablation whose steps change only the
-controllers' side (estimation, sensing, actuation, design, or the model the laws are
-designed on) pays for its baseline once.
+The runs are a sweep built in code (:func:`evaluation_spec`: an axis ``controller`` over
+``[run] controller``, the seeds last) in a directory of its own marker kind
+(:data:`KIND`), laid out as docs/outputs.md says. Open-loop runs taken from an earlier
+evaluation (``--baseline-from``, :func:`borrowed_baseline`) and a controller's runs
+taken from elsewhere (``--runs-from``): docs/whole_demand.md.
 """
 
 from __future__ import annotations
@@ -290,18 +276,7 @@ def run_evaluation(scenario: Path, controllers: Sequence[str], seeds: Sequence[i
                    command: str = "", baseline_from: Path | None = None,
                    runs_from: Sequence[Path] = ()) -> EvaluationResult:
     """Run ``controllers`` (the open loop added first when missing) on ``seeds`` and write
-    the report into ``out`` (module docstring).
-
-    ``out`` may be new, empty, or a previous evaluation: continued (runs already finished
-    with the same resolved scenario are not run again), or started afresh with
-    ``overwrite``. ``horizon`` and ``warmup`` (s) replace ``[sumo] horizon_s`` and ``[run]
-    warmup_s``. ``command`` is printed at the top of ``evaluation.md``.
-    ``baseline_from``: take the open-loop runs from this earlier evaluation (module
-    docstring) instead of running them. ``runs_from``: earlier evaluations or sweeps;
-    every controller whose runs on all ``seeds`` one of them holds (the same SUMO runs:
-    scenarios that differ only in what that controller does not read, :func:`inert_for`)
-    is taken from there instead of run.
-    """
+    the report into ``out``; the options as in :func:`arzsumo.evaluate`."""
     controllers = check_controllers(controllers)
     name = check_runs(scenario, controllers, horizon, warmup)
     borrowed = pd.DataFrame()
@@ -313,10 +288,9 @@ def run_evaluation(scenario: Path, controllers: Sequence[str], seeds: Sequence[i
         borrowed = borrowed_baseline(
             evaluation_spec(scenario, [BASELINE], seeds, horizon, warmup),
             Path(baseline_from), str(baseline_from))
-    taken = _borrow(scenario, controllers[1:] if baseline_from else controllers, seeds,
-                    horizon, warmup, runs_from)
-    to_run = [c for c in (controllers[1:] if baseline_from else controllers)
-              if c not in taken]
+    others = controllers[1:] if baseline_from else controllers
+    taken = _borrow(scenario, others, seeds, horizon, warmup, runs_from)
+    to_run = [c for c in others if c not in taken]
     if overwrite:
         _forget_previous(Path(out), str(out))
     rep, target = None, Path(out)
