@@ -1,8 +1,5 @@
-"""``arzsumo compare RUN_DIR... [--out DIR]``: one table across ``arzsumo run`` results.
-
-``arzsumo compare results/*/ --out results/comparison`` can be repeated: the glob then
-also matches the comparison's own directory, which is skipped with a one-line note, as
-is any other directory holding a comparison and no run summary.
+"""``arzsumo compare RUN_DIR... [--out DIR]``: one table across ``arzsumo run`` results;
+the comparison's own directory and earlier comparisons are skipped (a glob may match them).
 """
 
 from __future__ import annotations

@@ -1,10 +1,5 @@
-"""``arzsumo list``: the shipped scenario and sweep files by name, with their descriptions.
-
-Every name listed is what a command takes in place of a file (``arzsumo run default``,
-``arzsumo twin base_etc``, ``arzsumo sweep demand_sumo``). The scenarios are split by
-where they run: those with a ``[sumo]`` table are made for SUMO (``arzsumo run``; the
-twin runs them too), the others for the PDE twin only (``arzsumo twin``).
-"""
+"""``arzsumo list``: the shipped scenario and sweep files by name, with their descriptions,
+split by where they run (SUMO or the twin only)."""
 
 from __future__ import annotations
 

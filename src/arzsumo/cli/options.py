@@ -1,13 +1,6 @@
-"""The options several ``arzsumo`` commands share, each declared once here.
-
-A command module adds them with one call each (``add_out(p, "results directory")``), so
-a flag means the same and is checked the same in every command: where results go
-(``--out``, ``--overwrite``), how runs execute (``--workers``, ``--scheduler``, ``--quiet``,
-``--no-plots``), which seeds (``--seed``, ``--seeds``), which scenario (a positional
-``SCENARIO``, or ``--preset`` | ``--scenario``) and its warm-up (``--warmup``,
-``--allow-short-warmup``). The studies declare their options in
-:mod:`arzsumo_studies.common` (a room below the CLI).
-"""
+"""The options several ``arzsumo`` commands share, each declared once here, so that a flag
+means the same and is checked the same in every command (the studies' own:
+:mod:`arzsumo_studies.common`)."""
 
 from __future__ import annotations
 
@@ -15,9 +8,6 @@ import argparse
 
 from arzsumo.cli.args import non_negative_float, positive_int, seed_int, seed_list
 from arzsumo.model.params import PRESETS
-
-#: help of --scheduler wherever it appears
-SCHEDULER_HELP = "Dask scheduler address, e.g. tcp://SCHEDULER-HOST:8786"
 
 
 def add_out(p: argparse.ArgumentParser, help: str, *, default: str | None = None,
@@ -40,16 +30,12 @@ def add_workers(p: argparse.ArgumentParser, help: str | None = None,
                                 "--scheduler")
 
 
-def add_scheduler(p: argparse.ArgumentParser) -> None:
-    """``--scheduler ADDRESS``: run on a Dask cluster instead of local processes."""
-    p.add_argument("--scheduler", metavar="ADDRESS", help=SCHEDULER_HELP)
-
-
 def add_parallel(p: argparse.ArgumentParser) -> None:
     """``--workers N``, ``--scheduler ADDRESS`` (the sweep engine's executors) and
     ``--no-shared-warmup``."""
     add_workers(p)
-    add_scheduler(p)
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="Dask scheduler address, e.g. tcp://SCHEDULER-HOST:8786")
     p.add_argument("--no-shared-warmup", action="store_true",
                    help="give every SUMO run its own warm-up (by default the runs of a "
                         "seed that differ only in the controller simulate it once; the "

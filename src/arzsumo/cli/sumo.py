@@ -1,9 +1,5 @@
 """SUMO commands of the CLI: ``arzsumo build-net``, ``arzsumo calibrate`` and
-``arzsumo alinea-target`` (ALINEA's target from open-loop runs).
-
-Registered by :func:`register` and :func:`register_alinea_target` from
-:func:`arzsumo.cli.build_parser`; SUMO is imported only when one of these commands runs.
-"""
+``arzsumo alinea-target`` (ALINEA's target from open-loop runs)."""
 
 from __future__ import annotations
 
@@ -63,7 +59,6 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     cal = calibrate(scenario, out=args.out, quick=args.quick, horizon_s=args.horizon,
                     seed=args.seed, step_length_s=args.step_length, jobs=args.jobs,
                     overwrite=args.overwrite)
-    out = args.out
     for cls, name in (("h", "HV"), ("a", "AV")):
         f = cal.fits[cls]
         print(f"{name}: V = {ms_to_kmh(f.v_free):.1f} km/h, AO_max = {f.ao_max:.3f}, "
@@ -85,7 +80,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
               + ", ".join(f"{v:.2f}" for v in lam) + f" km/h; regime {eq['regime']}")
     else:
         print(f"regime: {eq.get('regime')} ({eq.get('note', '')})")
-    print(f"written: {out}")
+    print(f"written: {args.out}")
     return 0
 
 

@@ -1,13 +1,5 @@
-"""``arzsumo twin SCENARIO [--controller NAME] [--out DIR] [--json]``: the nonlinear PDE twin.
-
-The controller is ``--controller``, else the scenario's ``[twin] controller``, else its
-``[run] controller`` (the one ``arzsumo run`` drives the meter with) when that runs in
-the twin, else the open loop; the printed summary names it and where it came from. The
-work is done by :func:`arzsumo.engines.twin.run_twin` and
-:func:`arzsumo.outputs.twin.write_run`. Exit codes: 0 completed, 3 stopped early (state
-left the physical domain; the partial results are written and marked ``"complete":
-false``), 2 user error.
-"""
+"""``arzsumo twin SCENARIO [--controller NAME] [--out DIR] [--json]``: the nonlinear PDE twin
+(:func:`arzsumo.api.runs.twin`)."""
 
 from __future__ import annotations
 
