@@ -249,57 +249,45 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
     runs = spec.runs()
     if workers is not None and workers < 1:
         raise SweepError(f"--workers = {workers} is not allowed: an integer >= 1")
+    workers = workers or default_workers()
     with resumable_dir(out, kind) as target:
-        return _run(spec, target, runs, workers, scheduler, progress, plots, paper, t0,
-                    share_warmup)
+        with atomic_file(target / "sweep.toml") as tmp:
+            tmp.write_text(spec.text or f"# sweep {spec.name} (built in code)\n",
+                           encoding="utf-8")
+        todo = [r for r in runs if not _finished(target, r)]
+        by_id = {r.run_id: r for r in runs}
+        backend = f"dask {scheduler}" if scheduler else f"local pool, {workers} processes"
+        log.info("sweep %s: %d runs, %d finished before, %d to run (%s)", spec.name,
+                 len(runs), len(runs) - len(todo), len(todo), backend)
+        bar = Progress(len(todo), f"sweep {spec.name}", enabled=progress and bool(todo))
+        counts: Counter[str] = Counter()
 
+        def on_group_done(outcomes: list[RunOutcome]) -> None:
+            for outcome in outcomes:
+                write_outcome(target, by_id[outcome.run_id], outcome)
+                counts[outcome.status] += 1
+                if outcome.status not in FINISHED:
+                    first = outcome.error.splitlines()[0] if outcome.error else ""
+                    log.warning("run %s: %s: %s", outcome.run_id, outcome.status, first)
+                bar.update(sum(counts.values()))
 
-def _run(spec: SweepSpec, out: Path, runs: list[RunSpec], workers: int | None,
-         scheduler: str | None, progress: bool, plots: bool,
-         paper: Mapping[str, Mapping[float, float]] | None, t0: float,
-         share_warmup: bool = True) -> SweepReport:
-    """The body of :func:`run_sweep` inside its claimed output directory ``out``."""
-    with atomic_file(out / "sweep.toml") as tmp:
-        tmp.write_text(spec.text or f"# sweep {spec.name} (built in code)\n", encoding="utf-8")
-    todo = [r for r in runs if not _finished(out, r)]
-    by_id = {r.run_id: r for r in runs}
-    backend = f"dask {scheduler}" if scheduler else \
-        f"local pool, {workers or default_workers()} processes"
-    log.info("sweep %s: %d runs, %d finished before, %d to run (%s)", spec.name, len(runs),
-             len(runs) - len(todo), len(todo), backend)
-    bar = Progress(len(todo), f"sweep {spec.name}", enabled=progress and bool(todo))
-    counts: Counter[str] = Counter()
-
-    def on_done(outcome: RunOutcome) -> None:
-        write_outcome(out, by_id[outcome.run_id], outcome)
-        counts[outcome.status] += 1
-        if outcome.status not in FINISHED:
-            first = (outcome.error or "").splitlines()[0] if outcome.error else ""
-            log.warning("run %s: %s: %s", outcome.run_id, outcome.status, first)
-        bar.update(sum(counts.values()))
-
-    def on_group_done(outcomes: list[RunOutcome]) -> None:
-        for outcome in outcomes:
-            on_done(outcome)
-
-    tasks = [task_of(spec, r) for r in todo]
-    # a seed's runs are split over idle local workers; a cluster's size is not known here
-    spread = 1 if scheduler else workers or default_workers()
-    groups = (share_warmups(tasks, spread) if share_warmup
-              else [RunGroup((t,)) for t in tasks])
-    try:
-        if groups and scheduler:
-            run_dask(groups, scheduler, on_group_done, one_thread=spec.engine == "sumo",
-                     fn=execute_group, on_crash=crashed_group)
-        elif groups:
-            run_local(groups, workers or default_workers(), on_group_done,
-                      fn=execute_group, on_crash=crashed_group)
-    finally:
-        bar.close()
-    report = SweepReport(spec.name, out, backend, len(runs), len(runs) - len(todo),
-                         sum(counts.values()), dict(counts), time.perf_counter() - t0)
-    report.table = finish(spec, out, runs, report, plots, paper)
-    return report
+        tasks = [task_of(spec, r) for r in todo]
+        # a seed's runs are split over idle local workers; a cluster's size is not known here
+        groups = (share_warmups(tasks, 1 if scheduler else workers) if share_warmup
+                  else [RunGroup((t,)) for t in tasks])
+        try:
+            if groups and scheduler:
+                run_dask(groups, scheduler, on_group_done, one_thread=spec.engine == "sumo",
+                         fn=execute_group, on_crash=crashed_group)
+            elif groups:
+                run_local(groups, workers, on_group_done, fn=execute_group,
+                          on_crash=crashed_group)
+        finally:
+            bar.close()
+        report = SweepReport(spec.name, target, backend, len(runs), len(runs) - len(todo),
+                             sum(counts.values()), dict(counts), time.perf_counter() - t0)
+        report.table = finish(spec, target, runs, report, plots, paper)
+        return report
 
 
 def finish(spec: SweepSpec, out: Path, runs: list[RunSpec], report: SweepReport,

@@ -32,6 +32,7 @@ from arzsumo.sweep.spec import (
     RunSpec,
     SweepError,
     SweepSpec,
+    drop_fields,
     sweep_from_dict,
 )
 from arzsumo.sweep.table import run_dir, sweep_table
@@ -75,10 +76,8 @@ def inert_for(controller: str) -> tuple[str, ...]:
     return base + own
 
 
-#: tables that reach an open-loop SUMO run only through what it is given to simulate: the
-#: vehicles placed at t = 0 (``[run] start = "placement"``) and, from the model, the
-#: vehicle types and insertion columns of the route file (:func:`_sumo_input`). With
-#: ``start = "warmup"`` (the default) and the same route file, they drive only the twins
+#: tables that reach an open-loop SUMO run only through the vehicles placed at t = 0 and
+#: the route file (:func:`_sumo_input`); with neither, they drive only the twins
 PLACEMENT_ONLY = ("model", "equilibrium", "initial")
 #: evaluation measures computed with the model's parameters (section delay: TTT - TMT /
 #: v_free): a baseline borrowed under another [model] has them blanked (NaN)
@@ -166,12 +165,7 @@ def _model_inert(a: dict, b: dict) -> bool:
 def _without_inert(data: dict, model_inert: bool = False,
                    inert: Sequence[str] = inert_for(BASELINE)) -> dict:
     out = copy.deepcopy(data)
-    for name in tuple(inert) + (PLACEMENT_ONLY if model_inert else ()):
-        table, _, key = name.partition(".")
-        if key and isinstance(out.get(table), dict):
-            out[table].pop(key, None)
-        elif not key:
-            out.pop(table, None)
+    drop_fields(out, tuple(inert) + (PLACEMENT_ONLY if model_inert else ()))
     return out
 
 

@@ -21,7 +21,7 @@ import itertools
 import json
 import math
 import re
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -66,6 +66,16 @@ CONTROLLER_ONLY: dict[str, tuple[str, ...]] = {
 LABELS = ("name", "description")
 
 
+def drop_fields(data: dict[str, Any], names: Iterable[str]) -> None:
+    """Remove each table (``sensing``) or key (``run.controller``) of ``names`` from ``data``."""
+    for name in names:
+        table, _, key = name.partition(".")
+        if not key:
+            data.pop(table, None)
+        elif isinstance(data.get(table), dict):
+            data[table].pop(key, None)
+
+
 def deciding(scenario: Mapping[str, Any], engine: str) -> dict[str, Any]:
     """``scenario`` without what decides none of a run's numbers: its labels and, for a
     SUMO run, the :data:`CONTROLLER_ONLY` tables and keys its controller does not read."""
@@ -74,14 +84,7 @@ def deciding(scenario: Mapping[str, Any], engine: str) -> dict[str, Any]:
     if engine != "sumo":
         return data
     controller = str(data.get("run", {}).get("controller", "open"))
-    for dotted, users in CONTROLLER_ONLY.items():
-        if controller in users:
-            continue
-        table, _, key = dotted.partition(".")
-        if not key:
-            data.pop(table, None)
-        elif isinstance(data.get(table), dict):
-            data[table].pop(key, None)
+    drop_fields(data, [k for k, users in CONTROLLER_ONLY.items() if controller not in users])
     return data
 
 
