@@ -114,9 +114,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def run_command(parser: argparse.ArgumentParser, argv: Sequence[str] | None,
                 prog: str) -> int:
-    """Parse ``argv`` with ``parser`` and run the chosen command's ``func``: one line on
-    stderr (``PROG: error: ...``) and exit code 2 for a user error, 130 for Ctrl-C; the
-    logging is configured here (``-v``: debug)."""
+    """Parse ``argv`` with ``parser``, configure the logging and run the command's ``func``;
+    a user error is one line on stderr (``PROG: error: ...``) and exit code 2."""
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # --help, --version, or a refused argument (one line printed)

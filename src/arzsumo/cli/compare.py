@@ -24,12 +24,10 @@ def _skipped(run: Path, out: Path) -> str | None:
 
 
 def runs_to_compare(runs: list[Path], out: Path) -> list[Path]:
-    """``runs`` without the comparison's own ``out`` and other comparison outputs, each
-    skipped one named on stderr."""
+    """``runs`` without comparison outputs (``out`` among them), each named on stderr."""
     kept = []
     for run in runs:
-        why = _skipped(run, out)
-        if why is None:
+        if (why := _skipped(run, out)) is None:
             kept.append(run)
         else:
             print(f"arzsumo: note: skipped {run}: {why}", file=sys.stderr)

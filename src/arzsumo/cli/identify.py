@@ -70,8 +70,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
 
 
 def _print_references(study: IdentifyStudy) -> None:
-    """The held-out block errors of the references beside the model's, and the replay
-    error splits."""
+    """The held-out block errors of the references beside the model's; the error splits."""
     from arzsumo.workflows.identify.references import REFERENCES
 
     refs = study.references

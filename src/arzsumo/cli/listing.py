@@ -60,10 +60,9 @@ def _shown(path: Path) -> str:
         return str(path)
 
 
-def shipped(root: Path | None = None) -> list[dict[str, str]]:
-    """Every shipped file: group, path, name (stem, what commands take), description and
-    where it runs (``runs_in``: ``sumo`` or ``twin``)."""
-    root = shipped_scenarios_dir() if root is None else root
+def shipped() -> list[dict[str, str]]:
+    """Every shipped file: group, path, name (what commands take), description, runs_in."""
+    root = shipped_scenarios_dir()
     return [{"group": group, "path": _shown(f), "name": f.stem, "description": describe(f),
              "runs_in": runs_in(f, sub)}
             for group, sub in GROUPS for f in sorted((root / sub).glob("*.toml"))]

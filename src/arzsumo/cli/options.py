@@ -31,8 +31,7 @@ def add_workers(p: argparse.ArgumentParser, help: str | None = None,
 
 
 def add_parallel(p: argparse.ArgumentParser) -> None:
-    """``--workers N``, ``--scheduler ADDRESS`` (the sweep engine's executors) and
-    ``--no-shared-warmup``."""
+    """The sweep engine's ``--workers N``, ``--scheduler ADDRESS``, ``--no-shared-warmup``."""
     add_workers(p)
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="Dask scheduler address, e.g. tcp://SCHEDULER-HOST:8786")
@@ -72,8 +71,7 @@ def add_seeds(p: argparse.ArgumentParser, help: str, *, flag: str = "--seeds",
 
 def add_scenario(p: argparse.ArgumentParser, help: str = "scenario file", *,
                  optional: bool = False) -> None:
-    """The positional ``SCENARIO``: a TOML file or a shipped scenario name
-    (:func:`arzsumo.cli.scenarios.scenario_file`)."""
+    """The positional ``SCENARIO``: a TOML file or a shipped scenario name."""
     text = f"{help}, or a shipped scenario name ('arzsumo list')"
     if optional:
         p.add_argument("scenario", nargs="?", metavar="SCENARIO",
@@ -84,8 +82,7 @@ def add_scenario(p: argparse.ArgumentParser, help: str = "scenario file", *,
 
 def add_model_source(p: argparse.ArgumentParser, *, preset_help: str = "named model preset",
                      scenario_help: str = "scenario file instead of a preset") -> None:
-    """The exclusive ``--preset NAME`` | ``--scenario FILE|NAME``
-    (:func:`arzsumo.cli.scenarios.scenario_of` reads them)."""
+    """The exclusive ``--preset NAME`` | ``--scenario FILE|NAME`` (read by ``scenario_of``)."""
     src = p.add_mutually_exclusive_group()
     src.add_argument("--preset", default="paper_base",
                      help=f"{preset_help} ({', '.join(sorted(PRESETS))})")
@@ -94,8 +91,7 @@ def add_model_source(p: argparse.ArgumentParser, *, preset_help: str = "named mo
 
 
 def add_warmup(p: argparse.ArgumentParser, help: str) -> None:
-    """``--warmup S`` (>= 0 s) and ``--allow-short-warmup``
-    (:func:`arzsumo.bridge.session.check_warmup`)."""
+    """``--warmup S`` (>= 0 s) and ``--allow-short-warmup`` (checked by ``check_warmup``)."""
     p.add_argument("--warmup", type=non_negative_float, help=help)
     p.add_argument("--allow-short-warmup", action="store_true",
                    help="start control before the scenario's fill phase ([sumo] fill_s) "

@@ -60,8 +60,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         from arzsumo.outputs.bridge import SUMMARY_CSV
 
         print(key_table(summ, str(out / SUMMARY_CSV)))
-        line = updates_line(summ)
-        if line:
+        if line := updates_line(summ):
             print(line)
         print(f"results: {out}")
     return 0

@@ -180,12 +180,10 @@ def map_runs(fn: Callable[[Any], Any], tasks: Sequence[Any], *, workers: int = 1
              progress: str | None = None) -> list[Any]:
     """``[fn(t) for t in tasks]`` on the sweep's backends, results in the order of ``tasks``.
 
-    ``fn`` must be a picklable module-level function and the tasks picklable. With
-    ``scheduler`` the tasks run on that Dask cluster, else on ``workers`` fresh local
-    processes (:func:`run_local`); ``in_process`` runs them here, one after the other
-    (for runs shorter than a process start). A task whose process dies twice raises
-    ``RuntimeError``: unlike a sweep, the caller needs every result. ``progress``, when
-    given, labels a progress bar on stderr.
+    ``fn`` (module-level) and the tasks must be picklable. ``in_process`` runs them here,
+    one after the other (for runs shorter than a process start). A task whose process dies
+    twice raises ``RuntimeError``: unlike a sweep, the caller needs every result.
+    ``progress``, when given, labels a progress bar on stderr.
     """
     if in_process or not tasks:
         return [fn(t) for t in tasks]
@@ -293,8 +291,7 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
 def finish(spec: SweepSpec, out: Path, runs: list[RunSpec], report: SweepReport,
            plots: bool, paper: Mapping[str, Mapping[float, float]] | None = None
            ) -> pd.DataFrame:
-    """Write the table, the plots and the manifest of a sweep whose runs are done; return
-    the table."""
+    """Write the table, plots and manifest of a sweep whose runs are done; return the table."""
     import pyarrow.parquet as pq
 
     df = sweep_table(runs, out)

@@ -85,8 +85,7 @@ MODEL_DEPENDENT = ("section.total_delay.",)
 
 
 def check_controllers(controllers: Sequence[str]) -> list[str]:
-    """The controllers in order, baseline first (added when missing); unknown or repeated
-    names refused."""
+    """The controllers, baseline first (added when missing); unknown or repeated refused."""
     from arzsumo.control.registry import controller_names
 
     allowed = controller_names("sumo")
@@ -103,9 +102,8 @@ def check_controllers(controllers: Sequence[str]) -> list[str]:
 
 def evaluation_spec(scenario: Path, controllers: Sequence[str], seeds: Sequence[int],
                     horizon: float | None = None, warmup: float | None = None) -> SweepSpec:
-    """The sweep of an evaluation: ``scenario`` x controllers x seeds (``horizon``: the
-    control horizon, s, instead of ``[sumo] horizon_s``; ``warmup``: the warm-up, s,
-    instead of ``[run] warmup_s``)."""
+    """The sweep of an evaluation: ``scenario`` x controllers x seeds; ``horizon`` and
+    ``warmup`` (s) replace ``[sumo] horizon_s`` and ``[run] warmup_s``."""
     scenario = Path(scenario).resolve()
     name = re.sub(r"[^A-Za-z0-9._-]", "_", f"evaluate-{scenario.stem}")
     data: dict = {"name": name, "base": str(scenario), "engine": "sumo",
@@ -179,8 +177,7 @@ def _first_difference(a: dict, b: dict, prefix: str = "") -> str:
 
 
 def _their_run(source: Path, mine: RunSpec, user: str) -> RunSpec:
-    """The open-loop run of the earlier evaluation in ``source`` matching ``mine``,
-    checked to be the same SUMO run."""
+    """The run in ``source`` matching ``mine``, checked to be the same SUMO run."""
     path = run_dir(source, mine) / "scenario.toml"
     if not (path.parent / "summary.json").is_file():
         raise SweepError(f"--baseline-from = {user} is not allowed: it has no finished run "

@@ -70,9 +70,8 @@ class _Collect(logging.Handler):
 
 @contextlib.contextmanager
 def collected_warnings() -> Iterator[list[str]]:
-    """Warnings logged by arzsumo during a run go into its outcome, not onto the sweep's
-    terminal (a hundred workers would bury the progress bar). A child forked inside
-    inherits the list and adds its own (:mod:`arzsumo.sweep.groups`)."""
+    """The warnings arzsumo logs during a run, for its outcome, kept off the sweep's terminal
+    (a hundred workers would bury the progress bar); a child forked inside adds its own."""
     logger = logging.getLogger("arzsumo")
     handler, propagate = _Collect(), logger.propagate
     logger.addHandler(handler)
@@ -109,8 +108,7 @@ def _run_sumo(task: RunTask) -> tuple[str, dict[str, Any], dict[str, bytes]]:
 
 
 def sumo_outcome(session: Any) -> tuple[str, dict[str, Any], dict[str, bytes]]:
-    """Status, summary and tables of a finished SUMO session (a plain run's or a branch's
-    of :mod:`arzsumo.sweep.groups`)."""
+    """Status, summary and tables of a finished SUMO session (a plain run or a branch)."""
     from arzsumo.outputs.bridge import cells_table, periods_table, summary
 
     summ = json_safe(summary(session.result).to_dict())
