@@ -1,16 +1,7 @@
 """Sweep files: a base scenario, an engine and axes, expanded into runs with stable IDs.
 
-The file's keys, axes, groups and run IDs: docs/sweeps.md. Besides one field per value
-(``field = "equilibrium.penetration"``), an axis may set several fields per value::
-
-    [[axis]]
-    name = "demand_veh_h"
-    values = [4966, 5664]
-    set = [{ "sumo.demand_h_veh_h" = 3461, "sumo.demand_a_veh_h" = 1505 },
-           { "sumo.demand_h_veh_h" = 4104, "sumo.demand_a_veh_h" = 1560 }]
-
-In a group, the group's column names the varied axis; the group's other axes keep their
-base value. The SHA-256 of the resolved scenario tells a finished run from a stale one.
+The file's keys, axes (one field or several per value), groups and run IDs:
+docs/sweeps.md. The SHA-256 of the resolved scenario tells a finished run from a stale one.
 """
 
 from __future__ import annotations
