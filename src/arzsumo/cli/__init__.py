@@ -42,7 +42,7 @@ log = logging.getLogger("arzsumo")
 REGISTER: tuple[Callable[[argparse._SubParsersAction], None], ...] = (
     run.register, compare.register, evaluate.register, sweep.register, twin.register,
     reproduce.register, model.register, control.register, identify.register,
-    sumo.register, sumo.register_alinea_target, network.register, listing.register)
+    sumo.register, network.register, listing.register)
 
 #: entry-point group of packages that add commands of their own (a ``register(sub)``
 #: function each, as the modules of :data:`REGISTER`); listed after the tool's commands
