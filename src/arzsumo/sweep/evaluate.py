@@ -1,11 +1,7 @@
 """``arzsumo evaluate``: every controller on the same seeds in SUMO, compared with the open
-loop seed by seed.
-
-The runs are a sweep built in code (:func:`evaluation_spec`: an axis ``controller`` over
-``[run] controller``, the seeds last) in a directory of its own marker kind
-(:data:`KIND`), laid out as docs/outputs.md says. Open-loop runs taken from an earlier
-evaluation (``--baseline-from``, :func:`borrowed_baseline`) and a controller's runs
-taken from elsewhere (``--runs-from``): docs/whole_demand.md.
+loop seed by seed: a sweep built in code (:func:`evaluation_spec`) in a directory of its
+own marker kind (:data:`KIND`; docs/outputs.md). Runs taken from earlier evaluations
+(``--baseline-from``, ``--runs-from``) and when that is allowed: docs/whole_demand.md.
 """
 
 from __future__ import annotations

@@ -1,11 +1,7 @@
 """Runs of a sweep that share a warm-up, executed as one task (docs/sweeps.md, "One
-warm-up per seed").
-
-:func:`share_warmups` groups the SUMO runs that differ only in ``[run] controller`` into
-:class:`RunGroup` tasks; :func:`execute_group` simulates a group's warm-up once and runs
-every controller in a child forked at its end (:func:`arzsumo.bridge.branches.run_branched`),
-or, where the process may not fork (a threaded Dask worker), in a fresh single-threaded
-Python process (:func:`in_subprocess`), else as plain runs.
+warm-up per seed"): :func:`share_warmups` groups them; :func:`execute_group` runs each
+controller in a child forked at the end of the group's warm-up, in a fresh process where
+this one may not fork (a threaded Dask worker).
 """
 
 from __future__ import annotations
