@@ -180,8 +180,9 @@ def map_runs(fn: Callable[[Any], Any], tasks: Sequence[Any], *, workers: int = 1
              progress: str | None = None) -> list[Any]:
     """``[fn(t) for t in tasks]`` on the sweep's backends, results in the order of ``tasks``.
 
-    ``fn`` (module-level) and the tasks must be picklable. ``in_process`` runs them here,
-    one after the other (for runs shorter than a process start). A task whose process dies
+    ``fn`` (module-level) and the tasks must be picklable. They run on the Dask cluster of
+    ``scheduler``, else on ``workers`` local processes, or with ``in_process`` here, one
+    after the other (for runs shorter than a process start). A task whose process dies
     twice raises ``RuntimeError``: unlike a sweep, the caller needs every result.
     ``progress``, when given, labels a progress bar on stderr.
     """
