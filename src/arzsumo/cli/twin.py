@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import logging
 from pathlib import Path
 
 from arzsumo.cli.options import add_json, add_no_plots, add_out, add_overwrite, add_scenario
@@ -13,9 +12,6 @@ from arzsumo.cli.scenarios import load_named
 from arzsumo.control.registry import controller_names
 from arzsumo.errors import EXIT_INCOMPLETE
 from arzsumo.units import veh_s_to_veh_h
-
-log = logging.getLogger(__name__)
-
 
 #: (summary key, printed name, unit, factor from the summary's SI value); the times in
 #: veh h as ``arzsumo run`` prints them (docs/outputs.md: the indices and their units)
