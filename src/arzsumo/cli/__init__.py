@@ -1,12 +1,8 @@
 """Command-line interface: one thin command per stage, one module per command or group.
 
-``arzsumo.cli.options`` declares the options the commands share; each command module
-(``run``, ``compare``, ``evaluate``, ...) adds its parser with ``register(sub)``. Each
-command loads and validates its input, calls one library function and prints or
-saves. User mistakes (:class:`arzsumo.errors.ArzsumoError`) end as one line on stderr
-with exit code 2; Ctrl-C (SIGINT) ends as ``arzsumo: interrupted`` with exit code 130,
-after the command's temporary files are removed; logging is configured here and nowhere
-else.
+Each command module adds its parser with ``register(sub)``; ``arzsumo.cli.options``
+declares the options they share. User errors, Ctrl-C and the logging are handled here
+(:func:`run_command`; the exit codes: :data:`EPILOG`).
 """
 
 from __future__ import annotations
@@ -41,14 +37,12 @@ from arzsumo.version import __version__
 
 log = logging.getLogger("arzsumo")
 
-Command = Callable[[argparse.Namespace], int]
-
 #: what adds each command, in the order ``arzsumo --help`` lists them: a run first, then
 #: what compares runs, the twin and the paper, the model and its laws, the network
 REGISTER: tuple[Callable[[argparse._SubParsersAction], None], ...] = (
     run.register, compare.register, evaluate.register, sweep.register, twin.register,
     reproduce.register, model.register, control.register, identify.register,
-    sumo.register, sumo.register_alinea_target, network.register, listing.register)
+    sumo.register, network.register, listing.register)
 
 #: entry-point group of packages that add commands of their own (a ``register(sub)``
 #: function each, as the modules of :data:`REGISTER`); listed after the tool's commands
@@ -57,9 +51,7 @@ COMMAND_PLUGINS = "arzsumo.commands"
 
 def plugin_registers() -> list[Callable[[argparse._SubParsersAction], None]]:
     """The ``register`` functions of the installed packages' ``arzsumo.commands`` entry
-    points, by name (none when no such package is installed). One that cannot be
-    imported (its metadata left behind by an uninstalled package) is skipped: the tool's
-    own commands never depend on another package."""
+    points, by name; one that cannot be loaded is skipped."""
     from importlib.metadata import entry_points
 
     registers = []
@@ -122,9 +114,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def run_command(parser: argparse.ArgumentParser, argv: Sequence[str] | None,
                 prog: str) -> int:
-    """Parse ``argv`` with ``parser`` and run the chosen command's ``func``: one line on
-    stderr (``PROG: error: ...``) and exit code 2 for a user error, 130 for Ctrl-C; the
-    logging is configured here (``-v``: debug)."""
+    """Parse ``argv`` with ``parser``, configure the logging and run the command's ``func``;
+    a user error is one line on stderr (``PROG: error: ...``) and exit code 2."""
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # --help, --version, or a refused argument (one line printed)
@@ -133,11 +124,10 @@ def run_command(parser: argparse.ArgumentParser, argv: Sequence[str] | None,
                         else logging.INFO,
                         format="%(levelname)s %(name)s: %(message)s")
     logging.getLogger("matplotlib").setLevel(logging.WARNING)
-    func: Command = args.func
     main_thread = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGINT, _interrupt) if main_thread else None
     try:
-        return func(args)
+        return args.func(args)
     except ArzsumoError as exc:
         print(f"{prog}: error: {exc}", file=sys.stderr)
         return EXIT_USAGE

@@ -1,11 +1,5 @@
-"""Argument checking and help layout shared by every ``arzsumo`` command.
-
-Nonsense on the command line (a negative horizon, zero workers, a negative seed) is
-refused by argparse itself through the ``type=`` checks of :mod:`arzsumo.argtypes`;
-:class:`Parser` prints that refusal, like every other user error, as ONE line
-``arzsumo: error: ...`` and exits with code 2 (no usage block: ``arzsumo CMD --help``
-shows it). :class:`HelpFormatter` shows defaults in every help text.
-"""
+"""Argument checking and help layout shared by every ``arzsumo`` command: a refused
+argument (the ``type=`` checks of :mod:`arzsumo.argtypes`) is one line, exit code 2."""
 
 from __future__ import annotations
 
@@ -43,11 +37,8 @@ _OPTION_VALUE = re.compile(r"^argument (?:\S+/)?(\S+): (\S+ is not allowed: .*)$
 
 
 class Parser(argparse.ArgumentParser):
-    """An ArgumentParser whose errors are one line, ``arzsumo: error: ...``, exit 2.
-
-    Subcommand parsers are of this class too (argparse makes them with the parent's
-    class) and get :class:`HelpFormatter`.
-    """
+    """An ArgumentParser whose errors are one line, ``arzsumo: error: ...``, exit 2; its
+    subcommand parsers (argparse makes them of the parent's class) too."""
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         kwargs.setdefault("formatter_class", HelpFormatter)

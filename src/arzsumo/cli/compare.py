@@ -1,8 +1,5 @@
-"""``arzsumo compare RUN_DIR... [--out DIR]``: one table across ``arzsumo run`` results.
-
-``arzsumo compare results/*/ --out results/comparison`` can be repeated: the glob then
-also matches the comparison's own directory, which is skipped with a one-line note, as
-is any other directory holding a comparison and no run summary.
+"""``arzsumo compare RUN_DIR... [--out DIR]``: one table across ``arzsumo run`` results;
+the comparison's own directory and earlier comparisons are skipped (a glob may match them).
 """
 
 from __future__ import annotations
@@ -27,12 +24,10 @@ def _skipped(run: Path, out: Path) -> str | None:
 
 
 def runs_to_compare(runs: list[Path], out: Path) -> list[Path]:
-    """``runs`` without the comparison's own ``out`` and other comparison outputs, each
-    skipped one named on stderr."""
+    """``runs`` without comparison outputs (``out`` among them), each named on stderr."""
     kept = []
     for run in runs:
-        why = _skipped(run, out)
-        if why is None:
+        if (why := _skipped(run, out)) is None:
             kept.append(run)
         else:
             print(f"arzsumo: note: skipped {run}: {why}", file=sys.stderr)

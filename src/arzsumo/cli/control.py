@@ -70,11 +70,10 @@ def cmd_verify(args: argparse.Namespace) -> int:
             for key, value in summary.items():
                 print(f"  {key:28s} {value}")
         return 0
-    report = verify_backstepping(lin, args.cells, kernels)
+    r = verify_backstepping(lin, args.cells, kernels)
     if args.json:
-        print(json.dumps(report.as_dict(), indent=2))
+        print(json.dumps(r.as_dict(), indent=2))
         return 0
-    r = report
     print(f"linear plant checks on {r.grid} cells")
     print(f"  t_f                                  {r.t_f:10.1f} s")
     print(f"  backstepping ||z(t_f+20)||/||z(0)||  {r.closed_loop_ratio:10.2e}")

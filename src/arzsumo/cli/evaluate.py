@@ -1,13 +1,5 @@
 """``arzsumo evaluate SCENARIO --controllers LIST --seeds N``: controllers on the same seeds
-in SUMO, compared with the open loop seed by seed.
-
-Checks the scenario for every controller (as ``arzsumo run`` would, the warm-up against
-the scenario's fill phase included) before any run, then calls :func:`arzsumo.evaluate`
-(:func:`arzsumo.api.evaluation.evaluate`) and prints the headline differences and where the
-report is.
-Exit codes: 0 every run finished, 4 some runs were invalid, failed or crashed (the
-report uses the seeds that finished for both members of a pair), 2 a user error.
-"""
+in SUMO, compared with the open loop seed by seed (:func:`arzsumo.evaluate`)."""
 
 from __future__ import annotations
 
@@ -41,10 +33,9 @@ def cmd_evaluate(args: argparse.Namespace) -> int:
     from arzsumo.sweep.evaluate import BASELINE
 
     scenario = scenario_file(args.scenario)
-    controllers = [c.strip() for c in args.controllers.split(",") if c.strip()]
     command = "arzsumo " + " ".join(shlex.quote(a) for a in sys.argv[1:]) \
         if sys.argv[1:2] == ["evaluate"] else ""
-    res = evaluate(scenario, controllers=controllers,
+    res = evaluate(scenario, controllers=args.controllers,   # "open,etc": split there
                    seeds=seed_list(args.seeds, args.seed_start), out=args.out,
                    horizon_s=args.horizon, warmup_s=args.warmup,
                    allow_short_warmup=args.allow_short_warmup, workers=args.workers,

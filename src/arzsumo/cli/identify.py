@@ -1,11 +1,5 @@
 """``arzsumo identify SCENARIO --train-seeds ... --validate-seeds ...``: the macroscopic
-model identified from open-loop SUMO runs.
-
-Checks the seeds, the ``--vary`` points, the ``--which`` names and the output directory
-before any run, then calls :func:`arzsumo.workflows.identify.study.run_identification` and writes
-the results (:func:`arzsumo.workflows.identify.report.write_study`). Exit codes: 0 done,
-2 a user error (one line).
-"""
+model identified from open-loop SUMO runs (:mod:`arzsumo.workflows.identify`)."""
 
 from __future__ import annotations
 
@@ -56,8 +50,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
     fit = study.fit
     print(f"identify {sc.name}: {runs} runs, SUMO {study.wall['sumo']:.1f} s, fit "
           f"{study.wall['fit']:.1f} s ({fit.nfev} steps, {fit.evaluations} evaluations)")
-    if study.stage_one is not None:
-        _print_stage_one(study)
+    _print_stage_one(study)
     for i, name in enumerate(fit.which):
         print(f"  {name:<10} = {fit.values[i]:.4g} +- {fit.sigma[i]:.2g} (SI)")
     scores = [("start, training", study.start), ("training", study.training),
@@ -77,8 +70,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
 
 
 def _print_references(study: IdentifyStudy) -> None:
-    """The held-out block errors of the references beside the model's, and the replay
-    error splits."""
+    """The held-out block errors of the references beside the model's; the error splits."""
     from arzsumo.workflows.identify.references import REFERENCES
 
     refs = study.references
@@ -100,7 +92,7 @@ def _print_references(study: IdentifyStudy) -> None:
 
 
 def _print_stage_one(study: IdentifyStudy) -> None:
-    """Stage 1's diagram and the wave check on both run sets (km/h)."""
+    """Stage 1's diagram and the wave check on both run sets (km/h), if there was one."""
     from arzsumo.units import ms_to_kmh
     from arzsumo.workflows.identify.report import stage_lambda_4
 

@@ -1,10 +1,5 @@
-"""``arzsumo list``: the shipped scenario and sweep files by name, with their descriptions.
-
-Every name listed is what a command takes in place of a file (``arzsumo run default``,
-``arzsumo twin base_etc``, ``arzsumo sweep demand_sumo``). The scenarios are split by
-where they run: those with a ``[sumo]`` table are made for SUMO (``arzsumo run``; the
-twin runs them too), the others for the PDE twin only (``arzsumo twin``).
-"""
+"""``arzsumo list``: the shipped scenario and sweep files by name, with their descriptions,
+split by where they run (SUMO or the twin only)."""
 
 from __future__ import annotations
 
@@ -65,10 +60,9 @@ def _shown(path: Path) -> str:
         return str(path)
 
 
-def shipped(root: Path | None = None) -> list[dict[str, str]]:
-    """Every shipped file: group, path, name (stem, what commands take), description and
-    where it runs (``runs_in``: ``sumo`` or ``twin``)."""
-    root = shipped_scenarios_dir() if root is None else root
+def shipped() -> list[dict[str, str]]:
+    """Every shipped file: group, path, name (what commands take), description, runs_in."""
+    root = shipped_scenarios_dir()
     return [{"group": group, "path": _shown(f), "name": f.stem, "description": describe(f),
              "runs_in": runs_in(f, sub)}
             for group, sub in GROUPS for f in sorted((root / sub).glob("*.toml"))]

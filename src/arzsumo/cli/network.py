@@ -1,9 +1,4 @@
-"""``arzsumo network``: the section a scenario runs on and the detectors placed on it.
-
-Checks the scenario's ``[network]`` table as ``arzsumo run --dry-run`` does, prints where
-each detector sits (edge and lane position) and, with ``--figure FILE.png``, draws the
-section, the ramp, the meter's light, the loop stations and the cells' boundaries.
-"""
+"""``arzsumo network``: the section a scenario runs on and the detectors placed on it."""
 
 from __future__ import annotations
 

@@ -1,13 +1,6 @@
-"""The options several ``arzsumo`` commands share, each declared once here.
-
-A command module adds them with one call each (``add_out(p, "results directory")``), so
-a flag means the same and is checked the same in every command: where results go
-(``--out``, ``--overwrite``), how runs execute (``--workers``, ``--scheduler``, ``--quiet``,
-``--no-plots``), which seeds (``--seed``, ``--seeds``), which scenario (a positional
-``SCENARIO``, or ``--preset`` | ``--scenario``) and its warm-up (``--warmup``,
-``--allow-short-warmup``). The studies declare their options in
-:mod:`arzsumo_studies.common` (a room below the CLI).
-"""
+"""The options several ``arzsumo`` commands share, each declared once here, so that a flag
+means the same and is checked the same in every command (the studies' own:
+:mod:`arzsumo_studies.common`)."""
 
 from __future__ import annotations
 
@@ -15,9 +8,6 @@ import argparse
 
 from arzsumo.cli.args import non_negative_float, positive_int, seed_int, seed_list
 from arzsumo.model.params import PRESETS
-
-#: help of --scheduler wherever it appears
-SCHEDULER_HELP = "Dask scheduler address, e.g. tcp://SCHEDULER-HOST:8786"
 
 
 def add_out(p: argparse.ArgumentParser, help: str, *, default: str | None = None,
@@ -40,16 +30,11 @@ def add_workers(p: argparse.ArgumentParser, help: str | None = None,
                                 "--scheduler")
 
 
-def add_scheduler(p: argparse.ArgumentParser) -> None:
-    """``--scheduler ADDRESS``: run on a Dask cluster instead of local processes."""
-    p.add_argument("--scheduler", metavar="ADDRESS", help=SCHEDULER_HELP)
-
-
 def add_parallel(p: argparse.ArgumentParser) -> None:
-    """``--workers N``, ``--scheduler ADDRESS`` (the sweep engine's executors) and
-    ``--no-shared-warmup``."""
+    """The sweep engine's ``--workers N``, ``--scheduler ADDRESS``, ``--no-shared-warmup``."""
     add_workers(p)
-    add_scheduler(p)
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="Dask scheduler address, e.g. tcp://SCHEDULER-HOST:8786")
     p.add_argument("--no-shared-warmup", action="store_true",
                    help="give every SUMO run its own warm-up (by default the runs of a "
                         "seed that differ only in the controller simulate it once; the "
@@ -86,8 +71,7 @@ def add_seeds(p: argparse.ArgumentParser, help: str, *, flag: str = "--seeds",
 
 def add_scenario(p: argparse.ArgumentParser, help: str = "scenario file", *,
                  optional: bool = False) -> None:
-    """The positional ``SCENARIO``: a TOML file or a shipped scenario name
-    (:func:`arzsumo.cli.scenarios.scenario_file`)."""
+    """The positional ``SCENARIO``: a TOML file or a shipped scenario name."""
     text = f"{help}, or a shipped scenario name ('arzsumo list')"
     if optional:
         p.add_argument("scenario", nargs="?", metavar="SCENARIO",
@@ -98,8 +82,7 @@ def add_scenario(p: argparse.ArgumentParser, help: str = "scenario file", *,
 
 def add_model_source(p: argparse.ArgumentParser, *, preset_help: str = "named model preset",
                      scenario_help: str = "scenario file instead of a preset") -> None:
-    """The exclusive ``--preset NAME`` | ``--scenario FILE|NAME``
-    (:func:`arzsumo.cli.scenarios.scenario_of` reads them)."""
+    """The exclusive ``--preset NAME`` | ``--scenario FILE|NAME`` (read by ``scenario_of``)."""
     src = p.add_mutually_exclusive_group()
     src.add_argument("--preset", default="paper_base",
                      help=f"{preset_help} ({', '.join(sorted(PRESETS))})")
@@ -108,8 +91,7 @@ def add_model_source(p: argparse.ArgumentParser, *, preset_help: str = "named mo
 
 
 def add_warmup(p: argparse.ArgumentParser, help: str) -> None:
-    """``--warmup S`` (>= 0 s) and ``--allow-short-warmup``
-    (:func:`arzsumo.bridge.session.check_warmup`)."""
+    """``--warmup S`` (>= 0 s) and ``--allow-short-warmup`` (checked by ``check_warmup``)."""
     p.add_argument("--warmup", type=non_negative_float, help=help)
     p.add_argument("--allow-short-warmup", action="store_true",
                    help="start control before the scenario's fill phase ([sumo] fill_s) "

@@ -1,10 +1,5 @@
-"""``arzsumo reproduce [--out DIR] [--quick]``: every experiment of the paper's section 5.
-
-The work is done by :func:`arzsumo.workflows.paper.reproduce.reproduce` and
-:func:`arzsumo.workflows.paper.report.write_reproduction`. Exit codes: 0 completed, 3 some
-runs stopped early (state left the physical domain; partial results written), 2 user
-error.
-"""
+"""``arzsumo reproduce [--out DIR] [--quick]``: every experiment of the paper's section 5
+(:func:`arzsumo.workflows.paper.reproduce.reproduce`)."""
 
 from __future__ import annotations
 

@@ -1,11 +1,5 @@
-"""``arzsumo run [SCENARIO]``: one closed loop in SUMO with the PDE twins alongside.
-
-Checks the scenario and the options as the run would (:func:`arzsumo.api.runs.prepare`:
-every check of :func:`arzsumo.run`), claims the output directory, runs SUMO
-(:func:`arzsumo.api.runs.run_checked`, on what was checked), saves the results
-(:meth:`arzsumo.RunResult.save`) and prints the key columns of the summary (every column:
-``summary.csv``). ``--dry-run`` makes the same checks and prints what the run would do.
-"""
+"""``arzsumo run [SCENARIO]``: one closed loop in SUMO with the PDE twins alongside
+(:func:`arzsumo.api.runs.prepare`, then :func:`arzsumo.api.runs.run_checked`)."""
 
 from __future__ import annotations
 
@@ -66,8 +60,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         from arzsumo.outputs.bridge import SUMMARY_CSV
 
         print(key_table(summ, str(out / SUMMARY_CSV)))
-        line = updates_line(summ)
-        if line:
+        if line := updates_line(summ):
             print(line)
         print(f"results: {out}")
     return 0

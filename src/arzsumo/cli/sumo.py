@@ -1,9 +1,5 @@
 """SUMO commands of the CLI: ``arzsumo build-net``, ``arzsumo calibrate`` and
-``arzsumo alinea-target`` (ALINEA's target from open-loop runs).
-
-Registered by :func:`register` and :func:`register_alinea_target` from
-:func:`arzsumo.cli.build_parser`; SUMO is imported only when one of these commands runs.
-"""
+``arzsumo alinea-target`` (ALINEA's target from open-loop runs)."""
 
 from __future__ import annotations
 
@@ -63,7 +59,6 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     cal = calibrate(scenario, out=args.out, quick=args.quick, horizon_s=args.horizon,
                     seed=args.seed, step_length_s=args.step_length, jobs=args.jobs,
                     overwrite=args.overwrite)
-    out = args.out
     for cls, name in (("h", "HV"), ("a", "AV")):
         f = cal.fits[cls]
         print(f"{name}: V = {ms_to_kmh(f.v_free):.1f} km/h, AO_max = {f.ao_max:.3f}, "
@@ -85,47 +80,8 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
               + ", ".join(f"{v:.2f}" for v in lam) + f" km/h; regime {eq['regime']}")
     else:
         print(f"regime: {eq.get('regime')} ({eq.get('note', '')})")
-    print(f"written: {out}")
+    print(f"written: {args.out}")
     return 0
-
-
-def register(sub: argparse._SubParsersAction) -> None:
-    """Add the SUMO subcommands to the CLI's subparsers."""
-    p = sub.add_parser("build-net", help="write the SUMO network sources and build the network",
-                       description="Write the XML sources of the on-ramp network, build it "
-                                   "with netconvert, and write sumo-gui files.")
-    add_out(p, "network directory (default: $ARZSUMO_SUMO_NETS, else sumo_nets/ of a "
-               "source checkout)")
-    p.add_argument("--keep-sources", action="store_true",
-                   help="rebuild from the XML sources in DIR instead of rewriting them")
-    p.add_argument("--approach-length-m", dest="approach_length", type=non_negative_float,
-                   default=0.0, metavar="M",
-                   help="length of the approach edge before x = 0 where mainline vehicles "
-                        "are inserted (default 0: none, the shipped network)")
-    p.add_argument("--approach-piece-m", dest="approach_piece", type=non_negative_float,
-                   default=0.0, metavar="M",
-                   help="cut the approach into edges of at most M m (default 0: one edge)")
-    p.set_defaults(func=cmd_build_net)
-
-    p = sub.add_parser("calibrate", help="fit the AO fundamental diagram and the meter curve "
-                                         "to SUMO runs",
-                       description="Run SUMO at several demands and meter plans, fit the AO "
-                                   "fundamental diagram per class and the meter's outflow "
-                                   "curve, and write them.")
-    add_model_source(p, preset_help="model preset for vehicle types",
-                     scenario_help="scenario file (may hold [sumo])")
-    add_out(p, "output directory (written atomically)", default="runs/calibration")
-    add_overwrite(p, "calibration")
-    add_seed(p, "the scenario's [sumo] seed")
-    p.add_argument("--step-length", type=positive_float,
-                   help="SUMO step, s (default: the scenario's [sumo] step_length_s)")
-    p.add_argument("--horizon", type=positive_float,
-                   help="length of each run, s (default 450; 90 with --quick)")
-    p.add_argument("--jobs", type=positive_int, default=min(2, os.cpu_count() or 1),
-                   help="SUMO runs at a time (default: up to 2)")
-    p.add_argument("--quick", action="store_true",
-                   help="a tiny smoke calibration (3 short runs)")
-    p.set_defaults(func=cmd_calibrate)
 
 
 def _loop_samples(args: argparse.Namespace, sc: Scenario
@@ -194,8 +150,44 @@ def cmd_alinea_target(args: argparse.Namespace) -> int:
     return 0
 
 
-def register_alinea_target(sub: argparse._SubParsersAction) -> None:
-    """Add ``alinea-target`` to the top-level parser."""
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add ``build-net``, ``calibrate`` and ``alinea-target`` to the top-level parser."""
+    p = sub.add_parser("build-net", help="write the SUMO network sources and build the network",
+                       description="Write the XML sources of the on-ramp network, build it "
+                                   "with netconvert, and write sumo-gui files.")
+    add_out(p, "network directory (default: $ARZSUMO_SUMO_NETS, else sumo_nets/ of a "
+               "source checkout)")
+    p.add_argument("--keep-sources", action="store_true",
+                   help="rebuild from the XML sources in DIR instead of rewriting them")
+    p.add_argument("--approach-length-m", dest="approach_length", type=non_negative_float,
+                   default=0.0, metavar="M",
+                   help="length of the approach edge before x = 0 where mainline vehicles "
+                        "are inserted (default 0: none, the shipped network)")
+    p.add_argument("--approach-piece-m", dest="approach_piece", type=non_negative_float,
+                   default=0.0, metavar="M",
+                   help="cut the approach into edges of at most M m (default 0: one edge)")
+    p.set_defaults(func=cmd_build_net)
+
+    p = sub.add_parser("calibrate", help="fit the AO fundamental diagram and the meter curve "
+                                         "to SUMO runs",
+                       description="Run SUMO at several demands and meter plans, fit the AO "
+                                   "fundamental diagram per class and the meter's outflow "
+                                   "curve, and write them.")
+    add_model_source(p, preset_help="model preset for vehicle types",
+                     scenario_help="scenario file (may hold [sumo])")
+    add_out(p, "output directory (written atomically)", default="runs/calibration")
+    add_overwrite(p, "calibration")
+    add_seed(p, "the scenario's [sumo] seed")
+    p.add_argument("--step-length", type=positive_float,
+                   help="SUMO step, s (default: the scenario's [sumo] step_length_s)")
+    p.add_argument("--horizon", type=positive_float,
+                   help="length of each run, s (default 450; 90 with --quick)")
+    p.add_argument("--jobs", type=positive_int, default=min(2, os.cpu_count() or 1),
+                   help="SUMO runs at a time (default: up to 2)")
+    p.add_argument("--quick", action="store_true",
+                   help="a tiny smoke calibration (3 short runs)")
+    p.set_defaults(func=cmd_calibrate)
+
     p = sub.add_parser("alinea-target", help="ALINEA's target from the loop's flow-occupancy "
                                              "curve in open-loop runs",
                        description="Run open loops of a scenario (or read run directories), "

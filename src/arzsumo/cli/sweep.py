@@ -1,9 +1,5 @@
-"""``arzsumo sweep SWEEP.toml [--workers N] [--scheduler ADDRESS] [--out DIR]``.
-
-Loads and validates the sweep file, calls :func:`arzsumo.sweep.run_sweep`, prints the
-counts and where the table is. Exit codes: 0 every run finished, 4 some runs were
-invalid, failed or crashed (recorded; the others completed), 2 a user error.
-"""
+"""``arzsumo sweep SWEEP.toml [--workers N] [--scheduler ADDRESS] [--out DIR]``
+(:func:`arzsumo.sweep.run_sweep`)."""
 
 from __future__ import annotations
 

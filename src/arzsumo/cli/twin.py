@@ -1,19 +1,10 @@
-"""``arzsumo twin SCENARIO [--controller NAME] [--out DIR] [--json]``: the nonlinear PDE twin.
-
-The controller is ``--controller``, else the scenario's ``[twin] controller``, else its
-``[run] controller`` (the one ``arzsumo run`` drives the meter with) when that runs in
-the twin, else the open loop; the printed summary names it and where it came from. The
-work is done by :func:`arzsumo.engines.twin.run_twin` and
-:func:`arzsumo.outputs.twin.write_run`. Exit codes: 0 completed, 3 stopped early (state
-left the physical domain; the partial results are written and marked ``"complete":
-false``), 2 user error.
-"""
+"""``arzsumo twin SCENARIO [--controller NAME] [--out DIR] [--json]``: the nonlinear PDE twin
+(:func:`arzsumo.api.runs.twin`)."""
 
 from __future__ import annotations
 
 import argparse
 import json
-import logging
 from pathlib import Path
 
 from arzsumo.cli.options import add_json, add_no_plots, add_out, add_overwrite, add_scenario
@@ -21,9 +12,6 @@ from arzsumo.cli.scenarios import load_named
 from arzsumo.control.registry import controller_names
 from arzsumo.errors import EXIT_INCOMPLETE
 from arzsumo.units import veh_s_to_veh_h
-
-log = logging.getLogger(__name__)
-
 
 #: (summary key, printed name, unit, factor from the summary's SI value); the times in
 #: veh h as ``arzsumo run`` prints them (docs/outputs.md: the indices and their units)

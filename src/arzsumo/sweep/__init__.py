@@ -1,12 +1,9 @@
 """Sweeps: a base scenario, an engine (twin or SUMO) and axes, run on a process pool or
-a Dask cluster, resumable and failure-isolated, summarised in one tidy table.
+a Dask cluster, resumable and failure-isolated, summarised in one tidy table
+(docs/sweeps.md). :func:`~arzsumo.sweep.driver.map_runs` runs any batch on the same
+backends.
 
-``spec`` reads sweep files, ``worker`` runs one run anywhere, ``driver`` schedules and
-stores, ``table`` builds the table. :func:`~arzsumo.sweep.driver.map_runs` is the engine
-for any batch (``arzsumo reproduce`` runs through it).
-
-May import outputs and every room below (bridge, twin, scenarios, sumo, control, model,
-utilities), never studies or the CLI: reference values drawn on its figures come from the
+Never imports studies or the CLI: reference values drawn on its figures come from the
 caller (``run_sweep(..., paper=...)``).
 """
 

@@ -1,20 +1,9 @@
 """Run a sweep: skip finished runs, execute the rest on a process pool or a Dask cluster,
 write each outcome as it arrives, then the tidy table, the plots and a manifest.
 
-Layout of the output directory::
-
-    sweep.toml            the sweep file as given
-    sweep.json            manifest: version, engine, counts, one entry per invocation
-    summaries.parquet     one row per run (:mod:`arzsumo.sweep.table`)
-    executions.jsonl      one line per finished execution (run ID, execution ID, status)
-    runs/<run_id>/        scenario.toml (resolved), summary.json and tables, or error.json
-    plots/*.png
-
-Each run directory is written atomically, so a sweep killed at any moment leaves only
-whole runs; a restart executes exactly the runs without a current result. Both backends
-call the same :func:`arzsumo.sweep.groups.execute_group`: the SUMO runs that differ only
-in ``[run] controller`` share one warm-up (:mod:`arzsumo.sweep.groups`), each of the
-others is a plain :func:`arzsumo.sweep.worker.execute`.
+The output directory (docs/outputs.md, ``arzsumo sweep``) is written one whole run at a
+time, so a restart executes exactly the runs without a current result. Both backends call
+:func:`arzsumo.sweep.groups.execute_group` (docs/sweeps.md).
 """
 
 from __future__ import annotations
@@ -56,8 +45,6 @@ from arzsumo.version import __version__
 
 log = logging.getLogger(__name__)
 
-OnDone = Callable[[RunOutcome], None]
-
 
 @dataclass
 class SweepReport:
@@ -89,19 +76,17 @@ def task_of(spec: SweepSpec, run: RunSpec) -> RunTask:
 def write_outcome(out: Path, run: RunSpec, outcome: RunOutcome) -> None:
     """Store one outcome atomically under ``runs/<run_id>`` and log its execution."""
     record = sweep_record(run, outcome.status, outcome.execution)
+    finished = outcome.status in FINISHED and outcome.summary is not None
+    head = outcome.summary if finished else {"error": outcome.error}
+    doc = {**head, "warnings": outcome.warnings, "sweep": record}
     with atomic_dir(run_dir(out, run), RUN_KIND, overwrite=True) as tmp:
         (tmp / "scenario.toml").write_text(scenario_text(run, outcome.scenario_toml),
                                            encoding="utf-8")
-        if outcome.status in FINISHED and outcome.summary is not None:
-            doc = {**outcome.summary, "warnings": outcome.warnings, "sweep": record}
-            (tmp / "summary.json").write_text(json.dumps(doc, indent=2) + "\n",
-                                              encoding="utf-8")
+        (tmp / ("summary.json" if finished else "error.json")).write_text(
+            json.dumps(doc, indent=2) + "\n", encoding="utf-8")
+        if finished:
             for name, blob in outcome.tables.items():
                 (tmp / name).write_bytes(blob)
-        else:
-            doc = {"error": outcome.error, "warnings": outcome.warnings, "sweep": record}
-            (tmp / "error.json").write_text(json.dumps(doc, indent=2) + "\n",
-                                            encoding="utf-8")
     line = json.dumps({"run_id": run.run_id, "execution": outcome.execution.get("id"),
                        "status": outcome.status})
     with open(out / "executions.jsonl", "a", encoding="utf-8") as fh:
@@ -112,15 +97,13 @@ def write_outcome(out: Path, run: RunSpec, outcome: RunOutcome) -> None:
 def run_local(tasks: Iterable[Any], workers: int, on_done: Callable[[Any], None],
               fn: Callable[[Any], Any] = execute,
               on_crash: Callable[[Any, str], Any] = crashed) -> None:
-    """Execute ``fn`` (the worker function) on ``tasks`` in ``workers`` fresh processes
-    (spawned: libsumo holds one simulation per process and must not inherit a parent's
-    state).
+    """Execute ``fn`` on ``tasks`` in ``workers`` spawned processes (libsumo holds one
+    simulation per process and must not inherit a parent's state).
 
-    At most ``workers`` tasks are in flight, so when a process dies (a crash in SUMO, the
-    OOM killer) the suspects are known: each is run again alone, and the one that kills
-    its process again is recorded as ``crashed``; the sweep goes on. ``fn`` and
-    ``on_crash`` (task, reason -> outcome, or raise) default to the sweep's; any picklable
-    module-level function of a picklable task works (:func:`map_runs`).
+    At most ``workers`` tasks are in flight, so when a process dies the suspects are
+    known: each is run again alone, and one that kills its process again goes to
+    ``on_crash`` (task, reason -> outcome, or raise). Any picklable module-level ``fn`` of
+    a picklable task works (:func:`map_runs`).
     """
     ctx = multiprocessing.get_context("spawn")
     queue = deque(tasks)
@@ -154,13 +137,9 @@ def run_local(tasks: Iterable[Any], workers: int, on_done: Callable[[Any], None]
 def run_dask(tasks: list[Any], address: str, on_done: Callable[[Any], None], one_thread: bool,
              fn: Callable[[Any], Any] = execute,
              on_crash: Callable[[Any, str], Any] = crashed) -> None:
-    """Execute ``tasks`` on the Dask cluster whose scheduler is at ``address``.
-
-    A run whose worker dies is retried by Dask on another worker; after Dask gives up
-    (``KilledWorker``) it is recorded as ``crashed``. ``one_thread`` refuses workers with
-    more than one thread (libsumo: one simulation per process). ``fn`` and ``on_crash``
-    as in :func:`run_local`.
-    """
+    """Execute ``tasks`` on the Dask cluster whose scheduler is at ``address``; after Dask
+    gives up on a task (``KilledWorker``) it goes to ``on_crash``. ``one_thread`` refuses
+    workers with more than one thread (libsumo: one simulation per process)."""
     from distributed import Client, as_completed
     from distributed.scheduler import KilledWorker
 
@@ -201,12 +180,11 @@ def map_runs(fn: Callable[[Any], Any], tasks: Sequence[Any], *, workers: int = 1
              progress: str | None = None) -> list[Any]:
     """``[fn(t) for t in tasks]`` on the sweep's backends, results in the order of ``tasks``.
 
-    ``fn`` must be a picklable module-level function and the tasks picklable. With
-    ``scheduler`` the tasks run on that Dask cluster, else on ``workers`` fresh local
-    processes (:func:`run_local`); ``in_process`` runs them here, one after the other
-    (for runs shorter than a process start). A task whose process dies twice raises
-    ``RuntimeError``: unlike a sweep, the caller needs every result. ``progress``, when
-    given, labels a progress bar on stderr.
+    ``fn`` (module-level) and the tasks must be picklable. They run on the Dask cluster of
+    ``scheduler``, else on ``workers`` local processes, or with ``in_process`` here, one
+    after the other (for runs shorter than a process start). A task whose process dies
+    twice raises ``RuntimeError``: unlike a sweep, the caller needs every result.
+    ``progress``, when given, labels a progress bar on stderr.
     """
     if in_process or not tasks:
         return [fn(t) for t in tasks]
@@ -260,88 +238,61 @@ def run_sweep(spec: SweepSpec, out: str | Path, *, workers: int | None = None,
     """Execute the runs of ``spec`` that have no current result under ``out``; then write
     the table, plots and manifest.
 
-    Parameters
-    ----------
-    spec : SweepSpec
-    out : path
-        Output directory: new, empty, or a sweep output (continued); anything else is
-        refused (:func:`arzsumo.outdir.resumable_dir`).
-    workers : int, optional
-        Processes of the local pool (default: one per core). Ignored with ``scheduler``.
-    scheduler : str, optional
-        Address of a Dask scheduler (``tcp://host:8786``) to run on instead.
-    paper : mapping, optional
-        Reference points drawn on ``study.png``: metric -> {axis value: value} (the CLI
-        passes :func:`arzsumo.workflows.paper.values.paper_points` of ``spec.paper``).
-    kind : str
-        The kind of result ``out`` holds (its marker): ``sweep``, or ``evaluation`` for
-        ``arzsumo evaluate``; a directory of another kind is refused.
-    share_warmup : bool
-        SUMO runs that differ only in ``[run] controller`` continue one warm-up
-        (:mod:`arzsumo.sweep.groups`); False gives each its own (same results).
+    ``out`` is new, empty, or a sweep output of this ``kind`` (marker; ``evaluation``
+    for ``arzsumo evaluate``), continued. ``workers``: local processes (default one per
+    core), unless ``scheduler`` gives a Dask scheduler's address. ``paper``: reference
+    points drawn on ``study.png``, metric -> {axis value: value}. ``share_warmup``: SUMO
+    runs that differ only in ``[run] controller`` continue one warm-up (same results).
     """
     t0 = time.perf_counter()
     runs = spec.runs()
     if workers is not None and workers < 1:
         raise SweepError(f"--workers = {workers} is not allowed: an integer >= 1")
+    workers = workers or default_workers()
     with resumable_dir(out, kind) as target:
-        return _run(spec, target, runs, workers, scheduler, progress, plots, paper, t0,
-                    share_warmup)
+        with atomic_file(target / "sweep.toml") as tmp:
+            tmp.write_text(spec.text or f"# sweep {spec.name} (built in code)\n",
+                           encoding="utf-8")
+        todo = [r for r in runs if not _finished(target, r)]
+        by_id = {r.run_id: r for r in runs}
+        backend = f"dask {scheduler}" if scheduler else f"local pool, {workers} processes"
+        log.info("sweep %s: %d runs, %d finished before, %d to run (%s)", spec.name,
+                 len(runs), len(runs) - len(todo), len(todo), backend)
+        bar = Progress(len(todo), f"sweep {spec.name}", enabled=progress and bool(todo))
+        counts: Counter[str] = Counter()
 
+        def on_group_done(outcomes: list[RunOutcome]) -> None:
+            for outcome in outcomes:
+                write_outcome(target, by_id[outcome.run_id], outcome)
+                counts[outcome.status] += 1
+                if outcome.status not in FINISHED:
+                    first = outcome.error.splitlines()[0] if outcome.error else ""
+                    log.warning("run %s: %s: %s", outcome.run_id, outcome.status, first)
+                bar.update(sum(counts.values()))
 
-def _run(spec: SweepSpec, out: Path, runs: list[RunSpec], workers: int | None,
-         scheduler: str | None, progress: bool, plots: bool,
-         paper: Mapping[str, Mapping[float, float]] | None, t0: float,
-         share_warmup: bool = True) -> SweepReport:
-    """The body of :func:`run_sweep` inside its claimed output directory ``out``."""
-    with atomic_file(out / "sweep.toml") as tmp:
-        tmp.write_text(spec.text or f"# sweep {spec.name} (built in code)\n", encoding="utf-8")
-    todo = [r for r in runs if not _finished(out, r)]
-    by_id = {r.run_id: r for r in runs}
-    backend = f"dask {scheduler}" if scheduler else \
-        f"local pool, {workers or default_workers()} processes"
-    log.info("sweep %s: %d runs, %d finished before, %d to run (%s)", spec.name, len(runs),
-             len(runs) - len(todo), len(todo), backend)
-    bar = Progress(len(todo), f"sweep {spec.name}", enabled=progress and bool(todo))
-    counts: Counter[str] = Counter()
-
-    def on_done(outcome: RunOutcome) -> None:
-        write_outcome(out, by_id[outcome.run_id], outcome)
-        counts[outcome.status] += 1
-        if outcome.status not in FINISHED:
-            first = (outcome.error or "").splitlines()[0] if outcome.error else ""
-            log.warning("run %s: %s: %s", outcome.run_id, outcome.status, first)
-        bar.update(sum(counts.values()))
-
-    def on_group_done(outcomes: list[RunOutcome]) -> None:
-        for outcome in outcomes:
-            on_done(outcome)
-
-    tasks = [task_of(spec, r) for r in todo]
-    # a seed's runs are split over idle local workers; a cluster's size is not known here
-    spread = 1 if scheduler else workers or default_workers()
-    groups = (share_warmups(tasks, spread) if share_warmup
-              else [RunGroup((t,)) for t in tasks])
-    try:
-        if groups and scheduler:
-            run_dask(groups, scheduler, on_group_done, one_thread=spec.engine == "sumo",
-                     fn=execute_group, on_crash=crashed_group)
-        elif groups:
-            run_local(groups, workers or default_workers(), on_group_done,
-                      fn=execute_group, on_crash=crashed_group)
-    finally:
-        bar.close()
-    report = SweepReport(spec.name, out, backend, len(runs), len(runs) - len(todo),
-                         sum(counts.values()), dict(counts), time.perf_counter() - t0)
-    report.table = finish(spec, out, runs, report, plots, paper)
-    return report
+        tasks = [task_of(spec, r) for r in todo]
+        # a seed's runs are split over idle local workers; a cluster's size is not known here
+        groups = (share_warmups(tasks, 1 if scheduler else workers) if share_warmup
+                  else [RunGroup((t,)) for t in tasks])
+        try:
+            if groups and scheduler:
+                run_dask(groups, scheduler, on_group_done, one_thread=spec.engine == "sumo",
+                         fn=execute_group, on_crash=crashed_group)
+            elif groups:
+                run_local(groups, workers, on_group_done, fn=execute_group,
+                          on_crash=crashed_group)
+        finally:
+            bar.close()
+        report = SweepReport(spec.name, target, backend, len(runs), len(runs) - len(todo),
+                             sum(counts.values()), dict(counts), time.perf_counter() - t0)
+        report.table = finish(spec, target, runs, report, plots, paper)
+        return report
 
 
 def finish(spec: SweepSpec, out: Path, runs: list[RunSpec], report: SweepReport,
            plots: bool, paper: Mapping[str, Mapping[float, float]] | None = None
            ) -> pd.DataFrame:
-    """Write the table, the plots and the manifest of a sweep whose runs are done; return
-    the table."""
+    """Write the table, plots and manifest of a sweep whose runs are done; return the table."""
     import pyarrow.parquet as pq
 
     df = sweep_table(runs, out)
@@ -354,13 +305,10 @@ def finish(spec: SweepSpec, out: Path, runs: list[RunSpec], report: SweepReport,
                              [(a.name, a.group) for a in spec.axes])
         write_sweep_plots(df[df["status"].isin(FINISHED)], layout, out / "plots", paper)
     manifest_path = out / "sweep.json"
-    history: list[dict[str, Any]] = []
-    if manifest_path.is_file():
-        try:
-            history = json.loads(manifest_path.read_text(encoding="utf-8")).get(
-                "invocations", [])
-        except (OSError, json.JSONDecodeError):
-            history = []
+    try:   # the earlier invocations, if any
+        history = json.loads(manifest_path.read_text(encoding="utf-8")).get("invocations", [])
+    except (OSError, json.JSONDecodeError):
+        history = []
     manifest = {"name": spec.name, "description": spec.description, "engine": spec.engine,
                 "base": str(spec.base), "version": __version__, "runs": len(runs),
                 "statuses": {str(k): int(v) for k, v in df["status"].value_counts().items()},

@@ -1,25 +1,7 @@
 """``arzsumo evaluate``: every controller on the same seeds in SUMO, compared with the open
-loop seed by seed.
-
-The runs are a sweep built in code (:func:`evaluation_spec`: the scenario as base, engine
-``sumo``, an axis ``controller`` over ``[run] controller``, the seeds last), executed by
-:func:`~arzsumo.sweep.driver.run_sweep`: in parallel on local processes or on Dask, and
-resumable (a second call with the same output directory runs only what is missing). The
-directory is an ``evaluation`` result (its own marker kind, so a sweep directory is not
-mistaken for it) laid out like a sweep, plus the report of
-:func:`arzsumo.outputs.evaluation.write_evaluation`::
-
-    OUT/  runs/<controller=...,seed=...>/   summary.json, periods.parquet (each run)
-          summaries.parquet, sweep.json, sweep.toml, executions.jsonl   (the sweep's)
-          evaluation.csv, evaluation.md, paired_differences.png        (the report)
-
-With ``baseline_from`` (``--baseline-from DIR``) the open-loop runs are not run again but
-taken from an earlier evaluation in DIR (:func:`borrowed_baseline`), allowed only when
-their resolved scenarios differ from this evaluation's in nothing that acts on an open-loop
-SUMO run (:data:`OPEN_LOOP_INERT`; and :data:`PLACEMENT_ONLY` when SUMO fills the road
-itself and is given the same route file): an ablation whose steps change only the
-controllers' side (estimation, sensing, actuation, design, or the model the laws are
-designed on) pays for its baseline once.
+loop seed by seed: a sweep built in code (:func:`evaluation_spec`) in a directory of its
+own marker kind (:data:`KIND`; docs/outputs.md). Runs taken from earlier evaluations
+(``--baseline-from``, ``--runs-from``) and when that is allowed: docs/whole_demand.md.
 """
 
 from __future__ import annotations
@@ -46,6 +28,7 @@ from arzsumo.sweep.spec import (
     RunSpec,
     SweepError,
     SweepSpec,
+    drop_fields,
     sweep_from_dict,
 )
 from arzsumo.sweep.table import run_dir, sweep_table
@@ -89,10 +72,8 @@ def inert_for(controller: str) -> tuple[str, ...]:
     return base + own
 
 
-#: tables that reach an open-loop SUMO run only through what it is given to simulate: the
-#: vehicles placed at t = 0 (``[run] start = "placement"``) and, from the model, the
-#: vehicle types and insertion columns of the route file (:func:`_sumo_input`). With
-#: ``start = "warmup"`` (the default) and the same route file, they drive only the twins
+#: tables that reach an open-loop SUMO run only through the vehicles placed at t = 0 and
+#: the route file (:func:`_sumo_input`); with neither, they drive only the twins
 PLACEMENT_ONLY = ("model", "equilibrium", "initial")
 #: evaluation measures computed with the model's parameters (section delay: TTT - TMT /
 #: v_free): a baseline borrowed under another [model] has them blanked (NaN)
@@ -100,8 +81,7 @@ MODEL_DEPENDENT = ("section.total_delay.",)
 
 
 def check_controllers(controllers: Sequence[str]) -> list[str]:
-    """The controllers in order, baseline first (added when missing); unknown or repeated
-    names refused."""
+    """The controllers, baseline first (added when missing); unknown or repeated refused."""
     from arzsumo.control.registry import controller_names
 
     allowed = controller_names("sumo")
@@ -118,9 +98,8 @@ def check_controllers(controllers: Sequence[str]) -> list[str]:
 
 def evaluation_spec(scenario: Path, controllers: Sequence[str], seeds: Sequence[int],
                     horizon: float | None = None, warmup: float | None = None) -> SweepSpec:
-    """The sweep of an evaluation: ``scenario`` x controllers x seeds (``horizon``: the
-    control horizon, s, instead of ``[sumo] horizon_s``; ``warmup``: the warm-up, s,
-    instead of ``[run] warmup_s``)."""
+    """The sweep of an evaluation: ``scenario`` x controllers x seeds; ``horizon`` and
+    ``warmup`` (s) replace ``[sumo] horizon_s`` and ``[run] warmup_s``."""
     scenario = Path(scenario).resolve()
     name = re.sub(r"[^A-Za-z0-9._-]", "_", f"evaluate-{scenario.stem}")
     data: dict = {"name": name, "base": str(scenario), "engine": "sumo",
@@ -180,12 +159,7 @@ def _model_inert(a: dict, b: dict) -> bool:
 def _without_inert(data: dict, model_inert: bool = False,
                    inert: Sequence[str] = inert_for(BASELINE)) -> dict:
     out = copy.deepcopy(data)
-    for name in tuple(inert) + (PLACEMENT_ONLY if model_inert else ()):
-        table, _, key = name.partition(".")
-        if key and isinstance(out.get(table), dict):
-            out[table].pop(key, None)
-        elif not key:
-            out.pop(table, None)
+    drop_fields(out, tuple(inert) + (PLACEMENT_ONLY if model_inert else ()))
     return out
 
 
@@ -199,8 +173,7 @@ def _first_difference(a: dict, b: dict, prefix: str = "") -> str:
 
 
 def _their_run(source: Path, mine: RunSpec, user: str) -> RunSpec:
-    """The open-loop run of the earlier evaluation in ``source`` matching ``mine``,
-    checked to be the same SUMO run."""
+    """The run in ``source`` matching ``mine``, checked to be the same SUMO run."""
     path = run_dir(source, mine) / "scenario.toml"
     if not (path.parent / "summary.json").is_file():
         raise SweepError(f"--baseline-from = {user} is not allowed: it has no finished run "
@@ -290,18 +263,7 @@ def run_evaluation(scenario: Path, controllers: Sequence[str], seeds: Sequence[i
                    command: str = "", baseline_from: Path | None = None,
                    runs_from: Sequence[Path] = ()) -> EvaluationResult:
     """Run ``controllers`` (the open loop added first when missing) on ``seeds`` and write
-    the report into ``out`` (module docstring).
-
-    ``out`` may be new, empty, or a previous evaluation: continued (runs already finished
-    with the same resolved scenario are not run again), or started afresh with
-    ``overwrite``. ``horizon`` and ``warmup`` (s) replace ``[sumo] horizon_s`` and ``[run]
-    warmup_s``. ``command`` is printed at the top of ``evaluation.md``.
-    ``baseline_from``: take the open-loop runs from this earlier evaluation (module
-    docstring) instead of running them. ``runs_from``: earlier evaluations or sweeps;
-    every controller whose runs on all ``seeds`` one of them holds (the same SUMO runs:
-    scenarios that differ only in what that controller does not read, :func:`inert_for`)
-    is taken from there instead of run.
-    """
+    the report into ``out``; the options as in :func:`arzsumo.evaluate`."""
     controllers = check_controllers(controllers)
     name = check_runs(scenario, controllers, horizon, warmup)
     borrowed = pd.DataFrame()
@@ -313,10 +275,9 @@ def run_evaluation(scenario: Path, controllers: Sequence[str], seeds: Sequence[i
         borrowed = borrowed_baseline(
             evaluation_spec(scenario, [BASELINE], seeds, horizon, warmup),
             Path(baseline_from), str(baseline_from))
-    taken = _borrow(scenario, controllers[1:] if baseline_from else controllers, seeds,
-                    horizon, warmup, runs_from)
-    to_run = [c for c in (controllers[1:] if baseline_from else controllers)
-              if c not in taken]
+    others = controllers[1:] if baseline_from else controllers
+    taken = _borrow(scenario, others, seeds, horizon, warmup, runs_from)
+    to_run = [c for c in others if c not in taken]
     if overwrite:
         _forget_previous(Path(out), str(out))
     rep, target = None, Path(out)

@@ -1,18 +1,7 @@
-"""Runs of a sweep that share a warm-up, executed as one task.
-
-The SUMO runs of a sweep or an evaluation that differ only in ``[run] controller`` (the
-controllers of one seed) are the same SUMO run until the control window opens.
-:func:`share_warmups` groups them into :class:`RunGroup` tasks, and
-:func:`execute_group` (what the local pool and the Dask workers call) simulates each
-group's warm-up once and runs every controller in a child forked at its end
-(:func:`arzsumo.bridge.branches.run_branched`): the outcomes are those of plain runs, to
-the last bit. A child that dies is run again alone, and its execution says so
-(``rerun_alone``). Each outcome's ``wall_s`` is the shared warm-up's plus its own window's
-(what a plain run of it costs); ``shared_warmup`` names how many runs shared it.
-
-Where a process may not fork (a threaded Dask worker), :func:`execute_group` runs the
-group in a fresh single-threaded Python process of its own (:func:`in_subprocess`), and
-falls back to plain runs if that process gives no result.
+"""Runs of a sweep that share a warm-up, executed as one task (docs/sweeps.md, "One
+warm-up per seed"): :func:`share_warmups` groups them; :func:`execute_group` runs each
+controller in a child forked at the end of the group's warm-up, in a fresh process where
+this one may not fork (a threaded Dask worker).
 """
 
 from __future__ import annotations
@@ -90,7 +79,7 @@ def crashed_group(group: RunGroup, why: str) -> list[RunOutcome]:
 
 
 def execute_group(group: RunGroup) -> list[RunOutcome]:
-    """The outcome of every run of ``group``, its warm-up shared (module docstring)."""
+    """The outcome of every run of ``group``, its warm-up shared where it can be."""
     from arzsumo.sumo.fork import can_fork
 
     if len(group.tasks) == 1:

@@ -1,34 +1,7 @@
 """Sweep files: a base scenario, an engine and axes, expanded into runs with stable IDs.
 
-Example (``scenarios/sweeps/penetration_twin.toml``)::
-
-    name = "penetration_twin"
-    base = "../paper/penetration_44_etc.toml"   # relative to the sweep file
-    engine = "twin"                              # or "sumo"
-    seeds = [1, 2, 3]                            # the engine's seed: [twin] or [sumo] seed
-                                                 # (a count N: seeds 1..N)
-    paper = "diffpene"                           # paper values drawn on the plots
-
-    [set]                                        # changed in every run
-    initial.kind = "random"
-
-    [[axis]]                                     # one field per value
-    field = "equilibrium.penetration"
-    values = [0.44, 0.47, 0.50, 0.53]
-
-    [[axis]]                                     # several fields per value
-    name = "demand_veh_h"
-    values = [4966, 5664]
-    set = [{ "sumo.demand_h_veh_h" = 3461, "sumo.demand_a_veh_h" = 1505 },
-           { "sumo.demand_h_veh_h" = 4104, "sumo.demand_a_veh_h" = 1560 }]
-
-Axes multiply, in file order, seeds last. Axes that share a ``group`` are varied one at
-a time instead (a sensitivity study: the group's column names the varied axis, the other
-axes of the group keep their base value). A field is ``table.key`` of a scenario file
-(``model``, ``equilibrium``, ``twin``, ``initial``, ``design``, ``sumo``, ``run``), in the
-units its key names. Each run's ID is built from its axis values
-(``penetration=0.44,seed=1``), so it does not depend on the order of the runs or on the
-machine; the SHA-256 of the resolved scenario tells a finished run from a stale one.
+The file's keys, axes (one field or several per value), groups and run IDs:
+docs/sweeps.md. The SHA-256 of the resolved scenario tells a finished run from a stale one.
 """
 
 from __future__ import annotations
@@ -39,7 +12,7 @@ import itertools
 import json
 import math
 import re
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -84,6 +57,16 @@ CONTROLLER_ONLY: dict[str, tuple[str, ...]] = {
 LABELS = ("name", "description")
 
 
+def drop_fields(data: dict[str, Any], names: Iterable[str]) -> None:
+    """Remove each table (``sensing``) or key (``run.controller``) of ``names`` from ``data``."""
+    for name in names:
+        table, _, key = name.partition(".")
+        if not key:
+            data.pop(table, None)
+        elif isinstance(data.get(table), dict):
+            data[table].pop(key, None)
+
+
 def deciding(scenario: Mapping[str, Any], engine: str) -> dict[str, Any]:
     """``scenario`` without what decides none of a run's numbers: its labels and, for a
     SUMO run, the :data:`CONTROLLER_ONLY` tables and keys its controller does not read."""
@@ -92,14 +75,7 @@ def deciding(scenario: Mapping[str, Any], engine: str) -> dict[str, Any]:
     if engine != "sumo":
         return data
     controller = str(data.get("run", {}).get("controller", "open"))
-    for dotted, users in CONTROLLER_ONLY.items():
-        if controller in users:
-            continue
-        table, _, key = dotted.partition(".")
-        if not key:
-            data.pop(table, None)
-        elif isinstance(data.get(table), dict):
-            data[table].pop(key, None)
+    drop_fields(data, [k for k, users in CONTROLLER_ONLY.items() if controller not in users])
     return data
 
 
@@ -154,12 +130,10 @@ class SweepSpec:
         for index, combo in enumerate(itertools.product(*factors)):
             columns: dict[str, Scalar | None] = {}
             overrides: dict[str, Any] = {}
-            label: list[str] = []
-            for cols, sets, tag in combo:
+            for cols, sets, _ in combo:
                 columns.update(cols)
                 overrides.update(sets)
-                label.append(tag)
-            run_id = ",".join(label) or "base"
+            run_id = ",".join(tag for _, _, tag in combo) or "base"
             runs.append(RunSpec(run_id, index, columns, overrides, _apply(base, overrides),
                                 self.engine, self.baseline))
         seen: dict[str, int] = {}

@@ -1,10 +1,8 @@
 """The tidy table of a sweep: one row per run, axes as columns, then the summary's numbers.
 
-Nested summary entries become dotted columns (``J_TTT.total``, ``rmse.replay.v_h.relative``);
-lists are left out (they stay in each run's ``summary.json``); ``warnings`` counts the
-warnings the run logged (their text is in ``summary.json``). Times are s, densities
-veh/m, flows veh/s, as in the summaries; :func:`arrow_table` stores each column's unit in
-the Parquet field metadata (:mod:`arzsumo.schema`; every column in ``docs/outputs.md``).
+Nested summary entries become dotted columns; lists are left out (they stay in each run's
+``summary.json``). SI units, as in the summaries; :func:`arrow_table` stores each column's
+unit in the Parquet field metadata (:mod:`arzsumo.schema`; docs/outputs.md).
 """
 
 from __future__ import annotations
@@ -72,14 +70,10 @@ def scenario_text(run: RunSpec, toml: str) -> str:
 
 
 def read_record(out: Path, run: RunSpec) -> tuple[str, dict[str, Any]] | None:
-    """(status, stored document) of the run's current result, or None.
-
-    A result counts only if it was made from the same resolved scenario (same SHA-256):
-    after an edit of the sweep or its base scenario, the old result is stale.
-    """
-    d = run_dir(out, run)
+    """(status, stored document) of the run's current result, or None: one made from
+    another resolved scenario (another SHA-256) is stale."""
     for name in ("summary.json", "error.json"):
-        path = d / name
+        path = run_dir(out, run) / name
         if not path.is_file():
             continue
         try:
@@ -106,8 +100,7 @@ def uniform_types(col: pd.Series) -> pd.Series:
 
 def table_row(run: RunSpec, found: tuple[str, Mapping[str, Any]] | None) -> dict[str, Any]:
     """The table row of ``run`` from its (status, stored document), or marked missing."""
-    row: dict[str, Any] = {"run_id": run.run_id, "index": run.index}
-    row.update(run.columns)
+    row: dict[str, Any] = {"run_id": run.run_id, "index": run.index, **run.columns}
     if found is None:
         row.update(status="missing", error=None)
         return row
@@ -115,8 +108,7 @@ def table_row(run: RunSpec, found: tuple[str, Mapping[str, Any]] | None) -> dict
     row.update(status=status, error=doc.get("error"), warnings=len(doc.get("warnings", [])))
     ex = doc.get("sweep", {}).get("execution", {})
     row.update({f"execution.{k}": v for k, v in ex.items()})
-    metrics = flatten(doc)
-    row.update({k: v for k, v in metrics.items() if k not in row})
+    row.update({k: v for k, v in flatten(doc).items() if k not in row})
     return row
 
 
@@ -148,12 +140,8 @@ def _axis_columns(axes: Iterable[Axis], df: pd.DataFrame) -> dict[str, Column]:
 
 
 def table_columns(df: pd.DataFrame, axes: Iterable[Axis] = ()) -> dict[str, Column]:
-    """Unit and meaning of every column of the sweep table ``df``.
-
-    Summary columns take the unit of their summary key (:data:`arzsumo.schema.RUN_SUMMARY`
-    or :data:`~arzsumo.schema.TWIN_SUMMARY`); a key neither describes gets unit ``?``
-    (an old summary; the tests keep current summaries fully described).
-    """
+    """Unit and meaning of every column of the sweep table ``df``; a summary key that
+    :mod:`arzsumo.schema` does not describe (an old summary's) gets unit ``?``."""
     cols = {**SWEEP_FIXED, **_axis_columns(axes, df)}
     for name in df.columns:
         if name not in cols:

@@ -1,11 +1,9 @@
 """The worker function of a sweep: one run, in whatever process or machine it lands on.
 
-:func:`execute` is what the local process pool and the Dask workers both call. It takes a
-plain, picklable :class:`RunTask` (the resolved scenario as a mapping, no paths) and
-returns a :class:`RunOutcome` (the summary, the resolved scenario as TOML and small
-tables as Parquet bytes). It never writes files, so workers need no shared file system:
-the sweep driver writes what comes back. It never raises for a bad run either: a user
-error becomes status ``invalid``, anything else ``failed``, each with its message.
+:func:`execute` takes a picklable :class:`RunTask` and returns a :class:`RunOutcome`. It
+writes no files (workers need no shared file system: the driver writes what comes back)
+and never raises for a bad run: a user error is status ``invalid``, anything else
+``failed``, each with its message.
 """
 
 from __future__ import annotations
@@ -30,9 +28,8 @@ import pyarrow.parquet as pq
 from arzsumo.errors import ArzsumoError
 from arzsumo.io import dump_toml, json_safe
 
-#: statuses of a run: finished (``ok``, ``incomplete``: the twin left the physical domain
-#: and stopped early, partial summary kept) or not (the rest: an error is recorded)
-STATUSES = ("ok", "incomplete", "invalid", "failed", "crashed")
+#: the statuses of a finished run (``incomplete``: the twin left the physical domain and
+#: stopped early, partial summary kept); ``invalid``, ``failed``, ``crashed`` record an error
 FINISHED = ("ok", "incomplete")
 
 
@@ -73,9 +70,8 @@ class _Collect(logging.Handler):
 
 @contextlib.contextmanager
 def collected_warnings() -> Iterator[list[str]]:
-    """Warnings logged by arzsumo during a run go into its outcome, not onto the sweep's
-    terminal (a hundred workers would bury the progress bar). A child forked inside
-    inherits the list and adds its own (:mod:`arzsumo.sweep.groups`)."""
+    """The warnings arzsumo logs during a run, for its outcome, kept off the sweep's terminal
+    (a hundred workers would bury the progress bar); a child forked inside adds its own."""
     logger = logging.getLogger("arzsumo")
     handler, propagate = _Collect(), logger.propagate
     logger.addHandler(handler)
@@ -112,8 +108,7 @@ def _run_sumo(task: RunTask) -> tuple[str, dict[str, Any], dict[str, bytes]]:
 
 
 def sumo_outcome(session: Any) -> tuple[str, dict[str, Any], dict[str, bytes]]:
-    """Status, summary and tables of a finished SUMO session (a plain run's or a branch's
-    of :mod:`arzsumo.sweep.groups`)."""
+    """Status, summary and tables of a finished SUMO session (a plain run or a branch)."""
     from arzsumo.outputs.bridge import cells_table, periods_table, summary
 
     summ = json_safe(summary(session.result).to_dict())
@@ -128,7 +123,7 @@ ENGINES = {"twin": _run_twin, "sumo": _run_sumo}
 
 
 def execute(task: RunTask) -> RunOutcome:
-    """Run ``task`` and report; never raises for a bad run (see the module docstring)."""
+    """Run ``task`` and report; never raises for a bad run (module docstring)."""
     t0, c0 = time.perf_counter(), time.process_time()
     execution = execution_record()
     text = dump_toml(task.scenario)
