@@ -15,35 +15,18 @@ docs/sumo.md, "Actuation limits" (delay compensation).
 from __future__ import annotations
 
 import math
-from typing import Protocol
 
 import numpy as np
 
-from arzsumo.control.backstepping import StateMap
+from arzsumo.control.backstepping import Backstepping
 from arzsumo.control.base import Controller, ControlLog, MacroState
+from arzsumo.control.etc import EventTriggered
 from arzsumo.control.predictor import committed, predict_riemann
 from arzsumo.errors import ModelError, require
-from arzsumo.model.characteristic import Linearization
 
-
-class RiemannLaw(Protocol):
-    """A controller whose law takes scaled Riemann states on its kernel grid."""
-
-    name: str
-    lin: Linearization
-    state_map: StateMap
-    log: ControlLog
-
-    def check_riemann(self, t: float, w_bar: np.ndarray) -> float: ...
-
-    def reset(self) -> None: ...
-
-    def applied(self, u: float, lower: float = -math.inf, upper: float = math.inf) -> None: ...
-
-    def set_output_noise(self, sd: float) -> bool: ...
-
-    @property
-    def has_trigger(self) -> bool: ...
+#: the laws on scaled Riemann states :class:`DelayCompensated` wraps (the acting
+#: backstepping or ETC, :data:`arzsumo.bridge.delay.COMPENSATED`)
+RiemannLaw = Backstepping | EventTriggered
 
 
 class DelayCompensated(Controller):

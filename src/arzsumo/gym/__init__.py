@@ -16,9 +16,8 @@ try:
 except ImportError as exc:  # pragma: no cover - the extra is missing
     raise ImportError("arzsumo.gym needs gymnasium: pip install 'arzsumo[gym]'") from exc
 
-from arzsumo.gym.base import RampMeterEnv
+from arzsumo.gym.base import POLICIES, LawPolicy, RampMeterEnv, policy
 from arzsumo.gym.observe import denormalise
-from arzsumo.gym.policy import POLICIES, LawPolicy, policy
 from arzsumo.gym.rewards import NAMED as REWARDS
 from arzsumo.gym.rewards import StepRecord
 from arzsumo.gym.sumo_env import SumoRampMeterEnv
