@@ -174,11 +174,6 @@ def load_plugins() -> None:
         REGISTRY[spec.name] = spec
 
 
-def unregister_controller(name: str) -> None:
-    """Remove ``name`` (tests that registered one clean up with it)."""
-    REGISTRY.pop(name, None)
-
-
 for _spec in (
     ControllerSpec("open", lambda inp: OpenLoop(), description="no control (U = 0)"),
     ControllerSpec("backstepping", _pde(Backstepping), pde=True,

@@ -148,11 +148,10 @@ class Weighted:
 
 
 def _refuse(value: Any) -> EnvError:
-    allowed = (f"a callable(StepRecord) -> float, one of {', '.join(NAMED)}, or a mapping "
-               "of those names to finite weights")
-    exc = EnvError(f"reward = {value!r} is not allowed: {allowed}")
-    exc.field, exc.value, exc.allowed = "reward", value, allowed
-    return exc
+    from arzsumo.gym.options import refuse  # options imports this module
+
+    return refuse("reward", value, f"a callable(StepRecord) -> float, one of "
+                  f"{', '.join(NAMED)}, or a mapping of those names to finite weights")
 
 
 def reward_of(value: Any) -> Reward:
