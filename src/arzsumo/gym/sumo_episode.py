@@ -26,7 +26,6 @@ from arzsumo.bridge.cosim import Controlled, close_window, open_run, open_window
 from arzsumo.bridge.prepared import PreparedRun
 from arzsumo.bridge.result import CoSimResult
 from arzsumo.control.base import Applied, Command, Controller, MacroState
-from arzsumo.errors import EnvError
 from arzsumo.sumo.meter import MeterState
 
 if TYPE_CHECKING:
@@ -115,22 +114,17 @@ class SumoEpisode:
             opened = self._stack.enter_context(open_run(run, frontend=frontend))
             self._opened.append(opened)
             warmed = warm_start(opened.sim, run, opened.bar)
-            self.c: Controlled = open_window(
-                warmed, run, opened.bar, in_loop=lambda ctrl: StandIn(ctrl if law else None))
+
+            def in_loop(ctrl: Controller) -> StandIn:
+                self.stand_in = StandIn(ctrl if law else None)   # the loop's controller
+                return self.stand_in
+
+            self.c: Controlled = open_window(warmed, run, opened.bar, in_loop=in_loop)
             self.c.loop.begin(warmed.warm[-1])
             self.state: MacroState = self.c.loop.estimate(self.c.loop.m, 0.0)
         except BaseException as exc:
             self.abort(exc)
             raise
-
-    @property
-    def stand_in(self) -> StandIn:
-        """The loop's controller."""
-        ctrl = self.c.loop.controller
-        if not isinstance(ctrl, StandIn):
-            raise EnvError(f"the loop's controller is {ctrl.name!r}, not the environment's "
-                           "stand-in")
-        return ctrl
 
     def step(self, u: float, mirror: bool) -> tuple[Actuation, MeterState]:
         """Check the stand-in holding ``u`` (veh/s; ``mirror``: the law's own command),
