@@ -240,9 +240,3 @@ def controller_spec(name: str, engine: str | None = None) -> ControllerSpec:
                             f"{', '.join(controller_names(engine))}")
     return spec
 
-
-def make_controller(name: str, lin: Linearization, kernels: Kernels | None = None,
-                    design: EtcDesign = PAPER_DESIGN) -> Controller:
-    """A fresh controller called ``name`` for the equilibrium of ``lin`` (no meter rates,
-    no constant U: for those, build through :func:`controller_spec`)."""
-    return controller_spec(name).build(ControllerInputs(lin, kernels, design))
