@@ -5,12 +5,8 @@
 ``_start(seed)`` (the episode's first observation), ``_advance(u)`` (one control period
 under U) and ``_close()``. Everything the two must agree on lives here: the action space
 (U in veh/s, the meter's range cut by ``[actuation] u_max_fraction``), the observation
-(:mod:`arzsumo.gym.observe`), the seeds, the rewards (:mod:`arzsumo.gym.rewards`) and the
-package laws a policy stands in for (:func:`policy`).
-
-Seeds: ``reset(seed=s)`` runs the episode of seed ``s`` and seeds :attr:`np_random`;
-``reset()`` runs the constructor's ``seed`` (else the scenario's) first, then seeds drawn
-from :attr:`np_random` (docs/gym.md, "Seeds").
+(:mod:`arzsumo.gym.observe`), the seeds (docs/gym.md, "Seeds"), the rewards
+(:mod:`arzsumo.gym.rewards`) and the package laws a policy stands in for (:func:`policy`).
 """
 
 from __future__ import annotations

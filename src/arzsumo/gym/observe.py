@@ -1,16 +1,9 @@
 """What an agent observes, the same on the twin and in SUMO: spaces and normalisation.
 
-Three observations (``observation=``; docs/gym.md, "Spaces"), each an array of 4 rows,
-(rho_h, v_h, rho_a, v_a), over places, ``float32``: ``"state"``, the estimated state on
-the ``[sumo]`` cells (in SUMO the estimate the controllers act on, before any warm-up
-reference is subtracted); ``"loops"``, the ``[sensing]`` loop stations' readings of the
-period (a speed no vehicle gave is the fundamental diagram's at the station's densities);
-``"boundary"``, the stations at x = 0 and x = L (without loops, the first and last cells).
-On the twin, its own state at the same places (ideal loops).
-
-Every row is divided by its equilibrium value (a class with no equilibrium density by the
-total density rho_h* + rho_a*), so 1 is the operating point; a value no sensor gave
-(NaN) is 1; values are clipped below at 0. :func:`denormalise` undoes it.
+Three observations (``observation=`` ``"state"``, ``"loops"`` or ``"boundary"``), each 4
+rows (rho_h, v_h, rho_a, v_a) over places, ``float32``, every row divided by its
+equilibrium value (NaN: 1; clipped below at 0; :func:`denormalise` undoes it).
+docs/gym.md, "Spaces".
 """
 
 from __future__ import annotations
