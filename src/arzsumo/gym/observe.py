@@ -49,16 +49,8 @@ class Observer:
         self.x_loops = (np.asarray(scenario.sensing.loop_x(length), float)
                         if scenario.sensing.loops else np.empty(0))
         self.scale = scales(scenario.equilibrium)
-        self.space = spaces.Box(0.0, np.inf, (4, self.places), np.float32)
-
-    @property
-    def places(self) -> int:
-        """Columns of the observation."""
-        if self.kind == "state":
-            return self.x_cells.size
-        if self.kind == "loops":
-            return self.x_loops.size
-        return 2
+        places = {"state": self.x_cells.size, "loops": self.x_loops.size}.get(kind, 2)
+        self.space = spaces.Box(0.0, np.inf, (4, places), np.float32)
 
     def __call__(self, state: np.ndarray, loops: np.ndarray | None) -> np.ndarray:
         """The observation of ``state`` (4, cells, SI) and the stations' ``loops`` (4,

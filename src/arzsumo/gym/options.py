@@ -111,7 +111,8 @@ class EnvOptions:
         opts = cls(sc, check_seed(seed), reward,
                    check_choice(observation, "observation", OBSERVATIONS),
                    check_time(warmup_s, "warmup_s", 0.0),
-                   check_time(horizon_s, "horizon_s", period), check_law(law))
+                   check_time(horizon_s, "horizon_s", period),
+                   None if law is None else check_choice(law, "law", controller_names("sumo")))
         if observation == "loops" and not sc.sensing.loops:
             raise refuse("observation", observation,
                          f"'state' or 'boundary': scenario {sc.name} has no loop stations "
@@ -123,9 +124,3 @@ class EnvOptions:
         """The control horizon, s."""
         return self.horizon_s if self.horizon_s is not None else self.scenario.sumo.horizon
 
-
-def check_law(value: object) -> str | None:
-    """``value``: None or a registered controller that runs in SUMO."""
-    if value is None:
-        return None
-    return check_choice(value, "law", controller_names("sumo"))
