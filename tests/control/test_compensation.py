@@ -28,7 +28,7 @@ def kernels100(lin):
 def _state(ctrl, t, w_bar):
     """The MacroState whose deviations on the kernel grid are E^-1 T^-1 w-bar."""
     sm = ctrl.state_map
-    fields = sm.to_z(w_bar) + sm.reference
+    fields = sm.lin.T_inv @ (w_bar / sm.scaling) + sm.reference
     return MacroState(t, sm.x, *fields)
 
 

@@ -11,10 +11,8 @@ solves nothing: the kernel cache lives above it)::
     kernels = cached_kernels(lin.system, cells) if spec.pde else None
     ctrl = spec.build(ControllerInputs(lin, kernels, design))
 
-Installed packages add entries through the entry-point group ``arzsumo.controllers``
-(:data:`PLUGIN_GROUP`), read the first time a name is looked up: a
-:class:`ControllerSpec`, or a :class:`~arzsumo.control.base.Controller` subclass
-(registered under the entry point's name). docs/api.md, "``register_controller``, and
+Installed packages add entries through the entry-point group :data:`PLUGIN_GROUP`, read
+the first time a name is looked up. docs/api.md, "``register_controller``, and
 controllers in other processes".
 """
 
