@@ -31,15 +31,8 @@ def denormalise(obs: np.ndarray, eq: Equilibrium) -> np.ndarray:
 
 
 class Observer:
-    """Builds one kind of observation (module docstring) for a scenario.
-
-    Parameters
-    ----------
-    kind : {"state", "loops", "boundary"}
-    scenario : Scenario
-        Its equilibrium (the scales), ``[sumo] cell_length_m`` (the cells) and
-        ``[sensing]`` loops (the stations).
-    """
+    """Builds one kind of observation (module docstring) for a scenario: its equilibrium
+    gives the scales, ``[sumo] cell_length_m`` the cells, ``[sensing]`` the stations."""
 
     def __init__(self, kind: str, scenario: Scenario) -> None:
         self.kind, self.params = kind, scenario.params

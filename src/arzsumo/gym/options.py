@@ -74,24 +74,9 @@ def scenario_of(value: object) -> Scenario:
 
 @dataclass(frozen=True)
 class EnvOptions:
-    """The checked keyword arguments of an environment (module docstring).
-
-    Parameters
-    ----------
-    scenario : Scenario
-        The road, its model and equilibrium, its ``[sumo]`` grid, meter and period.
-    seed : int or None
-        The first episode's seed (None: the scenario's ``[sumo] seed``).
-    reward : callable, str or mapping
-        Resolved by :func:`arzsumo.gym.rewards.reward_of`.
-    observation : str
-        One of :data:`OBSERVATIONS`.
-    warmup_s, horizon_s : float or None
-        Warm-up (SUMO) and control horizon, s; None: the scenario's.
-    law : str or None
-        The package law an episode stands in for (:func:`arzsumo.gym.policy`); None: an
-        agent.
-    """
+    """The checked keyword arguments of an environment (module docstring; what each is:
+    docs/gym.md, "Keyword arguments"). None: the scenario's ``seed``, ``warmup_s`` or
+    ``horizon_s``; an agent for ``law``."""
 
     scenario: Scenario
     seed: int | None

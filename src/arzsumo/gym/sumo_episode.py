@@ -50,13 +50,8 @@ class StandIn(Controller):
     hands the law's U before the action space's clip, and the check is logged as the law
     logged it (its U held, its continuous U, its event, its trigger's terms), so the run's
     records are those of ``arzsumo run`` with that law. Any other U is logged as held, an
-    event where it changed.
-
-    Parameters
-    ----------
-    law : Controller, optional
-        The law built for the run (``arzsumo run``'s, wrappers included), checked by
-        :meth:`advise`; None for an agent.
+    event where it changed. ``law``: the law built for the run (``arzsumo run``'s, wrappers
+    included), checked by :meth:`advise`; None for an agent.
     """
 
     name = "agent"
@@ -93,17 +88,9 @@ class StandIn(Controller):
 
 
 class SumoEpisode:
-    """SUMO warmed up and the control window open at its first check.
-
-    Parameters
-    ----------
-    run : PreparedRun
-        What :func:`arzsumo.bridge.session.prepare_run` made of the scenario.
-    frontend : str
-        "libsumo" or "traci".
-    law : bool
-        Whether the stand-in may be advised by the run's law (a policy stands in for it).
-    """
+    """SUMO warmed up and the control window open at its first check: ``run`` from
+    :func:`arzsumo.bridge.session.prepare_run`, ``frontend`` "libsumo" or "traci", ``law``
+    whether the stand-in may be advised by the run's law (a policy stands in for it)."""
 
     def __init__(self, run: PreparedRun, frontend: str, law: bool) -> None:
         self.run = run
