@@ -13,7 +13,7 @@ import pytest
 import arzsumo
 from arzsumo.api.evaluation import seed_list
 from arzsumo.cli import main
-from arzsumo.control.registry import unregister_controller
+from arzsumo.control.registry import REGISTRY
 
 NAMES = {"load_scenario", "run", "twin", "evaluate", "calibrate", "Controller",
          "register_controller",
@@ -36,7 +36,7 @@ class DrainExcess(arzsumo.Controller):
 @pytest.fixture
 def drain_excess():
     yield DrainExcess
-    unregister_controller(DrainExcess.name)
+    REGISTRY.pop(DrainExcess.name, None)
 
 
 def test_the_public_names_are_in_all_and_import_nothing_heavy():

@@ -85,7 +85,6 @@ def test_controller_applies_the_law_in_physical_units(lin, kernels):
 
 
 def test_registry_builds_every_controller(lin, kernels):
-    from arzsumo.control import make_controller
     from arzsumo.control.alinea import Alinea, HeldMeter, PiAlinea, ReleaseRates
     from arzsumo.control.registry import ControllerInputs, controller_names, controller_spec
     from arzsumo.errors import ModelError, ScenarioError
@@ -109,6 +108,6 @@ def test_registry_builds_every_controller(lin, kernels):
     with pytest.raises(ModelError, match="needs the meter's release rates"):
         controller_spec("held").build(ControllerInputs(lin))
     with pytest.raises(ScenarioError, match="controller = 'pid' is not allowed"):
-        make_controller("pid", lin, kernels)
+        controller_spec("pid").build(ControllerInputs(lin, kernels))
     with pytest.raises(ModelError, match="needs backstepping kernels"):
-        make_controller("etc", lin, None)
+        controller_spec("etc").build(ControllerInputs(lin, None))

@@ -9,6 +9,8 @@ from arzsumo.control.plant import LinearPlant
 from arzsumo.control.predictor import committed, held, predict_riemann
 from arzsumo.errors import ModelError
 
+from .conftest import run_norms
+
 N = 200
 
 
@@ -32,7 +34,8 @@ def test_prediction_matches_the_plant_theta_later(lin, delay):
     plant = LinearPlant(lin.system, N)
     w0 = _initial(lin, plant.x)
     plant.reset(w0)
-    plant.run(delay, lambda t, w: float(_u_bar(t)), sample_every=delay)
+    while plant.t < delay - 1e-9:
+        plant.step(lambda t, w: float(_u_bar(t)))
     truth = plant.state
     pred = predict_riemann(lin.system, plant.x, w0, plant.t, lambda s: _u_bar(s))
     err_pred = np.sqrt(np.mean((pred - truth) ** 2))
@@ -77,7 +80,7 @@ def _closed_loop(lin, delay, predict, t_end):
         k = np.searchsorted(issued_t, t - delay, side="right") - 1
         return issued_u[k] if k >= 0 else 0.0
 
-    return plant.run(t_end, u_bar, sample_every=10.0).norm
+    return run_norms(plant, t_end, u_bar)
 
 
 def test_predictor_restores_convergence_under_one_cycle_of_delay(lin):

@@ -12,10 +12,10 @@ import pytest
 from arzsumo.cli import main
 from arzsumo.control.base import ConstantControl
 from arzsumo.control.registry import (
+    REGISTRY,
     ControllerSpec,
     controller_names,
     register_controller,
-    unregister_controller,
 )
 from arzsumo.engines.twin import twin_controller
 from arzsumo.errors import ScenarioError
@@ -68,7 +68,7 @@ def test_registry_plugs_controllers_in(base_lin):
         with pytest.raises(ScenarioError, match=r'\[run\] controller = "test-const" is not'):
             scenario_from_dict({"run": {"controller": "test-const"}})
     finally:
-        unregister_controller("test-const")
+        REGISTRY.pop("test-const", None)
     with pytest.raises(ScenarioError, match="controller = 'test-const' is not allowed: one of"):
         twin_controller(cfg, base_lin)
 

@@ -115,7 +115,5 @@ def controller_name(controller: ControllerLike | None, engine: str) -> str | Non
     return controller
 
 
-
-
 __all__ = ["BUILTIN", "Controller", "ControllerInputs", "ControllerLike", "controller_name",
            "controller_names", "register_controller"]

@@ -45,10 +45,9 @@ def road_geometry(scenario: str | Path | Scenario | None = None) -> RoadGeometry
     (1000.0, 1, 20)
     """
     sc = with_network(load_scenario(scenario))
-    L = sc.params.length
     with tempfile.TemporaryDirectory(prefix="arzsumo-net-") as tmp:
         layout = shipped_layout(sc.sumo, Path(tmp))
-        return _geometry(layout, sc.sensing.loop_x(L), sc.sumo.cell_length,
+        return _geometry(layout, sc.sensing.loop_x(sc.params.length), sc.sumo.cell_length,
                          sc.alinea.loop_distance)
 
 

@@ -9,10 +9,8 @@ from arzsumo.control.registry import (
     controller_names,
     controller_spec,
     is_pde,
-    make_controller,
     pde_controller_names,
 )
 
 __all__ = ["ConstantControl", "ControlLog", "Controller", "MacroState", "OpenLoop",
-           "controller_names", "controller_spec", "is_pde", "make_controller",
-           "pde_controller_names"]
+           "controller_names", "controller_spec", "is_pde", "pde_controller_names"]

@@ -1,19 +1,11 @@
 """ALINEA and PI-ALINEA as practitioners run them: local occupancy feedback on the release rate.
 
 ALINEA (Papageorgiou, Hadj-Salem and Blosseville, Transp. Res. Rec. 1320, 1991) and
-PI-ALINEA (Wang, Kosmatopoulos, Papageorgiou and Papamichail, IEEE T-ITS 15(5), 2014):
-
-    r(k) = r(k-1) + K_R (o_target - o(k)),
-    r(k) = r(k-1) - K_P (o(k) - o(k-1)) + K_I (o_target - o(k)),
-
-o(k) the occupancy of one loop downstream of the merge nose averaged over the period T,
-r clamped to [r_min, r_max] after each update (clamping the state is ALINEA's
-anti-windup). K_R and K_I are given at a reference period T_ref and scaled as
-K(T) = K(T_ref) T / T_ref, which keeps the integral action per second; K_P is not
-scaled. The closed loop checks every controller every control period (1 s); these
-average the occupancy samples of those checks over their own period and hold their
-command in between. The command is U = r_nominal - r (veh/s). docs/sumo.md, "Baselines
-a practitioner would field".
+PI-ALINEA (Wang, Kosmatopoulos, Papageorgiou and Papamichail, IEEE T-ITS 15(5), 2014),
+each updated once per its own period T on the period's mean occupancy o(k) of one loop
+past the merge nose, r clamped to [r_min, r_max]; K_R and K_I are given at T_ref and
+scaled as K(T_ref) T / T_ref. The command is U = r_nominal - r (veh/s). docs/sumo.md,
+"Baselines a practitioner would field".
 
 SI throughout: rates veh/s, occupancy a fraction (SUMO's loop occupancy; it can exceed 1
 with vehicles side by side under the sublane model), gains veh/s per unit occupancy,

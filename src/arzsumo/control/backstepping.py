@@ -65,10 +65,6 @@ class StateMap:
         """Scaled Riemann variables w-bar = E(x) T z."""
         return self.scaling * (self.lin.T @ z)
 
-    def to_z(self, w_bar: np.ndarray) -> np.ndarray:
-        """Inverse of :meth:`riemann`."""
-        return self.lin.T_inv @ (w_bar / self.scaling)
-
 
 class Backstepping(Controller):
     """Continuous backstepping: U(t) from control_law at every check.

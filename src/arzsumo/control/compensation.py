@@ -1,49 +1,27 @@
 """Delay compensation: a PDE law evaluated on the state predicted theta seconds ahead.
 
-The meter moves the section's outflow a dead time theta after a command: the U-bar issued
-at t enters clpsys4 at t + theta. :class:`DelayCompensated` wraps a law on scaled Riemann
-states (continuous backstepping, control_law; the full-state ETC, control law sam with
-defdynamic) and, at every check t, maps the state to w-bar(t) (clpsys1), predicts
-w-bar(t + theta) with the commands applied in [t - theta, t)
-(:mod:`arzsumo.control.predictor`; after the actuator's limits, told through
-:meth:`DelayCompensated.actuated`) and evaluates the wrapped law on the prediction. With
-theta = 0 the command is the wrapped law's exactly. The observer-ETC's boundary observer
-is not wrapped: its ob-sys2-bd already takes each command as acting at once.
-docs/sumo.md, "Actuation limits" (delay compensation).
+:class:`DelayCompensated` wraps continuous backstepping (control_law) or the full-state
+ETC (control law sam with defdynamic): at each check t it predicts w-bar(t + theta)
+(clpsys1) with the commands applied in [t - theta, t) (:mod:`arzsumo.control.predictor`)
+and evaluates the wrapped law on it; with theta = 0 the command is the wrapped law's
+exactly. docs/sumo.md, "Actuation limits" (delay compensation).
 """
 
 from __future__ import annotations
 
 import math
-from typing import Protocol
 
 import numpy as np
 
-from arzsumo.control.backstepping import StateMap
+from arzsumo.control.backstepping import Backstepping
 from arzsumo.control.base import Controller, ControlLog, MacroState
+from arzsumo.control.etc import EventTriggered
 from arzsumo.control.predictor import committed, predict_riemann
 from arzsumo.errors import ModelError, require
-from arzsumo.model.characteristic import Linearization
 
-
-class RiemannLaw(Protocol):
-    """A controller whose law takes scaled Riemann states on its kernel grid."""
-
-    name: str
-    lin: Linearization
-    state_map: StateMap
-    log: ControlLog
-
-    def check_riemann(self, t: float, w_bar: np.ndarray) -> float: ...
-
-    def reset(self) -> None: ...
-
-    def applied(self, u: float, lower: float = -math.inf, upper: float = math.inf) -> None: ...
-
-    def set_output_noise(self, sd: float) -> bool: ...
-
-    @property
-    def has_trigger(self) -> bool: ...
+#: the laws on scaled Riemann states :class:`DelayCompensated` wraps (the acting
+#: backstepping or ETC, :data:`arzsumo.bridge.delay.COMPENSATED`)
+RiemannLaw = Backstepping | EventTriggered
 
 
 class DelayCompensated(Controller):

@@ -83,10 +83,8 @@ def _inverse_norm(kernels: Kernels) -> float:
     """Spectral norm of the discrete inverse transform in the trapezoid L2 inner product."""
     n, nodes = kernels.K.shape[0], kernels.n_cells + 1
     tr = BacksteppingTransform(kernels)
-    eye = np.eye((n + 1) * nodes)
-    cols = [np.concatenate(tr.inverse(e.reshape(n + 1, nodes)[:n],
-                                      e.reshape(n + 1, nodes)[n]).reshape(1, -1))
-            for e in eye]
+    eye = np.eye((n + 1) * nodes).reshape(-1, n + 1, nodes)
+    cols = [tr.inverse(e[:n], e[n]).ravel() for e in eye]
     return float(np.linalg.norm(np.array(cols).T, 2))
 
 

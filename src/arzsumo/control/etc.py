@@ -91,9 +91,8 @@ class EtcDesign:
             value = getattr(self, name)
             require(math.isfinite(value) and value > 0, name, value, "a number > 0")
         for name in ("A", "varsigma"):
-            for value in getattr(self, name):
-                require(math.isfinite(value) and value > 0, name, getattr(self, name),
-                        "numbers > 0")
+            values = getattr(self, name)
+            require(all(math.isfinite(v) and v > 0 for v in values), name, values, "numbers > 0")
         require(len(self.varsigma) == len(self.A) + 1, "varsigma", self.varsigma,
                 f"{len(self.A) + 1} values (one per state)")
         require(math.isfinite(self.m0) and self.m0 < 0, "m0", self.m0,

@@ -3,7 +3,7 @@ Lyapunov convergence time of the sensitivity subsection."""
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -50,11 +50,6 @@ class EventSummary:
     release_time: float
     min_interval: float
     mean_interval: float
-    first_event: float
-    last_event: float
-
-    def as_dict(self) -> dict[str, float]:
-        return asdict(self)
 
 
 def event_summary(log: ControlLog, horizon: float) -> EventSummary:
@@ -64,6 +59,4 @@ def event_summary(log: ControlLog, horizon: float) -> EventSummary:
     return EventSummary(
         triggers=log.triggers, release_time=release_time(log.t, log.triggered, horizon),
         min_interval=float(intervals.min()) if intervals.size else float("inf"),
-        mean_interval=float(intervals.mean()) if intervals.size else float("inf"),
-        first_event=float(times[0]) if times.size else float("nan"),
-        last_event=float(times[-1]) if times.size else float("nan"))
+        mean_interval=float(intervals.mean()) if intervals.size else float("inf"))

@@ -77,10 +77,9 @@ class BoundaryObserver:
         self._dt_max = LinearPlant(system, n_cells).dt
         self.reset()
 
-    def reset(self, estimate: np.ndarray | None = None) -> None:
-        """Start from ``estimate`` (default zero: nothing known)."""
-        shape = (self.system.n + 1, self.n_cells + 1)
-        self.estimate = np.zeros(shape) if estimate is None else np.array(estimate, float)
+    def reset(self) -> None:
+        """Start from zero: nothing known."""
+        self.estimate = np.zeros((self.system.n + 1, self.n_cells + 1))
         self.t: float | None = None
         self.y_last = 0.0
 
@@ -120,7 +119,6 @@ class ObserverEtc(TriggeredLaw):
                  design: EtcDesign = PAPER_DESIGN) -> None:
         super().__init__(lin, kernels, design)
         self.observer = BoundaryObserver(lin.system, kernels.n_cells)
-        self.u_bar_held = 0.0
         #: U-bar the observer integrates over the next interval: the applied one
         self.u_bar_input = 0.0
         eq = lin.equilibrium
@@ -130,7 +128,7 @@ class ObserverEtc(TriggeredLaw):
     def reset(self) -> None:
         super().reset()
         self.observer.reset()
-        self.u_bar_held = self.u_bar_input = 0.0
+        self.u_bar_input = 0.0
 
     def measurement_of(self, state: MacroState) -> float:
         """y = w-(0) from the class speeds in the first cell (inlet densities at rho*)."""
@@ -141,7 +139,7 @@ class ObserverEtc(TriggeredLaw):
         """Advance the observer to t with y(t), run the mechanism on the estimate; U-bar."""
         estimate = self.observer.advance(t, y, self.u_bar_input)
         r = self.trigger.check(t, estimate)
-        self.u_bar_held = self.u_bar_input = r.u_bar_held
+        self.u_bar_input = r.u_bar_held
         return self._record(t, r, y=y)
 
     def applied(self, u: float, lower: float = -math.inf, upper: float = math.inf) -> None:

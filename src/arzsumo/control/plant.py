@@ -19,25 +19,15 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 
-from arzsumo.control.interp import lagrange_stencil
+from arzsumo.control.kernels import lagrange_stencil
 from arzsumo.errors import ModelError, require
 from arzsumo.model.characteristic import CharacteristicSystem
 
 #: maps (t, state) -> U-bar to apply on the outlet at time t
 UBarFunction = Callable[[float, np.ndarray], float]
-
-
-@dataclass
-class PlantHistory:
-    """Samples of a plant run: times (s), L2 norms of w-bar, and applied U-bar."""
-
-    t: np.ndarray
-    norm: np.ndarray
-    u_bar: np.ndarray
 
 
 class LinearPlant:
@@ -106,24 +96,6 @@ class LinearPlant:
         self.u_bar_applied = u_bar_fn(self.t, w)
         w[n, -1] = self.system.R @ w[:n, -1] + self.u_bar_applied
         self.state = w
-
-    def norm(self) -> float:
-        """L2 norm of w-bar over [0, L] (trapezoid)."""
-        return float(np.sqrt(np.trapezoid(np.sum(self.state**2, axis=0), self.x)))
-
-    def run(self, t_end: float, u_bar_fn: UBarFunction,
-            sample_every: float = 1.0) -> PlantHistory:
-        """Step until ``t_end`` (s); sample the norm about every ``sample_every`` s."""
-        ts, norms, us = [self.t], [self.norm()], [self.u_bar_applied]
-        next_sample = self.t + sample_every
-        while self.t < t_end - 1e-9:
-            self.step(u_bar_fn)
-            if self.t >= next_sample - 1e-9 or self.t >= t_end - 1e-9:
-                ts.append(self.t)
-                norms.append(self.norm())
-                us.append(self.u_bar_applied)
-                next_sample += sample_every
-        return PlantHistory(np.array(ts), np.array(norms), np.array(us))
 
 
 def step_dividing(period: float, dt_max: float) -> float:

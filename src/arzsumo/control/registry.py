@@ -11,10 +11,8 @@ solves nothing: the kernel cache lives above it)::
     kernels = cached_kernels(lin.system, cells) if spec.pde else None
     ctrl = spec.build(ControllerInputs(lin, kernels, design))
 
-Installed packages add entries through the entry-point group ``arzsumo.controllers``
-(:data:`PLUGIN_GROUP`), read the first time a name is looked up: a
-:class:`ControllerSpec`, or a :class:`~arzsumo.control.base.Controller` subclass
-(registered under the entry point's name). docs/api.md, "``register_controller``, and
+Installed packages add entries through the entry-point group :data:`PLUGIN_GROUP`, read
+the first time a name is looked up. docs/api.md, "``register_controller``, and
 controllers in other processes".
 """
 
@@ -174,11 +172,6 @@ def load_plugins() -> None:
         REGISTRY[spec.name] = spec
 
 
-def unregister_controller(name: str) -> None:
-    """Remove ``name`` (tests that registered one clean up with it)."""
-    REGISTRY.pop(name, None)
-
-
 for _spec in (
     ControllerSpec("open", lambda inp: OpenLoop(), description="no control (U = 0)"),
     ControllerSpec("backstepping", _pde(Backstepping), pde=True,
@@ -245,9 +238,3 @@ def controller_spec(name: str, engine: str | None = None) -> ControllerSpec:
                             f"{', '.join(controller_names(engine))}")
     return spec
 
-
-def make_controller(name: str, lin: Linearization, kernels: Kernels | None = None,
-                    design: EtcDesign = PAPER_DESIGN) -> Controller:
-    """A fresh controller called ``name`` for the equilibrium of ``lin`` (no meter rates,
-    no constant U: for those, build through :func:`controller_spec`)."""
-    return controller_spec(name).build(ControllerInputs(lin, kernels, design))

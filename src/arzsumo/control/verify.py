@@ -233,24 +233,3 @@ def run_closed_loop(lin: Linearization, kernels: Kernels, controller: str = "etc
     _run_held(plant, check, series, w0, period, horizon)
     return ClosedLoopRun(controller, period, horizon, *series.arrays(), ctrl.log)
 
-
-def sensitivity(lin: Linearization, kernels: Kernels, parameter: str,
-                values: list[float], period: float = 1.0, horizon: float = 450.0,
-                design=None, fraction: float = 0.01) -> list[dict[str, float]]:
-    """ETC release time and Lyapunov convergence time per value of one design parameter.
-
-    ``parameter`` is a field of :class:`~arzsumo.control.etc.EtcDesign` (mu, sigma, zeta,
-    ...). The convergence time is the first time after which V stays below ``fraction``
-    V(0) (sensitivity subsection of section 5).
-    """
-    base = design or PAPER_DESIGN
-    rows = []
-    for value in values:
-        run = run_closed_loop(lin, kernels, "etc", period, horizon,
-                              base.with_(**{parameter: value}))
-        summary = run.summary()
-        rows.append({"parameter": parameter, "value": float(value),
-                     "triggers": summary["triggers"], "release_time": summary["release_time"],
-                     "lyapunov_convergence_time": lyapunov_convergence_time(run.t, run.V,
-                                                                            fraction)})
-    return rows

@@ -123,8 +123,7 @@ def run_twin(scenario: Scenario, config: TwinConfig | None = None, *,
     init = initial_fields(cfg.initial, eq, x)
     res = simulate(eq, init, controller=ctrl, options=cfg.solver)
     perf = performance(eq.params, res.t, res.x, res.fields)
-    log = ctrl.log
-    mask = events(res.control_t, res.control_u, log.triggered if log.t else None)
+    mask = events(res.control_t, res.control_u, ctrl.log.triggered if ctrl.log.t else None)
     run = TwinRun(scenario, cfg, res, perf, deviation_norm(eq, res.x, res.fields), mask, None)
     if ctrl.name == "open":
         return replace(run, baseline_status="this run is the open loop")

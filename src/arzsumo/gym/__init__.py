@@ -1,12 +1,8 @@
 """The ramp meter as Gymnasium environments: learn on the PDE twin, test in SUMO.
 
-``import arzsumo.gym`` registers two environments with the same spaces, period and
-action range on a scenario (``pip install 'arzsumo[gym]'``; a first episode: docs/gym.md):
-``arzsumo/TwinRampMeter-v0`` (:class:`TwinRampMeterEnv`, the nonlinear PDE twin) and
-``arzsumo/SumoRampMeter-v0`` (:class:`SumoRampMeterEnv`, SUMO with the closed loop of
-``arzsumo run``: warm-up in ``reset``; ``close`` leaves no SUMO running). :func:`policy`
-offers the package's controllers as policies, :mod:`arzsumo.gym.rewards` the named
-rewards and :class:`StepRecord`, :mod:`arzsumo.gym.observe` the observations.
+``import arzsumo.gym`` registers ``arzsumo/TwinRampMeter-v0`` (:class:`TwinRampMeterEnv`)
+and ``arzsumo/SumoRampMeter-v0`` (:class:`SumoRampMeterEnv`); :func:`policy` offers the
+package's controllers as policies. docs/gym.md (``pip install 'arzsumo[gym]'``).
 """
 
 from __future__ import annotations
@@ -16,9 +12,8 @@ try:
 except ImportError as exc:  # pragma: no cover - the extra is missing
     raise ImportError("arzsumo.gym needs gymnasium: pip install 'arzsumo[gym]'") from exc
 
-from arzsumo.gym.base import RampMeterEnv
+from arzsumo.gym.base import POLICIES, LawPolicy, RampMeterEnv, policy
 from arzsumo.gym.observe import denormalise
-from arzsumo.gym.policy import POLICIES, LawPolicy, policy
 from arzsumo.gym.rewards import NAMED as REWARDS
 from arzsumo.gym.rewards import StepRecord
 from arzsumo.gym.sumo_env import SumoRampMeterEnv

@@ -5,12 +5,8 @@
 ``_start(seed)`` (the episode's first observation), ``_advance(u)`` (one control period
 under U) and ``_close()``. Everything the two must agree on lives here: the action space
 (U in veh/s, the meter's range cut by ``[actuation] u_max_fraction``), the observation
-(:mod:`arzsumo.gym.observe`), the seeds, the rewards (:mod:`arzsumo.gym.rewards`) and the
-package laws a policy stands in for (:func:`arzsumo.gym.policy`).
-
-Seeds: ``reset(seed=s)`` runs the episode of seed ``s`` and seeds :attr:`np_random`;
-``reset()`` runs the constructor's ``seed`` (else the scenario's) first, then seeds drawn
-from :attr:`np_random` (docs/gym.md, "Seeds").
+(:mod:`arzsumo.gym.observe`), the seeds (docs/gym.md, "Seeds"), the rewards
+(:mod:`arzsumo.gym.rewards`) and the package laws a policy stands in for (:func:`policy`).
 """
 
 from __future__ import annotations
@@ -25,7 +21,9 @@ import gymnasium
 import numpy as np
 from gymnasium import spaces
 
+from arzsumo.api.controllers import BUILTIN
 from arzsumo.control.base import Applied, Command, Controller, MacroState
+from arzsumo.control.registry import controller_names
 from arzsumo.errors import EnvError
 from arzsumo.gym.observe import Observer
 from arzsumo.gym.options import EnvOptions, check_seed, refuse
@@ -35,6 +33,9 @@ from arzsumo.units import VEH_H_PER_VEH_S
 
 #: an action this close (veh/s) outside the space is taken as its bound (float32 rounding)
 ACTION_TOLERANCE = 1e-6
+#: the package's own laws that run in SUMO, offered as policies (every name of the registry
+#: that runs in SUMO is accepted)
+POLICIES = tuple(n for n in controller_names("sumo") if n in BUILTIN)
 
 
 @dataclass(frozen=True)
@@ -170,7 +171,7 @@ class RampMeterEnv(gymnasium.Env):
     # -- package laws ---------------------------------------------------------------------
     def stand_in(self, name: str) -> None:
         """Let episodes from the next reset on stand in for the law ``name`` (a policy's
-        set-up, :func:`arzsumo.gym.policy`); an environment made for another law refuses."""
+        set-up, :func:`policy`); an environment made for another law refuses."""
         if self.law_name not in (None, name):
             raise refuse("policy", name, f"{self.law_name!r}: the law this environment "
                                          "was made for (law=...)")
@@ -182,7 +183,7 @@ class RampMeterEnv(gymnasium.Env):
 
     def law_action(self) -> np.ndarray:
         """The law's command at the present check, clipped to the action space (the law
-        is checked once per check; :func:`arzsumo.gym.policy`)."""
+        is checked once per check; :func:`policy`)."""
         if self.law is None or not self._running:
             raise EnvError(f"policy {self.law_name!r} cannot act now: allowed after "
                            "reset(), in an episode begun after the policy was made")
@@ -230,3 +231,58 @@ class RampMeterEnv(gymnasium.Env):
         """The estimated macroscopic state of the present check (SI), as the package's
         controllers would be handed it; None between episodes."""
         return self._law_state() if self._running else None
+
+
+class LawPolicy:
+    """A package law as a policy of one environment (:func:`policy`)."""
+
+    def __init__(self, name: str, env: RampMeterEnv) -> None:
+        self.name, self.env = name, env
+
+    def __call__(self, obs: Any = None) -> np.ndarray:
+        """The law's action at the environment's present check (veh/s, shape (1,))."""
+        return self.env.law_action()
+
+    def __repr__(self) -> str:
+        return f"policy({self.name!r}, {type(self.env).__name__})"
+
+
+def policy(name: str, env: Any) -> LawPolicy:
+    """The package law ``name`` as a policy of ``env``: observation in, action out.
+
+    ``policy("etc", env)`` makes ``env`` stand in for the law from its next ``reset`` and
+    returns a callable that returns the law's action at the present check: the law is
+    checked on the environment's own state (``env.unwrapped.state``, not the normalised
+    observation) and told what the actuator applied, as in ``arzsumo run`` (docs/gym.md,
+    "The package's controllers as policies"). Call the policy once per step, with the
+    observation of the present check (it reads the environment, not its argument, which is
+    there for the Gymnasium convention).
+
+    Parameters
+    ----------
+    name : str
+        ``"open"``, ``"backstepping"``, ``"etc"`` or ``"alinea"`` (any controller of the
+        registry that runs in SUMO; on the twin, one that runs on the twin).
+    env : gymnasium.Env
+        An environment of :mod:`arzsumo.gym` (wrappers allowed).
+
+    Returns
+    -------
+    LawPolicy
+        ``policy(obs) -> action``; reset ``env`` after making it.
+
+    Raises
+    ------
+    arzsumo.errors.EnvError
+        An unknown law, one that does not run on the twin, or an environment made for
+        another law.
+    """
+    base = getattr(env, "unwrapped", env)
+    if not isinstance(base, RampMeterEnv):
+        raise refuse("env", env, "an environment of arzsumo.gym (arzsumo/TwinRampMeter-v0, "
+                                 "arzsumo/SumoRampMeter-v0)")
+    allowed = controller_names("twin" if base.engine == "twin" else "sumo")
+    if not isinstance(name, str) or name not in allowed:
+        raise refuse("policy", name, f"on the {base.engine} one of {', '.join(allowed)}")
+    base.stand_in(name)
+    return LawPolicy(name, base)

@@ -1,16 +1,9 @@
 """What an agent observes, the same on the twin and in SUMO: spaces and normalisation.
 
-Three observations (``observation=``; docs/gym.md, "Spaces"), each an array of 4 rows,
-(rho_h, v_h, rho_a, v_a), over places, ``float32``: ``"state"``, the estimated state on
-the ``[sumo]`` cells (in SUMO the estimate the controllers act on, before any warm-up
-reference is subtracted); ``"loops"``, the ``[sensing]`` loop stations' readings of the
-period (a speed no vehicle gave is the fundamental diagram's at the station's densities);
-``"boundary"``, the stations at x = 0 and x = L (without loops, the first and last cells).
-On the twin, its own state at the same places (ideal loops).
-
-Every row is divided by its equilibrium value (a class with no equilibrium density by the
-total density rho_h* + rho_a*), so 1 is the operating point; a value no sensor gave
-(NaN) is 1; values are clipped below at 0. :func:`denormalise` undoes it.
+Three observations (``observation=`` ``"state"``, ``"loops"`` or ``"boundary"``), each 4
+rows (rho_h, v_h, rho_a, v_a) over places, ``float32``, every row divided by its
+equilibrium value (NaN: 1; clipped below at 0; :func:`denormalise` undoes it).
+docs/gym.md, "Spaces".
 """
 
 from __future__ import annotations
@@ -38,15 +31,8 @@ def denormalise(obs: np.ndarray, eq: Equilibrium) -> np.ndarray:
 
 
 class Observer:
-    """Builds one kind of observation (module docstring) for a scenario.
-
-    Parameters
-    ----------
-    kind : {"state", "loops", "boundary"}
-    scenario : Scenario
-        Its equilibrium (the scales), ``[sumo] cell_length_m`` (the cells) and
-        ``[sensing]`` loops (the stations).
-    """
+    """Builds one kind of observation (module docstring) for a scenario: its equilibrium
+    gives the scales, ``[sumo] cell_length_m`` the cells, ``[sensing]`` the stations."""
 
     def __init__(self, kind: str, scenario: Scenario) -> None:
         self.kind, self.params = kind, scenario.params
@@ -56,16 +42,8 @@ class Observer:
         self.x_loops = (np.asarray(scenario.sensing.loop_x(length), float)
                         if scenario.sensing.loops else np.empty(0))
         self.scale = scales(scenario.equilibrium)
-        self.space = spaces.Box(0.0, np.inf, (4, self.places), np.float32)
-
-    @property
-    def places(self) -> int:
-        """Columns of the observation."""
-        if self.kind == "state":
-            return self.x_cells.size
-        if self.kind == "loops":
-            return self.x_loops.size
-        return 2
+        places = {"state": self.x_cells.size, "loops": self.x_loops.size}.get(kind, 2)
+        self.space = spaces.Box(0.0, np.inf, (4, places), np.float32)
 
     def __call__(self, state: np.ndarray, loops: np.ndarray | None) -> np.ndarray:
         """The observation of ``state`` (4, cells, SI) and the stations' ``loops`` (4,

@@ -74,24 +74,9 @@ def scenario_of(value: object) -> Scenario:
 
 @dataclass(frozen=True)
 class EnvOptions:
-    """The checked keyword arguments of an environment (module docstring).
-
-    Parameters
-    ----------
-    scenario : Scenario
-        The road, its model and equilibrium, its ``[sumo]`` grid, meter and period.
-    seed : int or None
-        The first episode's seed (None: the scenario's ``[sumo] seed``).
-    reward : callable, str or mapping
-        Resolved by :func:`arzsumo.gym.rewards.reward_of`.
-    observation : str
-        One of :data:`OBSERVATIONS`.
-    warmup_s, horizon_s : float or None
-        Warm-up (SUMO) and control horizon, s; None: the scenario's.
-    law : str or None
-        The package law an episode stands in for (:func:`arzsumo.gym.policy`); None: an
-        agent.
-    """
+    """The checked keyword arguments of an environment (module docstring; what each is:
+    docs/gym.md, "Keyword arguments"). None: the scenario's ``seed``, ``warmup_s`` or
+    ``horizon_s``; an agent for ``law``."""
 
     scenario: Scenario
     seed: int | None
@@ -111,7 +96,8 @@ class EnvOptions:
         opts = cls(sc, check_seed(seed), reward,
                    check_choice(observation, "observation", OBSERVATIONS),
                    check_time(warmup_s, "warmup_s", 0.0),
-                   check_time(horizon_s, "horizon_s", period), check_law(law))
+                   check_time(horizon_s, "horizon_s", period),
+                   None if law is None else check_choice(law, "law", controller_names("sumo")))
         if observation == "loops" and not sc.sensing.loops:
             raise refuse("observation", observation,
                          f"'state' or 'boundary': scenario {sc.name} has no loop stations "
@@ -123,9 +109,3 @@ class EnvOptions:
         """The control horizon, s."""
         return self.horizon_s if self.horizon_s is not None else self.scenario.sumo.horizon
 
-
-def check_law(value: object) -> str | None:
-    """``value``: None or a registered controller that runs in SUMO."""
-    if value is None:
-        return None
-    return check_choice(value, "law", controller_names("sumo"))

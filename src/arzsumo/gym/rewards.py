@@ -1,12 +1,8 @@
 """Rewards: one control period's record in, a number out, the same on the twin and in SUMO.
 
-``reward=`` of both environments is a name, a mapping of names to weights (their
-weighted sum), or any callable taking a :class:`StepRecord` (a callable with a
-``reset()`` method is reset at every episode's start). The names (docs/gym.md,
-"Rewards"): ``"vehicle-hours"`` (its sum over an episode is minus the section's total
-time spent, ``summary["TTT"]["total"]`` / 3600 in SUMO up to the cells' aggregation; the
-ramp queue is not on the section), ``"ramp-queue"`` (the queue at the period's end times
-the period), ``"band-power"`` (:class:`BandPower`) and ``"plan-changes"``.
+``reward=`` is a name of :data:`NAMED`, a mapping of names to weights (their weighted
+sum), or any callable taking a :class:`StepRecord` (a callable with a ``reset()`` method
+is reset at every episode's start). docs/gym.md, "Rewards".
 """
 
 from __future__ import annotations
@@ -71,7 +67,8 @@ Reward = Callable[[StepRecord], float]
 
 
 def vehicle_hours(r: StepRecord) -> float:
-    """Minus the section's vehicle-hours of the period."""
+    """Minus the section's vehicle-hours of the period (an episode's sum: minus SUMO's
+    ``summary["TTT"]["total"]`` / 3600, up to the cells' aggregation)."""
     return -r.section_veh_h
 
 

@@ -21,7 +21,6 @@ import numpy as np
 
 from arzsumo.bridge.prepared import PreparedRun
 from arzsumo.bridge.records import micro_fields
-from arzsumo.bridge.result import CoSimResult
 from arzsumo.bridge.session import prepare_run
 from arzsumo.control.base import Applied, Command, MacroState
 from arzsumo.errors import ArzsumoError, EnvError
@@ -35,18 +34,6 @@ from arzsumo.units import s_to_h
 AGENT_RUN = "constant"
 #: the summary's controller of an agent's episode
 AGENT = "agent"
-
-
-def run_summary(res: CoSimResult, label: str | None = None) -> dict[str, Any]:
-    """The run's ``summary.json`` (:func:`arzsumo.outputs.bridge.summary`), its
-    controller renamed ``label`` when given (an agent's episode)."""
-    from arzsumo.outputs.bridge import summary
-
-    s = summary(res)
-    if label is not None:
-        s = replace(s, identity=replace(s.identity, controller=label),
-                    settings={**s.settings, "controller": label})
-    return s.to_dict()
 
 
 class SumoRampMeterEnv(RampMeterEnv):
@@ -166,7 +153,13 @@ class SumoRampMeterEnv(RampMeterEnv):
         if not self.with_summary:
             ep.close()
             return None
-        return run_summary(ep.finish(), None if self.law_name else AGENT)
+        from arzsumo.outputs.bridge import summary
+
+        s = summary(ep.finish())
+        if not self.law_name:      # an agent's episode: the controller named "agent"
+            s = replace(s, identity=replace(s.identity, controller=AGENT),
+                        settings={**s.settings, "controller": AGENT})
+        return s.to_dict()
 
     def _close(self) -> None:
         ep, self._episode = getattr(self, "_episode", None), None

@@ -4,8 +4,8 @@
 (:func:`arzsumo.bridge.cosim.run_cosimulation`) with the control window opened to an
 outside driver: :func:`~arzsumo.bridge.cosim.open_run` (entered on an
 :class:`contextlib.ExitStack` the episode owns), :func:`~arzsumo.bridge.cosim.warm_start`,
-:func:`~arzsumo.bridge.cosim.open_window` with a :class:`~arzsumo.gym.stand_in.StandIn`
-in the law's place, then one :meth:`~arzsumo.bridge.loop.ClosedLoop.advance` per step and
+:func:`~arzsumo.bridge.cosim.open_window` with a :class:`StandIn` in the law's place, then
+one :meth:`~arzsumo.bridge.loop.ClosedLoop.advance` per step and
 :func:`~arzsumo.bridge.cosim.close_window` at the horizon. The numbers are those of
 ``arzsumo run``: the same calls in the same order.
 
@@ -25,9 +25,7 @@ from arzsumo.bridge.actuator import Actuation
 from arzsumo.bridge.cosim import Controlled, close_window, open_run, open_window, warm_start
 from arzsumo.bridge.prepared import PreparedRun
 from arzsumo.bridge.result import CoSimResult
-from arzsumo.control.base import MacroState
-from arzsumo.errors import EnvError
-from arzsumo.gym.stand_in import StandIn
+from arzsumo.control.base import Applied, Command, Controller, MacroState
 from arzsumo.sumo.meter import MeterState
 
 if TYPE_CHECKING:
@@ -43,18 +41,56 @@ def _leave(stack: ExitStack, opened: list[OpenRun]) -> None:
             o.files.remove()
 
 
-class SumoEpisode:
-    """SUMO warmed up and the control window open at its first check.
+class StandIn(Controller):
+    """The controller the SUMO closed loop checks when an outside driver decides U.
 
-    Parameters
-    ----------
-    run : PreparedRun
-        What :func:`arzsumo.bridge.session.prepare_run` made of the scenario.
-    frontend : str
-        "libsumo" or "traci".
-    law : bool
-        Whether the stand-in may be advised by the run's law (a policy stands in for it).
+    It takes the place of the run's law in :class:`~arzsumo.bridge.loop.ClosedLoop`: at
+    each check it returns the U the driver handed it (:meth:`take`). A driver that took the
+    law's own command (the policies of :func:`arzsumo.gym.policy`, through :meth:`advise`)
+    hands the law's U before the action space's clip, and the check is logged as the law
+    logged it (its U held, its continuous U, its event, its trigger's terms), so the run's
+    records are those of ``arzsumo run`` with that law. Any other U is logged as held, an
+    event where it changed. ``law``: the law built for the run (``arzsumo run``'s, wrappers
+    included), checked by :meth:`advise`; None for an agent.
     """
+
+    name = "agent"
+
+    def __init__(self, law: Controller | None = None) -> None:
+        super().__init__()
+        self.law = law
+        self._u = 0.0
+        self._mirror = False
+
+    def advise(self, state: MacroState, told: Applied | None) -> Command:
+        """The law's command at this check (call it once per check): ``state`` as the
+        loop hands it to its controller, ``told`` what was applied for the last one."""
+        if self.law is None:
+            raise RuntimeError("no law to advise: the environment drives an agent")
+        return self.law.step(state, told)
+
+    def take(self, u: float, mirror: bool = False) -> None:
+        """Hold ``u`` (veh/s) at the next check; ``mirror``: ``u`` is the command the law
+        advised at this check, logged as the law logged it."""
+        self._u, self._mirror = float(u), mirror and self.law is not None
+
+    def decide(self, state: MacroState) -> float:
+        u = self._u
+        if self._mirror and self.law is not None:
+            log = self.law.log
+            self.log.record(state.t, log.u_applied[-1], log.u_continuous[-1],
+                            log.triggered[-1], **{k: v[-1] for k, v in log.extra.items() if v})
+        else:
+            changed = not self.log.t or u != self.log.u_applied[-1]
+            self.log.record(state.t, u, u, changed)
+        self._mirror = False
+        return u
+
+
+class SumoEpisode:
+    """SUMO warmed up and the control window open at its first check: ``run`` from
+    :func:`arzsumo.bridge.session.prepare_run`, ``frontend`` "libsumo" or "traci", ``law``
+    whether the stand-in may be advised by the run's law (a policy stands in for it)."""
 
     def __init__(self, run: PreparedRun, frontend: str, law: bool) -> None:
         self.run = run
@@ -65,22 +101,17 @@ class SumoEpisode:
             opened = self._stack.enter_context(open_run(run, frontend=frontend))
             self._opened.append(opened)
             warmed = warm_start(opened.sim, run, opened.bar)
-            self.c: Controlled = open_window(
-                warmed, run, opened.bar, in_loop=lambda ctrl: StandIn(ctrl if law else None))
+
+            def in_loop(ctrl: Controller) -> StandIn:
+                self.stand_in = StandIn(ctrl if law else None)   # the loop's controller
+                return self.stand_in
+
+            self.c: Controlled = open_window(warmed, run, opened.bar, in_loop=in_loop)
             self.c.loop.begin(warmed.warm[-1])
             self.state: MacroState = self.c.loop.estimate(self.c.loop.m, 0.0)
         except BaseException as exc:
             self.abort(exc)
             raise
-
-    @property
-    def stand_in(self) -> StandIn:
-        """The loop's controller."""
-        ctrl = self.c.loop.controller
-        if not isinstance(ctrl, StandIn):
-            raise EnvError(f"the loop's controller is {ctrl.name!r}, not the environment's "
-                           "stand-in")
-        return ctrl
 
     def step(self, u: float, mirror: bool) -> tuple[Actuation, MeterState]:
         """Check the stand-in holding ``u`` (veh/s; ``mirror``: the law's own command),

@@ -2,13 +2,10 @@
 
 The twin of the scenario's model at its equilibrium (:class:`arzsumo.pde.solver.
 TwinStepper`, the ``[run]`` twin grid and scheme, the paper's boundary conditions: the
-inlet at the equilibrium, the outlet flow q* + U) with the spaces, the control period and
-the action range of the SUMO environment on the same scenario, so that a policy learned
-here runs there unchanged. Every ``step`` holds U (limited as in SUMO by ``[actuation]``:
-the range and the rate) for one control period. The twin has no ramp: the queue is 0 and
-a *plan change* is a change of the U applied. An episode ends at the horizon
-(``truncated``) or when the state would leave the model's physical domain
-(``terminated``, ``info["status"]`` says where; :meth:`TwinRampMeterEnv._rest_of_horizon`).
+inlet at the equilibrium, the outlet flow q* + U) with the spaces, period and action range
+of the SUMO environment; no ramp (queue 0; a plan change is a change of the U applied).
+An episode ends at the horizon (``truncated``) or where the state would leave the model's
+physical domain (``terminated``; :meth:`TwinRampMeterEnv._rest_of_horizon`).
 """
 
 from __future__ import annotations
