@@ -10,8 +10,8 @@ from pathlib import Path
 
 import pytest
 
+from arzsumo.argtypes import cells_int, positive_float, positive_int, seed_int
 from arzsumo.cli import build_parser, main
-from arzsumo.cli.args import cells_int, positive_float, positive_int, seed_int
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -7,17 +7,6 @@ import argparse
 import re
 from typing import Any, NoReturn
 
-from arzsumo.argtypes import (  # noqa: F401 (the CLI's option types, re-exported)
-    SEED_LIMIT,
-    cells_int,
-    negative_float,
-    non_negative_float,
-    non_negative_int,
-    positive_float,
-    positive_int,
-    seed_int,
-    seed_list,
-)
 from arzsumo.errors import EXIT_USAGE
 
 

@@ -6,7 +6,7 @@ import argparse
 import json
 import time
 
-from arzsumo.cli.args import cells_int, positive_float
+from arzsumo.argtypes import cells_int, positive_float
 from arzsumo.cli.options import add_json, add_model_source
 from arzsumo.cli.scenarios import scenario_of
 from arzsumo.control.registry import pde_controller_names

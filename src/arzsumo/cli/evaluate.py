@@ -7,7 +7,7 @@ import argparse
 import shlex
 import sys
 
-from arzsumo.cli.args import positive_float, positive_int, seed_int
+from arzsumo.argtypes import positive_float, positive_int, seed_int
 from arzsumo.cli.options import (
     add_no_plots,
     add_out,

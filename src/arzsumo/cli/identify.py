@@ -8,7 +8,7 @@ import logging
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from arzsumo.cli.args import (
+from arzsumo.argtypes import (
     negative_float,
     non_negative_float,
     non_negative_int,

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import argparse
 
-from arzsumo.cli.args import non_negative_float, positive_int, seed_int, seed_list
+from arzsumo.argtypes import non_negative_float, positive_int, seed_int, seed_list
 from arzsumo.model.params import PRESETS
 
 

@@ -7,7 +7,7 @@ import argparse
 import json
 from pathlib import Path
 
-from arzsumo.cli.args import positive_float
+from arzsumo.argtypes import positive_float
 from arzsumo.cli.options import (
     add_json,
     add_no_plots,

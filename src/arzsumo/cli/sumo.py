@@ -10,7 +10,7 @@ import os
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from arzsumo.cli.args import non_negative_float, positive_float, positive_int
+from arzsumo.argtypes import non_negative_float, positive_float, positive_int
 from arzsumo.cli.options import (
     add_model_source,
     add_out,

@@ -16,7 +16,7 @@ import argparse
 import json
 from pathlib import Path
 
-from arzsumo.cli.args import SEED_LIMIT, positive_float, positive_int, seed_int
+from arzsumo.argtypes import SEED_LIMIT, positive_float, positive_int, seed_int
 from arzsumo.cli.options import (
     add_json,
     add_no_plots,
