@@ -22,12 +22,13 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 from types import ModuleType
+from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
 from arzsumo.errors import ScenarioError, require
 from arzsumo.estimate.observations import LoopNoise, LoopObservation
-from arzsumo.sumo.detectors import write_additional
+from arzsumo.io import atomic_file
 from arzsumo.sumo.layout import RoadLayout
 from arzsumo.sumo.network import DOWN, MAIN
 from arzsumo.sumo.vtypes import AV_TYPE
@@ -81,6 +82,16 @@ def _e1(det: str, lane: str, pos: float) -> dict[str, str]:
     return {"id": det, "lane": lane, "pos": f"{pos:.3f}", "period": "3600", "file": "NUL"}
 
 
+def _write_e1s(path: Path, elements: list[dict[str, str]]) -> Path:
+    """Write a SUMO additional file of the E1 ``elements`` atomically; return its path."""
+    lines = ["    <inductionLoop " + " ".join(f"{a}={quoteattr(v)}" for a, v in e.items()) + "/>"
+             for e in elements]
+    with atomic_file(path) as tmp:
+        tmp.write_text("<additional>\n" + "\n".join(lines) + "\n</additional>\n",
+                       encoding="utf-8")
+    return path
+
+
 def _vehicle_data(lib: ModuleType, ids: Sequence[str]) -> Sequence[tuple]:
     """The vehicles on the E1 loops ``ids`` in the step (every lane's)."""
     data = lib.inductionloop.getVehicleData
@@ -101,7 +112,7 @@ def write_loops(path: Path, x: Sequence[float], length: float,
             edge, pos = layout.locate(float(xj))
             elements += [_e1(det, f"{edge}_{k}", pos)
                          for k, det in enumerate(lane_loop_ids(station, layout.lanes))]
-    return write_additional(path, "inductionLoop", elements)
+    return _write_e1s(path, elements)
 
 
 def speed_means(entered: np.ndarray, speed_sum: np.ndarray, inverse_sum: np.ndarray
@@ -204,11 +215,9 @@ def write_downstream_loop(path: Path, distance: float = DOWNSTREAM_DISTANCE,
     require(0 < distance < 500, "loop_distance", distance,
             "a distance in (0, 500) m on the 500 m `down` edge", ScenarioError)
     if layout is None:
-        return write_additional(path, "inductionLoop",
-                                [_e1(DOWNSTREAM_LOOP, f"{DOWN}_0", distance)])
+        return _write_e1s(path, [_e1(DOWNSTREAM_LOOP, f"{DOWN}_0", distance)])
     pos = min(distance, layout.outlet_length - BOUNDARY_GAP)
-    return write_additional(path, "inductionLoop",
-                            [_e1(det, f"{layout.outlet_edge}_{k}", pos)
+    return _write_e1s(path, [_e1(det, f"{layout.outlet_edge}_{k}", pos)
                              for k, det in enumerate(downstream_ids(layout))])
 
 

@@ -168,11 +168,6 @@ class MeterLight:
         return MeterState(self.green_share, self.light_changes, self.plan_changes,
                           self.queue, self.max_queue, self.override())
 
-    @property
-    def released_this_green(self) -> int:
-        """Vehicles released since the current green interval began."""
-        return self.greens[-1].releases if self.greens else 0
-
     def override(self) -> bool:
         """Whether the queue override is on: from the step the queue exceeds
         ``cfg.ramp_storage`` (> 0) until it is back at :data:`OVERRIDE_OFF` of it, or the
