@@ -88,6 +88,6 @@ def actuator_for(plant: SumoPlant, q_nominal: float, controller: str, acting: st
     ``period`` the control period (s)."""
     limits = ActuationLimits.of(settings, q_nominal, period)
     if settings.actuator == "speed_limit" and is_pde(acting):
-        return SpeedLimitActuator(OutletSpeedLimit(plant.sim.lib), plant.meter, settings,
+        return SpeedLimitActuator(plant.outlet_speed_limit(), plant.meter, settings,
                                   limits)
     return MeterActuator(plant.meter, q_nominal, controller == "open", limits)

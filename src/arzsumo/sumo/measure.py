@@ -24,11 +24,6 @@ from arzsumo.sumo.layout import RoadLayout, VehicleClasses
 from arzsumo.sumo.network import MAIN
 
 
-def is_av(ids: tuple[str, ...] | list[str]) -> np.ndarray:
-    """Boolean array: which vehicle ids are AVs (ids starting with ``av``)."""
-    return np.fromiter((v.startswith("av") for v in ids), bool, len(ids))
-
-
 @dataclass(frozen=True)
 class CellData:
     """Edie aggregates over one window ending at ``t`` (SI).
@@ -146,7 +141,7 @@ class MainlineSensor:
         n = len(ids)
         pos = np.fromiter(map(v.getLanePosition, ids), float, n)
         speed = np.fromiter(map(v.getSpeed, ids), float, n)
-        return ids, pos, speed, is_av(ids)
+        return ids, pos, speed, self.classes.av_mask(ids)
 
     def _sample_section(self, layout: RoadLayout
                         ) -> tuple[tuple[str, ...], np.ndarray, np.ndarray, np.ndarray]:

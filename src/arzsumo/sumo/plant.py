@@ -27,6 +27,7 @@ from arzsumo.sumo.period_reads import OpenLoopEnd, OpenLoopPeriod, OpenLoopReads
 from arzsumo.sumo.sensing import SensorLayout
 from arzsumo.sumo.sensor import PeriodMeasurement, SumoSensor
 from arzsumo.sumo.simulation import SumoSimulation
+from arzsumo.sumo.speed_limit import OutletSpeedLimit
 from arzsumo.sumo.window import WindowStart
 
 #: an open-loop run that reads the sensor only
@@ -146,6 +147,10 @@ class SumoPlant:
                 self.meter.set_plan(plan)
             due += 1
         return due, plan
+
+    def outlet_speed_limit(self) -> OutletSpeedLimit:
+        """The speed limit of the edge past the merge, as an actuator."""
+        return OutletSpeedLimit(self.sim.lib)
 
     def expected(self) -> int:
         """Vehicles on the network or still to come (SUMO's ``getMinExpectedNumber``)."""
