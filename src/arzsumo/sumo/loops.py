@@ -1,19 +1,10 @@
 """Induction loops (E1) on ``main``: per-class counts, mean spot speeds and occupancy.
 
-A loop station at x_j is one SUMO E1 detector across the whole 6.5 m lane (one per lane
-on a user's section). Every SUMO step :class:`LoopSensor` reads
-``inductionloop.getVehicleData`` of each station and, once per control period of length
-T, returns a :class:`~arzsumo.estimate.observations.LoopObservation` per class i (h, a):
-
-* flow q_i = N_i / T, veh/s, with N_i the vehicles whose front reached x_j in the period;
-* speed v_i, m/s, from the spot speeds v_k of those vehicles at the end of the step their
-  front reached x_j, per ``[sensing] loop_speed``: the time-mean sum v_k / N_i or the
-  harmonic mean N_i / sum 1/max(v_k, :data:`V_MIN`) (both kept on every record);
-* density rho_i = (1/T) sum_k tau_k / l_k, veh/m, with tau_k the time vehicle k spent on
-  the loop within the period and l_k its length (Edie's density over a zone of one
-  vehicle length; vehicles side by side each count).
-
-Where the boundary stations sit, and why SUMO's interval getters are not used:
+A loop station is one E1 across the lane (one per lane on a user's section), read every
+step with ``inductionloop.getVehicleData``; once per control period :class:`LoopSensor`
+returns a :class:`~arzsumo.estimate.observations.LoopObservation` per class: flow (veh/s),
+speed (m/s, time-mean or harmonic, ``[sensing] loop_speed``) and density (veh/m). Their
+definitions, where the boundary stations sit and why SUMO's interval getters are not used:
 docs/sumo.md, "Sensing layouts".
 """
 

@@ -1,15 +1,7 @@
-"""Micro to macro: Edie's space-time density, flow and speed per class on a cell grid.
-
-Every SUMO step the positions and speeds of the vehicles on ``main`` are read with libsumo
-getters (the fastest way under libsumo: docs/sumo.md, "Micro to macro") and binned with
-``numpy.bincount``. Over a window of n steps of length dt on a cell of length dx,
-
-    rho = sum(dt) / (dx n dt),   q = sum(v dt) / (dx n dt),   v = q / rho,
-
-the sums running over the vehicle samples in the cell. AV ids start with ``av`` (the route
-files of :mod:`arzsumo.sumo.demand` and :mod:`arzsumo.sumo.placement`). Class flows count
-the vehicles that appeared on ``main`` (x = 0; initial vehicles, ids with ``_init``,
-excepted) and that left it (x = L).
+"""Micro to macro: Edie's space-time density, flow and speed per class on a cell grid,
+from the vehicles on ``main`` read every SUMO step (formulas: docs/sumo.md, "Micro to
+macro"). Class flows count the vehicles that appeared on ``main`` (x = 0; initial
+vehicles, ids with ``_init``, excepted) and that left it (x = L).
 """
 
 from __future__ import annotations
