@@ -218,19 +218,23 @@ class SumoSimulation:
         self.time = float(sim.getTime())
         return self.time
 
+    def requested(self, ramp_only: bool = False) -> int:
+        """Vehicles due by the current time (initial vehicles plus flows; or ramp flows):
+        SUMO's count of the vehicles it loaded (it keeps a flow's period in whole ms, so a
+        count from the flows' nominal periods would drift)."""
+        return self.loaded_ramp if ramp_only else self.loaded
+
     def take_report(self) -> RunReport:
         """Accounting at the current time (run must be open)."""
         sim, veh = self.lib.simulation, self.lib.vehicle
         waits = {v: float(veh.getWaitingTime(v)) for v in veh.getIDList()
                  if not self.classes.ramp(v)}   # the meter's queue stands by design
         still = max(waits, key=waits.__getitem__, default="")
-        # requested: SUMO's count of the vehicles it loaded (it keeps a flow's period in
-        # whole ms, so a count from the flows' nominal periods would drift)
-        return RunReport(self.time, self.loaded, self.loaded, self.inserted,
+        return RunReport(self.time, self.requested(), self.loaded, self.inserted,
                          len(sim.getPendingVehicles()), self.arrived, int(veh.getIDCount()),
                          self.collisions if self.cfg.collision_check else None,
                          self.teleports, self.emergency_stops, self.emergency_braking,
-                         self.loaded_ramp, self.inserted_ramp,
+                         self.requested(ramp_only=True), self.inserted_ramp,
                          waits.get(still, 0.0), still)
 
     def close(self, warn: bool = True) -> RunReport | None:
