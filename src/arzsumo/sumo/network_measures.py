@@ -256,7 +256,7 @@ def ramp_waits(trips: pd.DataFrame, crossings: Sequence[tuple[str, int]], dt: fl
 
     ``trips``: :func:`~arzsumo.sumo.network_measures.read_trips` rows; ``crossings``: the
     stop line's releases, vehicle id and SUMO steps since t = 0 when its front had left
-    ``ramp_up`` (:class:`arzsumo.sumo.stop_line.StopLine`); ``dt``: SUMO step, s;
+    ``ramp_up`` (:class:`arzsumo.sumo.sensor.StopLine`); ``dt``: SUMO step, s;
     ``free_time``: free-flow travel time over ``ramp_up``, s. The wait is the crossing
     time minus the wanted departure minus ``free_time``, at least 0; NaN for a vehicle
     still upstream of the line at the end.
