@@ -17,8 +17,8 @@ import pytest
 from arzsumo.bridge.cosim import run_cosimulation
 from arzsumo.outputs.bridge import write_results
 from arzsumo.scenario import load_scenario
+from arzsumo.sumo.calibrate import run_fixed_meter
 from arzsumo.sumo.green_share import plan_green_steps
-from arzsumo.sumo.runner import run_fixed_meter
 from tests.runs import SMALL_GRIDS, prepared
 
 DEFAULT = Path(__file__).resolve().parents[2] / "scenarios" / "legacy_default.toml"

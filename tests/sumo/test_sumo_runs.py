@@ -5,13 +5,13 @@ import pytest
 
 from arzsumo.bridge.actuator import command_meter
 from arzsumo.model import get_preset
+from arzsumo.sumo.calibrate import run_fixed_meter
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.measure import MainlineSensor
 from arzsumo.sumo.network import MAIN, RAMP_UP
 from arzsumo.sumo.paths import SumoError
 from arzsumo.sumo.placement import place_vehicles
 from arzsumo.sumo.plant import SumoPlant
-from arzsumo.sumo.runner import run_fixed_meter
 from arzsumo.sumo.simulation import open_simulation
 from tests.sumo import run_until
 

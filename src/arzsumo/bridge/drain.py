@@ -17,8 +17,8 @@ import pandas as pd
 from arzsumo.bridge.run_progress import DRAIN
 from arzsumo.progress import RunProgress
 from arzsumo.sumo.network import NetworkSpec
+from arzsumo.sumo.network_measures import ramp_waits, whole_demand_summary
 from arzsumo.sumo.plant import SumoPlant
-from arzsumo.sumo.whole_demand import ramp_waits, whole_demand_summary
 from arzsumo.sumo.window import NetworkMeasures, WindowEnd
 
 #: a drain with no arrival for this long while vehicles remain is a gridlock, s
@@ -62,9 +62,10 @@ def drain(plant: SumoPlant, limit: float, bar: RunProgress | None = None) -> Dra
 
 def whole_demand(network: NetworkMeasures, trips: pd.DataFrame, plant: SumoPlant,
                  drained: Drained) -> NetworkMeasures:
-    """``network`` with its ``whole_demand`` block (:mod:`arzsumo.sumo.whole_demand`):
-    the whole run after the drain, the per-step integral of vehicles in the system and
-    the ramp vehicles' waits at the meter."""
+    """``network`` with its ``whole_demand`` block
+    (:func:`~arzsumo.sumo.network_measures.whole_demand_summary`): the whole run after the
+    drain, the per-step integral of vehicles in the system and the ramp vehicles' waits at
+    the meter."""
     spec, sim = NetworkSpec(), plant.sim
     road = sim.cfg.layout
     free = spec.ramp_length / spec.ramp_speed if road is None else road.ramp_free_time

@@ -88,7 +88,8 @@ class ClosedLoop:
         Returns what was applied and the meter at the period's end."""
         act = self.actuator.apply(check.command.u)
         self.told = act.told(self.anti_windup)
-        m, meter = self.plant.run_period()
+        m = self.plant.advance()
+        meter = self.plant.meter.state()
         self.m, self.t = m, m.t - self.t0
         self.record(self.trace, self.t, check, act, m, meter)
         return act, meter

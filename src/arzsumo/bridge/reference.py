@@ -3,9 +3,8 @@ held in the warm-up (``[estimation] reference``, docs/scenarios.md).
 
 Where the model's fundamental diagram and SUMO disagree about the speed at SUMO's
 densities, a state SUMO holds for minutes under the nominal plan is a constant deviation
-to the law (paper, eq. ``control_law``), answered with a constant U: on the default
-scenario's open-loop runs -610 veh/h against q* = 4464 veh/h (the mean field of 450 s
-gives v_h 39.9 and v_a 14.5 km/h where the identified FD says 43.7 and 19.2). With
+to the law (paper, eq. ``control_law``), answered with a constant U (measured:
+research/readings/ablation_in_sumo.md, "The mismatches, measured"). With
 ``reference = "warmup"`` that state gets U = 0; the laws being linear in the fields
 (:class:`arzsumo.control.backstepping.StateMap`), this subtracts the law's answer to the
 constant offset.

@@ -116,12 +116,6 @@ def _chosen_at(sc: Scenario, settings: RunSettings, option: str | None) -> str:
             f"{sc.source}: [run] controller = {written(settings.controller)}")
 
 
-def _check_regime(sc: Scenario, settings: RunSettings, option: str | None) -> None:
-    """:func:`check_before_start`, its refusal naming where the controller was chosen."""
-    at = _chosen_at(sc, settings, option)
-    check_before_start(settings, sc.equilibrium, at, f"the [equilibrium] of {sc.source}")
-
-
 def _check_estimation(sc: Scenario, settings: RunSettings, option: str | None) -> None:
     """observer-etc with an estimator acts on the boundary stations: it needs loops."""
     method = sc.estimation.method
@@ -184,8 +178,9 @@ def prepare_run(sc: Scenario, *, controller: str | None = None, seed: int | None
     ic = seeded(sc.initial, cfg.seed)  # one seed draws all randomness
     _check_model(sc, cfg)
     chosen = names["controller"] if controller is not None else None
-    if settings.equilibrium == "scenario":
-        _check_regime(sc, settings, chosen)
+    if settings.equilibrium == "scenario":     # the refusal names where it was chosen
+        check_before_start(settings, sc.equilibrium, _chosen_at(sc, settings, chosen),
+                           f"the [equilibrium] of {sc.source}")
     _check_estimation(sc, settings, chosen)
     check_delay(sc, acting_controller(sc.estimation.method, settings.controller))
     initial = None

@@ -12,6 +12,7 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -50,13 +51,6 @@ def to_twin_grid(params: ModelParameters, data: CellData, x_twin: np.ndarray,
     return fields, removed
 
 
-class _InletState:
-    """Mutable holder of the inlet state (rho_h, v_h, rho_a, v_a) the ghost cell holds, SI."""
-
-    def __init__(self, values: np.ndarray) -> None:
-        self.values = np.array(values, float)
-
-
 @dataclass(frozen=True)
 class _GhostInlet(Inlet):
     """An inlet whose boundary state is the measured one (a ghost cell), not the l4 solve.
@@ -66,7 +60,8 @@ class _GhostInlet(Inlet):
     give negative boundary speeds. The measured state, smoothed, is always admissible.
     """
 
-    holder: _InletState = field(default_factory=lambda: _InletState(np.zeros(4)))
+    #: ``values``: the inlet state (rho_h, v_h, rho_a, v_a) the ghost cell holds, SI
+    holder: SimpleNamespace = field(default_factory=lambda: SimpleNamespace(values=np.zeros(4)))
 
     def boundary_primitive(self, t: float, z0: np.ndarray) -> np.ndarray:
         return self.holder.values
@@ -81,7 +76,7 @@ class MeasuredInlet:
                  ao_limit: float = TWIN_AO_LIMIT) -> None:
         self.params, self.tau, self.ao_limit = eq.params, tau, ao_limit
         self.smoothed = np.array([eq.rho_h, eq.v_h, eq.rho_a, eq.v_a])
-        self.state = _InletState(self.smoothed)
+        self.state = SimpleNamespace(values=np.array(self.smoothed, float))
         self.inlet = _GhostInlet(eq.rho_h, eq.rho_a, eq.q, lin.T[3], self.state)
 
     def _first(self, data: CellData) -> np.ndarray:

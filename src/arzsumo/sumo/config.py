@@ -32,6 +32,10 @@ METER_MODES = ("fixed_cycle", "one_per_green")
 RAMP_JAM_SPACING = 8.0
 
 
+def _require(ok: bool, field: str, value: object, allowed: str) -> None:
+    require(ok, field, value, allowed, ScenarioError)
+
+
 def ramp_capacity(length: float | None = None, spacing: float = RAMP_JAM_SPACING) -> int:
     """Vehicles a ramp of ``length`` (m; default: ``ramp_up`` of the network, 300 m) holds
     at jam spacing ``spacing`` (m): 37 on the shipped network."""
@@ -142,35 +146,29 @@ class SumoConfig:
                     "green_share_max", "lc_pushy"),
                    lambda v: 0.0 <= v <= 1.0, "a number in [0, 1]")
         self._check_gap_acceptance()
-        require(self.green_share_min <= self.green_share_max, "green_share_min",
-                self.green_share_min, f"at most green_share_max = {self.green_share_max}",
-                ScenarioError)
+        _require(self.green_share_min <= self.green_share_max, "green_share_min",
+                 self.green_share_min, f"at most green_share_max = {self.green_share_max}")
         # a cell holds a vehicle or more; shorter cells only multiply the work
-        require(self.cell_length >= 1.0, "cell_length", self.cell_length, "at least 1 m",
-                ScenarioError)
-        require(self.step_length <= 1.0, "step_length", self.step_length, "at most 1 s",
-                ScenarioError)
+        _require(self.cell_length >= 1.0, "cell_length", self.cell_length, "at least 1 m")
+        _require(self.step_length <= 1.0, "step_length", self.step_length, "at most 1 s")
         self._check_resolution()
         # a shorter run holds no complete control period: nothing measured, NaN summaries
-        require(self.horizon >= self.control_period, "horizon", self.horizon,
-                f"at least one control period (control_period = {self.control_period} s)",
-                ScenarioError)
+        _require(self.horizon >= self.control_period, "horizon", self.horizon,
+                 f"at least one control period (control_period = {self.control_period} s)")
         ratio = self.control_period / self.step_length
-        require(abs(ratio - round(ratio)) < 1e-9, "control_period", self.control_period,
-                f"a multiple of step_length = {self.step_length} s", ScenarioError)
-        require(self.min_green + self.min_red <= self.meter_cycle, "min_green + min_red",
-                self.min_green + self.min_red, f"at most meter_cycle = {self.meter_cycle} s",
-                ScenarioError)
+        _require(abs(ratio - round(ratio)) < 1e-9, "control_period", self.control_period,
+                 f"a multiple of step_length = {self.step_length} s")
+        _require(self.min_green + self.min_red <= self.meter_cycle, "min_green + min_red",
+                 self.min_green + self.min_red, f"at most meter_cycle = {self.meter_cycle} s")
         self._check_meter()
-        require(isinstance(self.seed, int) and not isinstance(self.seed, bool)
-                and 0 <= self.seed < 2**31, "seed", self.seed, "an integer in [0, 2^31)",
-                ScenarioError)
+        _require(isinstance(self.seed, int) and not isinstance(self.seed, bool)
+                 and 0 <= self.seed < 2**31, "seed", self.seed, "an integer in [0, 2^31)")
         self._resolve_storage()
-        require(self.time_to_teleport == -1 or self.time_to_teleport > 0, "time_to_teleport",
-                self.time_to_teleport, "-1 (off) or a time > 0 s", ScenarioError)
+        _require(self.time_to_teleport == -1 or self.time_to_teleport > 0, "time_to_teleport",
+                 self.time_to_teleport, "-1 (off) or a time > 0 s")
         for name in ("fcd", "eager_insert", "collision_check"):
-            require(isinstance(getattr(self, name), bool), name, getattr(self, name),
-                    "true or false", ScenarioError)
+            _require(isinstance(getattr(self, name), bool), name, getattr(self, name),
+                     "true or false")
         self._check_behaviour()
 
     def _each(self, names: tuple[str, ...], ok: Callable[[float], bool],
@@ -178,7 +176,7 @@ class SumoConfig:
         """Each field of ``names`` is a number for which ``ok`` holds."""
         for name in names:
             v = getattr(self, name)
-            require(isinstance(v, int | float) and ok(v), name, v, allowed, ScenarioError)
+            _require(isinstance(v, int | float) and ok(v), name, v, allowed)
 
     def _check_resolution(self) -> None:
         """The sublane width divides the lane (the section's lanes on a user's network
@@ -187,9 +185,9 @@ class SumoConfig:
             self.layout.lane_widths if self.layout.sublane else ()
         for width in sorted(set(widths)):
             subl = width / self.lateral_resolution
-            require(abs(subl - round(subl)) < 1e-6, "lateral_resolution",
-                    self.lateral_resolution,
-                    f"a width dividing the {width:g} m lane, e.g. 0.5 or 0.25", ScenarioError)
+            _require(abs(subl - round(subl)) < 1e-6, "lateral_resolution",
+                     self.lateral_resolution,
+                     f"a width dividing the {width:g} m lane, e.g. 0.5 or 0.25")
 
     @property
     def collision_options(self) -> dict[str, str]:
@@ -200,28 +198,24 @@ class SumoConfig:
 
     def _check_behaviour(self) -> None:
         """The car-following models, the lateral behaviour's choices, the HVs' action step."""
-        require(self.hv_model in HV_MODELS, "hv_model", self.hv_model,
-                " or ".join(HV_MODELS), ScenarioError)
-        require(self.av_model in AV_MODELS, "av_model", self.av_model,
-                " or ".join(AV_MODELS), ScenarioError)
+        _require(self.hv_model in HV_MODELS, "hv_model", self.hv_model, " or ".join(HV_MODELS))
+        _require(self.av_model in AV_MODELS, "av_model", self.av_model, " or ".join(AV_MODELS))
         check_values({a.field: getattr(self, a.field) for a in ATTRIBUTES})
-        require(self.lat_alignment in LAT_ALIGNMENTS, "lat_alignment", self.lat_alignment,
-                ", ".join(LAT_ALIGNMENTS), ScenarioError)
-        require(self.depart_pos_lat in DEPART_POS_LAT, "depart_pos_lat", self.depart_pos_lat,
-                ", ".join(DEPART_POS_LAT), ScenarioError)
+        _require(self.lat_alignment in LAT_ALIGNMENTS, "lat_alignment", self.lat_alignment,
+                 ", ".join(LAT_ALIGNMENTS))
+        _require(self.depart_pos_lat in DEPART_POS_LAT, "depart_pos_lat", self.depart_pos_lat,
+                 ", ".join(DEPART_POS_LAT))
         if self.hv_action_step > 0:
             k = self.hv_action_step / self.step_length
-            require(round(k) >= 1 and abs(k - round(k)) < 1e-9, "hv_action_step",
-                    self.hv_action_step,
-                    f"0 (every step) or a multiple of step_length = {self.step_length} s",
-                    ScenarioError)
+            _require(round(k) >= 1 and abs(k - round(k)) < 1e-9, "hv_action_step",
+                     self.hv_action_step,
+                     f"0 (every step) or a multiple of step_length = {self.step_length} s")
 
     def _resolve_storage(self) -> None:
         """Check ``ramp_storage``; -1 becomes what the ramp holds (:func:`ramp_capacity`)."""
-        require(isinstance(self.ramp_storage, int) and self.ramp_storage >= -1,
-                "ramp_storage", self.ramp_storage,
-                "an integer >= 0 (0 = no queue override; -1: what the ramp holds)",
-                ScenarioError)
+        _require(isinstance(self.ramp_storage, int) and self.ramp_storage >= -1,
+                 "ramp_storage", self.ramp_storage,
+                 "an integer >= 0 (0 = no queue override; -1: what the ramp holds)")
         if self.ramp_storage == -1:
             ramp = None if self.layout is None else self.layout.ramp_length
             object.__setattr__(self, "ramp_storage", ramp_capacity(ramp))
@@ -229,23 +223,23 @@ class SumoConfig:
     def _check_meter(self) -> None:
         """The meter's mode and timings fit together (clearance inside the cycle, release
         rates ordered, the fastest release cycle long enough for its phases)."""
-        require(self.meter_mode in METER_MODES, "meter_mode", self.meter_mode,
-                " or ".join(METER_MODES), ScenarioError)
+        _require(self.meter_mode in METER_MODES, "meter_mode", self.meter_mode,
+                 " or ".join(METER_MODES))
         phases = self.min_green + self.meter_clearance + self.min_red
         if self.meter_clearance > 0:
-            require(phases <= self.meter_cycle + 1e-9, "min_green + meter_clearance + min_red",
-                    phases, f"at most meter_cycle = {self.meter_cycle} s", ScenarioError)
-        require(self.release_rate_min <= self.release_rate <= self.release_rate_max,
-                "release_rate", self.release_rate,
-                f"a rate in [release_rate_min, release_rate_max] = [{self.release_rate_min}, "
-                f"{self.release_rate_max}] veh/s", ScenarioError)
-        require(self.min_green <= self.max_green, "max_green", self.max_green,
-                f"at least min_green = {self.min_green} s", ScenarioError)
+            _require(phases <= self.meter_cycle + 1e-9, "min_green + meter_clearance + min_red",
+                     phases, f"at most meter_cycle = {self.meter_cycle} s")
+        _require(self.release_rate_min <= self.release_rate <= self.release_rate_max,
+                 "release_rate", self.release_rate,
+                 f"a rate in [release_rate_min, release_rate_max] = [{self.release_rate_min}, "
+                 f"{self.release_rate_max}] veh/s")
+        _require(self.min_green <= self.max_green, "max_green", self.max_green,
+                 f"at least min_green = {self.min_green} s")
         if self.meter_mode == "one_per_green":
-            require(phases <= 1.0 / self.release_rate_max + 1e-9,
-                    "min_green + meter_clearance + min_red", phases,
-                    f"at most the cycle 1 / release_rate_max = {1 / self.release_rate_max:.3g} "
-                    "s of one_per_green", ScenarioError)
+            _require(phases <= 1.0 / self.release_rate_max + 1e-9,
+                     "min_green + meter_clearance + min_red", phases,
+                     f"at most the cycle 1 / release_rate_max = {1 / self.release_rate_max:.3g} "
+                     "s of one_per_green")
 
     def car_following(self, cls: str) -> dict[str, float | None]:
         """The car-following fields of class ``cls`` ("hv" or "av") by field name."""
@@ -259,13 +253,12 @@ class SumoConfig:
     def _check_gap_acceptance(self) -> None:
         """``lc_assertive`` > 0 and ``lc_impatience`` in [0, 1] where set."""
         if self.lc_assertive is not None:
-            require(math.isfinite(self.lc_assertive) and self.lc_assertive > 0,
-                    "lc_assertive", self.lc_assertive, "a finite number above 0",
-                    ScenarioError)
+            _require(math.isfinite(self.lc_assertive) and self.lc_assertive > 0,
+                     "lc_assertive", self.lc_assertive, "a finite number above 0")
         if self.lc_impatience is not None:
-            require(isinstance(self.lc_impatience, int | float)
-                    and 0.0 <= self.lc_impatience <= 1.0, "lc_impatience",
-                    self.lc_impatience, "a number in [0, 1]", ScenarioError)
+            _require(isinstance(self.lc_impatience, int | float)
+                     and 0.0 <= self.lc_impatience <= 1.0, "lc_impatience",
+                     self.lc_impatience, "a number in [0, 1]")
 
     def with_(self, **changes: Any) -> SumoConfig:
         """A copy with some fields changed (validated again)."""

@@ -1,19 +1,10 @@
 """Induction loops (E1) on ``main``: per-class counts, mean spot speeds and occupancy.
 
-A loop station at x_j is one SUMO E1 detector across the whole 6.5 m lane (one per lane
-on a user's section). Every SUMO step :class:`LoopSensor` reads
-``inductionloop.getVehicleData`` of each station and, once per control period of length
-T, returns a :class:`~arzsumo.estimate.observations.LoopObservation` per class i (h, a):
-
-* flow q_i = N_i / T, veh/s, with N_i the vehicles whose front reached x_j in the period;
-* speed v_i, m/s, from the spot speeds v_k of those vehicles at the end of the step their
-  front reached x_j, per ``[sensing] loop_speed``: the time-mean sum v_k / N_i or the
-  harmonic mean N_i / sum 1/max(v_k, :data:`V_MIN`) (both kept on every record);
-* density rho_i = (1/T) sum_k tau_k / l_k, veh/m, with tau_k the time vehicle k spent on
-  the loop within the period and l_k its length (Edie's density over a zone of one
-  vehicle length; vehicles side by side each count).
-
-Where the boundary stations sit, and why SUMO's interval getters are not used:
+A loop station is one E1 across the lane (one per lane on a user's section), read every
+step with ``inductionloop.getVehicleData``; once per control period :class:`LoopSensor`
+returns a :class:`~arzsumo.estimate.observations.LoopObservation` per class: flow (veh/s),
+speed (m/s, time-mean or harmonic, ``[sensing] loop_speed``) and density (veh/m). Their
+definitions, where the boundary stations sit and why SUMO's interval getters are not used:
 docs/sumo.md, "Sensing layouts".
 """
 
@@ -22,12 +13,13 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 from types import ModuleType
+from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
 from arzsumo.errors import ScenarioError, require
 from arzsumo.estimate.observations import LoopNoise, LoopObservation
-from arzsumo.sumo.detectors import write_additional
+from arzsumo.io import atomic_file
 from arzsumo.sumo.layout import RoadLayout
 from arzsumo.sumo.network import DOWN, MAIN
 from arzsumo.sumo.vtypes import AV_TYPE
@@ -81,6 +73,16 @@ def _e1(det: str, lane: str, pos: float) -> dict[str, str]:
     return {"id": det, "lane": lane, "pos": f"{pos:.3f}", "period": "3600", "file": "NUL"}
 
 
+def _write_e1s(path: Path, elements: list[dict[str, str]]) -> Path:
+    """Write a SUMO additional file of the E1 ``elements`` atomically; return its path."""
+    lines = ["    <inductionLoop " + " ".join(f"{a}={quoteattr(v)}" for a, v in e.items()) + "/>"
+             for e in elements]
+    with atomic_file(path) as tmp:
+        tmp.write_text("<additional>\n" + "\n".join(lines) + "\n</additional>\n",
+                       encoding="utf-8")
+    return path
+
+
 def _vehicle_data(lib: ModuleType, ids: Sequence[str]) -> Sequence[tuple]:
     """The vehicles on the E1 loops ``ids`` in the step (every lane's)."""
     data = lib.inductionloop.getVehicleData
@@ -101,7 +103,7 @@ def write_loops(path: Path, x: Sequence[float], length: float,
             edge, pos = layout.locate(float(xj))
             elements += [_e1(det, f"{edge}_{k}", pos)
                          for k, det in enumerate(lane_loop_ids(station, layout.lanes))]
-    return write_additional(path, "inductionLoop", elements)
+    return _write_e1s(path, elements)
 
 
 def speed_means(entered: np.ndarray, speed_sum: np.ndarray, inverse_sum: np.ndarray
@@ -204,11 +206,9 @@ def write_downstream_loop(path: Path, distance: float = DOWNSTREAM_DISTANCE,
     require(0 < distance < 500, "loop_distance", distance,
             "a distance in (0, 500) m on the 500 m `down` edge", ScenarioError)
     if layout is None:
-        return write_additional(path, "inductionLoop",
-                                [_e1(DOWNSTREAM_LOOP, f"{DOWN}_0", distance)])
+        return _write_e1s(path, [_e1(DOWNSTREAM_LOOP, f"{DOWN}_0", distance)])
     pos = min(distance, layout.outlet_length - BOUNDARY_GAP)
-    return write_additional(path, "inductionLoop",
-                            [_e1(det, f"{layout.outlet_edge}_{k}", pos)
+    return _write_e1s(path, [_e1(det, f"{layout.outlet_edge}_{k}", pos)
                              for k, det in enumerate(downstream_ids(layout))])
 
 

@@ -1,15 +1,7 @@
-"""Micro to macro: Edie's space-time density, flow and speed per class on a cell grid.
-
-Every SUMO step the positions and speeds of the vehicles on ``main`` are read with libsumo
-getters (the fastest way under libsumo: docs/sumo.md, "Micro to macro") and binned with
-``numpy.bincount``. Over a window of n steps of length dt on a cell of length dx,
-
-    rho = sum(dt) / (dx n dt),   q = sum(v dt) / (dx n dt),   v = q / rho,
-
-the sums running over the vehicle samples in the cell. AV ids start with ``av`` (the route
-files of :mod:`arzsumo.sumo.demand` and :mod:`arzsumo.sumo.placement`). Class flows count
-the vehicles that appeared on ``main`` (x = 0; initial vehicles, ids with ``_init``,
-excepted) and that left it (x = L).
+"""Micro to macro: Edie's space-time density, flow and speed per class on a cell grid,
+from the vehicles on ``main`` read every SUMO step (formulas: docs/sumo.md, "Micro to
+macro"). Class flows count the vehicles that appeared on ``main`` (x = 0; initial
+vehicles, ids with ``_init``, excepted) and that left it (x = L).
 """
 
 from __future__ import annotations
@@ -22,11 +14,6 @@ import numpy as np
 from arzsumo.errors import require
 from arzsumo.sumo.layout import RoadLayout, VehicleClasses
 from arzsumo.sumo.network import MAIN
-
-
-def is_av(ids: tuple[str, ...] | list[str]) -> np.ndarray:
-    """Boolean array: which vehicle ids are AVs (ids starting with ``av``)."""
-    return np.fromiter((v.startswith("av") for v in ids), bool, len(ids))
 
 
 @dataclass(frozen=True)
@@ -146,7 +133,7 @@ class MainlineSensor:
         n = len(ids)
         pos = np.fromiter(map(v.getLanePosition, ids), float, n)
         speed = np.fromiter(map(v.getSpeed, ids), float, n)
-        return ids, pos, speed, is_av(ids)
+        return ids, pos, speed, self.classes.av_mask(ids)
 
     def _sample_section(self, layout: RoadLayout
                         ) -> tuple[tuple[str, ...], np.ndarray, np.ndarray, np.ndarray]:

@@ -7,11 +7,10 @@ clearance yellow, queue override, counts over a window: docs/sumo.md, "Ramp mete
 "Meter realisation"); the other is :class:`arzsumo.sumo.meter_release.OnePerGreenMeter`,
 and :func:`arzsumo.sumo.meter_release.make_meter` builds the one ``[sumo] meter_mode`` names.
 
-The meter reads nothing from SUMO: every step the sensor hands it a
-:class:`~arzsumo.sumo.stop_line.MeterReading` (the ramp queue and the stop line's
-releases). Each realisation maps an outflow command U to its own plan variable and states
-the plan's bounds and the U it can realise; the actuator (:mod:`arzsumo.bridge.actuator`)
-saturates in one place.
+The meter reads nothing from SUMO: every step the sensor hands it a :class:`MeterReading`
+(the ramp queue and the stop line's releases). Each realisation maps an outflow command U
+to its own plan variable and states the plan's bounds and the U it can realise; the
+actuator (:mod:`arzsumo.bridge.actuator`) saturates in one place.
 """
 
 from __future__ import annotations
@@ -31,12 +30,19 @@ from arzsumo.sumo.green_share import (
     plan_green_steps,
 )
 from arzsumo.sumo.network import METER_TL
-from arzsumo.sumo.stop_line import MeterReading
 
 GREEN, YELLOW, RED = "G", "y", "r"
 #: the queue override, on above the ramp's storage, stays on until the queue is back at this
 #: share of the storage (rounded down)
 OVERRIDE_OFF = 0.8
+
+
+class MeterReading(NamedTuple):
+    """One step's reading for the meter: the ramp queue (vehicles) and the vehicles that
+    crossed the stop line in the step."""
+
+    queue: int
+    released: int
 
 
 class MeterState(NamedTuple):
@@ -167,11 +173,6 @@ class MeterLight:
         """The meter now (:class:`MeterState`)."""
         return MeterState(self.green_share, self.light_changes, self.plan_changes,
                           self.queue, self.max_queue, self.override())
-
-    @property
-    def released_this_green(self) -> int:
-        """Vehicles released since the current green interval began."""
-        return self.greens[-1].releases if self.greens else 0
 
     def override(self) -> bool:
         """Whether the queue override is on: from the step the queue exceeds

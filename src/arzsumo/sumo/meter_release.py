@@ -106,7 +106,8 @@ class OnePerGreenMeter(MeterLight):
             self._phases = self.max_green_steps + self.clearance_steps + self.min_red_steps
             return GREEN
         if self._green:
-            done = self.released_this_green > 0 and self._k >= self.min_green_steps
+            released = self.greens[-1].releases if self.greens else 0   # in this green
+            done = released > 0 and self._k >= self.min_green_steps
             if done or self._k >= self.max_green_steps:
                 self._green = False
                 self._phases = self._k + self.clearance_steps + self.min_red_steps

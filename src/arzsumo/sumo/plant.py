@@ -20,7 +20,7 @@ from arzsumo.estimate.observations import LoopNoise, ProbeNoise
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.disturbance import DisturbanceSchedule, Slowdown
 from arzsumo.sumo.green_share import DEFAULT_CURVE, GreenShareCurve
-from arzsumo.sumo.meter import MeterLight, MeterState, RampMeter
+from arzsumo.sumo.meter import MeterLight, RampMeter
 from arzsumo.sumo.meter_release import make_meter
 from arzsumo.sumo.network import APPROACH, approach_edges
 from arzsumo.sumo.period_reads import OpenLoopEnd, OpenLoopPeriod, OpenLoopReads, PeriodReader
@@ -151,12 +151,6 @@ class SumoPlant:
     def outlet_speed_limit(self) -> OutletSpeedLimit:
         """The speed limit of the edge past the merge, as an actuator."""
         return OutletSpeedLimit(self.sim.lib)
-
-    def run_period(self) -> tuple[PeriodMeasurement, MeterState]:
-        """One control period under the meter's present command: the sensor's
-        measurement of it and the meter at its end."""
-        m = self.advance()
-        return m, self.meter.state()
 
     def expected(self) -> int:
         """Vehicles on the network or still to come (SUMO's ``getMinExpectedNumber``)."""

@@ -20,7 +20,6 @@ import numpy as np
 
 from arzsumo.errors import ScenarioError, require
 from arzsumo.estimate.observations import ProbeNoise, ProbeObservation
-from arzsumo.sumo.measure import is_av
 from arzsumo.sumo.network import MAIN
 
 
@@ -69,4 +68,4 @@ class AvProbes:
         keep = [v for v, k in zip(ids, self.mask(ids), strict=True) if k]
         pos = np.fromiter(map(lib.vehicle.getLanePosition, keep), float, len(keep))
         speed = np.fromiter(map(lib.vehicle.getSpeed, keep), float, len(keep))
-        return self.observe(t, keep, pos, speed, is_av(keep))
+        return self.observe(t, keep, pos, speed, np.ones(len(keep), bool))   # AVs only

@@ -75,17 +75,8 @@ class EmissionsLedger:
         self._ids.append(ids)
         self._rates.append(rates)
 
-    @property
-    def fuel_mg(self) -> dict[str, float]:
-        """Fuel of every vehicle seen so far, mg."""
-        return self._summed()[0]
-
-    @property
-    def co2_mg(self) -> dict[str, float]:
-        """CO2 of every vehicle seen so far, mg."""
-        return self._summed()[1]
-
-    def _summed(self) -> tuple[dict[str, float], dict[str, float]]:
+    def totals(self) -> tuple[dict[str, float], dict[str, float]]:
+        """Fuel and CO2 of every vehicle seen so far, mg (vehicle id -> mg)."""
         if self._ids:
             ids = np.concatenate([np.asarray(i, dtype=object) for i in self._ids])
             rates = np.concatenate(self._rates, axis=1) * self.dt
@@ -105,13 +96,14 @@ class EmissionsLedger:
         """The :class:`WindowStart` at time ``t`` (s): read the vehicles now in the system."""
         v = self.lib.vehicle
         ids = list(v.getIDList())
+        fuel, co2 = self.totals()
         rows = {
             "sumo_time_loss_s": [v.getTimeLoss(i) for i in ids],
             "waiting_time_s": [float(v.getParameter(i, "device.tripinfo.waitingTime"))
                                for i in ids],
             "distance_m": [v.getDistance(i) for i in ids],
-            "fuel_g": [self.fuel_mg.get(i, 0.0) / MG_PER_G for i in ids],
-            "co2_g": [self.co2_mg.get(i, 0.0) / MG_PER_G for i in ids],
+            "fuel_g": [fuel.get(i, 0.0) / MG_PER_G for i in ids],
+            "co2_g": [co2.get(i, 0.0) / MG_PER_G for i in ids],
         }
         frame = pd.DataFrame(rows, index=pd.Index(ids, name="id"), dtype=float)
         waiting = tuple(self.lib.simulation.getPendingVehicles())
@@ -143,9 +135,10 @@ def window_end(lib: ModuleType, t: float) -> tuple[pd.DataFrame, EmissionsLedger
 
 def finish_window(t: float, on_network: pd.DataFrame, ledger: EmissionsLedger) -> WindowEnd:
     """The :class:`WindowEnd` of :func:`window_end` once the drain has run."""
-    ids = sorted(set(ledger.fuel_mg))
-    after = pd.DataFrame({"fuel_g": [ledger.fuel_mg[i] / MG_PER_G for i in ids],
-                          "co2_g": [ledger.co2_mg[i] / MG_PER_G for i in ids]},
+    fuel, co2 = ledger.totals()
+    ids = sorted(fuel)
+    after = pd.DataFrame({"fuel_g": [fuel[i] / MG_PER_G for i in ids],
+                          "co2_g": [co2[i] / MG_PER_G for i in ids]},
                          index=pd.Index(ids, name="id"), dtype=float)
     return WindowEnd(float(t), on_network.drop(columns=["fuel_g", "co2_g"]), after)
 
