@@ -14,8 +14,8 @@ import timeit
 
 import numpy as np
 
-from arzsumo.control import MacroState
 from arzsumo.control.backstepping import Backstepping
+from arzsumo.control.base import MacroState
 from arzsumo.control.kernels import solve_kernels
 from arzsumo.model import equilibrium_from_densities, get_preset, linearize
 

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from arzsumo.control import MacroState
 from arzsumo.control.backstepping import Backstepping
+from arzsumo.control.base import MacroState
 from arzsumo.control.kernels import Kernels, solve_kernels
 from arzsumo.control.transform import BacksteppingLaw, BacksteppingTransform
 from arzsumo.control.verify import _run, sinusoidal_deviation, verify_backstepping

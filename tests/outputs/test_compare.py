@@ -1,5 +1,5 @@
 """``arzsumo compare`` writes its table (from :mod:`arzsumo.bridge.compare`) and its bar plot
-(from :mod:`arzsumo.plots.compare`) through :mod:`arzsumo.outputs.compare`."""
+(from :mod:`arzsumo.plots.evaluation`) through :mod:`arzsumo.outputs.compare`."""
 
 from __future__ import annotations
 

@@ -56,7 +56,7 @@ def test_a_failed_save_closes_every_figure_and_leaves_no_part(tmp_path):
 
 
 def test_save_png_writes_the_path_and_closes(tmp_path):
-    from arzsumo.plots.alinea import loop_curve_figure
+    from arzsumo.plots.calibration import loop_curve_figure
 
     fig = loop_curve_figure(*loop_curve_args())
     assert save_png(fig, tmp_path / "curve.png", dpi=50) == tmp_path / "curve.png"

@@ -47,7 +47,7 @@ def twin_run(complete: bool = False) -> Record:
 
 
 def loop_curve_args() -> tuple:
-    """Arguments of :func:`arzsumo.plots.alinea.loop_curve_figure` (fractions, veh/s)."""
+    """Arguments of :func:`arzsumo.plots.calibration.loop_curve_figure` (fractions, veh/s)."""
     rng = np.random.default_rng(2)
     centres, o = np.linspace(0, 0.3, 10), np.linspace(0, 0.3, 50)
     return (rng.uniform(0, 0.3, 50), rng.uniform(0, 0.6, 50), centres, 2 * centres,

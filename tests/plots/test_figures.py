@@ -11,9 +11,8 @@ from matplotlib.figure import Figure
 
 import arzsumo.plots
 from arzsumo.plots import plt
-from arzsumo.plots.alinea import loop_curve_figure
 from arzsumo.plots.bridge import bridge_figures
-from arzsumo.plots.calibration import calibration_figure
+from arzsumo.plots.calibration import calibration_figure, loop_curve_figure
 from arzsumo.plots.twin import twin_figures
 from tests.plots.results import calibration_args, cosim_result, loop_curve_args, twin_run
 

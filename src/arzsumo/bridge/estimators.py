@@ -183,8 +183,11 @@ def estimation_stage(settings: EstimationSettings, layout: SensorLayout, control
                               measurements=[] if keep else None), acting)
 
 
-def _rmse(truth: np.ndarray, est: np.ndarray, ref: tuple[float, ...]) -> dict[str, Any]:
-    value, n = field_rmse(truth, est, 1, 1)
+def rmse_by_variable(truth: np.ndarray, est: np.ndarray, ref: tuple[float, ...],
+                     periods: int = 1, cells: int = 1) -> dict[str, Any]:
+    """RMSE of ``est`` against ``truth`` per variable on blocks of ``periods`` x ``cells``:
+    absolute (SI), relative to ``ref`` (the equilibrium's values) and the pairs used."""
+    value, n = field_rmse(truth, est, periods, cells)
     return {name: {"absolute": float(value[k]), "relative": float(value[k] / ref[k]),
                    "samples": int(n[k])} for k, name in enumerate(VARIABLES)}
 
@@ -200,8 +203,8 @@ def estimation_scores(truth: np.ndarray, est: RecordedEstimator,
         sd = np.asarray(est.sd[1:]).mean(axis=(0, 2))
         spread = {name: {"absolute": float(sd[k]), "relative": float(sd[k] / ref[k])}
                   for k, name in enumerate(VARIABLES)}
-    interp = (_rmse(truth, np.asarray(est.interpolation[1:]), ref)
+    interp = (rmse_by_variable(truth, np.asarray(est.interpolation[1:]), ref)
               if len(est.interpolation) > 1 else None)
     return {"method": est.method, "sensors": list(est.sensors),
-            **_rmse(truth, np.asarray(est.fields[1:]), ref), "spread": spread,
+            **rmse_by_variable(truth, np.asarray(est.fields[1:]), ref), "spread": spread,
             "interpolation": interp}

@@ -18,7 +18,7 @@ from arzsumo.evaluation.critical_occupancy import CriticalOccupancy, binned_curv
 from arzsumo.io import json_safe
 from arzsumo.outdir import OutputDir, atomic_dir, target_of
 from arzsumo.outputs.figures import save_png
-from arzsumo.plots.alinea import loop_curve_figure
+from arzsumo.plots.calibration import loop_curve_figure
 from arzsumo.units import veh_s_to_veh_h
 
 

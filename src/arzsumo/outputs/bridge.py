@@ -21,13 +21,13 @@ import pyarrow.parquet as pq
 from arzsumo.bridge.compare import row_of
 from arzsumo.bridge.delay import compensated_delay
 from arzsumo.bridge.estimator import fill_speeds
-from arzsumo.bridge.estimators import estimation_scores
+from arzsumo.bridge.estimators import estimation_scores, rmse_by_variable
 from arzsumo.bridge.result import CoSimResult
 from arzsumo.control.base import ControlLog
 from arzsumo.control.events import release_time
 from arzsumo.evaluation.authority import authority
 from arzsumo.evaluation.decay import decay, deviation_norm
-from arzsumo.evaluation.fields import field_rmse, oscillation, wave_travel
+from arzsumo.evaluation.fields import oscillation, wave_travel
 from arzsumo.evaluation.stationarity import count_trend
 from arzsumo.io import json_safe
 from arzsumo.model.characteristic import linearize
@@ -83,10 +83,8 @@ def rmse(res: CoSimResult, twin: np.ndarray, periods: int = 1,
     the equilibrium value, at blocks of ``periods`` x ``cells`` (1 x 1: the control grid);
     pairs where either is NaN (empty cells, re-synchronised periods) are skipped."""
     eq = res.equilibrium
-    ref = (eq.rho_h, eq.v_h, eq.rho_a, eq.v_a)
-    value, n = field_rmse(res.micro, twin, periods, cells)
-    return {name: {"absolute": float(value[k]), "relative": float(value[k] / ref[k]),
-                   "samples": int(n[k])} for k, name in enumerate(VARIABLES)}
+    return rmse_by_variable(res.micro, twin, (eq.rho_h, eq.v_h, eq.rho_a, eq.v_a), periods,
+                            cells)
 
 
 def rmse_blocks(res: CoSimResult) -> dict[str, Any]:

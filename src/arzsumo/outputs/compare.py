@@ -95,7 +95,7 @@ def compare_runs(runs: list[Path], out: Path,
     rewritten; any other directory (a run's results among them) is refused in one line.
     """
     from arzsumo.outputs.figures import save_png
-    from arzsumo.plots.compare import comparison_figure
+    from arzsumo.plots.evaluation import comparison_figure
 
     summaries = load_summaries(runs)
     check_comparable(runs, summaries, allow_mixed)

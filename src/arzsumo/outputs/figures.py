@@ -51,16 +51,16 @@ def save_figures(figs: Mapping[str, Figure], directory: str | Path,
 
 def write_regime_map(path: str | Path, rmap: RegimeMap,
                      point: tuple[float, float] | None = None, title: str = "") -> Path:
-    """Draw :func:`arzsumo.plots.regime.regime_figure` into ``path``; ``point`` is
+    """Draw :func:`arzsumo.plots.model.regime_figure` into ``path``; ``point`` is
     (rho_h, rho_a) in veh/m."""
-    from arzsumo.plots.regime import regime_figure
+    from arzsumo.plots.model import regime_figure
 
     return save_png(regime_figure(rmap, point, title), path, dpi=120)
 
 
 def write_kernels_plot(path: str | Path, kernels: Kernels, title: str = "") -> Path:
-    """Draw :func:`arzsumo.plots.kernels.kernels_figure` of ``kernels`` into ``path``."""
-    from arzsumo.plots.kernels import kernels_figure
+    """Draw :func:`arzsumo.plots.model.kernels_figure` of ``kernels`` into ``path``."""
+    from arzsumo.plots.model import kernels_figure
 
     fig = kernels_figure(kernels.x, kernels.K, kernels.M, kernels.L, kernels.N, title)
     return save_png(fig, path, dpi=110)
