@@ -10,18 +10,18 @@ import numpy as np
 import pytest
 from arzsumo_studies.estimation.sensor_record import (
     SensorRecord,
-    estimation_scores,
     record_run,
     replay_estimation,
 )
 
+from arzsumo.bridge.estimators import estimation_scores
 from arzsumo.bridge.session import run_in_sumo
 from arzsumo.outputs.bridge import VARIABLES, summary
 from arzsumo.scenario import load_scenario
 
 pytestmark = pytest.mark.sumo
 
-LEGACY = Path(__file__).resolve().parents[2] / "scenarios" / "legacy_default.toml"
+LEGACY = Path(__file__).resolve().parents[3] / "scenarios" / "legacy_default.toml"
 LAYOUT = {"sensing.kinds": ["loops", "av_probes"], "sensing.loop_spacing_m": 250}
 
 
