@@ -219,8 +219,7 @@ def edge_lengths(net_file: Path) -> dict[str, float]:
     """Lengths (m) of the non-internal edges of a built network, read with sumolib."""
     import sumolib
 
-    net = sumolib.net.readNet(str(net_file))
-    return {e.getID(): float(e.getLength()) for e in net.getEdges()}
+    return {e.getID(): float(e.getLength()) for e in sumolib.net.readNet(str(net_file)).getEdges()}
 
 
 def build_network(out_dir: Path, spec: NetworkSpec | None = None, *,

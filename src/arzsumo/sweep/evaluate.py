@@ -205,8 +205,7 @@ def borrowed_baseline(spec: SweepSpec, source: Path, user: str) -> pd.DataFrame:
                          "cannot be read back; allowed: a finished arzsumo evaluation")
     if any(t.scenario.get("model") != tomllib.loads(dump_toml(dict(m.scenario))).get("model")
            for t, m in zip(theirs, mine, strict=True)):
-        blank = [c for c in table.columns if c.startswith(MODEL_DEPENDENT)]
-        table[blank] = float("nan")
+        table[[c for c in table.columns if c.startswith(MODEL_DEPENDENT)]] = float("nan")
     return table
 
 

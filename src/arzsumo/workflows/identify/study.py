@@ -251,8 +251,7 @@ def simulate(task: RunTask) -> SumoRun:
         return SumoRun(task, data, float(info["wall_time"]), int(info["resyncs"]),
                        float(info["delivered"]))
     start = time.perf_counter()
-    session = run_in_sumo(scenario_from_dict(task.tables, task.source), seed=task.seed)
-    res = session.result
+    res = run_in_sumo(scenario_from_dict(task.tables, task.source), seed=task.seed).result
     data = replay_data_of(res, name=task.run_id)
     delivered = res.report.delivered_main if res.report is not None else math.nan
     run = SumoRun(task, data, time.perf_counter() - start,
