@@ -11,6 +11,7 @@ SUMO's step costs").
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import math
 import re
@@ -160,11 +161,9 @@ def _add_approach(spec: NetworkSpec, nodes: list[str], edges: list[str],
 def write_if_changed(path: Path, data: bytes) -> bool:
     """Write ``data`` to ``path`` (atomically) unless the file already holds exactly these
     bytes; return whether it was written. Untouched files keep their mtime and git status."""
-    try:
+    with contextlib.suppress(FileNotFoundError):
         if path.read_bytes() == data:
             return False
-    except FileNotFoundError:
-        pass
     with atomic_file(path) as tmp:
         tmp.write_bytes(data)
     return True

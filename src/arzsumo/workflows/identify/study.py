@@ -11,6 +11,7 @@ files' content.
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import logging
 import math
@@ -130,10 +131,8 @@ class IdentifySetup:
 def _value(text: str) -> Any:
     """A ``--vary`` value as TOML would read it: integer, number, boolean or string."""
     for kind in (int, float):
-        try:
+        with contextlib.suppress(ValueError):
             return kind(text)
-        except ValueError:
-            pass
     return {"true": True, "false": False}.get(text, text)
 
 
