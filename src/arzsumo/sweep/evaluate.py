@@ -156,8 +156,7 @@ def _model_inert(a: dict, b: dict) -> bool:
     return ours is not None and ours == _sumo_input(b)
 
 
-def _without_inert(data: dict, model_inert: bool = False,
-                   inert: Sequence[str] = inert_for(BASELINE)) -> dict:
+def _without_inert(data: dict, model_inert: bool, inert: Sequence[str]) -> dict:
     out = copy.deepcopy(data)
     drop_fields(out, tuple(inert) + (PLACEMENT_ONLY if model_inert else ()))
     return out
@@ -279,7 +278,7 @@ def run_evaluation(scenario: Path, controllers: Sequence[str], seeds: Sequence[i
     to_run = [c for c in others if c not in taken]
     if overwrite:
         _forget_previous(Path(out), str(out))
-    rep, target = None, Path(out)
+    rep = None
     if to_run:
         rep = run_sweep(evaluation_spec(scenario, to_run, seeds, horizon, warmup), out,
                         workers=workers, scheduler=scheduler, progress=progress,
