@@ -170,6 +170,4 @@ class MainlineSensor:
                 self.grid.flows[k] += len(moved) - na
                 self.grid.flows[k + 1] += na
         self._prev = cur
-        if self.grid.steps >= self.steps_per_window:
-            return self.grid.flush(t)
-        return None
+        return self.grid.flush(t) if self.grid.steps >= self.steps_per_window else None
