@@ -67,5 +67,4 @@ def network_figure(scenario: str | Path | Scenario | RoadGeometry | None = None)
     """
     from arzsumo.outputs.network import network_figure as draw
 
-    road = scenario if isinstance(scenario, RoadGeometry) else road_geometry(scenario)
-    return draw(road)
+    return draw(scenario if isinstance(scenario, RoadGeometry) else road_geometry(scenario))

@@ -78,9 +78,8 @@ class RunResult:
         plots : bool
             Draw the figures (``fields_h.png``, ``fields_a.png``, ``control.png``).
         """
-        path, _ = write_results(self.cosim, directory, self.scenario_text, plots=plots,
-                                overwrite=overwrite, summ=self.summary)
-        return path
+        return write_results(self.cosim, directory, self.scenario_text, plots=plots,
+                             overwrite=overwrite, summ=self.summary)[0]
 
 
 @dataclass(frozen=True)

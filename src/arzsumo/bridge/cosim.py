@@ -260,8 +260,7 @@ def run_cosimulation(run: PreparedRun, *, progress: bool | RunProgress = False,
     with ``[sumo] fcd``, its FCD output in ``files`` (:mod:`arzsumo.sumo.run_files`).
     """
     with open_run(run, progress=progress, frontend=frontend) as opened:
-        warmed = warm_start(opened.sim, run, opened.bar)
-        return finish_run(opened, warmed, run, keep_measurements)
+        return finish_run(opened, warm_start(opened.sim, run, opened.bar), run, keep_measurements)
 
 
 def finish_run(opened: OpenRun, warmed: Warmed, run: PreparedRun,
@@ -284,8 +283,7 @@ def close_window(opened: OpenRun, c: Controlled, run: PreparedRun) -> CoSimResul
     drained = drain(plant, cfg.drain_max, opened.bar) if cfg.drain_max > 0 else None
     opened.bar.enter(MEASURES)
     sim.close()                # SUMO writes the unfinished trips' tripinfo as it closes
-    records = c.trace.records
-    outlet = round(sum((r.outflow_h + r.outflow_a) * cfg.control_period for r in records))
+    outlet = round(sum((r.outflow_h + r.outflow_a) * cfg.control_period for r in c.trace.records))
     network, trips = measure_network(opened.out_dir, c.start, t_end, outlet,
                                      drained.end if drained else None, sim.time,
                                      **outlet_edge(cfg, sim))

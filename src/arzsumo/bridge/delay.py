@@ -55,6 +55,4 @@ def compensate(ctrl: Controller, acting: str, sc: Scenario) -> Controller:
     """``ctrl`` with its law on the predicted state when ``delay_compensation_s`` > 0 and
     ``acting`` is backstepping or etc; ``ctrl`` itself otherwise."""
     theta = sc.actuation.delay_compensation
-    if theta <= 0 or acting not in COMPENSATED:
-        return ctrl
-    return DelayCompensated(ctrl, theta)
+    return ctrl if theta <= 0 or acting not in COMPENSATED else DelayCompensated(ctrl, theta)

@@ -124,8 +124,7 @@ class Twin:
         """Fields at positions x (4, len(x)); NaN in a period that ended in a re-sync."""
         if self._fresh:
             return np.full((4, x.size), np.nan)
-        f = self.stepper.primitive()
-        return np.vstack([np.interp(x, self.stepper.x, row) for row in f])
+        return np.vstack([np.interp(x, self.stepper.x, row) for row in self.stepper.primitive()])
 
     def status(self) -> dict[str, Any]:
         """Re-synchronisations: count, first time (s) and its reason."""

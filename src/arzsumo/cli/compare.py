@@ -45,8 +45,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
                            "left to compare; allowed: results directories of arzsumo run")
     table, csv, png = compare_runs(runs, out, allow_mixed=args.allow_mixed)
     print(table)
-    fields = sorted(out.glob("fields_*.png"))
-    print("written: " + ", ".join(str(p) for p in (csv, png, *fields)))
+    print("written: " + ", ".join(str(p) for p in (csv, png, *sorted(out.glob("fields_*.png")))))
     return 0
 
 

@@ -54,8 +54,7 @@ class EventSummary:
 
 def event_summary(log: ControlLog, horizon: float) -> EventSummary:
     """Trigger count, release time and inter-event intervals of ``log``."""
-    times = log.event_times
-    intervals = np.diff(times)
+    intervals = np.diff(log.event_times)
     return EventSummary(
         triggers=log.triggers, release_time=release_time(log.t, log.triggered, horizon),
         min_interval=float(intervals.min()) if intervals.size else float("inf"),

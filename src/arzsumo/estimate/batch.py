@@ -81,7 +81,7 @@ class BatchStepper:
         self.dx = params.length / cells
         self.riemann = FLUXES[flux]
         self.x = cell_centres(params.length, cells)
-        self.steps = self.rejected = self.projected = 0
+        self.steps = self.projected = 0
         self.last_speed: float | None = None     # largest wave speed of the last step, m/s
 
     def rhs(self, q: np.ndarray, ghost: np.ndarray, outflow: np.ndarray
@@ -131,7 +131,6 @@ class BatchStepper:
                     s_step = float(s.max())
                     if s_step * (t_new - t) <= CFL_MAX * self.dx * (1 + 1e-12) or dt < 1e-9:
                         break
-                    self.rejected += 1
                     dt = self.cfl * self.dx / s_step
                 bad = outside(self.p, q_new)
                 if bad.any():

@@ -106,12 +106,11 @@ def place_spectra(blocks: np.ndarray, dt: float, min_coverage: float = 0.75
     return PlaceSpectra(f, np.array(psds).reshape(len(psds), f.size))
 
 
-def mean_periodogram(blocks: np.ndarray, dt: float, min_coverage: float = 0.75
-                     ) -> tuple[np.ndarray, np.ndarray]:
+def mean_periodogram(blocks: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
     """Periods (s, longest first; frequency 0 left out) and the places' mean one-sided
     periodogram density ((m/s)^2 s) of ``blocks`` (T, N; as :func:`place_spectra`); both
     empty without a place used."""
-    return place_spectra(blocks, dt, min_coverage).mean()
+    return place_spectra(blocks, dt).mean()
 
 
 def growth_upstream(x: np.ndarray, amplitude: np.ndarray, length: float) -> float:

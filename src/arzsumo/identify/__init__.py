@@ -21,22 +21,17 @@ command's side: ``docs/identify.md``, 'What it does'.
 """
 
 from arzsumo.identify.data import VARIABLES, IdentifyError, ReplayData
-from arzsumo.identify.fit import FitSettings, IdentificationResult, covariance, identify
+from arzsumo.identify.fit import FitSettings, IdentificationResult, identify
 from arzsumo.identify.objective import (
     DEFAULT_BOUNDS,
-    DEFAULT_WHICH,
     WHICH_BY_FAMILY,
-    Objective,
-    ParameterSpace,
     ValidationReport,
     validate,
 )
-from arzsumo.identify.replay import ReplayOptions, ReplayRun, replay, run_replay
-from arzsumo.identify.synthetic import SyntheticRun, synthetic_data
+from arzsumo.identify.replay import ReplayOptions, replay, run_replay
 
 __all__ = [
-    "DEFAULT_BOUNDS", "DEFAULT_WHICH", "VARIABLES", "WHICH_BY_FAMILY", "FitSettings",
-    "IdentificationResult", "IdentifyError", "Objective", "ParameterSpace", "ReplayData",
-    "ReplayOptions", "ReplayRun", "SyntheticRun", "ValidationReport", "covariance",
-    "identify", "replay", "run_replay", "synthetic_data", "validate",
+    "DEFAULT_BOUNDS", "VARIABLES", "WHICH_BY_FAMILY", "FitSettings", "IdentificationResult",
+    "IdentifyError", "ReplayData", "ReplayOptions", "ValidationReport", "identify", "replay",
+    "run_replay", "validate",
 ]

@@ -139,8 +139,7 @@ def _bootstrap(space: ParameterSpace, runs: tuple[ReplayData, ...], z_opt: np.nd
     for b in range(settings.bootstrap):
         pick = rng.integers(0, len(runs), size=len(runs))
         obj = Objective(space, [runs[i] for i in pick], weights, options, penalty, target)
-        res = _solve(obj, z_opt, settings)
-        rows.append(space.to_p(res.x))
+        rows.append(space.to_p(_solve(obj, z_opt, settings).x))
         log.info("bootstrap %d/%d on runs %s: %s", b + 1, settings.bootstrap, pick.tolist(),
                  np.array2string(rows[-1], precision=4))
     return np.array(rows)

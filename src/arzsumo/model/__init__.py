@@ -5,7 +5,6 @@ Pure math: no SUMO, no files, no plotting. May import only ``units`` and ``error
 """
 
 from arzsumo.model.characteristic import (
-    CharacteristicSystem,
     Linearization,
     characteristic_speeds,
     linearize,
@@ -16,23 +15,19 @@ from arzsumo.model.equilibrium import (
     equilibrium_from_demand,
     equilibrium_from_densities,
 )
-from arzsumo.model.fd import area_occupancy, equilibrium_speeds, speed_jacobian
-from arzsumo.model.params import PRESETS, VARIABLES, ModelParameters, Preset, get_preset
+from arzsumo.model.fd import area_occupancy, speed_jacobian
+from arzsumo.model.params import PRESETS, ModelParameters, get_preset
 
 __all__ = [
     "PRESETS",
-    "VARIABLES",
-    "CharacteristicSystem",
     "Equilibrium",
     "Linearization",
     "ModelParameters",
-    "Preset",
     "area_occupancy",
     "characteristic_speeds",
     "equilibrium_at_penetration",
     "equilibrium_from_demand",
     "equilibrium_from_densities",
-    "equilibrium_speeds",
     "get_preset",
     "linearize",
     "speed_jacobian",

@@ -6,10 +6,8 @@ Numerics only (its modules: docs/twin.md, "Pieces"); they may import only ``cont
 
 from arzsumo.pde.boundary import Inlet, outlet_flux
 from arzsumo.pde.initial import InitialCondition, initial_fields
-from arzsumo.pde.metrics import Performance, performance, relative_change
 from arzsumo.pde.solver import (
     SolverOptions,
-    TwinResult,
     TwinStepper,
     TwinStoppedError,
     simulate,
@@ -18,14 +16,10 @@ from arzsumo.pde.solver import (
 __all__ = [
     "InitialCondition",
     "Inlet",
-    "Performance",
     "SolverOptions",
-    "TwinResult",
     "TwinStepper",
     "TwinStoppedError",
     "initial_fields",
     "outlet_flux",
-    "performance",
-    "relative_change",
     "simulate",
 ]

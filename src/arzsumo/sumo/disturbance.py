@@ -75,9 +75,8 @@ class DisturbanceSchedule:
         eps = 1e-9
         if self.applied["began_s"] is None and t >= self.begin - eps:
             edge = self.disturbance.edge
-            n = int(self.lib.edge.getLaneNumber(edge))
             self.lanes = {f"{edge}_{i}": float(self.lib.lane.getMaxSpeed(f"{edge}_{i}"))
-                          for i in range(n)}
+                          for i in range(int(self.lib.edge.getLaneNumber(edge)))}
             self.lib.edge.setMaxSpeed(edge, self.disturbance.speed)
             self.applied.update(began_s=t, original_speed_m_s=max(self.lanes.values()))
         elif self.applied["ended_s"] is None and self.lanes and t >= self.end - eps:

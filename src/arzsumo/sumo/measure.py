@@ -84,9 +84,8 @@ class EdieGrid:
         span = self.steps * self.dt
         rho = self._cnt * self.dt / (self.dx * span)
         q = self._dist * self.dt / (self.dx * span)
-        f = self.flows / span
         data = CellData(float(t), span, self.x.copy(), rho[0], rho[1], q[0], q[1],
-                        self._cnt[0].copy(), self._cnt[1].copy(), *map(float, f))
+                        self._cnt[0].copy(), self._cnt[1].copy(), *map(float, self.flows / span))
         self.reset()
         return data
 
@@ -171,6 +170,4 @@ class MainlineSensor:
                 self.grid.flows[k] += len(moved) - na
                 self.grid.flows[k + 1] += na
         self._prev = cur
-        if self.grid.steps >= self.steps_per_window:
-            return self.grid.flush(t)
-        return None
+        return self.grid.flush(t) if self.grid.steps >= self.steps_per_window else None

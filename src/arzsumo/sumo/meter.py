@@ -77,10 +77,9 @@ class MeterLight:
 
     mode = ""
 
-    def __init__(self, lib: ModuleType, cfg: SumoConfig, tl_id: str = METER_TL) -> None:
-        if cfg.layout is not None and tl_id == METER_TL:   # a user's network: its light
-            tl_id = cfg.layout.meter_tl
-        self.lib, self.cfg, self.tl_id = lib, cfg, tl_id
+    def __init__(self, lib: ModuleType, cfg: SumoConfig) -> None:
+        self.lib, self.cfg = lib, cfg
+        self.tl_id = METER_TL if cfg.layout is None else cfg.layout.meter_tl  # a user's light
         self.dt = cfg.step_length
         self.clearance_steps = round(cfg.meter_clearance / self.dt)
         self.plan_changes = self.light_changes = self.override_steps = 0
@@ -247,8 +246,8 @@ class RampMeter(MeterLight):
     mode = "fixed_cycle"
 
     def __init__(self, lib: ModuleType, cfg: SumoConfig,
-                 curve: GreenShareCurve = DEFAULT_CURVE, tl_id: str = METER_TL) -> None:
-        super().__init__(lib, cfg, tl_id)
+                 curve: GreenShareCurve = DEFAULT_CURVE) -> None:
+        super().__init__(lib, cfg)
         self.curve = curve
         self.cycle_steps = max(1, round(cfg.meter_cycle / self.dt))
         self._k = 0                       # steps since the current cycle began

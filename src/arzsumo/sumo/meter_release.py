@@ -16,7 +16,6 @@ from arzsumo.errors import ArzsumoError, require
 from arzsumo.sumo.config import SumoConfig
 from arzsumo.sumo.green_share import DEFAULT_CURVE, GreenShareCurve, plan_green_steps
 from arzsumo.sumo.meter import GREEN, RED, YELLOW, MeterLight, RampMeter
-from arzsumo.sumo.network import METER_TL
 
 
 def release_rate_for(u: float, cfg: SumoConfig) -> float:
@@ -32,8 +31,8 @@ class OnePerGreenMeter(MeterLight):
 
     mode = "one_per_green"
 
-    def __init__(self, lib: ModuleType, cfg: SumoConfig, tl_id: str = METER_TL) -> None:
-        super().__init__(lib, cfg, tl_id)
+    def __init__(self, lib: ModuleType, cfg: SumoConfig) -> None:
+        super().__init__(lib, cfg)
         self.min_green_steps = max(1, round(cfg.min_green / self.dt))
         self.max_green_steps = max(self.min_green_steps, round(cfg.max_green / self.dt))
         self.min_red_steps = round(cfg.min_red / self.dt)

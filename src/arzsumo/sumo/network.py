@@ -11,6 +11,7 @@ SUMO's step costs").
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import math
 import re
@@ -160,11 +161,9 @@ def _add_approach(spec: NetworkSpec, nodes: list[str], edges: list[str],
 def write_if_changed(path: Path, data: bytes) -> bool:
     """Write ``data`` to ``path`` (atomically) unless the file already holds exactly these
     bytes; return whether it was written. Untouched files keep their mtime and git status."""
-    try:
+    with contextlib.suppress(FileNotFoundError):
         if path.read_bytes() == data:
             return False
-    except FileNotFoundError:
-        pass
     with atomic_file(path) as tmp:
         tmp.write_bytes(data)
     return True
@@ -219,8 +218,7 @@ def edge_lengths(net_file: Path) -> dict[str, float]:
     """Lengths (m) of the non-internal edges of a built network, read with sumolib."""
     import sumolib
 
-    net = sumolib.net.readNet(str(net_file))
-    return {e.getID(): float(e.getLength()) for e in net.getEdges()}
+    return {e.getID(): float(e.getLength()) for e in sumolib.net.readNet(str(net_file)).getEdges()}
 
 
 def build_network(out_dir: Path, spec: NetworkSpec | None = None, *,

@@ -44,8 +44,7 @@ def _targets(x: np.ndarray, rho: np.ndarray, length: float) -> np.ndarray:
     edges = np.concatenate([[0.0], 0.5 * (x[1:] + x[:-1]), [length]])
     cum = np.concatenate([[0.0], np.cumsum(rho * np.diff(edges))])
     n = int(np.floor(cum[-1] + 0.5))
-    pos = np.interp(np.arange(n) + 0.5, cum, edges)
-    return pos[::-1]
+    return np.interp(np.arange(n) + 0.5, cum, edges)[::-1]
 
 
 def _check_profiles(params: ModelParameters, x: np.ndarray, arrays: list[np.ndarray]) -> None:

@@ -95,20 +95,18 @@ class RunReport:
 class SumoSimulation:
     """One run of ``net_file`` with ``route_file`` under ``cfg``, driven by libsumo or TraCI.
 
-    ``requested_initial``: vehicles placed at t = 0 by the route file; ``workdir``: for
-    SUMO's statistics output (a temporary one by default), or ``output_dir``, kept after
-    the run (for :mod:`arzsumo.sumo.network_measures`); ``cleanup``: directories removed
-    at the close; ``frontend``: what drives the run (:mod:`arzsumo.sumo.frontend`:
-    "libsumo", "traci" or "gui").
+    ``workdir``: for SUMO's statistics output (a temporary one by default), or
+    ``output_dir``, kept after the run (for :mod:`arzsumo.sumo.network_measures`);
+    ``cleanup``: directories removed at the close; ``frontend``: what drives the run
+    (:mod:`arzsumo.sumo.frontend`: "libsumo", "traci" or "gui").
     """
 
     def __init__(self, net_file: Path, route_file: Path, cfg: SumoConfig, *,
-                 requested_initial: int = 0, workdir: Path | None = None,
+                 workdir: Path | None = None,
                  extra_args: Sequence[str] = (), cleanup: Sequence[Path] = (),
                  output_dir: Path | None = None, frontend: str = "libsumo") -> None:
         self.frontend = Frontend(frontend)
         self.net_file, self.route_file, self.cfg = Path(net_file), Path(route_file), cfg
-        self.requested_initial = requested_initial
         self._own_workdir = workdir is None
         self.workdir = Path(workdir) if workdir else Path(
             tempfile.mkdtemp(prefix="arzsumo-", dir=scratch_dir()))
@@ -336,7 +334,6 @@ def open_simulation(params: ModelParameters, cfg: SumoConfig, *,
     except BaseException:  # a bad demand or network, or Ctrl-C: leave no temporary files
         shutil.rmtree(workdir, ignore_errors=True)
         raise
-    sim = SumoSimulation(net, route, cfg, requested_initial=len(initial), workdir=workdir,
-                         extra_args=extra_args, cleanup=(workdir,), output_dir=output_dir,
-                         frontend=frontend)
+    sim = SumoSimulation(net, route, cfg, workdir=workdir, extra_args=extra_args,
+                         cleanup=(workdir,), output_dir=output_dir, frontend=frontend)
     return sim.start()

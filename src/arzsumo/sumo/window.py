@@ -106,8 +106,7 @@ class EmissionsLedger:
             "co2_g": [co2.get(i, 0.0) / MG_PER_G for i in ids],
         }
         frame = pd.DataFrame(rows, index=pd.Index(ids, name="id"), dtype=float)
-        waiting = tuple(self.lib.simulation.getPendingVehicles())
-        return WindowStart(float(t), frame, waiting)
+        return WindowStart(float(t), frame, tuple(self.lib.simulation.getPendingVehicles()))
 
 
 @dataclass(frozen=True)

@@ -7,11 +7,9 @@ Never imports studies or the CLI: reference values drawn on its figures come fro
 caller (``run_sweep(..., paper=...)``).
 """
 
-from arzsumo.sweep.driver import SweepReport, run_sweep
-from arzsumo.sweep.spec import RunSpec, SweepError, SweepSpec, load_sweep, sweep_from_dict
-from arzsumo.sweep.table import comparable, sweep_table
-from arzsumo.sweep.worker import RunOutcome, RunTask, execute
+from arzsumo.sweep.driver import run_sweep
+from arzsumo.sweep.spec import SweepError, SweepSpec, load_sweep, sweep_from_dict
+from arzsumo.sweep.table import comparable
 
-__all__ = ["RunOutcome", "RunSpec", "RunTask", "SweepError", "SweepReport", "SweepSpec",
-           "comparable", "execute", "load_sweep", "run_sweep", "sweep_from_dict",
-           "sweep_table"]
+__all__ = ["SweepError", "SweepSpec", "comparable", "load_sweep", "run_sweep",
+           "sweep_from_dict"]

@@ -156,8 +156,7 @@ def _model_inert(a: dict, b: dict) -> bool:
     return ours is not None and ours == _sumo_input(b)
 
 
-def _without_inert(data: dict, model_inert: bool = False,
-                   inert: Sequence[str] = inert_for(BASELINE)) -> dict:
+def _without_inert(data: dict, model_inert: bool, inert: Sequence[str]) -> dict:
     out = copy.deepcopy(data)
     drop_fields(out, tuple(inert) + (PLACEMENT_ONLY if model_inert else ()))
     return out
@@ -205,8 +204,7 @@ def borrowed_baseline(spec: SweepSpec, source: Path, user: str) -> pd.DataFrame:
                          "cannot be read back; allowed: a finished arzsumo evaluation")
     if any(t.scenario.get("model") != tomllib.loads(dump_toml(dict(m.scenario))).get("model")
            for t, m in zip(theirs, mine, strict=True)):
-        blank = [c for c in table.columns if c.startswith(MODEL_DEPENDENT)]
-        table[blank] = float("nan")
+        table[[c for c in table.columns if c.startswith(MODEL_DEPENDENT)]] = float("nan")
     return table
 
 
@@ -280,7 +278,7 @@ def run_evaluation(scenario: Path, controllers: Sequence[str], seeds: Sequence[i
     to_run = [c for c in others if c not in taken]
     if overwrite:
         _forget_previous(Path(out), str(out))
-    rep, target = None, Path(out)
+    rep = None
     if to_run:
         rep = run_sweep(evaluation_spec(scenario, to_run, seeds, horizon, warmup), out,
                         workers=workers, scheduler=scheduler, progress=progress,

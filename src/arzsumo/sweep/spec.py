@@ -356,5 +356,4 @@ def load_sweep(path: str | Path) -> SweepSpec:
     """Read and validate a sweep file."""
     path = Path(path)
     text, data = read_toml(path, "sweep", SweepError)
-    spec = sweep_from_dict(data, str(path), root=path.parent)
-    return replace(spec, text=text)
+    return replace(sweep_from_dict(data, str(path), root=path.parent), text=text)

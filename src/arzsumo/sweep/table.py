@@ -106,8 +106,7 @@ def table_row(run: RunSpec, found: tuple[str, Mapping[str, Any]] | None) -> dict
         return row
     status, doc = found
     row.update(status=status, error=doc.get("error"), warnings=len(doc.get("warnings", [])))
-    ex = doc.get("sweep", {}).get("execution", {})
-    row.update({f"execution.{k}": v for k, v in ex.items()})
+    row.update({f"execution.{k}": v for k, v in doc.get("sweep", {}).get("execution", {}).items()})
     row.update({k: v for k, v in flatten(doc).items() if k not in row})
     return row
 

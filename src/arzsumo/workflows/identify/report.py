@@ -42,15 +42,10 @@ from arzsumo.workflows.identify.study import IdentifyStudy, equilibrium_at, meas
 DIGITS = 7
 
 
-def _model_key(name: str) -> str:
-    return next(k for k, spec in MODEL_KEYS.items() if spec.field == name)
-
-
 def _put(table: dict[str, Any], name: str, value: float) -> tuple[str, float, str]:
     """Put ``value`` (SI) of parameter ``name`` into ``table`` in file units; its key,
     factor and unit (" km/h"; "" without one)."""
-    key = _model_key(name)
-    spec = MODEL_KEYS[key]
+    key, spec = next((k, spec) for k, spec in MODEL_KEYS.items() if spec.field == name)
     table[key] = float(f"{value * spec.factor:.{DIGITS}g}")
     return key, spec.factor, f" {spec.unit}" if spec.unit else ""
 

@@ -11,6 +11,7 @@ files' content.
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import logging
 import math
@@ -130,10 +131,8 @@ class IdentifySetup:
 def _value(text: str) -> Any:
     """A ``--vary`` value as TOML would read it: integer, number, boolean or string."""
     for kind in (int, float):
-        try:
+        with contextlib.suppress(ValueError):
             return kind(text)
-        except ValueError:
-            pass
     return {"true": True, "false": False}.get(text, text)
 
 
@@ -251,8 +250,7 @@ def simulate(task: RunTask) -> SumoRun:
         return SumoRun(task, data, float(info["wall_time"]), int(info["resyncs"]),
                        float(info["delivered"]))
     start = time.perf_counter()
-    session = run_in_sumo(scenario_from_dict(task.tables, task.source), seed=task.seed)
-    res = session.result
+    res = run_in_sumo(scenario_from_dict(task.tables, task.source), seed=task.seed).result
     data = replay_data_of(res, name=task.run_id)
     delivered = res.report.delivered_main if res.report is not None else math.nan
     run = SumoRun(task, data, time.perf_counter() - start,

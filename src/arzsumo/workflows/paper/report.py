@@ -72,12 +72,6 @@ def markdown_table(rows: Sequence[dict[str, Any]], columns: Sequence[str],
     return "\n".join(lines)
 
 
-def _claims_md(items: Sequence[Claim]) -> str:
-    return "\n".join(f"- **{c.verdict}** - {c.claim}. Paper: {c.paper}. Twin: {c.ours}."
-                     + (f" *{'Why' if c.verdict != REPRODUCED else 'Note'}:* {c.why}."
-                        if c.why else "") for c in items)
-
-
 def _reasons(rows: Sequence[dict[str, Any]]) -> str:
     """Group the per-cell notes ("column: reason") by reason."""
     by_reason: dict[str, list[str]] = {}
@@ -130,8 +124,10 @@ def _overview(rep: Reproduction) -> list[str]:
 def _claims_section(cl: Sequence[Claim]) -> list[str]:
     """Every claim with its verdict, and how many are reproduced."""
     n_ok = sum(c.verdict == REPRODUCED for c in cl)
-    return _section(f"## Claims ({n_ok} of {len(cl)} reproduced in direction)",
-                    _claims_md(cl))
+    return _section(f"## Claims ({n_ok} of {len(cl)} reproduced in direction)", "\n".join(
+        f"- **{c.verdict}** - {c.claim}. Paper: {c.paper}. Twin: {c.ours}."
+        + (f" *{'Why' if c.verdict != REPRODUCED else 'Note'}:* {c.why}." if c.why else "")
+        for c in cl))
 
 
 def _performance_section(perf: Sequence[dict[str, Any]]) -> list[str]:
