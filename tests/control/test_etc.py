@@ -150,6 +150,19 @@ def test_first_check_is_an_event(lin, kernels):
     assert not again.triggered and again.d == 0.0
 
 
+def test_m_integrates_the_first_interval_whatever_the_clock_origin(lin, kernels):
+    """mdyna depends on elapsed time only: the same two checks 1 s apart give the same m
+    whether the first falls at t = 0 or at t = 5 s, and m has moved from m(0)."""
+    w, w2 = np.full((4, N_CELLS + 1), 1e-3), np.full((4, N_CELLS + 1), 2e-3)
+    ms = []
+    for t0 in (0.0, 5.0):
+        trig = EventTrigger(lin.system, kernels, EtcDesign())
+        trig.check(t0, w)
+        ms.append(trig.check(t0 + 1.0, w2).m)
+    assert ms[0] == pytest.approx(ms[1], rel=1e-12)
+    assert ms[0] != EtcDesign().m0
+
+
 def test_output_noise_sd_recovers_white_noise_under_a_slow_signal_and_a_few_steps():
     from arzsumo.control.etc import output_noise_sd
     rng = np.random.default_rng(11)

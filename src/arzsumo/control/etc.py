@@ -255,7 +255,7 @@ class EventTrigger:
         d = min(max(self.u_held, lo), hi) - min(max(u_cont, lo), hi)
         d_db = math.copysign(max(abs(d) - self.dead_band, 0.0), d)
         g = self._forcing(d_db, energy, alpha, beta)
-        self.m = integrate_m(self.m, self.g_last, g, ds.eta, t - (self.t_last or t))
+        self.m = integrate_m(self.m, self.g_last, g, ds.eta, t - self.t_last)
         self.t_last = t
         if ds.trigger == "band":                     # the hold error left the noise band
             triggered = abs(d) > self.dead_band
